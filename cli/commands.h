@@ -1,0 +1,21 @@
+// The polydg subcommands: each registers its typed options on the CLI11 app and runs through
+// the library. Exit codes: 0 success, 1 a check failed (e.g. an invalid mesh), 2 bad input.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace polydg::cli {
+
+/// Shared by every subcommand.
+struct CommonOptions {
+  bool quiet = false;
+};
+
+void addInfoCommand(CLI::App& app, const CommonOptions& common, int& exitCode);
+void addCheckCommand(CLI::App& app, const CommonOptions& common, int& exitCode);
+void addMeshCommand(CLI::App& app, const CommonOptions& common, int& exitCode);
+
+/// True for files read as simulation meshes (VTU) rather than surfaces.
+bool isVolumeMeshPath(const std::string& path);
+
+}  // namespace polydg::cli

@@ -1,0 +1,78 @@
+#include "cli/json_reports.h"
+
+namespace polydg::cli {
+
+nlohmann::json toJson(const ValidationReport& r) {
+  return {{"passed", r.passed},
+          {"elements", r.elements},
+          {"faces", r.faces},
+          {"interior_faces", r.interiorFaces},
+          {"boundary_faces", r.boundaryFaces},
+          {"components", r.components},
+          {"volume", r.volume},
+          {"min_element_volume", r.minElementVolume},
+          {"max_element_volume", r.maxElementVolume},
+          {"problems",
+           {{"open_elements", r.openElements},
+            {"non_positive_elements", r.nonPositiveElements},
+            {"non_planar_faces", r.nonPlanarFaces},
+            {"degenerate_faces", r.degenerateFaces},
+            {"duplicate_faces", r.duplicateFaces},
+            {"inconsistent_faces", r.inconsistentFaces},
+            {"empty_elements", r.emptyElements}}},
+          {"messages", r.messages}};
+}
+
+nlohmann::json toJson(const Box3& box) {
+  if (box.isEmpty()) return nullptr;
+  return {{"min", {box.min().x(), box.min().y(), box.min().z()}},
+          {"max", {box.max().x(), box.max().y(), box.max().z()}}};
+}
+
+nlohmann::json toJson(const MeshingReport& r) {
+  nlohmann::json timings = nlohmann::json::object();
+  double total = 0.0;
+  for (const auto& [phase, seconds] : r.timings) {
+    timings[phase] = seconds;
+    total += seconds;
+  }
+  timings["total"] = total;
+  return {
+      {"input",
+       {{"vertices", r.inputVertices},
+        {"triangles", r.inputTriangles},
+        {"closed", r.inputClosed},
+        {"manifold", r.inputManifold},
+        {"self_intersecting", r.selfIntersectionsChecked ? nlohmann::json(r.selfIntersections > 0)
+                                                         : nlohmann::json(nullptr)},
+        {"self_intersections", r.selfIntersections},
+        {"shells", r.shells},
+        {"cavities", r.cavities},
+        {"volume", r.inputVolume},
+        {"volume_before_repair",
+         r.repairs.empty() ? nlohmann::json(nullptr) : nlohmann::json(r.volumeBeforeRepair)},
+        {"repairs", r.repairs}}},
+      {"grid",
+       {{"origin", {r.grid.origin().x(), r.grid.origin().y(), r.grid.origin().z()}},
+        {"cell_size", r.grid.cellSize},
+        {"cells", r.grid.cells}}},
+      {"output",
+       {{"elements", r.elements},
+        {"hexahedra", r.hexahedra},
+        {"polyhedra", r.polyhedra},
+        {"nonconvex", r.nonconvex},
+        {"faces", r.faces},
+        {"interior_faces", r.interiorFaces},
+        {"boundary_faces", r.boundaryFaces},
+        {"volume", r.outputVolume},
+        {"slivers", r.slivers.slivers},
+        {"slivers_merged", r.slivers.merged},
+        {"isolated_slivers", r.slivers.isolated},
+        {"sliver_threshold", r.slivers.threshold},
+        {"cells_with_several_pieces", r.slice.multiPieceCells}}},
+      {"volume_rel_error", r.volumeRelError},
+      {"validation", toJson(r.validation)},
+      {"timings_s", timings}};
+}
+
+}  // namespace polydg::cli

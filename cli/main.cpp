@@ -1,0 +1,34 @@
+// polydg: surface meshes to polyhedral DG simulation meshes, with exact integration and checks.
+//
+// Sample runs:
+//   polydg mesh testdata/torus.obj --cells 16 -o torus.vtu --report mesh.json
+//   polydg info testdata/cube.obj --report info.json
+//   polydg check mesh.vtu --report check.json
+#include <cstdio>
+#include <exception>
+#include <iostream>
+
+#include "cli/commands.h"
+#include "cli/report.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{"polydg: turn surface meshes into polyhedral DG simulation meshes"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "polydg 0.1.0");
+  polydg::cli::CommonOptions common;
+  int exitCode = 0;
+  app.add_flag("-q,--quiet", common.quiet, "print nothing but errors");
+  app.fallthrough();  // --quiet may follow the subcommand
+  polydg::cli::addInfoCommand(app, common, exitCode);
+  polydg::cli::addMeshCommand(app, common, exitCode);
+  polydg::cli::addCheckCommand(app, common, exitCode);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;
+  } catch (const std::exception& e) {
+    std::cerr << "polydg: error: " << e.what() << '\n';
+    return 2;
+  }
+  return exitCode;
+}

@@ -1,0 +1,103 @@
+// polydg mesh: a surface file in, a polyhedral DG simulation mesh (VTU) out.
+#include <iostream>
+
+#include "cli/commands.h"
+#include "cli/json_reports.h"
+#include "cli/progress.h"
+#include "cli/report.h"
+#include "mesh/meshing.h"
+#include "mesh/surface_io.h"
+#include "mesh/vtu_io.h"
+
+namespace polydg::cli {
+
+namespace {
+
+struct MeshCommandOptions {
+  std::string input;
+  std::string output;
+  std::string report;
+  std::optional<double> cell;
+  int cells = 0;
+  RepairMode repair = RepairMode::None;
+  double sliverTau = MeshingOptions{}.sliverTau;
+};
+
+void printSummary(const std::string& output, const MeshingReport& r) {
+  std::cout << output << ": " << r.elements << " elements (" << r.hexahedra << " hexahedra, "
+            << r.polyhedra << " polyhedra, " << r.nonconvex << " non-convex), " << r.faces
+            << " faces; grid " << r.grid.cells[0] << "x" << r.grid.cells[1] << "x"
+            << r.grid.cells[2] << " of " << r.grid.cellSize << "\n"
+            << "  volume " << r.outputVolume << " (input " << r.inputVolume << ", relative error "
+            << r.volumeRelError << "), slivers merged " << r.slivers.merged << ", validation "
+            << (r.validation.passed ? "passed" : "FAILED") << "\n";
+  for (const std::string& repair : r.repairs) std::cout << "  repair: " << repair << "\n";
+  double total = 0;
+  for (const auto& [phase, seconds] : r.timings) total += seconds;
+  std::cout << "  time " << total << " s\n";
+}
+
+}  // namespace
+
+void addMeshCommand(CLI::App& app, const CommonOptions& common, int& exitCode) {
+  auto o = std::make_shared<MeshCommandOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "mesh", "Slice a closed surface with a grid into a polyhedral DG simulation mesh (VTU)");
+  cmd->add_option("input", o->input, "surface file (OBJ, STL, PLY, OFF, glTF, ...)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("-o,--output", o->output, "output simulation mesh (.vtu)")->required();
+  auto* cell = cmd->add_option("--cell", o->cell, "grid cell edge length")
+                   ->check(CLI::PositiveNumber);
+  auto* cells = cmd->add_option("--cells", o->cells,
+                                "about N cells along the longest side of the bounding box")
+                    ->check(CLI::Range(1, 4096));
+  cell->excludes(cells);
+  cmd->add_option("--report", o->report, "write a JSON report to this file");
+  const std::map<std::string, RepairMode> repairs{
+      {"none", RepairMode::None}, {"fill", RepairMode::Fill}, {"wrap", RepairMode::Wrap}};
+  cmd->add_option("--repair", o->repair, "repair broken input: none, fill (close holes), wrap "
+                                         "(alpha wrap any soup)")
+      ->transform(CLI::CheckedTransformer(repairs, CLI::ignore_case));
+  cmd->add_option("--merge-slivers", o->sliverTau,
+                  "merge elements smaller than TAU x cell volume into a neighbour (0: off)")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  cmd->callback([o, &common, &exitCode, cmd] {
+    if (!o->cell && o->cells == 0)
+      throw UserError("polydg mesh needs --cell H or --cells N");
+    if (!isVolumeMeshPath(o->output))
+      throw UserError(o->output + ": the output must be a .vtu file");
+    requireDistinct(o->output, o->input);
+    if (!o->report.empty()) requireDistinct(o->report, o->input);
+
+    const TriangleSurface surface = readSurface(o->input);
+    MeshingOptions options;
+    options.cellSize = o->cell;
+    options.cellsAlongLongest = o->cells;
+    options.repair = o->repair;
+    options.sliverTau = o->sliverTau;
+    ProgressBar bar("slicing", common.quiet);
+    options.progress = [&bar](double f) { bar.update(f); };
+    MeshingResult result;
+    try {
+      result = meshSurface(surface, options);
+    } catch (const InputError& e) {
+      throw UserError(o->input + ": " + e.what());
+    }
+    bar.finish();
+    writeVtu(result.mesh, o->output);
+    if (!o->report.empty()) {
+      nlohmann::json report = toJson(result.report);
+      report["command"] = "mesh";
+      report["input"]["file"] = o->input;
+      report["output"]["file"] = o->output;
+      writeReport(o->report, report);
+    }
+    if (!common.quiet) printSummary(o->output, result.report);
+    exitCode = result.report.validation.passed ? 0 : 1;
+    (void)cmd;
+  });
+}
+
+}  // namespace polydg::cli

@@ -1,0 +1,30 @@
+// A one-line progress bar on stderr for long work: shown only on a terminal, never in CI
+// (CI set) or with --quiet, and redrawn at most every 100 ms.
+#pragma once
+
+#include <chrono>
+#include <string>
+
+namespace polydg::cli {
+
+class ProgressBar {
+ public:
+  ProgressBar(std::string label, bool quiet);
+  ~ProgressBar();
+  ProgressBar(const ProgressBar&) = delete;
+  ProgressBar& operator=(const ProgressBar&) = delete;
+
+  /// Fraction done in [0, 1].
+  void update(double fraction);
+  /// Clears the line.
+  void finish();
+  bool enabled() const { return enabled_; }
+
+ private:
+  std::string label_;
+  bool enabled_ = false;
+  bool drawn_ = false;
+  std::chrono::steady_clock::time_point last_{};
+};
+
+}  // namespace polydg::cli

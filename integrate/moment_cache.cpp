@@ -1,0 +1,111 @@
+#include "integrate/moment_cache.h"
+
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+
+#include <tbb/parallel_for.h>
+
+namespace polydg {
+
+namespace {
+/// Below this many items a loop runs serially: spawning tasks would cost more than it saves.
+constexpr std::size_t kParallelGrain = 256;
+
+template <class F>
+void forEach(std::size_t n, F&& f) {
+  if (n < 2 * kParallelGrain) {
+    for (std::size_t i = 0; i < n; ++i) f(i);
+    return;
+  }
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kParallelGrain),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t i = r.begin(); i != r.end(); ++i) f(i);
+                    });
+}
+}  // namespace
+
+MomentCache::MomentCache(const PolyMesh& mesh, int degree)
+    : mesh_(&mesh), degree_(degree), stride_(numMonomials(degree)) {
+  if (degree < 0 || degree > kMaxMomentDegree)
+    throw std::invalid_argument("MomentCache: degree outside 0.." +
+                                std::to_string(kMaxMomentDegree));
+  sync();
+}
+
+void MomentCache::sync() {
+  const std::size_t oldFaces = faceNormals_.size();
+  const std::size_t oldElements = elementOrigins_.size();
+  const std::size_t nf = mesh_->numFaces(), ne = mesh_->numElements();
+  faceMoments_.resize(nf * stride_, 0.0);
+  elementMoments_.resize(ne * stride_, 0.0);
+  faceNormals_.resize(nf, Vec3::Zero());
+  elementOrigins_.resize(ne, Vec3::Zero());
+  faceDirty_.resize(nf, 0);
+  elementDirty_.resize(ne, 0);
+  for (std::size_t f = oldFaces; f < nf; ++f) invalidateFace(FaceId(f));
+  for (std::size_t e = oldElements; e < ne; ++e) invalidateElement(ElementId(e));
+}
+
+void MomentCache::invalidateAll() {
+  for (std::size_t f = 0; f < faceDirty_.size(); ++f) invalidateFace(FaceId(f));
+}
+
+void MomentCache::invalidateFace(FaceId f) {
+  if (!faceDirty_[f.index()]) {
+    faceDirty_[f.index()] = 1;
+    dirtyFaces_.push_back(f);
+  }
+  const Face& face = mesh_->face(f);
+  if (face.front.valid()) invalidateElement(face.front);
+  if (face.back.valid()) invalidateElement(face.back);
+}
+
+void MomentCache::invalidateElement(ElementId e) {
+  if (e.index() >= elementDirty_.size()) return;  // appended later; sync() picks it up
+  if (!elementDirty_[e.index()]) {
+    elementDirty_[e.index()] = 1;
+    dirtyElements_.push_back(e);
+  }
+}
+
+std::size_t MomentCache::update() {
+  const PolyMesh& mesh = *mesh_;
+  const std::size_t stride = static_cast<std::size_t>(stride_);
+
+  forEach(dirtyFaces_.size(), [&](std::size_t i) {
+    const FaceId f = dirtyFaces_[i];
+    faceMoments(mesh, f, degree_, {faceMoments_.data() + f.index() * stride, stride},
+                faceNormals_[f]);
+  });
+
+  forEach(dirtyElements_.size(), [&](std::size_t i) {
+    const ElementId e = dirtyElements_[i];
+    const Vec3 origin = elementReferencePoint(mesh, e);
+    elementOrigins_[e] = origin;
+    std::span<double> out{elementMoments_.data() + e.index() * stride, stride};
+    std::fill(out.begin(), out.end(), 0.0);
+    double scratch[numMonomials(kMaxMomentDegree)];
+    for (const FaceUse& use : mesh.element(e).faces) {
+      accumulateElementMoments(degree_, face(use.face), faceReferencePoint(mesh, use.face),
+                               faceNormals_[use.face], use.reversed, origin,
+                               {scratch, stride}, out);
+    }
+  });
+
+  const std::size_t integrated = dirtyFaces_.size();
+  facesIntegrated_ += integrated;
+  for (FaceId f : dirtyFaces_) faceDirty_[f.index()] = 0;
+  for (ElementId e : dirtyElements_) elementDirty_[e.index()] = 0;
+  dirtyFaces_.clear();
+  dirtyElements_.clear();
+  return integrated;
+}
+
+Vec3 MomentCache::centroid(ElementId e) const {
+  const auto m = element(e);
+  if (degree_ < 1) return elementOrigins_[e];
+  return elementOrigins_[e] + Vec3(m[1], m[2], m[3]) / m[0];
+}
+
+}  // namespace polydg

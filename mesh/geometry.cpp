@@ -1,0 +1,85 @@
+#include "mesh/geometry.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace polydg {
+
+Vec3 areaVector(const PolyMesh& mesh, FaceId f) {
+  const Face& face = mesh.face(f);
+  const Vec3& c = faceReferencePoint(mesh, f);
+  Vec3 twiceArea = Vec3::Zero();
+  for (std::size_t k = 0; k < face.numLoops(); ++k) {
+    const auto loop = face.loop(k);
+    const std::size_t n = loop.size();
+    for (std::size_t i = 0; i < n; ++i) {
+      const Vec3 a = mesh.position(loop[i]) - c;
+      const Vec3 b = mesh.position(loop[(i + 1) % n]) - c;
+      twiceArea += a.cross(b);
+    }
+  }
+  return 0.5 * twiceArea;
+}
+
+Vec3 unitNormal(const PolyMesh& mesh, FaceId f) {
+  const Vec3 a = areaVector(mesh, f);
+  const double norm = a.norm();
+  return norm > 0.0 ? Vec3(a / norm) : Vec3::Zero();
+}
+
+Box3 faceBounds(const PolyMesh& mesh, FaceId f) {
+  Box3 box;
+  for (VertexId v : mesh.face(f).vertices) box.extend(mesh.position(v));
+  return box;
+}
+
+Box3 elementBounds(const PolyMesh& mesh, ElementId e) {
+  Box3 box;
+  for (const FaceUse& use : mesh.element(e).faces) box.extend(faceBounds(mesh, use.face));
+  return box;
+}
+
+Vec3 elementReferencePoint(const PolyMesh& mesh, ElementId e) {
+  const Box3 box = elementBounds(mesh, e);
+  return 0.5 * (box.min() + box.max());
+}
+
+double signedVolume(const PolyMesh& mesh, ElementId e) {
+  const Vec3 o = elementReferencePoint(mesh, e);
+  // Cone volume = height * area / 3, and a.dot(c - o) = area * height.
+  double threeVolume = 0.0;
+  for (const FaceUse& use : mesh.element(e).faces) {
+    const Vec3 a = areaVector(mesh, use.face);
+    const double h = a.dot(faceReferencePoint(mesh, use.face) - o);
+    threeVolume += use.reversed ? -h : h;
+  }
+  return threeVolume / 3.0;
+}
+
+double relativePlanarityError(const PolyMesh& mesh, FaceId f) {
+  const Face& face = mesh.face(f);
+  const Vec3 n = unitNormal(mesh, f);
+  const Box3 box = faceBounds(mesh, f);
+  const double diameter = box.diagonal().norm();
+  if (diameter == 0.0) return 0.0;
+  const Vec3& c = faceReferencePoint(mesh, f);
+  Vec3 mean = Vec3::Zero();
+  for (VertexId v : face.vertices) mean += mesh.position(v) - c;
+  mean /= static_cast<double>(face.vertices.size());
+  double worst = 0.0;
+  for (VertexId v : face.vertices)
+    worst = std::max(worst, std::abs(n.dot(mesh.position(v) - c - mean)));
+  return worst / diameter;
+}
+
+Box3 meshBounds(const PolyMesh& mesh) {
+  Box3 box;
+  for (const Vec3& p : mesh.positions()) box.extend(p);
+  return box;
+}
+
+void transform(PolyMesh& mesh, double scale, const Vec3& offset) {
+  for (Vec3& p : mesh.positions()) p = scale * p + offset;
+}
+
+}  // namespace polydg

@@ -1,0 +1,192 @@
+#include "mesh/meshing.h"
+
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include "mesh/surface_repair.h"
+
+namespace polydg {
+
+namespace {
+
+class PhaseTimer {
+ public:
+  explicit PhaseTimer(std::vector<std::pair<std::string, double>>& timings) : timings_(timings) {}
+  void done(const std::string& phase) {
+    const auto now = std::chrono::steady_clock::now();
+    timings_.emplace_back(phase, std::chrono::duration<double>(now - start_).count());
+    start_ = now;
+  }
+
+ private:
+  std::vector<std::pair<std::string, double>>& timings_;
+  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+};
+
+/// "open (12 boundary edges), self-intersecting (40 triangle pairs)".
+std::string describeDefects(const SurfaceDiagnosis& d) {
+  std::vector<std::string> parts;
+  const SurfaceTopology& t = d.topology;
+  if (t.boundaryEdges) parts.push_back("open (" + std::to_string(t.boundaryEdges) + " boundary edges)");
+  if (t.nonManifoldEdges)
+    parts.push_back("non-manifold (" + std::to_string(t.nonManifoldEdges) +
+                    " edges with more than two triangles)");
+  if (d.selfIntersections)
+    parts.push_back("self-intersecting (" + std::to_string(d.selfIntersections) +
+                    " pairs of intersecting triangles)");
+  std::string s;
+  for (std::size_t i = 0; i < parts.size(); ++i) s += (i ? ", " : "") + parts[i];
+  return s;
+}
+
+bool broken(const SurfaceDiagnosis& d) {
+  return !d.closed() || !d.manifold() || d.selfIntersections > 0;
+}
+
+double cellSizeFor(const Box3& box, const MeshingOptions& o) {
+  if (o.cellSize) {
+    if (!(*o.cellSize > 0) || !std::isfinite(*o.cellSize))
+      throw InputError("the cell size must be a positive number");
+    return *o.cellSize;
+  }
+  if (o.cellsAlongLongest < 1) throw InputError("the number of cells must be at least 1");
+  return box.diagonal().maxCoeff() / o.cellsAlongLongest;
+}
+
+}  // namespace
+
+bool isConvex(const PolyMesh& mesh, ElementId e, double relativeTolerance) {
+  const Box3 box = elementBounds(mesh, e);
+  const double tolerance = relativeTolerance * box.diagonal().norm();
+  std::vector<VertexId> vertices;
+  for (const FaceUse& use : mesh.element(e).faces)
+    for (VertexId v : mesh.face(use.face).vertices) vertices.push_back(v);
+  std::sort(vertices.begin(), vertices.end());
+  vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+  for (const FaceUse& use : mesh.element(e).faces) {
+    // A face narrower than the tolerance (area / diameter) cannot show non-convexity at that
+    // tolerance, and the normal of a face of round-off width means nothing.
+    const Vec3 a = areaVector(mesh, use.face);
+    if (a.norm() <= tolerance * faceBounds(mesh, use.face).diagonal().norm()) continue;
+    Vec3 n = a.normalized();
+    if (use.reversed) n = -n;
+    const Vec3& c = faceReferencePoint(mesh, use.face);
+    for (VertexId v : vertices)
+      if (n.dot(mesh.position(v) - c) > tolerance) return false;
+  }
+  return true;
+}
+
+MeshingResult meshSurface(const TriangleSurface& input, const MeshingOptions& options) {
+  MeshingResult result;
+  MeshingReport& r = result.report;
+  PhaseTimer timer(r.timings);
+  if (input.triangles.empty()) throw InputError("the surface has no triangles");
+
+  TriangleSurface surface = input;
+  SurfaceDiagnosis d = diagnose(surface);
+  r.inputVertices = input.vertices.size();
+  r.inputTriangles = input.triangles.size();
+  r.inputClosed = d.topology.closed();
+  r.inputManifold = d.manifold();
+  r.selfIntersections = d.selfIntersections;
+  r.selfIntersectionsChecked = d.checkedSelfIntersections;
+  if (d.topology.degenerateTriangles > 0) {
+    const std::size_t removed = removeDegenerateTriangles(surface);
+    r.repairs.push_back("removed " + std::to_string(removed) + " degenerate triangles");
+    d = diagnose(surface);
+  }
+  timer.done("check");
+
+  const double cellSize = cellSizeFor(bounds(input), options);
+  if (broken(d)) {
+    const std::string defects = describeDefects(d);
+    switch (options.repair) {
+      case RepairMode::None:
+        throw InputError("the surface is " + defects +
+                         "; use --repair fill to close holes in a manifold surface, or --repair "
+                         "wrap to rebuild a closed surface around any triangle soup");
+      case RepairMode::Fill: {
+        if (!d.manifold())
+          throw InputError("the surface is " + defects +
+                           "; --repair fill needs a manifold surface, use --repair wrap");
+        r.volumeBeforeRepair = enclosedVolume(surface);
+        std::size_t holes = 0;
+        surface = fillHoles(surface, holes);
+        r.repairs.push_back("filled " + std::to_string(holes) + " holes");
+        d = diagnose(surface);
+        if (broken(d))
+          throw InputError("the surface is still " + describeDefects(d) +
+                           " after --repair fill; use --repair wrap");
+        break;
+      }
+      case RepairMode::Wrap: {
+        r.volumeBeforeRepair = d.closed() ? enclosedVolume(surface) : 0.0;
+        // Alpha and offset follow the cell size: features finer than half a cell are closed
+        // over, and the wrap stays within 1/30 of a cell of the input.
+        const double alpha = 0.5 * cellSize, offset = cellSize / 30.0;
+        surface = alphaWrap(surface, alpha, offset);
+        std::ostringstream what;
+        what << "alpha-wrapped (alpha " << alpha << ", offset " << offset << ") into "
+             << surface.triangles.size() << " triangles";
+        r.repairs.push_back(what.str());
+        d = diagnose(surface);
+        if (broken(d))
+          throw InputError("alpha wrapping did not give a closed surface (" + describeDefects(d) +
+                           "); try a smaller cell size");
+        break;
+      }
+    }
+    timer.done("repair");
+  }
+
+  bool reoriented = false;
+  surface = orientToBoundVolume(surface, reoriented);
+  if (reoriented) r.repairs.push_back("re-oriented the surface to bound its volume outward");
+  d = diagnose(surface);
+  r.shells = d.shells;
+  r.cavities = d.cavities;
+  r.inputVolume = enclosedVolume(surface);
+  if (!(r.inputVolume > 0)) throw InputError("the surface encloses no volume");
+  timer.done("orient");
+
+  r.grid = Grid::covering(bounds(surface), cellSize);
+  PolyMesh sliced = sliceSurface(surface, r.grid, &r.slice, nullptr, options.progress);
+  timer.done("slice");
+
+  if (options.sliverTau > 0) {
+    SliverMergeReport merge;
+    result.mesh = mergeSlivers(sliced, options.sliverTau * r.grid.cellVolume(), &merge);
+    r.slivers = {merge.threshold, merge.slivers, merge.merged, merge.isolated};
+  } else {
+    result.mesh = std::move(sliced);
+  }
+  timer.done("merge_slivers");
+
+  const PolyMesh& mesh = result.mesh;
+  r.validation = validate(mesh);
+  r.elements = mesh.numElements();
+  r.faces = r.validation.faces;
+  r.interiorFaces = r.validation.interiorFaces;
+  r.boundaryFaces = r.validation.boundaryFaces;
+  r.outputVolume = r.validation.volume;
+  r.volumeRelError = std::abs(r.outputVolume - r.inputVolume) / r.inputVolume;
+  for (std::size_t e = 0; e < mesh.numElements(); ++e) {
+    const Element& element = mesh.element(ElementId(e));
+    bool hex = element.faces.size() == 6;
+    for (const FaceUse& use : element.faces) {
+      const Face& face = mesh.face(use.face);
+      const Vec3 n = unitNormal(mesh, use.face);
+      hex = hex && face.numLoops() == 1 && face.vertices.size() == 4 &&
+            (std::abs(n.x()) == 1.0 || std::abs(n.y()) == 1.0 || std::abs(n.z()) == 1.0);
+    }
+    r.hexahedra += hex;
+    if (!hex && !isConvex(mesh, ElementId(e))) ++r.nonconvex;
+  }
+  r.polyhedra = r.elements - r.hexahedra;
+  timer.done("validate");
+  return result;
+}
+
+}  // namespace polydg

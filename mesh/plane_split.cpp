@@ -1,0 +1,517 @@
+#include "mesh/plane_split.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <numeric>
+#include <stdexcept>
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Exact_rational.h>
+
+namespace polydg {
+
+namespace {
+
+using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Point2 = Kernel::Point_2;
+
+/// Projection of a plane with normal n onto the coordinate plane that drops n's largest
+/// component; `sign` is +1 when the projection keeps orientation (counter-clockwise about n
+/// stays counter-clockwise in 2D), -1 when it flips it.
+struct Projection {
+  int u = 0, w = 1;
+  int sign = 1;
+  explicit Projection(const Vec3& n) {
+    int k = 0;
+    if (std::abs(n.y()) > std::abs(n[k])) k = 1;
+    if (std::abs(n.z()) > std::abs(n[k])) k = 2;
+    u = (k + 1) % 3;
+    w = (k + 2) % 3;
+    sign = n[k] >= 0 ? 1 : -1;
+  }
+  Point2 operator()(const Vec3& p) const { return Point2(p[u], p[w]); }
+};
+
+struct DirectedEdge {
+  std::uint32_t from, to;
+};
+
+/// Exact point-in-loop test in 2D: 1 inside, 0 outside, -1 on the boundary.
+int locate(const Point2& p, const std::vector<Point2>& loop) {
+  bool inside = false;
+  const std::size_t n = loop.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    const Point2& a = loop[i];
+    const Point2& b = loop[(i + 1) % n];
+    const CGAL::Orientation o = CGAL::orientation(a, b, p);
+    if (o == CGAL::COLLINEAR && CGAL::collinear_are_ordered_along_line(a, p, b)) return -1;
+    if ((a.y() > p.y()) != (b.y() > p.y())) {
+      // The edge straddles the horizontal through p: does it cross to the right of p?
+      const bool upward = b.y() > a.y();
+      if ((o == CGAL::LEFT_TURN) == upward) inside = !inside;
+    }
+  }
+  return inside ? 1 : 0;
+}
+
+}  // namespace
+
+PlaneSplitter::PlaneSplitter(std::vector<Vec3> points) : points_(std::move(points)) {
+  onPlane_.assign(points_.size(), kNoPlane);
+  definition_.assign(points_.size(), Definition{});
+  edgePoints_.reserve(points_.size());
+  byPosition_.reserve(points_.size());
+}
+
+int PlaneSplitter::compareExactly(std::uint32_t v, std::uint32_t w, int k) const {
+  using Q = CGAL::Exact_rational;
+  auto exact = [&](std::uint32_t id) -> Q {
+    if (onPlane_[id] == kNoPlane) return Q(points_[id][k]);
+    const SplitPlane& plane = planes_.at(onPlane_[id]);
+    const Vec3& p = points_[definition_[id].a];
+    const Vec3& q = points_[definition_[id].b];
+    Q np(0), nq(0);
+    for (int i = 0; i < 3; ++i) {
+      np += Q(plane.normal[i]) * Q(p[i]);
+      nq += Q(plane.normal[i]) * Q(q[i]);
+    }
+    const Q t = (Q(plane.offset) - np) / (nq - np);
+    return Q(p[k]) + t * (Q(q[k]) - Q(p[k]));
+  };
+  const Q a = exact(v), b = exact(w);
+  return a < b ? -1 : (b < a ? 1 : 0);
+}
+
+int PlaneSplitter::side(std::uint32_t v, const SplitPlane& plane) const {
+  if (onPlane_[v] == plane.id) return 0;
+  const Vec3& p = points_[v];
+  if (plane.axis >= 0) {
+    const double x = p[plane.axis];
+    return x < plane.offset ? -1 : (x > plane.offset ? 1 : 0);
+  }
+  const Kernel::Plane_3 h(plane.normal.x(), plane.normal.y(), plane.normal.z(), -plane.offset);
+  switch (h.oriented_side(Kernel::Point_3(p.x(), p.y(), p.z()))) {
+    case CGAL::ON_NEGATIVE_SIDE: return -1;
+    case CGAL::ON_POSITIVE_SIDE: return 1;
+    default: return 0;
+  }
+}
+
+std::uint32_t PlaneSplitter::edgePoint(std::uint32_t u, std::uint32_t v, const SplitPlane& plane) {
+  const std::uint32_t a = std::min(u, v), b = std::max(u, v);
+  const EdgeKey key{a, b, plane.id};
+  if (auto it = edgePoints_.find(key); it != edgePoints_.end()) return it->second;
+  // Interpolate from the lower index, so the point depends only on the edge and the plane.
+  const Vec3 p = points_[a], q = points_[b];
+  Vec3 r;
+  if (plane.axis >= 0) {
+    const int k = plane.axis;
+    const double t = (plane.offset - p[k]) / (q[k] - p[k]);
+    r = p + t * (q - p);
+    r[k] = plane.offset;
+  } else {
+    const double dp = plane.normal.dot(p) - plane.offset;
+    const double dq = plane.normal.dot(q) - plane.offset;
+    r = p + (dp / (dp - dq)) * (q - p);
+  }
+  // Stay inside the edge's box, so later side tests against other planes keep the order of
+  // the edge's endpoints.
+  for (int i = 0; i < 3; ++i) r[i] = std::clamp(r[i], std::min(p[i], q[i]), std::max(p[i], q[i]));
+  planes_.try_emplace(plane.id, plane);
+  const std::array<double, 3> position{r.x() + 0.0, r.y() + 0.0, r.z() + 0.0};
+  if (auto it = byPosition_.find(position); it != byPosition_.end() && side(it->second, plane) == 0) {
+    edgePoints_.emplace(key, it->second);
+    return it->second;
+  }
+  points_.push_back(r);
+  onPlane_.push_back(plane.id);
+  definition_.push_back({a, b});
+  const auto id = static_cast<std::uint32_t>(points_.size() - 1);
+  edgePoints_.emplace(key, id);
+  byPosition_.emplace(position, id);
+  return id;
+}
+
+Vec3 PlaneSplitter::polygonNormal(const PiecePolygon& polygon) const {
+  const Vec3& c = points_[polygon.vertices.front()];
+  Vec3 n = Vec3::Zero();
+  for (std::size_t k = 0; k < polygon.numLoops(); ++k) {
+    const std::size_t begin = polygon.loopBegin(k), end = polygon.loopEnd[k];
+    for (std::size_t i = begin; i < end; ++i) {
+      const std::size_t j = i + 1 == end ? begin : i + 1;
+      n += (points_[polygon.vertices[i]] - c).cross(points_[polygon.vertices[j]] - c);
+    }
+  }
+  return n;
+}
+
+namespace {
+
+/// Traces closed loops from directed edges; where several edges leave a vertex (a pinch), takes
+/// the first one clockwise from the reversed incoming edge, so the region to the left of each
+/// loop is a proper face (the loops at a pinch are kept apart). `normal` orients the plane.
+std::vector<std::vector<std::uint32_t>> traceLoops(const std::vector<DirectedEdge>& edges,
+                                                   const std::vector<Vec3>& points,
+                                                   const Vec3& normal) {
+  std::vector<std::size_t> order(edges.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(),
+            [&](std::size_t i, std::size_t j) { return edges[i].from < edges[j].from; });
+  auto outgoing = [&](std::uint32_t v) {
+    auto lo = std::lower_bound(order.begin(), order.end(), v,
+                               [&](std::size_t i, std::uint32_t x) { return edges[i].from < x; });
+    auto hi = lo;
+    while (hi != order.end() && edges[*hi].from == v) ++hi;
+    return std::make_pair(lo, hi);
+  };
+  const Projection project(normal);
+  auto angleFrom = [&](std::uint32_t at, std::uint32_t back, std::uint32_t to) {
+    const Vec3 r = points[back] - points[at], d = points[to] - points[at];
+    const double ru = r[project.u], rw = r[project.w], du = d[project.u], dw = d[project.w];
+    double a = std::atan2(project.sign * (ru * dw - rw * du), ru * du + rw * dw);
+    if (a <= 0) a += 2 * std::numbers::pi;  // (0, 2 pi]: going straight back ranks last
+    if (to == back) a = 0.0;
+    return a;
+  };
+
+  std::vector<char> used(edges.size(), 0);
+  std::vector<std::vector<std::uint32_t>> loops;
+  for (std::size_t start : order) {
+    if (used[start]) continue;
+    std::vector<std::uint32_t> loop{edges[start].from};
+    used[start] = 1;
+    std::size_t current = start;
+    for (std::size_t guard = 0;; ++guard) {
+      if (guard > edges.size()) throw std::logic_error("traceLoops: loop does not close");
+      const std::uint32_t v = edges[current].to, back = edges[current].from;
+      auto [lo, hi] = outgoing(v);
+      std::size_t best = edges.size();
+      double bestAngle = -1.0;
+      for (auto it = lo; it != hi; ++it) {
+        if (used[*it] && *it != start) continue;
+        const double a = angleFrom(v, back, edges[*it].to);
+        if (a > bestAngle) {
+          bestAngle = a;
+          best = *it;
+        }
+      }
+      if (best == edges.size())
+        throw std::logic_error("traceLoops: open chain of edges (the piece is not closed)");
+      if (best == start) break;
+      used[best] = 1;
+      loop.push_back(v);
+      current = best;
+    }
+    loops.push_back(std::move(loop));
+  }
+  return loops;
+}
+
+/// Groups loops into polygons: loops counter-clockwise about `normal` are outer boundaries,
+/// clockwise ones are holes, each put in the smallest outer loop that contains it. A loop whose
+/// rounded area is zero (its points collapsed by rounding) stays a polygon of its own: it is
+/// needed to keep the piece closed, and welding identical points removes it later.
+std::vector<PiecePolygon> groupLoops(std::vector<std::vector<std::uint32_t>> loops,
+                                     const std::vector<Vec3>& points, const Vec3& normal,
+                                     FaceOrigin origin) {
+  const Vec3 n = normal.normalized();
+  std::vector<double> area(loops.size());
+  for (std::size_t k = 0; k < loops.size(); ++k) {
+    const auto& loop = loops[k];
+    const Vec3& c = points[loop[0]];
+    Vec3 a = Vec3::Zero();
+    for (std::size_t i = 1; i + 1 < loop.size(); ++i)
+      a += (points[loop[i]] - c).cross(points[loop[i + 1]] - c);
+    area[k] = 0.5 * a.dot(n);
+  }
+  std::vector<std::size_t> outers, holes;
+  for (std::size_t k = 0; k < loops.size(); ++k) {
+    if (loops[k].size() < 3) continue;
+    (area[k] >= 0 ? outers : holes).push_back(k);
+  }
+  std::vector<PiecePolygon> polygons(outers.size());
+  for (std::size_t i = 0; i < outers.size(); ++i) {
+    polygons[i].vertices = loops[outers[i]];
+    polygons[i].loopEnd = {static_cast<std::uint32_t>(loops[outers[i]].size())};
+    polygons[i].origin = origin;
+  }
+  if (holes.empty()) return polygons;
+
+  const Projection project(n);
+  std::vector<std::vector<Point2>> outer2(outers.size());
+  for (std::size_t i = 0; i < outers.size(); ++i)
+    for (std::uint32_t v : loops[outers[i]]) outer2[i].push_back(project(points[v]));
+  for (std::size_t h : holes) {
+    std::size_t best = outers.size();
+    for (std::size_t i = 0; i < outers.size(); ++i) {
+      if (best != outers.size() && area[outers[i]] >= area[outers[best]]) continue;
+      // The hole is inside the outer loop if a hole vertex off that loop's boundary is inside.
+      for (std::uint32_t v : loops[h]) {
+        const int where = locate(project(points[v]), outer2[i]);
+        if (where < 0) continue;
+        if (where > 0) best = i;
+        break;
+      }
+    }
+    if (best == outers.size())
+      throw std::logic_error("groupLoops: a hole lies in no outer boundary");
+    PiecePolygon& p = polygons[best];
+    p.vertices.insert(p.vertices.end(), loops[h].begin(), loops[h].end());
+    p.loopEnd.push_back(static_cast<std::uint32_t>(p.vertices.size()));
+  }
+  return polygons;
+}
+
+PiecePolygon reversed(const PiecePolygon& p) {
+  PiecePolygon r = p;
+  for (std::size_t k = 0; k < p.numLoops(); ++k)
+    std::reverse(r.vertices.begin() + p.loopBegin(k), r.vertices.begin() + p.loopEnd[k]);
+  return r;
+}
+
+}  // namespace
+
+void PlaneSplitter::splitPolygon(const PiecePolygon& polygon, const SplitPlane& plane,
+                                 Piece& minus, Piece& plus) {
+  // 1. The loops with every crossing edge subdivided at its intersection point.
+  struct Corner {
+    std::uint32_t v;
+    int side;
+  };
+  std::vector<std::vector<Corner>> loops(polygon.numLoops());
+  for (std::size_t k = 0; k < polygon.numLoops(); ++k) {
+    const std::size_t begin = polygon.loopBegin(k), end = polygon.loopEnd[k];
+    for (std::size_t i = begin; i < end; ++i) {
+      const std::uint32_t a = polygon.vertices[i];
+      const std::uint32_t b = polygon.vertices[i + 1 == end ? begin : i + 1];
+      const int sa = side(a, plane), sb = side(b, plane);
+      loops[k].push_back({a, sa});
+      if (sa * sb < 0) loops[k].push_back({edgePoint(a, b, plane), 0});
+    }
+  }
+
+  // Fast path: one loop that meets L in exactly two corners, both crossings. The boundary
+  // crosses L twice, so the polygon meets L in the one segment between them, and each side is
+  // its chain of corners closed by that segment.
+  if (loops.size() == 1) {
+    const auto& loop = loops[0];
+    const std::size_t m = loop.size();
+    std::size_t zeros = 0, first = m, second = m;
+    for (std::size_t i = 0; i < m; ++i)
+      if (loop[i].side == 0) {
+        ++zeros;
+        (first == m ? first : second) = i;
+      }
+    if (zeros == 2 && second - first > 1 && second - first + 1 < m &&
+        loop[(first + m - 1) % m].side != loop[(first + 1) % m].side) {
+      // Corners first..second on one side, second..first (wrapping) on the other.
+      PiecePolygon a, b;
+      a.origin = b.origin = polygon.origin;
+      for (std::size_t i = first; i <= second; ++i) a.vertices.push_back(loop[i].v);
+      for (std::size_t i = second; i != first; i = (i + 1) % m) b.vertices.push_back(loop[i].v);
+      b.vertices.push_back(loop[first].v);
+      a.loopEnd = {static_cast<std::uint32_t>(a.vertices.size())};
+      b.loopEnd = {static_cast<std::uint32_t>(b.vertices.size())};
+      const bool aIsMinus = loop[first + 1].side < 0;
+      minus.push_back(std::move(aIsMinus ? a : b));
+      plus.push_back(std::move(aIsMinus ? b : a));
+      return;
+    }
+  }
+
+  // 2. Positions along the line L = polygon plane ∩ split plane, in the direction t that has
+  //    the minus side on its left (seen from the polygon's normal).
+  const Vec3 n = polygonNormal(polygon);
+  const Vec3 t = n.cross(plane.normal);
+  int k = 0;
+  if (std::abs(t.y()) > std::abs(t[k])) k = 1;
+  if (std::abs(t.z()) > std::abs(t[k])) k = 2;
+  const double direction = t[k] > 0 ? 1.0 : -1.0;
+  auto key = [&](std::uint32_t v) { return direction * points_[v][k]; };
+
+  // 3. Points on L, and parity toggles where the boundary crosses L (a run of on-L corners
+  //    entered from one side and left to the other).
+  std::vector<std::pair<double, std::uint32_t>> onLine;
+  std::vector<std::uint32_t> toggles;  // ids of the points where the boundary crosses L
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> alongLine;  // boundary edges on L
+  for (const auto& loop : loops) {
+    const std::size_t m = loop.size();
+    std::size_t start = m;
+    for (std::size_t i = 0; i < m; ++i)
+      if (loop[i].side != 0) {
+        start = i;
+        break;
+      }
+    if (start == m) continue;  // a loop lying in L has no area; nothing to split
+    int before = loop[start].side;
+    for (std::size_t step = 1; step <= m; ++step) {
+      const Corner& c = loop[(start + step) % m];
+      if (c.side == 0) {
+        onLine.emplace_back(key(c.v), c.v);
+        const Corner& next = loop[(start + step + 1) % m];
+        if (next.side == 0) alongLine.emplace_back(std::min(c.v, next.v), std::max(c.v, next.v));
+        // Find where this run of on-L corners ends.
+        std::size_t run = step;
+        while (loop[(start + run + 1) % m].side == 0) ++run;
+        const int after = loop[(start + run + 1) % m].side;
+        if (after != before) toggles.push_back(c.v);
+        for (std::size_t r = step + 1; r <= run; ++r) {
+          const Corner& cr = loop[(start + r) % m];
+          onLine.emplace_back(key(cr.v), cr.v);
+          const Corner& cn = loop[(start + r + 1) % m];
+          if (cn.side == 0)
+            alongLine.emplace_back(std::min(cr.v, cn.v), std::max(cr.v, cn.v));
+        }
+        step = run;
+      } else {
+        before = c.side;
+      }
+    }
+  }
+  // Order along t; rounded coordinates that tie are ordered exactly.
+  // A polygon of round-off size has no meaningful direction t; its points can then tie on
+  // coordinate k, and the other coordinates (exactly, in t's direction) order them instead.
+  auto before = [&](const std::pair<double, std::uint32_t>& x,
+                    const std::pair<double, std::uint32_t>& y) {
+    if (x.first != y.first) return x.first < y.first;
+    if (x.second == y.second) return false;
+    for (int i = 0; i < 3; ++i) {
+      const int axis = (k + i) % 3;
+      const double sign = i == 0 ? direction : (t[axis] < 0 ? -1.0 : 1.0);
+      if (const int c = compareExactly(x.second, y.second, axis); c != 0) return sign * c < 0;
+    }
+    return false;
+  };
+  std::sort(onLine.begin(), onLine.end(), before);
+  onLine.erase(std::unique(onLine.begin(), onLine.end(),
+                           [](const auto& x, const auto& y) { return x.second == y.second; }),
+               onLine.end());
+  for (std::size_t i = 0; i + 1 < onLine.size(); ++i)
+    if (!before(onLine[i], onLine[i + 1])) {
+      throw std::runtime_error(
+          "plane split: two distinct points coincide on the cut line (self-touching face)");
+    }
+  std::sort(toggles.begin(), toggles.end());
+  std::sort(alongLine.begin(), alongLine.end());
+
+  // 4. Directed edges of each side: boundary pieces plus closing segments along L.
+  std::vector<DirectedEdge> minusEdges, plusEdges;
+  for (const auto& loop : loops) {
+    const std::size_t m = loop.size();
+    for (std::size_t i = 0; i < m; ++i) {
+      const Corner& a = loop[i];
+      const Corner& b = loop[(i + 1) % m];
+      const DirectedEdge e{a.v, b.v};
+      if (a.side < 0 || b.side < 0) minusEdges.push_back(e);
+      else if (a.side > 0 || b.side > 0) plusEdges.push_back(e);
+      else (key(b.v) > key(a.v) ? minusEdges : plusEdges).push_back(e);
+    }
+  }
+  std::size_t crossings = 0;
+  for (std::size_t i = 0; i + 1 < onLine.size(); ++i) {
+    crossings += static_cast<std::size_t>(std::count(toggles.begin(), toggles.end(), onLine[i].second));
+    if (crossings % 2 == 0) continue;  // outside the polygon
+    const std::uint32_t a = onLine[i].second, b = onLine[i + 1].second;
+    if (std::binary_search(alongLine.begin(), alongLine.end(),
+                           std::make_pair(std::min(a, b), std::max(a, b))))
+      continue;  // already a boundary edge
+    minusEdges.push_back({a, b});
+    plusEdges.push_back({b, a});
+  }
+
+  // 5. Loops, grouped into polygons with holes.
+  for (auto& p : groupLoops(traceLoops(minusEdges, points_, n), points_, n, polygon.origin))
+    minus.push_back(std::move(p));
+  for (auto& p : groupLoops(traceLoops(plusEdges, points_, n), points_, n, polygon.origin))
+    plus.push_back(std::move(p));
+}
+
+PieceSplit PlaneSplitter::split(Piece piece, const SplitPlane& plane, FaceOrigin capOrigin) {
+  PieceSplit out;
+  for (PiecePolygon& polygon : piece) {
+    int lo = 1, hi = -1;
+    for (std::uint32_t v : polygon.vertices) {
+      const int s = side(v, plane);
+      lo = std::min(lo, s);
+      hi = std::max(hi, s);
+    }
+    if (hi <= 0 && lo < 0) out.minus.push_back(std::move(polygon));
+    else if (lo >= 0 && hi > 0) out.plus.push_back(std::move(polygon));
+    else if (lo == 0 && hi == 0)  // in the plane: it bounds the side it faces away from
+      (polygonNormal(polygon).dot(plane.normal) > 0 ? out.minus : out.plus)
+          .push_back(std::move(polygon));
+    else {
+      splitPolygon(polygon, plane, out.minus, out.plus);
+      ++out.polygonsSplit;
+    }
+  }
+  if (out.minus.empty() || out.plus.empty()) return out;
+
+  // Caps: the minus side's edges in the plane that have no reverse within the minus side.
+  std::unordered_map<std::uint64_t, int> balance;
+  for (const PiecePolygon& polygon : out.minus) {
+    for (std::size_t k = 0; k < polygon.numLoops(); ++k) {
+      const std::size_t begin = polygon.loopBegin(k), end = polygon.loopEnd[k];
+      for (std::size_t i = begin; i < end; ++i) {
+        const std::uint32_t a = polygon.vertices[i];
+        const std::uint32_t b = polygon.vertices[i + 1 == end ? begin : i + 1];
+        if (side(a, plane) != 0 || side(b, plane) != 0) continue;
+        const std::uint64_t key = std::uint64_t(std::min(a, b)) << 32 | std::max(a, b);
+        balance[key] += a < b ? 1 : -1;
+      }
+    }
+  }
+  std::vector<DirectedEdge> capEdges;
+  for (const auto& [key, net] : balance) {
+    const auto lo = static_cast<std::uint32_t>(key >> 32);
+    const auto hi = static_cast<std::uint32_t>(key & 0xffffffffu);
+    for (int i = 0; i < std::abs(net); ++i)
+      capEdges.push_back(net > 0 ? DirectedEdge{hi, lo} : DirectedEdge{lo, hi});
+  }
+  if (capEdges.empty()) return out;
+  std::sort(capEdges.begin(), capEdges.end(), [](const DirectedEdge& a, const DirectedEdge& b) {
+    return a.from != b.from ? a.from < b.from : a.to < b.to;
+  });  // deterministic output, whatever the hash order
+  for (PiecePolygon& cap :
+       groupLoops(traceLoops(capEdges, points_, plane.normal), points_, plane.normal, capOrigin)) {
+    out.plus.push_back(reversed(cap));
+    out.minus.push_back(std::move(cap));
+    ++out.capPolygons;
+  }
+  return out;
+}
+
+std::vector<Piece> PlaneSplitter::components(Piece piece) {
+  const std::size_t n = piece.size();
+  std::vector<std::size_t> parent(n);
+  std::iota(parent.begin(), parent.end(), 0);
+  auto find = [&](std::size_t i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  };
+  std::unordered_map<std::uint64_t, std::size_t> firstUse;
+  for (std::size_t p = 0; p < n; ++p) {
+    const PiecePolygon& polygon = piece[p];
+    for (std::size_t k = 0; k < polygon.numLoops(); ++k) {
+      const std::size_t begin = polygon.loopBegin(k), end = polygon.loopEnd[k];
+      for (std::size_t i = begin; i < end; ++i) {
+        const std::uint32_t a = polygon.vertices[i];
+        const std::uint32_t b = polygon.vertices[i + 1 == end ? begin : i + 1];
+        const std::uint64_t key = std::uint64_t(std::min(a, b)) << 32 | std::max(a, b);
+        auto [it, inserted] = firstUse.try_emplace(key, p);
+        if (!inserted) parent[find(p)] = find(it->second);
+      }
+    }
+  }
+  std::vector<Piece> out;
+  std::unordered_map<std::size_t, std::size_t> index;
+  for (std::size_t p = 0; p < n; ++p) {
+    auto [it, inserted] = index.try_emplace(find(p), out.size());
+    if (inserted) out.emplace_back();
+    out[it->second].push_back(std::move(piece[p]));
+  }
+  return out;
+}
+
+}  // namespace polydg

@@ -1,0 +1,123 @@
+// Splitting closed polyhedral pieces by a plane, robustly: exact side tests, one shared vertex
+// per (edge, plane) intersection, non-convex faces and faces with holes, vertices and faces
+// lying in the plane. The building block of hexahedral slicing and of plane cutting.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <unordered_map>
+#include <vector>
+
+#include "mesh/poly_mesh.h"
+
+namespace polydg {
+
+/// A polygon of a piece: loops of point indices (outer loop counter-clockwise about the
+/// outward normal, holes clockwise), and where it came from.
+struct PiecePolygon {
+  std::vector<std::uint32_t> vertices;
+  std::vector<std::uint32_t> loopEnd;  ///< loop k is vertices[loopEnd[k-1] .. loopEnd[k])
+  FaceOrigin origin = FaceOrigin::Surface;
+
+  std::size_t numLoops() const { return loopEnd.size(); }
+  std::size_t loopBegin(std::size_t k) const { return k == 0 ? 0 : loopEnd[k - 1]; }
+};
+
+/// A closed, outward-oriented set of polygons (one or more connected components).
+using Piece = std::vector<PiecePolygon>;
+
+/// The plane {x : normal . x = offset}. Its minus side is normal . x < offset. When `axis` is
+/// 0, 1 or 2 the plane is axis-aligned (normal = e_axis) and side tests are plain comparisons.
+/// `id` identifies the plane in the shared-vertex map: one id per distinct plane.
+struct SplitPlane {
+  Vec3 normal = Vec3::UnitX();
+  double offset = 0.0;
+  int axis = -1;
+  std::uint32_t id = 0;
+
+  static SplitPlane axisAligned(int axis, double value, std::uint32_t id) {
+    SplitPlane p;
+    p.normal = Vec3::Unit(axis);
+    p.offset = value;
+    p.axis = axis;
+    p.id = id;
+    return p;
+  }
+};
+
+/// The result of splitting a piece: the parts on each side (each closed), the number of
+/// polygons that were split (not just assigned to a side), and the number of caps made.
+struct PieceSplit {
+  Piece minus, plus;
+  std::size_t polygonsSplit = 0;
+  std::size_t capPolygons = 0;
+};
+
+/// Owns the point array and the map of intersection points, so that every edge crossed by a
+/// plane yields one point, whichever polygon asks for it.
+class PlaneSplitter {
+ public:
+  explicit PlaneSplitter(std::vector<Vec3> points);
+
+  const std::vector<Vec3>& points() const { return points_; }
+  std::vector<Vec3> takePoints() { return std::move(points_); }
+
+  /// -1, 0, +1: the side of point v. Exact: axis-aligned planes compare coordinates, other
+  /// planes use an exact predicate; a point made on this plane is on it by definition.
+  int side(std::uint32_t v, const SplitPlane& plane) const;
+
+  /// Splits a closed piece. Polygons wholly on one side (touching the plane or not) go to that
+  /// side; polygons lying in the plane go to the side they face away from; polygons crossing it
+  /// are split. The new faces in the plane ("caps", tagged `capOrigin`) close both sides:
+  /// minus's caps face along +normal, plus's are the same polygons reversed.
+  PieceSplit split(Piece piece, const SplitPlane& plane, FaceOrigin capOrigin);
+
+  /// The connected components of a piece (polygons joined across shared edges).
+  static std::vector<Piece> components(Piece piece);
+
+ private:
+  static constexpr std::uint32_t kNoPlane = 0xffffffffu;
+
+  std::uint32_t edgePoint(std::uint32_t u, std::uint32_t v, const SplitPlane& plane);
+  void splitPolygon(const PiecePolygon& polygon, const SplitPlane& plane, Piece& minus,
+                    Piece& plus);
+  Vec3 polygonNormal(const PiecePolygon& polygon) const;
+
+  /// Exact comparison of two points on the cut line along coordinate k (used only when their
+  /// rounded coordinates tie): constructed points are recomputed in rational arithmetic from
+  /// the edge and plane that define them. Returns -1, 0, +1.
+  int compareExactly(std::uint32_t v, std::uint32_t w, int k) const;
+
+  std::vector<Vec3> points_;
+  std::vector<std::uint32_t> onPlane_;  ///< plane id that created each point, or kNoPlane
+  struct Definition {
+    std::uint32_t a = 0, b = 0;  ///< the edge (a < b) a constructed point lies on
+  };
+  std::vector<Definition> definition_;  ///< per point; meaningful where onPlane_ is set
+  std::unordered_map<std::uint32_t, SplitPlane> planes_;  ///< every plane used, by id
+
+  struct EdgeKey {
+    std::uint32_t a, b, plane;
+    bool operator==(const EdgeKey&) const = default;
+  };
+  struct EdgeKeyHash {
+    std::size_t operator()(const EdgeKey& k) const noexcept {
+      const std::uint64_t h = (std::uint64_t(k.a) << 32 | k.b) * 0x9E3779B97F4A7C15ull;
+      return static_cast<std::size_t>(h ^ (std::uint64_t(k.plane) * 0xC2B2AE3D27D4EB4Full));
+    }
+  };
+  std::unordered_map<EdgeKey, std::uint32_t, EdgeKeyHash> edgePoints_;
+  struct PositionHash {
+    std::size_t operator()(const std::array<double, 3>& p) const noexcept {
+      std::size_t h = 0;
+      for (double x : p) h = h * 0x9E3779B97F4A7C15ull + std::hash<double>{}(x);
+      return h;
+    }
+  };
+  /// Constructed points by exact position: a new intersection point that rounds onto an
+  /// existing one on the same plane is that point (otherwise distinct points at one position
+  /// would make zero-length edges and, at the next plane, coincident crossings).
+  std::unordered_map<std::array<double, 3>, std::uint32_t, PositionHash> byPosition_;
+};
+
+}  // namespace polydg

@@ -1,0 +1,164 @@
+#include "mesh/poly_mesh.h"
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace polydg {
+
+std::string_view toString(FaceOrigin origin) {
+  switch (origin) {
+    case FaceOrigin::Interior: return "interior";
+    case FaceOrigin::Surface: return "surface";
+    case FaceOrigin::Cut: return "cut";
+    case FaceOrigin::Box: return "box";
+    case FaceOrigin::Imported: return "imported";
+  }
+  return "unknown";
+}
+
+namespace {
+
+/// Order-independent hash of a face's vertex set (FNV-1a over the sorted ids).
+std::uint64_t vertexSetKey(const std::vector<Loop>& loops) {
+  std::vector<std::uint32_t> ids;
+  for (const Loop& loop : loops)
+    for (VertexId v : loop) ids.push_back(v.value);
+  std::sort(ids.begin(), ids.end());
+  std::uint64_t h = 1469598103934665603ull;
+  for (std::uint32_t id : ids) {
+    h ^= id;
+    h *= 1099511628211ull;
+  }
+  return h;
+}
+
+/// True if cycle `b` is cycle `a` traversed backwards (any rotation).
+bool isReversedCycle(std::span<const VertexId> a, const Loop& b) {
+  const std::size_t n = a.size();
+  if (b.size() != n || n == 0) return false;
+  const auto start = std::find(b.begin(), b.end(), a[0]);
+  if (start == b.end()) return false;
+  const std::size_t s = static_cast<std::size_t>(start - b.begin());
+  for (std::size_t i = 0; i < n; ++i)
+    if (a[i] != b[(s + n - i) % n]) return false;
+  return true;
+}
+
+}  // namespace
+
+bool isReverseOf(const Face& a, const std::vector<Loop>& loops) {
+  if (a.numLoops() != loops.size()) return false;
+  std::vector<bool> used(loops.size(), false);
+  for (std::size_t k = 0; k < a.numLoops(); ++k) {
+    bool found = false;
+    for (std::size_t j = 0; j < loops.size() && !found; ++j) {
+      if (!used[j] && isReversedCycle(a.loop(k), loops[j])) used[j] = found = true;
+    }
+    if (!found) return false;
+  }
+  return true;
+}
+
+VertexId PolyMesh::addVertex(const Vec3& p) {
+  positions_.push_back(p);
+  return VertexId(positions_.size() - 1);
+}
+
+void PolyMesh::setOrigin(FaceId f, FaceOrigin origin) {
+  Face& face = faces_[f];
+  if (!face.isBoundary()) throw std::logic_error("setOrigin: face is interior");
+  face.origin = origin;
+}
+
+FaceId PolyMesh::addFace(std::vector<Loop> loops, FaceOrigin origin) {
+  if (loops.empty()) throw std::invalid_argument("addFace: a face needs at least one loop");
+  for (const Loop& loop : loops)
+    if (loop.size() < 3)
+      throw std::invalid_argument("addFace: every loop of a face needs at least 3 vertices");
+  Face face;
+  for (Loop& loop : loops) {
+    for (VertexId v : loop) {
+      if (!v.valid() || v.index() >= positions_.size())
+        throw std::out_of_range("addFace: vertex id out of range");
+    }
+    face.vertices.insert(face.vertices.end(), loop.begin(), loop.end());
+    face.loopEnd.push_back(static_cast<std::uint32_t>(face.vertices.size()));
+  }
+  face.origin = origin;
+  faces_.push_back(std::move(face));
+  return FaceId(faces_.size() - 1);
+}
+
+FaceId PolyMesh::findOrCreateFace(const std::vector<Loop>& loops, FaceOrigin origin,
+                                  bool& reversed) {
+  const std::uint64_t key = vertexSetKey(loops);
+  auto [begin, end] = openFaces_.equal_range(key);
+  for (auto it = begin; it != end; ++it) {
+    const Face& candidate = faces_[it->second];
+    if (!candidate.back.valid() && isReverseOf(candidate, loops)) {
+      const FaceId f = it->second;
+      openFaces_.erase(it);
+      reversed = true;
+      return f;
+    }
+  }
+  reversed = false;
+  const FaceId f = addFace(loops, origin);
+  openFaces_.emplace(key, f);
+  return f;
+}
+
+ElementId PolyMesh::addElement(const std::vector<std::vector<Loop>>& boundary,
+                               FaceOrigin boundaryOrigin) {
+  std::vector<FaceUse> uses;
+  uses.reserve(boundary.size());
+  for (const auto& loops : boundary) {
+    bool reversed = false;
+    const FaceId f = findOrCreateFace(loops, boundaryOrigin, reversed);
+    uses.push_back({f, reversed});
+  }
+  return addElementFromFaces(uses);
+}
+
+ElementId PolyMesh::addElement(const std::vector<std::vector<Loop>>& boundary,
+                               const std::vector<FaceOrigin>& origins) {
+  if (origins.size() != boundary.size())
+    throw std::invalid_argument("addElement: one origin per face is needed");
+  std::vector<FaceUse> uses;
+  uses.reserve(boundary.size());
+  for (std::size_t i = 0; i < boundary.size(); ++i) {
+    if (origins[i] == FaceOrigin::Interior) {
+      bool reversed = false;
+      const FaceId f = findOrCreateFace(boundary[i], origins[i], reversed);
+      uses.push_back({f, reversed});
+    } else {
+      uses.push_back({addFace(boundary[i], origins[i]), false});
+    }
+  }
+  return addElementFromFaces(uses);
+}
+
+ElementId PolyMesh::addElementFromFaces(const std::vector<FaceUse>& faces) {
+  const ElementId e(elements_.size());
+  // Check every face first, so a failure leaves the mesh unchanged.
+  for (std::size_t i = 0; i < faces.size(); ++i) {
+    const FaceUse& use = faces[i];
+    if (!use.face.valid() || use.face.index() >= faces_.size())
+      throw std::out_of_range("addElementFromFaces: face id out of range");
+    const Face& face = faces_[use.face];
+    if ((use.reversed ? face.back : face.front).valid())
+      throw std::invalid_argument("addElementFromFaces: face side already used by an element");
+    for (std::size_t j = 0; j < i; ++j)
+      if (faces[j].face == use.face && faces[j].reversed == use.reversed)
+        throw std::invalid_argument("addElementFromFaces: the same face side listed twice");
+  }
+  for (const FaceUse& use : faces) {
+    Face& face = faces_[use.face];
+    (use.reversed ? face.back : face.front) = e;
+    if (face.front.valid() && face.back.valid()) face.origin = FaceOrigin::Interior;
+  }
+  elements_.push_back(Element{faces});
+  return e;
+}
+
+}  // namespace polydg

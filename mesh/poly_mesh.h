@@ -1,0 +1,129 @@
+// The polyhedral mesh: shared vertices, planar polygonal faces with holes, and elements that are
+// closed sets of oriented faces; elements and faces may be non-convex.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string_view>
+#include <unordered_map>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "mesh/ids.h"
+
+namespace polydg {
+
+using Vec3 = Eigen::Vector3d;
+
+/// Where a face came from. Interior faces are shared by two elements; every other tag marks a
+/// boundary face (or, before a mesh is finished, a face that will be one).
+enum class FaceOrigin : std::uint8_t {
+  Interior = 0,  ///< shared by two elements
+  Surface = 1,   ///< lies on the input surface
+  Cut = 2,       ///< created by a plane cut; the two sides are not coupled
+  Box = 3,       ///< on the outer boundary of a generated box or grid
+  Imported = 4,  ///< boundary face read from a file that did not say where it came from
+};
+std::string_view toString(FaceOrigin origin);
+
+/// How an element uses a face. `reversed == false`: the face's own normal (right-hand rule on
+/// its outer loop) points out of the element; `reversed == true`: it points into the element.
+struct FaceUse {
+  FaceId face;
+  bool reversed = false;
+};
+
+/// A face: one outer loop followed by zero or more hole loops, all in one plane. The outer loop
+/// runs counter-clockwise about the face normal, holes clockwise, so the face normal is the
+/// Newell normal of all loops together. `front` is the element the normal points out of,
+/// `back` the element it points into (invalid for a boundary face).
+struct Face {
+  std::vector<VertexId> vertices;      ///< all loops, concatenated
+  std::vector<std::uint32_t> loopEnd;  ///< loop k is vertices[loopEnd[k-1] .. loopEnd[k])
+  ElementId front;
+  ElementId back;
+  FaceOrigin origin = FaceOrigin::Interior;
+
+  std::size_t numLoops() const { return loopEnd.size(); }
+  std::span<const VertexId> loop(std::size_t k) const {
+    const std::size_t begin = k == 0 ? 0 : loopEnd[k - 1];
+    return {vertices.data() + begin, loopEnd[k] - begin};
+  }
+  bool isBoundary() const { return !back.valid(); }
+};
+
+/// An element: the faces that bound it, each with its orientation.
+struct Element {
+  std::vector<FaceUse> faces;
+};
+
+/// A loop of vertex ids; used to describe faces to the mesh.
+using Loop = std::vector<VertexId>;
+
+/// A polyhedral mesh. Topology (faces, elements) and vertex positions live together here; data
+/// computed from them (moments, solutions) lives outside in FaceData / ElementData containers.
+///
+/// Faces are shared: two elements that touch across a polygon hold the same FaceId, one with
+/// `reversed == false` (front) and one with `reversed == true` (back).
+class PolyMesh {
+ public:
+  // --- vertices ----------------------------------------------------------------------------
+  std::size_t numVertices() const { return positions_.size(); }
+  const Vec3& position(VertexId v) const { return positions_[v]; }
+  const VertexData<Vec3>& positions() const { return positions_; }
+  /// Mutable positions, for transforming a mesh in place (topology is unaffected).
+  VertexData<Vec3>& positions() { return positions_; }
+  VertexId addVertex(const Vec3& p);
+
+  // --- faces -------------------------------------------------------------------------------
+  std::size_t numFaces() const { return faces_.size(); }
+  const Face& face(FaceId f) const { return faces_[f]; }
+  const FaceData<Face>& faces() const { return faces_; }
+  /// Sets the origin tag of a boundary face (interior faces stay `Interior`).
+  void setOrigin(FaceId f, FaceOrigin origin);
+
+  // --- elements ----------------------------------------------------------------------------
+  std::size_t numElements() const { return elements_.size(); }
+  const Element& element(ElementId e) const { return elements_[e]; }
+  const ElementData<Element>& elements() const { return elements_; }
+
+  /// Adds an element bounded by `boundary`: each entry is one face given as loops (outer
+  /// first, then holes) ordered so that the normal points OUT of the new element. A face whose
+  /// loops equal, reversed, those of an existing face with a free back side is shared with that
+  /// face's element (it becomes an interior face); otherwise a new face is created with tag
+  /// `boundaryOrigin` — also when the polygon would be used a third time or twice with the same
+  /// orientation, so that such (invalid) input is kept and reported by validate() as duplicate
+  /// faces rather than rejected here. Returns the new element's id.
+  ElementId addElement(const std::vector<std::vector<Loop>>& boundary,
+                       FaceOrigin boundaryOrigin = FaceOrigin::Imported);
+
+  /// As above with one origin per face. Only faces tagged `Interior` (grid or cut caps known to
+  /// be shared) are matched with existing faces; every other face is created new, so two
+  /// touching surface faces of separate objects are never glued together.
+  ElementId addElement(const std::vector<std::vector<Loop>>& boundary,
+                       const std::vector<FaceOrigin>& origins);
+
+  /// Adds an element from existing faces and orientations. Each face must have a free side
+  /// (front if `reversed == false`, back otherwise). Used by readers that build faces first.
+  ElementId addElementFromFaces(const std::vector<FaceUse>& faces);
+
+  /// Adds a face from loops without attaching it to an element.
+  FaceId addFace(std::vector<Loop> loops, FaceOrigin origin);
+
+ private:
+  FaceId findOrCreateFace(const std::vector<Loop>& loops, FaceOrigin origin, bool& reversed);
+
+  VertexData<Vec3> positions_;
+  FaceData<Face> faces_;
+  ElementData<Element> elements_;
+  /// Boundary faces by the sorted list of their vertex ids, for sharing in addElement.
+  std::unordered_multimap<std::uint64_t, FaceId> openFaces_;
+};
+
+/// True if face `a`'s loops, reversed, equal `loops` (same loops, each the same cycle
+/// traversed the other way, in any rotation; hole order is irrelevant).
+bool isReverseOf(const Face& a, const std::vector<Loop>& loops);
+
+}  // namespace polydg

@@ -1,0 +1,175 @@
+#include "mesh/slice.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+#include <unordered_map>
+
+#include "mesh/plane_split.h"
+
+namespace polydg {
+
+Grid Grid::covering(const Box3& bounds, double cellSize) {
+  if (!(cellSize > 0.0) || !std::isfinite(cellSize))
+    throw std::invalid_argument("grid cell size must be positive and finite");
+  if (bounds.isEmpty()) throw std::invalid_argument("cannot build a grid around an empty box");
+  Grid g;
+  g.cellSize = cellSize;
+  const Vec3 extent = bounds.diagonal();
+  const Vec3 centre = 0.5 * (bounds.min() + bounds.max());
+  for (int a = 0; a < 3; ++a) {
+    const double n = std::max(1.0, std::ceil(extent[a] / cellSize));
+    if (n > 1 << 20) throw std::invalid_argument("grid would have more than 2^20 cells per axis");
+    g.cells[a] = static_cast<int>(n);
+  }
+  g.centre = centre;
+  return g;
+}
+
+Grid Grid::withCellsAlongLongest(const Box3& bounds, int cellsAlongLongest) {
+  if (cellsAlongLongest < 1) throw std::invalid_argument("need at least one cell");
+  return covering(bounds, bounds.diagonal().maxCoeff() / cellsAlongLongest);
+}
+
+namespace {
+
+struct CoordinateHash {
+  std::size_t operator()(const std::array<double, 3>& p) const noexcept {
+    std::size_t h = 0;
+    for (double x : p) h = h * 0x9E3779B97F4A7C15ull + std::hash<double>{}(x);
+    return h;
+  }
+};
+
+class Slicer {
+ public:
+  Slicer(const Grid& grid, std::vector<Vec3> points, const ProgressFn& progress)
+      : grid_(grid), splitter_(std::move(points)), progress_(progress) {}
+
+  void run(Piece solid) {
+    totalCells_ = static_cast<double>(grid_.cells[0]) * grid_.cells[1] * grid_.cells[2];
+    recurse(std::move(solid), {0, 0, 0}, grid_.cells);
+  }
+
+  PolyMesh build(std::vector<std::array<int, 3>>* elementCell) {
+    PolyMesh mesh;
+    const std::vector<Vec3>& points = splitter_.points();
+    // Points that rounding made identical (intersection points of edges that meet a plane
+    // within round-off of one of their ends) are welded: exact equality, no tolerance. Then
+    // only used points are kept, in order of first use.
+    std::unordered_map<std::array<double, 3>, std::uint32_t, CoordinateHash> byPosition;
+    std::vector<std::uint32_t> remap(points.size(), 0xffffffffu);
+    auto vertexOf = [&](std::uint32_t v) {
+      if (remap[v] == 0xffffffffu) {
+        const Vec3& p = points[v];
+        auto [it, inserted] = byPosition.try_emplace({p.x() + 0.0, p.y() + 0.0, p.z() + 0.0}, 0);
+        if (inserted) it->second = mesh.addVertex(p).value;
+        remap[v] = it->second;
+      }
+      return VertexId(remap[v]);
+    };
+    for (const Leaf& leaf : leaves_) {
+      std::vector<std::vector<Loop>> boundary;
+      std::vector<FaceOrigin> origins;
+      for (const PiecePolygon& polygon : leaf.piece) {
+        std::vector<Loop> loops;
+        for (std::size_t k = 0; k < polygon.numLoops(); ++k) {
+          Loop loop;
+          for (std::size_t i = polygon.loopBegin(k); i < polygon.loopEnd[k]; ++i) {
+            const VertexId v = vertexOf(polygon.vertices[i]);
+            if (loop.empty() || loop.back() != v) loop.push_back(v);
+          }
+          while (loop.size() > 1 && loop.front() == loop.back()) loop.pop_back();
+          if (loop.size() >= 3) loops.push_back(std::move(loop));
+          else if (k == 0) break;  // the outer boundary collapsed: the polygon is gone
+        }
+        if (loops.empty()) {
+          ++stats.collapsedPolygons;
+          continue;
+        }
+        boundary.push_back(std::move(loops));
+        origins.push_back(polygon.origin);
+      }
+      if (boundary.empty()) continue;
+      mesh.addElement(boundary, origins);
+      if (elementCell) elementCell->push_back(leaf.cell);
+    }
+    return mesh;
+  }
+
+  SliceStats stats;
+
+ private:
+  struct Leaf {
+    Piece piece;
+    std::array<int, 3> cell;
+  };
+
+  void recurse(Piece piece, std::array<int, 3> lo, std::array<int, 3> hi) {
+    for (int axis = 0; axis < 3; ++axis) {
+      if (hi[axis] - lo[axis] <= 1) continue;
+      const int mid = (lo[axis] + hi[axis]) / 2;
+      const auto id = static_cast<std::uint32_t>(axis * ((1 << 20) + 1) + mid);
+      const SplitPlane plane = SplitPlane::axisAligned(axis, grid_.plane(axis, mid), id);
+      PieceSplit s = splitter_.split(std::move(piece), plane, FaceOrigin::Interior);
+      ++stats.splits;
+      stats.polygonsSplit += s.polygonsSplit;
+      std::array<int, 3> hiMinus = hi, loPlus = lo;
+      hiMinus[axis] = mid;
+      loPlus[axis] = mid;
+      if (s.minus.empty()) reportSkipped(lo, hiMinus);
+      else recurse(std::move(s.minus), lo, hiMinus);
+      if (s.plus.empty()) reportSkipped(loPlus, hi);
+      else recurse(std::move(s.plus), loPlus, hi);
+      return;
+    }
+    ++stats.leafCells;
+    std::vector<Piece> parts = PlaneSplitter::components(std::move(piece));
+    if (parts.size() > 1) ++stats.multiPieceCells;
+    for (Piece& part : parts) leaves_.push_back({std::move(part), lo});
+    reportSkipped(lo, hi);
+  }
+
+  void reportSkipped(const std::array<int, 3>& lo, const std::array<int, 3>& hi) {
+    if (!progress_) return;
+    doneCells_ += static_cast<double>(hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]);
+    progress_(doneCells_ / totalCells_);
+  }
+
+  const Grid& grid_;
+  PlaneSplitter splitter_;
+  const ProgressFn& progress_;
+  std::vector<Leaf> leaves_;
+  double totalCells_ = 1.0;
+  double doneCells_ = 0.0;
+};
+
+}  // namespace
+
+PolyMesh sliceSurface(const TriangleSurface& surface, const Grid& grid, SliceStats* stats,
+                      std::vector<std::array<int, 3>>* elementCell, const ProgressFn& progress) {
+  Piece solid;
+  solid.reserve(surface.triangles.size());
+  for (const auto& tri : surface.triangles) {
+    if (tri[0] == tri[1] || tri[1] == tri[2] || tri[2] == tri[0]) continue;
+    PiecePolygon p;
+    p.vertices = {tri[0], tri[1], tri[2]};
+    p.loopEnd = {3};
+    p.origin = FaceOrigin::Surface;
+    solid.push_back(std::move(p));
+  }
+  const auto start = std::chrono::steady_clock::now();
+  Slicer slicer(grid, surface.vertices, progress);
+  slicer.run(std::move(solid));
+  const auto split = std::chrono::steady_clock::now();
+  if (elementCell) elementCell->clear();
+  PolyMesh mesh = slicer.build(elementCell);
+  slicer.stats.secondsSplitting = std::chrono::duration<double>(split - start).count();
+  slicer.stats.secondsBuilding =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - split).count();
+  if (stats) *stats = slicer.stats;
+  return mesh;
+}
+
+}  // namespace polydg

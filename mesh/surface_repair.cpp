@@ -1,0 +1,164 @@
+#include "mesh/surface_repair.h"
+
+#include <stdexcept>
+#include <vector>
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Polygon_mesh_processing/border.h>
+#include <CGAL/Polygon_mesh_processing/connected_components.h>
+#include <CGAL/Polygon_mesh_processing/orient_polygon_soup.h>
+#include <CGAL/Polygon_mesh_processing/orientation.h>
+#include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
+#include <CGAL/Polygon_mesh_processing/repair_degeneracies.h>
+#include <CGAL/Polygon_mesh_processing/self_intersections.h>
+#include <CGAL/Polygon_mesh_processing/triangulate_hole.h>
+#include <CGAL/Surface_mesh.h>
+#include <CGAL/alpha_wrap_3.h>
+
+namespace polydg {
+
+namespace {
+
+namespace PMP = CGAL::Polygon_mesh_processing;
+using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Point = Kernel::Point_3;
+using Mesh = CGAL::Surface_mesh<Point>;
+
+std::vector<Point> toPoints(const TriangleSurface& s) {
+  std::vector<Point> points;
+  points.reserve(s.vertices.size());
+  for (const Vec3& p : s.vertices) points.emplace_back(p.x(), p.y(), p.z());
+  return points;
+}
+
+std::vector<std::vector<std::size_t>> toPolygons(const TriangleSurface& s) {
+  std::vector<std::vector<std::size_t>> polygons;
+  polygons.reserve(s.triangles.size());
+  for (const auto& t : s.triangles)
+    if (t[0] != t[1] && t[1] != t[2] && t[2] != t[0]) polygons.push_back({t[0], t[1], t[2]});
+  return polygons;
+}
+
+TriangleSurface fromMesh(const Mesh& mesh) {
+  TriangleSurface s;
+  std::vector<std::uint32_t> index(mesh.number_of_vertices() + mesh.number_of_removed_vertices());
+  for (Mesh::Vertex_index v : mesh.vertices()) {
+    index[v] = static_cast<std::uint32_t>(s.vertices.size());
+    const Point& p = mesh.point(v);
+    s.vertices.emplace_back(p.x(), p.y(), p.z());
+  }
+  for (Mesh::Face_index f : mesh.faces()) {
+    std::array<std::uint32_t, 3> t{};
+    int i = 0;
+    for (Mesh::Vertex_index v : CGAL::vertices_around_face(mesh.halfedge(f), mesh)) {
+      if (i == 3) throw std::logic_error("fromMesh: a face is not a triangle");
+      t[i++] = index[v];
+    }
+    s.triangles.push_back(t);
+  }
+  return s;
+}
+
+}  // namespace
+
+SurfaceDiagnosis diagnose(const TriangleSurface& surface) {
+  SurfaceDiagnosis d;
+  d.topology = analyzeTopology(surface);
+  if (surface.triangles.empty()) return d;
+  if (d.topology.nonManifoldEdges > 0) return d;
+  // Consistently oriented copy (orientation does not change intersections or nesting).
+  auto points = toPoints(surface);
+  auto polygons = toPolygons(surface);
+  PMP::orient_polygon_soup(points, polygons);
+  Mesh mesh;
+  PMP::polygon_soup_to_polygon_mesh(points, polygons, mesh);
+  std::vector<std::pair<Mesh::Face_index, Mesh::Face_index>> pairs;
+  PMP::self_intersections<CGAL::Parallel_if_available_tag>(faces(mesh), mesh,
+                                                           std::back_inserter(pairs));
+  d.selfIntersections = pairs.size();
+  d.checkedSelfIntersections = true;
+  if (CGAL::is_closed(mesh) && pairs.empty()) {
+    auto volumeIds = mesh.add_property_map<Mesh::Face_index, std::size_t>("f:volume", 0).first;
+    std::vector<std::size_t> nesting;
+    PMP::volume_connected_components(mesh, volumeIds,
+                                     CGAL::parameters::nesting_levels(std::ref(nesting)));
+    d.shells = nesting.size();
+    for (std::size_t level : nesting) d.cavities += level % 2 == 1;
+  } else {
+    d.shells = d.topology.components;
+  }
+  return d;
+}
+
+TriangleSurface orientToBoundVolume(const TriangleSurface& surface, bool& changed) {
+  auto points = toPoints(surface);
+  auto polygons = toPolygons(surface);
+  const auto before = polygons;
+  PMP::orient_polygon_soup(points, polygons);
+  Mesh mesh;
+  PMP::polygon_soup_to_polygon_mesh(points, polygons, mesh);
+  if (!CGAL::is_closed(mesh))
+    throw std::invalid_argument("orientToBoundVolume: the surface is not closed");
+  PMP::orient_to_bound_a_volume(mesh);
+  TriangleSurface out = fromMesh(mesh);
+  // Compare triangle by triangle: the conversion keeps vertex and face order when no vertex
+  // was duplicated, so a flipped triangle is one whose cyclic order changed.
+  changed = out.vertices.size() != surface.vertices.size() ||
+            out.triangles.size() != before.size();
+  for (std::size_t i = 0; !changed && i < before.size(); ++i) {
+    const auto& t = out.triangles[i];
+    const auto& b = before[i];
+    const bool same = (t[0] == b[0] && t[1] == b[1] && t[2] == b[2]) ||
+                      (t[0] == b[1] && t[1] == b[2] && t[2] == b[0]) ||
+                      (t[0] == b[2] && t[1] == b[0] && t[2] == b[1]);
+    changed = !same;
+  }
+  return out;
+}
+
+std::size_t removeDegenerateTriangles(TriangleSurface& surface) {
+  const std::size_t before = surface.triangles.size();
+  auto points = toPoints(surface);
+  auto polygons = toPolygons(surface);
+  PMP::orient_polygon_soup(points, polygons);
+  Mesh mesh;
+  PMP::polygon_soup_to_polygon_mesh(points, polygons, mesh);
+  PMP::remove_degenerate_faces(mesh);
+  mesh.collect_garbage();
+  surface = fromMesh(mesh);
+  return before - surface.triangles.size();
+}
+
+TriangleSurface fillHoles(const TriangleSurface& surface, std::size_t& filled) {
+  if (analyzeTopology(surface).nonManifoldEdges > 0)
+    throw std::invalid_argument("hole filling needs a manifold surface; use --repair wrap");
+  auto points = toPoints(surface);
+  auto polygons = toPolygons(surface);
+  PMP::orient_polygon_soup(points, polygons);
+  Mesh mesh;
+  PMP::polygon_soup_to_polygon_mesh(points, polygons, mesh);
+  std::vector<Mesh::Halfedge_index> borders;
+  PMP::extract_boundary_cycles(mesh, std::back_inserter(borders));
+  filled = 0;
+  for (Mesh::Halfedge_index h : borders) {
+    std::vector<Mesh::Face_index> patch;
+    PMP::triangulate_hole(mesh, h, std::back_inserter(patch));
+    filled += !patch.empty();
+  }
+  mesh.collect_garbage();
+  return fromMesh(mesh);
+}
+
+TriangleSurface alphaWrap(const TriangleSurface& surface, double alpha, double offset) {
+  if (!(alpha > 0) || !(offset > 0))
+    throw std::invalid_argument("alpha wrapping needs positive alpha and offset");
+  const auto points = toPoints(surface);
+  std::vector<std::array<std::size_t, 3>> faces;
+  for (const auto& t : surface.triangles)
+    if (t[0] != t[1] && t[1] != t[2] && t[2] != t[0]) faces.push_back({t[0], t[1], t[2]});
+  Mesh wrap;
+  CGAL::alpha_wrap_3(points, faces, alpha, offset, wrap);
+  return fromMesh(wrap);
+}
+
+}  // namespace polydg

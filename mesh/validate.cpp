@@ -1,0 +1,176 @@
+#include "mesh/validate.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <limits>
+#include <map>
+#include <numeric>
+#include <set>
+#include <sstream>
+
+#include "mesh/geometry.h"
+
+namespace polydg {
+
+namespace {
+
+class Problems {
+ public:
+  Problems(ValidationReport& report, std::size_t maxMessages)
+      : report_(report), maxMessages_(maxMessages) {}
+
+  void add(std::size_t& counter, const std::string& message) {
+    ++counter;
+    if (report_.messages.size() < maxMessages_) report_.messages.push_back(message);
+  }
+
+ private:
+  ValidationReport& report_;
+  std::size_t maxMessages_;
+};
+
+std::string describe(const char* what, std::size_t index) {
+  return std::string(what) + " " + std::to_string(index);
+}
+
+/// Checks a face's loops: each has >= 3 vertices and no vertex appears twice in the face.
+bool isDegenerate(const PolyMesh& mesh, FaceId f) {
+  const Face& face = mesh.face(f);
+  for (std::size_t k = 0; k < face.numLoops(); ++k)
+    if (face.loop(k).size() < 3) return true;
+  std::vector<VertexId> sorted = face.vertices;
+  std::sort(sorted.begin(), sorted.end());
+  if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) return true;
+  return areaVector(mesh, f).squaredNorm() == 0.0;
+}
+
+/// True if every directed edge of the element's oriented faces is matched by its reverse.
+bool isClosed(const PolyMesh& mesh, ElementId e) {
+  std::map<std::pair<std::uint32_t, std::uint32_t>, int> balance;
+  for (const FaceUse& use : mesh.element(e).faces) {
+    const Face& face = mesh.face(use.face);
+    for (std::size_t k = 0; k < face.numLoops(); ++k) {
+      const auto loop = face.loop(k);
+      for (std::size_t i = 0; i < loop.size(); ++i) {
+        std::uint32_t a = loop[i].value, b = loop[(i + 1) % loop.size()].value;
+        if (use.reversed) std::swap(a, b);
+        // Count a->b as +1 on the key (min, max) when a < b, -1 otherwise.
+        balance[{std::min(a, b), std::max(a, b)}] += a < b ? 1 : -1;
+      }
+    }
+  }
+  return std::all_of(balance.begin(), balance.end(), [](const auto& kv) { return kv.second == 0; });
+}
+
+}  // namespace
+
+ElementData<std::uint32_t> connectedComponents(const PolyMesh& mesh, std::size_t& count) {
+  const std::size_t n = mesh.numElements();
+  std::vector<std::size_t> parent(n);
+  std::iota(parent.begin(), parent.end(), 0);
+  auto find = [&](std::size_t i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  };
+  for (const Face& face : mesh.faces()) {
+    if (face.front.valid() && face.back.valid())
+      parent[find(face.front.index())] = find(face.back.index());
+  }
+  ElementData<std::uint32_t> component(n, 0);
+  std::vector<std::uint32_t> label(n, std::numeric_limits<std::uint32_t>::max());
+  count = 0;
+  for (std::size_t e = 0; e < n; ++e) {
+    const std::size_t root = find(e);
+    if (label[root] == std::numeric_limits<std::uint32_t>::max())
+      label[root] = static_cast<std::uint32_t>(count++);
+    component[ElementId(e)] = label[root];
+  }
+  return component;
+}
+
+ValidationReport validate(const PolyMesh& mesh, const ValidationOptions& options) {
+  ValidationReport report;
+  Problems problems(report, options.maxMessages);
+  report.elements = mesh.numElements();
+  report.faces = mesh.numFaces();
+
+  // Faces: shape, planarity, links to elements, duplicates.
+  std::map<std::vector<VertexId>, FaceId> byVertexSet;
+  for (std::size_t i = 0; i < mesh.numFaces(); ++i) {
+    const FaceId f(i);
+    const Face& face = mesh.face(f);
+    if (face.front.valid() && face.back.valid()) ++report.interiorFaces;
+    else if (face.front.valid() || face.back.valid()) ++report.boundaryFaces;
+
+    if (isDegenerate(mesh, f)) {
+      problems.add(report.degenerateFaces, describe("degenerate face", i));
+    } else if (relativePlanarityError(mesh, f) > options.planarityTolerance) {
+      std::ostringstream msg;
+      msg << "face " << i << " is not planar (relative error " << relativePlanarityError(mesh, f)
+          << ")";
+      problems.add(report.nonPlanarFaces, msg.str());
+    }
+
+    if (!face.front.valid() && !face.back.valid()) {
+      problems.add(report.inconsistentFaces, describe("face not used by any element:", i));
+    } else if (!face.front.valid()) {
+      // A face used only from its back is legal in principle, but polydg always attaches the
+      // first element to the front; treat it as a link error.
+      problems.add(report.inconsistentFaces, describe("face used only from its back:", i));
+    }
+
+    std::vector<VertexId> key = face.vertices;
+    std::sort(key.begin(), key.end());
+    auto [it, inserted] = byVertexSet.emplace(std::move(key), f);
+    if (!inserted) {
+      problems.add(report.duplicateFaces,
+                   "faces " + std::to_string(it->second.value) + " and " + std::to_string(i) +
+                       " are the same polygon but not shared (a face used by more than two "
+                       "elements, or twice with the same orientation)");
+    }
+  }
+
+  // Elements: links back to faces, closure, volume.
+  bool first = true;
+  for (std::size_t i = 0; i < mesh.numElements(); ++i) {
+    const ElementId e(i);
+    const Element& element = mesh.element(e);
+    if (element.faces.empty()) {
+      problems.add(report.emptyElements, describe("element without faces:", i));
+      continue;
+    }
+    for (const FaceUse& use : element.faces) {
+      const Face& face = mesh.face(use.face);
+      if ((use.reversed ? face.back : face.front) != e)
+        problems.add(report.inconsistentFaces,
+                     "element " + std::to_string(i) + " uses face " +
+                         std::to_string(use.face.value) + " but the face does not list it");
+    }
+    if (!isClosed(mesh, e))
+      problems.add(report.openElements,
+                   describe("element", i) + " is not closed (an edge of its faces is not "
+                                            "matched by the reverse edge of another)");
+    const double v = signedVolume(mesh, e);
+    report.volume += v;
+    report.minElementVolume = first ? v : std::min(report.minElementVolume, v);
+    report.maxElementVolume = first ? v : std::max(report.maxElementVolume, v);
+    first = false;
+    if (!(v > 0.0)) {
+      std::ostringstream msg;
+      msg << "element " << i << " has non-positive volume " << v
+          << (v < 0 ? " (inverted: faces oriented inward)" : "");
+      problems.add(report.nonPositiveElements, msg.str());
+    }
+  }
+
+  connectedComponents(mesh, report.components);
+  report.passed = report.openElements == 0 && report.nonPositiveElements == 0 &&
+                  report.nonPlanarFaces == 0 && report.degenerateFaces == 0 &&
+                  report.duplicateFaces == 0 && report.inconsistentFaces == 0 &&
+                  report.emptyElements == 0 && mesh.numElements() > 0;
+  if (mesh.numElements() == 0 && report.messages.size() < options.maxMessages)
+    report.messages.push_back("the mesh has no elements");
+  return report;
+}
+
+}  // namespace polydg

@@ -1,0 +1,1110 @@
+#include "mesh/vtu_io.h"
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <new>
+#include <optional>
+#include <ostream>
+#include <span>
+#include <sstream>
+#include <stdexcept>
+#include <unordered_map>
+#include <unordered_set>
+
+#include <zlib.h>
+#include <pugixml.hpp>
+
+#include "mesh/face_triangulation.h"
+#include "mesh/geometry.h"
+
+namespace polydg {
+
+namespace {
+
+constexpr std::int64_t kVtkPolyhedron = 42;
+// The field data arrays with which readVtu restores writeVtu's faces exactly (see vtu_io.h).
+constexpr std::string_view kFaceGroupArray = "polydg_face_group";
+constexpr std::string_view kFaceReversedArray = "polydg_face_reversed";
+constexpr std::string_view kFaceOriginArray = "polydg_face_origin";
+
+// ============================================================================================
+// Base64
+// ============================================================================================
+
+constexpr char kBase64Alphabet[] =
+    "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+
+/// Streams bytes out as base64 text; finish() writes the last, padded group.
+class Base64Writer {
+ public:
+  explicit Base64Writer(std::ostream& os) : os_(os) {}
+
+  void write(const void* data, std::size_t size) {
+    const auto* bytes = static_cast<const unsigned char*>(data);
+    for (std::size_t i = 0; i < size; ++i) {
+      group_[count_++] = bytes[i];
+      if (count_ == 3) emit();
+    }
+  }
+
+  void finish() {
+    if (count_ > 0) emit();
+  }
+
+ private:
+  void emit() {
+    const std::uint32_t bits = (std::uint32_t{group_[0]} << 16) |
+                               (count_ > 1 ? std::uint32_t{group_[1]} << 8 : 0) |
+                               (count_ > 2 ? std::uint32_t{group_[2]} : 0);
+    char out[4] = {kBase64Alphabet[(bits >> 18) & 63], kBase64Alphabet[(bits >> 12) & 63],
+                   count_ > 1 ? kBase64Alphabet[(bits >> 6) & 63] : '=',
+                   count_ > 2 ? kBase64Alphabet[bits & 63] : '='};
+    os_.write(out, 4);
+    count_ = 0;
+  }
+
+  std::ostream& os_;
+  unsigned char group_[3] = {0, 0, 0};
+  int count_ = 0;
+};
+
+int base64Value(char c) {
+  if (c >= 'A' && c <= 'Z') return c - 'A';
+  if (c >= 'a' && c <= 'z') return c - 'a' + 26;
+  if (c >= '0' && c <= '9') return c - '0' + 52;
+  if (c == '+') return 62;
+  if (c == '/') return 63;
+  return -1;
+}
+
+bool isXmlSpace(char c) { return c == ' ' || c == '\n' || c == '\r' || c == '\t'; }
+
+/// A problem with the file's contents; readVtu prefixes the file name.
+class VtuError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Reads consecutive bytes from a region of the file, either raw or base64 text decoded one
+/// group of four characters at a time (so separately encoded pieces decode seamlessly).
+class ByteReader {
+ public:
+  ByteReader(std::string_view data, bool base64) : data_(data), base64_(base64) {}
+
+  /// Appends the next `n` bytes to `out`; returns false if the data ends first.
+  bool read(std::size_t n, std::string& out) {
+    if (!base64_) {
+      if (n > data_.size() - pos_) return false;
+      out.append(data_.substr(pos_, n));
+      pos_ += n;
+      return true;
+    }
+    while (pending_.size() - pendingPos_ < n) {
+      if (!decodeGroup()) return false;
+    }
+    out.append(pending_, pendingPos_, n);
+    pendingPos_ += n;
+    if (pendingPos_ == pending_.size()) {
+      pending_.clear();
+      pendingPos_ = 0;
+    }
+    return true;
+  }
+
+  /// An upper bound on the bytes left, to reject absurd sizes before allocating.
+  std::size_t maxRemaining() const {
+    const std::size_t left = data_.size() - pos_;
+    return base64_ ? left / 4 * 3 + 3 + (pending_.size() - pendingPos_) : left;
+  }
+
+ private:
+  /// Decodes the next group into pending_; false at the end of the text.
+  bool decodeGroup() {
+    int values[4];
+    int count = 0;
+    int padding = 0;
+    while (count < 4) {
+      while (pos_ < data_.size() && isXmlSpace(data_[pos_])) ++pos_;
+      if (pos_ == data_.size()) {
+        if (count == 0) return false;
+        throw VtuError("base64 data ends inside a group of four characters");
+      }
+      const char c = data_[pos_++];
+      if (c == '=' && count >= 2) {
+        ++padding;
+        values[count++] = 0;
+      } else {
+        const int v = base64Value(c);
+        if (v < 0 || padding > 0)
+          throw VtuError(std::string("invalid character '") + c + "' in base64 data");
+        values[count++] = v;
+      }
+    }
+    const std::uint32_t bits = (std::uint32_t(values[0]) << 18) | (std::uint32_t(values[1]) << 12) |
+                               (std::uint32_t(values[2]) << 6) | std::uint32_t(values[3]);
+    pending_.push_back(static_cast<char>((bits >> 16) & 0xff));
+    if (padding < 2) pending_.push_back(static_cast<char>((bits >> 8) & 0xff));
+    if (padding < 1) pending_.push_back(static_cast<char>(bits & 0xff));
+    return true;
+  }
+
+  std::string_view data_;
+  bool base64_;
+  std::size_t pos_ = 0;
+  std::string pending_;
+  std::size_t pendingPos_ = 0;
+};
+
+// ============================================================================================
+// Writing
+// ============================================================================================
+
+/// The cell arrays of the file, with the polydg field data that goes with them.
+struct CellStreams {
+  std::vector<std::int64_t> connectivity, offsets, types, faces, faceOffsets;
+  std::vector<std::int64_t> faceGroup, faceReversed, faceOrigin;
+};
+
+CellStreams buildCellStreams(const PolyMesh& mesh) {
+  // Records of each face in the face's own orientation, computed when first needed.
+  FaceData<std::vector<std::vector<VertexId>>> records(mesh.numFaces());
+  auto recordsOf = [&](FaceId f) -> const std::vector<std::vector<VertexId>>& {
+    auto& r = records[f];
+    if (r.empty()) {
+      const Face& face = mesh.face(f);
+      if (face.numLoops() == 1) {
+        r.emplace_back(face.vertices.begin(), face.vertices.end());
+      } else {
+        for (const auto& t : triangulateFace(mesh, f)) r.push_back({t[0], t[1], t[2]});
+      }
+    }
+    return r;
+  };
+
+  CellStreams s;
+  VertexData<std::uint32_t> seenIn(mesh.numVertices(), Id<ElementTag>::kInvalid);
+  for (std::size_t e = 0; e < mesh.numElements(); ++e) {
+    const ElementId element(e);
+    const std::size_t countAt = s.faces.size();
+    s.faces.push_back(0);
+    std::int64_t count = 0;
+    for (const FaceUse& use : mesh.element(element).faces) {
+      for (const auto& record : recordsOf(use.face)) {
+        const std::size_t n = record.size();
+        s.faces.push_back(static_cast<std::int64_t>(n));
+        for (std::size_t i = 0; i < n; ++i) {
+          // Backwards keeps the first vertex first: v0, v(n-1), ..., v1.
+          const VertexId v = use.reversed ? record[(n - i) % n] : record[i];
+          s.faces.push_back(v.value);
+          if (seenIn[v] != element.value) {
+            seenIn[v] = element.value;
+            s.connectivity.push_back(v.value);
+          }
+        }
+        s.faceGroup.push_back(use.face.value);
+        s.faceReversed.push_back(use.reversed ? 1 : 0);
+        ++count;
+      }
+    }
+    s.faces[countAt] = count;
+    s.faceOffsets.push_back(static_cast<std::int64_t>(s.faces.size()));
+    s.offsets.push_back(static_cast<std::int64_t>(s.connectivity.size()));
+    s.types.push_back(kVtkPolyhedron);
+  }
+  for (const Face& face : mesh.faces())
+    s.faceOrigin.push_back(static_cast<std::int64_t>(face.origin));
+  return s;
+}
+
+template <class Tag>
+void checkArrays(const std::vector<VtuArray<Tag>>& arrays, std::size_t count, const char* kind,
+                 std::unordered_set<std::string>& names) {
+  for (const auto& a : arrays) {
+    if (a.name.empty())
+      throw std::invalid_argument(std::string("writeVtu: a ") + kind + " array has no name");
+    if (!names.insert(a.name).second)
+      throw std::invalid_argument(std::string("writeVtu: ") + kind + " array name '" + a.name +
+                                  "' is used twice");
+    if (a.components != 1 && a.components != 3)
+      throw std::invalid_argument("writeVtu: array '" + a.name + "' has " +
+                                  std::to_string(a.components) + " components; use 1 or 3");
+    if (a.values.size() != count * static_cast<std::size_t>(a.components))
+      throw std::invalid_argument("writeVtu: array '" + a.name + "' has " +
+                                  std::to_string(a.values.size()) + " values, expected " +
+                                  std::to_string(count * a.components));
+  }
+}
+
+std::string xmlEscape(std::string_view text) {
+  std::string out;
+  for (char c : text) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      case '\'': out += "&apos;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
+template <class T>
+constexpr std::string_view vtkTypeName() {
+  if constexpr (std::is_same_v<T, double>)
+    return "Float64";
+  else
+    return "Int64";
+}
+
+/// Writes one <DataArray> with its values; `tuples` is given for field data, which needs it.
+template <class T>
+void writeDataArray(std::ostream& os, std::string_view indent, std::string_view name,
+                    int components, std::span<const T> values, VtuEncoding encoding,
+                    std::optional<std::size_t> tuples = std::nullopt) {
+  os << indent << "<DataArray type=\"" << vtkTypeName<T>() << "\" Name=\"" << xmlEscape(name)
+     << '"';
+  // Like VTK, only for several components: meshio 5 turns any array that has the attribute
+  // into a 2D one, which its polyhedron reader cannot take for 'faces'.
+  if (components != 1) os << " NumberOfComponents=\"" << components << '"';
+  if (tuples) os << " NumberOfTuples=\"" << *tuples << '"';
+  os << " format=\"" << (encoding == VtuEncoding::Ascii ? "ascii" : "binary") << "\">\n"
+     << indent << "  ";
+  if (encoding == VtuEncoding::Ascii) {
+    char buffer[64];
+    for (std::size_t i = 0; i < values.size(); ++i) {
+      if (i > 0 && i % 12 == 0)
+        os << '\n' << indent << "  ";
+      else if (i > 0)
+        os << ' ';
+      const auto result = std::to_chars(buffer, buffer + sizeof buffer, values[i]);
+      os.write(buffer, result.ptr - buffer);
+    }
+  } else {
+    Base64Writer out(os);
+    auto writeLittleEndian = [&](auto value) {
+      auto bytes = std::bit_cast<std::array<unsigned char, sizeof value>>(value);
+      if constexpr (std::endian::native == std::endian::big)
+        std::reverse(bytes.begin(), bytes.end());
+      out.write(bytes.data(), bytes.size());
+    };
+    writeLittleEndian(std::uint64_t{values.size() * sizeof(T)});
+    for (const T& v : values) writeLittleEndian(v);
+    out.finish();
+  }
+  os << '\n' << indent << "</DataArray>\n";
+}
+
+void writeContents(std::ostream& os, const PolyMesh& mesh, const CellStreams& s,
+                   const std::vector<CellArray>& cellData, const std::vector<PointArray>& pointData,
+                   VtuEncoding enc) {
+  os << "<?xml version=\"1.0\"?>\n"
+     << "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\""
+        " header_type=\"UInt64\">\n"
+     << "  <UnstructuredGrid>\n"
+     << "    <FieldData>\n";
+  const std::string_view fieldIndent = "      ";
+  writeDataArray<std::int64_t>(os, fieldIndent, kFaceGroupArray, 1, s.faceGroup, enc,
+                               s.faceGroup.size());
+  writeDataArray<std::int64_t>(os, fieldIndent, kFaceReversedArray, 1, s.faceReversed, enc,
+                               s.faceReversed.size());
+  writeDataArray<std::int64_t>(os, fieldIndent, kFaceOriginArray, 1, s.faceOrigin, enc,
+                               s.faceOrigin.size());
+  os << "    </FieldData>\n"
+     << "    <Piece NumberOfPoints=\"" << mesh.numVertices() << "\" NumberOfCells=\""
+     << mesh.numElements() << "\">\n";
+
+  os << "      <PointData>\n";
+  for (const PointArray& a : pointData)
+    writeDataArray<double>(os, "        ", a.name, a.components, a.values, enc);
+  os << "      </PointData>\n      <CellData>\n";
+  std::vector<double> volume(mesh.numElements());
+  for (std::size_t e = 0; e < mesh.numElements(); ++e) volume[e] = signedVolume(mesh, ElementId(e));
+  writeDataArray<double>(os, "        ", "volume", 1, volume, enc);
+  for (const CellArray& a : cellData)
+    writeDataArray<double>(os, "        ", a.name, a.components, a.values, enc);
+  os << "      </CellData>\n      <Points>\n";
+
+  std::vector<double> points;
+  points.reserve(3 * mesh.numVertices());
+  for (const Vec3& p : mesh.positions()) points.insert(points.end(), {p.x(), p.y(), p.z()});
+  writeDataArray<double>(os, "        ", "Points", 3, points, enc);
+  os << "      </Points>\n      <Cells>\n";
+  writeDataArray<std::int64_t>(os, "        ", "connectivity", 1, s.connectivity, enc);
+  writeDataArray<std::int64_t>(os, "        ", "offsets", 1, s.offsets, enc);
+  writeDataArray<std::int64_t>(os, "        ", "types", 1, s.types, enc);
+  writeDataArray<std::int64_t>(os, "        ", "faces", 1, s.faces, enc);
+  writeDataArray<std::int64_t>(os, "        ", "faceoffsets", 1, s.faceOffsets, enc);
+  os << "      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n";
+}
+
+std::string errnoText(int error) { return error != 0 ? std::strerror(error) : "I/O error"; }
+
+// ============================================================================================
+// Reading: arrays
+// ============================================================================================
+
+enum class Scalar { Int8, UInt8, Int16, UInt16, Int32, UInt32, Int64, UInt64, Float32, Float64 };
+
+Scalar parseScalar(std::string_view type, std::string_view array) {
+  static const std::pair<std::string_view, Scalar> kTypes[] = {
+      {"Int8", Scalar::Int8},       {"UInt8", Scalar::UInt8},   {"Int16", Scalar::Int16},
+      {"UInt16", Scalar::UInt16},   {"Int32", Scalar::Int32},   {"UInt32", Scalar::UInt32},
+      {"Int64", Scalar::Int64},     {"UInt64", Scalar::UInt64}, {"Float32", Scalar::Float32},
+      {"Float64", Scalar::Float64}, {"Char", Scalar::Int8},     {"UChar", Scalar::UInt8},
+      {"Short", Scalar::Int16},     {"UShort", Scalar::UInt16}, {"Int", Scalar::Int32},
+      {"UInt", Scalar::UInt32},     {"Long", Scalar::Int64},    {"ULong", Scalar::UInt64},
+      {"Float", Scalar::Float32},   {"Double", Scalar::Float64}};
+  for (const auto& [name, scalar] : kTypes)
+    if (name == type) return scalar;
+  throw VtuError("array '" + std::string(array) + "' has unknown type '" + std::string(type) + "'");
+}
+
+std::size_t scalarSize(Scalar s) {
+  switch (s) {
+    case Scalar::Int8:
+    case Scalar::UInt8: return 1;
+    case Scalar::Int16:
+    case Scalar::UInt16: return 2;
+    case Scalar::Int32:
+    case Scalar::UInt32:
+    case Scalar::Float32: return 4;
+    case Scalar::Int64:
+    case Scalar::UInt64:
+    case Scalar::Float64: return 8;
+  }
+  return 1;
+}
+
+bool isFloat(Scalar s) { return s == Scalar::Float32 || s == Scalar::Float64; }
+
+/// Converts one value to the requested kind: any value to double; integers (or floats holding
+/// integers) to int64.
+template <class Out, class In>
+Out convertValue(In v, std::string_view array) {
+  if constexpr (std::is_same_v<Out, double>) {
+    return static_cast<double>(v);
+  } else if constexpr (std::is_floating_point_v<In>) {
+    if (!(v == std::floor(v) && std::abs(v) < 9.0e18))
+      throw VtuError("array '" + std::string(array) +
+                     "' holds a non-integer value where ids are expected");
+    return static_cast<std::int64_t>(v);
+  } else if constexpr (std::is_same_v<In, std::uint64_t>) {
+    if (v > static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max()))
+      throw VtuError("array '" + std::string(array) + "' holds a value too large for an id");
+    return static_cast<std::int64_t>(v);
+  } else {
+    return static_cast<std::int64_t>(v);
+  }
+}
+
+template <class T>
+T loadScalar(const char* p, bool swap) {
+  std::array<char, sizeof(T)> bytes;
+  std::memcpy(bytes.data(), p, sizeof(T));
+  if (swap) std::reverse(bytes.begin(), bytes.end());
+  return std::bit_cast<T>(bytes);
+}
+
+template <class Out, class In>
+void appendConverted(const std::string& bytes, bool swap, std::string_view array,
+                     std::vector<Out>& out) {
+  const std::size_t n = bytes.size() / sizeof(In);
+  out.reserve(out.size() + n);
+  for (std::size_t i = 0; i < n; ++i)
+    out.push_back(convertValue<Out>(loadScalar<In>(bytes.data() + i * sizeof(In), swap), array));
+}
+
+template <class Out>
+void convertBytes(const std::string& bytes, Scalar s, bool swap, std::string_view array,
+                  std::vector<Out>& out) {
+  switch (s) {
+    case Scalar::Int8: return appendConverted<Out, std::int8_t>(bytes, swap, array, out);
+    case Scalar::UInt8: return appendConverted<Out, std::uint8_t>(bytes, swap, array, out);
+    case Scalar::Int16: return appendConverted<Out, std::int16_t>(bytes, swap, array, out);
+    case Scalar::UInt16: return appendConverted<Out, std::uint16_t>(bytes, swap, array, out);
+    case Scalar::Int32: return appendConverted<Out, std::int32_t>(bytes, swap, array, out);
+    case Scalar::UInt32: return appendConverted<Out, std::uint32_t>(bytes, swap, array, out);
+    case Scalar::Int64: return appendConverted<Out, std::int64_t>(bytes, swap, array, out);
+    case Scalar::UInt64: return appendConverted<Out, std::uint64_t>(bytes, swap, array, out);
+    case Scalar::Float32: return appendConverted<Out, float>(bytes, swap, array, out);
+    case Scalar::Float64: return appendConverted<Out, double>(bytes, swap, array, out);
+  }
+}
+
+/// The parts of the file that every array read needs.
+struct FileLayout {
+  bool swapBytes = false;      ///< the file's byte order differs from this machine's
+  std::size_t headerSize = 4;  ///< UInt32 or UInt64 headers
+  bool compressed = false;     ///< vtkZLibDataCompressor
+  std::string_view appended;   ///< the bytes after AppendedData's '_'
+  bool appendedBase64 = true;
+};
+
+std::string arrayName(pugi::xml_node array) {
+  const char* name = array.attribute("Name").value();
+  return *name ? name : array.parent().name();
+}
+
+std::uint64_t readHeaderWord(ByteReader& in, const FileLayout& layout, const std::string& what) {
+  std::string bytes;
+  if (!in.read(layout.headerSize, bytes)) throw VtuError("truncated " + what);
+  return layout.headerSize == 4 ? loadScalar<std::uint32_t>(bytes.data(), layout.swapBytes)
+                                : loadScalar<std::uint64_t>(bytes.data(), layout.swapBytes);
+}
+
+/// The raw bytes of one binary array: a header, then the data, possibly in zlib blocks.
+std::string readBinaryBytes(ByteReader& in, const FileLayout& layout, const std::string& what) {
+  std::string data;
+  if (!layout.compressed) {
+    const std::uint64_t size = readHeaderWord(in, layout, what);
+    if (size > in.maxRemaining() || !in.read(size, data)) throw VtuError("truncated " + what);
+    return data;
+  }
+  const std::uint64_t blocks = readHeaderWord(in, layout, what);
+  const std::uint64_t blockSize = readHeaderWord(in, layout, what);
+  const std::uint64_t lastSize = readHeaderWord(in, layout, what);
+  if (blocks > in.maxRemaining() / layout.headerSize) throw VtuError("truncated " + what);
+  std::vector<std::uint64_t> compressedSizes(blocks);
+  std::uint64_t totalCompressed = 0;
+  for (auto& c : compressedSizes) {
+    c = readHeaderWord(in, layout, what);
+    totalCompressed += c;
+  }
+  if (totalCompressed > in.maxRemaining()) throw VtuError("truncated " + what);
+  std::string block;
+  for (std::uint64_t b = 0; b < blocks; ++b) {
+    const std::uint64_t expected = (b + 1 == blocks && lastSize != 0) ? lastSize : blockSize;
+    block.clear();
+    if (!in.read(compressedSizes[b], block)) throw VtuError("truncated " + what);
+    // zlib cannot expand data by more than about 1032:1; larger claims are corrupt headers.
+    if (expected > 1100 * compressedSizes[b] + 1024)
+      throw VtuError("corrupt compression header in " + what);
+    const std::size_t at = data.size();
+    data.resize(at + expected);
+    uLongf produced = static_cast<uLongf>(expected);
+    const int status =
+        uncompress(reinterpret_cast<Bytef*>(data.data() + at), &produced,
+                   reinterpret_cast<const Bytef*>(block.data()), static_cast<uLong>(block.size()));
+    if (status != Z_OK || produced != expected)
+      throw VtuError("cannot decompress " + what +
+                     " (zlib: " + (status == Z_OK ? "wrong block size" : zError(status)) + ")");
+  }
+  return data;
+}
+
+/// Reads a DataArray's values as `Out` (double or int64), whatever its stored type and format.
+template <class Out>
+std::vector<Out> readArray(pugi::xml_node array, const FileLayout& layout) {
+  const std::string name = arrayName(array);
+  const Scalar scalar = parseScalar(array.attribute("type").value(), name);
+  const std::string_view format = array.attribute("format").value();
+  std::vector<Out> out;
+  if (format == "ascii" || format.empty()) {
+    const std::string_view text = array.child_value();
+    std::size_t pos = 0;
+    while (true) {
+      while (pos < text.size() && isXmlSpace(text[pos])) ++pos;
+      if (pos == text.size()) break;
+      std::size_t end = pos;
+      while (end < text.size() && !isXmlSpace(text[end])) ++end;
+      const char* first = text.data() + pos;
+      const char* last = text.data() + end;
+      std::from_chars_result result{};
+      if (isFloat(scalar)) {
+        double v = 0.0;
+        result = std::from_chars(first, last, v);
+        if (result.ec == std::errc()) out.push_back(convertValue<Out>(v, name));
+      } else if (scalar == Scalar::UInt64) {
+        std::uint64_t v = 0;
+        result = std::from_chars(first, last, v);
+        if (result.ec == std::errc()) out.push_back(convertValue<Out>(v, name));
+      } else {
+        std::int64_t v = 0;
+        result = std::from_chars(first, last, v);
+        if (result.ec == std::errc()) out.push_back(convertValue<Out>(v, name));
+      }
+      if (result.ec != std::errc() || result.ptr != last)
+        throw VtuError("array '" + name + "' has an invalid number '" +
+                       std::string(first, std::min<std::size_t>(last - first, 32)) + "'");
+      pos = end;
+    }
+    return out;
+  }
+  std::string bytes;
+  if (format == "binary") {
+    ByteReader in(array.child_value(), /*base64=*/true);
+    bytes = readBinaryBytes(in, layout, "data in array '" + name + "'");
+  } else if (format == "appended") {
+    const pugi::xml_attribute offsetAttr = array.attribute("offset");
+    const unsigned long long offset = offsetAttr.as_ullong(~0ull);
+    if (!offsetAttr || offset == ~0ull)
+      throw VtuError("array '" + name + "' has no valid offset into the appended data");
+    if (offset > layout.appended.size())
+      throw VtuError("truncated appended data (array '" + name + "')");
+    ByteReader in(layout.appended.substr(offset), layout.appendedBase64);
+    bytes = readBinaryBytes(in, layout, "appended data (array '" + name + "')");
+  } else {
+    throw VtuError("array '" + name + "' has unknown format '" + std::string(format) + "'");
+  }
+  if (bytes.size() % scalarSize(scalar) != 0)
+    throw VtuError("array '" + name + "' has a byte count that is not a multiple of its type size");
+  convertBytes(bytes, scalar, layout.swapBytes, name, out);
+  return out;
+}
+
+pugi::xml_node findArray(pugi::xml_node parent, std::string_view name) {
+  for (pugi::xml_node a : parent.children("DataArray"))
+    if (name == a.attribute("Name").value()) return a;
+  return {};
+}
+
+std::uint64_t readCount(pugi::xml_node node, const char* attribute) {
+  const pugi::xml_attribute a = node.attribute(attribute);
+  std::uint64_t value = 0;
+  const std::string_view text = a.value();
+  const auto result = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (!a || result.ec != std::errc() || result.ptr != text.data() + text.size())
+    throw VtuError(std::string(node.name()) + " has no valid " + attribute);
+  return value;
+}
+
+// ============================================================================================
+// Reading: cells to face records
+// ============================================================================================
+
+/// Every cell's faces, each one loop of vertex ids oriented out of the cell, flattened.
+struct CellFaces {
+  std::vector<std::size_t> cellEnd;    ///< records of cell c: [cellEnd[c-1], cellEnd[c])
+  std::vector<std::size_t> recordEnd;  ///< vertices of record r: [recordEnd[r-1], recordEnd[r])
+  std::vector<VertexId> vertices;
+
+  std::size_t numCells() const { return cellEnd.size(); }
+  std::size_t cellBegin(std::size_t c) const { return c == 0 ? 0 : cellEnd[c - 1]; }
+  std::span<const VertexId> record(std::size_t r) const {
+    const std::size_t begin = r == 0 ? 0 : recordEnd[r - 1];
+    return {vertices.data() + begin, recordEnd[r] - begin};
+  }
+};
+
+/// Outward faces of the 3D linear cells in VTK's point numbering (vtkTetra::GetFaceArray etc.).
+struct LinearCellType {
+  std::int64_t type;
+  std::size_t points;
+  std::vector<std::vector<int>> faces;
+};
+
+const LinearCellType* linearCellType(std::int64_t type) {
+  static const std::vector<LinearCellType> kTypes = [] {
+    const std::vector<std::vector<int>> hex = {{0, 4, 7, 3}, {1, 2, 6, 5}, {0, 1, 5, 4},
+                                               {3, 7, 6, 2}, {0, 3, 2, 1}, {4, 5, 6, 7}};
+    // A voxel numbers its points x fastest, then y, then z; as a hexahedron: 0 1 3 2 4 5 7 6.
+    const int voxelToHex[8] = {0, 1, 3, 2, 4, 5, 7, 6};
+    std::vector<std::vector<int>> voxel = hex;
+    for (auto& face : voxel)
+      for (int& p : face) p = voxelToHex[p];
+    return std::vector<LinearCellType>{
+        {10, 4, {{0, 1, 3}, {1, 2, 3}, {2, 0, 3}, {0, 2, 1}}},
+        {11, 8, voxel},
+        {12, 8, hex},
+        {13, 6, {{0, 1, 2}, {3, 5, 4}, {0, 3, 4, 1}, {1, 4, 5, 2}, {2, 5, 3, 0}}},
+        {14, 5, {{0, 3, 2, 1}, {0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}}},
+        {15,
+         10,
+         {{0, 4, 3, 2, 1},
+          {5, 6, 7, 8, 9},
+          {0, 1, 6, 5},
+          {1, 2, 7, 6},
+          {2, 3, 8, 7},
+          {3, 4, 9, 8},
+          {4, 0, 5, 9}}},
+        {16,
+         12,
+         {{0, 5, 4, 3, 2, 1},
+          {6, 7, 8, 9, 10, 11},
+          {0, 1, 7, 6},
+          {1, 2, 8, 7},
+          {2, 3, 9, 8},
+          {3, 4, 10, 9},
+          {4, 5, 11, 10},
+          {5, 0, 6, 11}}}};
+  }();
+  for (const auto& t : kTypes)
+    if (t.type == type) return &t;
+  return nullptr;
+}
+
+/// Reads one Piece: appends its points to `points` and its cells' faces to `cells`.
+void readPiece(pugi::xml_node piece, const FileLayout& layout, std::vector<Vec3>& points,
+               CellFaces& cells) {
+  const std::uint64_t numPoints = readCount(piece, "NumberOfPoints");
+  const std::uint64_t numCells = readCount(piece, "NumberOfCells");
+  const std::size_t pointBase = points.size();
+  const std::size_t cellBase = cells.numCells();
+
+  if (numPoints > 0) {
+    const pugi::xml_node array = piece.child("Points").child("DataArray");
+    if (!array) throw VtuError("Piece has no Points array");
+    if (array.attribute("NumberOfComponents").as_int(1) != 3)
+      throw VtuError("Points array does not have 3 components");
+    const std::vector<double> xyz = readArray<double>(array, layout);
+    if (xyz.size() != 3 * numPoints)
+      throw VtuError("Points array has " + std::to_string(xyz.size()) + " values, expected " +
+                     std::to_string(3 * numPoints));
+    for (std::size_t i = 0; i < numPoints; ++i)
+      points.emplace_back(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
+  }
+  if (numCells == 0) return;
+
+  const pugi::xml_node cellsNode = piece.child("Cells");
+  auto required = [&](const char* name) {
+    const pugi::xml_node a = findArray(cellsNode, name);
+    if (!a) throw VtuError(std::string("Cells has no '") + name + "' array");
+    std::vector<std::int64_t> values = readArray<std::int64_t>(a, layout);
+    return values;
+  };
+  const std::vector<std::int64_t> types = required("types");
+  const std::vector<std::int64_t> offsets = required("offsets");
+  const std::vector<std::int64_t> connectivity = required("connectivity");
+  if (types.size() != numCells || offsets.size() != numCells)
+    throw VtuError("Cells arrays 'types' and 'offsets' need " + std::to_string(numCells) +
+                   " values");
+  std::vector<std::int64_t> faces, faceOffsets;
+  if (std::find(types.begin(), types.end(), kVtkPolyhedron) != types.end()) {
+    faces = required("faces");
+    faceOffsets = required("faceoffsets");
+    if (faceOffsets.size() != numCells)
+      throw VtuError("Cells array 'faceoffsets' needs " + std::to_string(numCells) + " values");
+  }
+
+  auto cellError = [&](std::size_t c, const std::string& problem) {
+    return VtuError("cell " + std::to_string(cellBase + c) + " " + problem);
+  };
+  auto vertex = [&](std::size_t c, std::int64_t id) {
+    if (id < 0 || static_cast<std::uint64_t>(id) >= numPoints)
+      throw cellError(c, "refers to point " + std::to_string(id) + ", but its piece has " +
+                             std::to_string(numPoints) + " points");
+    return VertexId(pointBase + static_cast<std::size_t>(id));
+  };
+  auto endRecord = [&](std::size_t c) {
+    const std::size_t begin = cells.recordEnd.empty() ? 0 : cells.recordEnd.back();
+    if (cells.vertices.size() - begin < 3)
+      throw cellError(c, "has a face with fewer than 3 points");
+    cells.recordEnd.push_back(cells.vertices.size());
+  };
+
+  std::int64_t connectivityBegin = 0;
+  std::int64_t facesBegin = 0;
+  for (std::size_t c = 0; c < numCells; ++c) {
+    const std::int64_t connectivityEnd = offsets[c];
+    if (connectivityEnd < connectivityBegin ||
+        connectivityEnd > static_cast<std::int64_t>(connectivity.size()))
+      throw cellError(c, "has an invalid offset into 'connectivity'");
+    const std::int64_t type = types[c];
+    if (type == kVtkPolyhedron) {
+      const std::int64_t end = faceOffsets[c];
+      if (end < facesBegin || end > static_cast<std::int64_t>(faces.size()) || end == facesBegin)
+        throw cellError(c, "has an invalid 'faceoffsets' entry");
+      std::int64_t at = facesBegin;
+      const std::int64_t count = faces[at++];
+      for (std::int64_t k = 0; k < count; ++k) {
+        if (at >= end) throw cellError(c, "has a 'faces' run shorter than its face count");
+        const std::int64_t n = faces[at++];
+        if (n < 0 || n > end - at) throw cellError(c, "has a face running past its 'faces' run");
+        for (std::int64_t i = 0; i < n; ++i) cells.vertices.push_back(vertex(c, faces[at++]));
+        endRecord(c);
+      }
+      if (at != end) throw cellError(c, "has a 'faces' run longer than its faces");
+      facesBegin = end;
+    } else if (const LinearCellType* linear = linearCellType(type)) {
+      const std::size_t n = static_cast<std::size_t>(connectivityEnd - connectivityBegin);
+      if (n != linear->points)
+        throw cellError(c, "has VTK type " + std::to_string(type) + " and " + std::to_string(n) +
+                               " points; that type has " + std::to_string(linear->points));
+      for (const auto& face : linear->faces) {
+        for (int p : face) cells.vertices.push_back(vertex(c, connectivity[connectivityBegin + p]));
+        endRecord(c);
+      }
+    } else {
+      throw cellError(c, "has VTK type " + std::to_string(type) +
+                             ", which polydg does not read; only 3D linear cells and polyhedra "
+                             "are supported");
+    }
+    if (!faceOffsets.empty() && faceOffsets[c] >= 0 && type != kVtkPolyhedron)
+      facesBegin = std::max(facesBegin, faceOffsets[c]);
+    cells.cellEnd.push_back(cells.recordEnd.size());
+    connectivityBegin = connectivityEnd;
+  }
+}
+
+// ============================================================================================
+// Reading: faces from records
+// ============================================================================================
+
+/// Order-independent key of a vertex set (FNV-1a over the sorted ids); equal sets, equal keys.
+std::uint64_t vertexSetKey(std::span<const VertexId> vertices) {
+  std::vector<std::uint32_t> ids;
+  ids.reserve(vertices.size());
+  for (VertexId v : vertices) ids.push_back(v.value);
+  std::sort(ids.begin(), ids.end());
+  std::uint64_t h = 1469598103934665603ull;
+  for (std::uint32_t id : ids) {
+    h ^= id;
+    h *= 1099511628211ull;
+  }
+  return h;
+}
+
+/// Builds faces by matching: a record whose vertex set and reversed cycle equal those of an
+/// open face of an earlier cell shares it; any other record becomes a new face.
+void buildByMatching(PolyMesh& mesh, const CellFaces& cells) {
+  struct OpenFace {
+    FaceId face;
+    std::size_t cell;
+  };
+  std::unordered_map<std::uint64_t, std::vector<OpenFace>> open;
+  for (std::size_t c = 0; c < cells.numCells(); ++c) {
+    std::vector<FaceUse> uses;
+    for (std::size_t r = cells.cellBegin(c); r < cells.cellEnd[c]; ++r) {
+      const auto record = cells.record(r);
+      const std::vector<Loop> loops{Loop(record.begin(), record.end())};
+      auto& candidates = open[vertexSetKey(record)];
+      const auto match = std::find_if(candidates.begin(), candidates.end(), [&](const OpenFace& o) {
+        return o.cell != c && isReverseOf(mesh.face(o.face), loops);
+      });
+      if (match != candidates.end()) {
+        uses.push_back({match->face, true});
+        candidates.erase(match);
+      } else {
+        const FaceId f = mesh.addFace(loops, FaceOrigin::Imported);
+        candidates.push_back({f, c});
+        uses.push_back({f, false});
+      }
+    }
+    mesh.addElementFromFaces(uses);
+  }
+}
+
+/// The polydg field data of a file, if present.
+struct PolydgFields {
+  std::vector<std::int64_t> group, reversed, origin;
+  bool hasReversed = false;
+};
+
+/// A mesh's faces and elements, ready to be added.
+struct FacePlan {
+  std::vector<std::vector<Loop>> loops;    ///< per face
+  std::vector<FaceOrigin> origins;         ///< per face
+  std::vector<std::vector<FaceUse>> uses;  ///< per element
+};
+
+double loopArea(const PolyMesh& mesh, const Loop& loop) {
+  Vec3 twice = Vec3::Zero();
+  const Vec3& c = mesh.position(loop[0]);
+  for (std::size_t i = 1; i + 1 < loop.size(); ++i)
+    twice += (mesh.position(loop[i]) - c).cross(mesh.position(loop[i + 1]) - c);
+  return 0.5 * twice.norm();
+}
+
+/// The loops bounding the union of `records` (triangles of one face, in the face's
+/// orientation): directed edges whose reverse is not among them, chained into cycles. The
+/// largest loop by area comes first. Empty if the edges do not form cycles.
+std::vector<Loop> boundaryLoops(const PolyMesh& mesh, const std::vector<Loop>& records) {
+  auto key = [](VertexId a, VertexId b) { return (std::uint64_t{a.value} << 32) | b.value; };
+  std::unordered_set<std::uint64_t> edges;
+  for (const Loop& r : records)
+    for (std::size_t i = 0; i < r.size(); ++i) edges.insert(key(r[i], r[(i + 1) % r.size()]));
+  std::vector<std::pair<VertexId, VertexId>> boundary;
+  std::unordered_multimap<std::uint32_t, std::size_t> outgoing;
+  for (const Loop& r : records)
+    for (std::size_t i = 0; i < r.size(); ++i) {
+      const VertexId a = r[i], b = r[(i + 1) % r.size()];
+      if (!edges.contains(key(b, a))) {
+        outgoing.emplace(a.value, boundary.size());
+        boundary.emplace_back(a, b);
+      }
+    }
+  std::vector<bool> used(boundary.size(), false);
+  std::vector<Loop> loops;
+  for (std::size_t start = 0; start < boundary.size(); ++start) {
+    if (used[start]) continue;
+    Loop loop;
+    std::size_t e = start;
+    while (true) {
+      used[e] = true;
+      loop.push_back(boundary[e].first);
+      if (boundary[e].second == boundary[start].first) break;
+      const auto [begin, end] = outgoing.equal_range(boundary[e].second.value);
+      const auto next = std::find_if(begin, end, [&](const auto& kv) { return !used[kv.second]; });
+      if (next == end) return {};
+      e = next->second;
+    }
+    if (loop.size() < 3) return {};
+    loops.push_back(std::move(loop));
+  }
+  if (loops.empty()) return {};
+  std::size_t outer = 0;
+  for (std::size_t k = 1; k < loops.size(); ++k)
+    if (loopArea(mesh, loops[k]) > loopArea(mesh, loops[outer])) outer = k;
+  std::rotate(loops.begin(), loops.begin() + static_cast<std::ptrdiff_t>(outer),
+              loops.begin() + static_cast<std::ptrdiff_t>(outer) + 1);
+  return loops;
+}
+
+/// The loop run backwards from the same first vertex (v0, v(n-1), ..., v1), as the writer does.
+Loop reversedLoop(std::span<const VertexId> loop) {
+  Loop out(loop.begin(), loop.end());
+  std::reverse(out.begin() + 1, out.end());
+  return out;
+}
+
+/// Plans the faces exactly as writeVtu wrote them, from its field data. Empty if the field data
+/// does not match the cells (then the reader falls back to matching).
+std::optional<FacePlan> planFromFields(const PolyMesh& mesh, const CellFaces& cells,
+                                       const PolydgFields& fields) {
+  const std::size_t numFaces = fields.origin.size();
+  const std::size_t numRecords = cells.recordEnd.size();
+  if (fields.group.size() != numRecords) return std::nullopt;
+  if (fields.hasReversed && fields.reversed.size() != numRecords) return std::nullopt;
+  FacePlan plan;
+  for (std::int64_t o : fields.origin) {
+    if (o < 0 || o > static_cast<std::int64_t>(FaceOrigin::Imported)) return std::nullopt;
+    plan.origins.push_back(static_cast<FaceOrigin>(o));
+  }
+
+  // Per face: its users, and the records (in the face's orientation) of the first user.
+  std::vector<int> users(numFaces, 0);
+  std::vector<int> flagOfFirst(numFaces, -1);
+  std::vector<std::size_t> lastCell(numFaces, std::numeric_limits<std::size_t>::max());
+  std::vector<int> currentFlag(numFaces, 0);
+  std::vector<std::vector<Loop>> records(numFaces);
+  plan.uses.resize(cells.numCells());
+  for (std::size_t c = 0; c < cells.numCells(); ++c) {
+    for (std::size_t r = cells.cellBegin(c); r < cells.cellEnd[c]; ++r) {
+      const std::int64_t g = fields.group[r];
+      if (g < 0 || static_cast<std::size_t>(g) >= numFaces) return std::nullopt;
+      const auto f = static_cast<std::size_t>(g);
+      if (lastCell[f] != c) {
+        lastCell[f] = c;
+        if (++users[f] > 2) return std::nullopt;
+        const int flag = fields.hasReversed ? static_cast<int>(fields.reversed[r]) : users[f] - 1;
+        if (flag != 0 && flag != 1) return std::nullopt;
+        if (users[f] == 1)
+          flagOfFirst[f] = flag;
+        else if (fields.hasReversed && flag == flagOfFirst[f])
+          return std::nullopt;
+        currentFlag[f] = flag;
+        plan.uses[c].push_back({FaceId(f), flag == 1});
+      } else if (fields.hasReversed && fields.reversed[r] != currentFlag[f]) {
+        return std::nullopt;
+      }
+      if (users[f] == 1) {
+        const auto rec = cells.record(r);
+        records[f].push_back(currentFlag[f] ? reversedLoop(rec) : Loop(rec.begin(), rec.end()));
+      }
+    }
+  }
+  plan.loops.resize(numFaces);
+  for (std::size_t f = 0; f < numFaces; ++f) {
+    if (users[f] == 0) return std::nullopt;
+    if (records[f].size() == 1) {
+      plan.loops[f] = {records[f][0]};
+    } else {
+      plan.loops[f] = boundaryLoops(mesh, records[f]);
+      if (plan.loops[f].empty()) return std::nullopt;
+    }
+  }
+  return plan;
+}
+
+std::optional<PolydgFields> readPolydgFields(pugi::xml_node grid, const FileLayout& layout) {
+  const pugi::xml_node fieldData = grid.child("FieldData");
+  const pugi::xml_node group = findArray(fieldData, kFaceGroupArray);
+  const pugi::xml_node reversed = findArray(fieldData, kFaceReversedArray);
+  const pugi::xml_node origin = findArray(fieldData, kFaceOriginArray);
+  if (!group || !origin) return std::nullopt;
+  PolydgFields fields;
+  fields.group = readArray<std::int64_t>(group, layout);
+  fields.origin = readArray<std::int64_t>(origin, layout);
+  if (reversed) {
+    fields.reversed = readArray<std::int64_t>(reversed, layout);
+    fields.hasReversed = true;
+  }
+  return fields;
+}
+
+std::string readWholeFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw VtuError("cannot open: " + errnoText(errno));
+  std::error_code error;
+  if (std::filesystem::is_directory(path, error)) throw VtuError("cannot open: it is a directory");
+  std::ostringstream bytes;
+  bytes << in.rdbuf();
+  if (in.bad()) throw VtuError("cannot read: " + errnoText(errno));
+  return std::move(bytes).str();
+}
+
+PolyMesh readVtuContents(const std::string& path) {
+  const std::string bytes = readWholeFile(path);
+
+  // Appended data may be raw binary, which is not XML: parse the text before it, closed off.
+  FileLayout layout;
+  std::string xmlText;
+  const std::size_t appendedTag = bytes.find("<AppendedData");
+  if (appendedTag != std::string::npos) {
+    const std::size_t tagEnd = bytes.find('>', appendedTag);
+    if (tagEnd == std::string::npos) throw VtuError("truncated AppendedData element");
+    std::size_t underscore = tagEnd + 1;
+    while (underscore < bytes.size() && isXmlSpace(bytes[underscore])) ++underscore;
+    if (underscore == bytes.size() || bytes[underscore] != '_')
+      throw VtuError("AppendedData does not start with '_'");
+    const std::size_t begin = underscore + 1;
+    const std::size_t close = bytes.rfind("</AppendedData>");
+    const std::size_t end = close != std::string::npos && close >= begin ? close : bytes.size();
+    layout.appended = std::string_view(bytes).substr(begin, end - begin);
+    xmlText = bytes.substr(0, tagEnd + 1) + "</AppendedData></VTKFile>";
+  }
+
+  pugi::xml_document doc;
+  const std::string& text = appendedTag != std::string::npos ? xmlText : bytes;
+  const pugi::xml_parse_result parsed = doc.load_buffer(text.data(), text.size());
+  const pugi::xml_node root = doc.child("VTKFile");
+  if (!parsed && !root)
+    throw VtuError(std::string("not a VTK UnstructuredGrid file (XML error: ") +
+                   parsed.description() + " at byte " + std::to_string(parsed.offset) + ")");
+  if (!parsed)
+    throw VtuError(std::string("truncated or malformed XML (") + parsed.description() +
+                   " at byte " + std::to_string(parsed.offset) + ")");
+  const pugi::xml_node grid = root.child("UnstructuredGrid");
+  if (std::string_view(root.attribute("type").value()) != "UnstructuredGrid" || !grid)
+    throw VtuError("not a VTK UnstructuredGrid file");
+
+  const std::string_view byteOrder = root.attribute("byte_order").as_string("LittleEndian");
+  if (byteOrder != "LittleEndian" && byteOrder != "BigEndian")
+    throw VtuError("unknown byte_order '" + std::string(byteOrder) + "'");
+  layout.swapBytes = (byteOrder == "BigEndian") != (std::endian::native == std::endian::big);
+  const std::string_view headerType = root.attribute("header_type").as_string("UInt32");
+  if (headerType != "UInt32" && headerType != "UInt64")
+    throw VtuError("unknown header_type '" + std::string(headerType) + "'");
+  layout.headerSize = headerType == "UInt64" ? 8 : 4;
+  const std::string_view compressor = root.attribute("compressor").value();
+  if (!compressor.empty() && compressor != "vtkZLibDataCompressor")
+    throw VtuError("compressor " + std::string(compressor) +
+                   " is not supported (only vtkZLibDataCompressor)");
+  layout.compressed = !compressor.empty();
+  if (const pugi::xml_node appended = root.child("AppendedData")) {
+    const std::string_view encoding = appended.attribute("encoding").as_string("raw");
+    if (encoding != "raw" && encoding != "base64")
+      throw VtuError("unknown AppendedData encoding '" + std::string(encoding) + "'");
+    layout.appendedBase64 = encoding == "base64";
+  }
+
+  std::vector<Vec3> points;
+  CellFaces cells;
+  std::size_t pieces = 0;
+  for (pugi::xml_node piece : grid.children("Piece")) {
+    readPiece(piece, layout, points, cells);
+    ++pieces;
+  }
+  if (pieces == 0) throw VtuError("UnstructuredGrid has no Piece");
+
+  PolyMesh mesh;
+  for (const Vec3& p : points) mesh.addVertex(p);
+  const std::optional<PolydgFields> fields =
+      pieces == 1 ? readPolydgFields(grid, layout) : std::nullopt;
+  std::optional<FacePlan> plan;
+  if (fields) plan = planFromFields(mesh, cells, *fields);
+  if (!plan) {
+    buildByMatching(mesh, cells);
+    return mesh;
+  }
+  for (std::size_t f = 0; f < plan->loops.size(); ++f)
+    mesh.addFace(std::move(plan->loops[f]), plan->origins[f]);
+  for (const auto& uses : plan->uses) mesh.addElementFromFaces(uses);
+  return mesh;
+}
+
+}  // namespace
+
+// ============================================================================================
+// Public functions
+// ============================================================================================
+
+void writeVtu(const PolyMesh& mesh, const std::string& path, const VtuWriteOptions& options,
+              const std::vector<CellArray>& cellData, const std::vector<PointArray>& pointData) {
+  std::unordered_set<std::string> cellNames{"volume"}, pointNames;
+  checkArrays(cellData, mesh.numElements(), "cell", cellNames);
+  checkArrays(pointData, mesh.numVertices(), "point", pointNames);
+  // Everything that can fail for reasons other than I/O happens before the file is opened.
+  const CellStreams streams = buildCellStreams(mesh);
+
+  const std::string tmp = path + ".tmp";
+  auto fail = [&](int error) {
+    std::remove(tmp.c_str());
+    throw std::runtime_error("cannot write " + path + ": " + errnoText(error));
+  };
+  {
+    std::ofstream os(tmp, std::ios::binary | std::ios::trunc);
+    if (!os) fail(errno);
+    errno = 0;
+    try {
+      writeContents(os, mesh, streams, cellData, pointData, options.encoding);
+    } catch (...) {
+      os.close();
+      std::remove(tmp.c_str());
+      throw;
+    }
+    os.flush();
+    if (!os) fail(errno);
+    os.close();
+    if (os.fail()) fail(errno);
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) fail(errno);
+}
+
+PolyMesh readVtu(const std::string& path) {
+  try {
+    return readVtuContents(path);
+  } catch (const VtuError& e) {
+    throw std::runtime_error(path + ": " + e.what());
+  } catch (const std::bad_alloc&) {
+    throw std::runtime_error(path + ": array sizes in the file are too large for memory");
+  }
+}
+
+namespace vtu_detail {
+
+std::string base64Encode(std::string_view bytes) {
+  std::ostringstream os;
+  Base64Writer out(os);
+  out.write(bytes.data(), bytes.size());
+  out.finish();
+  return os.str();
+}
+
+std::string base64Decode(std::string_view text) {
+  ByteReader in(text, /*base64=*/true);
+  std::string out;
+  try {
+    while (in.read(1, out)) {
+    }
+  } catch (const VtuError& e) {
+    throw std::runtime_error(e.what());
+  }
+  return out;
+}
+
+}  // namespace vtu_detail
+
+}  // namespace polydg

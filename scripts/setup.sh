@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# Installs the Debian packages polydg needs to build, test and check its output.
+# Idempotent: when every package is already present it only runs dpkg-query and exits.
+set -euo pipefail
+
+packages=(
+  build-essential cmake ninja-build ccache pkg-config
+  libcgal-dev libeigen3-dev libpugixml-dev zlib1g-dev libopenvdb-dev libassimp-dev
+  libsuitesparse-dev libopenblas0-pthread libopenblas-pthread-dev
+  libtbb-dev libcli11-dev nlohmann-json3-dev
+  libgtest-dev libgmock-dev libbenchmark-dev libspectra-dev
+  python3-vtk9 python3-meshio python3-numpy assimp-testmodels
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  status=$(dpkg-query -W -f='${Status}' "$p" 2>/dev/null || true)
+  [[ "$status" == "install ok installed" ]] || missing+=("$p")
+done
+
+if ((${#missing[@]} == 0)); then
+  exit 0
+fi
+
+echo "setup: installing ${missing[*]}"
+SUDO=""
+if [[ $(id -u) -ne 0 ]]; then SUDO="sudo"; fi
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null

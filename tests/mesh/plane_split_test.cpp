@@ -1,0 +1,207 @@
+// Splitting closed pieces by planes in the degenerate cases that are normal cases here: planes
+// through vertices, along edges, containing faces, touching a single vertex; non-convex faces,
+// faces with holes, and pieces falling apart into several components.
+#include "mesh/plane_split.h"
+
+#include <gtest/gtest.h>
+
+#include <map>
+
+#include "mesh/primitives.h"
+
+namespace polydg {
+namespace {
+
+constexpr double kTolerance = 1e-14;
+
+/// The single element of `mesh` as a piece over the mesh's points.
+Piece toPiece(const PolyMesh& mesh) {
+  Piece piece;
+  for (const FaceUse& use : mesh.element(ElementId(0)).faces) {
+    const Face& face = mesh.face(use.face);
+    PiecePolygon p;
+    for (std::size_t k = 0; k < face.numLoops(); ++k) {
+      std::vector<std::uint32_t> loop;
+      for (VertexId v : face.loop(k)) loop.push_back(v.value);
+      if (use.reversed) std::reverse(loop.begin(), loop.end());
+      p.vertices.insert(p.vertices.end(), loop.begin(), loop.end());
+      p.loopEnd.push_back(static_cast<std::uint32_t>(p.vertices.size()));
+    }
+    piece.push_back(p);
+  }
+  return piece;
+}
+
+std::vector<Vec3> pointsOf(const PolyMesh& mesh) { return mesh.positions().raw(); }
+
+/// Volume of a closed piece by signed cones (independent of the mesh code).
+double volume(const Piece& piece, const std::vector<Vec3>& points) {
+  double six = 0.0;
+  for (const PiecePolygon& p : piece)
+    for (std::size_t k = 0; k < p.numLoops(); ++k) {
+      const std::size_t b = p.loopBegin(k), e = p.loopEnd[k];
+      const Vec3& c = points[p.vertices[0]];
+      for (std::size_t i = b; i < e; ++i) {
+        const Vec3& u = points[p.vertices[i]];
+        const Vec3& w = points[p.vertices[i + 1 == e ? b : i + 1]];
+        six += c.dot(u.cross(w));
+      }
+    }
+  return six / 6.0;
+}
+
+/// Every directed edge of a closed piece is matched by its reverse.
+bool closed(const Piece& piece) {
+  std::map<std::pair<std::uint32_t, std::uint32_t>, int> count;
+  for (const PiecePolygon& p : piece)
+    for (std::size_t k = 0; k < p.numLoops(); ++k) {
+      const std::size_t b = p.loopBegin(k), e = p.loopEnd[k];
+      for (std::size_t i = b; i < e; ++i) {
+        const std::uint32_t u = p.vertices[i], w = p.vertices[i + 1 == e ? b : i + 1];
+        count[{u, w}]++;
+        count[{w, u}]--;
+      }
+    }
+  for (const auto& [edge, c] : count)
+    if (c != 0) return false;
+  return true;
+}
+
+SplitPlane generalPlane(const Vec3& n, double d, std::uint32_t id) {
+  SplitPlane p;
+  p.normal = n;
+  p.offset = d;
+  p.id = id;
+  return p;
+}
+
+TEST(PlaneSplit, CubeThroughItsMiddle) {
+  const PolyMesh cube = boxMesh(Box3(Vec3(0, 0, 0), Vec3(1, 1, 1)));
+  PlaneSplitter splitter(pointsOf(cube));
+  const PieceSplit s = splitter.split(toPiece(cube), SplitPlane::axisAligned(0, 0.25, 1),
+                                      FaceOrigin::Interior);
+  EXPECT_EQ(s.polygonsSplit, 4u);
+  EXPECT_EQ(s.capPolygons, 1u);
+  EXPECT_TRUE(closed(s.minus));
+  EXPECT_TRUE(closed(s.plus));
+  EXPECT_NEAR(volume(s.minus, splitter.points()), 0.25, kTolerance);
+  EXPECT_NEAR(volume(s.plus, splitter.points()), 0.75, kTolerance);
+  EXPECT_EQ(splitter.points().size(), 12u);  // 4 shared intersection points, made once
+}
+
+TEST(PlaneSplit, PlaneContainingAFaceSplitsNothing) {
+  const PolyMesh cube = boxMesh(Box3(Vec3(0, 0, 0), Vec3(1, 1, 1)));
+  PlaneSplitter splitter(pointsOf(cube));
+  for (double x : {0.0, 1.0}) {
+    const PieceSplit s =
+        splitter.split(toPiece(cube), SplitPlane::axisAligned(0, x, 2), FaceOrigin::Interior);
+    EXPECT_EQ(s.polygonsSplit, 0u);
+    EXPECT_EQ(s.capPolygons, 0u);
+    EXPECT_EQ((x == 0.0 ? s.plus : s.minus).size(), 6u);
+    EXPECT_TRUE((x == 0.0 ? s.minus : s.plus).empty());
+  }
+  EXPECT_EQ(splitter.points().size(), 8u);
+}
+
+TEST(PlaneSplit, DiagonalPlaneAlongEdgesAndThroughVertices) {
+  // x + y = 1 contains the vertical edges at (1,0) and (0,1): two triangular prisms.
+  const PolyMesh cube = boxMesh(Box3(Vec3(0, 0, 0), Vec3(1, 1, 1)));
+  PlaneSplitter splitter(pointsOf(cube));
+  const PieceSplit s = splitter.split(toPiece(cube), generalPlane(Vec3(1, 1, 0), 1.0, 3),
+                                      FaceOrigin::Cut);
+  EXPECT_EQ(splitter.points().size(), 8u);  // no new point: the plane passes through vertices
+  EXPECT_EQ(s.polygonsSplit, 2u);           // top and bottom
+  EXPECT_TRUE(closed(s.minus));
+  EXPECT_TRUE(closed(s.plus));
+  EXPECT_NEAR(volume(s.minus, splitter.points()), 0.5, kTolerance);
+  EXPECT_NEAR(volume(s.plus, splitter.points()), 0.5, kTolerance);
+  EXPECT_EQ(s.minus.size(), 5u);  // 2 triangles, 2 squares, the diagonal cap
+}
+
+TEST(PlaneSplit, PlaneGrazingOneVertex) {
+  const PolyMesh cube = boxMesh(Box3(Vec3(0, 0, 0), Vec3(1, 1, 1)));
+  PlaneSplitter splitter(pointsOf(cube));
+  const PieceSplit s = splitter.split(toPiece(cube), generalPlane(Vec3(1, 1, 1), 0.0, 4),
+                                      FaceOrigin::Cut);
+  EXPECT_TRUE(s.minus.empty());
+  EXPECT_EQ(s.plus.size(), 6u);
+  EXPECT_EQ(s.capPolygons, 0u);
+}
+
+TEST(PlaneSplit, UShapeFallsApartIntoTwoArms) {
+  Polygon2 u;
+  u.outer = {{0, 0}, {3, 0}, {3, 2}, {2, 2}, {2, 1}, {1, 1}, {1, 2}, {0, 2}};
+  const PolyMesh prism = prismMesh(u, 0.0, 1.0);
+  PlaneSplitter splitter(pointsOf(prism));
+  const PieceSplit s = splitter.split(toPiece(prism), SplitPlane::axisAligned(1, 1.5, 5),
+                                      FaceOrigin::Interior);
+  EXPECT_TRUE(closed(s.minus));
+  EXPECT_TRUE(closed(s.plus));
+  EXPECT_NEAR(volume(s.minus, splitter.points()), 4.0, kTolerance);
+  EXPECT_NEAR(volume(s.plus, splitter.points()), 1.0, kTolerance);
+  EXPECT_EQ(PlaneSplitter::components(s.minus).size(), 1u);
+  EXPECT_EQ(PlaneSplitter::components(s.plus).size(), 2u);
+  EXPECT_EQ(s.capPolygons, 2u);
+}
+
+TEST(PlaneSplit, PlaneThroughTheNotchOfAnL) {
+  // y = 1 passes through the reflex vertex (1, 1) and along the edge (2,1)-(1,1).
+  Polygon2 l;
+  l.outer = {{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}};
+  const PolyMesh prism = prismMesh(l, 0.0, 1.0);
+  PlaneSplitter splitter(pointsOf(prism));
+  const PieceSplit s = splitter.split(toPiece(prism), SplitPlane::axisAligned(1, 1.0, 6),
+                                      FaceOrigin::Interior);
+  EXPECT_TRUE(closed(s.minus));
+  EXPECT_TRUE(closed(s.plus));
+  EXPECT_NEAR(volume(s.minus, splitter.points()), 2.0, kTolerance);
+  EXPECT_NEAR(volume(s.plus, splitter.points()), 1.0, kTolerance);
+  EXPECT_EQ(s.capPolygons, 1u);  // the square [0,1]x{1}x[0,1] only
+}
+
+TEST(PlaneSplit, FaceWithHoleSplitThroughTheHole) {
+  Polygon2 p;
+  p.outer = {{0, 0}, {3, 0}, {3, 3}, {0, 3}};
+  p.holes = {{{1, 1}, {1, 2}, {2, 2}, {2, 1}}};
+  const PolyMesh prism = prismMesh(p, 0.0, 1.0);
+  PlaneSplitter splitter(pointsOf(prism));
+  // Through the hole: the holed caps become U shapes; each side stays one component.
+  const PieceSplit s = splitter.split(toPiece(prism), SplitPlane::axisAligned(0, 1.5, 7),
+                                      FaceOrigin::Interior);
+  EXPECT_TRUE(closed(s.minus));
+  EXPECT_TRUE(closed(s.plus));
+  EXPECT_NEAR(volume(s.minus, splitter.points()), 4.0, kTolerance);
+  EXPECT_NEAR(volume(s.plus, splitter.points()), 4.0, kTolerance);
+  EXPECT_EQ(s.capPolygons, 2u);  // two rectangles either side of the hole
+  // Across the top: the caps keep their holes on one side.
+  const PieceSplit t = splitter.split(toPiece(prism), SplitPlane::axisAligned(2, 0.5, 8),
+                                      FaceOrigin::Interior);
+  EXPECT_EQ(t.capPolygons, 1u);
+  std::size_t holed = 0;
+  for (const PiecePolygon& q : t.minus) holed += q.numLoops() == 2;
+  EXPECT_EQ(holed, 2u);  // the bottom face and the cap
+  EXPECT_NEAR(volume(t.minus, splitter.points()), 4.0, kTolerance);
+  // Along a side of the hole (x = 1): the plane contains the hole's wall.
+  const PieceSplit w = splitter.split(toPiece(prism), SplitPlane::axisAligned(0, 1.0, 9),
+                                      FaceOrigin::Interior);
+  EXPECT_TRUE(closed(w.minus));
+  EXPECT_TRUE(closed(w.plus));
+  EXPECT_NEAR(volume(w.minus, splitter.points()), 3.0, kTolerance);
+  EXPECT_NEAR(volume(w.plus, splitter.points()), 5.0, kTolerance);
+}
+
+TEST(PlaneSplit, SplittingTwiceByTheSamePlaneIsANoOp) {
+  const PolyMesh cube = boxMesh(Box3(Vec3(0, 0, 0), Vec3(1, 1, 1)));
+  PlaneSplitter splitter(pointsOf(cube));
+  const SplitPlane plane = generalPlane(Vec3(1, 2, 3), 2.0, 10);
+  const PieceSplit first = splitter.split(toPiece(cube), plane, FaceOrigin::Cut);
+  const std::size_t points = splitter.points().size();
+  const PieceSplit again = splitter.split(first.minus, plane, FaceOrigin::Cut);
+  EXPECT_EQ(again.polygonsSplit, 0u);
+  EXPECT_TRUE(again.plus.empty());
+  EXPECT_EQ(again.minus.size(), first.minus.size());
+  EXPECT_EQ(splitter.points().size(), points);
+}
+
+}  // namespace
+}  // namespace polydg

@@ -1,0 +1,111 @@
+// Face sharing and orientation in PolyMesh, and the generated shapes of mesh/primitives.h.
+#include "mesh/poly_mesh.h"
+
+#include <gtest/gtest.h>
+
+#include "mesh/primitives.h"
+#include "mesh/surface.h"
+
+namespace polydg {
+namespace {
+
+TEST(PolyMesh, HexGridSharesInteriorFaces) {
+  const PolyMesh mesh = hexGridMesh(2, 2, 2, Box3(Vec3(0, 0, 0), Vec3(1, 1, 1)));
+  EXPECT_EQ(mesh.numVertices(), 27u);
+  EXPECT_EQ(mesh.numElements(), 8u);
+  EXPECT_EQ(mesh.numFaces(), 36u);
+  std::size_t interior = 0;
+  for (const Face& face : mesh.faces()) {
+    if (!face.isBoundary()) {
+      ++interior;
+      EXPECT_EQ(face.origin, FaceOrigin::Interior);
+      EXPECT_NE(face.front, face.back);
+    } else {
+      EXPECT_EQ(face.origin, FaceOrigin::Box);
+    }
+  }
+  EXPECT_EQ(interior, 12u);
+  // Each element uses each of its faces with the orientation recorded on the face.
+  for (std::size_t e = 0; e < mesh.numElements(); ++e)
+    for (const FaceUse& use : mesh.element(ElementId(e)).faces) {
+      const Face& face = mesh.face(use.face);
+      EXPECT_EQ(use.reversed ? face.back : face.front, ElementId(e));
+    }
+  // Outward orientation: every element has volume 1/8.
+  for (std::size_t e = 0; e < mesh.numElements(); ++e)
+    EXPECT_DOUBLE_EQ(signedVolume(mesh, ElementId(e)), 0.125);
+}
+
+TEST(PolyMesh, ReverseMatchingIgnoresRotationButNotDirection) {
+  PolyMesh mesh;
+  for (int i = 0; i < 4; ++i) mesh.addVertex(Vec3(i, i * i, 0));
+  const FaceId f = mesh.addFace({Loop{VertexId(0), VertexId(1), VertexId(2), VertexId(3)}},
+                                FaceOrigin::Surface);
+  const Face& face = mesh.face(f);
+  EXPECT_TRUE(isReverseOf(face, {Loop{VertexId(2), VertexId(1), VertexId(0), VertexId(3)}}));
+  EXPECT_TRUE(isReverseOf(face, {Loop{VertexId(3), VertexId(2), VertexId(1), VertexId(0)}}));
+  EXPECT_FALSE(isReverseOf(face, {Loop{VertexId(1), VertexId(2), VertexId(3), VertexId(0)}}));
+  EXPECT_FALSE(isReverseOf(face, {Loop{VertexId(3), VertexId(1), VertexId(2), VertexId(0)}}));
+}
+
+TEST(PolyMesh, RejectsFaceSideUsedTwice) {
+  PolyMesh mesh;
+  for (int i = 0; i < 3; ++i) mesh.addVertex(Vec3(i, i * i, 1));
+  const FaceId f =
+      mesh.addFace({Loop{VertexId(0), VertexId(1), VertexId(2)}}, FaceOrigin::Surface);
+  mesh.addElementFromFaces({{f, false}});
+  EXPECT_THROW(mesh.addElementFromFaces({{f, false}}), std::invalid_argument);
+  EXPECT_THROW(mesh.addFace({Loop{VertexId(0), VertexId(7), VertexId(2)}}, FaceOrigin::Surface),
+               std::out_of_range);
+}
+
+TEST(PolyMesh, PrismWithHoleHasHoledCaps) {
+  Polygon2 p;
+  p.outer = {{0, 0}, {3, 0}, {3, 3}, {0, 3}};
+  p.holes = {{{1, 1}, {1, 2}, {2, 2}, {2, 1}}};
+  const PolyMesh mesh = prismMesh(p, 0.0, 2.0);
+  EXPECT_EQ(mesh.numElements(), 1u);
+  EXPECT_EQ(mesh.numFaces(), 10u);  // 4 outer walls, 4 tunnel walls, top, bottom
+  EXPECT_DOUBLE_EQ(signedVolume(mesh, ElementId(0)), 16.0);
+  std::size_t holed = 0;
+  for (const Face& face : mesh.faces()) holed += face.numLoops() == 2;
+  EXPECT_EQ(holed, 2u);
+  EXPECT_DOUBLE_EQ(areaVector(mesh, FaceId(9)).z(), 8.0);  // top: 9 - 1
+}
+
+TEST(PolyMesh, SingleElementFromClosedSurface) {
+  TriangleSurface tet;
+  tet.vertices = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)};
+  tet.triangles = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+  EXPECT_TRUE(analyzeTopology(tet).closed());
+  EXPECT_DOUBLE_EQ(enclosedVolume(tet), 1.0 / 6.0);
+  const PolyMesh mesh = singleElementMesh(tet);
+  EXPECT_EQ(mesh.numFaces(), 4u);
+  EXPECT_DOUBLE_EQ(signedVolume(mesh, ElementId(0)), 1.0 / 6.0);
+  for (const Face& face : mesh.faces()) EXPECT_EQ(face.origin, FaceOrigin::Surface);
+}
+
+TEST(SurfaceTopology, CountsBoundaryNonManifoldAndMisorientedEdges) {
+  TriangleSurface s;
+  s.vertices = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1), Vec3(1, 1, 1)};
+  s.triangles = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+  SurfaceTopology t = analyzeTopology(s);
+  EXPECT_TRUE(t.closed());
+  EXPECT_EQ(t.edges, 6u);
+  EXPECT_EQ(t.components, 1u);
+  s.triangles[3] = {1, 3, 2};  // flipped
+  t = analyzeTopology(s);
+  EXPECT_EQ(t.misorientedEdges, 3u);
+  EXPECT_FALSE(t.closed());
+  s.triangles.pop_back();  // open
+  t = analyzeTopology(s);
+  EXPECT_EQ(t.boundaryEdges, 3u);
+  s.triangles.push_back({1, 2, 4});
+  s.triangles.push_back({4, 2, 1});
+  t = analyzeTopology(s);
+  EXPECT_EQ(t.nonManifoldEdges, 1u);  // edge 1-2 used by three triangles
+  EXPECT_EQ(t.boundaryEdges, 2u);     // 1-3 and 3-2 still open
+}
+
+}  // namespace
+}  // namespace polydg

@@ -1,0 +1,126 @@
+// Hexahedral slicing of generated shapes whose exact polyhedral volume is known: the elements
+// fill the input's volume, every element is valid, and components come out right, also for
+// faces on grid planes, thin plates, nearby shells, cavities, and far from the origin.
+#include "mesh/slice.h"
+
+#include <gtest/gtest.h>
+
+#include "integrate/moment_cache.h"
+#include "mesh/surface_shapes.h"
+#include "mesh/validate.h"
+
+namespace polydg {
+namespace {
+
+/// Slicing keeps the polyhedral volume to this relative accuracy.
+constexpr double kVolumeTolerance = 1e-10;
+
+struct Sliced {
+  PolyMesh mesh;
+  ValidationReport validation;
+  double volume = 0.0;
+  std::size_t hexahedra = 0;
+  std::vector<double> elementVolumes;
+};
+
+Sliced slice(const TriangleSurface& surface, const Grid& grid) {
+  Sliced s;
+  s.mesh = sliceSurface(surface, grid);
+  s.validation = validate(s.mesh);
+  MomentCache moments(s.mesh, 0);
+  moments.update();
+  for (std::size_t e = 0; e < s.mesh.numElements(); ++e) {
+    s.volume += moments.volume(ElementId(e));
+    s.elementVolumes.push_back(moments.volume(ElementId(e)));
+    const Element& element = s.mesh.element(ElementId(e));
+    bool hex = element.faces.size() == 6;
+    for (const FaceUse& use : element.faces)
+      hex = hex && s.mesh.face(use.face).vertices.size() == 4 &&
+            s.mesh.face(use.face).origin == FaceOrigin::Interior;
+    s.hexahedra += hex;
+  }
+  return s;
+}
+
+void expectGood(const Sliced& s, double exactVolume, std::size_t components) {
+  EXPECT_TRUE(s.validation.passed);
+  for (const std::string& m : s.validation.messages) ADD_FAILURE() << m;
+  EXPECT_NEAR(s.volume, exactVolume, kVolumeTolerance * std::abs(exactVolume));
+  EXPECT_NEAR(s.validation.volume, exactVolume, kVolumeTolerance * std::abs(exactVolume));
+  EXPECT_EQ(s.validation.components, components);
+}
+
+TEST(Slice, SphereFillsItsVolume) {
+  const TriangleSurface sphere = icosphere(Vec3(0.1, -0.2, 0.05), 1.0, 3);
+  const Sliced s = slice(sphere, Grid::withCellsAlongLongest(bounds(sphere), 8));
+  expectGood(s, enclosedVolume(sphere), 1);
+  EXPECT_GT(s.hexahedra, 50u);  // the inside is hexahedra
+  EXPECT_GT(s.mesh.numElements(), s.hexahedra + 100);
+}
+
+TEST(Slice, TorusIsOneComponentWithAHole) {
+  const TriangleSurface t = torus(Vec3::Zero(), 1.0, 0.35, 48, 24);
+  const Sliced s = slice(t, Grid::withCellsAlongLongest(bounds(t), 10));
+  expectGood(s, enclosedVolume(t), 1);
+}
+
+TEST(Slice, GridAlignedCubeGivesExactHexahedra) {
+  // Faces on grid planes, corners on grid nodes, edges on grid lines.
+  const TriangleSurface cube = boxSurface(Box3(Vec3(0, 0, 0), Vec3(1, 1, 1)));
+  const Grid grid = Grid::covering(bounds(cube), 0.25);
+  ASSERT_EQ(grid.origin(), Vec3::Zero());
+  const Sliced s = slice(cube, grid);
+  expectGood(s, 1.0, 1);
+  EXPECT_EQ(s.mesh.numElements(), 64u);
+  EXPECT_EQ(s.hexahedra, 8u);  // the 2 x 2 x 2 cells that touch no side
+  for (double v : s.elementVolumes) EXPECT_NEAR(v, 1.0 / 64, 1e-16);
+}
+
+TEST(Slice, PlateThinnerThanOneCell) {
+  const TriangleSurface plate = boxSurface(Box3(Vec3(0, 0, 0.4), Vec3(1, 1, 0.41)));
+  const Grid grid = Grid::covering(Box3(Vec3(0, 0, 0), Vec3(1, 1, 1)), 0.25);
+  const Sliced s = slice(plate, grid);
+  expectGood(s, 0.01, 1);
+  EXPECT_EQ(s.mesh.numElements(), 16u);
+}
+
+TEST(Slice, TwoSpheresInOneCellAreTwoElements) {
+  const TriangleSurface two = combine(icosphere(Vec3(0.3, 0.5, 0.5), 0.15, 2),
+                                      icosphere(Vec3(0.7, 0.5, 0.5), 0.15, 2));
+  const Grid grid = Grid::covering(Box3(Vec3(0, 0, 0), Vec3(1, 1, 1)), 1.0);
+  ASSERT_EQ(grid.cells, (std::array<int, 3>{1, 1, 1}));
+  const Sliced s = slice(two, grid);
+  expectGood(s, enclosedVolume(two), 2);
+  EXPECT_EQ(s.mesh.numElements(), 2u);
+  EXPECT_EQ(s.validation.interiorFaces, 0u);
+  // Finer: still two components, never coupled.
+  const Sliced fine = slice(two, Grid::covering(bounds(two), 0.1));
+  expectGood(fine, enclosedVolume(two), 2);
+}
+
+TEST(Slice, HollowSphereKeepsItsCavity) {
+  const TriangleSurface hollow = combine(icosphere(Vec3::Zero(), 1.0, 3),
+                                         reversedSurface(icosphere(Vec3::Zero(), 0.6, 2)));
+  const Sliced s = slice(hollow, Grid::withCellsAlongLongest(bounds(hollow), 7));
+  expectGood(s, enclosedVolume(hollow), 1);
+  EXPECT_LT(enclosedVolume(hollow), enclosedVolume(icosphere(Vec3::Zero(), 1.0, 3)));
+}
+
+TEST(Slice, FarFromTheOriginAndAtSmallScale) {
+  struct Case {
+    double scale;
+    Vec3 offset;
+  };
+  const TriangleSurface base = combine(icosphere(Vec3::Zero(), 1.0, 3),
+                                       reversedSurface(icosphere(Vec3::Zero(), 0.5, 2)));
+  for (const Case& c : {Case{1.0, Vec3(1e6, -1e6, 1e6)}, Case{1e-6, Vec3::Zero()},
+                        Case{1e6, Vec3::Zero()}}) {
+    const TriangleSurface moved = transformed(base, c.scale, c.offset);
+    const Sliced s = slice(moved, Grid::withCellsAlongLongest(bounds(moved), 6));
+    SCOPED_TRACE("scale " + std::to_string(c.scale) + " offset " + std::to_string(c.offset.x()));
+    expectGood(s, enclosedVolume(moved), 1);
+  }
+}
+
+}  // namespace
+}  // namespace polydg

@@ -1,0 +1,638 @@
+// Tests of mesh/vtu_io.h (VTU writing and reading) and mesh/face_triangulation.h.
+//
+// Two groups only run when ctest sets an environment variable (they skip otherwise):
+//   POLYDG_VTK_FILES=DIR/vtk_cells.vtu: files written by VTK itself (tests/mesh/vtk_check.py
+//     --write-vtk), read back with known exact volumes;
+//   POLYDG_VTU_OUT_DIR=DIR: writes polydg files into DIR for vtk_check.py to open with VTK and
+//     meshio.
+#include "mesh/vtu_io.h"
+
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <optional>
+#include <span>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "mesh/face_triangulation.h"
+#include "mesh/geometry.h"
+#include "mesh/primitives.h"
+
+namespace polydg {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// Relative tolerance for volumes and areas computed in different ways from the same numbers.
+constexpr double kRelativeTolerance = 1e-12;
+
+/// A fresh, empty directory for the current test.
+fs::path testDir() {
+  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  std::string name = std::string(info->test_suite_name()) + "_" + info->name();
+  std::replace(name.begin(), name.end(), '/', '_');
+  const fs::path dir = fs::path(::testing::TempDir()) / "polydg_vtu_test" / name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+void writeText(const fs::path& path, const std::string& text) {
+  std::ofstream(path, std::ios::binary) << text;
+}
+
+std::string readText(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+/// The message of the std::runtime_error that `f` throws ("" if it throws nothing).
+template <class F>
+std::string errorMessage(F&& f) {
+  try {
+    f();
+  } catch (const std::runtime_error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// --- meshes --------------------------------------------------------------------------------
+
+/// A U-shaped polygon with a square hole in its base and a triangular hole in its left arm.
+/// Area 6 * 5 - 2 * 3 - 1 - 0.75 = 22.25.
+Polygon2 uWithHoles() {
+  Polygon2 p;
+  p.outer = {{0, 0}, {6, 0}, {6, 5}, {4, 5}, {4, 2}, {2, 2}, {2, 5}, {0, 5}};
+  p.holes = {{{2.5, 0.5}, {2.5, 1.5}, {3.5, 1.5}, {3.5, 0.5}}, {{0.5, 3}, {1, 4.5}, {1.5, 3}}};
+  return p;
+}
+constexpr double kUArea = 22.25;
+
+PolyMesh holedPrism() { return prismMesh(uWithHoles(), 0.0, 1.5, Vec2(0.25, -0.125)); }
+
+/// A grid whose coordinates are not exact binary fractions, to check exact round trips.
+PolyMesh skewGrid() {
+  return hexGridMesh(3, 2, 2, Box3(Vec3(-1.0, 0.1, 2.0), Vec3(2.0, 1.3, 3.7)));
+}
+
+/// Three polyhedra whose point counts are not in increasing order: the unit cube (8 points), an
+/// L-shaped prism (14 points, volume 3) sharing the cube's x = 1 face, and a pyramid (5 points,
+/// volume 1/3) on the cube's top. Boundary faces are tagged Box, Surface and one Cut.
+PolyMesh mixedCells() {
+  PolyMesh mesh;
+  std::map<std::array<double, 3>, VertexId> index;
+  auto vertex = [&](double x, double y, double z) {
+    const auto [it, added] = index.try_emplace({x, y, z});
+    if (added) it->second = mesh.addVertex(Vec3(x, y, z));
+    return it->second;
+  };
+  auto prism = [&](const std::vector<Vec2>& polygon) {  // counter-clockwise polygon, z in [0, 1]
+    std::vector<std::vector<Loop>> faces;
+    Loop bottom, top;
+    for (std::size_t i = 0; i < polygon.size(); ++i) {
+      const Vec2& a = polygon[i];
+      const Vec2& b = polygon[(i + 1) % polygon.size()];
+      faces.push_back({{vertex(a.x(), a.y(), 0), vertex(b.x(), b.y(), 0), vertex(b.x(), b.y(), 1),
+                        vertex(a.x(), a.y(), 1)}});
+      bottom.insert(bottom.begin(), vertex(a.x(), a.y(), 0));
+      top.push_back(vertex(a.x(), a.y(), 1));
+    }
+    faces.push_back({bottom});
+    faces.push_back({top});
+    return faces;
+  };
+  const std::vector<Vec2> square{{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  mesh.addElement(prism(square), FaceOrigin::Box);
+  mesh.addElement(prism({{1, 0}, {3, 0}, {3, 1}, {2, 1}, {2, 2}, {1, 2}, {1, 1}}), FaceOrigin::Box);
+  std::vector<std::vector<Loop>> pyramid{
+      {{vertex(0, 0, 1), vertex(0, 1, 1), vertex(1, 1, 1), vertex(1, 0, 1)}}};
+  for (std::size_t i = 0; i < 4; ++i) {
+    const Vec2& a = square[i];
+    const Vec2& b = square[(i + 1) % 4];
+    pyramid.push_back({{vertex(a.x(), a.y(), 1), vertex(b.x(), b.y(), 1), vertex(0.5, 0.5, 2)}});
+  }
+  mesh.addElement(pyramid, FaceOrigin::Surface);
+  mesh.setOrigin(FaceId(0), FaceOrigin::Cut);
+  return mesh;
+}
+
+// --- comparisons ---------------------------------------------------------------------------
+
+/// True if `b` is the cycle `a`, possibly starting elsewhere.
+bool sameCycle(std::span<const VertexId> a, std::span<const VertexId> b) {
+  if (a.size() != b.size() || a.empty()) return a.size() == b.size();
+  const auto start = std::find(b.begin(), b.end(), a[0]);
+  if (start == b.end()) return false;
+  const std::size_t s = static_cast<std::size_t>(start - b.begin());
+  for (std::size_t i = 0; i < a.size(); ++i)
+    if (a[i] != b[(s + i) % b.size()]) return false;
+  return true;
+}
+
+/// Same vertices (bitwise), faces (outer loop as a cycle, holes as cycles in any order, as in
+/// isReverseOf), sides, origins, element face uses, and signed volumes.
+void expectSameMesh(const PolyMesh& expected, const PolyMesh& actual) {
+  ASSERT_EQ(expected.numVertices(), actual.numVertices());
+  ASSERT_EQ(expected.numFaces(), actual.numFaces());
+  ASSERT_EQ(expected.numElements(), actual.numElements());
+  for (std::size_t v = 0; v < expected.numVertices(); ++v)
+    EXPECT_EQ(expected.position(VertexId(v)), actual.position(VertexId(v))) << "vertex " << v;
+  for (std::size_t i = 0; i < expected.numFaces(); ++i) {
+    const Face& a = expected.face(FaceId(i));
+    const Face& b = actual.face(FaceId(i));
+    EXPECT_EQ(toString(a.origin), toString(b.origin)) << "face " << i;
+    EXPECT_EQ(a.front, b.front) << "face " << i;
+    EXPECT_EQ(a.back, b.back) << "face " << i;
+    ASSERT_EQ(a.numLoops(), b.numLoops()) << "face " << i;
+    EXPECT_TRUE(sameCycle(a.loop(0), b.loop(0))) << "outer loop of face " << i;
+    std::vector<bool> matched(b.numLoops(), false);
+    for (std::size_t k = 1; k < a.numLoops(); ++k) {
+      bool found = false;
+      for (std::size_t j = 1; j < b.numLoops() && !found; ++j)
+        if (!matched[j] && sameCycle(a.loop(k), b.loop(j))) matched[j] = found = true;
+      EXPECT_TRUE(found) << "hole " << k << " of face " << i;
+    }
+  }
+  for (std::size_t i = 0; i < expected.numElements(); ++i) {
+    const ElementId e(i);
+    const auto& a = expected.element(e).faces;
+    const auto& b = actual.element(e).faces;
+    ASSERT_EQ(a.size(), b.size()) << "element " << i;
+    for (std::size_t k = 0; k < a.size(); ++k) {
+      EXPECT_EQ(a[k].face, b[k].face) << "element " << i << " use " << k;
+      EXPECT_EQ(a[k].reversed, b[k].reversed) << "element " << i << " use " << k;
+    }
+    const double va = signedVolume(expected, e);
+    EXPECT_NEAR(va, signedVolume(actual, e), kRelativeTolerance * std::abs(va)) << "element " << i;
+  }
+}
+
+std::size_t countInteriorFaces(const PolyMesh& mesh) {
+  return static_cast<std::size_t>(std::count_if(mesh.faces().begin(), mesh.faces().end(),
+                                                [](const Face& f) { return !f.isBoundary(); }));
+}
+
+// --- face triangulation --------------------------------------------------------------------
+
+/// Checks that `triangles` tile face `f`: total area equals the face's, each triangle is
+/// oriented like the face, and each loop edge is an edge of exactly one triangle, in the loop's
+/// direction (so the element stays closed).
+void expectTilesFace(const PolyMesh& mesh, FaceId f,
+                     const std::vector<std::array<VertexId, 3>>& triangles) {
+  const Vec3 faceArea = areaVector(mesh, f);
+  double sum = 0.0;
+  std::map<std::pair<VertexId, VertexId>, int> edges;
+  for (const auto& t : triangles) {
+    const Vec3 a = 0.5 * (mesh.position(t[1]) - mesh.position(t[0]))
+                             .cross(mesh.position(t[2]) - mesh.position(t[0]));
+    EXPECT_GT(a.dot(faceArea), 0.0) << "triangle oriented against the face";
+    EXPECT_NEAR(a.cross(faceArea).norm(), 0.0, kRelativeTolerance * faceArea.squaredNorm());
+    sum += a.norm();
+    for (int i = 0; i < 3; ++i) ++edges[{t[i], t[(i + 1) % 3]}];
+  }
+  EXPECT_NEAR(sum, faceArea.norm(), kRelativeTolerance * faceArea.norm());
+  const Face& face = mesh.face(f);
+  for (std::size_t k = 0; k < face.numLoops(); ++k) {
+    const auto loop = face.loop(k);
+    for (std::size_t i = 0; i < loop.size(); ++i) {
+      const auto edge = std::make_pair(loop[i], loop[(i + 1) % loop.size()]);
+      EXPECT_EQ(edges[edge], 1) << "loop " << k << " edge " << i;
+    }
+  }
+}
+
+TEST(FaceTriangulation, SquareWithSquareHoleGivesEightTriangles) {
+  PolyMesh mesh;
+  Loop outer, hole;
+  for (const Vec2& p : std::vector<Vec2>{{0, 0}, {4, 0}, {4, 4}, {0, 4}})
+    outer.push_back(mesh.addVertex(Vec3(p.x(), p.y(), 1.0)));
+  for (const Vec2& p : std::vector<Vec2>{{1, 1}, {1, 3}, {3, 3}, {3, 1}})  // clockwise
+    hole.push_back(mesh.addVertex(Vec3(p.x(), p.y(), 1.0)));
+  const FaceId f = mesh.addFace({outer, hole}, FaceOrigin::Box);
+  const auto triangles = triangulateFace(mesh, f);
+  EXPECT_EQ(triangles.size(), 8u);
+  EXPECT_DOUBLE_EQ(areaVector(mesh, f).norm(), 12.0);
+  expectTilesFace(mesh, f, triangles);
+}
+
+TEST(FaceTriangulation, TiltedFaceFacingNegativeAxis) {
+  // The square-with-hole face, turned so that its normal is mostly -x; orientation must survive
+  // the projection that drops x.
+  PolyMesh mesh;
+  auto place = [&](double u, double v) { return mesh.addVertex(Vec3(0.3 * v - 2.0, v, u)); };
+  Loop outer, hole;
+  for (const Vec2& p : std::vector<Vec2>{{0, 0}, {4, 0}, {4, 4}, {0, 4}})
+    outer.push_back(place(p.x(), p.y()));
+  for (const Vec2& p : std::vector<Vec2>{{1, 1}, {1, 3}, {3, 3}, {3, 1}})
+    hole.push_back(place(p.x(), p.y()));
+  const FaceId f = mesh.addFace({outer, hole}, FaceOrigin::Box);
+  ASSERT_LT(areaVector(mesh, f).x(), 0.0);
+  const auto triangles = triangulateFace(mesh, f);
+  EXPECT_EQ(triangles.size(), 8u);
+  expectTilesFace(mesh, f, triangles);
+}
+
+TEST(FaceTriangulation, PrismCapsWithHolesAreTiled) {
+  const PolyMesh mesh = holedPrism();
+  int capped = 0;
+  for (std::size_t i = 0; i < mesh.numFaces(); ++i) {
+    const FaceId f(i);
+    const Face& face = mesh.face(f);
+    if (face.numLoops() == 1) continue;
+    ++capped;
+    const auto triangles = triangulateFace(mesh, f);
+    // n vertices in all and h holes give n + 2h - 2 triangles.
+    EXPECT_EQ(triangles.size(), face.vertices.size() + 2 * (face.numLoops() - 1) - 2);
+    EXPECT_NEAR(areaVector(mesh, f).norm(), kUArea, kRelativeTolerance * kUArea);
+    expectTilesFace(mesh, f, triangles);
+  }
+  EXPECT_EQ(capped, 2);
+}
+
+TEST(FaceTriangulation, CrossingLoopsThrow) {
+  PolyMesh mesh;
+  Loop outer, hole;
+  for (const Vec2& p : std::vector<Vec2>{{0, 0}, {4, 0}, {4, 4}, {0, 4}})
+    outer.push_back(mesh.addVertex(Vec3(p.x(), p.y(), 0.0)));
+  for (const Vec2& p : std::vector<Vec2>{{1, 1}, {1, 5}, {3, 5}, {3, 1}})  // sticks out
+    hole.push_back(mesh.addVertex(Vec3(p.x(), p.y(), 0.0)));
+  const FaceId f = mesh.addFace({outer, hole}, FaceOrigin::Box);
+  EXPECT_THROW(triangulateFace(mesh, f), std::runtime_error);
+}
+
+// --- round trips ---------------------------------------------------------------------------
+
+struct RoundTripCase {
+  std::string name;
+  PolyMesh (*make)();
+  VtuEncoding encoding;
+};
+
+void PrintTo(const RoundTripCase& c, std::ostream* os) { *os << c.name; }
+
+class VtuRoundTrip : public ::testing::TestWithParam<RoundTripCase> {};
+
+TEST_P(VtuRoundTrip, RestoresTheMeshExactly) {
+  const PolyMesh mesh = GetParam().make();
+  const fs::path path = testDir() / "mesh.vtu";
+  writeVtu(mesh, path.string(), {.encoding = GetParam().encoding});
+  expectSameMesh(mesh, readVtu(path.string()));
+}
+
+TEST_P(VtuRoundTrip, WithoutPolydgFieldDataSharesFacesByMatching) {
+  // Strip the field data: faces are then matched between cells; simple faces come back
+  // the same, faces with holes as their triangles, and every boundary face is Imported.
+  const PolyMesh mesh = GetParam().make();
+  const fs::path path = testDir() / "mesh.vtu";
+  writeVtu(mesh, path.string(), {.encoding = GetParam().encoding});
+  std::string text = readText(path);
+  const auto begin = text.find("<FieldData>");
+  const auto end = text.find("</FieldData>");
+  ASSERT_NE(begin, std::string::npos);
+  text.erase(begin, end + std::string("</FieldData>").size() - begin);
+  writeText(path, text);
+
+  const PolyMesh read = readVtu(path.string());
+  ASSERT_EQ(read.numElements(), mesh.numElements());
+  EXPECT_EQ(countInteriorFaces(read), countInteriorFaces(mesh));
+  double total = 0.0, expectedTotal = 0.0;
+  for (std::size_t e = 0; e < mesh.numElements(); ++e) {
+    total += signedVolume(read, ElementId(e));
+    expectedTotal += signedVolume(mesh, ElementId(e));
+  }
+  EXPECT_NEAR(total, expectedTotal, kRelativeTolerance * expectedTotal);
+  for (const Face& f : read.faces()) {
+    EXPECT_EQ(f.numLoops(), 1u);
+    if (f.isBoundary()) {
+      EXPECT_EQ(toString(f.origin), "imported");
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Meshes, VtuRoundTrip,
+    ::testing::Values(RoundTripCase{"HexGridAscii", skewGrid, VtuEncoding::Ascii},
+                      RoundTripCase{"HexGridBinary", skewGrid, VtuEncoding::Binary},
+                      RoundTripCase{"HoledPrismAscii", holedPrism, VtuEncoding::Ascii},
+                      RoundTripCase{"HoledPrismBinary", holedPrism, VtuEncoding::Binary},
+                      RoundTripCase{"MixedCellsAscii", mixedCells, VtuEncoding::Ascii},
+                      RoundTripCase{"MixedCellsBinary", mixedCells, VtuEncoding::Binary}),
+    [](const auto& info) { return info.param.name; });
+
+TEST(VtuRoundTrip, InteriorFaceWhoseFrontIsTheLaterElement) {
+  // Faces are added first and used with the later element in front, which the reader can
+  // only restore from polydg_face_reversed.
+  PolyMesh mesh = hexGridMesh(2, 1, 1, Box3(Vec3(0, 0, 0), Vec3(2, 1, 1)));
+  PolyMesh swapped;
+  for (const Vec3& p : mesh.positions()) swapped.addVertex(p);
+  for (const Face& f : mesh.faces()) {
+    std::vector<Loop> loops;
+    for (std::size_t k = 0; k < f.numLoops(); ++k)
+      loops.emplace_back(f.loop(k).begin(), f.loop(k).end());
+    swapped.addFace(loops, f.origin);
+  }
+  for (std::size_t e = mesh.numElements(); e-- > 0;)
+    swapped.addElementFromFaces(mesh.element(ElementId(e)).faces);
+  ASSERT_EQ(countInteriorFaces(swapped), 1u);
+  const fs::path path = testDir() / "swapped.vtu";
+  writeVtu(swapped, path.string());
+  expectSameMesh(swapped, readVtu(path.string()));
+}
+
+// --- writer --------------------------------------------------------------------------------
+
+TEST(VtuWrite, LeavesNoTemporaryFileAndReplacesAnOldFile) {
+  const fs::path path = testDir() / "grid.vtu";
+  writeText(path, "old contents");
+  writeVtu(skewGrid(), path.string());
+  EXPECT_TRUE(fs::exists(path));
+  EXPECT_FALSE(fs::exists(path.string() + ".tmp"));
+  EXPECT_EQ(readVtu(path.string()).numElements(), 12u);
+}
+
+TEST(VtuWrite, UnwritablePathThrowsNamingTheFile) {
+  const fs::path path = testDir() / "no_such_dir" / "grid.vtu";
+  const std::string message = errorMessage([&] { writeVtu(skewGrid(), path.string()); });
+  EXPECT_NE(message.find("cannot write " + path.string()), std::string::npos) << message;
+  EXPECT_FALSE(fs::exists(path.string() + ".tmp"));
+}
+
+TEST(VtuWrite, WritesCallerArraysAndVolume) {
+  const PolyMesh mesh = skewGrid();
+  CellArray id{"element_id", 1, {}};
+  CellArray centre{"centre", 3, {}};
+  for (std::size_t e = 0; e < mesh.numElements(); ++e) {
+    id.values.push_back(static_cast<double>(e));
+    const Vec3 c = elementReferencePoint(mesh, ElementId(e));
+    centre.values.insert(centre.values.end(), {c.x(), c.y(), c.z()});
+  }
+  PointArray height{"height & \"z\"", 1, {}};
+  for (const Vec3& p : mesh.positions()) height.values.push_back(p.z());
+  const fs::path path = testDir() / "data.vtu";
+  writeVtu(mesh, path.string(), {.encoding = VtuEncoding::Ascii}, {id, centre}, {height});
+  const std::string text = readText(path);
+  EXPECT_NE(text.find("Name=\"volume\""), std::string::npos);
+  EXPECT_NE(text.find("Name=\"element_id\""), std::string::npos);
+  EXPECT_NE(text.find("Name=\"centre\" NumberOfComponents=\"3\""), std::string::npos);
+  EXPECT_NE(text.find("Name=\"height &amp; &quot;z&quot;\""), std::string::npos);
+  EXPECT_EQ(readVtu(path.string()).numElements(), mesh.numElements());
+}
+
+TEST(VtuWrite, RejectsMalformedArrays) {
+  const PolyMesh mesh = skewGrid();
+  const std::string path = (testDir() / "bad.vtu").string();
+  EXPECT_THROW(writeVtu(mesh, path, {}, {CellArray{"short", 1, {1.0}}}), std::invalid_argument);
+  EXPECT_THROW(writeVtu(mesh, path, {}, {CellArray{"volume", 1, std::vector<double>(12)}}),
+               std::invalid_argument);
+  EXPECT_THROW(writeVtu(mesh, path, {}, {CellArray{"pair", 2, std::vector<double>(24)}}),
+               std::invalid_argument);
+  EXPECT_THROW(writeVtu(mesh, path, {}, {}, {PointArray{"", 1, std::vector<double>(48)}}),
+               std::invalid_argument);
+  EXPECT_FALSE(fs::exists(path));
+}
+
+// --- reader errors and hand-written files --------------------------------------------------
+
+TEST(VtuRead, MissingFileThrowsNamingTheFile) {
+  const std::string path = (testDir() / "missing.vtu").string();
+  const std::string message = errorMessage([&] { readVtu(path); });
+  EXPECT_EQ(message.rfind(path + ": cannot open", 0), 0u) << message;
+}
+
+TEST(VtuRead, OtherXmlThrowsNotAVtkFile) {
+  const fs::path path = testDir() / "page.vtu";
+  writeText(path, "<?xml version=\"1.0\"?>\n<html><body>hello</body></html>\n");
+  EXPECT_EQ(errorMessage([&] { readVtu(path.string()); }),
+            path.string() + ": not a VTK UnstructuredGrid file");
+  writeText(path, "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\"><PolyData/></VTKFile>\n");
+  EXPECT_EQ(errorMessage([&] { readVtu(path.string()); }),
+            path.string() + ": not a VTK UnstructuredGrid file");
+}
+
+TEST(VtuRead, TruncatedFilesThrowNamingTheFile) {
+  for (VtuEncoding encoding : {VtuEncoding::Ascii, VtuEncoding::Binary}) {
+    const fs::path path = testDir() / "cut.vtu";
+    writeVtu(holedPrism(), path.string(), {.encoding = encoding});
+    const std::string text = readText(path);
+    for (double fraction : {0.3, 0.6, 0.95}) {
+      writeText(path, text.substr(0, static_cast<std::size_t>(fraction * text.size())));
+      const std::string message = errorMessage([&] { readVtu(path.string()); });
+      EXPECT_EQ(message.rfind(path.string() + ": ", 0), 0u) << message;
+      EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+    }
+  }
+}
+
+/// Twelve points p(i, j, k) = i + 3 j + 6 k at (i, j, k), i < 3, j, k < 2; `cells` is the
+/// inside of <Cells>.
+std::string handWrittenVtu(int numCells, const std::string& cells) {
+  std::string points;
+  for (int k = 0; k < 2; ++k)
+    for (int j = 0; j < 2; ++j)
+      for (int i = 0; i < 3; ++i)
+        points += std::to_string(i) + " " + std::to_string(j) + " " + std::to_string(k) + " ";
+  return "<?xml version=\"1.0\"?>\n"
+         "<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
+         "<UnstructuredGrid><Piece NumberOfPoints=\"12\" NumberOfCells=\"" +
+         std::to_string(numCells) +
+         "\">\n<Points><DataArray type=\"Float32\" NumberOfComponents=\"3\" format=\"ascii\">" +
+         points + "</DataArray></Points>\n<Cells>" + cells +
+         "</Cells></Piece></UnstructuredGrid></VTKFile>\n";
+}
+
+std::string asciiArray(const char* type, const char* name, const std::string& values) {
+  return std::string("<DataArray type=\"") + type + "\" Name=\"" + name + "\" format=\"ascii\">" +
+         values + "</DataArray>\n";
+}
+
+TEST(VtuRead, InvalidSharingBuildsDuplicateFacesWithoutThrowing) {
+  // Cell 0: unit cube [0,1]^3 as a VTK hexahedron; cell 1: [1,2]x[0,1]^2 as a polyhedron
+  // sharing x = 1 with cell 0; cell 2: cell 0 again, whose faces then have the same
+  // orientation as cell 0's (or, at x = 1, would be used a third time): all duplicated.
+  const std::string cells =
+      asciiArray("Int32", "connectivity", "0 1 4 3 6 7 10 9  1 2 5 4 7 8 11 10  0 1 4 3 6 7 10 9") +
+      asciiArray("Int32", "offsets", "8 16 24") + asciiArray("UInt8", "types", "12 42 12") +
+      asciiArray("Int32", "faces",
+                 "6 4 1 7 10 4  4 2 5 11 8  4 1 2 8 7  4 4 10 11 5  4 1 4 5 2  4 7 8 11 10") +
+      asciiArray("Int32", "faceoffsets", "-1 31 -1");
+  const fs::path path = testDir() / "duplicates.vtu";
+  writeText(path, handWrittenVtu(3, cells));
+  const PolyMesh mesh = readVtu(path.string());
+  ASSERT_EQ(mesh.numElements(), 3u);
+  EXPECT_EQ(mesh.numVertices(), 12u);
+  EXPECT_EQ(mesh.numFaces(), 6u + 5u + 6u);
+  EXPECT_EQ(countInteriorFaces(mesh), 1u);
+  for (std::size_t e = 0; e < 3; ++e) {
+    EXPECT_EQ(mesh.element(ElementId(e)).faces.size(), 6u);
+    EXPECT_NEAR(signedVolume(mesh, ElementId(e)), 1.0, kRelativeTolerance);
+  }
+  for (const Face& f : mesh.faces())
+    if (f.isBoundary()) {
+      EXPECT_EQ(toString(f.origin), "imported");
+    }
+}
+
+TEST(VtuRead, UnsupportedCellTypeThrows) {
+  const std::string cells = asciiArray("Int32", "connectivity", "0 1 4") +
+                            asciiArray("Int32", "offsets", "3") + asciiArray("UInt8", "types", "5");
+  const fs::path path = testDir() / "triangle.vtu";
+  writeText(path, handWrittenVtu(1, cells));
+  EXPECT_EQ(errorMessage([&] { readVtu(path.string()); }),
+            path.string() +
+                ": cell 0 has VTK type 5, which polydg does not read; only 3D linear cells and "
+                "polyhedra are supported");
+}
+
+TEST(VtuRead, PointIdOutOfRangeThrows) {
+  const std::string cells = asciiArray("Int32", "connectivity", "0 1 4 12") +
+                            asciiArray("Int32", "offsets", "4") +
+                            asciiArray("UInt8", "types", "10");
+  const fs::path path = testDir() / "range.vtu";
+  writeText(path, handWrittenVtu(1, cells));
+  const std::string message = errorMessage([&] { readVtu(path.string()); });
+  EXPECT_EQ(message.rfind(path.string() + ": cell 0 refers to point 12", 0), 0u) << message;
+}
+
+// --- base64 --------------------------------------------------------------------------------
+
+TEST(Base64, MatchesRfc4648Vectors) {
+  const std::pair<std::string, std::string> vectors[] = {{"", ""},
+                                                         {"f", "Zg=="},
+                                                         {"fo", "Zm8="},
+                                                         {"foo", "Zm9v"},
+                                                         {"foob", "Zm9vYg=="},
+                                                         {"fooba", "Zm9vYmE="},
+                                                         {"foobar", "Zm9vYmFy"}};
+  for (const auto& [plain, encoded] : vectors) {
+    EXPECT_EQ(vtu_detail::base64Encode(plain), encoded);
+    EXPECT_EQ(vtu_detail::base64Decode(encoded), plain);
+  }
+  const std::string binary("\x00\xff\x10\x80\x7f", 5);
+  EXPECT_EQ(vtu_detail::base64Decode(vtu_detail::base64Encode(binary)), binary);
+}
+
+TEST(Base64, DecodesConcatenatedPaddedPiecesAndSkipsWhitespace) {
+  EXPECT_EQ(vtu_detail::base64Decode("Zg==Zm8=\n  Zm9v"), "ffofoo");
+  EXPECT_THROW(vtu_detail::base64Decode("Zm9v!"), std::runtime_error);
+  EXPECT_THROW(vtu_detail::base64Decode("Zm9vY"), std::runtime_error);
+  EXPECT_THROW(vtu_detail::base64Decode("Z==="), std::runtime_error);
+}
+
+// --- files written by VTK (ctest fixture: vtk_check.py --write-vtk) -------------------------
+
+/// The path of a file made by vtk_check.py --write-vtk: `suffix` "" for the main file.
+std::optional<fs::path> vtkFile(const std::string& suffix) {
+  const char* main = std::getenv("POLYDG_VTK_FILES");
+  if (main == nullptr || *main == '\0') return std::nullopt;
+  const fs::path path(main);
+  return path.parent_path() / (path.stem().string() + suffix + ".vtu");
+}
+
+#define REQUIRE_VTK_FILE(var, suffix)                                                        \
+  const auto var = vtkFile(suffix);                                                          \
+  if (!var) GTEST_SKIP() << "POLYDG_VTK_FILES is not set; ctest runs this as vtu_vtk_files"; \
+  ASSERT_TRUE(fs::exists(*var)) << *var
+
+/// The VTK-written mesh: cell 0 the unit cube, cell 1 an L-shaped prism of volume 3 sharing the
+/// cube's x = 1 face, cell 2 a pyramid of volume 1/3 on the cube's top; 19 points, 18 faces.
+const double kVtkCellVolumes[] = {1.0, 3.0, 1.0 / 3.0};
+
+class VtkWrittenFile : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(VtkWrittenFile, ReadsWithExactVolumes) {
+  REQUIRE_VTK_FILE(path, GetParam());
+  const PolyMesh mesh = readVtu(path->string());
+  ASSERT_EQ(mesh.numElements(), 3u);
+  EXPECT_EQ(mesh.numVertices(), 19u);
+  EXPECT_EQ(mesh.numFaces(), 18u);
+  EXPECT_EQ(countInteriorFaces(mesh), 2u);
+  for (std::size_t e = 0; e < 3; ++e)
+    EXPECT_NEAR(signedVolume(mesh, ElementId(e)), kVtkCellVolumes[e], kRelativeTolerance)
+        << "element " << e;
+  for (const Face& f : mesh.faces())
+    EXPECT_EQ(toString(f.origin), f.isBoundary() ? "imported" : "interior");
+}
+
+// Suffixes of vtk_check.py --write-vtk: defaults (appended, base64, zlib, UInt32 headers, Int64
+// ids); appended raw with UInt64 headers; inline binary; ascii; uncompressed raw with Int32 ids
+// and Float32 points; inline binary uncompressed with UInt64 headers.
+INSTANTIATE_TEST_SUITE_P(Encodings, VtkWrittenFile,
+                         ::testing::Values("", "_raw", "_binary", "_ascii", "_uncompressed",
+                                           "_binary_uncompressed"),
+                         [](const auto& info) {
+                           return info.param.empty() ? std::string("Default")
+                                                     : info.param.substr(1);
+                         });
+
+TEST(VtkWrittenFiles, InvertedCopyReadsWithNegativeVolumes) {
+  REQUIRE_VTK_FILE(path, "_inverted");
+  const PolyMesh mesh = readVtu(path->string());
+  ASSERT_EQ(mesh.numElements(), 3u);
+  EXPECT_EQ(mesh.numFaces(), 18u);
+  EXPECT_EQ(countInteriorFaces(mesh), 2u);
+  for (std::size_t e = 0; e < 3; ++e)
+    EXPECT_NEAR(signedVolume(mesh, ElementId(e)), -kVtkCellVolumes[e], kRelativeTolerance);
+}
+
+TEST(VtkWrittenFiles, LeakyCopyReadsWithAFaceMissing) {
+  REQUIRE_VTK_FILE(path, "_leaky");
+  const PolyMesh mesh = readVtu(path->string());
+  ASSERT_EQ(mesh.numElements(), 3u);
+  EXPECT_EQ(mesh.numFaces(), 17u);
+  EXPECT_EQ(mesh.element(ElementId(1)).faces.size(), 8u);  // the L prism lost its top
+}
+
+TEST(VtkWrittenFiles, LinearCellsBecomeOutwardPolyhedra) {
+  // One cell of each 3D linear type, then a polyhedron, each positively oriented in VTK's
+  // numbering: tetra 1/6, voxel 1, hexahedron 2, wedge 1/2, pyramid 1/3, pentagonal prism 3,
+  // hexagonal prism 6, polyhedron (unit cube) 1.
+  REQUIRE_VTK_FILE(path, "_linear");
+  const PolyMesh mesh = readVtu(path->string());
+  const double volumes[] = {1.0 / 6.0, 1.0, 2.0, 0.5, 1.0 / 3.0, 3.0, 6.0, 1.0};
+  const std::size_t faces[] = {4, 6, 6, 5, 5, 7, 8, 6};
+  ASSERT_EQ(mesh.numElements(), 8u);
+  for (std::size_t e = 0; e < 8; ++e) {
+    EXPECT_EQ(mesh.element(ElementId(e)).faces.size(), faces[e]) << "element " << e;
+    EXPECT_NEAR(signedVolume(mesh, ElementId(e)), volumes[e], kRelativeTolerance)
+        << "element " << e;
+  }
+}
+
+TEST(VtkWrittenFiles, TruncatedAppendedDataThrows) {
+  REQUIRE_VTK_FILE(path, "");
+  const std::string text = readText(*path);
+  const fs::path cut = testDir() / "cut.vtu";
+  writeText(cut, text.substr(0, text.size() * 8 / 10));
+  const std::string message = errorMessage([&] { readVtu(cut.string()); });
+  EXPECT_EQ(message.rfind(cut.string() + ": truncated appended data", 0), 0u) << message;
+}
+
+// --- files for vtk_check.py (ctest fixture) ------------------------------------------------
+
+TEST(WriteForVtkCheck, HexGridHoledPrismAndMixedCells) {
+  const char* dir = std::getenv("POLYDG_VTU_OUT_DIR");
+  if (dir == nullptr || *dir == '\0')
+    GTEST_SKIP() << "POLYDG_VTU_OUT_DIR is not set; ctest runs this before vtk_check.py";
+  fs::create_directories(dir);
+  // tests/CMakeLists.txt checks the volumes: 3 * 1.2 * 1.7 = 6.12 in 12 cells,
+  // 22.25 * 1.5 = 33.375 in one cell, and 1 + 3 + 1/3 in three cells.
+  writeVtu(skewGrid(), (fs::path(dir) / "hex_grid.vtu").string());
+  writeVtu(skewGrid(), (fs::path(dir) / "hex_grid_ascii.vtu").string(),
+           {.encoding = VtuEncoding::Ascii});
+  writeVtu(holedPrism(), (fs::path(dir) / "holed_prism.vtu").string());
+  writeVtu(holedPrism(), (fs::path(dir) / "holed_prism_ascii.vtu").string(),
+           {.encoding = VtuEncoding::Ascii});
+  writeVtu(mixedCells(), (fs::path(dir) / "mixed_cells.vtu").string());
+}
+
+}  // namespace
+}  // namespace polydg
