@@ -24,8 +24,16 @@ int main(int argc, char** argv) {
   polydg::cli::addCheckCommand(app, common, exitCode);
   try {
     app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? 0 : 2;
+    // One line, like every other error; CLI11's own would add a second.
+    std::cerr << "polydg: error: " << e.what() << " (see polydg --help)\n";
+    return 2;
   } catch (const std::exception& e) {
     std::cerr << "polydg: error: " << e.what() << '\n';
     return 2;

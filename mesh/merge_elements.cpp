@@ -7,43 +7,42 @@
 
 #include "mesh/geometry.h"
 
+#include <tbb/parallel_for.h>
+
 namespace polydg {
 
 PolyMesh mergeElements(const PolyMesh& mesh, const std::vector<std::uint32_t>& group,
                        std::size_t groups) {
-  if (group.size() != mesh.numElements())
-    throw std::invalid_argument("mergeElements: one group per element is needed");
-  PolyMesh out;
-  for (const Vec3& p : mesh.positions()) out.addVertex(p);
-  std::vector<std::vector<FaceUse>> uses(groups);
-  std::vector<FaceId> newFace(mesh.numFaces());
-  for (std::size_t i = 0; i < mesh.numFaces(); ++i) {
-    const Face& face = mesh.face(FaceId(i));
-    const bool inside = face.front.valid() && face.back.valid() &&
-                        group[face.front.index()] == group[face.back.index()];
-    if (inside) continue;
-    std::vector<Loop> loops;
-    for (std::size_t k = 0; k < face.numLoops(); ++k) {
-      const auto l = face.loop(k);
-      loops.emplace_back(l.begin(), l.end());
-    }
-    newFace[i] = out.addFace(std::move(loops), face.origin);
-  }
-  for (std::size_t e = 0; e < mesh.numElements(); ++e)
-    for (const FaceUse& use : mesh.element(ElementId(e)).faces)
-      if (newFace[use.face.index()].valid())
-        uses[group[e]].push_back({newFace[use.face.index()], use.reversed});
-  for (std::size_t g = 0; g < groups; ++g) out.addElementFromFaces(uses[g]);
+  PolyMesh out = mesh;
+  out.mergeElementGroups(group, groups);
   return out;
 }
 
-PolyMesh mergeSlivers(const PolyMesh& mesh, double volumeThreshold, SliverMergeReport* report) {
+PolyMesh mergeSlivers(PolyMesh mesh, double volumeThreshold, SliverMergeReport* report) {
   const std::size_t n = mesh.numElements();
+  // Each face's area vector once; element volumes from them (signed cones from the element's
+  // reference point).
+  std::vector<Vec3> area(mesh.numFaces());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.numFaces(), 1024),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t f = r.begin(); f != r.end(); ++f)
+                        area[f] = areaVector(mesh, FaceId(f));
+                    });
   std::vector<double> volume(n);
-  for (std::size_t e = 0; e < n; ++e) volume[e] = signedVolume(mesh, ElementId(e));
-  std::vector<double> faceArea(mesh.numFaces());
-  for (std::size_t f = 0; f < mesh.numFaces(); ++f)
-    faceArea[f] = areaVector(mesh, FaceId(f)).norm();
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 512),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t e = r.begin(); e != r.end(); ++e) {
+                        const Vec3 o = elementReferencePoint(mesh, ElementId(e));
+                        double threeVolume = 0.0;
+                        for (const FaceUse& use : mesh.element(ElementId(e)).faces) {
+                          const double h = area[use.face.index()].dot(
+                              faceReferencePoint(mesh, use.face) - o);
+                          threeVolume += use.reversed ? -h : h;
+                        }
+                        volume[e] = threeVolume / 3.0;
+                      }
+                    });
+  auto faceArea = [&](std::size_t f) { return area[f].norm(); };
 
   std::vector<std::size_t> parent(n);
   std::iota(parent.begin(), parent.end(), 0);
@@ -74,7 +73,7 @@ PolyMesh mergeSlivers(const PolyMesh& mesh, double volumeThreshold, SliverMergeR
           const Face& face = mesh.face(use.face);
           if (!face.front.valid() || !face.back.valid()) continue;
           const std::size_t other = find((use.reversed ? face.front : face.back).index());
-          if (other != g) shared[other] += faceArea[use.face.index()];
+          if (other != g) shared[other] += faceArea(use.face.index());
         }
       if (shared.empty()) {
         if (members[g].size() == 1) ++r.isolated;
@@ -101,9 +100,9 @@ PolyMesh mergeSlivers(const PolyMesh& mesh, double volumeThreshold, SliverMergeR
     if (label[root] == 0xffffffffu) label[root] = groups++;
     r.group[e] = label[root];
   }
-  PolyMesh out = groups == n ? mesh : mergeElements(mesh, r.group, groups);
+  if (groups != n) mesh.mergeElementGroups(r.group, groups);
   if (report) *report = std::move(r);
-  return out;
+  return mesh;
 }
 
 }  // namespace polydg

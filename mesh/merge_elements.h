@@ -32,7 +32,7 @@ struct SliverMergeReport {
 /// Merges every element with volume below `volumeThreshold` into the neighbour across the
 /// largest total shared face area, smallest first, until no sliver with a neighbour is left
 /// (a merged pair that is still below the threshold keeps merging). Deterministic.
-PolyMesh mergeSlivers(const PolyMesh& mesh, double volumeThreshold,
+PolyMesh mergeSlivers(PolyMesh mesh, double volumeThreshold,
                       SliverMergeReport* report = nullptr);
 
 }  // namespace polydg

@@ -142,11 +142,8 @@ MeshingResult meshSurface(const TriangleSurface& input, const MeshingOptions& op
   }
 
   bool reoriented = false;
-  surface = orientToBoundVolume(surface, reoriented);
+  surface = orientToBoundVolume(surface, reoriented, &r.shells, &r.cavities);
   if (reoriented) r.repairs.push_back("re-oriented the surface to bound its volume outward");
-  d = diagnose(surface);
-  r.shells = d.shells;
-  r.cavities = d.cavities;
   r.inputVolume = enclosedVolume(surface);
   if (!(r.inputVolume > 0)) throw InputError("the surface encloses no volume");
   timer.done("orient");
@@ -157,7 +154,7 @@ MeshingResult meshSurface(const TriangleSurface& input, const MeshingOptions& op
 
   if (options.sliverTau > 0) {
     SliverMergeReport merge;
-    result.mesh = mergeSlivers(sliced, options.sliverTau * r.grid.cellVolume(), &merge);
+    result.mesh = mergeSlivers(std::move(sliced), options.sliverTau * r.grid.cellVolume(), &merge);
     r.slivers = {merge.threshold, merge.slivers, merge.merged, merge.isolated};
   } else {
     result.mesh = std::move(sliced);

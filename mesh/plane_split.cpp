@@ -57,20 +57,28 @@ int locate(const Point2& p, const std::vector<Point2>& loop) {
 
 }  // namespace
 
-PlaneSplitter::PlaneSplitter(std::vector<Vec3> points) : points_(std::move(points)) {
-  onPlane_.assign(points_.size(), kNoPlane);
-  definition_.assign(points_.size(), Definition{});
-  edgePoints_.reserve(points_.size());
-  byPosition_.reserve(points_.size());
+PlaneSplitter::PlaneSplitter(const std::vector<Vec3>& points) {
+  records_.reserve(2 * points.size());
+  for (const Vec3& p : points) records_.push_back({p, kNoPlane, 0, 0});
+}
+
+std::vector<Vec3> PlaneSplitter::points() const {
+  std::vector<Vec3> out;
+  out.reserve(records_.size());
+  for (const PointRecord& r : records_) out.push_back(r.position);
+  return out;
 }
 
 int PlaneSplitter::compareExactly(std::uint32_t v, std::uint32_t w, int k) const {
   using Q = CGAL::Exact_rational;
   auto exact = [&](std::uint32_t id) -> Q {
-    if (onPlane_[id] == kNoPlane) return Q(points_[id][k]);
-    const SplitPlane& plane = planes_.at(onPlane_[id]);
-    const Vec3& p = points_[definition_[id].a];
-    const Vec3& q = points_[definition_[id].b];
+    const PointRecord& r = records_[id];
+    if (r.onPlane == kNoPlane) return Q(r.position[k]);
+    decltype(planes_)::const_accessor found;
+    if (!planes_.find(found, r.onPlane)) throw std::logic_error("compareExactly: unknown plane");
+    const SplitPlane& plane = found->second;
+    const Vec3& p = records_[r.a].position;
+    const Vec3& q = records_[r.b].position;
     Q np(0), nq(0);
     for (int i = 0; i < 3; ++i) {
       np += Q(plane.normal[i]) * Q(p[i]);
@@ -84,8 +92,9 @@ int PlaneSplitter::compareExactly(std::uint32_t v, std::uint32_t w, int k) const
 }
 
 int PlaneSplitter::side(std::uint32_t v, const SplitPlane& plane) const {
-  if (onPlane_[v] == plane.id) return 0;
-  const Vec3& p = points_[v];
+  const PointRecord& r = records_[v];
+  if (r.onPlane == plane.id) return 0;
+  const Vec3& p = r.position;
   if (plane.axis >= 0) {
     const double x = p[plane.axis];
     return x < plane.offset ? -1 : (x > plane.offset ? 1 : 0);
@@ -99,11 +108,19 @@ int PlaneSplitter::side(std::uint32_t v, const SplitPlane& plane) const {
 }
 
 std::uint32_t PlaneSplitter::edgePoint(std::uint32_t u, std::uint32_t v, const SplitPlane& plane) {
-  const std::uint32_t a = std::min(u, v), b = std::max(u, v);
-  const EdgeKey key{a, b, plane.id};
-  if (auto it = edgePoints_.find(key); it != edgePoints_.end()) return it->second;
-  // Interpolate from the lower index, so the point depends only on the edge and the plane.
-  const Vec3 p = points_[a], q = points_[b];
+  // Interpolate from the lexicographically smaller end, so the point depends only on the
+  // edge's geometry and the plane (not on ids or the order of calls).
+  const Vec3& pu = records_[u].position;
+  const Vec3& pv = records_[v].position;
+  const bool uFirst = std::lexicographical_compare(pu.data(), pu.data() + 3, pv.data(),
+                                                   pv.data() + 3) ||
+                      (pu == pv && u < v);
+  const std::uint32_t a = uFirst ? u : v, b = uFirst ? v : u;
+  decltype(edgePoints_)::accessor edge;
+  if (!edgePoints_.insert(edge, EdgeKey{std::min(u, v), std::max(u, v), plane.id}))
+    return edge->second;  // made already (we held no lock while another thread made it)
+  planes_.insert({plane.id, plane});
+  const Vec3 p = records_[a].position, q = records_[b].position;
   Vec3 r;
   if (plane.axis >= 0) {
     const int k = plane.axis;
@@ -118,29 +135,27 @@ std::uint32_t PlaneSplitter::edgePoint(std::uint32_t u, std::uint32_t v, const S
   // Stay inside the edge's box, so later side tests against other planes keep the order of
   // the edge's endpoints.
   for (int i = 0; i < 3; ++i) r[i] = std::clamp(r[i], std::min(p[i], q[i]), std::max(p[i], q[i]));
-  planes_.try_emplace(plane.id, plane);
   const std::array<double, 3> position{r.x() + 0.0, r.y() + 0.0, r.z() + 0.0};
-  if (auto it = byPosition_.find(position); it != byPosition_.end() && side(it->second, plane) == 0) {
-    edgePoints_.emplace(key, it->second);
-    return it->second;
+  decltype(byPosition_)::accessor at;
+  if (!byPosition_.insert(at, position) && side(at->second, plane) == 0) {
+    edge->second = at->second;
+    return at->second;
   }
-  points_.push_back(r);
-  onPlane_.push_back(plane.id);
-  definition_.push_back({a, b});
-  const auto id = static_cast<std::uint32_t>(points_.size() - 1);
-  edgePoints_.emplace(key, id);
-  byPosition_.emplace(position, id);
+  const auto id = static_cast<std::uint32_t>(records_.push_back({r, plane.id, a, b}) -
+                                             records_.begin());
+  at->second = id;
+  edge->second = id;
   return id;
 }
 
 Vec3 PlaneSplitter::polygonNormal(const PiecePolygon& polygon) const {
-  const Vec3& c = points_[polygon.vertices.front()];
+  const Vec3& c = point(polygon.vertices.front());
   Vec3 n = Vec3::Zero();
   for (std::size_t k = 0; k < polygon.numLoops(); ++k) {
     const std::size_t begin = polygon.loopBegin(k), end = polygon.loopEnd[k];
     for (std::size_t i = begin; i < end; ++i) {
       const std::size_t j = i + 1 == end ? begin : i + 1;
-      n += (points_[polygon.vertices[i]] - c).cross(points_[polygon.vertices[j]] - c);
+      n += (point(polygon.vertices[i]) - c).cross(point(polygon.vertices[j]) - c);
     }
   }
   return n;
@@ -151,8 +166,9 @@ namespace {
 /// Traces closed loops from directed edges; where several edges leave a vertex (a pinch), takes
 /// the first one clockwise from the reversed incoming edge, so the region to the left of each
 /// loop is a proper face (the loops at a pinch are kept apart). `normal` orients the plane.
+template <class PointOf>
 std::vector<std::vector<std::uint32_t>> traceLoops(const std::vector<DirectedEdge>& edges,
-                                                   const std::vector<Vec3>& points,
+                                                   const PointOf& points,
                                                    const Vec3& normal) {
   std::vector<std::size_t> order(edges.size());
   std::iota(order.begin(), order.end(), 0);
@@ -167,7 +183,7 @@ std::vector<std::vector<std::uint32_t>> traceLoops(const std::vector<DirectedEdg
   };
   const Projection project(normal);
   auto angleFrom = [&](std::uint32_t at, std::uint32_t back, std::uint32_t to) {
-    const Vec3 r = points[back] - points[at], d = points[to] - points[at];
+    const Vec3 r = points(back) - points(at), d = points(to) - points(at);
     const double ru = r[project.u], rw = r[project.w], du = d[project.u], dw = d[project.w];
     double a = std::atan2(project.sign * (ru * dw - rw * du), ru * du + rw * dw);
     if (a <= 0) a += 2 * std::numbers::pi;  // (0, 2 pi]: going straight back ranks last
@@ -212,17 +228,18 @@ std::vector<std::vector<std::uint32_t>> traceLoops(const std::vector<DirectedEdg
 /// clockwise ones are holes, each put in the smallest outer loop that contains it. A loop whose
 /// rounded area is zero (its points collapsed by rounding) stays a polygon of its own: it is
 /// needed to keep the piece closed, and welding identical points removes it later.
+template <class PointOf>
 std::vector<PiecePolygon> groupLoops(std::vector<std::vector<std::uint32_t>> loops,
-                                     const std::vector<Vec3>& points, const Vec3& normal,
+                                     const PointOf& points, const Vec3& normal,
                                      FaceOrigin origin) {
   const Vec3 n = normal.normalized();
   std::vector<double> area(loops.size());
   for (std::size_t k = 0; k < loops.size(); ++k) {
     const auto& loop = loops[k];
-    const Vec3& c = points[loop[0]];
+    const Vec3& c = points(loop[0]);
     Vec3 a = Vec3::Zero();
     for (std::size_t i = 1; i + 1 < loop.size(); ++i)
-      a += (points[loop[i]] - c).cross(points[loop[i + 1]] - c);
+      a += (points(loop[i]) - c).cross(points(loop[i + 1]) - c);
     area[k] = 0.5 * a.dot(n);
   }
   std::vector<std::size_t> outers, holes;
@@ -232,7 +249,7 @@ std::vector<PiecePolygon> groupLoops(std::vector<std::vector<std::uint32_t>> loo
   }
   std::vector<PiecePolygon> polygons(outers.size());
   for (std::size_t i = 0; i < outers.size(); ++i) {
-    polygons[i].vertices = loops[outers[i]];
+    polygons[i].vertices.assign(loops[outers[i]].begin(), loops[outers[i]].end());
     polygons[i].loopEnd = {static_cast<std::uint32_t>(loops[outers[i]].size())};
     polygons[i].origin = origin;
   }
@@ -241,14 +258,14 @@ std::vector<PiecePolygon> groupLoops(std::vector<std::vector<std::uint32_t>> loo
   const Projection project(n);
   std::vector<std::vector<Point2>> outer2(outers.size());
   for (std::size_t i = 0; i < outers.size(); ++i)
-    for (std::uint32_t v : loops[outers[i]]) outer2[i].push_back(project(points[v]));
+    for (std::uint32_t v : loops[outers[i]]) outer2[i].push_back(project(points(v)));
   for (std::size_t h : holes) {
     std::size_t best = outers.size();
     for (std::size_t i = 0; i < outers.size(); ++i) {
       if (best != outers.size() && area[outers[i]] >= area[outers[best]]) continue;
       // The hole is inside the outer loop if a hole vertex off that loop's boundary is inside.
       for (std::uint32_t v : loops[h]) {
-        const int where = locate(project(points[v]), outer2[i]);
+        const int where = locate(project(points(v)), outer2[i]);
         if (where < 0) continue;
         if (where > 0) best = i;
         break;
@@ -328,7 +345,7 @@ void PlaneSplitter::splitPolygon(const PiecePolygon& polygon, const SplitPlane& 
   if (std::abs(t.y()) > std::abs(t[k])) k = 1;
   if (std::abs(t.z()) > std::abs(t[k])) k = 2;
   const double direction = t[k] > 0 ? 1.0 : -1.0;
-  auto key = [&](std::uint32_t v) { return direction * points_[v][k]; };
+  auto key = [&](std::uint32_t v) { return direction * point(v)[k]; };
 
   // 3. Points on L, and parity toggles where the boundary crosses L (a run of on-L corners
   //    entered from one side and left to the other).
@@ -421,14 +438,17 @@ void PlaneSplitter::splitPolygon(const PiecePolygon& polygon, const SplitPlane& 
   }
 
   // 5. Loops, grouped into polygons with holes.
-  for (auto& p : groupLoops(traceLoops(minusEdges, points_, n), points_, n, polygon.origin))
+  const auto pointOf = [this](std::uint32_t v) -> const Vec3& { return point(v); };
+  for (auto& p : groupLoops(traceLoops(minusEdges, pointOf, n), pointOf, n, polygon.origin))
     minus.push_back(std::move(p));
-  for (auto& p : groupLoops(traceLoops(plusEdges, points_, n), points_, n, polygon.origin))
+  for (auto& p : groupLoops(traceLoops(plusEdges, pointOf, n), pointOf, n, polygon.origin))
     plus.push_back(std::move(p));
 }
 
 PieceSplit PlaneSplitter::split(Piece piece, const SplitPlane& plane, FaceOrigin capOrigin) {
   PieceSplit out;
+  out.minus.reserve(piece.size() + 8);
+  out.plus.reserve(piece.size() + 8);
   for (PiecePolygon& polygon : piece) {
     int lo = 1, hi = -1;
     for (std::uint32_t v : polygon.vertices) {
@@ -470,11 +490,12 @@ PieceSplit PlaneSplitter::split(Piece piece, const SplitPlane& plane, FaceOrigin
       capEdges.push_back(net > 0 ? DirectedEdge{hi, lo} : DirectedEdge{lo, hi});
   }
   if (capEdges.empty()) return out;
+  const auto pointOf = [this](std::uint32_t v) -> const Vec3& { return point(v); };
   std::sort(capEdges.begin(), capEdges.end(), [](const DirectedEdge& a, const DirectedEdge& b) {
     return a.from != b.from ? a.from < b.from : a.to < b.to;
   });  // deterministic output, whatever the hash order
   for (PiecePolygon& cap :
-       groupLoops(traceLoops(capEdges, points_, plane.normal), points_, plane.normal, capOrigin)) {
+       groupLoops(traceLoops(capEdges, pointOf, plane.normal), pointOf, plane.normal, capOrigin)) {
     out.plus.push_back(reversed(cap));
     out.minus.push_back(std::move(cap));
     ++out.capPolygons;

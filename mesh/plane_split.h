@@ -6,6 +6,10 @@
 #include <array>
 #include <cstdint>
 #include <unordered_map>
+
+#include <boost/container/small_vector.hpp>
+#include <tbb/concurrent_hash_map.h>
+#include <tbb/concurrent_vector.h>
 #include <vector>
 
 #include "mesh/poly_mesh.h"
@@ -15,8 +19,9 @@ namespace polydg {
 /// A polygon of a piece: loops of point indices (outer loop counter-clockwise about the
 /// outward normal, holes clockwise), and where it came from.
 struct PiecePolygon {
-  std::vector<std::uint32_t> vertices;
-  std::vector<std::uint32_t> loopEnd;  ///< loop k is vertices[loopEnd[k-1] .. loopEnd[k])
+  /// Inline storage for up to 8 corners and 2 loops: most polygons never allocate.
+  boost::container::small_vector<std::uint32_t, 8> vertices;
+  boost::container::small_vector<std::uint32_t, 2> loopEnd;  ///< loop k ends at loopEnd[k]
   FaceOrigin origin = FaceOrigin::Surface;
 
   std::size_t numLoops() const { return loopEnd.size(); }
@@ -54,13 +59,17 @@ struct PieceSplit {
 };
 
 /// Owns the point array and the map of intersection points, so that every edge crossed by a
-/// plane yields one point, whichever polygon asks for it.
+/// plane yields one point, whichever polygon asks for it. split() may run concurrently on
+/// different pieces: points are appended to a concurrent vector and each (edge, plane) point is
+/// made under that key's lock. Point coordinates do not depend on the order of calls.
 class PlaneSplitter {
  public:
-  explicit PlaneSplitter(std::vector<Vec3> points);
+  explicit PlaneSplitter(const std::vector<Vec3>& points);
 
-  const std::vector<Vec3>& points() const { return points_; }
-  std::vector<Vec3> takePoints() { return std::move(points_); }
+  std::size_t numPoints() const { return records_.size(); }
+  const Vec3& point(std::uint32_t v) const { return records_[v].position; }
+  /// A copy of all points, in id order.
+  std::vector<Vec3> points() const;
 
   /// -1, 0, +1: the side of point v. Exact: axis-aligned planes compare coordinates, other
   /// planes use an exact predicate; a point made on this plane is on it by definition.
@@ -88,36 +97,40 @@ class PlaneSplitter {
   /// the edge and plane that define them. Returns -1, 0, +1.
   int compareExactly(std::uint32_t v, std::uint32_t w, int k) const;
 
-  std::vector<Vec3> points_;
-  std::vector<std::uint32_t> onPlane_;  ///< plane id that created each point, or kNoPlane
-  struct Definition {
-    std::uint32_t a = 0, b = 0;  ///< the edge (a < b) a constructed point lies on
+  struct PointRecord {
+    Vec3 position;
+    std::uint32_t onPlane = kNoPlane;  ///< id of the plane that made it, or kNoPlane
+    std::uint32_t a = 0, b = 0;        ///< the edge it was made on (a's point <= b's)
   };
-  std::vector<Definition> definition_;  ///< per point; meaningful where onPlane_ is set
-  std::unordered_map<std::uint32_t, SplitPlane> planes_;  ///< every plane used, by id
+  tbb::concurrent_vector<PointRecord> records_;
 
   struct EdgeKey {
     std::uint32_t a, b, plane;
     bool operator==(const EdgeKey&) const = default;
   };
-  struct EdgeKeyHash {
-    std::size_t operator()(const EdgeKey& k) const noexcept {
+  struct EdgeKeyHashCompare {
+    static std::size_t hash(const EdgeKey& k) {
       const std::uint64_t h = (std::uint64_t(k.a) << 32 | k.b) * 0x9E3779B97F4A7C15ull;
       return static_cast<std::size_t>(h ^ (std::uint64_t(k.plane) * 0xC2B2AE3D27D4EB4Full));
     }
+    static bool equal(const EdgeKey& x, const EdgeKey& y) { return x == y; }
   };
-  std::unordered_map<EdgeKey, std::uint32_t, EdgeKeyHash> edgePoints_;
-  struct PositionHash {
-    std::size_t operator()(const std::array<double, 3>& p) const noexcept {
+  tbb::concurrent_hash_map<EdgeKey, std::uint32_t, EdgeKeyHashCompare> edgePoints_;
+  struct PositionHashCompare {
+    static std::size_t hash(const std::array<double, 3>& p) {
       std::size_t h = 0;
       for (double x : p) h = h * 0x9E3779B97F4A7C15ull + std::hash<double>{}(x);
       return h;
+    }
+    static bool equal(const std::array<double, 3>& x, const std::array<double, 3>& y) {
+      return x == y;
     }
   };
   /// Constructed points by exact position: a new intersection point that rounds onto an
   /// existing one on the same plane is that point (otherwise distinct points at one position
   /// would make zero-length edges and, at the next plane, coincident crossings).
-  std::unordered_map<std::array<double, 3>, std::uint32_t, PositionHash> byPosition_;
+  tbb::concurrent_hash_map<std::array<double, 3>, std::uint32_t, PositionHashCompare> byPosition_;
+  tbb::concurrent_hash_map<std::uint32_t, SplitPlane> planes_;  ///< every plane used, by id
 };
 
 }  // namespace polydg

@@ -91,6 +91,18 @@ FaceId PolyMesh::addFace(std::vector<Loop> loops, FaceOrigin origin) {
 
 FaceId PolyMesh::findOrCreateFace(const std::vector<Loop>& loops, FaceOrigin origin,
                                   bool& reversed) {
+  if (openFacesStale_) {
+    openFaces_.clear();
+    for (std::size_t i = 0; i < faces_.size(); ++i) {
+      const Face& face = faces_[FaceId(i)];
+      if (face.back.valid() || !face.front.valid()) continue;
+      std::vector<Loop> faceLoops;
+      for (std::size_t k = 0; k < face.numLoops(); ++k)
+        faceLoops.emplace_back(face.loop(k).begin(), face.loop(k).end());
+      openFaces_.emplace(vertexSetKey(faceLoops), FaceId(i));
+    }
+    openFacesStale_ = false;
+  }
   const std::uint64_t key = vertexSetKey(loops);
   auto [begin, end] = openFaces_.equal_range(key);
   for (auto it = begin; it != end; ++it) {
@@ -136,6 +148,31 @@ ElementId PolyMesh::addElement(const std::vector<std::vector<Loop>>& boundary,
     }
   }
   return addElementFromFaces(uses);
+}
+
+void PolyMesh::mergeElementGroups(const std::vector<std::uint32_t>& group, std::size_t groups) {
+  if (group.size() != elements_.size())
+    throw std::invalid_argument("mergeElementGroups: one group per element is needed");
+  std::vector<FaceId> newId(faces_.size());
+  FaceData<Face> kept;
+  for (std::size_t i = 0; i < faces_.size(); ++i) {
+    Face& face = faces_[FaceId(i)];
+    if (face.front.valid() && face.back.valid() &&
+        group[face.front.index()] == group[face.back.index()])
+      continue;  // inside a group
+    if (face.front.valid()) face.front = ElementId(group[face.front.index()]);
+    if (face.back.valid()) face.back = ElementId(group[face.back.index()]);
+    newId[i] = FaceId(kept.size());
+    kept.push_back(std::move(face));
+  }
+  ElementData<Element> merged(groups);
+  for (std::size_t e = 0; e < elements_.size(); ++e)
+    for (const FaceUse& use : elements_[ElementId(e)].faces)
+      if (newId[use.face.index()].valid())
+        merged[ElementId(group[e])].faces.push_back({newId[use.face.index()], use.reversed});
+  faces_ = std::move(kept);
+  elements_ = std::move(merged);
+  openFacesStale_ = true;
 }
 
 ElementId PolyMesh::addElementFromFaces(const std::vector<FaceUse>& faces) {

@@ -112,14 +112,22 @@ class PolyMesh {
   /// Adds a face from loops without attaching it to an element.
   FaceId addFace(std::vector<Loop> loops, FaceOrigin origin);
 
+  /// Merges elements in place: `group[e]` (0 .. groups-1) is element e's new element. Faces
+  /// between two members of one group disappear, the others keep their vertices, orientation
+  /// and origin; element and face ids are renumbered (new element g is group g; faces keep
+  /// their relative order). Vertices are unchanged.
+  void mergeElementGroups(const std::vector<std::uint32_t>& group, std::size_t groups);
+
  private:
   FaceId findOrCreateFace(const std::vector<Loop>& loops, FaceOrigin origin, bool& reversed);
 
   VertexData<Vec3> positions_;
   FaceData<Face> faces_;
   ElementData<Element> elements_;
-  /// Boundary faces by the sorted list of their vertex ids, for sharing in addElement.
+  /// Boundary faces by the sorted list of their vertex ids, for sharing in addElement; rebuilt
+  /// on demand after ids change.
   std::unordered_multimap<std::uint64_t, FaceId> openFaces_;
+  bool openFacesStale_ = false;
 };
 
 /// True if face `a`'s loops, reversed, equal `loops` (same loops, each the same cycle

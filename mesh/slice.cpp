@@ -1,12 +1,18 @@
 #include "mesh/slice.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
+#include <mutex>
+#include <tuple>
 #include <cmath>
 #include <stdexcept>
 #include <unordered_map>
 
 #include "mesh/plane_split.h"
+
+#include <boost/container/small_vector.hpp>
+#include <tbb/parallel_invoke.h>
 
 namespace polydg {
 
@@ -34,6 +40,14 @@ Grid Grid::withCellsAlongLongest(const Box3& bounds, int cellsAlongLongest) {
 
 namespace {
 
+struct SortedIdsHash {
+  std::size_t operator()(const boost::container::small_vector<std::uint32_t, 8>& ids) const {
+    std::size_t h = ids.size();
+    for (std::uint32_t id : ids) h = h * 0x9E3779B97F4A7C15ull + id;
+    return h;
+  }
+};
+
 struct CoordinateHash {
   std::size_t operator()(const std::array<double, 3>& p) const noexcept {
     std::size_t h = 0;
@@ -49,12 +63,21 @@ class Slicer {
 
   void run(Piece solid) {
     totalCells_ = static_cast<double>(grid_.cells[0]) * grid_.cells[1] * grid_.cells[2];
-    recurse(std::move(solid), {0, 0, 0}, grid_.cells);
+    leaves_ = recurse(std::move(solid), {0, 0, 0}, grid_.cells);
+    // Deterministic order whatever the schedule: by cell, then by piece within the cell.
+    std::sort(leaves_.begin(), leaves_.end(), [](const Leaf& a, const Leaf& b) {
+      return std::tie(a.cell[2], a.cell[1], a.cell[0], a.part) <
+             std::tie(b.cell[2], b.cell[1], b.cell[0], b.part);
+    });
+    stats.splits = splits_;
+    stats.polygonsSplit = polygonsSplit_;
+    stats.leafCells = leafCells_;
+    stats.multiPieceCells = multiPieceCells_;
   }
 
   PolyMesh build(std::vector<std::array<int, 3>>* elementCell) {
     PolyMesh mesh;
-    const std::vector<Vec3>& points = splitter_.points();
+    const std::vector<Vec3> points = splitter_.points();
     // Points that rounding made identical (intersection points of edges that meet a plane
     // within round-off of one of their ends) are welded: exact equality, no tolerance. Then
     // only used points are kept, in order of first use.
@@ -69,13 +92,18 @@ class Slicer {
       }
       return VertexId(remap[v]);
     };
+    // Caps (interior faces) are shared: the second element to use one finds it here by its
+    // sorted vertex ids and uses it reversed.
+    std::unordered_map<boost::container::small_vector<std::uint32_t, 8>, FaceId, SortedIdsHash>
+        openCaps;
+    std::vector<FaceUse> uses;
     for (const Leaf& leaf : leaves_) {
-      std::vector<std::vector<Loop>> boundary;
-      std::vector<FaceOrigin> origins;
+      uses.clear();
       for (const PiecePolygon& polygon : leaf.piece) {
         std::vector<Loop> loops;
         for (std::size_t k = 0; k < polygon.numLoops(); ++k) {
           Loop loop;
+          loop.reserve(polygon.loopEnd[k] - polygon.loopBegin(k));
           for (std::size_t i = polygon.loopBegin(k); i < polygon.loopEnd[k]; ++i) {
             const VertexId v = vertexOf(polygon.vertices[i]);
             if (loop.empty() || loop.back() != v) loop.push_back(v);
@@ -88,11 +116,26 @@ class Slicer {
           ++stats.collapsedPolygons;
           continue;
         }
-        boundary.push_back(std::move(loops));
-        origins.push_back(polygon.origin);
+        if (polygon.origin != FaceOrigin::Interior) {
+          uses.push_back({mesh.addFace(std::move(loops), polygon.origin), false});
+          continue;
+        }
+        boost::container::small_vector<std::uint32_t, 8> key;
+        for (const Loop& loop : loops)
+          for (VertexId v : loop) key.push_back(v.value);
+        std::sort(key.begin(), key.end());
+        auto it = openCaps.find(key);
+        if (it != openCaps.end() && isReverseOf(mesh.face(it->second), loops)) {
+          uses.push_back({it->second, true});
+          openCaps.erase(it);
+        } else {
+          const FaceId f = mesh.addFace(std::move(loops), FaceOrigin::Interior);
+          openCaps.emplace(std::move(key), f);
+          uses.push_back({f, false});
+        }
       }
-      if (boundary.empty()) continue;
-      mesh.addElement(boundary, origins);
+      if (uses.empty()) continue;
+      mesh.addElementFromFaces(uses);
       if (elementCell) elementCell->push_back(leaf.cell);
     }
     return mesh;
@@ -104,35 +147,55 @@ class Slicer {
   struct Leaf {
     Piece piece;
     std::array<int, 3> cell;
+    std::size_t part;  ///< index of the piece among its cell's connected pieces
   };
 
-  void recurse(Piece piece, std::array<int, 3> lo, std::array<int, 3> hi) {
+  /// Pieces with more polygons than this are split into two tasks.
+  static constexpr std::size_t kParallelPolygons = 512;
+
+  std::vector<Leaf> recurse(Piece piece, std::array<int, 3> lo, std::array<int, 3> hi) {
     for (int axis = 0; axis < 3; ++axis) {
       if (hi[axis] - lo[axis] <= 1) continue;
       const int mid = (lo[axis] + hi[axis]) / 2;
       const auto id = static_cast<std::uint32_t>(axis * ((1 << 20) + 1) + mid);
       const SplitPlane plane = SplitPlane::axisAligned(axis, grid_.plane(axis, mid), id);
       PieceSplit s = splitter_.split(std::move(piece), plane, FaceOrigin::Interior);
-      ++stats.splits;
-      stats.polygonsSplit += s.polygonsSplit;
+      ++splits_;
+      polygonsSplit_ += s.polygonsSplit;
       std::array<int, 3> hiMinus = hi, loPlus = lo;
       hiMinus[axis] = mid;
       loPlus[axis] = mid;
-      if (s.minus.empty()) reportSkipped(lo, hiMinus);
-      else recurse(std::move(s.minus), lo, hiMinus);
-      if (s.plus.empty()) reportSkipped(loPlus, hi);
-      else recurse(std::move(s.plus), loPlus, hi);
-      return;
+      std::vector<Leaf> minus, plus;
+      auto doMinus = [&] {
+        if (s.minus.empty()) reportDone(lo, hiMinus);
+        else minus = recurse(std::move(s.minus), lo, hiMinus);
+      };
+      auto doPlus = [&] {
+        if (s.plus.empty()) reportDone(loPlus, hi);
+        else plus = recurse(std::move(s.plus), loPlus, hi);
+      };
+      if (s.minus.size() + s.plus.size() > kParallelPolygons) tbb::parallel_invoke(doMinus, doPlus);
+      else {
+        doMinus();
+        doPlus();
+      }
+      if (minus.empty()) return plus;
+      minus.insert(minus.end(), std::make_move_iterator(plus.begin()),
+                   std::make_move_iterator(plus.end()));
+      return minus;
     }
-    ++stats.leafCells;
+    ++leafCells_;
     std::vector<Piece> parts = PlaneSplitter::components(std::move(piece));
-    if (parts.size() > 1) ++stats.multiPieceCells;
-    for (Piece& part : parts) leaves_.push_back({std::move(part), lo});
-    reportSkipped(lo, hi);
+    if (parts.size() > 1) ++multiPieceCells_;
+    std::vector<Leaf> leaves;
+    for (std::size_t i = 0; i < parts.size(); ++i) leaves.push_back({std::move(parts[i]), lo, i});
+    reportDone(lo, hi);
+    return leaves;
   }
 
-  void reportSkipped(const std::array<int, 3>& lo, const std::array<int, 3>& hi) {
+  void reportDone(const std::array<int, 3>& lo, const std::array<int, 3>& hi) {
     if (!progress_) return;
+    std::lock_guard<std::mutex> lock(progressMutex_);
     doneCells_ += static_cast<double>(hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]);
     progress_(doneCells_ / totalCells_);
   }
@@ -143,6 +206,8 @@ class Slicer {
   std::vector<Leaf> leaves_;
   double totalCells_ = 1.0;
   double doneCells_ = 0.0;
+  std::mutex progressMutex_;
+  std::atomic<std::size_t> splits_{0}, polygonsSplit_{0}, leafCells_{0}, multiPieceCells_{0};
 };
 
 }  // namespace

@@ -77,20 +77,12 @@ SurfaceDiagnosis diagnose(const TriangleSurface& surface) {
                                                            std::back_inserter(pairs));
   d.selfIntersections = pairs.size();
   d.checkedSelfIntersections = true;
-  if (CGAL::is_closed(mesh) && pairs.empty()) {
-    auto volumeIds = mesh.add_property_map<Mesh::Face_index, std::size_t>("f:volume", 0).first;
-    std::vector<std::size_t> nesting;
-    PMP::volume_connected_components(mesh, volumeIds,
-                                     CGAL::parameters::nesting_levels(std::ref(nesting)));
-    d.shells = nesting.size();
-    for (std::size_t level : nesting) d.cavities += level % 2 == 1;
-  } else {
-    d.shells = d.topology.components;
-  }
+  d.shells = d.topology.components;
   return d;
 }
 
-TriangleSurface orientToBoundVolume(const TriangleSurface& surface, bool& changed) {
+TriangleSurface orientToBoundVolume(const TriangleSurface& surface, bool& changed,
+                                    std::size_t* shells, std::size_t* cavities) {
   auto points = toPoints(surface);
   auto polygons = toPolygons(surface);
   const auto before = polygons;
@@ -100,6 +92,17 @@ TriangleSurface orientToBoundVolume(const TriangleSurface& surface, bool& change
   if (!CGAL::is_closed(mesh))
     throw std::invalid_argument("orientToBoundVolume: the surface is not closed");
   PMP::orient_to_bound_a_volume(mesh);
+  if (shells || cavities) {
+    auto volumeIds = mesh.add_property_map<Mesh::Face_index, std::size_t>("f:volume", 0).first;
+    std::vector<std::size_t> nesting;
+    PMP::volume_connected_components(mesh, volumeIds,
+                                     CGAL::parameters::nesting_levels(std::ref(nesting)));
+    if (shells) *shells = nesting.size();
+    if (cavities) {
+      *cavities = 0;
+      for (std::size_t level : nesting) *cavities += level % 2 == 1;
+    }
+  }
   TriangleSurface out = fromMesh(mesh);
   // Compare triangle by triangle: the conversion keeps vertex and face order when no vertex
   // was duplicated, so a flipped triangle is one whose cyclic order changed.

@@ -13,8 +13,7 @@ struct SurfaceDiagnosis {
   SurfaceTopology topology;
   std::size_t selfIntersections = 0;  ///< pairs of triangles that intersect improperly
   bool checkedSelfIntersections = false;  ///< only possible on a manifold (orientable) soup
-  std::size_t shells = 0;             ///< closed components
-  std::size_t cavities = 0;           ///< shells inside another shell (holes in the solid)
+  std::size_t shells = 0;             ///< connected components (see orientToBoundVolume)
 
   bool closed() const { return topology.closed() || misorientedOnly(); }
   bool manifold() const { return topology.nonManifoldEdges == 0; }
@@ -31,8 +30,12 @@ SurfaceDiagnosis diagnose(const TriangleSurface& surface);
 
 /// Orients a closed, manifold, non-self-intersecting surface so that it bounds a volume: outer
 /// shells outward, cavities inward (CGAL's orient_to_bound_a_volume, after making the
-/// orientation consistent). `changed` says whether any triangle was flipped.
-TriangleSurface orientToBoundVolume(const TriangleSurface& surface, bool& changed);
+/// orientation consistent). `changed` says whether any triangle was flipped; `shells` and
+/// `cavities` (optional) receive the number of closed components and of those nested at odd
+/// depth (holes in the solid).
+TriangleSurface orientToBoundVolume(const TriangleSurface& surface, bool& changed,
+                                    std::size_t* shells = nullptr,
+                                    std::size_t* cavities = nullptr);
 
 /// Removes triangles with repeated vertices or zero area, welding their edges away (CGAL's
 /// remove_degenerate_faces on the soup made into a mesh). Returns how many were removed.

@@ -1,6 +1,10 @@
 #include "mesh/validate.h"
 
 #include <algorithm>
+#include <unordered_map>
+
+#include <boost/container/small_vector.hpp>
+#include <tbb/parallel_for.h>
 #include <cstdio>
 #include <limits>
 #include <map>
@@ -44,9 +48,10 @@ bool isDegenerate(const PolyMesh& mesh, FaceId f) {
   return areaVector(mesh, f).squaredNorm() == 0.0;
 }
 
-/// True if every directed edge of the element's oriented faces is matched by its reverse.
+/// True if every directed edge of the element's oriented faces is matched by its reverse:
+/// each undirected edge's uses in the two directions balance.
 bool isClosed(const PolyMesh& mesh, ElementId e) {
-  std::map<std::pair<std::uint32_t, std::uint32_t>, int> balance;
+  boost::container::small_vector<std::pair<std::uint64_t, int>, 64> uses;
   for (const FaceUse& use : mesh.element(e).faces) {
     const Face& face = mesh.face(use.face);
     for (std::size_t k = 0; k < face.numLoops(); ++k) {
@@ -54,12 +59,19 @@ bool isClosed(const PolyMesh& mesh, ElementId e) {
       for (std::size_t i = 0; i < loop.size(); ++i) {
         std::uint32_t a = loop[i].value, b = loop[(i + 1) % loop.size()].value;
         if (use.reversed) std::swap(a, b);
-        // Count a->b as +1 on the key (min, max) when a < b, -1 otherwise.
-        balance[{std::min(a, b), std::max(a, b)}] += a < b ? 1 : -1;
+        uses.emplace_back(std::uint64_t(std::min(a, b)) << 32 | std::max(a, b), a < b ? 1 : -1);
       }
     }
   }
-  return std::all_of(balance.begin(), balance.end(), [](const auto& kv) { return kv.second == 0; });
+  std::sort(uses.begin(), uses.end());
+  for (std::size_t i = 0; i < uses.size();) {
+    int balance = 0;
+    std::size_t j = i;
+    for (; j < uses.size() && uses[j].first == uses[i].first; ++j) balance += uses[j].second;
+    if (balance != 0) return false;
+    i = j;
+  }
+  return true;
 }
 
 }  // namespace
@@ -95,7 +107,16 @@ ValidationReport validate(const PolyMesh& mesh, const ValidationOptions& options
   report.faces = mesh.numFaces();
 
   // Faces: shape, planarity, links to elements, duplicates.
-  std::map<std::vector<VertexId>, FaceId> byVertexSet;
+  struct SortedIdsHash {
+    std::size_t operator()(const boost::container::small_vector<std::uint32_t, 8>& ids) const {
+      std::size_t h = ids.size();
+      for (std::uint32_t id : ids) h = h * 0x9E3779B97F4A7C15ull + id;
+      return h;
+    }
+  };
+  std::unordered_map<boost::container::small_vector<std::uint32_t, 8>, FaceId, SortedIdsHash>
+      byVertexSet;
+  byVertexSet.reserve(mesh.numFaces());
   for (std::size_t i = 0; i < mesh.numFaces(); ++i) {
     const FaceId f(i);
     const Face& face = mesh.face(f);
@@ -119,7 +140,8 @@ ValidationReport validate(const PolyMesh& mesh, const ValidationOptions& options
       problems.add(report.inconsistentFaces, describe("face used only from its back:", i));
     }
 
-    std::vector<VertexId> key = face.vertices;
+    boost::container::small_vector<std::uint32_t, 8> key;
+    for (VertexId v : face.vertices) key.push_back(v.value);
     std::sort(key.begin(), key.end());
     auto [it, inserted] = byVertexSet.emplace(std::move(key), f);
     if (!inserted) {
@@ -130,7 +152,17 @@ ValidationReport validate(const PolyMesh& mesh, const ValidationOptions& options
     }
   }
 
-  // Elements: links back to faces, closure, volume.
+  // Elements: closure and volume in parallel (they are the costly part), then links back to
+  // faces and the report in order.
+  std::vector<char> closed(mesh.numElements());
+  std::vector<double> volumes(mesh.numElements());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.numElements(), 512),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                        closed[i] = isClosed(mesh, ElementId(i));
+                        volumes[i] = signedVolume(mesh, ElementId(i));
+                      }
+                    });
   bool first = true;
   for (std::size_t i = 0; i < mesh.numElements(); ++i) {
     const ElementId e(i);
@@ -146,11 +178,11 @@ ValidationReport validate(const PolyMesh& mesh, const ValidationOptions& options
                      "element " + std::to_string(i) + " uses face " +
                          std::to_string(use.face.value) + " but the face does not list it");
     }
-    if (!isClosed(mesh, e))
+    if (!closed[i])
       problems.add(report.openElements,
                    describe("element", i) + " is not closed (an edge of its faces is not "
                                             "matched by the reverse edge of another)");
-    const double v = signedVolume(mesh, e);
+    const double v = volumes[i];
     report.volume += v;
     report.minElementVolume = first ? v : std::min(report.minElementVolume, v);
     report.maxElementVolume = first ? v : std::max(report.maxElementVolume, v);
