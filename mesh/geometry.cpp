@@ -56,12 +56,9 @@ double signedVolume(const PolyMesh& mesh, ElementId e) {
   return threeVolume / 3.0;
 }
 
-double relativePlanarityError(const PolyMesh& mesh, FaceId f) {
+double planarityDeviation(const PolyMesh& mesh, FaceId f) {
   const Face& face = mesh.face(f);
   const Vec3 n = unitNormal(mesh, f);
-  const Box3 box = faceBounds(mesh, f);
-  const double diameter = box.diagonal().norm();
-  if (diameter == 0.0) return 0.0;
   const Vec3& c = faceReferencePoint(mesh, f);
   Vec3 mean = Vec3::Zero();
   for (VertexId v : face.vertices) mean += mesh.position(v) - c;
@@ -69,7 +66,12 @@ double relativePlanarityError(const PolyMesh& mesh, FaceId f) {
   double worst = 0.0;
   for (VertexId v : face.vertices)
     worst = std::max(worst, std::abs(n.dot(mesh.position(v) - c - mean)));
-  return worst / diameter;
+  return worst;
+}
+
+double relativePlanarityError(const PolyMesh& mesh, FaceId f) {
+  const double diameter = faceBounds(mesh, f).diagonal().norm();
+  return diameter == 0.0 ? 0.0 : planarityDeviation(mesh, f) / diameter;
 }
 
 Box3 meshBounds(const PolyMesh& mesh) {

@@ -37,8 +37,11 @@ Vec3 elementReferencePoint(const PolyMesh& mesh, ElementId e);
 /// cones from the element's reference point to its faces.
 double signedVolume(const PolyMesh& mesh, ElementId e);
 
-/// Largest distance of a face vertex from the face's best plane (through the vertex mean,
-/// with the Newell normal), divided by the face's bounding-box diagonal.
+/// Largest distance of a face vertex from the face's plane (through the vertex mean, with the
+/// Newell normal).
+double planarityDeviation(const PolyMesh& mesh, FaceId f);
+
+/// planarityDeviation divided by the face's bounding-box diagonal.
 double relativePlanarityError(const PolyMesh& mesh, FaceId f);
 
 /// Bounding box of all vertices.

@@ -33,7 +33,7 @@ std::uint64_t vertexSetKey(const std::vector<Loop>& loops) {
 }
 
 /// True if cycle `b` is cycle `a` traversed backwards (any rotation).
-bool isReversedCycle(std::span<const VertexId> a, const Loop& b) {
+bool isReversedCycle(std::span<const VertexId> a, std::span<const VertexId> b) {
   const std::size_t n = a.size();
   if (b.size() != n || n == 0) return false;
   const auto start = std::find(b.begin(), b.end(), a[0]);
@@ -53,6 +53,22 @@ bool isReverseOf(const Face& a, const std::vector<Loop>& loops) {
     bool found = false;
     for (std::size_t j = 0; j < loops.size() && !found; ++j) {
       if (!used[j] && isReversedCycle(a.loop(k), loops[j])) used[j] = found = true;
+    }
+    if (!found) return false;
+  }
+  return true;
+}
+
+bool isReverseOf(const Face& a, std::span<const VertexId> vertices,
+                 std::span<const std::uint32_t> loopEnd) {
+  if (a.numLoops() != loopEnd.size()) return false;
+  std::vector<bool> used(loopEnd.size(), false);
+  for (std::size_t k = 0; k < a.numLoops(); ++k) {
+    bool found = false;
+    for (std::size_t j = 0; j < loopEnd.size() && !found; ++j) {
+      const std::size_t begin = j == 0 ? 0 : loopEnd[j - 1];
+      if (!used[j] && isReversedCycle(a.loop(k), vertices.subspan(begin, loopEnd[j] - begin)))
+        used[j] = found = true;
     }
     if (!found) return false;
   }
@@ -84,6 +100,27 @@ FaceId PolyMesh::addFace(std::vector<Loop> loops, FaceOrigin origin) {
     face.vertices.insert(face.vertices.end(), loop.begin(), loop.end());
     face.loopEnd.push_back(static_cast<std::uint32_t>(face.vertices.size()));
   }
+  face.origin = origin;
+  faces_.push_back(std::move(face));
+  return FaceId(faces_.size() - 1);
+}
+
+FaceId PolyMesh::addFace(std::span<const VertexId> vertices,
+                         std::span<const std::uint32_t> loopEnd, FaceOrigin origin) {
+  if (loopEnd.empty()) throw std::invalid_argument("addFace: a face needs at least one loop");
+  std::uint32_t begin = 0;
+  for (std::uint32_t end : loopEnd) {
+    if (end < begin + 3 || end > vertices.size())
+      throw std::invalid_argument("addFace: every loop of a face needs at least 3 vertices");
+    begin = end;
+  }
+  if (begin != vertices.size()) throw std::invalid_argument("addFace: loop ends do not match");
+  for (VertexId v : vertices)
+    if (!v.valid() || v.index() >= positions_.size())
+      throw std::out_of_range("addFace: vertex id out of range");
+  Face face;
+  face.vertices.assign(vertices.begin(), vertices.end());
+  face.loopEnd.assign(loopEnd.begin(), loopEnd.end());
   face.origin = origin;
   faces_.push_back(std::move(face));
   return FaceId(faces_.size() - 1);
@@ -175,7 +212,7 @@ void PolyMesh::mergeElementGroups(const std::vector<std::uint32_t>& group, std::
   openFacesStale_ = true;
 }
 
-ElementId PolyMesh::addElementFromFaces(const std::vector<FaceUse>& faces) {
+ElementId PolyMesh::addElementFromFaces(std::span<const FaceUse> faces) {
   const ElementId e(elements_.size());
   // Check every face first, so a failure leaves the mesh unchanged.
   for (std::size_t i = 0; i < faces.size(); ++i) {
@@ -194,7 +231,9 @@ ElementId PolyMesh::addElementFromFaces(const std::vector<FaceUse>& faces) {
     (use.reversed ? face.back : face.front) = e;
     if (face.front.valid() && face.back.valid()) face.origin = FaceOrigin::Interior;
   }
-  elements_.push_back(Element{faces});
+  Element element;
+  element.faces.assign(faces.begin(), faces.end());
+  elements_.push_back(std::move(element));
   return e;
 }
 

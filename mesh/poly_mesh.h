@@ -8,6 +8,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include <boost/container/small_vector.hpp>
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
@@ -40,8 +41,9 @@ struct FaceUse {
 /// Newell normal of all loops together. `front` is the element the normal points out of,
 /// `back` the element it points into (invalid for a boundary face).
 struct Face {
-  std::vector<VertexId> vertices;      ///< all loops, concatenated
-  std::vector<std::uint32_t> loopEnd;  ///< loop k is vertices[loopEnd[k-1] .. loopEnd[k])
+  /// All loops, concatenated; up to 6 corners are stored inline (no allocation).
+  boost::container::small_vector<VertexId, 6> vertices;
+  boost::container::small_vector<std::uint32_t, 1> loopEnd;  ///< loop k ends at loopEnd[k]
   ElementId front;
   ElementId back;
   FaceOrigin origin = FaceOrigin::Interior;
@@ -55,8 +57,11 @@ struct Face {
 };
 
 /// An element: the faces that bound it, each with its orientation.
+/// The faces of an element; up to 7 are stored inline.
+using FaceList = boost::container::small_vector<FaceUse, 7>;
+
 struct Element {
-  std::vector<FaceUse> faces;
+  FaceList faces;
 };
 
 /// A loop of vertex ids; used to describe faces to the mesh.
@@ -76,6 +81,12 @@ class PolyMesh {
   /// Mutable positions, for transforming a mesh in place (topology is unaffected).
   VertexData<Vec3>& positions() { return positions_; }
   VertexId addVertex(const Vec3& p);
+  /// Reserves room, to build large meshes without reallocation.
+  void reserve(std::size_t vertices, std::size_t faces, std::size_t elements) {
+    positions_.raw().reserve(vertices);
+    faces_.raw().reserve(faces);
+    elements_.raw().reserve(elements);
+  }
 
   // --- faces -------------------------------------------------------------------------------
   std::size_t numFaces() const { return faces_.size(); }
@@ -107,10 +118,19 @@ class PolyMesh {
 
   /// Adds an element from existing faces and orientations. Each face must have a free side
   /// (front if `reversed == false`, back otherwise). Used by readers that build faces first.
-  ElementId addElementFromFaces(const std::vector<FaceUse>& faces);
+  ElementId addElementFromFaces(std::span<const FaceUse> faces);
+  ElementId addElementFromFaces(const std::vector<FaceUse>& faces) {
+    return addElementFromFaces(std::span<const FaceUse>(faces.data(), faces.size()));
+  }
+  ElementId addElementFromFaces(const FaceList& faces) {
+    return addElementFromFaces(std::span<const FaceUse>(faces.data(), faces.size()));
+  }
 
   /// Adds a face from loops without attaching it to an element.
   FaceId addFace(std::vector<Loop> loops, FaceOrigin origin);
+  /// The same from all loops' vertices concatenated and each loop's end offset.
+  FaceId addFace(std::span<const VertexId> vertices, std::span<const std::uint32_t> loopEnd,
+                 FaceOrigin origin);
 
   /// Merges elements in place: `group[e]` (0 .. groups-1) is element e's new element. Faces
   /// between two members of one group disappear, the others keep their vertices, orientation
@@ -133,5 +153,8 @@ class PolyMesh {
 /// True if face `a`'s loops, reversed, equal `loops` (same loops, each the same cycle
 /// traversed the other way, in any rotation; hole order is irrelevant).
 bool isReverseOf(const Face& a, const std::vector<Loop>& loops);
+/// The same with loops given as concatenated vertices and loop ends.
+bool isReverseOf(const Face& a, std::span<const VertexId> vertices,
+                 std::span<const std::uint32_t> loopEnd);
 
 }  // namespace polydg

@@ -81,7 +81,11 @@ class Slicer {
     // Points that rounding made identical (intersection points of edges that meet a plane
     // within round-off of one of their ends) are welded: exact equality, no tolerance. Then
     // only used points are kept, in order of first use.
+    std::size_t polygons = 0;
+    for (const Leaf& leaf : leaves_) polygons += leaf.piece.size();
+    mesh.reserve(points.size(), polygons, leaves_.size());
     std::unordered_map<std::array<double, 3>, std::uint32_t, CoordinateHash> byPosition;
+    byPosition.reserve(points.size());
     std::vector<std::uint32_t> remap(points.size(), 0xffffffffu);
     auto vertexOf = [&](std::uint32_t v) {
       if (remap[v] == 0xffffffffu) {
@@ -96,40 +100,47 @@ class Slicer {
     // sorted vertex ids and uses it reversed.
     std::unordered_map<boost::container::small_vector<std::uint32_t, 8>, FaceId, SortedIdsHash>
         openCaps;
+    openCaps.reserve(polygons / 2);
     std::vector<FaceUse> uses;
     for (const Leaf& leaf : leaves_) {
       uses.clear();
       for (const PiecePolygon& polygon : leaf.piece) {
-        std::vector<Loop> loops;
+        boost::container::small_vector<VertexId, 8> vertices;
+        boost::container::small_vector<std::uint32_t, 2> loopEnd;
         for (std::size_t k = 0; k < polygon.numLoops(); ++k) {
-          Loop loop;
-          loop.reserve(polygon.loopEnd[k] - polygon.loopBegin(k));
+          const std::size_t begin = vertices.size();
           for (std::size_t i = polygon.loopBegin(k); i < polygon.loopEnd[k]; ++i) {
             const VertexId v = vertexOf(polygon.vertices[i]);
-            if (loop.empty() || loop.back() != v) loop.push_back(v);
+            if (vertices.size() == begin || vertices.back() != v) vertices.push_back(v);
           }
-          while (loop.size() > 1 && loop.front() == loop.back()) loop.pop_back();
-          if (loop.size() >= 3) loops.push_back(std::move(loop));
-          else if (k == 0) break;  // the outer boundary collapsed: the polygon is gone
+          while (vertices.size() > begin + 1 && vertices[begin] == vertices.back())
+            vertices.pop_back();
+          if (vertices.size() >= begin + 3) {
+            loopEnd.push_back(static_cast<std::uint32_t>(vertices.size()));
+          } else {
+            vertices.resize(begin);
+            if (k == 0) break;  // the outer boundary collapsed: the polygon is gone
+          }
         }
-        if (loops.empty()) {
+        if (loopEnd.empty()) {
           ++stats.collapsedPolygons;
           continue;
         }
+        const std::span<const VertexId> vs(vertices.data(), vertices.size());
+        const std::span<const std::uint32_t> ends(loopEnd.data(), loopEnd.size());
         if (polygon.origin != FaceOrigin::Interior) {
-          uses.push_back({mesh.addFace(std::move(loops), polygon.origin), false});
+          uses.push_back({mesh.addFace(vs, ends, polygon.origin), false});
           continue;
         }
         boost::container::small_vector<std::uint32_t, 8> key;
-        for (const Loop& loop : loops)
-          for (VertexId v : loop) key.push_back(v.value);
+        for (VertexId v : vertices) key.push_back(v.value);
         std::sort(key.begin(), key.end());
         auto it = openCaps.find(key);
-        if (it != openCaps.end() && isReverseOf(mesh.face(it->second), loops)) {
+        if (it != openCaps.end() && isReverseOf(mesh.face(it->second), vs, ends)) {
           uses.push_back({it->second, true});
           openCaps.erase(it);
         } else {
-          const FaceId f = mesh.addFace(std::move(loops), FaceOrigin::Interior);
+          const FaceId f = mesh.addFace(vs, ends, FaceOrigin::Interior);
           openCaps.emplace(std::move(key), f);
           uses.push_back({f, false});
         }

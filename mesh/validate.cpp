@@ -42,7 +42,7 @@ bool isDegenerate(const PolyMesh& mesh, FaceId f) {
   const Face& face = mesh.face(f);
   for (std::size_t k = 0; k < face.numLoops(); ++k)
     if (face.loop(k).size() < 3) return true;
-  std::vector<VertexId> sorted = face.vertices;
+  boost::container::small_vector<VertexId, 8> sorted(face.vertices.begin(), face.vertices.end());
   std::sort(sorted.begin(), sorted.end());
   if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) return true;
   return areaVector(mesh, f).squaredNorm() == 0.0;
@@ -106,32 +106,47 @@ ValidationReport validate(const PolyMesh& mesh, const ValidationOptions& options
   report.elements = mesh.numElements();
   report.faces = mesh.numFaces();
 
-  // Faces: shape, planarity, links to elements, duplicates.
-  struct SortedIdsHash {
-    std::size_t operator()(const boost::container::small_vector<std::uint32_t, 8>& ids) const {
-      std::size_t h = ids.size();
-      for (std::uint32_t id : ids) h = h * 0x9E3779B97F4A7C15ull + id;
-      return h;
-    }
+  // Faces: shape and planarity in parallel (the costly part), then links, duplicates and the
+  // report in order.
+  struct FaceCheck {
+    bool degenerate = false;
+    double planarity = 0.0;  ///< relative deviation, if beyond the tolerance; else 0
+    std::uint64_t key = 0;   ///< hash of the sorted vertex ids
   };
-  std::unordered_map<boost::container::small_vector<std::uint32_t, 8>, FaceId, SortedIdsHash>
-      byVertexSet;
-  byVertexSet.reserve(mesh.numFaces());
+  std::vector<FaceCheck> checks(mesh.numFaces());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.numFaces(), 1024),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                        const FaceId f(i);
+                        FaceCheck& c = checks[i];
+                        boost::container::small_vector<std::uint32_t, 8> ids;
+                        for (VertexId v : mesh.face(f).vertices) ids.push_back(v.value);
+                        std::sort(ids.begin(), ids.end());
+                        c.key = ids.size();
+                        for (std::uint32_t id : ids) c.key = c.key * 0x9E3779B97F4A7C15ull + id;
+                        c.degenerate = isDegenerate(mesh, f);
+                        if (c.degenerate) continue;
+                        const Box3 box = faceBounds(mesh, f);
+                        const double deviation = planarityDeviation(mesh, f);
+                        const double resolution =
+                            16.0 * std::numeric_limits<double>::epsilon() *
+                            std::max(box.min().cwiseAbs().maxCoeff(), box.max().cwiseAbs().maxCoeff());
+                        const double diameter = box.diagonal().norm();
+                        if (deviation > options.planarityTolerance * diameter + resolution)
+                          c.planarity = deviation / diameter;
+                      }
+                    });
   for (std::size_t i = 0; i < mesh.numFaces(); ++i) {
-    const FaceId f(i);
-    const Face& face = mesh.face(f);
+    const Face& face = mesh.face(FaceId(i));
     if (face.front.valid() && face.back.valid()) ++report.interiorFaces;
     else if (face.front.valid() || face.back.valid()) ++report.boundaryFaces;
-
-    if (isDegenerate(mesh, f)) {
+    if (checks[i].degenerate) {
       problems.add(report.degenerateFaces, describe("degenerate face", i));
-    } else if (relativePlanarityError(mesh, f) > options.planarityTolerance) {
+    } else if (checks[i].planarity > 0) {
       std::ostringstream msg;
-      msg << "face " << i << " is not planar (relative error " << relativePlanarityError(mesh, f)
-          << ")";
+      msg << "face " << i << " is not planar (relative error " << checks[i].planarity << ")";
       problems.add(report.nonPlanarFaces, msg.str());
     }
-
     if (!face.front.valid() && !face.back.valid()) {
       problems.add(report.inconsistentFaces, describe("face not used by any element:", i));
     } else if (!face.front.valid()) {
@@ -139,17 +154,30 @@ ValidationReport validate(const PolyMesh& mesh, const ValidationOptions& options
       // first element to the front; treat it as a link error.
       problems.add(report.inconsistentFaces, describe("face used only from its back:", i));
     }
-
-    boost::container::small_vector<std::uint32_t, 8> key;
-    for (VertexId v : face.vertices) key.push_back(v.value);
-    std::sort(key.begin(), key.end());
-    auto [it, inserted] = byVertexSet.emplace(std::move(key), f);
-    if (!inserted) {
-      problems.add(report.duplicateFaces,
-                   "faces " + std::to_string(it->second.value) + " and " + std::to_string(i) +
-                       " are the same polygon but not shared (a face used by more than two "
-                       "elements, or twice with the same orientation)");
-    }
+  }
+  // Duplicates: faces with equal vertex-set hashes, confirmed by comparing the sets.
+  std::vector<std::size_t> byKey(mesh.numFaces());
+  std::iota(byKey.begin(), byKey.end(), 0);
+  std::sort(byKey.begin(), byKey.end(), [&](std::size_t a, std::size_t b) {
+    return checks[a].key != checks[b].key ? checks[a].key < checks[b].key : a < b;
+  });
+  auto sortedIds = [&](std::size_t f) {
+    boost::container::small_vector<VertexId, 8> ids(mesh.face(FaceId(f)).vertices.begin(),
+                                                   mesh.face(FaceId(f)).vertices.end());
+    std::sort(ids.begin(), ids.end());
+    return ids;
+  };
+  for (std::size_t a = 0; a < byKey.size();) {
+    std::size_t b = a + 1;
+    while (b < byKey.size() && checks[byKey[b]].key == checks[byKey[a]].key) ++b;
+    for (std::size_t x = a; x < b; ++x)
+      for (std::size_t y = x + 1; y < b; ++y)
+        if (sortedIds(byKey[x]) == sortedIds(byKey[y]))
+          problems.add(report.duplicateFaces,
+                       "faces " + std::to_string(byKey[x]) + " and " + std::to_string(byKey[y]) +
+                           " are the same polygon but not shared (a face used by more than two "
+                           "elements, or twice with the same orientation)");
+    a = b;
   }
 
   // Elements: closure and volume in parallel (they are the costly part), then links back to

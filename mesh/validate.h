@@ -11,8 +11,10 @@ namespace polydg {
 
 struct ValidationOptions {
   /// A face is planar if every vertex lies within this fraction of the face's bounding-box
-  /// diagonal from its plane. 1e-6 accepts single-precision files; polydg's own meshes are
-  /// planar to round-off.
+  /// diagonal from its plane, or within the resolution of its coordinates (16 units in the
+  /// last place of its largest coordinate: a face can be no flatter than its vertices can be
+  /// placed). 1e-6 accepts single-precision files; polydg's own meshes are planar to
+  /// round-off.
   double planarityTolerance = 1e-6;
   /// How many problem descriptions to keep (counts are always complete).
   std::size_t maxMessages = 20;

@@ -53,8 +53,8 @@ TEST(PolyMesh, RejectsFaceSideUsedTwice) {
   for (int i = 0; i < 3; ++i) mesh.addVertex(Vec3(i, i * i, 1));
   const FaceId f =
       mesh.addFace({Loop{VertexId(0), VertexId(1), VertexId(2)}}, FaceOrigin::Surface);
-  mesh.addElementFromFaces({{f, false}});
-  EXPECT_THROW(mesh.addElementFromFaces({{f, false}}), std::invalid_argument);
+  mesh.addElementFromFaces(std::vector<FaceUse>{{f, false}});
+  EXPECT_THROW(mesh.addElementFromFaces(std::vector<FaceUse>{{f, false}}), std::invalid_argument);
   EXPECT_THROW(mesh.addFace({Loop{VertexId(0), VertexId(7), VertexId(2)}}, FaceOrigin::Surface),
                std::out_of_range);
 }

@@ -117,7 +117,7 @@ TEST(Validate, RejectsDegenerateFaceAndEmptyMesh) {
   for (int i = 0; i < 3; ++i) mesh.addVertex(Vec3(i, 0, 0));  // collinear
   const FaceId f =
       mesh.addFace({Loop{VertexId(0), VertexId(1), VertexId(2)}}, FaceOrigin::Surface);
-  mesh.addElementFromFaces({{f, false}});
+  mesh.addElementFromFaces(std::vector<FaceUse>{{f, false}});
   const ValidationReport r = validate(mesh);
   EXPECT_FALSE(r.passed);
   EXPECT_EQ(r.degenerateFaces, 1u);
