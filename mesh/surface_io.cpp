@@ -1,25 +1,42 @@
-// Reading surfaces through assimp: guard, import, bake transforms, weld by exact position,
+// Reading surfaces: guard the header counts; read OBJ/OFF/PLY/STL in double precision through
+// CGAL's polygon-soup readers (after checks for what they misread) and everything else, or what
+// CGAL cannot read, through assimp with transforms baked in; then weld by exact position and
 // triangulate polygons exactly.
 #include "mesh/surface_io.h"
 
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/IO/OBJ.h>
+#include <CGAL/IO/OFF.h>
+#include <CGAL/IO/PLY.h>
+#include <CGAL/IO/STL.h>
 #include <assimp/Importer.hpp>
 #include <assimp/config.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <cctype>
 #include <cstdint>
+#include <cstdlib>
+#include <cstring>
 #include <exception>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
+#include <iterator>
 #include <limits>
+#include <mutex>
+#include <optional>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <unordered_map>
 #include <utility>
+#include <variant>
 #include <vector>
 
 #include "mesh/face_triangulation.h"
@@ -52,9 +69,25 @@ std::string oneLine(const std::string& text) {
   return out.empty() ? "unknown error" : out;
 }
 
-std::string assimpError(const std::string& message) {
-  return "assimp cannot read it (" + oneLine(message) +
-         "); check that it is a valid mesh file in a format assimp supports";
+/// assimp's reason, and CGAL's if CGAL was tried first (`cgalReason` not empty).
+std::string assimpError(const std::string& message, const std::string& cgalReason) {
+  return "assimp cannot read it (" + oneLine(message) + ")" +
+         (cgalReason.empty() ? "" : "; nor can CGAL (" + oneLine(cgalReason) + ")") +
+         "; check that it is a valid mesh file in a format assimp supports";
+}
+
+std::string lowercase(std::string text) {
+  for (char& c : text) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return text;
+}
+
+/// The first 64 KiB of the file: enough for any real OFF or PLY header.
+std::string readHead(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string head(64 * 1024, '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<std::size_t>(in.gcount()));
+  return head;
 }
 
 // --- header guard -----------------------------------------------------------------------------
@@ -81,12 +114,8 @@ std::uint64_t parseCount(const std::string& token, bool& ok) {
 /// one corrupt count can take all memory (assimp's own invalid/OutOfMemory.off asks for 16 GB).
 /// Every declared vertex, face or PLY element takes at least one byte of the file, so a header
 /// declaring more of them than the file has bytes is rejected before assimp sees it.
-void checkDeclaredCounts(const std::string& path, std::uintmax_t fileSize) {
-  std::ifstream in(path, std::ios::binary);
-  std::string head(64 * 1024, '\0');
-  in.read(head.data(), static_cast<std::streamsize>(head.size()));
-  head.resize(static_cast<std::size_t>(in.gcount()));
-
+void checkDeclaredCounts(const std::string& path, const std::string& head,
+                         std::uintmax_t fileSize) {
   const auto check = [&](const std::string& token, const std::string& what) {
     bool ok = false;
     const std::uint64_t count = parseCount(token, ok);
@@ -148,9 +177,11 @@ bool onlyPointsOrLines(const aiScene& scene) {
   return true;
 }
 
-/// Imports the file and post-processes it, or throws. Point clouds are recognised before
-/// post-processing because validation rejects their face-less meshes with a cryptic message.
-const aiScene* importScene(Assimp::Importer& importer, const std::string& path) {
+/// Imports the file and post-processes it, or throws (quoting `cgalReason` too if not empty).
+/// Point clouds are recognised before post-processing because validation rejects their
+/// face-less meshes with a cryptic message.
+const aiScene* importScene(Assimp::Importer& importer, const std::string& path,
+                           const std::string& cgalReason) {
   // Files holding only a skeleton or animation would otherwise get a made-up mesh of bones.
   importer.SetPropertyBool(AI_CONFIG_IMPORT_NO_SKELETON_MESHES, true);
   // assimp reports errors by returning null; the catch is for anything that escapes it.
@@ -159,9 +190,9 @@ const aiScene* importScene(Assimp::Importer& importer, const std::string& path) 
     try {
       scene = step();
     } catch (const std::exception& e) {
-      fail(path, assimpError(e.what()));
+      fail(path, assimpError(e.what(), cgalReason));
     }
-    if (scene == nullptr) fail(path, assimpError(importer.GetErrorString()));
+    if (scene == nullptr) fail(path, assimpError(importer.GetErrorString(), cgalReason));
     return scene;
   };
   const aiScene* raw = checked([&] { return importer.ReadFile(path.c_str(), 0); });
@@ -171,11 +202,412 @@ const aiScene* importScene(Assimp::Importer& importer, const std::string& path) 
   return checked([&] { return importer.ApplyPostProcessing(kPostProcess); });
 }
 
+// --- CGAL: OBJ, OFF, PLY and STL in double precision --------------------------------------------
+
+using CgalPoint = CGAL::Exact_predicates_inexact_constructions_kernel::Point_3;
+using SoupPolygon = std::vector<std::size_t>;
+
+/// What a CGAL reader returned, in polydg's terms. Face indices are checked against `points`.
+struct PolygonSoup {
+  std::vector<Vec3> points;
+  std::vector<SoupPolygon> polygons;
+  std::size_t meshes = 1;
+  std::size_t inputVertices = 0;
+  std::size_t ignoredPoints = 0;  ///< OBJ `p` indices, removed before CGAL parsed the file
+  std::size_t ignoredLines = 0;   ///< OBJ `l` segments, removed likewise
+  bool onlyPointsOrLines = false;  ///< an OBJ file with vertices and no `f` line
+};
+
+/// The point type for CGAL's STL reader, which merges equal points through a std::map: ordered
+/// by bits, so that a NaN is kept (and reported) instead of breaking the map's ordering.
+struct StlPoint {
+  std::array<double, 3> c{};
+  double& operator[](std::size_t i) { return c[i]; }
+  const double& operator[](std::size_t i) const { return c[i]; }
+  bool operator<(const StlPoint& o) const {
+    for (std::size_t i = 0; i < 3; ++i) {
+      const auto a = std::bit_cast<std::uint64_t>(c[i]), b = std::bit_cast<std::uint64_t>(o.c[i]);
+      if (a != b) return a < b;
+    }
+    return false;
+  }
+};
+
+/// For its lifetime, std::cout, std::cerr and std::clog write into a buffer: CGAL's readers print
+/// their errors and notes there in verbose mode. One capture at a time in this process.
+class CapturedOutput {
+ public:
+  CapturedOutput()
+      : lock_(mutex()),
+        out_(std::cout.rdbuf(buffer_.rdbuf())),
+        err_(std::cerr.rdbuf(buffer_.rdbuf())),
+        log_(std::clog.rdbuf(buffer_.rdbuf())) {}
+  ~CapturedOutput() {
+    std::cout.rdbuf(out_);
+    std::cerr.rdbuf(err_);
+    std::clog.rdbuf(log_);
+  }
+  CapturedOutput(const CapturedOutput&) = delete;
+  CapturedOutput& operator=(const CapturedOutput&) = delete;
+
+  /// The last line that mentions an error or a warning, or "" if none did.
+  std::string lastError() const {
+    std::istringstream lines(buffer_.str());
+    std::string line, found;
+    while (std::getline(lines, line)) {
+      const std::string lower = lowercase(line);
+      if (lower.find("error") != std::string::npos || lower.find("warning") != std::string::npos)
+        found = line;
+    }
+    return found;
+  }
+
+ private:
+  static std::mutex& mutex() {
+    static std::mutex m;
+    return m;
+  }
+  std::lock_guard<std::mutex> lock_;
+  std::ostringstream buffer_;
+  std::streambuf* out_;
+  std::streambuf* err_;
+  std::streambuf* log_;
+};
+
+/// Why CGAL did not read a file: "" while nothing went wrong.
+using Reason = std::string;
+
+/// Runs `read` (a CGAL reader call returning bool) with output captured; returns "" on success,
+/// else CGAL's last error line (or the exception it threw).
+template <typename Read>
+Reason runCgal(Read read) {
+  CapturedOutput captured;
+  try {
+    if (read()) return "";
+  } catch (const std::exception& e) {  // CGAL assertions, std::bad_alloc
+    return oneLine(e.what());
+  }
+  const std::string error = captured.lastError();
+  return error.empty() ? "its reader failed without a message" : oneLine(error);
+}
+
+/// Every index of every polygon names a point, and no polygon is empty.
+Reason checkIndices(const std::vector<SoupPolygon>& polygons, std::size_t numPoints) {
+  for (std::size_t f = 0; f < polygons.size(); ++f) {
+    if (polygons[f].empty()) return "face " + std::to_string(f) + " has no corners";
+    for (std::size_t v : polygons[f])
+      if (v >= numPoints)
+        return "face " + std::to_string(f) + " refers to a vertex beyond the " +
+               std::to_string(numPoints) + " of the file";
+  }
+  return "";
+}
+
+template <typename Point>
+std::vector<Vec3> toVec3(const std::vector<Point>& points) {
+  std::vector<Vec3> out;
+  out.reserve(points.size());
+  for (const Point& p : points) out.emplace_back(p[0], p[1], p[2]);
+  return out;
+}
+
+/// The whitespace-separated words of `line`.
+std::vector<std::string_view> words(std::string_view line) {
+  std::vector<std::string_view> out;
+  std::size_t i = 0;
+  while (true) {
+    while (i < line.size() && line[i] == ' ') ++i;
+    if (i == line.size()) return out;
+    const std::size_t start = i;
+    while (i < line.size() && line[i] != ' ') ++i;
+    out.push_back(line.substr(start, i - start));
+  }
+}
+
+/// The OBJ text that CGAL's reader parses safely, with the facts CGAL does not report.
+struct ObjScan {
+  std::string text;  ///< tabs and CRs as spaces, comments cut, `p`/`l` lines removed,
+                     ///< `f` lines reduced to their vertex indices
+  std::size_t vertices = 0, faces = 0, points = 0, lines = 0;
+  std::set<std::string> materials;  ///< used by faces, points and lines ("" before any usemtl)
+};
+
+/// Prepares an OBJ file for CGAL's reader, or returns why CGAL must not read it: CGAL would
+/// silently misread face indices that are zero (taken as relative), overflow an int or are not
+/// integers (the face ends there), homogeneous coordinates (w ignored) and line continuations;
+/// it rejects `l` lines, which are counted and removed here like `p` lines; it keeps an `f` line
+/// without indices as an empty face, which is removed here (assimp skips it).
+std::variant<ObjScan, Reason> scanObj(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (!in.good() && !in.eof()) return Reason("cannot read the file");
+  if (text.find('\0') != std::string::npos) return Reason("the file is not text (NUL bytes)");
+  ObjScan scan;
+  scan.text.reserve(text.size());
+  std::string material;  // the default material until the first usemtl
+  std::size_t lineNumber = 0;
+  for (std::size_t begin = 0; begin < text.size();) {
+    std::size_t end = text.find('\n', begin);
+    if (end == std::string::npos) end = text.size();
+    std::string line = text.substr(begin, end - begin);
+    begin = end + 1;
+    ++lineNumber;
+    const std::string where = "line " + std::to_string(lineNumber) + ": ";
+    for (char& c : line)
+      if (c == '\t' || c == '\r' || c == '\v' || c == '\f') c = ' ';
+    if (const std::size_t hash = line.find('#'); hash != std::string::npos) line.resize(hash);
+    while (!line.empty() && line.back() == ' ') line.pop_back();
+    if (!line.empty() && line.back() == '\\') return where + "line continuation";
+    const std::vector<std::string_view> w = words(line);
+    if (w.empty()) {
+      scan.text += '\n';
+      continue;
+    }
+    const std::string_view keyword = w[0];
+    if (keyword == "v") {
+      ++scan.vertices;
+      if (w.size() == 5) {  // x y z w
+        const std::string weight(w[4]);
+        char* stop = nullptr;
+        const double value = std::strtod(weight.c_str(), &stop);
+        if (*stop != '\0' || value != 1.0) return where + "homogeneous vertex (w != 1)";
+      }
+      scan.text += line;
+    } else if (keyword == "f" && w.size() == 1) {
+      // An empty face, which assimp skips too; CGAL would keep it as a face of no corners.
+    } else if (keyword == "f") {
+      ++scan.faces;
+      scan.materials.insert(material);
+      std::string face = "f";
+      for (std::size_t k = 1; k < w.size(); ++k) {
+        // An index: [+-]digits, optionally followed by /texture/normal.
+        const std::string_view token = w[k];
+        std::size_t digits = token.starts_with('-') || token.starts_with('+') ? 1 : 0;
+        const std::size_t first = digits;
+        while (digits < token.size() && std::isdigit(static_cast<unsigned char>(token[digits])))
+          ++digits;
+        const std::string_view number = token.substr(0, digits);
+        if (digits == first || digits - first > 9 ||
+            (digits < token.size() && token[digits] != '/') ||
+            number.find_first_not_of("+-0") == std::string_view::npos)
+          return where + "face index '" + std::string(token) + "' is not a nonzero integer";
+        face += ' ';
+        face += number;
+      }
+      scan.text += face;
+    } else if (keyword == "p") {
+      scan.points += w.size() - 1;
+      scan.materials.insert(material);
+    } else if (keyword == "l") {
+      scan.lines += w.size() > 2 ? w.size() - 2 : 0;
+      scan.materials.insert(material);
+    } else {
+      if (keyword == "usemtl") {
+        const std::size_t start = line.find("usemtl") + 6;
+        material = line.substr(std::min(line.size(), line.find_first_not_of(' ', start)));
+      }
+      scan.text += line;
+    }
+    scan.text += '\n';
+  }
+  return scan;
+}
+
+std::variant<PolygonSoup, Reason> readObjWithCgal(const std::string& path) {
+  auto scanned = scanObj(path);
+  if (auto* reason = std::get_if<Reason>(&scanned)) return *reason;
+  const ObjScan& scan = std::get<ObjScan>(scanned);
+  PolygonSoup soup;
+  soup.meshes = std::max<std::size_t>(1, scan.materials.size());
+  soup.inputVertices = scan.vertices;
+  soup.ignoredPoints = scan.points;
+  soup.ignoredLines = scan.lines;
+  if (scan.faces == 0 && scan.vertices > 0) {
+    soup.onlyPointsOrLines = true;
+    return soup;
+  }
+  std::vector<CgalPoint> points;
+  std::istringstream in(scan.text);
+  Reason reason = runCgal([&] {
+    return CGAL::IO::read_OBJ(in, points, soup.polygons, CGAL::parameters::verbose(true));
+  });
+  if (!reason.empty()) return reason;
+  if (points.size() != scan.vertices || soup.polygons.size() != scan.faces)
+    return Reason("its reader found " + std::to_string(points.size()) + " vertices and " +
+                  std::to_string(soup.polygons.size()) + " faces, not " +
+                  std::to_string(scan.vertices) + " and " + std::to_string(scan.faces));
+  soup.points = toVec3(points);
+  return soup;
+}
+
+/// One property of a PLY element as its header declares it.
+struct PlyProperty {
+  std::string name, type, sizeType;  // sizeType: the count type of a list, else ""
+};
+
+struct PlyElement {
+  std::string name;
+  std::vector<PlyProperty> properties;
+};
+
+/// Why CGAL's PLY reader must not read a file with this header, or "": it asserts (crashes when
+/// assertions are off) on x/y/z of integer type, silently misaligns on a property type it does
+/// not know, fills a list from its declared count (a corrupt 32-bit count allocates gigabytes),
+/// reads "vertices"/"faces"/"halfedge" elements its own way, and ignores the triangle strips and
+/// range grids that assimp reads.
+Reason plyHeaderProblem(const std::string& head) {
+  static const std::set<std::string> kScalar = {"char",  "int8",  "uchar",   "uint8",
+                                                "short", "int16", "ushort",  "uint16",
+                                                "int",   "int32", "uint",    "uint32",
+                                                "float", "float32", "double", "float64"};
+  static const std::set<std::string> kListCount = {"char",  "int8",  "uchar",  "uint8",
+                                                   "short", "int16", "ushort", "uint16"};
+  static const std::set<std::string> kReal = {"float", "float32", "double", "float64"};
+  static const std::set<std::string> kForeign = {"vertices", "faces", "halfedge", "tristrips",
+                                                 "range_grid"};
+  std::istringstream lines(head);
+  std::string line;
+  std::vector<PlyElement> elements;
+  bool ended = false;
+  for (std::size_t number = 1; std::getline(lines, line); ++number) {
+    std::istringstream in(line);
+    std::string keyword;
+    in >> keyword;
+    if (number == 2 && keyword != "format") return "the header's second line is not its format";
+    if (number == 2) {
+      std::string format;
+      in >> format;
+      if (format != "ascii" && format != "binary_little_endian" && format != "binary_big_endian")
+        return "unknown PLY format '" + format + "'";
+    } else if (keyword == "element") {
+      PlyElement element;
+      in >> element.name;
+      if (kForeign.contains(element.name))
+        return "element '" + element.name + "' is not read the same way by CGAL";
+      elements.push_back(element);
+    } else if (keyword == "property") {
+      if (elements.empty()) return "a property before any element";
+      PlyProperty property;
+      in >> property.type;
+      if (property.type == "list") {
+        in >> property.sizeType >> property.type;
+        if (!kListCount.contains(property.sizeType))
+          return "list count type '" + property.sizeType + "' (CGAL reads 8 and 16 bits only)";
+      }
+      if (!kScalar.contains(property.type)) return "property type '" + property.type + "'";
+      in >> property.name;
+      elements.back().properties.push_back(property);
+    } else if (keyword == "end_header") {
+      ended = true;
+      break;
+    }
+  }
+  if (!ended) return "no end_header in the first 64 KiB";
+  bool haveVertex = false;
+  for (const PlyElement& element : elements) {
+    if (element.name != "vertex") continue;
+    haveVertex = true;
+    for (const char* axis : {"x", "y", "z"}) {
+      const auto it = std::find_if(element.properties.begin(), element.properties.end(),
+                                   [&](const PlyProperty& p) { return p.name == axis; });
+      if (it == element.properties.end()) return std::string("vertex has no ") + axis;
+      if (!it->sizeType.empty() || !kReal.contains(it->type))
+        return std::string("vertex ") + axis + " is of type " + it->type;
+    }
+  }
+  if (!haveVertex) return "no vertex element";
+  return "";
+}
+
+/// Why CGAL's OFF reader must not read a file with this header, or "": it allocates the vertex
+/// and face counts before reading, so only the ASCII forms whose counts checkDeclaredCounts has
+/// bounded are given to it ([ST][C][N][4]OFF, then the counts): not nOFF (a dimension first),
+/// binary OFF (binary counts) or SKEL.
+Reason offHeaderProblem(const std::string& head) {
+  std::istringstream lines(head);
+  std::vector<std::string> tokens;
+  for (std::string line; tokens.size() < 3 && std::getline(lines, line);) {
+    std::istringstream words(line.substr(0, line.find('#')));
+    for (std::string word; tokens.size() < 3 && words >> word;) tokens.push_back(word);
+  }
+  if (tokens.empty()) return "no OFF header";
+  std::string keyword = tokens[0];
+  for (const char* prefix : {"ST", "C", "N", "4"})
+    if (keyword.starts_with(prefix)) keyword.erase(0, std::strlen(prefix));
+  if (keyword != "OFF") return "header keyword '" + tokens[0] + "' is not one CGAL reads here";
+  for (std::size_t k = 1; k < 3; ++k) {
+    bool ok = k < tokens.size();
+    if (ok) parseCount(tokens[k], ok);
+    if (!ok) return "no vertex and face counts after '" + tokens[0] + "'";
+  }
+  return "";
+}
+
+/// Reads an STL file with the binary or the ASCII parser of CGAL/IO/STL/STL_reader.h (CGAL 5.5),
+/// chosen as assimp chooses: binary if the file has exactly 84 + 50 n bytes, n being the facet
+/// count at byte 80; else ASCII if its first word is "solid". CGAL's read_STL is not used: it
+/// takes "solid" followed by a tab for binary, and when one parser fails it runs the other on
+/// the same output, appending the second parse to what the first left.
+Reason readStl(const std::string& path, const std::string& head, std::vector<StlPoint>& points,
+               std::vector<SoupPolygon>& triangles) {
+  std::error_code ec;
+  const std::uintmax_t size = std::filesystem::file_size(path, ec);
+  if (ec) return "cannot find its size";
+  std::uint32_t facets = 0;
+  if (head.size() >= 84) std::memcpy(&facets, head.data() + 80, sizeof facets);
+  const bool binary = size >= 84 && size == 84 + 50 * std::uintmax_t{facets};
+  const std::size_t word = head.find_first_not_of(" \t\r\n\v\f");
+  if (!binary && (word == std::string::npos || head.compare(word, 5, "solid") != 0))
+    return "neither binary (" + std::to_string(size) + " bytes, not 84 + 50 x its facet count) "
+           "nor ASCII (no 'solid' first)";
+  std::ifstream in(path, std::ios::binary);
+  return runCgal([&] {
+    return binary ? CGAL::IO::internal::parse_binary_STL(in, points, triangles, true)
+                  : CGAL::IO::internal::parse_ASCII_STL(in, points, triangles, true);
+  });
+}
+
+/// Reads an OBJ, OFF, PLY or STL file (`extension` in lower case) with CGAL, or returns why not.
+std::variant<PolygonSoup, Reason> readWithCgal(const std::string& path,
+                                               const std::string& extension,
+                                               const std::string& head) {
+  if (head.empty()) return Reason("the file is empty");
+  PolygonSoup soup;
+  Reason reason;
+  if (extension == "obj") {
+    auto read = readObjWithCgal(path);
+    if (auto* r = std::get_if<Reason>(&read)) return *r;
+    soup = std::move(std::get<PolygonSoup>(read));
+    if (soup.onlyPointsOrLines) return soup;
+  } else if (extension == "stl") {
+    std::vector<StlPoint> points;
+    reason = readStl(path, head, points, soup.polygons);
+    soup.points = toVec3(points);
+    soup.inputVertices = 3 * soup.polygons.size();
+  } else {
+    reason = extension == "ply" ? plyHeaderProblem(head) : offHeaderProblem(head);
+    if (!reason.empty()) return reason;
+    std::vector<CgalPoint> points;
+    reason = runCgal([&] {
+      const auto verbose = CGAL::parameters::verbose(true);
+      return extension == "ply" ? CGAL::IO::read_PLY(path, points, soup.polygons, verbose)
+                                : CGAL::IO::read_OFF(path, points, soup.polygons, verbose);
+    });
+    soup.points = toVec3(points);
+    soup.inputVertices = soup.points.size();
+  }
+  if (!reason.empty()) return reason;
+  if (soup.points.empty()) return Reason("no vertices");
+  reason = checkIndices(soup.polygons, soup.points.size());
+  if (!reason.empty()) return reason;
+  return soup;
+}
+
 // --- welding ----------------------------------------------------------------------------------
 
 /// A coordinate widened to double, with -0.0 replaced by 0.0: after this, two coordinates are
 /// equal exactly when their bits are.
-double canonical(ai_real x) { return x == 0 ? 0.0 : static_cast<double>(x); }
+double canonical(double x) { return x == 0 ? 0.0 : x; }
 
 /// The bits of a canonical position; the weld key.
 using PositionKey = std::array<std::uint64_t, 3>;
@@ -272,47 +704,84 @@ TriangleSurface readSurface(const std::string& path, SurfaceReadInfo* info) {
   const fs::file_status status = fs::status(path, ec);
   if (!fs::exists(status)) fail(path, "no such file");
   if (fs::is_directory(status)) fail(path, "is a directory; give the path of a mesh file");
+  const std::string head = readHead(path);
   const std::uintmax_t size = fs::file_size(path, ec);
-  if (!ec) checkDeclaredCounts(path, size);
-
-  Assimp::Importer importer;
-  const aiScene* scene = importScene(importer, path);
+  if (!ec) checkDeclaredCounts(path, head, size);
 
   SurfaceReadInfo counts;
-  counts.meshes = scene->mNumMeshes;
   SurfaceBuilder builder(path, counts);
   std::size_t inputFaces = 0;  // faces with three or more corners
   std::vector<Vec3> corners;
-  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
-    const aiMesh& mesh = *scene->mMeshes[m];
-    counts.inputVertices += mesh.mNumVertices;
-    for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
-      const aiFace& face = mesh.mFaces[f];
-      if (face.mNumIndices == 1) {
-        ++counts.ignoredPoints;
-        continue;
-      }
-      if (face.mNumIndices == 2) {
-        ++counts.ignoredLines;
-        continue;
-      }
-      ++inputFaces;
+  // Adds a face whose corners are in `corners` (points and lines are counted, not added).
+  const auto addFace = [&] {
+    if (corners.empty()) return;
+    if (corners.size() == 1) {
+      ++counts.ignoredPoints;
+      return;
+    }
+    if (corners.size() == 2) {
+      ++counts.ignoredLines;
+      return;
+    }
+    ++inputFaces;
+    for (const Vec3& p : corners)
+      if (!p.allFinite())
+        fail(path, "a vertex has a non-finite coordinate (NaN or infinity); fix the file");
+    if (corners.size() == 3) {
+      builder.addTriangle(corners[0], corners[1], corners[2]);
+    } else {
+      ++counts.polygons;
+      builder.addPolygon(corners);
+    }
+  };
+
+  const std::string extension = lowercase(fs::path(path).extension().string());
+  Reason cgalReason;
+  std::optional<PolygonSoup> soup;
+  if (extension == ".obj" || extension == ".off" || extension == ".ply" || extension == ".stl") {
+    auto read = readWithCgal(path, extension.substr(1), head);
+    if (auto* reason = std::get_if<Reason>(&read))
+      cgalReason = *reason;
+    else
+      soup = std::move(std::get<PolygonSoup>(read));
+  }
+
+  Assimp::Importer importer;
+  if (soup) {
+    if (soup->onlyPointsOrLines)
+      fail(path, "contains only points/lines, no triangles; polydg needs a surface mesh");
+    counts.reader = "cgal";
+    counts.meshes = soup->meshes;
+    counts.inputVertices = soup->inputVertices;
+    for (const SoupPolygon& polygon : soup->polygons) {
       corners.clear();
-      for (unsigned k = 0; k < face.mNumIndices; ++k) {
-        const unsigned v = face.mIndices[k];
-        if (v >= mesh.mNumVertices)
-          fail(path, "mesh " + std::to_string(m) + " refers to vertex " + std::to_string(v) +
-                         " of " + std::to_string(mesh.mNumVertices) + "; the file is corrupt");
-        const aiVector3D& p = mesh.mVertices[v];
-        corners.emplace_back(canonical(p.x), canonical(p.y), canonical(p.z));
-        if (!corners.back().allFinite())
-          fail(path, "a vertex has a non-finite coordinate (NaN or infinity); fix the file");
+      for (std::size_t v : polygon) {
+        const Vec3& p = soup->points[v];
+        corners.emplace_back(canonical(p.x()), canonical(p.y()), canonical(p.z()));
       }
-      if (corners.size() == 3) {
-        builder.addTriangle(corners[0], corners[1], corners[2]);
-      } else {
-        ++counts.polygons;
-        builder.addPolygon(corners);
+      addFace();
+    }
+    counts.ignoredPoints += soup->ignoredPoints;
+    counts.ignoredLines += soup->ignoredLines;
+  } else {
+    const aiScene* scene = importScene(importer, path, cgalReason);
+    counts.reader = "assimp";
+    counts.meshes = scene->mNumMeshes;
+    for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
+      const aiMesh& mesh = *scene->mMeshes[m];
+      counts.inputVertices += mesh.mNumVertices;
+      for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
+        const aiFace& face = mesh.mFaces[f];
+        corners.clear();
+        for (unsigned k = 0; k < face.mNumIndices; ++k) {
+          const unsigned v = face.mIndices[k];
+          if (v >= mesh.mNumVertices)
+            fail(path, "mesh " + std::to_string(m) + " refers to vertex " + std::to_string(v) +
+                           " of " + std::to_string(mesh.mNumVertices) + "; the file is corrupt");
+          const aiVector3D& p = mesh.mVertices[v];
+          corners.emplace_back(canonical(p.x), canonical(p.y), canonical(p.z));
+        }
+        addFace();
       }
     }
   }
