@@ -14,6 +14,8 @@ struct CommonOptions {
 void addInfoCommand(CLI::App& app, const CommonOptions& common, int& exitCode);
 void addCheckCommand(CLI::App& app, const CommonOptions& common, int& exitCode);
 void addMeshCommand(CLI::App& app, const CommonOptions& common, int& exitCode);
+void addSolveCommand(CLI::App& app, const CommonOptions& common, int& exitCode);
+void addBenchCommand(CLI::App& app, const CommonOptions& common, int& exitCode);
 
 /// True for files read as simulation meshes (VTU) rather than surfaces.
 bool isVolumeMeshPath(const std::string& path);

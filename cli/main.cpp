@@ -4,6 +4,8 @@
 //   polydg mesh testdata/torus.obj --cells 16 -o torus.vtu --report mesh.json
 //   polydg info testdata/cube.obj --report info.json
 //   polydg check mesh.vtu --report check.json
+//   polydg solve beam.vtu -o out.vtu --degree 2 --clamp x=0 --traction x=10:0,0,-1
+//   polydg bench --suite accuracy --out bench/
 #include <cstdio>
 #include <exception>
 #include <iostream>
@@ -22,6 +24,8 @@ int main(int argc, char** argv) {
   polydg::cli::addInfoCommand(app, common, exitCode);
   polydg::cli::addMeshCommand(app, common, exitCode);
   polydg::cli::addCheckCommand(app, common, exitCode);
+  polydg::cli::addSolveCommand(app, common, exitCode);
+  polydg::cli::addBenchCommand(app, common, exitCode);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -45,7 +45,8 @@ class IndexedData {
   const T& operator[](Id<Tag> id) const { return data_[id.index()]; }
 
   std::size_t size() const { return data_.size(); }
-  void resize(std::size_t n, const T& value = T()) { data_.resize(n, value); }
+  void resize(std::size_t n) { data_.resize(n); }
+  void resize(std::size_t n, const T& value) { data_.resize(n, value); }
   void push_back(const T& value) { data_.push_back(value); }
   auto begin() { return data_.begin(); }
   auto end() { return data_.end(); }

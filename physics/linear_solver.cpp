@@ -1,0 +1,212 @@
+#include "physics/linear_solver.h"
+
+#include <chrono>
+#include <cmath>
+
+#include <Eigen/CholmodSupport>
+#include <Eigen/Dense>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+
+namespace polydg {
+
+namespace {
+
+using SpMat = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
+using Clock = std::chrono::steady_clock;
+
+double secondsSince(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+/// Quiet CHOLMOD: "not positive definite" is an expected outcome of a penalty search.
+template <class Solver>
+void silence(Solver& solver) {
+  solver.cholmod().print = 0;
+}
+
+template <class Solver>
+void setOrdering(Solver& solver, CholeskyOrdering ordering) {
+  cholmod_common& c = solver.cholmod();
+  switch (ordering) {
+    case CholeskyOrdering::Cholmod: return;
+    case CholeskyOrdering::Amd:
+      c.nmethods = 1;
+      c.method[0].ordering = CHOLMOD_AMD;
+      return;
+    case CholeskyOrdering::Metis:
+      c.nmethods = 1;
+      c.method[0].ordering = CHOLMOD_METIS;
+      return;
+  }
+}
+
+double parallelDot(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+  return tbb::parallel_reduce(
+      tbb::blocked_range<Eigen::Index>(0, a.size(), 8192), 0.0,
+      [&](const tbb::blocked_range<Eigen::Index>& r, double s) {
+        return s + a.segment(r.begin(), r.size()).dot(b.segment(r.begin(), r.size()));
+      },
+      std::plus<double>());
+}
+
+}  // namespace
+
+void symmetricProduct(const SpMat& matrix, const Eigen::VectorXd& x, Eigen::VectorXd& y) {
+  y.resize(matrix.rows());
+  const int* outer = matrix.outerIndexPtr();
+  const int* inner = matrix.innerIndexPtr();
+  const double* values = matrix.valuePtr();
+  tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, matrix.cols(), 512),
+                    [&](const tbb::blocked_range<Eigen::Index>& r) {
+                      for (Eigen::Index c = r.begin(); c != r.end(); ++c) {
+                        double s = 0.0;
+                        for (int k = outer[c]; k < outer[c + 1]; ++k) s += values[k] * x[inner[k]];
+                        y[c] = s;
+                      }
+                    });
+}
+
+SolverKind chooseSolver(const SpMat& matrix, const SolverOptions& options) {
+  if (options.kind != SolverKind::Auto) return options.kind;
+  const bool small = static_cast<std::size_t>(matrix.rows()) <= options.directLimitDofs &&
+                     static_cast<std::size_t>(matrix.nonZeros()) <= options.directLimitNonzeros;
+  return small ? SolverKind::Cholesky : SolverKind::ConjugateGradient;
+}
+
+struct LinearSolver::Impl {
+  SolverOptions options;
+  SolverKind kind = SolverKind::Auto;
+  const SpMat* matrix = nullptr;
+  int blockSize = 0;
+  double factorSeconds = 0.0;
+  std::unique_ptr<Eigen::CholmodSupernodalLLT<SpMat, Eigen::Lower>> cholesky;
+  std::vector<Eigen::MatrixXd> blockInverses;
+
+  bool buildPreconditioner() {
+    const Eigen::Index nb = matrix->rows() / blockSize;
+    blockInverses.assign(static_cast<std::size_t>(nb), Eigen::MatrixXd());
+    std::atomic<bool> ok{true};
+    tbb::parallel_for(Eigen::Index(0), nb, [&](Eigen::Index b) {
+      const Eigen::Index base = b * blockSize;
+      Eigen::MatrixXd block = Eigen::MatrixXd::Zero(blockSize, blockSize);
+      for (int c = 0; c < blockSize; ++c)
+        for (SpMat::InnerIterator it(*matrix, base + c); it; ++it)
+          if (it.row() >= base && it.row() < base + blockSize) block(it.row() - base, c) = it.value();
+      Eigen::LLT<Eigen::MatrixXd> llt(block);
+      if (llt.info() != Eigen::Success) {
+        ok = false;
+        block = block.diagonal().cwiseAbs().cwiseMax(1e-300).cwiseInverse().asDiagonal();
+      } else {
+        block = llt.solve(Eigen::MatrixXd::Identity(blockSize, blockSize));
+      }
+      blockInverses[static_cast<std::size_t>(b)] = std::move(block);
+    });
+    return ok;
+  }
+
+  void precondition(const Eigen::VectorXd& r, Eigen::VectorXd& z) const {
+    z.resize(r.size());
+    tbb::parallel_for(std::size_t(0), blockInverses.size(), [&](std::size_t b) {
+      const Eigen::Index base = static_cast<Eigen::Index>(b) * blockSize;
+      z.segment(base, blockSize).noalias() = blockInverses[b] * r.segment(base, blockSize);
+    });
+  }
+
+  Eigen::VectorXd conjugateGradient(const Eigen::VectorXd& f, SolveReport& report) const {
+    const double fNorm = std::sqrt(parallelDot(f, f));
+    Eigen::VectorXd u = Eigen::VectorXd::Zero(f.size());
+    if (fNorm == 0.0) {
+      report.success = true;
+      return u;
+    }
+    Eigen::VectorXd r = f, z, p, q;
+    precondition(r, z);
+    p = z;
+    double rz = parallelDot(r, z);
+    const double target = options.tolerance * fNorm;
+    int it = 0;
+    double rNorm = fNorm;
+    for (; it < options.maxIterations && rNorm > target; ++it) {
+      symmetricProduct(*matrix, p, q);
+      const double alpha = rz / parallelDot(p, q);
+      u += alpha * p;
+      r -= alpha * q;
+      rNorm = std::sqrt(parallelDot(r, r));
+      precondition(r, z);
+      const double rzNew = parallelDot(r, z);
+      p = z + (rzNew / rz) * p;
+      rz = rzNew;
+    }
+    report.iterations = it;
+    report.success = rNorm <= target;
+    return u;
+  }
+};
+
+LinearSolver::LinearSolver(const SolverOptions& options) : impl_(std::make_unique<Impl>()) {
+  impl_->options = options;
+}
+LinearSolver::~LinearSolver() = default;
+LinearSolver::LinearSolver(LinearSolver&&) noexcept = default;
+LinearSolver& LinearSolver::operator=(LinearSolver&&) noexcept = default;
+
+SolverKind LinearSolver::kind() const { return impl_->kind; }
+
+bool LinearSolver::compute(const SpMat& matrix, int blockSize) {
+  Impl& m = *impl_;
+  m.matrix = &matrix;
+  m.blockSize = blockSize;
+  m.kind = chooseSolver(matrix, m.options);
+  const auto t0 = Clock::now();
+  bool ok = true;
+  if (m.kind == SolverKind::Cholesky) {
+    m.cholesky = std::make_unique<Eigen::CholmodSupernodalLLT<SpMat, Eigen::Lower>>();
+    silence(*m.cholesky);
+    setOrdering(*m.cholesky, m.options.ordering);
+    m.cholesky->compute(matrix);
+    ok = m.cholesky->info() == Eigen::Success;
+  } else {
+    ok = m.buildPreconditioner();
+  }
+  m.factorSeconds = secondsSince(t0);
+  return ok;
+}
+
+Eigen::VectorXd LinearSolver::solve(const Eigen::VectorXd& rhs, SolveReport& report) {
+  Impl& m = *impl_;
+  report = SolveReport{};
+  report.used = m.kind;
+  report.factorSeconds = m.factorSeconds;
+  const auto t0 = Clock::now();
+  Eigen::VectorXd u;
+  if (m.kind == SolverKind::Cholesky) {
+    report.success = m.cholesky && m.cholesky->info() == Eigen::Success;
+    u = report.success ? Eigen::VectorXd(m.cholesky->solve(rhs))
+                       : Eigen::VectorXd::Zero(rhs.size());
+  } else {
+    u = m.conjugateGradient(rhs, report);
+  }
+  report.solveSeconds = secondsSince(t0);
+  Eigen::VectorXd ku;
+  symmetricProduct(*m.matrix, u, ku);
+  const double fNorm = rhs.norm();
+  report.residual = fNorm > 0.0 ? (rhs - ku).norm() / fNorm : (ku).norm();
+  return u;
+}
+
+Eigen::VectorXd solveLinearSystem(const SpMat& matrix, const Eigen::VectorXd& rhs, int blockSize,
+                                  const SolverOptions& options, SolveReport& report) {
+  LinearSolver solver(options);
+  solver.compute(matrix, blockSize);
+  return solver.solve(rhs, report);
+}
+
+bool isPositiveDefinite(const SpMat& matrix) {
+  Eigen::CholmodSupernodalLLT<SpMat, Eigen::Lower> llt;
+  silence(llt);
+  llt.compute(matrix);
+  return llt.info() == Eigen::Success;
+}
+
+}  // namespace polydg

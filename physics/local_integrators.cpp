@@ -1,0 +1,254 @@
+#include "physics/local_integrators.h"
+
+#include <cmath>
+
+
+#include "physics/polynomial_tables.h"
+
+namespace polydg {
+
+namespace {
+
+/// The degree-P kernels. Fixed-size matrices: N = numMonomials(P) functions per component,
+/// N1 = numMonomials(P - 1) lifting functions.
+template <int P>
+struct Kernel {
+  using Tab = detail::PolyTables<P>;
+  static constexpr int N = Tab::N;
+  static constexpr int N1 = Tab::N1;
+  static constexpr int N2 = Tab::N2;
+  using Mat = Eigen::Matrix<double, N, N>;
+  using Mat1 = Eigen::Matrix<double, N1, N>;
+  using Mat11 = Eigen::Matrix<double, N1, N1>;
+
+  /// int m_a m_b from moments about the monomials' centre, divided by h^(|a|+|b|).
+  static Mat gram(std::span<const double> moments, double h) {
+    double scaled[N2];
+    double hp[2 * P + 1];
+    hp[0] = 1.0;
+    for (int k = 1; k <= 2 * P; ++k) hp[k] = hp[k - 1] / h;
+    for (int g = 0; g < N2; ++g) scaled[g] = moments[g] * hp[kMonomialTable[g].degree()];
+    Mat m;
+    for (int a = 0; a < N; ++a)
+      for (int b = 0; b < N; ++b) m(a, b) = scaled[Tab::sum[a][b]];
+    return m;
+  }
+
+  /// R with d/dx_k (t m)(x) = (R m)(x) * h for monomials m scaled by h: R(i, pred(a)) +=
+  /// power_k(a) t(i, a).
+  static Mat derive(const Mat& t, int k) {
+    Mat r = Mat::Zero();
+    for (int a = 0; a < N; ++a) {
+      const int b = Tab::pred[k][a];
+      if (b >= 0) r.col(b) += Tab::power[k][a] * t.col(a);
+    }
+    return r;
+  }
+
+  /// S with m_a((x - c)/h) = sum_b S(a, b) y^b for x = r + hF y: the binomial expansion of
+  /// (sigma y + d)^a, sigma = hF / h, d = (r - c) / h.
+  static Mat shift(double sigma, const Vec3& d) {
+    double sp[P + 1], dp[3][P + 1];
+    sp[0] = 1.0;
+    for (int k = 0; k < 3; ++k) dp[k][0] = 1.0;
+    for (int m = 1; m <= P; ++m) {
+      sp[m] = sp[m - 1] * sigma;
+      for (int k = 0; k < 3; ++k) dp[k][m] = dp[k][m - 1] * d[k];
+    }
+    Mat s = Mat::Zero();
+    for (int a = 0; a < N; ++a)
+      for (int b = 0; b < N; ++b) {
+        double v = 1.0;
+        for (int k = 0; k < 3 && v != 0.0; ++k) {
+          const int pa = Tab::power[k][a], pb = Tab::power[k][b];
+          if (pb > pa) v = 0.0;
+          else v *= Tab::binomial[pa][pb] * sp[pb] * dp[k][pa - pb];
+        }
+        s(a, b) = v;
+      }
+    return s;
+  }
+
+  static Mat coefficients(const DgBasis& basis, ElementId e) {
+    return Mat(basis.coefficients(e));
+  }
+
+  // --- elements ------------------------------------------------------------------------
+  static void stiffness(const DgBasis& basis, const MomentCache& moments, ElementId e,
+                        double mu, double lambda, Eigen::MatrixXd& out) {
+    const double h = basis.scale(e);
+    const Mat g = gram(moments.element(e), h);
+    const Mat t = coefficients(basis, e);
+    Mat r[3];
+    for (int k = 0; k < 3; ++k) r[k] = derive(t, k) / h;
+    Mat rg[3];
+    for (int k = 0; k < 3; ++k) rg[k] = r[k] * g;
+    Mat gd[3][3];  // gd[k][l](i, j) = int d_k phi_i d_l phi_j
+    for (int k = 0; k < 3; ++k)
+      for (int l = k; l < 3; ++l) {
+        gd[k][l] = rg[k] * r[l].transpose();
+        if (l != k) gd[l][k] = gd[k][l].transpose();
+      }
+    const Mat lap = gd[0][0] + gd[1][1] + gd[2][2];
+    out.resize(3 * N, 3 * N);
+    for (int d = 0; d < 3; ++d)
+      for (int c = 0; c < 3; ++c) {
+        Mat b = mu * gd[c][d] + lambda * gd[d][c];
+        if (c == d) b += mu * lap;
+        out.template block<N, N>(d * N, c * N) = b;
+      }
+  }
+
+  static void mass(const DgBasis& basis, const MomentCache& moments, ElementId e,
+                   Eigen::MatrixXd& out) {
+    const Mat t = coefficients(basis, e);
+    out = t * gram(moments.element(e), basis.scale(e)) * t.transpose();
+  }
+
+  // --- faces ---------------------------------------------------------------------------
+  /// One element's functions expressed in the face's scaled monomials y^b.
+  struct Side {
+    Mat p;      ///< phi_i = sum_b p(i, b) y^b
+    Mat q[3];   ///< d phi_i / dx_k = sum_b q[k](i, b) y^b
+    Mat1 psi;   ///< lifting functions psi_q = sum_b psi(q, b) y^b
+  };
+
+  struct FaceFrame {
+    Vec3 origin;
+    double h = 1.0;
+    Mat gram;  ///< int_F y^a y^b
+  };
+
+  static FaceFrame frame(const PolyMesh& mesh, const MomentCache& moments, FaceId f) {
+    FaceFrame fr;
+    fr.origin = faceReferencePoint(mesh, f);
+    fr.h = 0.5 * faceBounds(mesh, f).diagonal().norm();
+    fr.gram = gram(moments.face(f), fr.h);
+    return fr;
+  }
+
+  static Side side(const DgBasis& basis, const FaceFrame& fr, ElementId e) {
+    const double h = basis.scale(e);
+    const Mat s = shift(fr.h / h, (fr.origin - basis.centre(e)) / h);
+    const Mat t = coefficients(basis, e);
+    Side sd;
+    sd.p = t * s;
+    for (int k = 0; k < 3; ++k) sd.q[k] = (derive(t, k) / h) * s;
+    const Mat11 o(basis.liftingCoefficients(e));
+    sd.psi = o * s.template topRows<N1>();
+    return sd;
+  }
+
+  static void faceRows(const PolyMesh& mesh, const DgBasis& basis, const MomentCache& moments,
+                       const FaceView& view, const FormCoefficients& form,
+                       Eigen::MatrixXd& selfBlock, Eigen::MatrixXd& otherBlock) {
+    const bool interior = view.kind == FaceKind::Interior;
+    const FaceFrame fr = frame(mesh, moments, view.face);
+    const Vec3 n = view.selfIsFront ? moments.faceNormal(view.face)
+                                    : Vec3(-moments.faceNormal(view.face));
+    const double area = moments.area(view.face);
+    double inverseVolumes = 1.0 / moments.volume(view.self);
+    if (interior) inverseVolumes += 1.0 / moments.volume(view.other);
+    const double etaF = form.eta * area * inverseVolumes;
+    const double w = interior ? 0.5 : 1.0;
+    const double mu = form.mu, lambda = form.lambda;
+    const bool ip = form.method == Method::IP;
+
+    const Side sk = side(basis, fr, view.self);
+    Side sl;
+    if (interior) sl = side(basis, fr, view.other);
+    const Mat ck = fr.gram * sk.p.transpose();
+    Mat cl;
+    if (interior) cl = fr.gram * sl.p.transpose();
+    const Mat ak = sk.p * fr.gram;
+    // Lifting face matrices psi_E against phi_X: mpsi[E][X] = psi_E G phi_X^T (N1 x N).
+    Mat1 mkk = Mat1::Zero(), mkl = Mat1::Zero(), mlk = Mat1::Zero(), mll = Mat1::Zero();
+    if (ip) {
+      mkk = sk.psi * ck;
+      if (interior) {
+        mkl = sk.psi * cl;
+        mlk = sl.psi * ck;
+        mll = sl.psi * cl;
+      }
+    }
+    const double cK = view.selfCoupledFaces, cL = view.otherCoupledFaces;
+
+    auto block = [&](const Side& b, const Mat& cb, double sb, const Mat1* liftK,
+                     const Mat1* liftL, Eigen::MatrixXd& out) {
+      out.setZero(3 * N, 3 * N);
+      const Mat m = sk.p * cb;
+      for (int d = 0; d < 3; ++d)
+        out.template block<N, N>(d * N, d * N) += (mu * etaF * sb) * m;
+      if (!ip) return;
+      Mat wk[3], vk[3];  // wk: int phi^K_i d_k phi^B_j; vk: int d_k phi^K_i phi^B_j
+      for (int k = 0; k < 3; ++k) {
+        wk[k] = ak * b.q[k].transpose();
+        vk[k] = sk.q[k] * cb;
+      }
+      const Mat wn = n.x() * wk[0] + n.y() * wk[1] + n.z() * wk[2];
+      const Mat vn = n.x() * vk[0] + n.y() * vk[1] + n.z() * vk[2];
+      // Lifting: sum_E c_E (psi_E phi_K)^T (psi_E phi_B).
+      Mat lift = cK * liftK[0].transpose() * liftK[1];
+      if (liftL) lift += cL * liftL[0].transpose() * liftL[1];
+      for (int d = 0; d < 3; ++d)
+        for (int c = 0; c < 3; ++c) {
+          Mat blk = (-w * mu * n[c]) * wk[d] + (-w * lambda * n[d]) * wk[c] +
+                    (-w * sb * mu * n[d]) * vk[c] + (-w * sb * lambda * n[c]) * vk[d] +
+                    (lambda * w * w * sb * n[d] * n[c]) * lift;
+          if (c == d) blk += (-w * mu) * wn + (-w * sb * mu) * vn;
+          out.template block<N, N>(d * N, c * N) += blk;
+        }
+    };
+
+    const Mat1 kk[2] = {mkk, mkk};
+    if (interior) {
+      const Mat1 llk[2] = {mlk, mlk};
+      block(sk, ck, 1.0, kk, llk, selfBlock);
+      const Mat1 kl[2] = {mkk, mkl};
+      const Mat1 ll[2] = {mlk, mll};
+      block(sl, cl, -1.0, kl, ll, otherBlock);
+    } else {
+      block(sk, ck, 1.0, kk, nullptr, selfBlock);
+      otherBlock.resize(0, 0);
+    }
+  }
+
+  static Eigen::MatrixXd liftingGram(const DgBasis& basis, const MomentCache& moments,
+                                     const PolyMesh& mesh, FaceId f, ElementId e) {
+    const FaceFrame fr = frame(mesh, moments, f);
+    const Side s = side(basis, fr, e);
+    return s.psi * fr.gram * s.psi.transpose();
+  }
+};
+
+}  // namespace
+
+void elementStiffness(const DgBasis& basis, const MomentCache& moments, ElementId e, double mu,
+                      double lambda, Eigen::MatrixXd& out) {
+  detail::dispatchBasisDegree(basis.degree(), [&](auto p) {
+    Kernel<p()>::stiffness(basis, moments, e, mu, lambda, out);
+  });
+}
+
+void elementMass(const DgBasis& basis, const MomentCache& moments, ElementId e,
+                 Eigen::MatrixXd& out) {
+  detail::dispatchBasisDegree(basis.degree(),
+                              [&](auto p) { Kernel<p()>::mass(basis, moments, e, out); });
+}
+
+void faceRows(const PolyMesh& mesh, const DgBasis& basis, const MomentCache& moments,
+              const FaceView& view, const FormCoefficients& form, Eigen::MatrixXd& selfBlock,
+              Eigen::MatrixXd& otherBlock) {
+  detail::dispatchBasisDegree(basis.degree(), [&](auto p) {
+    Kernel<p()>::faceRows(mesh, basis, moments, view, form, selfBlock, otherBlock);
+  });
+}
+
+Eigen::MatrixXd liftingFaceGram(const DgBasis& basis, const MomentCache& moments,
+                                const PolyMesh& mesh, FaceId f, ElementId e) {
+  return detail::dispatchBasisDegree(basis.degree(), [&](auto p) {
+    return Kernel<p()>::liftingGram(basis, moments, mesh, f, e);
+  });
+}
+
+}  // namespace polydg

@@ -1,0 +1,63 @@
+// Quantities derived from a DG solution: point values and gradients, the averaged vertex
+// displacements of eq. (17), per-element mean displacement, von Mises stress and largest jump,
+// and error norms against a known solution.
+#pragma once
+
+#include <functional>
+
+#include <Eigen/Core>
+
+#include "physics/dg_basis.h"
+#include "physics/material.h"
+
+namespace polydg {
+
+/// u_h(x) restricted to element e (x may lie outside e: the element's polynomial is used).
+Vec3 displacementAt(const DgBasis& basis, const Eigen::VectorXd& coefficients, ElementId e,
+                    const Vec3& x);
+
+/// The displacement gradient G(d, k) = d u_d / d x_k of element e's polynomial at x.
+Eigen::Matrix3d displacementGradientAt(const DgBasis& basis, const Eigen::VectorXd& coefficients,
+                                       ElementId e, const Vec3& x);
+
+/// Paper eq. (17): at each vertex, the mean of u|_K(vertex) over the elements K having it as
+/// a face vertex (zero for a vertex used by no element).
+VertexData<Vec3> vertexDisplacements(const PolyMesh& mesh, const DgBasis& basis,
+                                     const Eigen::VectorXd& coefficients);
+
+struct ElementFields {
+  ElementData<Vec3> meanDisplacement;  ///< (1/vol) int_K u_h
+  ElementData<double> vonMises;        ///< von Mises stress of the element's mean stress
+  ElementData<double> largestJump;     ///< max |u_K - u_L| at the vertices of interior faces
+};
+
+/// Per-element fields of a solution (moments up to degree p, e.g. the solve's cache).
+ElementFields elementFields(const PolyMesh& mesh, const DgBasis& basis,
+                            const MomentCache& moments, const Eigen::VectorXd& coefficients,
+                            const Material& material);
+
+/// Gradient of a vector field: G(d, k) = d u_d / d x_k.
+using GradientField = std::function<Eigen::Matrix3d(const Vec3&)>;
+
+struct ErrorNorms {
+  double l2 = 0.0;         ///< |u - u_h|_L2
+  double h1 = 0.0;         ///< broken H1 seminorm: sqrt(sum_K |grad(u - u_h)|^2_L2(K))
+  double l2Exact = 0.0;    ///< |u|_L2
+  double h1Exact = 0.0;    ///< |grad u|_L2
+};
+
+/// Errors against (u, grad u) by element quadrature (integrate/quadrature.h) exact to
+/// `quadratureDegree` (use >= p + 4 for smooth u).
+ErrorNorms errorNorms(const PolyMesh& mesh, const DgBasis& basis,
+                      const Eigen::VectorXd& coefficients,
+                      const std::function<Vec3(const Vec3&)>& exact,
+                      const GradientField& exactGradient, int quadratureDegree);
+
+/// Coefficients of the element-wise L2 projection of `field` onto the basis (quadrature of
+/// degree `quadratureDegree`; exact for polynomial fields of degree <= quadratureDegree - p).
+Eigen::VectorXd projectField(const PolyMesh& mesh, const DgBasis& basis,
+                             const MomentCache& moments,
+                             const std::function<Vec3(const Vec3&)>& field,
+                             int quadratureDegree);
+
+}  // namespace polydg

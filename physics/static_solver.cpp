@@ -1,0 +1,135 @@
+#include "physics/static_solver.h"
+
+#include <chrono>
+#include <stdexcept>
+
+namespace polydg {
+
+namespace {
+using Clock = std::chrono::steady_clock;
+double secondsSince(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+/// Doubling gives up after this many factorizations (eta grows by 2^kMaxDoublings).
+constexpr int kMaxDoublings = 40;
+}  // namespace
+
+StaticSolver::StaticSolver(const PolyMesh& mesh, const Material& material,
+                           const StaticOptions& options)
+    : mesh_(&mesh), material_(material), options_(options), solver_(options.solver) {
+  material_.check();
+}
+
+void StaticSolver::integrate() {
+  const auto t0 = Clock::now();
+  const int p = options_.discretization.basis.degree;
+  moments_ = std::make_unique<MomentCache>(*mesh_, 2 * p);
+  moments_->update();
+  basis_ = std::make_unique<DgBasis>(*mesh_, *moments_, options_.discretization.basis);
+  report_.integrateSeconds = secondsSince(t0);
+  report_.elements = mesh_->numElements();
+  report_.basisFallbacks = basis_->fallbackElements();
+}
+
+void StaticSolver::assemble(const LoadCase& loads) {
+  if (!basis_) integrate();
+  const auto t0 = Clock::now();
+  const DiscretizationOptions& disc = options_.discretization;
+  roles_ = classifyFaces(*mesh_, loads);
+  report_.dirichletFaces = roles_.dirichletFaces;
+  report_.tractionFaces = roles_.tractionFaces;
+  form_.method = disc.method;
+  form_.mu = material_.mu();
+  form_.lambda = material_.lambda();
+  report_.etaThreshold = penaltyThreshold(*mesh_, *basis_, *moments_, roles_);
+  const int quadrature =
+      disc.quadratureDegree >= 0 ? disc.quadratureDegree : 2 * basis_->degree() + 2;
+  system_.blockSize = 3 * basis_->size();
+  factorized_ = false;
+  report_.penaltyAttempts = 1;
+
+  switch (disc.penalty.rule) {
+    case PenaltyRule::TraceBound:
+      form_.eta = disc.penalty.safety * report_.etaThreshold;
+      if (form_.eta <= 0.0) form_.eta = 1.0;  // no coupled faces: any positive value
+      break;
+    case PenaltyRule::Fixed:
+      form_.eta = disc.penalty.eta;
+      break;
+    case PenaltyRule::Doubling:
+      form_.eta = disc.penalty.eta;
+      break;
+  }
+  if (!(form_.eta > 0.0)) throw std::invalid_argument("the penalty eta must be positive");
+  system_.matrix = assembleStiffness(*mesh_, *basis_, *moments_, roles_, form_);
+
+  double searchSeconds = 0.0;
+  if (disc.penalty.rule == PenaltyRule::Doubling) {
+    SolverOptions direct = options_.solver;
+    direct.kind = SolverKind::Cholesky;
+    for (int attempt = 1;; ++attempt) {
+      const auto ts = Clock::now();
+      solver_ = LinearSolver(direct);
+      const bool ok = solver_.compute(system_.matrix, system_.blockSize);
+      searchSeconds += secondsSince(ts);
+      report_.penaltyAttempts = attempt;
+      if (ok) {
+        factorized_ = true;
+        break;
+      }
+      if (attempt == kMaxDoublings)
+        throw std::runtime_error("penalty doubling: the stiffness matrix is not positive "
+                                 "definite even at eta = " + std::to_string(form_.eta) +
+                                 "; is a Dirichlet condition missing?");
+      form_.eta *= 2.0;
+      system_.matrix = assembleStiffness(*mesh_, *basis_, *moments_, roles_, form_);
+    }
+  }
+  report_.eta = form_.eta;
+  system_.rhs = assembleLoad(*mesh_, *basis_, *moments_, roles_, form_, material_, loads,
+                             quadrature);
+  report_.dofs = static_cast<std::size_t>(system_.matrix.rows());
+  report_.nonzeros = static_cast<std::size_t>(system_.matrix.nonZeros());
+  // Trial factorizations belong to the solve phase; the one that succeeded is reused.
+  report_.assembleSeconds = secondsSince(t0) - searchSeconds;
+  report_.solveSeconds = searchSeconds;
+}
+
+const Eigen::VectorXd& StaticSolver::solve() {
+  if (system_.matrix.rows() == 0 && mesh_->numElements() > 0)
+    throw std::logic_error("StaticSolver::solve: call assemble() first");
+  const auto t0 = Clock::now();
+  if (!factorized_) {
+    solver_ = LinearSolver(options_.solver);
+    if (!solver_.compute(system_.matrix, system_.blockSize) &&
+        solver_.kind() == SolverKind::Cholesky)
+      throw std::runtime_error(
+          "the stiffness matrix is not positive definite: is the body held by a Dirichlet "
+          "condition (e.g. --clamp)?");
+    factorized_ = true;
+  }
+  coefficients_ = solver_.solve(system_.rhs, report_.solver);
+  report_.solveSeconds += secondsSince(t0);
+  report_.energy = 0.5 * coefficients_.dot(system_.rhs);
+  return coefficients_;
+}
+
+StaticSolution StaticSolver::release() {
+  StaticSolution s;
+  s.moments = std::move(moments_);
+  s.basis = std::move(basis_);
+  s.coefficients = std::move(coefficients_);
+  s.report = report_;
+  return s;
+}
+
+StaticSolution solveStatic(const PolyMesh& mesh, const Material& material,
+                           const LoadCase& loads, const StaticOptions& options) {
+  StaticSolver solver(mesh, material, options);
+  solver.integrate();
+  solver.assemble(loads);
+  solver.solve();
+  return solver.release();
+}
+
+}  // namespace polydg

@@ -1,0 +1,153 @@
+// Invariants of the DG discretization over a corpus of small meshes: the patch test (a linear
+// field is reproduced by IP), exactly six rigid zero modes per connected component without
+// boundary conditions, and a symmetric positive definite matrix with them; on hex grids,
+// non-convex prisms (an L and a square with a hole), a grid with a sliver element, and meshes
+// translated by 1e6 or scaled by 1e-6 and 1e6. Degrees 1 to 3.
+#include "physics/validation.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "mesh/primitives.h"
+#include "mesh/validate.h"
+
+namespace polydg {
+namespace {
+
+/// Patch-test tolerance of the issue: reproduction to 1e-9 relative (also per element).
+constexpr double kPatchTolerance = 1e-9;
+/// Rigid motions must be in the kernel of the Jacobi-scaled matrix to round-off (with the
+/// absolute-coordinate floor of a mesh translated by 1e6, see patchTest()).
+constexpr double kRigidResidualTolerance = 1e-8;
+/// Symmetry of the assembled matrix, relative to its largest entry.
+constexpr double kSymmetryTolerance = 1e-12;
+
+struct NamedMesh {
+  std::string name;
+  PolyMesh mesh;
+};
+
+PolyMesh lPrism() {
+  Polygon2 l;
+  l.outer = {{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}};
+  return prismMesh(l, 0.0, 0.5, Vec2(0.5, 0.25));
+}
+
+PolyMesh holePrism() {
+  Polygon2 h;
+  h.outer = {{0, 0}, {3, 0}, {3, 3}, {0, 3}};
+  h.holes = {{{1, 1}, {1, 2}, {2, 2}, {2, 1}}};
+  return prismMesh(h, 0.0, 1.0, Vec2(0.25, 0.0));
+}
+
+/// A 3 x 3 x 3 grid of the unit cube whose node plane x = 1/3 is moved to x = 1e-6: the first
+/// layer of elements are slivers of relative thickness 1e-6.
+PolyMesh sliverGrid() {
+  PolyMesh mesh = hexGridMesh(3, 3, 3, Box3(Vec3::Zero(), Vec3::Ones()));
+  for (Vec3& p : mesh.positions().raw())
+    if (std::abs(p.x() - 1.0 / 3.0) < 1e-12) p.x() = 1e-6;
+  return mesh;
+}
+
+PolyMesh transformed(PolyMesh mesh, double scale, const Vec3& offset) {
+  transform(mesh, scale, offset);
+  return mesh;
+}
+
+std::vector<NamedMesh> corpus() {
+  const PolyMesh grid = hexGridMesh(3, 2, 2, Box3(Vec3::Zero(), Vec3(1.5, 1.0, 1.0)));
+  std::vector<NamedMesh> meshes;
+  meshes.push_back({"hex grid", grid});
+  meshes.push_back({"L prism", lPrism()});
+  meshes.push_back({"prism with hole", holePrism()});
+  meshes.push_back({"sliver", sliverGrid()});
+  meshes.push_back({"translated 1e6", transformed(grid, 1.0, Vec3(1e6, -1e6, 1e6))});
+  meshes.push_back({"scaled 1e-6", transformed(grid, 1e-6, Vec3::Zero())});
+  meshes.push_back({"scaled 1e6", transformed(grid, 1e6, Vec3::Zero())});
+  meshes.push_back({"L prism scaled 1e-6", transformed(lPrism(), 1e-6, Vec3::Zero())});
+  // Two separate blocks: two components, twelve zero modes.
+  PolyMesh two = hexGridMesh(2, 1, 1, Box3(Vec3::Zero(), Vec3(2, 1, 1)));
+  {
+    const PolyMesh other = hexGridMesh(1, 1, 1, Box3(Vec3(3, 0, 0), Vec3(4, 1, 1)));
+    const std::size_t base = two.numVertices();
+    for (const Vec3& p : other.positions().raw()) two.addVertex(p);
+    // Rebuild the second block's single element from its faces' loops.
+    std::vector<std::vector<Loop>> boundary;
+    for (const FaceUse& use : other.element(ElementId(0)).faces) {
+      Loop loop;
+      for (VertexId v : other.face(use.face).vertices) loop.push_back(VertexId(v.index() + base));
+      if (use.reversed) std::reverse(loop.begin(), loop.end());
+      boundary.push_back({loop});
+    }
+    two.addElement(boundary, FaceOrigin::Box);
+  }
+  meshes.push_back({"two components", two});
+  return meshes;
+}
+
+class PhysicsValidation : public ::testing::TestWithParam<int> {};
+
+TEST_P(PhysicsValidation, PatchTestReproducesLinearFields) {
+  for (const NamedMesh& m : corpus()) {
+    ASSERT_TRUE(validate(m.mesh).passed) << m.name;
+    PhysicsCheckOptions options;
+    options.basis.degree = GetParam();
+    const PatchTestResult r = patchTest(m.mesh, options);
+    EXPECT_LT(r.relativeError, kPatchTolerance) << m.name;
+    EXPECT_LT(r.maxElementError, kPatchTolerance) << m.name;
+  }
+}
+
+TEST_P(PhysicsValidation, SixRigidZeroModesPerComponent) {
+  for (const NamedMesh& m : corpus()) {
+    PhysicsCheckOptions options;
+    options.basis.degree = GetParam();
+    const ZeroModeReport r = rigidModes(m.mesh, options);
+    EXPECT_EQ(r.zeroModes, 6 * r.components) << m.name;
+    for (std::size_t c = 0; c < r.components; ++c)
+      EXPECT_EQ(r.zeroModesPerComponent[c], 6u) << m.name << " component " << c;
+    EXPECT_LT(r.largestZeroEigenvalue, 1e-3 * kZeroModeThreshold) << m.name;
+    EXPECT_GT(r.smallestNonzeroEigenvalue, 1e3 * kZeroModeThreshold) << m.name;
+    EXPECT_LT(r.rigidMotionResidual, kRigidResidualTolerance) << m.name;
+  }
+  EXPECT_EQ(rigidModes(corpus().back().mesh, {}).components, 2u);
+}
+
+TEST_P(PhysicsValidation, ClampedStiffnessIsSymmetricPositiveDefinite) {
+  for (const NamedMesh& m : corpus()) {
+    for (Method method : {Method::IP, Method::BZ}) {
+      PhysicsCheckOptions options;
+      options.basis.degree = GetParam();
+      options.method = method;
+      const DefinitenessReport r = definiteness(m.mesh, options);
+      EXPECT_LT(r.asymmetry, kSymmetryTolerance) << m.name;
+      EXPECT_TRUE(r.choleskySucceeded) << m.name;
+      EXPECT_EQ(r.modes.zeroModes, 0u) << m.name;
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Degrees, PhysicsValidation, ::testing::Values(1, 2, 3),
+                         [](const auto& info) { return "p" + std::to_string(info.param); });
+
+TEST(PhysicsValidation, ScaledMonomialBasisPassesThePatchTest) {
+  PhysicsCheckOptions options;
+  options.basis = {.degree = 2, .kind = BasisKind::ScaledMonomial};
+  EXPECT_LT(patchTest(lPrism(), options).relativeError, kPatchTolerance);
+  EXPECT_EQ(rigidModes(lPrism(), options).zeroModes, 6u);
+}
+
+TEST(PhysicsValidation, NearlyIncompressiblePatchTestAndRigidModes) {
+  PhysicsCheckOptions options;
+  options.basis.degree = 2;
+  options.material.poissonRatio = 0.4999;
+  const PolyMesh grid = hexGridMesh(2, 2, 2, Box3(Vec3::Zero(), Vec3::Ones()));
+  EXPECT_LT(patchTest(grid, options).relativeError, kPatchTolerance);
+  EXPECT_EQ(rigidModes(grid, options).zeroModes, 6u);
+}
+
+}  // namespace
+}  // namespace polydg
