@@ -94,6 +94,9 @@ MeshingResult meshSurface(const TriangleSurface& input, const MeshingOptions& op
   r.selfIntersectionsChecked = d.checkedSelfIntersections;
   if (d.topology.degenerateTriangles > 0) {
     const std::size_t removed = removeDegenerateTriangles(surface);
+    if (surface.triangles.empty())
+      throw InputError("all " + std::to_string(removed) +
+                       " triangles are degenerate (zero area); the surface encloses nothing");
     r.repairs.push_back("removed " + std::to_string(removed) + " degenerate triangles");
     d = diagnose(surface);
   }

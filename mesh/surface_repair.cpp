@@ -89,6 +89,8 @@ TriangleSurface orientToBoundVolume(const TriangleSurface& surface, bool& change
   PMP::orient_polygon_soup(points, polygons);
   Mesh mesh;
   PMP::polygon_soup_to_polygon_mesh(points, polygons, mesh);
+  if (mesh.number_of_faces() == 0)
+    throw std::invalid_argument("orientToBoundVolume: the surface has no triangles");
   if (!CGAL::is_closed(mesh))
     throw std::invalid_argument("orientToBoundVolume: the surface is not closed");
   PMP::orient_to_bound_a_volume(mesh);

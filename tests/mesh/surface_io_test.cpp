@@ -4,6 +4,7 @@
 // assimp's own test models; agreement with meshio's and VTK's volumes
 // (tests/mesh/surface_volume.py).
 #include "mesh/surface_io.h"
+#include "tests/support/assimp_models.h"
 
 #include <gtest/gtest.h>
 
@@ -42,7 +43,7 @@ constexpr double kVtkRelTol = 1e-9;
 /// Address space allowed while reading foreign or corrupt files (see AddressSpaceCap).
 constexpr rlim_t kReadAddressSpace = rlim_t{4} << 30;
 
-const fs::path kAssimpModels = "/usr/share/assimp/models";
+using polydg::corpus::kAssimpModels;
 const fs::path kSystemPython = "/usr/bin/python3";
 
 std::string testdata(const std::string& name) {
@@ -711,17 +712,7 @@ TEST(ReadSurface, PrintsNothing) {
 
 // --- assimp's test models ---------------------------------------------------------------------
 
-bool isSupportedModel(const fs::path& path) {
-  static const std::set<std::string> kExtensions = {
-      "obj", "stl", "ply", "off", "gltf", "glb", "3ds", "dae", "fbx", "x",   "ase", "lwo",
-      "ms3d", "md2", "md3", "mdl", "blend", "ac", "3mf", "amf", "ifc", "nff", "raw", "smd",
-      "xgl", "irrmesh", "cob", "q3o", "q3s", "ter", "hmp", "lws", "csm", "b3d"};
-  std::string name = path.filename().string();
-  for (char& ch : name) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
-  if (name.size() > 9 && name.ends_with(".mesh.xml")) return true;  // Ogre XML
-  const std::size_t dot = name.rfind('.');
-  return dot != std::string::npos && kExtensions.contains(name.substr(dot + 1));
-}
+using polydg::corpus::isSupportedModel;
 
 TEST(AssimpModels, EveryModelReadsOrFailsWithOneLine) {
   if (!fs::is_directory(kAssimpModels))
