@@ -32,15 +32,7 @@ struct Tables {
     for (int i = 0; i < N; ++i) c[i] = 1.0 / (kMonomialTable[i].degree() + 3);
     return c;
   }();
-  /// Binomial coefficients C(n, k), n, k <= K.
-  static constexpr auto binomial = [] {
-    std::array<std::array<double, K + 1>, K + 1> c{};
-    for (int n = 0; n <= K; ++n) {
-      c[n][0] = 1.0;
-      for (int k = 1; k <= n; ++k) c[n][k] = c[n - 1][k - 1] + (k <= n - 1 ? c[n - 1][k] : 0.0);
-    }
-    return c;
-  }();
+  static constexpr auto binomial = kBinomial<K>;
 };
 
 /// Calls f(std::integral_constant<int, K>) for the runtime degree.
@@ -102,13 +94,7 @@ void faceMomentsK(const PolyMesh& mesh, FaceId f, double* out, Vec3& normal) {
   const Face& face = mesh.face(f);
   const Vec3 c = mesh.position(face.vertices.front());
 
-  Vec3 twiceArea = Vec3::Zero();
-  for (std::size_t k = 0; k < face.numLoops(); ++k) {
-    const auto loop = face.loop(k);
-    const std::size_t n = loop.size();
-    for (std::size_t i = 0; i < n; ++i)
-      twiceArea += (mesh.position(loop[i]) - c).cross(mesh.position(loop[(i + 1) % n]) - c);
-  }
+  const Vec3 twiceArea = 2.0 * areaVector(mesh, f);  // about c, the face's first vertex
   std::fill(out, out + T::N, 0.0);
   const double norm = twiceArea.norm();
   if (norm == 0.0) {

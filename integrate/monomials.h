@@ -48,6 +48,17 @@ constexpr Exponents monomialExponents(int index) {
   return kMonomialTable[index];
 }
 
+/// Binomial coefficients C(n, k) for n, k <= N, as doubles.
+template <int N>
+inline constexpr auto kBinomial = [] {
+  std::array<std::array<double, N + 1>, N + 1> c{};
+  for (int n = 0; n <= N; ++n) {
+    c[n][0] = 1.0;
+    for (int k = 1; k <= n; ++k) c[n][k] = c[n - 1][k - 1] + (k <= n - 1 ? c[n - 1][k] : 0.0);
+  }
+  return c;
+}();
+
 static_assert(monomialIndex(0, 0, 0) == 0);
 static_assert(monomialIndex(0, 0, 1) == 3);
 static_assert(monomialIndex(1, 1, 0) == 5);

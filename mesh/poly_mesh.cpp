@@ -18,18 +18,10 @@ std::string_view toString(FaceOrigin origin) {
 
 namespace {
 
-/// Order-independent hash of a face's vertex set (FNV-1a over the sorted ids).
 std::uint64_t vertexSetKey(const std::vector<Loop>& loops) {
-  std::vector<std::uint32_t> ids;
-  for (const Loop& loop : loops)
-    for (VertexId v : loop) ids.push_back(v.value);
-  std::sort(ids.begin(), ids.end());
-  std::uint64_t h = 1469598103934665603ull;
-  for (std::uint32_t id : ids) {
-    h ^= id;
-    h *= 1099511628211ull;
-  }
-  return h;
+  std::vector<VertexId> all;
+  for (const Loop& loop : loops) all.insert(all.end(), loop.begin(), loop.end());
+  return vertexSetKey(all);
 }
 
 /// True if cycle `b` is cycle `a` traversed backwards (any rotation).
@@ -45,6 +37,19 @@ bool isReversedCycle(std::span<const VertexId> a, std::span<const VertexId> b) {
 }
 
 }  // namespace
+
+std::uint64_t vertexSetKey(std::span<const VertexId> vertices) {
+  std::vector<std::uint32_t> ids;
+  ids.reserve(vertices.size());
+  for (VertexId v : vertices) ids.push_back(v.value);
+  std::sort(ids.begin(), ids.end());
+  std::uint64_t h = 1469598103934665603ull;
+  for (std::uint32_t id : ids) {
+    h ^= id;
+    h *= 1099511628211ull;
+  }
+  return h;
+}
 
 bool isReverseOf(const Face& a, const std::vector<Loop>& loops) {
   if (a.numLoops() != loops.size()) return false;

@@ -150,6 +150,9 @@ class PolyMesh {
   bool openFacesStale_ = false;
 };
 
+/// Order-independent key of a vertex set (FNV-1a over the sorted ids): equal sets, equal keys.
+std::uint64_t vertexSetKey(std::span<const VertexId> vertices);
+
 /// True if face `a`'s loops, reversed, equal `loops` (same loops, each the same cycle
 /// traversed the other way, in any rotation; hole order is irrelevant).
 bool isReverseOf(const Face& a, const std::vector<Loop>& loops);

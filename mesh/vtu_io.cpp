@@ -752,19 +752,6 @@ void readPiece(pugi::xml_node piece, const FileLayout& layout, std::vector<Vec3>
 // Reading: faces from records
 // ============================================================================================
 
-/// Order-independent key of a vertex set (FNV-1a over the sorted ids); equal sets, equal keys.
-std::uint64_t vertexSetKey(std::span<const VertexId> vertices) {
-  std::vector<std::uint32_t> ids;
-  ids.reserve(vertices.size());
-  for (VertexId v : vertices) ids.push_back(v.value);
-  std::sort(ids.begin(), ids.end());
-  std::uint64_t h = 1469598103934665603ull;
-  for (std::uint32_t id : ids) {
-    h ^= id;
-    h *= 1099511628211ull;
-  }
-  return h;
-}
 
 /// Builds faces by matching: a record whose vertex set and reversed cycle equal those of an
 /// open face of an earlier cell shares it; any other record becomes a new face.

@@ -61,14 +61,7 @@ struct PolyTables {
   }();
 
   /// Binomial coefficients C(n, k) for n, k <= P.
-  static constexpr auto binomial = [] {
-    std::array<std::array<double, P + 1>, P + 1> c{};
-    for (int n = 0; n <= P; ++n) {
-      c[n][0] = 1.0;
-      for (int k = 1; k <= n; ++k) c[n][k] = c[n - 1][k - 1] + (k <= n - 1 ? c[n - 1][k] : 0.0);
-    }
-    return c;
-  }();
+  static constexpr auto binomial = kBinomial<P>;
 };
 
 template <class F>
