@@ -6,6 +6,7 @@
 #include <mutex>
 #include <tuple>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <unordered_map>
 
@@ -48,10 +49,10 @@ struct SortedIdsHash {
   }
 };
 
-struct CoordinateHash {
-  std::size_t operator()(const std::array<double, 3>& p) const noexcept {
+struct CellHash {
+  std::size_t operator()(const std::array<std::int64_t, 3>& c) const noexcept {
     std::size_t h = 0;
-    for (double x : p) h = h * 0x9E3779B97F4A7C15ull + std::hash<double>{}(x);
+    for (std::int64_t x : c) h = h * 0x9E3779B97F4A7C15ull + static_cast<std::size_t>(x);
     return h;
   }
 };
@@ -78,21 +79,47 @@ class Slicer {
   PolyMesh build(std::vector<std::array<int, 3>>* elementCell) {
     PolyMesh mesh;
     const std::vector<Vec3> points = splitter_.points();
-    // Points that rounding made identical (intersection points of edges that meet a plane
-    // within round-off of one of their ends) are welded: exact equality, no tolerance. Then
-    // only used points are kept, in order of first use.
+    // Points closer than the resolution of the coordinates are one point: 8 units in the last
+    // place of the largest coordinate, in every coordinate. Such points are intersections that
+    // are the same point mathematically but were built along different paths (or a surface
+    // vertex within round-off of a grid line); kept apart they would leave edges of round-off
+    // length, which VTK's polygon triangulation rejects. Welding moves geometry by at most that
+    // resolution and collapses the round-off faces on both sides of a shared face alike. Only
+    // points that elements use are kept, in order of first use (deterministic).
+    double largest = 0.0;
+    for (const Vec3& p : points) largest = std::max(largest, p.cwiseAbs().maxCoeff());
+    const double resolution = 8.0 * std::numeric_limits<double>::epsilon() * largest;
     std::size_t polygons = 0;
     for (const Leaf& leaf : leaves_) polygons += leaf.piece.size();
     mesh.reserve(points.size(), polygons, leaves_.size());
-    std::unordered_map<std::array<double, 3>, std::uint32_t, CoordinateHash> byPosition;
-    byPosition.reserve(points.size());
+    std::unordered_map<std::array<std::int64_t, 3>, std::vector<std::uint32_t>, CellHash> cells;
+    cells.reserve(points.size());
+    auto cellOf = [&](const Vec3& p) {
+      std::array<std::int64_t, 3> c{};
+      for (int i = 0; i < 3; ++i)
+        c[i] = resolution > 0 ? static_cast<std::int64_t>(std::floor(p[i] / resolution)) : 0;
+      return c;
+    };
     std::vector<std::uint32_t> remap(points.size(), 0xffffffffu);
     auto vertexOf = [&](std::uint32_t v) {
+      if (remap[v] != 0xffffffffu) return VertexId(remap[v]);
+      const Vec3& p = points[v];
+      const auto c = cellOf(p);
+      for (int dx = -1; dx <= 1 && remap[v] == 0xffffffffu; ++dx)
+        for (int dy = -1; dy <= 1 && remap[v] == 0xffffffffu; ++dy)
+          for (int dz = -1; dz <= 1 && remap[v] == 0xffffffffu; ++dz) {
+            auto it = cells.find({c[0] + dx, c[1] + dy, c[2] + dz});
+            if (it == cells.end()) continue;
+            for (std::uint32_t w : it->second)
+              if ((mesh.position(VertexId(w)) - p).cwiseAbs().maxCoeff() <= resolution) {
+                remap[v] = w;
+                ++stats.weldedPoints;
+                break;
+              }
+          }
       if (remap[v] == 0xffffffffu) {
-        const Vec3& p = points[v];
-        auto [it, inserted] = byPosition.try_emplace({p.x() + 0.0, p.y() + 0.0, p.z() + 0.0}, 0);
-        if (inserted) it->second = mesh.addVertex(p).value;
-        remap[v] = it->second;
+        remap[v] = mesh.addVertex(p).value;
+        cells[c].push_back(remap[v]);
       }
       return VertexId(remap[v]);
     };

@@ -37,6 +37,7 @@ struct SliceStats {
   std::size_t leafCells = 0;       ///< cells that hold part of the solid
   std::size_t multiPieceCells = 0; ///< cells holding two or more disconnected pieces
   std::size_t collapsedPolygons = 0;  ///< polygons removed when rounding made points equal
+  std::size_t weldedPoints = 0;       ///< points within coordinate resolution of another
   double secondsSplitting = 0.0;   ///< wall time of the recursive plane splits
   double secondsBuilding = 0.0;    ///< wall time of welding and assembling the PolyMesh
 };

@@ -1,6 +1,7 @@
 #include "mesh/vtu_io.h"
 
 #include <algorithm>
+#include <numeric>
 #include <array>
 #include <bit>
 #include <cerrno>
@@ -35,6 +36,11 @@ constexpr std::int64_t kVtkPolyhedron = 42;
 // The field data arrays with which readVtu restores writeVtu's faces exactly (see vtu_io.h).
 constexpr std::string_view kFaceGroupArray = "polydg_face_group";
 constexpr std::string_view kFaceReversedArray = "polydg_face_reversed";
+/// For each cell in file order, the polydg element it is. Cells are written in increasing
+/// order of their point count: meshio 5 groups polyhedra into blocks by point count in order
+/// of first appearance but splits cell data by point count in increasing order, so only that
+/// order keeps cell data with its cells.
+constexpr std::string_view kElementArray = "polydg_element";
 constexpr std::string_view kFaceOriginArray = "polydg_face_origin";
 
 // ============================================================================================
@@ -173,7 +179,25 @@ class ByteReader {
 struct CellStreams {
   std::vector<std::int64_t> connectivity, offsets, types, faces, faceOffsets;
   std::vector<std::int64_t> faceGroup, faceReversed, faceOrigin;
+  std::vector<std::int64_t> element;  ///< the element written as each cell, in file order
 };
+
+/// Elements in increasing order of their number of distinct points (stable).
+std::vector<std::size_t> cellOrder(const PolyMesh& mesh) {
+  std::vector<std::size_t> points(mesh.numElements());
+  for (std::size_t e = 0; e < mesh.numElements(); ++e) {
+    std::vector<VertexId> ids;
+    for (const FaceUse& use : mesh.element(ElementId(e)).faces)
+      ids.insert(ids.end(), mesh.face(use.face).vertices.begin(), mesh.face(use.face).vertices.end());
+    std::sort(ids.begin(), ids.end());
+    points[e] = static_cast<std::size_t>(std::unique(ids.begin(), ids.end()) - ids.begin());
+  }
+  std::vector<std::size_t> order(mesh.numElements());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return points[a] < points[b]; });
+  return order;
+}
 
 CellStreams buildCellStreams(const PolyMesh& mesh) {
   // Records of each face in the face's own orientation, computed when first needed.
@@ -193,8 +217,9 @@ CellStreams buildCellStreams(const PolyMesh& mesh) {
 
   CellStreams s;
   VertexData<std::uint32_t> seenIn(mesh.numVertices(), Id<ElementTag>::kInvalid);
-  for (std::size_t e = 0; e < mesh.numElements(); ++e) {
+  for (std::size_t e : cellOrder(mesh)) {
     const ElementId element(e);
+    s.element.push_back(static_cast<std::int64_t>(e));
     const std::size_t countAt = s.faces.size();
     s.faces.push_back(0);
     std::int64_t count = 0;
@@ -321,6 +346,8 @@ void writeContents(std::ostream& os, const PolyMesh& mesh, const CellStreams& s,
                                s.faceReversed.size());
   writeDataArray<std::int64_t>(os, fieldIndent, kFaceOriginArray, 1, s.faceOrigin, enc,
                                s.faceOrigin.size());
+  writeDataArray<std::int64_t>(os, fieldIndent, kElementArray, 1, s.element, enc,
+                               s.element.size());
   os << "    </FieldData>\n"
      << "    <Piece NumberOfPoints=\"" << mesh.numVertices() << "\" NumberOfCells=\""
      << mesh.numElements() << "\">\n";
@@ -329,11 +356,19 @@ void writeContents(std::ostream& os, const PolyMesh& mesh, const CellStreams& s,
   for (const PointArray& a : pointData)
     writeDataArray<double>(os, "        ", a.name, a.components, a.values, enc);
   os << "      </PointData>\n      <CellData>\n";
+  // Cell data in file (cell) order.
   std::vector<double> volume(mesh.numElements());
-  for (std::size_t e = 0; e < mesh.numElements(); ++e) volume[e] = signedVolume(mesh, ElementId(e));
+  for (std::size_t c = 0; c < s.element.size(); ++c)
+    volume[c] = signedVolume(mesh, ElementId(static_cast<std::size_t>(s.element[c])));
   writeDataArray<double>(os, "        ", "volume", 1, volume, enc);
-  for (const CellArray& a : cellData)
-    writeDataArray<double>(os, "        ", a.name, a.components, a.values, enc);
+  for (const CellArray& a : cellData) {
+    std::vector<double> values(a.values.size());
+    const auto k = static_cast<std::size_t>(a.components);
+    for (std::size_t c = 0; c < s.element.size(); ++c)
+      for (std::size_t i = 0; i < k; ++i)
+        values[c * k + i] = a.values[static_cast<std::size_t>(s.element[c]) * k + i];
+    writeDataArray<double>(os, "        ", a.name, a.components, values, enc);
+  }
   os << "      </CellData>\n      <Points>\n";
 
   std::vector<double> points;
@@ -785,7 +820,7 @@ void buildByMatching(PolyMesh& mesh, const CellFaces& cells) {
 
 /// The polydg field data of a file, if present.
 struct PolydgFields {
-  std::vector<std::int64_t> group, reversed, origin;
+  std::vector<std::int64_t> group, reversed, origin, element;
   bool hasReversed = false;
 };
 
@@ -928,6 +963,8 @@ std::optional<PolydgFields> readPolydgFields(pugi::xml_node grid, const FileLayo
     fields.reversed = readArray<std::int64_t>(reversed, layout);
     fields.hasReversed = true;
   }
+  if (const pugi::xml_node element = findArray(fieldData, kElementArray))
+    fields.element = readArray<std::int64_t>(element, layout);
   return fields;
 }
 
@@ -1018,7 +1055,21 @@ PolyMesh readVtuContents(const std::string& path) {
   }
   for (std::size_t f = 0; f < plan->loops.size(); ++f)
     mesh.addFace(std::move(plan->loops[f]), plan->origins[f]);
-  for (const auto& uses : plan->uses) mesh.addElementFromFaces(uses);
+  // Elements in their original order when the file says which cell is which element.
+  std::vector<std::size_t> cellOfElement(plan->uses.size());
+  std::iota(cellOfElement.begin(), cellOfElement.end(), 0);
+  if (fields->element.size() == plan->uses.size()) {
+    std::vector<std::size_t> inverse(plan->uses.size(), plan->uses.size());
+    bool permutation = true;
+    for (std::size_t c = 0; c < fields->element.size() && permutation; ++c) {
+      const std::int64_t e = fields->element[c];
+      permutation = e >= 0 && static_cast<std::size_t>(e) < inverse.size() &&
+                    inverse[static_cast<std::size_t>(e)] == inverse.size();
+      if (permutation) inverse[static_cast<std::size_t>(e)] = c;
+    }
+    if (permutation) cellOfElement = std::move(inverse);
+  }
+  for (std::size_t c : cellOfElement) mesh.addElementFromFaces(plan->uses[c]);
   return mesh;
 }
 
