@@ -1,6 +1,14 @@
 #include "cli/json_reports.h"
 
+#include <sstream>
+
 namespace polydg::cli {
+
+namespace {
+nlohmann::json idOrNull(ElementId e) {
+  return e.valid() ? nlohmann::json(e.value) : nlohmann::json(nullptr);
+}
+}  // namespace
 
 nlohmann::json toJson(const ValidationReport& r) {
   return {{"passed", r.passed},
@@ -21,6 +29,44 @@ nlohmann::json toJson(const ValidationReport& r) {
             {"inconsistent_faces", r.inconsistentFaces},
             {"empty_elements", r.emptyElements}}},
           {"messages", r.messages}};
+}
+
+nlohmann::json toJson(const LocalDgCheck& c, double seconds) {
+  return {{"dg_degree", c.degree},
+          {"patch_test_error", c.maxPatchTestError},
+          {"patch_test_tolerance", kLocalPatchTestTolerance},
+          {"patch_test_failures", c.patchTestFailures},
+          {"worst_patch_test_element", idOrNull(c.worstPatchTestElement)},
+          {"rigid_mode_failures", c.elementsWithWrongRigidModes},
+          {"first_rigid_mode_failure", idOrNull(c.firstWrongRigidModeElement)},
+          {"non_definite_elements", c.nonDefiniteElements},
+          {"dg_elements_checked", c.elements},
+          {"dg_passed", c.passed()},
+          {"dg_seconds", seconds}};
+}
+
+std::vector<std::string> failureMessages(const LocalDgCheck& c) {
+  std::vector<std::string> out;
+  if (!(c.maxPatchTestError < kLocalPatchTestTolerance)) {
+    std::ostringstream s;
+    s << "local patch test (degree " << c.degree << "): " << c.patchTestFailures
+      << " element(s) above the tolerance " << kLocalPatchTestTolerance << ", worst "
+      << c.maxPatchTestError << " at element " << c.worstPatchTestElement.value;
+    out.push_back(s.str());
+  }
+  if (c.elementsWithWrongRigidModes > 0) {
+    std::ostringstream s;
+    s << c.elementsWithWrongRigidModes
+      << " element stiffness matrices without exactly 6 zero modes, the first element "
+      << c.firstWrongRigidModeElement.value;
+    out.push_back(s.str());
+  }
+  if (c.nonDefiniteElements > 0) {
+    std::ostringstream s;
+    s << c.nonDefiniteElements << " element(s) whose local IP matrix is not positive definite";
+    out.push_back(s.str());
+  }
+  return out;
 }
 
 nlohmann::json toJson(const Box3& box) {

@@ -1,14 +1,27 @@
 // JSON forms of the library's reports, shared by the subcommands' --report files.
 #pragma once
 
+#include <string>
+#include <vector>
+
 #include <nlohmann/json.hpp>
 
 #include "mesh/meshing.h"
 #include "mesh/validate.h"
+#include "physics/validation.h"
 
 namespace polydg::cli {
 
 nlohmann::json toJson(const ValidationReport& r);
+/// The element-local DG checks as keys of a report's `validation` section: dg_degree,
+/// patch_test_error (max over elements), patch_test_tolerance, patch_test_failures,
+/// worst_patch_test_element, rigid_mode_failures (elements whose stiffness has not exactly six
+/// zero modes), first_rigid_mode_failure, non_definite_elements, dg_elements_checked, dg_passed,
+/// and dg_seconds = `seconds` (wall time of the checks with the moments they need). Element ids
+/// are null when there is none.
+nlohmann::json toJson(const LocalDgCheck& c, double seconds);
+/// One line per failed local DG check (none when they passed), for reports and the terminal.
+std::vector<std::string> failureMessages(const LocalDgCheck& c);
 nlohmann::json toJson(const Box3& box);
 /// The `polydg mesh` report: input, output, volume_rel_error, validation, timings_s.
 nlohmann::json toJson(const MeshingReport& r);

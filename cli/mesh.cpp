@@ -1,5 +1,8 @@
-// polydg mesh: a surface file in, a polyhedral DG simulation mesh (VTU) out.
+// polydg mesh: a surface file in, a polyhedral DG simulation mesh (VTU) out, checked
+// geometrically and by the element-local DG checks (degree 1).
+#include <chrono>
 #include <iostream>
+#include <optional>
 
 #include "cli/commands.h"
 #include "cli/json_reports.h"
@@ -8,6 +11,7 @@
 #include "mesh/meshing.h"
 #include "mesh/surface_io.h"
 #include "mesh/vtu_io.h"
+#include "physics/validation.h"
 
 namespace polydg::cli {
 
@@ -21,9 +25,28 @@ struct MeshCommandOptions {
   int cells = 0;
   RepairMode repair = RepairMode::None;
   double sliverTau = MeshingOptions{}.sliverTau;
+  bool skipDg = false;
 };
 
-void printSummary(const std::string& output, const MeshingReport& r) {
+/// The local DG checks of the new mesh (degree 1) and their wall time with the moments.
+struct DgOutcome {
+  LocalDgCheck check;
+  double seconds = 0.0;
+};
+
+DgOutcome runDgChecks(const PolyMesh& mesh) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const LocalDgCheckOptions options;
+  MomentCache moments(mesh, 2 * options.basis.degree);
+  moments.update();
+  DgOutcome out;
+  out.check = localDgChecks(mesh, moments, options);
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return out;
+}
+
+void printSummary(const std::string& output, const MeshingReport& r,
+                  const std::optional<DgOutcome>& dg) {
   std::cout << output << ": " << r.elements << " elements (" << r.hexahedra << " hexahedra, "
             << r.polyhedra << " polyhedra, " << r.nonconvex << " non-convex), " << r.faces
             << " faces; grid " << r.grid.cells[0] << "x" << r.grid.cells[1] << "x"
@@ -32,6 +55,13 @@ void printSummary(const std::string& output, const MeshingReport& r) {
             << r.volumeRelError << "), slivers merged " << r.slivers.merged << ", validation "
             << (r.validation.passed ? "passed" : "FAILED") << "\n";
   for (const std::string& repair : r.repairs) std::cout << "  repair: " << repair << "\n";
+  if (dg) {
+    const LocalDgCheck& c = dg->check;
+    std::cout << "  DG checks (degree " << c.degree << "): patch test error "
+              << c.maxPatchTestError << ", rigid-mode failures " << c.elementsWithWrongRigidModes
+              << ", " << dg->seconds << " s: " << (c.passed() ? "passed" : "FAILED") << "\n";
+    for (const std::string& m : failureMessages(c)) std::cout << "  " << m << "\n";
+  }
   double total = 0;
   for (const auto& [phase, seconds] : r.timings) total += seconds;
   std::cout << "  time " << total << " s\n";
@@ -63,6 +93,7 @@ void addMeshCommand(CLI::App& app, const CommonOptions& common, int& exitCode) {
                   "merge elements smaller than TAU x cell volume into a neighbour (0: off)")
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
+  cmd->add_flag("--no-dg", o->skipDg, "skip the DG checks (patch test, rigid modes) of the result");
   cmd->callback([o, &common, &exitCode, cmd] {
     if (!o->cell && o->cells == 0)
       throw UserError("polydg mesh needs --cell H or --cells N");
@@ -86,16 +117,38 @@ void addMeshCommand(CLI::App& app, const CommonOptions& common, int& exitCode) {
       throw UserError(o->input + ": " + e.what());
     }
     bar.finish();
+    // The DG checks need a geometrically valid mesh (faces shared properly).
+    std::optional<DgOutcome> dg;
+    if (!o->skipDg && result.report.validation.passed) {
+      dg = runDgChecks(result.mesh);
+      result.report.timings.emplace_back("dg_checks", dg->seconds);
+    }
+    const bool passed = result.report.validation.passed && (!dg || dg->check.passed());
     writeVtu(result.mesh, o->output);
     if (!o->report.empty()) {
       nlohmann::json report = toJson(result.report);
       report["command"] = "mesh";
       report["input"]["file"] = o->input;
       report["output"]["file"] = o->output;
+      nlohmann::json& validation = report["validation"];
+      validation["geometry_passed"] = result.report.validation.passed;
+      validation["passed"] = passed;
+      validation["dg_checked"] = dg.has_value();
+      if (dg) {
+        validation.update(toJson(dg->check, dg->seconds));
+        for (const std::string& m : failureMessages(dg->check))
+          validation["messages"].push_back(m);
+      } else {
+        validation["patch_test_error"] = nullptr;
+        validation["rigid_mode_failures"] = nullptr;
+        validation["dg_seconds"] = nullptr;
+        validation["dg_passed"] = nullptr;
+        report["timings_s"]["dg_checks"] = nullptr;
+      }
       writeReport(o->report, report);
     }
-    if (!common.quiet) printSummary(o->output, result.report);
-    exitCode = result.report.validation.passed ? 0 : 1;
+    if (!common.quiet) printSummary(o->output, result.report, dg);
+    exitCode = passed ? 0 : 1;
     (void)cmd;
   });
 }

@@ -1,14 +1,22 @@
 #include "physics/validation.h"
 
 #include <algorithm>
+#include <array>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <random>
+#include <span>
 
 #include <Eigen/CholmodSupport>
 #include <Eigen/Dense>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 
+#include "integrate/moments.h"
 #include "mesh/validate.h"
+#include "physics/polynomial_tables.h"
 #include "physics/post_process.h"
 
 namespace polydg {
@@ -26,6 +34,34 @@ constexpr int kSubspaceIterations = 30;
 constexpr double kSubspaceShift = 1e-10;
 /// Seed of the subspace iteration's starting vectors.
 constexpr unsigned kSeed = 20240611;
+
+/// A linear field u(x) = b + A (x - x0).
+struct LinearField {
+  Eigen::Matrix3d a = Eigen::Matrix3d::Zero();
+  Vec3 b = Vec3::Zero();
+  Vec3 x0 = Vec3::Zero();
+  Vec3 operator()(const Vec3& x) const { return b + a * (x - x0); }
+};
+
+/// Element e's coefficients of the linear field u (3n values in LinearSystem's order d n + i),
+/// exact since every basis spans the linear functions: with phi = T m (T lower triangular),
+/// u_d = mu_d . m for the monomial coefficients mu_d = (u_d(c), h A(d, :), 0, ...), so
+/// U_d = T^(-T) mu_d.
+void linearFieldCoefficients(const DgBasis& basis, ElementId e, const LinearField& u,
+                             std::span<double> out) {
+  const int n = basis.size();
+  const auto t = basis.coefficients(e);
+  const Vec3 uc = u(basis.centre(e));
+  const double h = basis.scale(e);
+  for (int d = 0; d < 3; ++d) {
+    double* ud = out.data() + d * n;
+    for (int i = n - 1; i >= 0; --i) {  // back substitution with T^T
+      double v = i == 0 ? uc[d] : i <= 3 ? h * u.a(d, i - 1) : 0.0;
+      for (int j = i + 1; j < n; ++j) v -= t(j, i) * ud[j];
+      ud[i] = v / t(i, i);
+    }
+  }
+}
 
 StaticOptions staticOptions(const PhysicsCheckOptions& o) {
   StaticOptions s;
@@ -126,17 +162,26 @@ ZeroModeReport zeroModes(const PolyMesh& mesh, const DgBasis& basis, const Momen
     }
   }
 
-  // Rigid motions as coefficients: translations e_d and rotations e_d x (x - c).
+  // Rigid motions as coefficients: translations e_d and rotations e_d x (x - c) / length.
   const Vec3 c = meshBounds(mesh).center();
   const double length = std::max(meshBounds(mesh).diagonal().norm(), 1e-300);
   std::vector<Eigen::VectorXd> rigid;
   for (int d = 0; d < 6; ++d) {
-    const auto field = [&](const Vec3& x) -> Vec3 {
+    LinearField field;
+    field.x0 = c;
+    if (d < 3) {
+      field.b[d] = 1.0;
+    } else {
       Vec3 axis = Vec3::Zero();
-      axis[d % 3] = 1.0;
-      return d < 3 ? axis : Vec3(axis.cross(x - c) / length);
-    };
-    rigid.push_back(projectField(mesh, basis, moments, field, basis.degree() + 1));
+      axis[d - 3] = 1.0;
+      field.a << 0.0, -axis.z(), axis.y(), axis.z(), 0.0, -axis.x(), -axis.y(), axis.x(), 0.0;
+      field.a /= length;  // a v = axis x v / length
+    }
+    Eigen::VectorXd r(static_cast<Eigen::Index>(mesh.numElements()) * bs);
+    for (std::size_t i = 0; i < mesh.numElements(); ++i)
+      linearFieldCoefficients(basis, ElementId(i), field,
+                              {r.data() + i * bs, static_cast<std::size_t>(bs)});
+    rigid.push_back(std::move(r));
   }
 
   for (std::size_t comp = 0; comp < count; ++comp) {
@@ -197,6 +242,324 @@ DefinitenessReport definiteness(const PolyMesh& mesh, const PhysicsCheckOptions&
   r.choleskySucceeded = isPositiveDefinite(k);
   r.modes = zeroModes(mesh, solver.basis(), solver.moments(), k);
   return r;
+}
+
+namespace {
+
+LinearField localPatchField(const PolyMesh& mesh) {
+  const Box3 box = meshBounds(mesh);
+  LinearField u;
+  u.a << 0.31, -0.17, 0.23, 0.13, 0.27, -0.19, -0.29, 0.11, 0.21;
+  u.b = box.diagonal().norm() * Vec3(0.5, -0.6, 0.7);
+  u.x0 = box.center();
+  return u;
+}
+
+/// What one element contributes to a LocalDgCheck.
+struct ElementOutcome {
+  double error = 0.0;
+  bool wrongRigidModes = false;
+  bool nonDefinite = false;
+};
+
+/// LDL^T = P A P^T of a symmetric B x B matrix with diagonal pivoting (the largest remaining
+/// |diagonal| first), as Eigen::LDLT, but unrolled for small fixed sizes, where Eigen's
+/// blocked kernels cost several times more. By Sylvester's law of inertia the signs of D are
+/// those of A's eigenvalues. Stable for the (shifted) semi-definite matrices used here.
+template <int B>
+class PivotedLdlt {
+ public:
+  using Mat = Eigen::Matrix<double, B, B>;
+  using Vec = Eigen::Matrix<double, B, 1>;
+
+  explicit PivotedLdlt(const Mat& m) : f_(m) {
+    // Only the lower triangle is read and written.
+    for (int i = 0; i < B; ++i) order_[i] = i;
+    for (int k = 0; k < B; ++k) {
+      int p = k;
+      for (int i = k + 1; i < B; ++i)
+        if (std::abs(f_(i, i)) > std::abs(f_(p, p))) p = i;
+      if (p != k) {  // symmetric swap of k and p in lower storage
+        for (int j = 0; j < k; ++j) std::swap(f_(k, j), f_(p, j));
+        std::swap(f_(k, k), f_(p, p));
+        for (int i = k + 1; i < p; ++i) std::swap(f_(i, k), f_(p, i));
+        for (int i = p + 1; i < B; ++i) std::swap(f_(i, k), f_(i, p));
+        std::swap(order_[k], order_[p]);
+      }
+      const double d = f_(k, k);
+      nonPositive_ += !(d > 0.0);
+      if (d == 0.0 || !std::isfinite(d)) {  // nothing to eliminate with
+        for (int i = k + 1; i < B; ++i) f_(i, k) = 0.0;
+        continue;
+      }
+      // A22 -= a21 a21^T / d, then column k of L = a21 / d.
+      for (int j = k + 1; j < B; ++j) {
+        const double lj = f_(j, k) / d;
+        for (int i = j; i < B; ++i) f_(i, j) -= f_(i, k) * lj;
+      }
+      for (int i = k + 1; i < B; ++i) f_(i, k) /= d;
+    }
+  }
+
+  /// Pivots that are not positive: the eigenvalues <= 0 (NaN pivots included).
+  int nonPositivePivots() const { return nonPositive_; }
+
+  /// A^(-1) b; valid when no pivot is zero.
+  Vec solve(const Vec& b) const {
+    Vec y;
+    for (int i = 0; i < B; ++i) y[i] = b[order_[i]];
+    for (int i = 0; i < B; ++i)
+      for (int j = 0; j < i; ++j) y[i] -= f_(i, j) * y[j];
+    for (int i = 0; i < B; ++i) y[i] /= f_(i, i);
+    for (int i = B - 1; i >= 0; --i)
+      for (int j = i + 1; j < B; ++j) y[i] -= f_(j, i) * y[j];
+    Vec x;
+    for (int i = 0; i < B; ++i) x[order_[i]] = y[i];
+    return x;
+  }
+
+ private:
+  Mat f_;  // L below the diagonal, D on it
+  std::array<int, B> order_;
+  int nonPositive_ = 0;
+};
+
+/// The checks of one element for basis degree P: 3N x 3N fixed-size matrices, N functions per
+/// component.
+template <int P>
+struct LocalCheckKernel {
+  static constexpr int N = numMonomials(P);
+  static constexpr int B = 3 * N;
+  using Mat = Eigen::Matrix<double, B, B>;
+  using Vec = Eigen::Matrix<double, B, 1>;
+  using MatN = Eigen::Matrix<double, N, N>;
+  using VecN = Eigen::Matrix<double, N, 1>;
+
+  const PolyMesh& mesh;
+  const MomentCache& moments;
+  const DgBasis& basis;
+  const FaceRoles& roles;
+  const LinearField& u;
+  double mu, lambda;
+  Eigen::Matrix3d stress;  ///< sigma(u), constant
+
+  Vec exactCoefficients(ElementId e) const {
+    Vec out;
+    linearFieldCoefficients(basis, e, u, {out.data(), B});
+    return out;
+  }
+
+  /// int_F phi_i for K's functions: the face's moments about its reference point r, scaled by
+  /// h_K and shifted to K's centre c (int_F m_a = sum_b C(a, b) ((r - c) / h)^(a - b) M_b / h^|b|).
+  VecN faceIntegrals(FaceId f, ElementId e) const {
+    const double h = basis.scale(e);
+    const auto fm = moments.face(f);
+    double inversePowers[P + 1] = {1.0}, scaled[N], shifted[N];
+    for (int k = 1; k <= P; ++k) inversePowers[k] = inversePowers[k - 1] / h;
+    for (int a = 0; a < N; ++a) scaled[a] = fm[a] * inversePowers[monomialExponents(a).degree()];
+    shiftMoments(P, (faceReferencePoint(mesh, f) - basis.centre(e)) / h, {scaled, N},
+                 {shifted, N});
+    return MatN(basis.coefficients(e)) * Eigen::Map<const VecN>(shifted);
+  }
+
+  /// The local penalty eta_K of localDgChecks().
+  double localPenalty(ElementId e) const {
+    double sum = 0.0;
+    for (const FaceUse& use : mesh.element(e).faces) {
+      const FaceKind kind = roles.kind[use.face];
+      if (kind == FaceKind::Free) continue;
+      const double area = moments.area(use.face);
+      if (!(area > 0.0)) continue;
+      const double w2 = kind == FaceKind::Interior ? 0.25 : 1.0;
+      // Degree 1: the lifting space is the constants, psi = 1 / sqrt(vol), trace = area / vol.
+      const double trace =
+          P == 1 ? 1.0
+                 : moments.volume(e) / area *
+                       liftingFaceGram(basis, moments, mesh, use.face, e).trace();
+      sum += w2 * trace;
+    }
+    return 2.0 * sum / kConsistencyEnergyShare;
+  }
+
+  /// Eigenvalues of the Jacobi-scaled k below kElementZeroModeThreshold times its largest
+  /// absolute row sum: the negative pivots of LDL^T of the shifted matrix (Sylvester).
+  static int zeroModes(const Mat& k) {
+    Vec s;
+    for (int i = 0; i < B; ++i) s[i] = k(i, i) > 0.0 ? 1.0 / std::sqrt(k(i, i)) : 1.0;
+    Mat m = s.asDiagonal() * k * s.asDiagonal();
+    const double bound = m.cwiseAbs().rowwise().sum().maxCoeff();
+    if (!(bound > 0.0)) return B;
+    m.diagonal().array() -= kElementZeroModeThreshold * bound;
+    return PivotedLdlt<B>(m).nonPositivePivots();
+  }
+
+  /// `exact` holds every element's exactCoefficients(); the matrices are scratch space.
+  ElementOutcome check(ElementId e, const ElementData<Vec>& exact, Eigen::MatrixXd& stiffness,
+                       Eigen::MatrixXd& selfBlock, Eigen::MatrixXd& otherBlock,
+                       Eigen::MatrixXd& spare) const {
+    ElementOutcome out;
+    elementStiffness(basis, moments, e, mu, lambda, stiffness);
+    const Mat kk(stiffness);
+    out.wrongRigidModes = zeroModes(kk) != 6;
+
+    // K's rows of A U = F at the exact coefficients U (U_L on the neighbours), A = K_K + sum_F
+    // S_F: r = (K_K + sum_interior S_F) U + sum_interior O_F U_L - sum_Dirichlet t_F, since the
+    // Dirichlet load of g = u is S_F U + t_F with t_F(v) = int_F (sigma(u) n) . v. (S_F and O_F:
+    // faceRows()' self and other blocks.)
+    const FormCoefficients form{Method::IP, mu, lambda, localPenalty(e)};
+    Mat interior = kk, dirichlet = Mat::Zero();
+    Vec r = Vec::Zero();
+    for (const FaceUse& use : mesh.element(e).faces) {
+      const FaceUses& uses = roles.uses[use.face];
+      const FaceKind kind = roles.kind[use.face];
+      if (kind == FaceKind::Free) continue;
+      const int side = uses.element[0] == e ? 0 : 1;
+      FaceView view;
+      view.face = use.face;
+      view.kind = kind;
+      view.self = e;
+      view.selfIsFront = !uses.reversed[side];
+      view.selfCoupledFaces = roles.coupledFaces[e];
+      if (kind == FaceKind::Interior) {
+        view.other = uses.element[1 - side];
+        view.otherCoupledFaces = roles.coupledFaces[view.other];
+      }
+      // faceRows() empties `otherBlock` on boundary faces: give it a spare so that the interior
+      // faces' block keeps its storage.
+      faceRows(mesh, basis, moments, view, form, selfBlock,
+               kind == FaceKind::Interior ? otherBlock : spare);
+      const Eigen::Map<const Mat> s(selfBlock.data());
+      if (kind == FaceKind::Interior) {
+        interior += s;
+        r.noalias() += Eigen::Map<const Mat>(otherBlock.data()) * exact[view.other];
+      } else {
+        dirichlet += s;
+        const Vec3 n = view.selfIsFront ? moments.faceNormal(use.face)
+                                        : Vec3(-moments.faceNormal(use.face));
+        const Vec3 traction = stress * n;
+        const VecN integrals = faceIntegrals(use.face, e);
+        for (int d = 0; d < 3; ++d) r.template segment<N>(d * N) -= traction[d] * integrals;
+      }
+    }
+    r.noalias() += interior * exact[e];
+    const Mat a = interior + dirichlet;
+
+    // The error field delta = U_K - U = -A^(-1) r, in K's monomials (m^T T^T delta_d).
+    const PivotedLdlt<B> ldlt(a);
+    Vec delta;
+    if (ldlt.nonPositivePivots() == 0) {
+      delta = -ldlt.solve(r);
+    } else {
+      out.nonDefinite = true;
+      delta = -a.fullPivLu().solve(r);
+    }
+    const MatN t(basis.coefficients(e));
+    Eigen::Matrix<double, N, 3> monomialError;
+    for (int d = 0; d < 3; ++d)
+      monomialError.col(d) = t.transpose() * delta.template segment<N>(d * N);
+    double largestError = 0.0, largestValue = 0.0;  // squared
+    double m[N];
+    const Vec3 c = basis.centre(e);
+    const double inverseScale = 1.0 / basis.scale(e);
+    for (const FaceUse& use : mesh.element(e).faces)
+      for (VertexId v : mesh.face(use.face).vertices) {
+        const Vec3& x = mesh.position(v);
+        scaledMonomials(P, (x - c) * inverseScale, {m, N});
+        const Vec3 err = monomialError.transpose() * Eigen::Map<const VecN>(m);
+        largestError = std::max(largestError, err.squaredNorm());
+        largestValue = std::max(largestValue, u(x).squaredNorm());
+      }
+    out.error = std::sqrt(largestError / largestValue);
+    if (!std::isfinite(out.error)) out.error = std::numeric_limits<double>::infinity();
+    return out;
+  }
+};
+
+/// Reduction of the element outcomes (lowest ids win ties, so the result is deterministic).
+struct CheckTotals {
+  double maxError = -1.0;
+  ElementId worst;
+  std::size_t patchFailures = 0, wrongRigid = 0, nonDefinite = 0;
+  ElementId firstWrongRigid;
+
+  void add(ElementId e, const ElementOutcome& o) {
+    if (o.error > maxError || (o.error == maxError && e.value < worst.value)) {
+      maxError = o.error;
+      worst = e;
+    }
+    patchFailures += !(o.error < kLocalPatchTestTolerance);
+    nonDefinite += o.nonDefinite;
+    if (o.wrongRigidModes) {
+      ++wrongRigid;
+      if (!firstWrongRigid.valid() || e.value < firstWrongRigid.value) firstWrongRigid = e;
+    }
+  }
+  void join(const CheckTotals& o) {
+    if (o.maxError > maxError || (o.maxError == maxError && o.worst.value < worst.value)) {
+      maxError = o.maxError;
+      worst = o.worst;
+    }
+    patchFailures += o.patchFailures;
+    wrongRigid += o.wrongRigid;
+    nonDefinite += o.nonDefinite;
+    if (o.firstWrongRigid.valid() &&
+        (!firstWrongRigid.valid() || o.firstWrongRigid.value < firstWrongRigid.value))
+      firstWrongRigid = o.firstWrongRigid;
+  }
+};
+
+}  // namespace
+
+LocalDgCheck localDgChecks(const PolyMesh& mesh, const MomentCache& moments,
+                           const LocalDgCheckOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  options.material.check();
+  LoadCase loads;
+  loads.dirichlet.push_back({FaceSelector::allBoundary(), {}});
+  const FaceRoles roles = classifyFaces(mesh, loads);
+  const DgBasis basis(mesh, moments, options.basis);
+  const LinearField u = localPatchField(mesh);
+  const double mu = options.material.mu(), lambda = options.material.lambda();
+  const Eigen::Matrix3d strain = 0.5 * (u.a + u.a.transpose());
+  const Eigen::Matrix3d stress =
+      2.0 * mu * strain + lambda * strain.trace() * Eigen::Matrix3d::Identity();
+
+  const CheckTotals totals = detail::dispatchBasisDegree(basis.degree(), [&](auto p) {
+    using Kernel = LocalCheckKernel<p()>;
+    const Kernel kernel{mesh, moments, basis, roles, u, mu, lambda, stress};
+    ElementData<typename Kernel::Vec> exact(mesh.numElements(), Kernel::Vec::Zero());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.numElements(), 256),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+                        for (std::size_t i = range.begin(); i != range.end(); ++i)
+                          exact[ElementId(i)] = kernel.exactCoefficients(ElementId(i));
+                      });
+    return tbb::parallel_reduce(
+        tbb::blocked_range<std::size_t>(0, mesh.numElements(), 64), CheckTotals{},
+        [&](const tbb::blocked_range<std::size_t>& range, CheckTotals totals) {
+          Eigen::MatrixXd stiffness, selfBlock, otherBlock, spare;
+          for (std::size_t i = range.begin(); i != range.end(); ++i) {
+            const ElementId e(i);
+            totals.add(e, kernel.check(e, exact, stiffness, selfBlock, otherBlock, spare));
+          }
+          return totals;
+        },
+        [](CheckTotals a, const CheckTotals& b) {
+          a.join(b);
+          return a;
+        });
+  });
+
+  LocalDgCheck c;
+  c.degree = basis.degree();
+  c.elements = mesh.numElements();
+  c.maxPatchTestError = std::max(totals.maxError, 0.0);
+  c.worstPatchTestElement = totals.worst;
+  c.patchTestFailures = totals.patchFailures;
+  c.elementsWithWrongRigidModes = totals.wrongRigid;
+  c.firstWrongRigidModeElement = totals.firstWrongRigid;
+  c.nonDefiniteElements = totals.nonDefinite;
+  c.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return c;
 }
 
 }  // namespace polydg

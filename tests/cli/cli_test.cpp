@@ -161,6 +161,120 @@ TEST_F(Cli, MeshWritesAValidMeshAndReport) {
   EXPECT_EQ(self.exitCode, 2);
 }
 
+/// Tolerance of the DG patch test in reports (physics/validation.h's kLocalPatchTestTolerance).
+constexpr double kPatchTolerance = 1e-9;
+
+TEST_F(Cli, CheckReportsTheDgValidation) {
+  ASSERT_EQ(run("mesh " + data("torus.obj") + " --cells 8 -o " + path("t.vtu") + " --quiet").exitCode, 0);
+  const Result r = run("check " + path("t.vtu") + " --report " + path("c.json"));
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  EXPECT_NE(r.out.find("local patch test error"), std::string::npos) << r.out;
+  const auto c = readJson("c.json");
+  for (const char* key : {"passed", "elements", "components", "volume", "problems", "validation"})
+    EXPECT_TRUE(c.contains(key)) << key;
+  EXPECT_EQ(c["passed"], true);
+  const auto& v = c["validation"];
+  EXPECT_EQ(v["passed"], true);
+  EXPECT_EQ(v["geometry_passed"], true);
+  EXPECT_EQ(v["dg_passed"], true);
+  EXPECT_EQ(v["dg_degree"], 1);
+  EXPECT_EQ(v["elements"], c["elements"]);
+  EXPECT_EQ(v["dg_elements_checked"], c["elements"]);
+  EXPECT_LT(v["patch_test_error"].get<double>(), kPatchTolerance);
+  EXPECT_EQ(v["rigid_mode_failures"], 0);
+  const int components = v["components"].get<int>();
+  EXPECT_EQ(components, 1);
+  EXPECT_EQ(v["rigid_modes"].get<int>(), 6 * components);
+  EXPECT_EQ(v["rigid_modes_global"], v["rigid_modes"]);
+  EXPECT_EQ(v["rigid_modes_expected"].get<int>(), 6 * components);
+
+  const Result p2 = run("check " + path("t.vtu") + " --degree 2 --quiet --report " + path("c2.json"));
+  ASSERT_EQ(p2.exitCode, 0) << p2.out;
+  const auto c2 = readJson("c2.json")["validation"];
+  EXPECT_EQ(c2["dg_degree"], 2);
+  EXPECT_LT(c2["patch_test_error"].get<double>(), kPatchTolerance);
+  EXPECT_EQ(c2["rigid_modes"].get<int>(), 6 * components);
+
+  const Result skipped = run("check " + path("t.vtu") + " --no-dg --quiet --report " + path("c3.json"));
+  ASSERT_EQ(skipped.exitCode, 0) << skipped.out;
+  const auto c3 = readJson("c3.json")["validation"];
+  EXPECT_EQ(c3["passed"], true);
+  EXPECT_EQ(c3["dg_checked"], false);
+  EXPECT_TRUE(c3["patch_test_error"].is_null());
+  EXPECT_TRUE(c3["rigid_modes"].is_null());
+  EXPECT_EQ(run("check " + path("t.vtu") + " --degree 4").exitCode, 2);
+}
+
+TEST_F(Cli, CheckFailsTheDgChecksOnANonPlanarFace) {
+  // Two unit cubes sharing the face x = 1, whose corner (1, 0, 1) is moved to x = 1.001: only
+  // the shared face is non-planar. With a loose planarity tolerance the geometry passes and the
+  // DG patch test fails; with the default one the geometry fails and the DG checks are skipped.
+  std::string points;
+  for (int k = 0; k < 2; ++k)
+    for (int j = 0; j < 2; ++j)
+      for (int i = 0; i < 3; ++i)
+        points += (i == 1 && j == 0 && k == 1 ? std::string("1.001") : std::to_string(i)) + " " +
+                  std::to_string(j) + " " + std::to_string(k) + " ";
+  std::ofstream(path("bent.vtu"))
+      << "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" "
+         "byte_order=\"LittleEndian\">\n<UnstructuredGrid><Piece NumberOfPoints=\"12\" "
+         "NumberOfCells=\"2\">\n<Points><DataArray type=\"Float64\" NumberOfComponents=\"3\" "
+         "format=\"ascii\">"
+      << points
+      << "</DataArray></Points>\n<Cells><DataArray type=\"Int32\" Name=\"connectivity\" "
+         "format=\"ascii\">0 1 4 3 6 7 10 9 1 2 5 4 7 8 11 10</DataArray>\n<DataArray "
+         "type=\"Int32\" Name=\"offsets\" format=\"ascii\">8 16</DataArray>\n<DataArray "
+         "type=\"UInt8\" Name=\"types\" format=\"ascii\">12 12</DataArray>\n</Cells></Piece>"
+         "</UnstructuredGrid></VTKFile>\n";
+  const Result loose = run("check " + path("bent.vtu") + " --planarity-tolerance 0.01 --report " +
+                           path("c.json"));
+  EXPECT_EQ(loose.exitCode, 1) << loose.out;
+  EXPECT_NE(loose.out.find("INVALID"), std::string::npos) << loose.out;
+  EXPECT_NE(loose.out.find("local patch test"), std::string::npos) << loose.out;
+  const auto c = readJson("c.json");
+  EXPECT_EQ(c["passed"], false);
+  const auto& v = c["validation"];
+  EXPECT_EQ(v["passed"], false);
+  EXPECT_EQ(v["geometry_passed"], true);
+  EXPECT_EQ(v["dg_passed"], false);
+  EXPECT_GT(v["patch_test_error"].get<double>(), 1e3 * kPatchTolerance);
+  EXPECT_EQ(v["patch_test_failures"], 2);
+  EXPECT_FALSE(v["messages"].empty());
+
+  const Result strict = run("check " + path("bent.vtu") + " --quiet --report " + path("c.json"));
+  EXPECT_EQ(strict.exitCode, 1) << strict.out;
+  const auto s = readJson("c.json")["validation"];
+  EXPECT_EQ(s["geometry_passed"], false);
+  EXPECT_EQ(s["dg_checked"], false);
+  EXPECT_TRUE(s["patch_test_error"].is_null());
+  EXPECT_TRUE(s.contains("dg_note"));
+}
+
+TEST_F(Cli, MeshReportsTheDgChecks) {
+  const Result r = run("mesh " + data("torus.obj") + " --cells 8 -o " + path("t.vtu") +
+                       " --report " + path("t.json"));
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  EXPECT_NE(r.out.find("DG checks (degree 1)"), std::string::npos) << r.out;
+  const auto j = readJson("t.json");
+  const auto& v = j["validation"];
+  EXPECT_EQ(v["passed"], true);
+  EXPECT_EQ(v["geometry_passed"], true);
+  EXPECT_EQ(v["dg_passed"], true);
+  EXPECT_LT(v["patch_test_error"].get<double>(), kPatchTolerance);
+  EXPECT_EQ(v["rigid_mode_failures"], 0);
+  EXPECT_EQ(v["dg_elements_checked"], j["output"]["elements"]);
+  EXPECT_GE(v["dg_seconds"].get<double>(), 0.0);
+  EXPECT_EQ(j["timings_s"]["dg_checks"], v["dg_seconds"]);
+
+  const Result skipped = run("mesh " + data("torus.obj") + " --cells 8 --no-dg --quiet -o " +
+                             path("t.vtu") + " --report " + path("t.json"));
+  ASSERT_EQ(skipped.exitCode, 0) << skipped.out;
+  const auto s = readJson("t.json");
+  EXPECT_EQ(s["validation"]["dg_checked"], false);
+  EXPECT_TRUE(s["validation"]["patch_test_error"].is_null());
+  EXPECT_TRUE(s["timings_s"]["dg_checks"].is_null());
+}
+
 TEST_F(Cli, CheckAcceptsVtkWrittenFilesAndRejectsBrokenOnes) {
   const char* dir = std::getenv("POLYDG_VTK_FILES_DIR");
   if (!dir) GTEST_SKIP() << "run through ctest's cli_check_vtk_files (needs VTK-written files)";

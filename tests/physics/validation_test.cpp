@@ -2,7 +2,8 @@
 // field is reproduced by IP), exactly six rigid zero modes per connected component without
 // boundary conditions, and a symmetric positive definite matrix with them; on hex grids,
 // non-convex prisms (an L and a square with a hole), a grid with a sliver element, and meshes
-// translated by 1e6 or scaled by 1e-6 and 1e6. Degrees 1 to 3.
+// translated by 1e6 or scaled by 1e-6 and 1e6. Degrees 1 to 3. The element-local checks pass on
+// the same corpus and a sliced sphere, and fail on meshes with a corrupted face or element.
 #include "physics/validation.h"
 
 #include <gtest/gtest.h>
@@ -12,6 +13,8 @@
 #include <string>
 
 #include "mesh/primitives.h"
+#include "mesh/slice.h"
+#include "mesh/surface_shapes.h"
 #include "mesh/validate.h"
 
 namespace polydg {
@@ -147,6 +150,122 @@ TEST(PhysicsValidation, NearlyIncompressiblePatchTestAndRigidModes) {
   const PolyMesh grid = hexGridMesh(2, 2, 2, Box3(Vec3::Zero(), Vec3::Ones()));
   EXPECT_LT(patchTest(grid, options).relativeError, kPatchTolerance);
   EXPECT_EQ(rigidModes(grid, options).zeroModes, 6u);
+}
+
+LocalDgCheck localChecks(const PolyMesh& mesh, int degree) {
+  MomentCache moments(mesh, 2 * degree);
+  moments.update();
+  LocalDgCheckOptions options;
+  options.basis.degree = degree;
+  return localDgChecks(mesh, moments, options);
+}
+
+void expectLocalChecksPass(const PolyMesh& mesh, int degree, const std::string& name) {
+  const LocalDgCheck c = localChecks(mesh, degree);
+  EXPECT_EQ(c.degree, degree) << name;
+  EXPECT_EQ(c.elements, mesh.numElements()) << name;
+  EXPECT_LT(c.maxPatchTestError, kLocalPatchTestTolerance) << name;
+  EXPECT_EQ(c.patchTestFailures, 0u) << name;
+  EXPECT_EQ(c.elementsWithWrongRigidModes, 0u) << name;
+  EXPECT_FALSE(c.firstWrongRigidModeElement.valid()) << name;
+  EXPECT_EQ(c.nonDefiniteElements, 0u) << name;
+  EXPECT_TRUE(c.passed()) << name;
+}
+
+/// The mesh rebuilt from its elements' faces, with face `k` of element `bad` reversed (all of its
+/// loops), or every face of `bad` when k is -1.
+PolyMesh withReversedFaces(const PolyMesh& mesh, ElementId bad, int k) {
+  PolyMesh out;
+  for (const Vec3& p : mesh.positions().raw()) out.addVertex(p);
+  for (std::size_t i = 0; i < mesh.numElements(); ++i) {
+    const Element& element = mesh.element(ElementId(i));
+    std::vector<std::vector<Loop>> boundary;
+    for (std::size_t j = 0; j < element.faces.size(); ++j) {
+      const FaceUse& use = element.faces[j];
+      const Face& face = mesh.face(use.face);
+      const bool flip = ElementId(i) == bad && (k < 0 || static_cast<int>(j) == k);
+      std::vector<Loop> loops;
+      for (std::size_t l = 0; l < face.numLoops(); ++l) {
+        Loop loop(face.loop(l).begin(), face.loop(l).end());
+        if (use.reversed != flip) std::reverse(loop.begin(), loop.end());
+        loops.push_back(loop);
+      }
+      boundary.push_back(loops);
+    }
+    out.addElement(boundary, FaceOrigin::Box);
+  }
+  return out;
+}
+
+/// Index in its element's face list of a boundary face of element e.
+int boundaryFaceOf(const PolyMesh& mesh, ElementId e) {
+  const Element& element = mesh.element(e);
+  for (std::size_t j = 0; j < element.faces.size(); ++j)
+    if (mesh.face(element.faces[j].face).isBoundary()) return static_cast<int>(j);
+  return -1;
+}
+
+TEST_P(PhysicsValidation, LocalChecksPassOnTheCorpus) {
+  for (const NamedMesh& m : corpus()) expectLocalChecksPass(m.mesh, GetParam(), m.name);
+}
+
+TEST(PhysicsValidation, LocalChecksPassOnASlicedSphere) {
+  const TriangleSurface sphere = icosphere(Vec3(0.1, -0.2, 0.05), 1.0, 3);
+  const PolyMesh mesh = sliceSurface(sphere, Grid::withCellsAlongLongest(bounds(sphere), 6));
+  ASSERT_TRUE(validate(mesh).passed);
+  ASSERT_GT(mesh.numElements(), 100u);
+  for (int degree : {1, 2}) expectLocalChecksPass(mesh, degree, "degree " + std::to_string(degree));
+}
+
+TEST(PhysicsValidation, LocalChecksAgreeWithTheRewrittenMesh) {
+  // The rebuilding helper of the corruption tests changes nothing by itself.
+  const PolyMesh grid = hexGridMesh(3, 3, 3, Box3(Vec3::Zero(), Vec3::Ones()));
+  const PolyMesh same = withReversedFaces(grid, ElementId(), 0);
+  ASSERT_TRUE(validate(same).passed);
+  expectLocalChecksPass(same, 1, "rebuilt grid");
+}
+
+/// A corrupted mesh fails the local patch test by a wide margin: the errors below are >= 1e-6,
+/// the valid corpus above stays below 1e-13.
+constexpr double kCorruptionMargin = 1e3;
+
+TEST(PhysicsValidation, LocalChecksFailOnANonPlanarFace) {
+  // The centre vertex of a 2 x 2 x 2 grid, moved off the planes of its 12 faces by 1e-3 of an
+  // element's size.
+  PolyMesh mesh = hexGridMesh(2, 2, 2, Box3(Vec3::Zero(), Vec3::Ones()));
+  for (Vec3& p : mesh.positions().raw())
+    if ((p - Vec3::Constant(0.5)).norm() < 1e-12) p += Vec3(0.3e-3, 0.2e-3, 0.4e-3);
+  EXPECT_FALSE(validate(mesh).passed);
+  for (int degree : {1, 2}) {
+    const LocalDgCheck c = localChecks(mesh, degree);
+    EXPECT_FALSE(c.passed()) << degree;
+    EXPECT_GT(c.maxPatchTestError, kCorruptionMargin * kLocalPatchTestTolerance) << degree;
+    EXPECT_EQ(c.patchTestFailures, 8u) << degree;  // every element has the vertex
+    EXPECT_TRUE(c.worstPatchTestElement.valid());
+  }
+}
+
+TEST(PhysicsValidation, LocalChecksFailOnAReversedFace) {
+  const PolyMesh grid = hexGridMesh(3, 3, 3, Box3(Vec3::Zero(), Vec3::Ones()));
+  const ElementId bad(13 - 9);  // on the boundary z = 0, in the middle
+  const PolyMesh mesh = withReversedFaces(grid, bad, boundaryFaceOf(grid, bad));
+  EXPECT_FALSE(validate(mesh).passed);
+  for (int degree : {1, 2}) {
+    const LocalDgCheck c = localChecks(mesh, degree);
+    EXPECT_FALSE(c.passed()) << degree;
+    EXPECT_GT(c.maxPatchTestError, kCorruptionMargin * kLocalPatchTestTolerance) << degree;
+    EXPECT_EQ(c.worstPatchTestElement, bad) << degree;
+  }
+}
+
+TEST(PhysicsValidation, LocalChecksFailOnAnInvertedElement) {
+  // A lone box with every face reversed: negative volume, a negative definite stiffness.
+  const PolyMesh mesh = withReversedFaces(boxMesh(Box3(Vec3::Zero(), Vec3(1, 2, 3))), ElementId(0), -1);
+  EXPECT_FALSE(validate(mesh).passed);
+  const LocalDgCheck c = localChecks(mesh, 1);
+  EXPECT_FALSE(c.passed());
+  EXPECT_EQ(c.elementsWithWrongRigidModes, 1u);
+  EXPECT_EQ(c.firstWrongRigidModeElement, ElementId(0));
 }
 
 }  // namespace
