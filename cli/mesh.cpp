@@ -34,9 +34,19 @@ struct DgOutcome {
   double seconds = 0.0;
 };
 
+/// Checks every element except whole grid cells, of which one stands for all: they are
+/// congruent boxes bounded by exact axis-aligned squares, so their local equations are the
+/// same up to translation (the geometric validation still covers each one).
 DgOutcome runDgChecks(const PolyMesh& mesh) {
   const auto t0 = std::chrono::steady_clock::now();
-  const LocalDgCheckOptions options;
+  LocalDgCheckOptions options;
+  options.only.assign(mesh.numElements(), 1);
+  bool representative = false;
+  for (std::size_t e = 0; e < mesh.numElements(); ++e) {
+    if (!isGridHexahedron(mesh, ElementId(e))) continue;
+    options.only[e] = representative ? 0 : 1;
+    representative = true;
+  }
   MomentCache moments(mesh, 2 * options.basis.degree);
   moments.update();
   DgOutcome out;
@@ -57,7 +67,8 @@ void printSummary(const std::string& output, const MeshingReport& r,
   for (const std::string& repair : r.repairs) std::cout << "  repair: " << repair << "\n";
   if (dg) {
     const LocalDgCheck& c = dg->check;
-    std::cout << "  DG checks (degree " << c.degree << "): patch test error "
+    std::cout << "  DG checks (degree " << c.degree << ", " << c.elements
+              << " elements: all but congruent grid cells): patch test error "
               << c.maxPatchTestError << ", rigid-mode failures " << c.elementsWithWrongRigidModes
               << ", " << dg->seconds << " s: " << (c.passed() ? "passed" : "FAILED") << "\n";
     for (const std::string& m : failureMessages(c)) std::cout << "  " << m << "\n";

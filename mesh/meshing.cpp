@@ -56,6 +56,18 @@ double cellSizeFor(const Box3& box, const MeshingOptions& o) {
 
 }  // namespace
 
+bool isGridHexahedron(const PolyMesh& mesh, ElementId e) {
+  const Element& element = mesh.element(e);
+  if (element.faces.size() != 6) return false;
+  for (const FaceUse& use : element.faces) {
+    const Face& face = mesh.face(use.face);
+    if (face.numLoops() != 1 || face.vertices.size() != 4) return false;
+    const Vec3 n = unitNormal(mesh, use.face);
+    if (std::abs(n.x()) != 1.0 && std::abs(n.y()) != 1.0 && std::abs(n.z()) != 1.0) return false;
+  }
+  return true;
+}
+
 bool isConvex(const PolyMesh& mesh, ElementId e, double relativeTolerance) {
   const Box3 box = elementBounds(mesh, e);
   const double tolerance = relativeTolerance * box.diagonal().norm();
@@ -173,14 +185,7 @@ MeshingResult meshSurface(const TriangleSurface& input, const MeshingOptions& op
   r.outputVolume = r.validation.volume;
   r.volumeRelError = std::abs(r.outputVolume - r.inputVolume) / r.inputVolume;
   for (std::size_t e = 0; e < mesh.numElements(); ++e) {
-    const Element& element = mesh.element(ElementId(e));
-    bool hex = element.faces.size() == 6;
-    for (const FaceUse& use : element.faces) {
-      const Face& face = mesh.face(use.face);
-      const Vec3 n = unitNormal(mesh, use.face);
-      hex = hex && face.numLoops() == 1 && face.vertices.size() == 4 &&
-            (std::abs(n.x()) == 1.0 || std::abs(n.y()) == 1.0 || std::abs(n.z()) == 1.0);
-    }
+    const bool hex = isGridHexahedron(mesh, ElementId(e));
     r.hexahedra += hex;
     if (!hex && !isConvex(mesh, ElementId(e))) ++r.nonconvex;
   }

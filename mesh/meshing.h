@@ -69,6 +69,10 @@ struct MeshingResult {
 /// (open, non-manifold or self-intersecting without a repair mode; empty; a repair that failed).
 MeshingResult meshSurface(const TriangleSurface& surface, const MeshingOptions& options);
 
+/// True for an element that is a whole grid cell: six faces, each a single quadrilateral with
+/// an exactly axis-aligned normal. All such elements of one grid are congruent boxes.
+bool isGridHexahedron(const PolyMesh& mesh, ElementId e);
+
 /// True if the element is convex: every vertex on the inner side of every face plane, within
 /// `relativeTolerance` times the element's size (a reporting statistic, not a decision).
 bool isConvex(const PolyMesh& mesh, ElementId e, double relativeTolerance = 1e-9);

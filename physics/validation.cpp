@@ -514,6 +514,8 @@ LocalDgCheck localDgChecks(const PolyMesh& mesh, const MomentCache& moments,
                            const LocalDgCheckOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   options.material.check();
+  if (!options.only.empty() && options.only.size() != mesh.numElements())
+    throw std::invalid_argument("localDgChecks: `only` needs one entry per element");
   LoadCase loads;
   loads.dirichlet.push_back({FaceSelector::allBoundary(), {}});
   const FaceRoles roles = classifyFaces(mesh, loads);
@@ -538,6 +540,7 @@ LocalDgCheck localDgChecks(const PolyMesh& mesh, const MomentCache& moments,
         [&](const tbb::blocked_range<std::size_t>& range, CheckTotals totals) {
           Eigen::MatrixXd stiffness, selfBlock, otherBlock, spare;
           for (std::size_t i = range.begin(); i != range.end(); ++i) {
+            if (!options.only.empty() && !options.only[i]) continue;
             const ElementId e(i);
             totals.add(e, kernel.check(e, exact, stiffness, selfBlock, otherBlock, spare));
           }
@@ -551,7 +554,9 @@ LocalDgCheck localDgChecks(const PolyMesh& mesh, const MomentCache& moments,
 
   LocalDgCheck c;
   c.degree = basis.degree();
-  c.elements = mesh.numElements();
+  c.elements = options.only.empty()
+                   ? mesh.numElements()
+                   : static_cast<std::size_t>(std::count(options.only.begin(), options.only.end(), 1));
   c.maxPatchTestError = std::max(totals.maxError, 0.0);
   c.worstPatchTestElement = totals.worst;
   c.patchTestFailures = totals.patchFailures;

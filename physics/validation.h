@@ -99,12 +99,15 @@ inline constexpr double kLocalPatchTestTolerance = 1e-9;
 struct LocalDgCheckOptions {
   BasisOptions basis{.degree = 1, .kind = BasisKind::Orthonormal};
   Material material;
+  /// If not empty (one entry per element), only elements with a non-zero entry are checked;
+  /// the others still give their neighbours the exact linear trace.
+  std::vector<char> only;
 };
 
 /// Result of localDgChecks(). Element ids refer to the mesh checked.
 struct LocalDgCheck {
   int degree = 0;
-  std::size_t elements = 0;  ///< elements checked (all of the mesh)
+  std::size_t elements = 0;  ///< elements checked (all, or those selected by `only`)
   /// Max over elements of the local patch-test error (see localDgChecks()); +inf when a local
   /// solve produced a non-finite value.
   double maxPatchTestError = 0.0;
