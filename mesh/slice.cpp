@@ -94,21 +94,25 @@ class Slicer {
     mesh.reserve(points.size(), polygons, leaves_.size());
     std::unordered_map<std::array<std::int64_t, 3>, std::vector<std::uint32_t>, CellHash> cells;
     cells.reserve(points.size());
-    auto cellOf = [&](const Vec3& p) {
-      std::array<std::int64_t, 3> c{};
-      for (int i = 0; i < 3; ++i)
-        c[i] = resolution > 0 ? static_cast<std::int64_t>(std::floor(p[i] / resolution)) : 0;
-      return c;
+    // Hash cells four times the weld distance: a point's search box [p - d, p + d] overlaps
+    // one or two cells per axis.
+    const double cellSize = 4.0 * resolution;
+    auto cellIndex = [&](double x) {
+      return cellSize > 0 ? static_cast<std::int64_t>(std::floor(x / cellSize)) : 0;
     };
     std::vector<std::uint32_t> remap(points.size(), 0xffffffffu);
     auto vertexOf = [&](std::uint32_t v) {
       if (remap[v] != 0xffffffffu) return VertexId(remap[v]);
       const Vec3& p = points[v];
-      const auto c = cellOf(p);
-      for (int dx = -1; dx <= 1 && remap[v] == 0xffffffffu; ++dx)
-        for (int dy = -1; dy <= 1 && remap[v] == 0xffffffffu; ++dy)
-          for (int dz = -1; dz <= 1 && remap[v] == 0xffffffffu; ++dz) {
-            auto it = cells.find({c[0] + dx, c[1] + dy, c[2] + dz});
+      std::array<std::int64_t, 3> lo{}, hi{};
+      for (int i = 0; i < 3; ++i) {
+        lo[i] = cellIndex(p[i] - resolution);
+        hi[i] = cellIndex(p[i] + resolution);
+      }
+      for (std::int64_t x = lo[0]; x <= hi[0] && remap[v] == 0xffffffffu; ++x)
+        for (std::int64_t y = lo[1]; y <= hi[1] && remap[v] == 0xffffffffu; ++y)
+          for (std::int64_t z = lo[2]; z <= hi[2] && remap[v] == 0xffffffffu; ++z) {
+            auto it = cells.find({x, y, z});
             if (it == cells.end()) continue;
             for (std::uint32_t w : it->second)
               if ((mesh.position(VertexId(w)) - p).cwiseAbs().maxCoeff() <= resolution) {
@@ -119,7 +123,7 @@ class Slicer {
           }
       if (remap[v] == 0xffffffffu) {
         remap[v] = mesh.addVertex(p).value;
-        cells[c].push_back(remap[v]);
+        cells[{cellIndex(p.x()), cellIndex(p.y()), cellIndex(p.z())}].push_back(remap[v]);
       }
       return VertexId(remap[v]);
     };
