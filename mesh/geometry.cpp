@@ -69,11 +69,6 @@ double planarityDeviation(const PolyMesh& mesh, FaceId f) {
   return worst;
 }
 
-double relativePlanarityError(const PolyMesh& mesh, FaceId f) {
-  const double diameter = faceBounds(mesh, f).diagonal().norm();
-  return diameter == 0.0 ? 0.0 : planarityDeviation(mesh, f) / diameter;
-}
-
 Box3 meshBounds(const PolyMesh& mesh) {
   Box3 box;
   for (const Vec3& p : mesh.positions()) box.extend(p);

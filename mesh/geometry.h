@@ -41,8 +41,6 @@ double signedVolume(const PolyMesh& mesh, ElementId e);
 /// Newell normal).
 double planarityDeviation(const PolyMesh& mesh, FaceId f);
 
-/// planarityDeviation divided by the face's bounding-box diagonal.
-double relativePlanarityError(const PolyMesh& mesh, FaceId f);
 
 /// Bounding box of all vertices.
 Box3 meshBounds(const PolyMesh& mesh);

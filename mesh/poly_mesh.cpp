@@ -18,11 +18,17 @@ std::string_view toString(FaceOrigin origin) {
 
 namespace {
 
-std::uint64_t vertexSetKey(const std::vector<Loop>& loops) {
-  std::vector<VertexId> all;
-  for (const Loop& loop : loops) all.insert(all.end(), loop.begin(), loop.end());
-  return vertexSetKey(all);
-}
+/// Loops as concatenated vertices and loop ends, for the span-based functions.
+struct FlatLoops {
+  std::vector<VertexId> vertices;
+  std::vector<std::uint32_t> loopEnd;
+  explicit FlatLoops(const std::vector<Loop>& loops) {
+    for (const Loop& loop : loops) {
+      vertices.insert(vertices.end(), loop.begin(), loop.end());
+      loopEnd.push_back(static_cast<std::uint32_t>(vertices.size()));
+    }
+  }
+};
 
 /// True if cycle `b` is cycle `a` traversed backwards (any rotation).
 bool isReversedCycle(std::span<const VertexId> a, std::span<const VertexId> b) {
@@ -39,8 +45,7 @@ bool isReversedCycle(std::span<const VertexId> a, std::span<const VertexId> b) {
 }  // namespace
 
 std::uint64_t vertexSetKey(std::span<const VertexId> vertices) {
-  std::vector<std::uint32_t> ids;
-  ids.reserve(vertices.size());
+  boost::container::small_vector<std::uint32_t, 8> ids;
   for (VertexId v : vertices) ids.push_back(v.value);
   std::sort(ids.begin(), ids.end());
   std::uint64_t h = 1469598103934665603ull;
@@ -52,16 +57,8 @@ std::uint64_t vertexSetKey(std::span<const VertexId> vertices) {
 }
 
 bool isReverseOf(const Face& a, const std::vector<Loop>& loops) {
-  if (a.numLoops() != loops.size()) return false;
-  std::vector<bool> used(loops.size(), false);
-  for (std::size_t k = 0; k < a.numLoops(); ++k) {
-    bool found = false;
-    for (std::size_t j = 0; j < loops.size() && !found; ++j) {
-      if (!used[j] && isReversedCycle(a.loop(k), loops[j])) used[j] = found = true;
-    }
-    if (!found) return false;
-  }
-  return true;
+  const FlatLoops flat(loops);
+  return isReverseOf(a, flat.vertices, flat.loopEnd);
 }
 
 bool isReverseOf(const Face& a, std::span<const VertexId> vertices,
@@ -92,22 +89,8 @@ void PolyMesh::setOrigin(FaceId f, FaceOrigin origin) {
 }
 
 FaceId PolyMesh::addFace(std::vector<Loop> loops, FaceOrigin origin) {
-  if (loops.empty()) throw std::invalid_argument("addFace: a face needs at least one loop");
-  for (const Loop& loop : loops)
-    if (loop.size() < 3)
-      throw std::invalid_argument("addFace: every loop of a face needs at least 3 vertices");
-  Face face;
-  for (Loop& loop : loops) {
-    for (VertexId v : loop) {
-      if (!v.valid() || v.index() >= positions_.size())
-        throw std::out_of_range("addFace: vertex id out of range");
-    }
-    face.vertices.insert(face.vertices.end(), loop.begin(), loop.end());
-    face.loopEnd.push_back(static_cast<std::uint32_t>(face.vertices.size()));
-  }
-  face.origin = origin;
-  faces_.push_back(std::move(face));
-  return FaceId(faces_.size() - 1);
+  const FlatLoops flat(loops);
+  return addFace(flat.vertices, flat.loopEnd, origin);
 }
 
 FaceId PolyMesh::addFace(std::span<const VertexId> vertices,
@@ -131,35 +114,30 @@ FaceId PolyMesh::addFace(std::span<const VertexId> vertices,
   return FaceId(faces_.size() - 1);
 }
 
-FaceId PolyMesh::findOrCreateFace(const std::vector<Loop>& loops, FaceOrigin origin,
-                                  bool& reversed) {
+FaceUse PolyMesh::findOrCreateFace(std::span<const VertexId> vertices,
+                                   std::span<const std::uint32_t> loopEnd, FaceOrigin origin) {
   if (openFacesStale_) {
     openFaces_.clear();
     for (std::size_t i = 0; i < faces_.size(); ++i) {
       const Face& face = faces_[FaceId(i)];
       if (face.back.valid() || !face.front.valid()) continue;
-      std::vector<Loop> faceLoops;
-      for (std::size_t k = 0; k < face.numLoops(); ++k)
-        faceLoops.emplace_back(face.loop(k).begin(), face.loop(k).end());
-      openFaces_.emplace(vertexSetKey(faceLoops), FaceId(i));
+      openFaces_.emplace(vertexSetKey({face.vertices.data(), face.vertices.size()}), FaceId(i));
     }
     openFacesStale_ = false;
   }
-  const std::uint64_t key = vertexSetKey(loops);
+  const std::uint64_t key = vertexSetKey(vertices);
   auto [begin, end] = openFaces_.equal_range(key);
   for (auto it = begin; it != end; ++it) {
     const Face& candidate = faces_[it->second];
-    if (!candidate.back.valid() && isReverseOf(candidate, loops)) {
+    if (!candidate.back.valid() && isReverseOf(candidate, vertices, loopEnd)) {
       const FaceId f = it->second;
       openFaces_.erase(it);
-      reversed = true;
-      return f;
+      return {f, true};
     }
   }
-  reversed = false;
-  const FaceId f = addFace(loops, origin);
+  const FaceId f = addFace(vertices, loopEnd, origin);
   openFaces_.emplace(key, f);
-  return f;
+  return {f, false};
 }
 
 ElementId PolyMesh::addElement(const std::vector<std::vector<Loop>>& boundary,
@@ -167,9 +145,8 @@ ElementId PolyMesh::addElement(const std::vector<std::vector<Loop>>& boundary,
   std::vector<FaceUse> uses;
   uses.reserve(boundary.size());
   for (const auto& loops : boundary) {
-    bool reversed = false;
-    const FaceId f = findOrCreateFace(loops, boundaryOrigin, reversed);
-    uses.push_back({f, reversed});
+    const FlatLoops flat(loops);
+    uses.push_back(findOrCreateFace(flat.vertices, flat.loopEnd, boundaryOrigin));
   }
   return addElementFromFaces(uses);
 }
@@ -182,9 +159,8 @@ ElementId PolyMesh::addElement(const std::vector<std::vector<Loop>>& boundary,
   uses.reserve(boundary.size());
   for (std::size_t i = 0; i < boundary.size(); ++i) {
     if (origins[i] == FaceOrigin::Interior) {
-      bool reversed = false;
-      const FaceId f = findOrCreateFace(boundary[i], origins[i], reversed);
-      uses.push_back({f, reversed});
+      const FlatLoops flat(boundary[i]);
+      uses.push_back(findOrCreateFace(flat.vertices, flat.loopEnd, origins[i]));
     } else {
       uses.push_back({addFace(boundary[i], origins[i]), false});
     }

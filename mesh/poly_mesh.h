@@ -132,6 +132,12 @@ class PolyMesh {
   FaceId addFace(std::span<const VertexId> vertices, std::span<const std::uint32_t> loopEnd,
                  FaceOrigin origin);
 
+  /// A face for a new element, given outward like addElement's: if an existing face with a free
+  /// back side is this polygon reversed, that face, used reversed; otherwise a new face tagged
+  /// `origin`, used as given (and offered to later calls).
+  FaceUse findOrCreateFace(std::span<const VertexId> vertices,
+                           std::span<const std::uint32_t> loopEnd, FaceOrigin origin);
+
   /// Merges elements in place: `group[e]` (0 .. groups-1) is element e's new element. Faces
   /// between two members of one group disappear, the others keep their vertices, orientation
   /// and origin; element and face ids are renumbered (new element g is group g; faces keep
@@ -139,7 +145,6 @@ class PolyMesh {
   void mergeElementGroups(const std::vector<std::uint32_t>& group, std::size_t groups);
 
  private:
-  FaceId findOrCreateFace(const std::vector<Loop>& loops, FaceOrigin origin, bool& reversed);
 
   VertexData<Vec3> positions_;
   FaceData<Face> faces_;

@@ -41,14 +41,6 @@ Grid Grid::withCellsAlongLongest(const Box3& bounds, int cellsAlongLongest) {
 
 namespace {
 
-struct SortedIdsHash {
-  std::size_t operator()(const boost::container::small_vector<std::uint32_t, 8>& ids) const {
-    std::size_t h = ids.size();
-    for (std::uint32_t id : ids) h = h * 0x9E3779B97F4A7C15ull + id;
-    return h;
-  }
-};
-
 struct CellHash {
   std::size_t operator()(const std::array<std::int64_t, 3>& c) const noexcept {
     std::size_t h = 0;
@@ -127,11 +119,7 @@ class Slicer {
       }
       return VertexId(remap[v]);
     };
-    // Caps (interior faces) are shared: the second element to use one finds it here by its
-    // sorted vertex ids and uses it reversed.
-    std::unordered_map<boost::container::small_vector<std::uint32_t, 8>, FaceId, SortedIdsHash>
-        openCaps;
-    openCaps.reserve(polygons / 2);
+    // Caps (interior faces) are shared: the second element to use one finds it (reversed).
     std::vector<FaceUse> uses;
     for (const Leaf& leaf : leaves_) {
       uses.clear();
@@ -163,18 +151,7 @@ class Slicer {
           uses.push_back({mesh.addFace(vs, ends, polygon.origin), false});
           continue;
         }
-        boost::container::small_vector<std::uint32_t, 8> key;
-        for (VertexId v : vertices) key.push_back(v.value);
-        std::sort(key.begin(), key.end());
-        auto it = openCaps.find(key);
-        if (it != openCaps.end() && isReverseOf(mesh.face(it->second), vs, ends)) {
-          uses.push_back({it->second, true});
-          openCaps.erase(it);
-        } else {
-          const FaceId f = mesh.addFace(vs, ends, FaceOrigin::Interior);
-          openCaps.emplace(std::move(key), f);
-          uses.push_back({f, false});
-        }
+        uses.push_back(mesh.findOrCreateFace(vs, ends, FaceOrigin::Interior));
       }
       if (uses.empty()) continue;
       mesh.addElementFromFaces(uses);

@@ -119,11 +119,8 @@ ValidationReport validate(const PolyMesh& mesh, const ValidationOptions& options
                       for (std::size_t i = r.begin(); i != r.end(); ++i) {
                         const FaceId f(i);
                         FaceCheck& c = checks[i];
-                        boost::container::small_vector<std::uint32_t, 8> ids;
-                        for (VertexId v : mesh.face(f).vertices) ids.push_back(v.value);
-                        std::sort(ids.begin(), ids.end());
-                        c.key = ids.size();
-                        for (std::uint32_t id : ids) c.key = c.key * 0x9E3779B97F4A7C15ull + id;
+                        const Face& face = mesh.face(f);
+                        c.key = vertexSetKey({face.vertices.data(), face.vertices.size()});
                         c.degenerate = isDegenerate(mesh, f);
                         if (c.degenerate) continue;
                         const Box3 box = faceBounds(mesh, f);
