@@ -1,9 +1,11 @@
 #include "physics/benchmarks.h"
 
+#include <chrono>
 #include <cmath>
 #include <numbers>
 
 #include "mesh/merge_elements.h"
+#include "mesh/meshing.h"
 #include "mesh/primitives.h"
 #include "mesh/slice.h"
 #include "mesh/surface_shapes.h"
@@ -175,6 +177,39 @@ CantileverResult runBenchmarkB3(const CantileverSetup& setup, const StaticOption
                                               FaceSelector::plane(0, beam.max().x()), 2);
   r.report = s.report;
   return r;
+}
+
+MeshingCostRun runMeshingCostCase(const std::string& model, const TriangleSurface& surface,
+                                  int cells) {
+  MeshingOptions options;
+  options.cellsAlongLongest = cells;
+  const MeshingResult result = meshSurface(surface, options);
+  const MeshingReport& r = result.report;
+  MeshingCostRun run;
+  MeshingBenchmarkRun& m = run.meshing;
+  m.model = model;
+  m.triangles = surface.triangles.size();
+  m.cells = cells;
+  m.elements = r.elements;
+  m.hexahedra = r.hexahedra;
+  m.polyhedra = r.polyhedra;
+  m.slivers_merged = r.slivers.merged;
+  m.volumeRelError = r.volumeRelError;
+  m.valid = r.validation.passed;
+  m.phases = r.timings;
+  for (const auto& [phase, seconds] : r.timings) {
+    m.secondsTotal += seconds;
+    if (phase == "validate") run.geometricValidationSeconds += seconds;
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  LocalDgCheckOptions checks;
+  MomentCache moments(result.mesh, 2 * checks.basis.degree);
+  moments.update();
+  const LocalDgCheck check = localDgChecks(result.mesh, moments, checks);
+  run.dgCheckSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  run.dgElements = check.elements;
+  run.dgPassed = check.passed();
+  return run;
 }
 
 }  // namespace polydg

@@ -5,7 +5,9 @@
 
 #include <string>
 
+#include "mesh/meshing_benchmark.h"
 #include "physics/post_process.h"
+#include "physics/validation.h"
 #include "physics/static_solver.h"
 
 namespace polydg {
@@ -88,5 +90,22 @@ double cantileverReference(double poissonRatio);
 double meanBoundaryDisplacement(const PolyMesh& mesh, const DgBasis& basis,
                                 const Eigen::VectorXd& coefficients, const FaceSelector& where,
                                 int axis);
+
+/// The meshing benchmark with the cost of validating the result: the meshing pipeline
+/// (meshSurface() with default options; its phases include the geometric validation
+/// "validate") followed by the local DG checks (degree 1) of every element, with the degree 2
+/// moments they need.
+struct MeshingCostRun {
+  MeshingBenchmarkRun meshing;
+  double geometricValidationSeconds = 0.0;  ///< the "validate" phase of meshing
+  double dgCheckSeconds = 0.0;              ///< moments + localDgChecks(), wall
+  std::size_t dgElements = 0;
+  bool dgPassed = false;
+};
+
+/// Meshes `surface` (named `model` in the run) with `cells` cells along its longest side.
+/// Throws InputError as meshSurface() does.
+MeshingCostRun runMeshingCostCase(const std::string& model, const TriangleSurface& surface,
+                                  int cells);
 
 }  // namespace polydg
