@@ -384,11 +384,12 @@ SuiteOutput stabilitySuite(const BenchOptions& o, bool quiet) {
   // Scale and position.
   nlohmann::json scale = nlohmann::json::array();
   SeriesSet scalePlot;
-  double worstChange = 0.0, worstChangeOverResolution = 0.0;
+  double worstChange = 0.0, worstChangeOverBound = 0.0;
   const std::vector<Vec3> offsets{Vec3::Zero(), Vec3(1e6, -1e6, 1e6)};
   for (ScaleProblem problem : {ScaleProblem::B1, ScaleProblem::B3}) {
     const std::string name = problem == ScaleProblem::B1 ? "B1" : "B3";
     const double base = runScaleCase(problem, 1.0, Vec3::Zero(), 2, o.quick).value;
+    const double cond = scaleProblemCondition(problem, 2, o.quick);
     for (const Vec3& offset : offsets)
       for (double sc : {1e-6, 1.0, 1e6}) {
         const ScaleRun run = runScaleCase(problem, sc, offset, 2, o.quick);
@@ -401,13 +402,15 @@ SuiteOutput stabilitySuite(const BenchOptions& o, bool quiet) {
                          {"rel_error", relError},
                          {"value", run.value},
                          {"change", change},
-                         {"coordinate_resolution", run.coordinateResolution}};
+                         {"coordinate_resolution", run.coordinateResolution},
+                         {"cond", cond},
+                         {"roundoff_bound", cond * std::max(run.coordinateResolution, eps)}};
         scale.push_back(j);
         j["case"] = "scale";
         s.rows.push_back(j);
         worstChange = std::max(worstChange, change);
-        worstChangeOverResolution =
-            std::max(worstChangeOverResolution, change / run.coordinateResolution);
+        worstChangeOverBound =
+            std::max(worstChangeOverBound, change / (cond * std::max(run.coordinateResolution, eps)));
         scalePlot.add(name + (offset.isZero() ? ", offset 0" : ", offset (1e6,-1e6,1e6)"), sc,
                       std::max(change, eps));
         log("scale " + name + " x" + shortNumber(sc) + " offset " + shortNumber(offset.x()) +
@@ -422,8 +425,7 @@ SuiteOutput stabilitySuite(const BenchOptions& o, bool quiet) {
                        {"incompressible_worst_rel_error", worstTip},
                        {"incompressible_within_5_percent", worstTip <= 0.05},
                        {"scale_worst_change", worstChange},
-                       {"scale_worst_change_over_coordinate_resolution",
-                        worstChangeOverResolution}};
+                       {"scale_worst_change_over_roundoff_bound", worstChangeOverBound}};
 
   s.plots.push_back({"stability_sliver.svg",
                      {"B4 sliver: stiffness condition estimate (IP, clamped)",

@@ -259,7 +259,7 @@ LockingSetup lockingSetup(int degree, bool quick) {
     s.mesh.nz = 8;
     s.options.discretization.penalty.rule = PenaltyRule::Doubling;
   }
-  if (quick) s.mesh.nx /= 2;
+  if (quick) s.mesh.nx /= 4;
   return s;
 }
 
@@ -301,6 +301,18 @@ ScaleRun runScaleCase(ScaleProblem problem, double scale, const Vec3& offset, in
   const double extent = offset.cwiseAbs().maxCoeff() + scale * size;
   run.coordinateResolution = std::numeric_limits<double>::epsilon() * extent / (scale * size);
   return run;
+}
+
+double scaleProblemCondition(ScaleProblem problem, int degree, bool quick) {
+  if (problem == ScaleProblem::B1)
+    return stiffnessCondition(benchmarkB1Mesh(BenchmarkMesh::Hex, quick ? 2 : 4), degree,
+                              FaceSelector::allBoundary())
+        .estimate.cond;
+  const CantileverSetup beam = lockingSetup(degree, quick).mesh;
+  return stiffnessCondition(
+             hexGridMesh(beam.nx, beam.ny, beam.nz, Box3(Vec3::Zero(), Vec3(10.0, 1.0, 1.0))),
+             degree, FaceSelector::plane(0, 0.0))
+      .estimate.cond;
 }
 
 }  // namespace polydg

@@ -77,8 +77,8 @@ StabilityConditionRun runThinNeckCase(double eps, int degree);
 
 /// The cantilever meshes of the locking test (tests/physics/benchmarks_test.cpp, issue 4):
 /// 40 x 4 x 4 with the trace-bound penalty for p = 2; 160 x 4 x 8 with penalty doubling for
-/// p = 1 (linear elements need the smaller penalty in bending). `quick` halves nx (a coarser,
-/// faster check; the 5% locking criterion is not meant for it).
+/// p = 1 (linear elements need the smaller penalty in bending). `quick` divides nx by 4 (a
+/// coarser, faster smoke test; the 5% locking criterion is not meant for it).
 struct LockingSetup {
   CantileverSetup mesh;
   StaticOptions options;
@@ -113,5 +113,11 @@ struct ScaleRun {
 };
 ScaleRun runScaleCase(ScaleProblem problem, double scale, const Vec3& offset, int degree,
                       bool quick = false);
+
+/// The condition estimate of the unscaled problem's stiffness (the mesh and boundary condition
+/// of runScaleCase(), E = 1: the condition number does not depend on E). Scaling and
+/// translation perturb the geometry by about ScaleRun::coordinateResolution relatively; the
+/// solution then changes by up to about that times this condition number.
+double scaleProblemCondition(ScaleProblem problem, int degree, bool quick = false);
 
 }  // namespace polydg
