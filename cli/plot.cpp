@@ -118,6 +118,14 @@ std::string markerPath(int shape, double x, double y) {
   return d.str();
 }
 
+/// Series k's marker: after every ten series (one cycle of colours) the shapes shift by one,
+/// so that colour and shape together stay distinct for 50 series.
+int markerShape(std::size_t k) { return static_cast<int>((k + k / kColours.size()) % kMarkerShapes); }
+/// Series of the second, fourth, ... colour cycle are dashed.
+std::string dash(std::size_t k) {
+  return (k / kColours.size()) % 2 ? " stroke-dasharray=\"7,3\"" : "";
+}
+
 }  // namespace
 
 std::vector<double> axisTicks(double lo, double hi, AxisScale scale) {
@@ -204,6 +212,7 @@ std::string renderSvg(const Plot& plot, const PlotLayout& l) {
   for (std::size_t k = 0; k < plot.series.size(); ++k) {
     const PlotSeries& s = plot.series[k];
     const char* colour = kColours[k % kColours.size()];
+    const int shape = markerShape(k);
     svg << "<g class=\"series\" data-label=\"" << escape(s.label) << "\" clip-path=\"url(#frame)\">\n";
     std::ostringstream line, markers;
     for (std::size_t i = 0; i < std::min(s.x.size(), s.y.size()); ++i) {
@@ -211,11 +220,11 @@ std::string renderSvg(const Plot& plot, const PlotLayout& l) {
       const double x = px(s.x[i]), y = py(s.y[i]);
       line << fixed(x) << ',' << fixed(y) << ' ';
       markers << "<path class=\"marker\" data-px=\"" << fixed(x) << "\" data-py=\"" << fixed(y)
-              << "\" d=\"" << markerPath(static_cast<int>(k), x, y) << "\" fill=\"" << colour
+              << "\" d=\"" << markerPath(shape, x, y) << "\" fill=\"" << colour
               << "\" stroke=\"white\" stroke-width=\"0.8\"/>\n";
     }
     svg << "<polyline class=\"line\" points=\"" << line.str() << "\" fill=\"none\" stroke=\""
-        << colour << "\" stroke-width=\"1.8\"/>\n"
+        << colour << "\" stroke-width=\"1.8\"" << dash(k) << "/>\n"
         << markers.str() << "</g>\n";
   }
   // Legend, right of the frame.
@@ -225,7 +234,7 @@ std::string renderSvg(const Plot& plot, const PlotLayout& l) {
     const char* colour = kColours[k % kColours.size()];
     svg << "<g class=\"legend-entry\"><line x1=\"" << fixed(lx) << "\" y1=\"" << fixed(y)
         << "\" x2=\"" << fixed(lx + 26) << "\" y2=\"" << fixed(y) << "\" stroke=\"" << colour
-        << "\" stroke-width=\"1.8\"/><path d=\"" << markerPath(static_cast<int>(k), lx + 13, y)
+        << "\" stroke-width=\"1.8\"" << dash(k) << "/><path d=\"" << markerPath(markerShape(k), lx + 13, y)
         << "\" fill=\"" << colour << "\"/><text x=\"" << fixed(lx + 32) << "\" y=\""
         << fixed(y + 4) << "\" font-size=\"11\">" << escape(plot.series[k].label)
         << "</text></g>\n";
