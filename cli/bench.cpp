@@ -11,7 +11,8 @@
 //              8, 12; p = 3: 2, 3, 4, 6, 8) and sliced cubes (p = 1: 4, 8, 12; p = 2: 2, 4, 8;
 //              p = 3: 2, 4, 6). Plot: L2 error against assembly + solve time.
 //   table41    B2 (10^3 hexahedra) with BZ and IP, degrees 1 and 2, beside the thesis's Table 4.1.
-//   stability  B4: sliver (volume ratio 1 .. 1e-12, merged or not, p = 1, 2), thin neck (eps
+//   stability  B4: sliver (volume ratio 1 .. 1e-12 by factors of 10, and 0.05 and 0.02 near
+//              the merge threshold; merged or not, p = 1, 2), thin neck (eps
 //              1e-1 .. 1e-9), near-incompressible cantilever (nu 0.3 .. 0.4999, p = 1, 2),
 //              scale and position (B1 and B3 scaled by 1e-6, 1, 1e6, offsets 0 and
 //              (1e6, -1e6, 1e6), p = 2).
@@ -299,8 +300,8 @@ SuiteOutput stabilitySuite(const BenchOptions& o, bool quiet) {
   // Sliver.
   const std::vector<double> ratios =
       o.quick ? std::vector<double>{1, 1e-4, 1e-12}
-              : std::vector<double>{1, 1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6,
-                                    1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12};
+              : std::vector<double>{1, 1e-1, 5e-2, 2e-2, 1e-2, 1e-3, 1e-4, 1e-5,
+                                    1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12};
   nlohmann::json sliver = nlohmann::json::array(), regular = nlohmann::json::object();
   SeriesSet sliverPlot;
   bool mergedWithin100 = true;

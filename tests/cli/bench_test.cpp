@@ -13,6 +13,8 @@
 #include <sstream>
 #include <string>
 
+#include <unistd.h>
+
 #include <nlohmann/json.hpp>
 
 #include "cli/csv.h"
@@ -178,7 +180,9 @@ Result run(const std::string& arguments) {
 }
 
 TEST(BenchCommand, StabilitySuiteWritesJsonCsvAndPlots) {
-  const fs::path dir = fs::temp_directory_path() / "polydg_bench_stability";
+  // Unique per process: two test runs at once must not share (and delete) the folder.
+  const fs::path dir =
+      fs::temp_directory_path() / ("polydg_bench_stability_" + std::to_string(getpid()));
   fs::remove_all(dir);
   const Result r = run("bench --suite stability --quick --quiet --out " + dir.string());
   ASSERT_EQ(r.exitCode, 0) << r.out;
