@@ -273,6 +273,8 @@ nlohmann::json conditionJson(const StabilityConditionRun& r) {
           {"lambda_min", c.lambdaMin},
           {"lambda_max", c.lambdaMax},
           {"positive_definite", c.positiveDefinite},
+          {"cond_jacobi", r.jacobiEstimate.positiveDefinite ? nlohmann::json(r.jacobiEstimate.cond)
+                                                            : nlohmann::json(nullptr)},
           // Beyond 1/eps the smallest eigenvalue is below the round-off of K's entries: the
           // estimate says "singular to double precision", not a precise number.
           {"beyond_double_precision", c.cond * std::numeric_limits<double>::epsilon() > 1.0}};

@@ -96,6 +96,14 @@ ConditionEstimate conditionEstimate(const SparseMatrix& matrix, int blockSize) {
   return c;
 }
 
+SparseMatrix jacobiScaled(const SparseMatrix& matrix) {
+  const Eigen::VectorXd d = matrix.diagonal();
+  if (!(d.minCoeff() > 0.0))
+    throw std::invalid_argument("jacobiScaled: the diagonal must be positive");
+  const Eigen::VectorXd s = d.cwiseSqrt().cwiseInverse();
+  return s.asDiagonal() * matrix * s.asDiagonal();
+}
+
 // --- meshes ---------------------------------------------------------------------------------
 
 namespace {
@@ -237,6 +245,8 @@ StabilityConditionRun stiffnessCondition(const PolyMesh& mesh, int degree,
   run.dofs = solver.report().dofs;
   run.eta = solver.report().eta;
   run.estimate = conditionEstimate(solver.system().matrix, solver.system().blockSize);
+  run.jacobiEstimate =
+      conditionEstimate(jacobiScaled(solver.system().matrix), solver.system().blockSize);
   return run;
 }
 

@@ -36,6 +36,11 @@ inline constexpr const char* kConditionMethod =
 ConditionEstimate conditionEstimate(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix,
                                     int blockSize);
 
+/// D^-1/2 K D^-1/2 with D = diag(K) (unit diagonal): the matrix a diagonally preconditioned
+/// iterative solver sees. Throws std::invalid_argument if a diagonal entry is not positive.
+Eigen::SparseMatrix<double, Eigen::ColMajor, int> jacobiScaled(
+    const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix);
+
 /// A mesh of axis-aligned boxes that meet face to face, where a box side may touch several
 /// smaller boxes (hanging vertices are inserted into every face whose edge they lie on, so each
 /// element is closed). Each side of a box is tiled by its overlaps with the boxes across it;
@@ -60,11 +65,13 @@ struct StabilityConditionRun {
   int degree = 1;
   std::size_t elements = 0, dofs = 0;
   double eta = 0.0;  ///< the penalty used (PenaltyRule::TraceBound)
-  ConditionEstimate estimate;
+  ConditionEstimate estimate;        ///< of K
+  ConditionEstimate jacobiEstimate;  ///< of jacobiScaled(K)
 };
 
 /// The IP stiffness of `mesh` (E = 1, nu = 0.3, orthonormal basis of `degree`) with u = 0
-/// weakly on the boundary faces chosen by `clamp`, and its condition estimate.
+/// weakly on the boundary faces chosen by `clamp`, and the condition estimates of it and of its
+/// Jacobi-scaled form.
 StabilityConditionRun stiffnessCondition(const PolyMesh& mesh, int degree,
                                          const FaceSelector& clamp);
 

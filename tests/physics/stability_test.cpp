@@ -23,6 +23,8 @@ namespace {
 /// regular grid's; the thin neck's bounded (here: within 100x of eps = 0.1's).
 constexpr double kMergedSliverFactor = 100.0;
 constexpr double kThinNeckFactor = 100.0;
+/// Asymmetry of an assembled matrix with unit diagonal: round-off (1e-14 seen on a sliver grid).
+constexpr double kAssemblySymmetryTolerance = 1e-12;
 /// Lanczos' relative accuracy against dense eigenvalues (its tolerance is 1e-8).
 constexpr double kEigenvalueTolerance = 1e-6;
 
@@ -74,6 +76,22 @@ TEST(ConditionEstimate, NotPositiveDefiniteWithoutBoundaryConditions) {
   EXPECT_TRUE(std::isinf(c.cond));
 }
 
+TEST(ConditionEstimate, JacobiScalingHasUnitDiagonalAndSameDefiniteness) {
+  StaticOptions options;
+  options.discretization.basis.degree = 2;
+  LoadCase loads;
+  loads.dirichlet.push_back({FaceSelector::allBoundary(), {}});
+  const PolyMesh mesh = sliverMesh(1e-3);
+  StaticSolver solver(mesh, Material{}, options);
+  solver.assemble(loads);
+  const auto scaled = jacobiScaled(solver.system().matrix);
+  EXPECT_NEAR((scaled.diagonal().array() - 1.0).abs().maxCoeff(), 0.0, 1e-15);
+  const Eigen::MatrixXd dense(scaled);
+  // K is symmetric to the round-off of its assembly; the scaled matrix (|entries| <= 1) too.
+  EXPECT_LT((dense - dense.transpose()).cwiseAbs().maxCoeff(), kAssemblySymmetryTolerance);
+  EXPECT_TRUE(conditionEstimate(scaled, solver.system().blockSize).positiveDefinite);
+}
+
 TEST(StabilityMeshes, SliverMeshIsValidWithExactVolumes) {
   for (double r : {1.0, 1e-1, 1e-6, 1e-12}) {
     const PolyMesh mesh = sliverMesh(r);
@@ -121,8 +139,9 @@ TEST(Stability, MergedSliverStaysNearTheRegularGrid) {
     for (double r : {1e-1, 1e-4, 1e-8, 1e-12}) {
       const StabilityConditionRun merged = runSliverCase(r, true, p);
       const StabilityConditionRun raw = runSliverCase(r, false, p);
-      std::printf("sliver p=%d r=%.0e: cond merged %.4e, unmerged %.4e (regular %.4e)\n", p, r,
-                  merged.estimate.cond, raw.estimate.cond, regular);
+      std::printf("sliver p=%d r=%.0e: cond merged %.4e, unmerged %.4e (Jacobi-scaled %.4e), "
+                  "regular %.4e\n", p, r, merged.estimate.cond, raw.estimate.cond,
+                  raw.jacobiEstimate.cond, regular);
       EXPECT_LE(merged.estimate.cond, kMergedSliverFactor * regular) << "p " << p << " r " << r;
     }
   }
