@@ -18,12 +18,16 @@
 //              (1e6, -1e6, 1e6), p = 2).
 //   meshing    the meshing pipeline and its validation (geometric, DG checks) for the bundled
 //              testdata/torus.obj and the generated sphere and torus knot at 16 .. 128 cells.
+#include <array>
+#include <cctype>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <limits>
 #include <map>
+#include <optional>
 
 #include <nlohmann/json.hpp>
 
