@@ -168,7 +168,8 @@ std::string renderSvg(const Plot& plot, const PlotLayout& l) {
         xs.push_back(s.x[i]);
         ys.push_back(s.y[i]);
       }
-  const auto xr = axisRange(xs, plot.x.scale), yr = axisRange(ys, plot.y.scale);
+  auto xr = axisRange(xs, plot.x.scale), yr = axisRange(ys, plot.y.scale);
+  if (!plot.x.categories.empty()) xr = {0.5, plot.x.categories.size() + 0.5};
   const double w = l.width - l.left - l.right, h = l.height - l.top - l.bottom;
   auto px = [&](double v) { return l.left + w * fraction(v, xr, plot.x.scale); };
   auto py = [&](double v) { return l.top + h * (1.0 - fraction(v, yr, plot.y.scale)); };
@@ -184,7 +185,16 @@ std::string renderSvg(const Plot& plot, const PlotLayout& l) {
       << "</text>\n";
   // Grid and ticks.
   svg << "<g class=\"grid\" stroke=\"#dddddd\" stroke-width=\"1\">\n";
-  const auto xt = axisTicks(xr[0], xr[1], plot.x.scale), yt = axisTicks(yr[0], yr[1], plot.y.scale);
+  std::vector<double> xt = axisTicks(xr[0], xr[1], plot.x.scale);
+  const std::vector<double> yt = axisTicks(yr[0], yr[1], plot.y.scale);
+  if (!plot.x.categories.empty()) {
+    xt.clear();
+    for (std::size_t i = 0; i < plot.x.categories.size(); ++i) xt.push_back(i + 1.0);
+  }
+  auto xTickLabel = [&](double t) {
+    if (plot.x.categories.empty()) return tickLabel(t, plot.x.scale);
+    return escape(plot.x.categories[static_cast<std::size_t>(t) - 1]);
+  };
   for (double t : xt)
     svg << "<line x1=\"" << fixed(px(t)) << "\" y1=\"" << fixed(l.top) << "\" x2=\"" << fixed(px(t))
         << "\" y2=\"" << fixed(l.top + h) << "\"/>\n";
@@ -195,7 +205,7 @@ std::string renderSvg(const Plot& plot, const PlotLayout& l) {
       << fixed(w) << "\" height=\"" << fixed(h) << "\" fill=\"none\" stroke=\"black\"/>\n";
   for (double t : xt)
     svg << "<text class=\"tick-label\" x=\"" << fixed(px(t)) << "\" y=\"" << fixed(l.top + h + 18)
-        << "\" text-anchor=\"middle\">" << tickLabel(t, plot.x.scale) << "</text>\n";
+        << "\" text-anchor=\"middle\">" << xTickLabel(t) << "</text>\n";
   for (double t : yt)
     svg << "<text class=\"tick-label\" x=\"" << fixed(l.left - 8) << "\" y=\"" << fixed(py(t) + 4)
         << "\" text-anchor=\"end\">" << tickLabel(t, plot.y.scale) << "</text>\n";

@@ -14,6 +14,9 @@ enum class AxisScale { Linear, Log };
 struct PlotAxis {
   std::string label;
   AxisScale scale = AxisScale::Linear;
+  /// If not empty (linear axes only): a categorical axis, value i + 1 labelled categories[i],
+  /// ticks only there.
+  std::vector<std::string> categories = {};
 };
 
 /// One line of a plot: points (x[i], y[i]) joined in the given order. On a log axis,

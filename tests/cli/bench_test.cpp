@@ -150,6 +150,23 @@ TEST(Plot, LinearAxisTicksAreRoundNumbers) {
   EXPECT_EQ(axisTicks(1.0, 10.0, AxisScale::Log), (std::vector<double>{1.0, 2.0, 5.0, 10.0}));
 }
 
+TEST(Plot, CategoricalAxisLabelsEachValue) {
+  Plot p;
+  p.title = "phases";
+  p.x = {"phase", AxisScale::Linear, {"integration", "assembly", "solve"}};
+  p.y = {"time", AxisScale::Log};
+  p.series.push_back({"run", {1, 2, 3}, {0.01, 0.1, 1.0}});
+  const std::string svg = renderSvg(p);
+  for (const char* c : {">integration</text>", ">assembly</text>", ">solve</text>"})
+    EXPECT_NE(svg.find(c), std::string::npos) << c;
+  const auto m = markers(svg);
+  ASSERT_EQ(m.size(), 1u);
+  ASSERT_EQ(m[0].size(), 3u);
+  // Equally spaced, half a step of margin on both sides.
+  EXPECT_NEAR(m[0][2].px - m[0][1].px, m[0][1].px - m[0][0].px, 0.02);
+  EXPECT_NEAR(m[0][0].px - PlotLayout{}.left, (m[0][1].px - m[0][0].px) / 2, 0.02);
+}
+
 TEST(Plot, EmptyPlotStillRenders) {
   Plot p;
   p.title = "nothing";
