@@ -53,12 +53,18 @@ std::array<double, 2> axisRange(const std::vector<double>& values, AxisScale sca
     }
   if (scale == AxisScale::Log) {
     if (!(lo <= hi)) return {1.0, 10.0};
-    double a = std::floor(std::log10(lo)), b = std::ceil(std::log10(hi));
-    if (a == b) {
-      a -= 1.0;
-      b += 1.0;
+    // The nearest values 1, 2 or 5 times a power of ten around the data.
+    const double a = std::pow(10.0, std::floor(std::log10(lo))), b = std::pow(10.0, std::ceil(std::log10(hi)));
+    double from = a, to = b;
+    for (double m : {2.0, 5.0})
+      if (m * a <= lo) from = m * a;
+    for (double m : {0.5, 0.2})
+      if (m * b >= hi) to = m * b;
+    if (from == to) {
+      from /= 10.0;
+      to *= 10.0;
     }
-    return {std::pow(10.0, a), std::pow(10.0, b)};
+    return {from, to};
   }
   if (!(lo <= hi)) return {0.0, 1.0};
   if (lo == hi) {
@@ -135,12 +141,13 @@ std::vector<double> axisTicks(double lo, double hi, AxisScale scale) {
     const int a = static_cast<int>(std::floor(std::log10(lo) + 1e-9));
     const int b = static_cast<int>(std::ceil(std::log10(hi) - 1e-9));
     const int decades = b - a;
+    const bool narrow = std::log10(hi / lo) < 2.0 - 1e-9;
     // Thin the labels of long ranges to at most about 12 decades.
     const int every = std::max(1, (decades + 11) / 12);
     for (int k = a; k <= b; ++k) {
       const double p = std::pow(10.0, k);
       if (k % every == 0 && p >= lo * (1 - 1e-12) && p <= hi * (1 + 1e-12)) ticks.push_back(p);
-      if (decades < 2 && k < b)
+      if (narrow && k < b)
         for (double m : {2.0, 5.0})
           if (m * p >= lo && m * p <= hi) ticks.push_back(m * p);
     }
