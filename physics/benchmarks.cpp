@@ -161,8 +161,8 @@ double cantileverReference(double poissonRatio) {
          load * length / (5.0 / 6.0 * shear * areaSection);
 }
 
-CantileverResult runBenchmarkB3(const CantileverSetup& setup, const StaticOptions& options) {
-  const DomainTransform& t = setup.transform;
+CantileverResult runBenchmarkB3(const CantileverSetup& setup, const StaticOptions& options,
+                                const DomainTransform& t) {
   const Box3 beam(t.offset, t.offset + t.scale * Vec3(10.0, 1.0, 1.0));
   const PolyMesh mesh = hexGridMesh(setup.nx, setup.ny, setup.nz, beam);
   Material material;

@@ -67,19 +67,19 @@ BenchmarkRun runBenchmarkB1(int n, const StaticOptions& options,
 BenchmarkRun runBenchmarkB2(const StaticOptions& options);
 
 /// B3: beam [0,10] x [0,1] x [0,1] on an nx x ny x nz hex grid, E = 1000, clamped on x = 0,
-/// traction (0, 0, -1) on x = 10 (total load 1). With `transform`, the beam is T([0,10] x
-/// [0,1] x [0,1]) with the clamp and the traction on the images of x = 0 and x = 10 (the same
-/// traction, so the deflection scales with `scale`).
+/// traction (0, 0, -1) on x = 10 (total load 1).
 struct CantileverSetup {
   int nx = 40, ny = 4, nz = 4;
   double poissonRatio = 0.3;
-  DomainTransform transform;
 };
 struct CantileverResult {
   double tipDeflection = 0.0;  ///< -(mean u_z over the face x = 10), by face quadrature
   StaticReport report;
 };
-CantileverResult runBenchmarkB3(const CantileverSetup& setup, const StaticOptions& options);
+/// With `transform` T the beam is T([0,10] x [0,1] x [0,1]), clamped and loaded on the images of
+/// x = 0 and x = 10 (the same traction, so the deflection scales with T's scale).
+CantileverResult runBenchmarkB3(const CantileverSetup& setup, const StaticOptions& options,
+                                const DomainTransform& transform = {});
 
 /// Reference tip deflection of B3: P L^3 / (3 E I) + P L / (k G A) with k = 5/6 (Euler-
 /// Bernoulli plus Timoshenko shear): 4.031 for nu = 0.3, 4.036 for nu = 0.499.

@@ -303,9 +303,8 @@ ScaleRun runScaleCase(ScaleProblem problem, double scale, const Vec3& offset, in
     run.value = r.l2Error / r.l2Norm;
     size = 1.0;
   } else {
-    LockingSetup s = lockingSetup(degree, quick);
-    s.mesh.transform = transform;
-    run.value = runBenchmarkB3(s.mesh, s.options).tipDeflection / scale;
+    const LockingSetup s = lockingSetup(degree, quick);
+    run.value = runBenchmarkB3(s.mesh, s.options, transform).tipDeflection / scale;
     size = 10.0;
   }
   const double extent = offset.cwiseAbs().maxCoeff() + scale * size;
