@@ -1,13 +1,10 @@
-// polydg solve: static linear elasticity on a simulation mesh (VTU) with the DG methods, and
-// polydg bench: the accuracy (B1) and Table 4.1 (B2) benchmark suites.
+// polydg solve: static linear elasticity on a simulation mesh (VTU) with the DG methods
+// (polydg bench is in bench.cpp).
 //
 // Sample runs:
 //   polydg solve beam.vtu -o beam_out.vtu --method ip --degree 2 --E 1000 --nu 0.3
 //       --clamp x=0 --traction x=10:0,0,-1 --report solve.json   (one line)
-//   polydg bench --suite accuracy --out bench/
-//   polydg bench --suite table41 --out bench/
 #include <chrono>
-#include <filesystem>
 #include <iostream>
 #include <map>
 #include <sstream>
@@ -17,9 +14,7 @@
 #include "cli/commands.h"
 #include "cli/report.h"
 #include "mesh/validate.h"
-#include "mesh/meshing_benchmark.h"
 #include "mesh/vtu_io.h"
-#include "physics/benchmarks.h"
 #include "physics/post_process.h"
 #include "physics/static_solver.h"
 
@@ -249,118 +244,6 @@ void runSolve(const SolveOptions& o, const CommonOptions& common) {
   }
 }
 
-// --- bench ---------------------------------------------------------------------------------
-
-struct BenchOptions {
-  std::string suite;
-  std::string out;
-  bool skipSliced = false;
-};
-
-nlohmann::json runJson(const BenchmarkRun& r) {
-  return {{"method", toString(r.method)},
-          {"degree", r.degree},
-          {"mesh", r.mesh == BenchmarkMesh::Hex ? "hex" : "sliced"},
-          {"n", r.n},
-          {"elements", r.report.elements},
-          {"dofs", r.report.dofs},
-          {"nonzeros", r.report.nonzeros},
-          {"sparsity", r.sparsity},
-          {"t_integrate", r.report.integrateSeconds},
-          {"t_assemble", r.report.assembleSeconds},
-          {"t_solve", r.report.solveSeconds},
-          {"l2_error", r.l2Error},
-          {"h1_error", r.h1Error},
-          {"eta", r.report.eta},
-          {"solver", toString(r.report.solver.used)},
-          {"iterations", r.report.solver.iterations},
-          {"residual", r.report.solver.residual}};
-}
-
-/// Grid sizes of the accuracy suite per degree (at least three each).
-std::vector<int> accuracySizes(int degree, BenchmarkMesh mesh) {
-  if (mesh == BenchmarkMesh::Sliced) {
-    switch (degree) {
-      case 1: return {4, 8, 12};
-      case 2: return {2, 4, 8};
-      default: return {2, 4, 6};
-    }
-  }
-  switch (degree) {
-    case 1: return {4, 8, 16, 24};
-    case 2: return {2, 4, 8, 12};
-    default: return {2, 3, 4, 6, 8};
-  }
-}
-
-void runBench(const BenchOptions& o, const CommonOptions& common) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  fs::create_directories(o.out, ec);
-  if (ec) throw UserError("cannot create " + o.out + ": " + ec.message());
-  nlohmann::json runs = nlohmann::json::array();
-  auto log = [&](const BenchmarkRun& r) {
-    runs.push_back(runJson(r));
-    if (!common.quiet)
-      std::cout << toString(r.method) << " p=" << r.degree << ' '
-                << (r.mesh == BenchmarkMesh::Hex ? "hex" : "sliced") << " n=" << r.n << ": "
-                << r.report.dofs << " DOFs, integrate " << r.report.integrateSeconds
-                << " s, assemble " << r.report.assembleSeconds << " s, solve "
-                << r.report.solveSeconds << " s" << (r.l2Error > 0 ? ", L2 " : "")
-                << (r.l2Error > 0 ? std::to_string(r.l2Error) : std::string()) << std::endl;
-  };
-  if (o.suite == "meshing") {
-    for (const MeshingBenchmarkRun& r :
-         runMeshingBenchmark({"sphere", "torus_knot"}, {16, 32, 64, 128},
-                             [&](const MeshingBenchmarkRun& r) {
-                               if (!common.quiet)
-                                 std::cout << r.model << " (" << r.triangles << " triangles), "
-                                           << r.cells << " cells: " << r.elements
-                                           << " elements in " << r.secondsTotal << " s"
-                                           << std::endl;
-                             })) {
-      nlohmann::json phases = nlohmann::json::object();
-      for (const auto& [phase, seconds] : r.phases) phases[phase] = seconds;
-      runs.push_back({{"model", r.model},
-                      {"triangles", r.triangles},
-                      {"cells", r.cells},
-                      {"elements", r.elements},
-                      {"hexahedra", r.hexahedra},
-                      {"polyhedra", r.polyhedra},
-                      {"slivers_merged", r.slivers_merged},
-                      {"volume_rel_error", r.volumeRelError},
-                      {"valid", r.valid},
-                      {"t_total", r.secondsTotal},
-                      {"timings_s", phases}});
-    }
-    writeReport(fs::path(o.out) / "meshing.json", runs);
-    return;
-  }
-  if (o.suite == "accuracy") {
-    std::vector<BenchmarkMesh> meshes{BenchmarkMesh::Hex};
-    if (!o.skipSliced) meshes.push_back(BenchmarkMesh::Sliced);
-    for (BenchmarkMesh mesh : meshes)
-      for (Method method : {Method::IP, Method::BZ})
-        for (int p = 1; p <= 3; ++p)
-          for (int n : accuracySizes(p, mesh)) {
-            StaticOptions so;
-            so.discretization.method = method;
-            so.discretization.basis.degree = p;
-            log(runBenchmarkB1(n, so, mesh));
-          }
-    writeReport(fs::path(o.out) / "accuracy.json", runs);
-  } else {
-    for (Method method : {Method::BZ, Method::IP})
-      for (int p = 1; p <= 2; ++p) {
-        StaticOptions so;
-        so.discretization.method = method;
-        so.discretization.basis.degree = p;
-        log(runBenchmarkB2(so));
-      }
-    writeReport(fs::path(o.out) / "table41.json", runs);
-  }
-}
-
 }  // namespace
 
 void addSolveCommand(CLI::App& app, const CommonOptions& common, int& exitCode) {
@@ -423,21 +306,6 @@ void addSolveCommand(CLI::App& app, const CommonOptions& common, int& exitCode) 
   cmd->add_option("--report", o->report, "write the figures as JSON to this file");
   cmd->callback([o, &common, &exitCode] {
     runSolve(*o, common);
-    exitCode = 0;
-  });
-}
-
-void addBenchCommand(CLI::App& app, const CommonOptions& common, int& exitCode) {
-  auto o = std::make_shared<BenchOptions>();
-  CLI::App* cmd = app.add_subcommand(
-      "bench", "Benchmark suites: accuracy (B1), table41 (B2), meshing (slicing time and elements)");
-  cmd->add_option("--suite", o->suite, "accuracy, table41 or meshing")
-      ->required()
-      ->check(CLI::IsMember({"accuracy", "table41", "meshing"}));
-  cmd->add_option("--out", o->out, "folder for the JSON results")->required();
-  cmd->add_flag("--skip-sliced", o->skipSliced, "accuracy: hex grids only");
-  cmd->callback([o, &common, &exitCode] {
-    runBench(*o, common);
     exitCode = 0;
   });
 }

@@ -1,9 +1,11 @@
 #include "physics/benchmarks.h"
 
+#include <chrono>
 #include <cmath>
 #include <numbers>
 
 #include "mesh/merge_elements.h"
+#include "mesh/meshing.h"
 #include "mesh/primitives.h"
 #include "mesh/slice.h"
 #include "mesh/surface_shapes.h"
@@ -11,7 +13,9 @@
 
 namespace polydg {
 
-ManufacturedProblem benchmarkB1Problem() {
+namespace {
+/// The B1 fields on the unit cube.
+ManufacturedProblem unitCubeB1Problem() {
   using std::cos;
   using std::sin;
   constexpr double pi = std::numbers::pi;
@@ -42,6 +46,22 @@ ManufacturedProblem benchmarkB1Problem() {
   };
   return p;
 }
+}  // namespace
+
+ManufacturedProblem benchmarkB1Problem(const DomainTransform& t) {
+  ManufacturedProblem unit = unitCubeB1Problem();
+  if (t.scale == 1.0 && t.offset.isZero()) return unit;
+  const double s = t.scale;
+  const Vec3 o = t.offset;
+  ManufacturedProblem p;
+  p.material = unit.material;
+  p.displacement = [u = unit.displacement, s, o](const Vec3& x) -> Vec3 {
+    return s * u((x - o) / s);
+  };
+  p.gradient = [g = unit.gradient, s, o](const Vec3& x) -> Eigen::Matrix3d { return g((x - o) / s); };
+  p.bodyForce = [f = unit.bodyForce, s, o](const Vec3& x) -> Vec3 { return f((x - o) / s) / s; };
+  return p;
+}
 
 LoadCase benchmarkB1Loads(const ManufacturedProblem& problem) {
   LoadCase loads;
@@ -65,7 +85,8 @@ BenchmarkRun makeRun(const StaticOptions& options, int n, const StaticReport& re
 }
 }  // namespace
 
-PolyMesh benchmarkB1Mesh(BenchmarkMesh kind, int n) {
+namespace {
+PolyMesh unitCubeB1Mesh(BenchmarkMesh kind, int n) {
   const Box3 cube(Vec3::Zero(), Vec3::Ones());
   if (kind == BenchmarkMesh::Hex) return hexGridMesh(n, n, n, cube);
   Grid grid;
@@ -75,10 +96,19 @@ PolyMesh benchmarkB1Mesh(BenchmarkMesh kind, int n) {
   const PolyMesh sliced = sliceSurface(boxSurface(cube), grid);
   return mergeSlivers(sliced, 0.01 * grid.cellVolume());
 }
+}  // namespace
 
-BenchmarkRun runBenchmarkB1(int n, const StaticOptions& options, BenchmarkMesh kind) {
-  const ManufacturedProblem problem = benchmarkB1Problem();
-  const PolyMesh mesh = benchmarkB1Mesh(kind, n);
+PolyMesh benchmarkB1Mesh(BenchmarkMesh kind, int n, const DomainTransform& transform) {
+  PolyMesh mesh = unitCubeB1Mesh(kind, n);
+  if (transform.scale != 1.0 || !transform.offset.isZero())
+    polydg::transform(mesh, transform.scale, transform.offset);
+  return mesh;
+}
+
+BenchmarkRun runBenchmarkB1(int n, const StaticOptions& options, BenchmarkMesh kind,
+                            const DomainTransform& transform) {
+  const ManufacturedProblem problem = benchmarkB1Problem(transform);
+  const PolyMesh mesh = benchmarkB1Mesh(kind, n, transform);
   const StaticSolution s = solveStatic(mesh, problem.material, benchmarkB1Loads(problem), options);
   BenchmarkRun run = makeRun(options, n, s.report);
   run.mesh = kind;
@@ -87,6 +117,7 @@ BenchmarkRun runBenchmarkB1(int n, const StaticOptions& options, BenchmarkMesh k
                  benchmarkErrorQuadratureDegree(s.basis->degree()));
   run.l2Error = e.l2;
   run.h1Error = e.h1;
+  run.l2Norm = e.l2Exact;
   return run;
 }
 
@@ -130,21 +161,55 @@ double cantileverReference(double poissonRatio) {
          load * length / (5.0 / 6.0 * shear * areaSection);
 }
 
-CantileverResult runBenchmarkB3(const CantileverSetup& setup, const StaticOptions& options) {
-  const PolyMesh mesh =
-      hexGridMesh(setup.nx, setup.ny, setup.nz, Box3(Vec3::Zero(), Vec3(10.0, 1.0, 1.0)));
+CantileverResult runBenchmarkB3(const CantileverSetup& setup, const StaticOptions& options,
+                                const DomainTransform& t) {
+  const Box3 beam(t.offset, t.offset + t.scale * Vec3(10.0, 1.0, 1.0));
+  const PolyMesh mesh = hexGridMesh(setup.nx, setup.ny, setup.nz, beam);
   Material material;
   material.youngsModulus = 1000.0;
   material.poissonRatio = setup.poissonRatio;
   LoadCase loads;
-  loads.dirichlet.push_back({FaceSelector::plane(0, 0.0), {}});
-  loads.tractions.push_back({FaceSelector::plane(0, 10.0), Vec3(0, 0, -1)});
+  loads.dirichlet.push_back({FaceSelector::plane(0, beam.min().x()), {}});
+  loads.tractions.push_back({FaceSelector::plane(0, beam.max().x()), Vec3(0, 0, -1)});
   const StaticSolution s = solveStatic(mesh, material, loads, options);
   CantileverResult r;
-  r.tipDeflection =
-      -meanBoundaryDisplacement(mesh, *s.basis, s.coefficients, FaceSelector::plane(0, 10.0), 2);
+  r.tipDeflection = -meanBoundaryDisplacement(mesh, *s.basis, s.coefficients,
+                                              FaceSelector::plane(0, beam.max().x()), 2);
   r.report = s.report;
   return r;
+}
+
+MeshingCostRun runMeshingCostCase(const std::string& model, const TriangleSurface& surface,
+                                  int cells) {
+  MeshingOptions options;
+  options.cellsAlongLongest = cells;
+  const MeshingResult result = meshSurface(surface, options);
+  const MeshingReport& r = result.report;
+  MeshingCostRun run;
+  MeshingBenchmarkRun& m = run.meshing;
+  m.model = model;
+  m.triangles = surface.triangles.size();
+  m.cells = cells;
+  m.elements = r.elements;
+  m.hexahedra = r.hexahedra;
+  m.polyhedra = r.polyhedra;
+  m.slivers_merged = r.slivers.merged;
+  m.volumeRelError = r.volumeRelError;
+  m.valid = r.validation.passed;
+  m.phases = r.timings;
+  for (const auto& [phase, seconds] : r.timings) {
+    m.secondsTotal += seconds;
+    if (phase == "validate") run.geometricValidationSeconds += seconds;
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  LocalDgCheckOptions checks;
+  MomentCache moments(result.mesh, 2 * checks.basis.degree);
+  moments.update();
+  const LocalDgCheck check = localDgChecks(result.mesh, moments, checks);
+  run.dgCheckSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  run.dgElements = check.elements;
+  run.dgPassed = check.passed();
+  return run;
 }
 
 }  // namespace polydg
