@@ -2,6 +2,7 @@
 // shared by at most two elements with opposite orientation, and connected components.
 #pragma once
 
+#include <span>
 #include <string>
 #include <vector>
 
@@ -44,6 +45,13 @@ struct ValidationReport {
 
 /// Runs every check over the whole mesh.
 ValidationReport validate(const PolyMesh& mesh, const ValidationOptions& options = {});
+
+/// The same checks restricted to `elements` and their faces, at a cost that grows with them:
+/// closure, volume, planarity and degeneracy of their faces, links between those faces and
+/// their elements, and duplicates among those faces. Components and the volume range are
+/// not computed (components = 0); `volume` is the sum over `elements`.
+ValidationReport validateElements(const PolyMesh& mesh, std::span<const ElementId> elements,
+                                  const ValidationOptions& options = {});
 
 /// Components of the mesh: component index per element (0-based, in order of first element),
 /// with elements connected when they share a face.
