@@ -11,6 +11,12 @@
 
 namespace polydg {
 
+/// The caller's element moments must equal, relative to |vol(K)| h_K^|a| (h_K half the
+/// element's bounding-box diagonal), those computed afresh from the region's geometry to this.
+/// Both are computed by the same code from the same vertices, so they agree to round-off
+/// (1e-16 .. 1e-15); a moment not updated after an edit differs by the size of the edit.
+inline constexpr double kRegionMomentTolerance = 1e-12;
+
 struct RegionDgCheck {
   int degree = 0;
   std::size_t elements = 0;    ///< elements in the region
@@ -18,23 +24,43 @@ struct RegionDgCheck {
   std::vector<std::size_t> zeroModesPerComponent;
   std::size_t zeroModes = 0;
   /// Patch test: |u_h - u|_L2 / |u|_L2 over the region (exact, element mass matrices), with u
-  /// the linear field of localDgChecks().
+  /// the linear field of localDgChecks() built on the region's bounding box; +inf when the
+  /// region's matrix is not positive definite (an inverted element) or the error not finite.
   double patchTestError = 0.0;
+  /// Largest relative difference between the caller's element moments and the region's moments
+  /// recomputed from its geometry (see kRegionMomentTolerance): a stale cache shows here.
+  double momentMismatch = 0.0;
   double seconds = 0.0;
 
-  bool passed() const;  ///< error below kLocalPatchTestTolerance, 6 zero modes per component
+  /// Patch test error below kLocalPatchTestTolerance, moments up to date
+  /// (kRegionMomentTolerance) and exactly 6 zero modes per component. An empty region passes.
+  bool passed() const;
 };
 
-/// Checks the elements with region[e] != 0 (region.size() == mesh.numElements()).
+/// Checks the elements with region[e] != 0 (region.size() == mesh.numElements()). The region
+/// and the neighbours across its faces are copied into a small mesh (faces, loops and vertex
+/// orders as they are) whose moments are computed afresh and compared with `moments`; the
+/// discretization is IP with `options`' basis and material (`options.only` is ignored).
 ///  1. Patch test: the IP system whose unknowns are the region's elements only. Faces between
 ///     two region elements are interior faces; a face to an element outside the region couples
 ///     to that element held at u exactly (its coefficients are u's, moved to the right-hand
-///     side); boundary faces are Dirichlet faces with g = u. Solved with a sparse Cholesky
-///     factorization; IP is consistent, so the solution is u up to round-off.
+///     side); boundary faces are Dirichlet faces with g = u. One penalty for the region: the
+///     largest local penalty eta_K of localDgChecks() over its elements, which makes the
+///     region's matrix SPD. The error U_h - U solves A delta = -r, r the residual of the exact
+///     coefficients U (as in localDgChecks()), with CHOLMOD's Cholesky factorization; IP is
+///     consistent, so the solution is u up to round-off.
 ///  2. Zero modes: the region's stiffness with every face to the outside and every boundary face
 ///     free (no face terms) has exactly 6 zero modes per connected component of the region
-///     (zeroModes() of validation.h on the region's matrix).
-/// Costs O(region): uses Face::front/back and element face lists, never a loop over the mesh.
+///     (zeroModes() of validation.h on the region's matrix, threshold kZeroModeThreshold).
+///     The region's free boundary is part of the question: a sliver of relative thickness t
+///     left free bends at ~3.7 t^2 from degree 2 on, and slivers joined to the region only
+///     through their thin faces hinge at ~t^2, so for t below ~1e-6 such regions count extra
+///     zero modes (tests/physics/region_checks_test.cpp). Slivers held through a large face,
+///     and every piece that sliver merging keeps (relative size >= its fraction), count 6.
+/// Costs O(region): uses Face::front/back and element face lists, never a loop over the mesh
+/// (apart from one scan of the `region` flags). Throws std::invalid_argument if `region` has
+/// the wrong size, `moments` holds less than degree 2p, or the region's faces are used
+/// inconsistently (a face side used twice).
 /// `moments` must be up to date and hold degree 2p moments.
 RegionDgCheck regionDgChecks(const PolyMesh& mesh, const MomentCache& moments,
                              std::span<const char> region,
