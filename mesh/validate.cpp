@@ -74,6 +74,17 @@ bool isClosed(const PolyMesh& mesh, ElementId e) {
   return true;
 }
 
+/// True for the two sides of a cut: boundary faces tagged Cut with the same loops, reversed.
+/// They are one polygon, but deliberately not shared (the sides are not coupled).
+bool areCutSides(const PolyMesh& mesh, FaceId a, FaceId b) {
+  const Face& x = mesh.face(a);
+  const Face& y = mesh.face(b);
+  return x.origin == FaceOrigin::Cut && y.origin == FaceOrigin::Cut && x.isBoundary() &&
+         y.isBoundary() &&
+         isReverseOf(x, {y.vertices.data(), y.vertices.size()},
+                     {y.loopEnd.data(), y.loopEnd.size()});
+}
+
 /// Relative planarity error of a face beyond the tolerance, or 0 when it is planar enough.
 double planarityExcess(const PolyMesh& mesh, FaceId f, const ValidationOptions& options) {
   const Box3 box = faceBounds(mesh, f);
@@ -155,7 +166,8 @@ ValidationReport validateElements(const PolyMesh& mesh, std::span<const ElementI
   };
   for (std::size_t a = 0; a < keys.size(); ++a)
     for (std::size_t b = a + 1; b < keys.size() && keys[b].first == keys[a].first; ++b)
-      if (sortedIds(keys[a].second) == sortedIds(keys[b].second))
+      if (sortedIds(keys[a].second) == sortedIds(keys[b].second) &&
+          !areCutSides(mesh, keys[a].second, keys[b].second))
         problems.add(report.duplicateFaces, "faces " + std::to_string(keys[a].second.index()) +
                                                 " and " + std::to_string(keys[b].second.index()) +
                                                 " are the same polygon but not shared");
@@ -259,7 +271,8 @@ ValidationReport validate(const PolyMesh& mesh, const ValidationOptions& options
     while (b < byKey.size() && checks[byKey[b]].key == checks[byKey[a]].key) ++b;
     for (std::size_t x = a; x < b; ++x)
       for (std::size_t y = x + 1; y < b; ++y)
-        if (sortedIds(byKey[x]) == sortedIds(byKey[y]))
+        if (sortedIds(byKey[x]) == sortedIds(byKey[y]) &&
+            !areCutSides(mesh, FaceId(byKey[x]), FaceId(byKey[y])))
           problems.add(report.duplicateFaces,
                        "faces " + std::to_string(byKey[x]) + " and " + std::to_string(byKey[y]) +
                            " are the same polygon but not shared (a face used by more than two "

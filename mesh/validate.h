@@ -37,7 +37,9 @@ struct ValidationReport {
   std::size_t nonPositiveElements = 0;  ///< volume <= 0 (inverted or flat)
   std::size_t nonPlanarFaces = 0;
   std::size_t degenerateFaces = 0;      ///< a loop with < 3 vertices, a repeated vertex, or zero area
-  std::size_t duplicateFaces = 0;       ///< the same polygon as another face (not shared)
+  /// The same polygon as another face, not shared (except the two sides of a cut: boundary
+  /// faces tagged Cut, one the other reversed).
+  std::size_t duplicateFaces = 0;
   std::size_t inconsistentFaces = 0;    ///< face/element links disagree, or unused face
   std::size_t emptyElements = 0;        ///< an element without faces
   std::vector<std::string> messages;    ///< the first few problems, one line each
