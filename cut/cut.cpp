@@ -12,6 +12,7 @@
 #include <unordered_set>
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Exact_rational.h>
 
 #include "cut/element_grid.h"
 #include "mesh/plane_split.h"
@@ -181,9 +182,27 @@ struct MeshEditor::State {
   double referenceVolume = 0.0;
   double volume = 0.0;
   std::vector<char> region;  ///< scratch for the DG region, by element (kept all zero)
+  /// The plane each vertex was constructed on (index into `planes`), kNoPlane for others: a
+  /// later cut by the same plane sees it on the plane (its rounded position may not be).
+  std::vector<std::uint32_t> vertexPlane;
+  std::vector<std::pair<Vec3, double>> planes;  ///< (normal, offset) of every cut so far
 };
 
 namespace {
+
+constexpr std::uint32_t kNoPlane = 0xffffffffu;
+
+/// True if {a.x = da} and {b.x = db} are the same plane: (a, da) and (b, db) proportional,
+/// decided exactly (every 2x2 minor zero, in rational arithmetic).
+bool samePlane(const Vec3& a, double da, const Vec3& b, double db) {
+  if (a.cross(b).norm() > 1e-8 * a.norm() * b.norm()) return false;  // clearly not parallel
+  using Q = CGAL::Exact_rational;
+  const double x[4] = {a.x(), a.y(), a.z(), da}, y[4] = {b.x(), b.y(), b.z(), db};
+  for (int i = 0; i < 4; ++i)
+    for (int j = i + 1; j < 4; ++j)
+      if (Q(x[i]) * Q(y[j]) != Q(x[j]) * Q(y[i])) return false;
+  return true;  // opposite normals describe the same set of points
+}
 
 /// One editing operation on an editor's state: topology changes with ids kept stable (dead
 /// faces and elements are only marked), then compaction by swap-with-last, with the moments,
@@ -212,6 +231,15 @@ class Edit {
     newFaces_.insert(f);
     pendingFaces_.push_back(f);
     return f;
+  }
+  /// Face f changed shape in place (same polygon, more vertices): re-integrate it.
+  void refresh(FaceId f) {
+    pendingFaces_.push_back(f);
+    for (ElementId e : {mesh_.face(f).front, mesh_.face(f).back})
+      if (e.valid()) {
+        touch(e);
+        if (!created_.contains(e)) changed_.insert(e);
+      }
   }
   /// Detaches every face of e and marks e dead (its volume is recorded first).
   FaceList detachAll(ElementId e) {
@@ -335,14 +363,20 @@ class Edit {
   std::vector<ElementId> deadElements_;
 };
 
-/// Vertex sides for one plane, computed once per vertex.
+/// Vertex sides for one plane, computed once per vertex. A vertex constructed by an earlier
+/// cut on this same plane is on it.
 class VertexSides {
  public:
-  VertexSides(const PolyMesh& mesh, const Blade& blade)
-      : mesh_(mesh), plane_(blade.normal.x(), blade.normal.y(), blade.normal.z(), -blade.offset) {}
+  VertexSides(const PolyMesh& mesh, const Blade& blade, const std::vector<std::uint32_t>& tags,
+              std::uint32_t planeId)
+      : mesh_(mesh), plane_(blade.normal.x(), blade.normal.y(), blade.normal.z(), -blade.offset),
+        tags_(tags), planeId_(planeId) {}
   int operator()(VertexId v) {
     const auto [it, inserted] = sides_.try_emplace(v.value, 0);
-    if (inserted) it->second = exactSide(plane_, mesh_.position(v));
+    if (inserted) {
+      const bool onThisPlane = v.index() < tags_.size() && tags_[v.index()] == planeId_;
+      it->second = onThisPlane ? 0 : exactSide(plane_, mesh_.position(v));
+    }
     return it->second;
   }
   /// Lowest and highest side over the face's vertices.
@@ -368,6 +402,8 @@ class VertexSides {
  private:
   const PolyMesh& mesh_;
   Kernel::Plane_3 plane_;
+  const std::vector<std::uint32_t>& tags_;
+  std::uint32_t planeId_;
   std::unordered_map<std::uint32_t, int> sides_;
 };
 
@@ -385,8 +421,10 @@ struct Part {
 /// split once, each element's caps, and the pieces built into the mesh.
 class Splitter {
  public:
-  Splitter(Edit& edit, VertexSides& sides, const Blade& blade)
-      : edit_(edit), mesh_(edit.mesh()), sides_(sides), blade_(blade) {
+  Splitter(Edit& edit, VertexSides& sides, const Blade& blade, std::vector<std::uint32_t>& tags,
+           std::uint32_t planeId)
+      : edit_(edit), mesh_(edit.mesh()), sides_(sides), blade_(blade), tags_(tags),
+        planeId_(planeId) {
     plane_.normal = blade.normal;
     plane_.offset = blade.offset;
     for (int a = 0; a < 3; ++a)
@@ -470,6 +508,44 @@ class Splitter {
     return pieces;
   }
 
+  /// The points this cut made on edges of the split faces: (a, b) -> p, mesh vertex ids.
+  /// In a part (the face's orientation), an edge from an original vertex x to a new point
+  /// lies on x's outgoing edge of the face, one from a new point to y on y's incoming edge.
+  std::map<std::pair<std::uint32_t, std::uint32_t>, VertexId> edgePoints() {
+    std::map<std::pair<std::uint32_t, std::uint32_t>, VertexId> out;
+    auto key = [](VertexId a, VertexId b) {
+      return std::make_pair(std::min(a.value, b.value), std::max(a.value, b.value));
+    };
+    for (const auto& [id, parts] : faces_) {
+      const Face& face = mesh_.face(FaceId(id));
+      auto neighbour = [&](VertexId x, int step) {
+        for (std::size_t k = 0; k < face.numLoops(); ++k) {
+          const auto loop = face.loop(k);
+          for (std::size_t i = 0; i < loop.size(); ++i)
+            if (loop[i] == x) return loop[(i + loop.size() + step) % loop.size()];
+        }
+        return VertexId();
+      };
+      for (const Piece* side : {&parts.minus, &parts.plus})
+        for (const PiecePolygon& p : *side)
+          for (std::size_t k = 0; k < p.numLoops(); ++k) {
+            const std::size_t begin = p.loopBegin(k), end = p.loopEnd[k];
+            for (std::size_t i = begin; i < end; ++i) {
+              const std::uint32_t u = p.vertices[i], w = p.vertices[i + 1 == end ? begin : i + 1];
+              const bool uOld = u < meshOf_.size(), wOld = w < meshOf_.size();
+              if (uOld && !wOld) {
+                const VertexId x = meshOf_[u], y = neighbour(x, 1);
+                if (y.valid()) out[key(x, y)] = meshVertex(w);
+              } else if (!uOld && wOld) {
+                const VertexId y = meshOf_[w], x = neighbour(y, -1);
+                if (x.valid()) out[key(x, y)] = meshVertex(u);
+              }
+            }
+          }
+    }
+    return out;
+  }
+
   /// Faces split by this cut, for the neighbours that keep them whole.
   struct FaceParts {
     Piece minus, plus;                      ///< in the face's own orientation, local ids
@@ -541,7 +617,11 @@ class Splitter {
   VertexId meshVertex(std::uint32_t local) {
     if (local < meshOf_.size()) return meshOf_[local];
     const auto [it, inserted] = newVertices_.try_emplace(local, VertexId());
-    if (inserted) it->second = mesh_.addVertex(splitter_->point(local));
+    if (inserted) {
+      it->second = mesh_.addVertex(splitter_->point(local));
+      tags_.resize(mesh_.numVertices(), kNoPlane);
+      tags_[it->second.index()] = planeId_;
+    }
     return it->second;
   }
 
@@ -608,6 +688,8 @@ class Splitter {
   PolyMesh& mesh_;
   VertexSides& sides_;
   const Blade& blade_;
+  std::vector<std::uint32_t>& tags_;
+  std::uint32_t planeId_;
   SplitPlane plane_;
   std::unordered_map<std::uint32_t, std::uint32_t> local_;
   std::vector<VertexId> meshOf_;
@@ -699,6 +781,7 @@ MeshEditor::MeshEditor(PolyMesh mesh, double referenceVolume) : state_(std::make
   s.referenceVolume = referenceVolume;
   s.grid = ElementGrid(s.mesh, std::cbrt(referenceVolume));
   s.region.assign(s.mesh.numElements(), 0);
+  s.vertexPlane.assign(s.mesh.numVertices(), kNoPlane);
 }
 
 MeshEditor::~MeshEditor() = default;
@@ -819,7 +902,13 @@ OperationReport MeshEditor::cut(const Blade& blade, const CutOptions& options) {
   }
   const double volumeBefore = s.volume;
   Edit edit(s.mesh, *s.moments, s.grid);
-  VertexSides sides(s.mesh, blade);
+  std::uint32_t planeId = 0;
+  while (planeId < s.planes.size() &&
+         !samePlane(s.planes[planeId].first, s.planes[planeId].second, blade.normal, blade.offset))
+    ++planeId;
+  if (planeId == s.planes.size()) s.planes.emplace_back(blade.normal, blade.offset);
+  s.vertexPlane.resize(s.mesh.numVertices(), kNoPlane);
+  VertexSides sides(s.mesh, blade, s.vertexPlane, planeId);
   const int removeSide = blade.finite() ? 0 : options.removeSide;
   std::optional<PolygonTest> polygon;
   if (blade.finite()) polygon.emplace(blade);
@@ -859,13 +948,18 @@ OperationReport MeshEditor::cut(const Blade& blade, const CutOptions& options) {
 
   // 3. Crossed elements: caps first (a finite blade splits only elements whose section lies
   //    in the polygon), then the pieces.
-  Splitter splitter(edit, sides, blade);
+  Splitter splitter(edit, sides, blade, s.vertexPlane, planeId);
   splitter.setElements(crossed);
   std::vector<std::pair<ElementId, std::pair<Piece, Piece>>> toSplit;
+  std::vector<ElementId> unsplit;  ///< crossed but kept whole
   for (ElementId e : crossed) {
     auto caps = splitter.caps(e);
-    if (caps.first.empty() || caps.second.empty())
-      throw std::logic_error("cut: a crossed element has no section");
+    if (caps.first.empty() || caps.second.empty()) {
+      // The section collapsed in rounding (the element is within round-off of the plane):
+      // kept whole, like an element at a finite blade's edge.
+      unsplit.push_back(e);
+      continue;
+    }
     if (polygon) {
       std::size_t in = 0, total = 0;
       for (const PiecePolygon& cap : caps.first)
@@ -875,6 +969,7 @@ OperationReport MeshEditor::cut(const Blade& blade, const CutOptions& options) {
         }
       if (in != total) {
         if (in > 0) edit.leftWhole().insert(e);
+        unsplit.push_back(e);
         continue;
       }
     }
@@ -902,6 +997,28 @@ OperationReport MeshEditor::cut(const Blade& blade, const CutOptions& options) {
         s.mesh.attachFace(n, {splitter.subFace(f, 1, i), reversed});
     }
     edit.markDeadIfUnused(f);
+  }
+  // Edges the cut divided also bound faces of crossed elements kept whole: insert the new
+  // points there too, so every element stays closed (no T-junctions).
+  if (!unsplit.empty() && !toSplit.empty()) {
+    const auto points = splitter.edgePoints();
+    for (ElementId e : unsplit) {
+      const FaceList uses = s.mesh.element(e).faces;
+      for (const FaceUse& use : uses) {
+        bool changed = false;
+        const Face face = s.mesh.face(use.face);
+        for (std::size_t k = 0; k < face.numLoops(); ++k) {
+          const auto loop = face.loop(k);
+          for (std::size_t i = 0; i < loop.size(); ++i) {
+            const VertexId a = loop[i], b = loop[(i + 1) % loop.size()];
+            const auto it = points.find({std::min(a.value, b.value), std::max(a.value, b.value)});
+            if (it != points.end()) changed |= s.mesh.splitEdge(use.face, a, b, it->second);
+          }
+        }
+        if (!changed) continue;
+        edit.refresh(use.face);
+      }
+    }
   }
   report.facesReintegrated += edit.updateMoments();
 

@@ -265,6 +265,24 @@ ElementId PolyMesh::removeElement(ElementId e) {
   return last;
 }
 
+bool PolyMesh::splitEdge(FaceId f, VertexId a, VertexId b, VertexId p) {
+  Face& face = faces_[f];
+  for (std::size_t k = 0; k < face.numLoops(); ++k) {
+    const std::size_t begin = k == 0 ? 0 : face.loopEnd[k - 1], end = face.loopEnd[k];
+    for (std::size_t i = begin; i < end; ++i) {
+      const std::size_t j = i + 1 == end ? begin : i + 1;
+      const VertexId u = face.vertices[i], w = face.vertices[j];
+      if (!((u == a && w == b) || (u == b && w == a))) continue;
+      // Insert after position i (at the loop's end when the edge closes the loop).
+      face.vertices.insert(face.vertices.begin() + static_cast<std::ptrdiff_t>(i + 1), p);
+      for (std::size_t m = k; m < face.loopEnd.size(); ++m) ++face.loopEnd[m];
+      openFacesStale_ = true;
+      return true;
+    }
+  }
+  return false;
+}
+
 ElementId PolyMesh::addElementFromFaces(std::span<const FaceUse> faces) {
   const ElementId e(elements_.size());
   // Check every face first, so a failure leaves the mesh unchanged.

@@ -165,6 +165,9 @@ class PolyMesh {
   /// slot and patching the front/back links of the moved element's faces. Returns the id the
   /// moved element had (invalid if e was the last element): that element is now e.
   ElementId removeElement(ElementId e);
+  /// Inserts vertex p between a and b wherever a and b follow each other (either way) in a
+  /// loop of face f: p must lie on that edge. Returns true if the face changed.
+  bool splitEdge(FaceId f, VertexId a, VertexId b, VertexId p);
 
  private:
 

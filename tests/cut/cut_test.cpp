@@ -3,6 +3,9 @@
 // side, finite polygon blades, and incremental moments against moments from scratch.
 #include "cut/cut.h"
 
+#include <cmath>
+#include <random>
+
 #include <gtest/gtest.h>
 
 #include "mesh/primitives.h"
@@ -56,6 +59,171 @@ TEST(Cut, ObliquePlaneSplitsCrossedElements) {
   std::size_t components = 0;
   connectedComponents(editor.mesh(), components);
   EXPECT_EQ(components, 2u);
+}
+
+
+CutOptions noMerging() {
+  CutOptions options;
+  options.sliverFraction = 0.0;
+  return options;
+}
+
+TEST(Cut, PlaneThroughVerticesMakesNoDegenerateFace) {
+  // x + y + z = 1.5 on a 2^3 grid passes through grid vertices such as (0.5, 0.5, 0.5).
+  MeshEditor editor(unitGrid(2));
+  const auto r = editor.cut(Blade::plane(Vec3(1, 1, 1), 1.5), noMerging());
+  EXPECT_TRUE(r.validation.passed) << r.validation.failure;
+  EXPECT_GT(r.elementsSplit, 0u);
+  expectConsistent(editor, 1.0);
+}
+
+TEST(Cut, PlaneAlongEdgesMakesNoDegenerateFace) {
+  // x = y contains the grid edges on the diagonal of every xy layer.
+  MeshEditor editor(unitGrid(3));
+  const auto r = editor.cut(Blade::plane(Vec3(1, -1, 0), 0.0), noMerging());
+  EXPECT_TRUE(r.validation.passed) << r.validation.failure;
+  EXPECT_EQ(r.elementsSplit, 9u);   // the three diagonal cells of each layer
+  EXPECT_EQ(r.piecesCreated, 18u);  // two prisms each
+  expectConsistent(editor, 1.0);
+  std::size_t components = 0;
+  connectedComponents(editor.mesh(), components);
+  EXPECT_EQ(components, 2u);
+}
+
+TEST(Cut, GridPlaneDecouplesWithoutSplitting) {
+  MeshEditor editor(unitGrid(4));
+  const std::size_t faces = editor.mesh().numFaces();
+  const auto r = editor.cut(Blade::plane(Vec3(0, 0, 1), 0.5), noMerging());
+  EXPECT_TRUE(r.validation.passed) << r.validation.failure;
+  EXPECT_EQ(r.elementsSplit, 0u);
+  EXPECT_EQ(r.piecesCreated, 0u);
+  EXPECT_EQ(editor.mesh().numElements(), 64u);
+  EXPECT_EQ(editor.mesh().numFaces(), faces + 16);  // each of 16 faces gets a second side
+  EXPECT_EQ(countCutFaces(editor.mesh()), 32u);
+  EXPECT_EQ(r.facesReintegrated, 16u);
+  expectConsistent(editor, 1.0);
+  std::size_t components = 0;
+  connectedComponents(editor.mesh(), components);
+  EXPECT_EQ(components, 2u);
+}
+
+TEST(Cut, PlaneThroughExistingFacesOfSplitPieces) {
+  // A first cut makes faces in x + y = 1; cutting again along it splits nothing.
+  MeshEditor editor(unitGrid(3));
+  editor.cut(Blade::plane(Vec3(0, 0, 1), 0.4), noMerging());
+  const auto first = editor.cut(Blade::plane(Vec3(1, 1, 0), 1.0), noMerging());
+  ASSERT_TRUE(first.validation.passed) << first.validation.failure;
+  const std::size_t elements = editor.mesh().numElements();
+  const auto again = editor.cut(Blade::plane(Vec3(2, 2, 0), 2.0), noMerging());
+  EXPECT_TRUE(again.validation.passed) << again.validation.failure;
+  EXPECT_EQ(again.elementsSplit, 0u);
+  EXPECT_EQ(again.facesReintegrated, 0u);
+  EXPECT_EQ(editor.mesh().numElements(), elements);
+  expectConsistent(editor, 1.0);
+}
+
+TEST(Cut, PlaneGrazingOneVertexChangesNothing) {
+  MeshEditor editor(unitGrid(2));
+  const std::size_t faces = editor.mesh().numFaces();
+  const auto r = editor.cut(Blade::plane(Vec3(1, 1, 1), 3.0), noMerging());  // touches (1,1,1)
+  EXPECT_TRUE(r.validation.passed) << r.validation.failure;
+  EXPECT_EQ(r.elementsSplit, 0u);
+  EXPECT_EQ(r.facesReintegrated, 0u);
+  EXPECT_EQ(editor.mesh().numFaces(), faces);
+  EXPECT_EQ(countCutFaces(editor.mesh()), 0u);
+  expectConsistent(editor, 1.0);
+}
+
+TEST(Cut, SameCutTwiceIsANoOp) {
+  MeshEditor editor(unitGrid(4));
+  const Blade blade = Blade::plane(Vec3(0.3, -0.7, 1.1), 0.37);
+  const auto first = editor.cut(blade);
+  ASSERT_TRUE(first.validation.passed) << first.validation.failure;
+  ASSERT_GT(first.elementsSplit, 0u);
+  const std::size_t elements = editor.mesh().numElements(), faces = editor.mesh().numFaces();
+  const auto second = editor.cut(blade);
+  EXPECT_TRUE(second.validation.passed) << second.validation.failure;
+  EXPECT_EQ(second.elementsSplit, 0u);
+  EXPECT_EQ(second.facesReintegrated, 0u);
+  EXPECT_EQ(editor.mesh().numElements(), elements);
+  EXPECT_EQ(editor.mesh().numFaces(), faces);
+  expectConsistent(editor, 1.0);
+}
+
+TEST(Cut, ParallelCutsOneTrillionthApart) {
+  for (const double fraction : {0.0, kDefaultSliverFraction}) {
+    MeshEditor editor(unitGrid(4));
+    CutOptions options;
+    options.sliverFraction = fraction;
+    const Vec3 n(0.2, 0.3, 1.0);
+    const auto a = editor.cut(Blade::plane(n, 0.61), options);
+    ASSERT_TRUE(a.validation.passed) << a.validation.failure;
+    const auto b = editor.cut(Blade::plane(n, 0.61 + 1e-12), options);
+    EXPECT_TRUE(b.validation.passed) << b.validation.failure;
+    EXPECT_GT(b.elementsSplit, 0u);
+    if (fraction > 0) EXPECT_EQ(b.sliversMerged + b.isolatedSlivers, b.slivers);
+    expectConsistent(editor, 1.0);
+  }
+}
+
+TEST(Cut, RemovingEachSideLeavesComplementaryVolumes) {
+  const Blade blade = Blade::plane(Vec3(1, 2, -0.5), 0.77);
+  double kept[2];
+  for (int side : {-1, 1}) {
+    MeshEditor editor(unitGrid(5));
+    CutOptions options;
+    options.removeSide = side;
+    const auto r = editor.cut(blade, options);
+    EXPECT_TRUE(r.validation.passed) << r.validation.failure;
+    EXPECT_GT(r.elementsRemoved, 0u);
+    EXPECT_NEAR(r.volumeRemoved + editor.volume(), 1.0, kVolumeTolerance);
+    kept[side < 0 ? 0 : 1] = editor.volume();
+    expectConsistent(editor, editor.volume());
+    for (const Face& f : editor.mesh().faces())  // the cut surface is all that is new
+      if (f.origin == FaceOrigin::Cut) EXPECT_TRUE(f.isBoundary());
+  }
+  EXPECT_NEAR(kept[0] + kept[1], 1.0, kVolumeTolerance);
+}
+
+TEST(Cut, ManyCutsKeepIncrementalMomentsExact) {
+  MeshEditor editor(unitGrid(4));
+  std::mt19937_64 rng(20261123);
+  std::uniform_real_distribution<double> coordinate(0.0, 1.0), component(-1.0, 1.0);
+  CutOptions options;
+  options.validation = ValidationLevel::None;
+  for (int i = 0; i < 40; ++i) {
+    const Vec3 p(coordinate(rng), coordinate(rng), coordinate(rng));
+    const Vec3 n(component(rng), component(rng), component(rng));
+    const auto r = editor.cut(Blade::plane(n, n.dot(p)), options);
+    ASSERT_TRUE(r.validation.passed) << "cut " << i << ": " << r.validation.failure;
+  }
+  expectConsistent(editor, 1.0);
+}
+
+TEST(Cut, PolygonBladeSplitsOnlyInside) {
+  MeshEditor editor(unitGrid(4));
+  const Blade blade = Blade::fromPolygon(
+      {Vec3(0.1, 0.1, 0.4), Vec3(0.6, 0.1, 0.4), Vec3(0.6, 0.6, 0.55), Vec3(0.1, 0.6, 0.55)});
+  const auto r = editor.cut(blade, noMerging());
+  EXPECT_TRUE(r.validation.passed) << r.validation.failure;
+  EXPECT_GT(r.elementsSplit, 0u);
+  EXPECT_FALSE(r.leftWhole.empty());
+  expectConsistent(editor, 1.0);
+  std::size_t components = 0;
+  connectedComponents(editor.mesh(), components);
+  EXPECT_EQ(components, 1u);  // a slit, not a separation
+}
+
+TEST(Blade, RejectsBadInput) {
+  EXPECT_THROW(Blade::plane(Vec3::Zero(), 1.0), std::invalid_argument);
+  EXPECT_THROW(Blade::plane(Vec3(1, 0, 0), std::nan("")), std::invalid_argument);
+  EXPECT_THROW(Blade::fromPolygon({Vec3(0, 0, 0), Vec3(1, 0, 0)}), std::invalid_argument);
+  EXPECT_THROW(Blade::fromPolygon({Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(2, 0, 0)}),
+               std::invalid_argument);
+  EXPECT_THROW(Blade::fromPolygon({Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1, 1, 0), Vec3(0, 1, 1)}),
+               std::invalid_argument);  // not coplanar
+  EXPECT_THROW(Blade::fromPolygon({Vec3(0, 0, 0), Vec3(2, 0, 0), Vec3(1, 0.2, 0), Vec3(1, 2, 0)}),
+               std::invalid_argument);  // not convex
 }
 
 }  // namespace
