@@ -216,8 +216,12 @@ double regionPatchTest(const SubMesh& sub, std::size_t regionSize, const DgBasis
     r.noalias() += block * ue;
     for (const FaceUse& use : mesh.element(e).faces) {
       const ElementId other = across(mesh, use.face, e);
-      FaceView view{.face = use.face, .kind = FaceKind::Dirichlet, .self = e,
-                    .selfIsFront = !use.reversed, .selfCoupledFaces = coupled(e)};
+      FaceView view;
+      view.face = use.face;
+      view.kind = FaceKind::Dirichlet;
+      view.self = e;
+      view.selfIsFront = !use.reversed;
+      view.selfCoupledFaces = coupled(e);
       if (other.valid()) {
         view.kind = FaceKind::Interior;
         view.other = other;
