@@ -804,7 +804,8 @@ namespace {
 /// The checks after an operation on the elements it touched (see ValidationLevel).
 void validateOperation(const PolyMesh& mesh, const MomentCache& moments,
                        const std::vector<ElementId>& touched, std::vector<char>& region,
-                       ValidationLevel level, int degree, OperationValidation& v) {
+                       ValidationLevel level, int degree, double sliverThreshold,
+                       OperationValidation& v) {
   v.level = level;
   auto fail = [&](const std::string& message) {
     if (v.passed) v.failure = message;
@@ -826,7 +827,16 @@ void validateOperation(const PolyMesh& mesh, const MomentCache& moments,
         members.push_back(e);
       }
     };
+    // Isolated slivers (below the sliver threshold, no interior face) are left out of the DG
+    // region: they are reported as isolated and are too thin for a meaningful solve.
+    auto isolatedSliver = [&](ElementId e) {
+      if (!(moments.volume(e) < sliverThreshold)) return false;
+      const auto& uses = mesh.element(e).faces;
+      return std::none_of(uses.begin(), uses.end(),
+                          [&](const FaceUse& u) { return !mesh.face(u.face).isBoundary(); });
+    };
     for (ElementId e : touched) {
+      if (isolatedSliver(e)) continue;
       add(e);
       for (const FaceUse& use : mesh.element(e).faces) {
         const Face& face = mesh.face(use.face);
@@ -834,6 +844,7 @@ void validateOperation(const PolyMesh& mesh, const MomentCache& moments,
         if (face.back.valid()) add(face.back);
       }
     }
+    if (members.empty()) return;
     LocalDgCheckOptions options;
     options.basis.degree = degree;
     const RegionDgCheck dg = regionDgChecks(mesh, moments, region, options);
@@ -1061,7 +1072,7 @@ OperationReport MeshEditor::cut(const Blade& blade, const CutOptions& options) {
   // 7. Checks.
   OperationValidation& v = report.validation;
   validateOperation(s.mesh, *s.moments, touched, s.region, options.validation,
-                    options.validationDegree, v);
+                    options.validationDegree, options.sliverFraction * s.referenceVolume, v);
   v.volumeRelError =
       std::abs(volumeBefore - report.volumeRemoved - s.volume) / std::abs(volumeBefore);
   if (!(v.volumeRelError <= kVolumeBalanceTolerance)) {
@@ -1108,7 +1119,7 @@ OperationReport MeshEditor::mergeSlivers(double fraction, ValidationLevel valida
   s.volume = volumeBefore - oldVolume + newVolume;
   report.facesTotal = s.mesh.numFaces();
   validateOperation(s.mesh, *s.moments, touched, s.region, validation, validationDegree,
-                    report.validation);
+                    fraction * s.referenceVolume, report.validation);
   report.validation.volumeRelError = std::abs(volumeBefore - s.volume) / std::abs(volumeBefore);
   if (!(report.validation.volumeRelError <= kVolumeBalanceTolerance)) {
     if (report.validation.passed)
