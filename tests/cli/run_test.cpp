@@ -204,6 +204,27 @@ TEST_F(Run, BrokenInputsFailAloneAndTheOthersSucceed) {
   }
 }
 
+TEST_F(Run, ASolverFailureLeavesOnlyTheReport) {
+  // The cut along x = 0.5 decouples the half x > 0.5 of the cube, which no clamp holds: the
+  // stiffness is singular. The mesh written before the solve does not stay behind.
+  const std::string pipeline = write("solve.json", R"({"steps": [
+    {"step": "mesh", "cells": 4},
+    {"step": "cut", "plane": [1, 0, 0, 0.5]},
+    {"step": "write", "path": "{stem}.vtu"},
+    {"step": "solve", "clamp": [{"axis": "x", "value": 0}], "output": "{stem}_u.vtu"}]})");
+  const Result r = run("run " + pipeline + " --inputs " + data("cube.obj") + " --out " + path("out"));
+  EXPECT_EQ(r.exitCode, 1) << r.out;
+  EXPECT_EQ(listing("out/cube"), std::vector<std::string>{"report.json"});
+  const json report = readJson("out/cube/report.json");
+  EXPECT_EQ(report["status"], "failed");
+  const std::string error = report["error"];
+  EXPECT_NE(error.find("step 3 (solve)"), std::string::npos) << error;
+  EXPECT_NE(error.find("not positive definite"), std::string::npos) << error;
+  EXPECT_EQ(report["steps"].size(), 4u);
+  EXPECT_EQ(report["steps"][3]["error"], error.substr(error.find(": ") + 2));
+  EXPECT_NE(summaryLine(r.out, "cube.obj").find("FAILED"), std::string::npos) << r.out;
+}
+
 TEST_F(Run, SimulationMeshInputsSkipTheMeshStep) {
   ASSERT_EQ(run("mesh " + data("cube.obj") + " --cells 4 -o " + path("cube4.vtu") + " --quiet").exitCode, 0);
   const std::string pipeline = write("batch.json", kBatchPipeline);
