@@ -479,6 +479,11 @@ class InputRun {
         result["error"] = e.what();
         steps_.push_back(result);
         throw StepFailure("step " + std::to_string(k) + " (" + stepName(step) + "): " + e.what());
+      } catch (...) {
+        result["time_s"] = secondsSince(t0);
+        result["error"] = "an unknown error";
+        steps_.push_back(result);
+        throw StepFailure("step " + std::to_string(k) + " (" + stepName(step) + "): an unknown error");
       }
       result["time_s"] = secondsSince(t0);
       steps_.push_back(result);
@@ -712,6 +717,8 @@ InputOutcome runInput(const Pipeline& pipeline, const std::string& input, const 
     o.passed = true;
   } catch (const std::exception& e) {
     o.error = e.what();
+  } catch (...) {
+    o.error = "an unknown error";
   }
   o.elements = run.elements();
   try {
@@ -782,6 +789,7 @@ void runPipeline(const RunOptions& o, const CommonOptions& common, int& exitCode
         outcome.error = e.what();
       }
       const std::lock_guard lock(printing);
+      bar.finish();  // clear the bar's line before the input's lines; redrawn below
       if (!common.quiet) {
         std::cout << outcome.input << ": " << (outcome.passed ? "ok" : "FAILED") << " -> "
                   << (out / stems[i]).string() << '\n'
