@@ -357,8 +357,8 @@ struct StepFailure : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-/// The mesh of one input as it goes through the steps: a PolyMesh, or a MeshEditor owning it
-/// from the first cut on.
+/// The mesh of one input as it goes through the steps: a PolyMesh, and from the first cut or
+/// merge on a MeshEditor owning it.
 class WorkMesh {
  public:
   WorkMesh(PolyMesh mesh, double referenceVolume)
@@ -368,14 +368,11 @@ class WorkMesh {
     if (!editor_) editor_ = std::make_unique<MeshEditor>(std::move(mesh_), referenceVolume_);
     return *editor_;
   }
-  bool editing() const { return editor_ != nullptr; }
-  double referenceVolume() const { return editor_ ? editor_->referenceVolume() : referenceVolume_; }
-  PolyMesh& plain() { return mesh_; }
 
  private:
   PolyMesh mesh_;
   std::unique_ptr<MeshEditor> editor_;
-  double referenceVolume_;
+  double referenceVolume_;  ///< what sliver fractions multiply
 };
 
 double meshVolume(const PolyMesh& mesh) {
@@ -538,22 +535,12 @@ class InputRun {
   }
 
   void apply(const MergeStep& s, json& result) {
-    if (work_->editing()) {
-      const OperationReport r = work_->editor().mergeSlivers(s.fraction);
-      result["operations"] = json::array({operationJson(r)});
-      if (!r.validation.passed)
-        throw StepFailure("merging failed its validation: " + r.validation.failure);
-    } else {
-      SliverMergeReport r;
-      const double threshold = s.fraction * work_->referenceVolume();
-      work_->plain() = mergeSlivers(std::move(work_->plain()), threshold, &r);
-      result["slivers"] = r.slivers;
-      result["slivers_merged"] = r.merged;
-      result["isolated_slivers"] = r.isolated;
-      result["threshold"] = r.threshold;
-    }
-    result["elements"] = mesh().numElements();
-    log("merge: " + std::to_string(mesh().numElements()) + " elements");
+    const OperationReport r = work_->editor().mergeSlivers(s.fraction);
+    result["operations"] = json::array({operationJson(r)});
+    result["output"] = {{"elements", mesh().numElements()}, {"volume", work_->editor().volume()}};
+    if (!r.validation.passed) throw StepFailure("merging failed its validation: " + r.validation.failure);
+    log("merge: " + std::to_string(r.sliversMerged) + " slivers merged, " +
+        std::to_string(mesh().numElements()) + " elements");
   }
 
   void apply(const CheckStep& s, json& result) {

@@ -193,6 +193,10 @@ TEST_F(Run, BrokenInputsFailAloneAndTheOthersSucceed) {
     const json summary = readJson(out + ".json");
     EXPECT_EQ(summary["failed"], 2);
     EXPECT_NEAR(summary["inputs"][0]["volume"].get<double>(), 0.9, kVolumeTolerance);
+    const json& merge = summary["inputs"][0]["steps"][2];
+    EXPECT_EQ(merge["step"], "merge");
+    EXPECT_EQ(merge["operations"][0]["op"], "merge");
+    EXPECT_TRUE(merge["operations"][0]["validation"]["passed"]);
     EXPECT_EQ(summary["inputs"][0]["elements"], summary["inputs"][4]["elements"]);
   }
   // Concurrency changes nothing in the results.
