@@ -408,20 +408,13 @@ std::string toString(ValidationLevel v) {
   return v == ValidationLevel::None ? "none" : v == ValidationLevel::Local ? "local" : "full";
 }
 
-/// One cut or merge operation as `polydg cut` reports it.
+/// One cut or merge operation, in the form of `polydg cut`'s report (cli/cut.cpp).
 json operationJson(const OperationReport& r) {
   const OperationValidation& v = r.validation;
-  json validation{{"level", toString(v.level)},
-                  {"passed", v.passed},
-                  {"elements_checked", v.elementsChecked},
-                  {"region_elements", v.regionElements},
-                  {"patch_test_error", v.patchTestError},
-                  {"region_components", v.regionComponents},
-                  {"zero_modes", v.zeroModes},
-                  {"volume_rel_error", v.volumeRelError}};
-  if (!v.failure.empty()) validation["failure"] = v.failure;
-  json left = json::array();
-  for (ElementId e : r.leftWhole) left.push_back(e.value);
+  constexpr std::size_t kListedIds = 20;
+  std::vector<std::uint32_t> firstIds;
+  for (std::size_t i = 0; i < r.leftWhole.size() && i < kListedIds; ++i)
+    firstIds.push_back(r.leftWhole[i].value);
   return {{"op", r.op},
           {"elements_split", r.elementsSplit},
           {"pieces_created", r.piecesCreated},
@@ -432,8 +425,17 @@ json operationJson(const OperationReport& r) {
           {"isolated_slivers", r.isolatedSlivers},
           {"faces_reintegrated", r.facesReintegrated},
           {"faces_total", r.facesTotal},
-          {"left_whole", left},
-          {"validation", validation},
+          {"left_whole", {{"count", r.leftWhole.size()}, {"first_ids", firstIds}}},
+          {"validation",
+           {{"passed", v.passed},
+            {"level", toString(v.level)},
+            {"elements_checked", v.elementsChecked},
+            {"region_elements", v.regionElements},
+            {"patch_test_error", v.patchTestError},
+            {"region_components", v.regionComponents},
+            {"zero_modes", v.zeroModes},
+            {"volume_rel_error", v.volumeRelError},
+            {"failure", v.failure}}},
           {"time_s", r.seconds}};
 }
 

@@ -240,6 +240,20 @@ TEST_F(Run, SimulationMeshInputsSkipTheMeshStep) {
   EXPECT_EQ(report["steps"][1]["step"], "cut");
   EXPECT_NEAR(report["volume"].get<double>(), 0.9, kVolumeTolerance);
   EXPECT_TRUE(fs::exists(path("out/cube4/meshes/cube4_trimmed.vtu")));
+  // The cut is reported with the keys of `polydg cut`'s report, and the same figures.
+  const Result cut = run("cut " + path("cube4.vtu") + " -o " + path("cut.vtu") +
+                         " --plane 0,0,1,0.1 --remove-side - --report " + path("cut.json") + " --quiet");
+  ASSERT_EQ(cut.exitCode, 0) << cut.out;
+  const json a = readJson("cut.json")["operations"][0], b = report["steps"][1]["operations"][0];
+  const auto keys = [](const json& j) {
+    std::vector<std::string> k;
+    for (const auto& [key, value] : j.items()) k.push_back(key);
+    return k;
+  };
+  EXPECT_EQ(keys(a), keys(b));
+  EXPECT_EQ(keys(a["validation"]), keys(b["validation"]));
+  for (const char* key : {"elements_split", "pieces_created", "elements_removed", "faces_total"})
+    EXPECT_EQ(a[key], b[key]) << key;
   // The same pipeline with --quiet and a failure: one line on stderr, exit 1.
   const Result bad = run("run " + pipeline + " --inputs " + path("nothing.vtu") + " --out " + path("out") + " --quiet");
   EXPECT_EQ(bad.exitCode, 1) << bad.out;
