@@ -1,6 +1,7 @@
 #include "cut/cut.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <map>
@@ -439,10 +440,41 @@ class Splitter {
       for (const FaceUse& use : mesh_.element(e).faces)
         for (VertexId v : mesh_.face(use.face).vertices)
           if (local_.try_emplace(v.value, static_cast<std::uint32_t>(points.size())).second) {
-            points.push_back(mesh_.position(v));
+            const Vec3& p = mesh_.position(v);
+            byPosition_.try_emplace({p.x(), p.y(), p.z()}, static_cast<std::uint32_t>(points.size()));
+            points.push_back(p);
             meshOf_.push_back(v);
           }
     splitter_ = std::make_unique<PlaneSplitter>(points);
+  }
+
+  /// The polygon in mesh vertex ids, with repeated consecutive vertices (a constructed point
+  /// that rounded onto a vertex) merged and collapsed holes dropped; false if its outer loop
+  /// collapsed (the polygon has no area left).
+  bool meshLoops(const PiecePolygon& polygon, boost::container::small_vector<VertexId, 8>& out,
+                 boost::container::small_vector<std::uint32_t, 2>& loopEnd) {
+    out.clear();
+    loopEnd.clear();
+    for (std::size_t k = 0; k < polygon.numLoops(); ++k) {
+      const std::size_t begin = out.size();
+      for (std::size_t i = polygon.loopBegin(k); i < polygon.loopEnd[k]; ++i) {
+        const VertexId v = meshVertex(polygon.vertices[i]);
+        if (out.size() == begin || out.back() != v) out.push_back(v);
+      }
+      while (out.size() > begin + 1 && out[begin] == out.back()) out.pop_back();
+      if (out.size() >= begin + 3) {
+        loopEnd.push_back(static_cast<std::uint32_t>(out.size()));
+      } else {
+        out.resize(begin);
+        if (k == 0) return false;
+      }
+    }
+    return true;
+  }
+  bool collapses(const PiecePolygon& polygon) {
+    boost::container::small_vector<VertexId, 8> vertices;
+    boost::container::small_vector<std::uint32_t, 2> loopEnd;
+    return !meshLoops(polygon, vertices, loopEnd);
   }
 
   /// Element e's outward polygons in local ids.
@@ -494,14 +526,25 @@ class Splitter {
       minus.push_back({Part::Kind::Cap, {}, i, &caps.first[i]});
     for (std::size_t i = 0; i < caps.second.size(); ++i)
       plus.push_back({Part::Kind::Cap, {}, i, &caps.second[i]});
+    for (std::vector<Part>* parts : {&minus, &plus})  // parts that rounding collapsed
+      parts->erase(std::remove_if(parts->begin(), parts->end(),
+                                  [&](const Part& part) {
+                                    return part.kind != Part::Kind::Whole &&
+                                           collapses(*part.polygon);
+                                  }),
+                   parts->end());
 
     edit_.detachAll(e);
     std::vector<std::pair<ElementId, int>> pieces;
     for (int side : {-1, 1}) {
       const std::vector<Part>& parts = side < 0 ? minus : plus;
       for (const std::vector<std::size_t>& component : components(parts)) {
+        if (component.size() < 2) continue;  // a lone polygon bounds no volume
         FaceList faces;
-        for (std::size_t i : component) faces.push_back(faceFor(parts[i], side));
+        for (std::size_t i : component) {
+          const FaceUse use = faceFor(parts[i], side);
+          if (use.face.valid()) faces.push_back(use);
+        }
         pieces.emplace_back(edit_.addElement({faces.data(), faces.size()}), side);
       }
     }
@@ -534,11 +577,11 @@ class Splitter {
               const std::uint32_t u = p.vertices[i], w = p.vertices[i + 1 == end ? begin : i + 1];
               const bool uOld = u < meshOf_.size(), wOld = w < meshOf_.size();
               if (uOld && !wOld) {
-                const VertexId x = meshOf_[u], y = neighbour(x, 1);
-                if (y.valid()) out[key(x, y)] = meshVertex(w);
+                const VertexId x = meshOf_[u], y = neighbour(x, 1), q = meshVertex(w);
+                if (y.valid() && q != x && q != y) out[key(x, y)] = q;
               } else if (!uOld && wOld) {
-                const VertexId y = meshOf_[w], x = neighbour(y, -1);
-                if (x.valid()) out[key(x, y)] = meshVertex(u);
+                const VertexId y = meshOf_[w], x = neighbour(y, -1), q = meshVertex(u);
+                if (x.valid() && q != x && q != y) out[key(x, y)] = q;
               }
             }
           }
@@ -618,18 +661,24 @@ class Splitter {
     if (local < meshOf_.size()) return meshOf_[local];
     const auto [it, inserted] = newVertices_.try_emplace(local, VertexId());
     if (inserted) {
-      it->second = mesh_.addVertex(splitter_->point(local));
+      const Vec3& p = splitter_->point(local);
+      // A constructed point that rounded onto one of the elements' vertices is that vertex.
+      const auto same = byPosition_.find({p.x(), p.y(), p.z()});
+      if (same != byPosition_.end()) return it->second = meshOf_[same->second];
+      it->second = mesh_.addVertex(p);
       tags_.resize(mesh_.numVertices(), kNoPlane);
       tags_[it->second.index()] = planeId_;
     }
     return it->second;
   }
 
+  /// The face of a polygon; invalid if rounding collapsed it.
   FaceId makeFace(const PiecePolygon& polygon, FaceOrigin origin) {
     boost::container::small_vector<VertexId, 8> vertices;
-    for (std::uint32_t v : polygon.vertices) vertices.push_back(meshVertex(v));
-    return edit_.addFace({vertices.data(), vertices.size()},
-                         {polygon.loopEnd.data(), polygon.loopEnd.size()}, origin);
+    boost::container::small_vector<std::uint32_t, 2> loopEnd;
+    if (!meshLoops(polygon, vertices, loopEnd)) return FaceId();
+    return edit_.addFace({vertices.data(), vertices.size()}, {loopEnd.data(), loopEnd.size()},
+                         origin);
   }
 
   FaceUse faceFor(const Part& part, int side) {
@@ -665,12 +714,13 @@ class Splitter {
             addEdge(p, loop[i], loop[(i + 1) % loop.size()]);
         }
       } else {
-        const PiecePolygon& polygon = *parts[p].polygon;
-        for (std::size_t k = 0; k < polygon.numLoops(); ++k) {
-          const std::size_t begin = polygon.loopBegin(k), end = polygon.loopEnd[k];
+        boost::container::small_vector<VertexId, 8> vertices;
+        boost::container::small_vector<std::uint32_t, 2> loopEnd;
+        meshLoops(*parts[p].polygon, vertices, loopEnd);
+        for (std::size_t k = 0; k < loopEnd.size(); ++k) {
+          const std::size_t begin = k == 0 ? 0 : loopEnd[k - 1], end = loopEnd[k];
           for (std::size_t i = begin; i < end; ++i)
-            addEdge(p, meshVertex(polygon.vertices[i]),
-                    meshVertex(polygon.vertices[i + 1 == end ? begin : i + 1]));
+            addEdge(p, vertices[i], vertices[i + 1 == end ? begin : i + 1]);
         }
       }
     }
@@ -695,6 +745,14 @@ class Splitter {
   std::vector<VertexId> meshOf_;
   std::unique_ptr<PlaneSplitter> splitter_;
   std::unordered_map<std::uint32_t, VertexId> newVertices_;
+  struct PositionHash {
+    std::size_t operator()(const std::array<double, 3>& p) const {
+      std::size_t h = 0;
+      for (double x : p) h = h * 0x9E3779B97F4A7C15ull + std::hash<double>{}(x);
+      return h;
+    }
+  };
+  std::unordered_map<std::array<double, 3>, std::uint32_t, PositionHash> byPosition_;
   std::map<std::uint32_t, FaceParts> faces_;
 };
 
@@ -1002,10 +1060,10 @@ OperationReport MeshEditor::cut(const Blade& blade, const CutOptions& options) {
       const bool reversed = n == back;
       edit.touch(n);
       s.mesh.detachFace(n, f);
-      for (std::size_t i = 0; i < parts.minus.size(); ++i)
-        s.mesh.attachFace(n, {splitter.subFace(f, -1, i), reversed});
-      for (std::size_t i = 0; i < parts.plus.size(); ++i)
-        s.mesh.attachFace(n, {splitter.subFace(f, 1, i), reversed});
+      for (int side : {-1, 1})
+        for (std::size_t i = 0; i < (side < 0 ? parts.minus : parts.plus).size(); ++i)
+          if (const FaceId part = splitter.subFace(f, side, i); part.valid())
+            s.mesh.attachFace(n, {part, reversed});
     }
     edit.markDeadIfUnused(f);
   }

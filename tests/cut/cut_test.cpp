@@ -90,6 +90,24 @@ TEST(Cut, PlaneAlongEdgesMakesNoDegenerateFace) {
   EXPECT_EQ(components, 2u);
 }
 
+TEST(Cut, PlaneThroughRoundedVerticesWeldsThem) {
+  // Grid coordinates k/12 and k/3 are rounded: these planes pass within round-off of grid
+  // vertices (5/12 + 0.3 * 9/12 + 0.1 * 7/12 = 0.7; 1/3 + 2/3 = 1), so intersection points
+  // round onto them. They are welded to the vertex; no degenerate face is left.
+  struct Case {
+    int n;
+    Vec3 normal;
+    double offset;
+  };
+  for (const Case& c : {Case{12, Vec3(1, 0.3, 0.1), 0.7}, Case{3, Vec3(1, 1, 0), 1.0}}) {
+    MeshEditor editor(unitGrid(c.n));
+    const auto r = editor.cut(Blade::plane(c.normal, c.offset), noMerging());
+    EXPECT_TRUE(r.validation.passed) << c.n << ": " << r.validation.failure;
+    EXPECT_GT(r.elementsSplit, 0u);
+    expectConsistent(editor, 1.0);
+  }
+}
+
 TEST(Cut, GridPlaneDecouplesWithoutSplitting) {
   MeshEditor editor(unitGrid(4));
   const std::size_t faces = editor.mesh().numFaces();
