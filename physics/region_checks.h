@@ -55,10 +55,14 @@ struct RegionDgCheck {
 ///     The region's free boundary is part of the question: a sliver of relative thickness t
 ///     left free bends at ~3.7 t^2 from degree 2 on, and slivers joined to the region only
 ///     through their thin faces hinge at ~t^2, so for t below ~1e-6 such regions count extra
-///     zero modes (tests/physics/region_checks_test.cpp). Slivers held through a large face,
-///     and every piece that sliver merging keeps (relative size >= its fraction), count 6.
+///     zero modes (tests/physics/region_checks_test.cpp). Slivers held through a large face
+///     count 6, and so do pieces of relative thickness 1e-2 (what sliver merging at its
+///     default fraction leaves within a grid cell): t^2 = 1e-4 is far above the threshold.
 /// Costs O(region): uses Face::front/back and element face lists, never a loop over the mesh
-/// (apart from one scan of the `region` flags). Throws std::invalid_argument if `region` has
+/// (apart from one scan of the `region` flags). Degree 1, 2026-11-23, load average 6-9 on two
+/// cores: an element and its 6 neighbours of a hexahedral grid take 1.7-1.9 ms on grids of 1k,
+/// 8k and 64k elements; a block of 512 hexahedra (6k DOFs) 0.9-1.5 s, 70% of it zeroModes()'s
+/// subspace iteration. Throws std::invalid_argument if `region` has
 /// the wrong size, `moments` holds less than degree 2p, or the region's faces are used
 /// inconsistently (a face side used twice).
 /// `moments` must be up to date and hold degree 2p moments.
