@@ -10,6 +10,7 @@
 
 #include "mesh/primitives.h"
 #include "mesh/validate.h"
+#include "physics/validation.h"
 
 namespace polydg {
 namespace {
@@ -251,6 +252,59 @@ TEST(Blade, RejectsBadInput) {
                std::invalid_argument);  // not coplanar
   EXPECT_THROW(Blade::fromPolygon({Vec3(0, 0, 0), Vec3(2, 0, 0), Vec3(1, 0.2, 0), Vec3(1, 2, 0)}),
                std::invalid_argument);  // not convex
+}
+
+TEST(Cut, FullValidationChecksTheWholeMesh) {
+  MeshEditor editor(unitGrid(3));
+  CutOptions options;
+  options.validation = ValidationLevel::Full;
+  options.validationDegree = 2;
+  const auto r = editor.cut(Blade::plane(Vec3(0.4, 1, -0.3), 0.45), options);
+  EXPECT_TRUE(r.validation.passed) << r.validation.failure;
+  EXPECT_EQ(r.validation.level, ValidationLevel::Full);
+  EXPECT_EQ(r.validation.elementsChecked, editor.mesh().numElements());
+  EXPECT_EQ(r.validation.regionComponents, 2u);
+  EXPECT_EQ(r.validation.zeroModes, 12u);
+  EXPECT_LT(r.validation.patchTestError, kLocalPatchTestTolerance);
+  EXPECT_GE(editor.moments().degree(), 4);
+  expectConsistent(editor, 1.0);
+}
+
+TEST(Cut, LocalValidationCoversTheTouchedRegion) {
+  MeshEditor editor(unitGrid(4));
+  const auto r = editor.cut(Blade::plane(Vec3(0, 1, 0), 0.6), noMerging());
+  ASSERT_TRUE(r.validation.passed) << r.validation.failure;
+  EXPECT_EQ(r.elementsSplit, 16u);
+  EXPECT_EQ(r.validation.elementsChecked, 32u);          // the pieces
+  EXPECT_EQ(r.validation.regionElements, 32u + 16u + 16u);  // and one ring on each side
+  EXPECT_EQ(r.validation.regionComponents, 2u);
+  EXPECT_EQ(r.validation.zeroModes, 12u);
+  EXPECT_LE(r.validation.volumeRelError, 1e-15);
+}
+
+TEST(MergeSlivers, MergesSmallPiecesIntoNeighbours) {
+  // Unmerged cuts near grid planes leave thin pieces; merging joins each to a neighbour.
+  MeshEditor editor(unitGrid(4));
+  editor.cut(Blade::plane(Vec3(0, 0, 1), 0.5 + 1e-4), noMerging());
+  editor.cut(Blade::plane(Vec3(1, 0, 0), 0.25 - 1e-4), noMerging());
+  const std::size_t before = editor.mesh().numElements();
+  const auto r = editor.mergeSlivers(kDefaultSliverFraction);
+  EXPECT_TRUE(r.validation.passed) << r.validation.failure;
+  EXPECT_EQ(r.op, "merge");
+  EXPECT_GT(r.sliversMerged, 0u);
+  EXPECT_EQ(r.facesReintegrated, 0u);  // merging integrates no face
+  EXPECT_EQ(editor.mesh().numElements(), before - r.sliversMerged);
+  expectConsistent(editor, 1.0);
+  for (std::size_t e = 0; e < editor.mesh().numElements(); ++e) {
+    const bool hasNeighbour = [&] {
+      for (const FaceUse& use : editor.mesh().element(ElementId(e)).faces)
+        if (!editor.mesh().face(use.face).isBoundary()) return true;
+      return false;
+    }();
+    if (hasNeighbour)
+      EXPECT_GE(editor.moments().volume(ElementId(e)),
+                kDefaultSliverFraction * editor.referenceVolume());
+  }
 }
 
 }  // namespace
