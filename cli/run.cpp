@@ -750,16 +750,35 @@ void printSummary(const std::vector<InputOutcome>& outcomes, std::ostream& out) 
   }
 }
 
+/// True if `path` is `folder` or lies inside it (after resolving both).
+bool isWithin(const fs::path& path, const fs::path& folder) {
+  const fs::path p = fs::weakly_canonical(fs::absolute(path));
+  const fs::path f = fs::weakly_canonical(fs::absolute(folder));
+  const auto [fEnd, pAt] = std::mismatch(f.begin(), f.end(), p.begin(), p.end());
+  return fEnd == f.end();
+}
+
+/// Each input's folder is replaced at the end of its run: no input may lie in one.
+void refuseInputsInOutputs(const std::vector<std::string>& inputs,
+                           const std::vector<std::string>& stems, const fs::path& out) {
+  for (const std::string& input : inputs)
+    for (const std::string& stem : stems)
+      if (isWithin(input, out / stem))
+        throw UserError("the input " + input + " lies in the output folder " + (out / stem).string() +
+                        ", which the run replaces; choose another --out");
+}
+
 void runPipeline(const RunOptions& o, const CommonOptions& common, int& exitCode) {
   Pipeline pipeline = readPipeline(o.pipeline);
   if (!o.inputs.empty()) pipeline.inputs = o.inputs;
   if (pipeline.inputs.empty())
     throw UserError(o.pipeline + ": no inputs; list them under \"inputs\" or give --inputs");
   const fs::path out = o.out.empty() ? fs::path(fs::path(o.pipeline).stem().string() + "-out") : fs::path(o.out);
+  const std::vector<std::string> stems = uniqueStems(pipeline.inputs);
+  refuseInputsInOutputs(pipeline.inputs, stems, out);
   std::error_code ec;
   fs::create_directories(out, ec);
   if (ec) throw UserError("cannot create " + out.string() + ": " + ec.message());
-  const std::vector<std::string> stems = uniqueStems(pipeline.inputs);
 
   const std::size_t n = pipeline.inputs.size();
   std::vector<InputOutcome> outcomes(n);

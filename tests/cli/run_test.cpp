@@ -254,6 +254,13 @@ TEST_F(Run, SimulationMeshInputsSkipTheMeshStep) {
   EXPECT_EQ(keys(a["validation"]), keys(b["validation"]));
   for (const char* key : {"elements_split", "pieces_created", "elements_removed", "faces_total"})
     EXPECT_EQ(a[key], b[key]) << key;
+  // An input inside the folder its run would replace is refused before anything is written.
+  fs::copy_file(path("cube4.vtu"), path("out/cube4/cube4.vtu"));
+  const Result inside = run("run " + pipeline + " --inputs " + path("out/cube4/cube4.vtu") +
+                            " --out " + path("out/../out") + " --quiet");
+  expectRefused(inside, "lies in the output folder");
+  EXPECT_TRUE(fs::exists(path("out/cube4/cube4.vtu")));
+  EXPECT_TRUE(fs::exists(path("out/cube4/meshes/cube4_trimmed.vtu")));
   // The same pipeline with --quiet and a failure: one line on stderr, exit 1.
   const Result bad = run("run " + pipeline + " --inputs " + path("nothing.vtu") + " --out " + path("out") + " --quiet");
   EXPECT_EQ(bad.exitCode, 1) << bad.out;
