@@ -176,6 +176,9 @@ Blade Blade::fromPolygon(std::vector<Vec3> corners) {
 
 // --- MeshEditor state --------------------------------------------------------------------
 
+/// Plane ids of one vertex (usually none, one or two).
+using PlaneTags = boost::container::small_vector<std::uint32_t, 2>;
+
 struct MeshEditor::State {
   PolyMesh mesh;
   std::unique_ptr<MomentCache> moments;
@@ -183,15 +186,15 @@ struct MeshEditor::State {
   double referenceVolume = 0.0;
   double volume = 0.0;
   std::vector<char> region;  ///< scratch for the DG region, by element (kept all zero)
-  /// The plane each vertex was constructed on (index into `planes`), kNoPlane for others: a
+  /// The planes each vertex lies on by construction (indices into `planes`): the plane of the
+  /// cut that made it, and the planes both ends of its edge lay on. A later cut by one of them
+  /// sees it on the plane (its rounded position may not be).
   /// later cut by the same plane sees it on the plane (its rounded position may not be).
-  std::vector<std::uint32_t> vertexPlane;
+  std::vector<PlaneTags> vertexPlane;
   std::vector<std::pair<Vec3, double>> planes;  ///< (normal, offset) of every cut so far
 };
 
 namespace {
-
-constexpr std::uint32_t kNoPlane = 0xffffffffu;
 
 /// True if {a.x = da} and {b.x = db} are the same plane: (a, da) and (b, db) proportional,
 /// decided exactly (every 2x2 minor zero, in rational arithmetic).
@@ -368,14 +371,17 @@ class Edit {
 /// cut on this same plane is on it.
 class VertexSides {
  public:
-  VertexSides(const PolyMesh& mesh, const Blade& blade, const std::vector<std::uint32_t>& tags,
+  VertexSides(const PolyMesh& mesh, const Blade& blade, const std::vector<PlaneTags>& tags,
               std::uint32_t planeId)
       : mesh_(mesh), plane_(blade.normal.x(), blade.normal.y(), blade.normal.z(), -blade.offset),
         tags_(tags), planeId_(planeId) {}
   int operator()(VertexId v) {
     const auto [it, inserted] = sides_.try_emplace(v.value, 0);
     if (inserted) {
-      const bool onThisPlane = v.index() < tags_.size() && tags_[v.index()] == planeId_;
+      const bool onThisPlane =
+          v.index() < tags_.size() &&
+          std::find(tags_[v.index()].begin(), tags_[v.index()].end(), planeId_) !=
+              tags_[v.index()].end();
       it->second = onThisPlane ? 0 : exactSide(plane_, mesh_.position(v));
     }
     return it->second;
@@ -403,7 +409,7 @@ class VertexSides {
  private:
   const PolyMesh& mesh_;
   Kernel::Plane_3 plane_;
-  const std::vector<std::uint32_t>& tags_;
+  const std::vector<PlaneTags>& tags_;
   std::uint32_t planeId_;
   std::unordered_map<std::uint32_t, int> sides_;
 };
@@ -422,7 +428,7 @@ struct Part {
 /// split once, each element's caps, and the pieces built into the mesh.
 class Splitter {
  public:
-  Splitter(Edit& edit, VertexSides& sides, const Blade& blade, std::vector<std::uint32_t>& tags,
+  Splitter(Edit& edit, VertexSides& sides, const Blade& blade, std::vector<PlaneTags>& tags,
            std::uint32_t planeId)
       : edit_(edit), mesh_(edit.mesh()), sides_(sides), blade_(blade), tags_(tags),
         planeId_(planeId) {
@@ -552,8 +558,9 @@ class Splitter {
   }
 
   /// The points this cut made on edges of the split faces: (a, b) -> p, mesh vertex ids.
-  /// In a part (the face's orientation), an edge from an original vertex x to a new point
-  /// lies on x's outgoing edge of the face, one from a new point to y on y's incoming edge.
+  /// In a part (the face's orientation), an edge from an original vertex x off the plane to a
+  /// new point lies on x's outgoing edge of the face, one from a new point to such a y on y's
+  /// incoming edge.
   std::map<std::pair<std::uint32_t, std::uint32_t>, VertexId> edgePoints() {
     std::map<std::pair<std::uint32_t, std::uint32_t>, VertexId> out;
     auto key = [](VertexId a, VertexId b) {
@@ -575,7 +582,11 @@ class Splitter {
             const std::size_t begin = p.loopBegin(k), end = p.loopEnd[k];
             for (std::size_t i = begin; i < end; ++i) {
               const std::uint32_t u = p.vertices[i], w = p.vertices[i + 1 == end ? begin : i + 1];
+              // An original vertex on the plane starts or ends segments along the cut line,
+              // not pieces of its face's edges.
               const bool uOld = u < meshOf_.size(), wOld = w < meshOf_.size();
+              if ((uOld && sides_(meshOf_[u]) == 0) || (wOld && sides_(meshOf_[w]) == 0))
+                continue;
               if (uOld && !wOld) {
                 const VertexId x = meshOf_[u], y = neighbour(x, 1), q = meshVertex(w);
                 if (y.valid() && q != x && q != y) out[key(x, y)] = q;
@@ -666,8 +677,8 @@ class Splitter {
       const auto same = byPosition_.find({p.x(), p.y(), p.z()});
       if (same != byPosition_.end()) return it->second = meshOf_[same->second];
       it->second = mesh_.addVertex(p);
-      tags_.resize(mesh_.numVertices(), kNoPlane);
-      tags_[it->second.index()] = planeId_;
+      tags_.resize(mesh_.numVertices());
+      tags_[it->second.index()] = {planeId_};
     }
     return it->second;
   }
@@ -738,7 +749,7 @@ class Splitter {
   PolyMesh& mesh_;
   VertexSides& sides_;
   const Blade& blade_;
-  std::vector<std::uint32_t>& tags_;
+  std::vector<PlaneTags>& tags_;
   std::uint32_t planeId_;
   SplitPlane plane_;
   std::unordered_map<std::uint32_t, std::uint32_t> local_;
@@ -839,7 +850,7 @@ MeshEditor::MeshEditor(PolyMesh mesh, double referenceVolume) : state_(std::make
   s.referenceVolume = referenceVolume;
   s.grid = ElementGrid(s.mesh, std::cbrt(referenceVolume));
   s.region.assign(s.mesh.numElements(), 0);
-  s.vertexPlane.assign(s.mesh.numVertices(), kNoPlane);
+  s.vertexPlane.assign(s.mesh.numVertices(), {});
 }
 
 MeshEditor::~MeshEditor() = default;
@@ -962,6 +973,24 @@ OperationReport MeshEditor::cut(const Blade& blade, const CutOptions& options) {
   checkOptions(options);
   if (!state_) throw std::logic_error("MeshEditor: used after release()");
   const auto start = std::chrono::steady_clock::now();
+  try {
+    return cutInPlace(blade, options);
+  } catch (const std::exception& e) {
+    // The splitter could not close a piece (constructions at round-off scale): the operation
+    // fails like a failed check, and the part-edited mesh must not be used further.
+    OperationReport report;
+    report.op = blade.finite() ? "cut_polygon" : "cut";
+    report.validation.level = options.validation;
+    report.validation.passed = false;
+    report.validation.failure = std::string("split: ") + e.what();
+    report.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return report;
+  }
+}
+
+OperationReport MeshEditor::cutInPlace(const Blade& blade, const CutOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
   State& s = *state_;
   OperationReport report;
   report.op = blade.finite() ? "cut_polygon" : "cut";
@@ -976,7 +1005,8 @@ OperationReport MeshEditor::cut(const Blade& blade, const CutOptions& options) {
          !samePlane(s.planes[planeId].first, s.planes[planeId].second, blade.normal, blade.offset))
     ++planeId;
   if (planeId == s.planes.size()) s.planes.emplace_back(blade.normal, blade.offset);
-  s.vertexPlane.resize(s.mesh.numVertices(), kNoPlane);
+  s.vertexPlane.resize(s.mesh.numVertices());
+  const std::size_t oldVertices = s.mesh.numVertices();
   VertexSides sides(s.mesh, blade, s.vertexPlane, planeId);
   const int removeSide = blade.finite() ? 0 : options.removeSide;
   std::optional<PolygonTest> polygon;
@@ -1067,10 +1097,30 @@ OperationReport MeshEditor::cut(const Blade& blade, const CutOptions& options) {
     }
     edit.markDeadIfUnused(f);
   }
+  // A new point on an edge whose ends both lie on an earlier plane lies on it too.
+  std::map<std::pair<std::uint32_t, std::uint32_t>, VertexId> points;
+  if (!toSplit.empty()) points = splitter.edgePoints();
+  // (An end lies on a plane if it was made on it or lies on it exactly.)
+  auto onPlane = [&](std::uint32_t v, std::uint32_t t) {
+    const PlaneTags& tags = s.vertexPlane[v];
+    if (std::find(tags.begin(), tags.end(), t) != tags.end()) return true;
+    const auto& [n, d] = s.planes[t];
+    return exactSide(Kernel::Plane_3(n.x(), n.y(), n.z(), -d), s.mesh.position(VertexId(v))) == 0;
+  };
+  for (const auto& [edge, p] : points) {
+    if (p.index() < oldVertices) continue;
+    PlaneTags candidates = s.vertexPlane[edge.first];
+    candidates.insert(candidates.end(), s.vertexPlane[edge.second].begin(),
+                      s.vertexPlane[edge.second].end());
+    PlaneTags& tags = s.vertexPlane[p.index()];
+    for (std::uint32_t t : candidates)
+      if (std::find(tags.begin(), tags.end(), t) == tags.end() && onPlane(edge.first, t) &&
+          onPlane(edge.second, t))
+        tags.push_back(t);
+  }
   // Edges the cut divided also bound faces of crossed elements kept whole: insert the new
   // points there too, so every element stays closed (no T-junctions).
   if (!unsplit.empty() && !toSplit.empty()) {
-    const auto points = splitter.edgePoints();
     for (ElementId e : unsplit) {
       const FaceList uses = s.mesh.element(e).faces;
       for (const FaceUse& use : uses) {

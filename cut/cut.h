@@ -106,8 +106,9 @@ class MeshEditor {
   double volume() const;
 
   /// Cuts with `blade`. When validation fails the report says so (validation.passed == false,
-  /// validation.failure names the check) and the mesh must not be used further: callers stop
-  /// and leave their input untouched.
+  /// validation.failure names the check; "split: ..." when a piece could not be closed) and
+  /// the mesh must not be used further: callers stop and leave their input untouched.
+  /// Throws std::invalid_argument for invalid options.
   OperationReport cut(const Blade& blade, const CutOptions& options = {});
 
   /// Merges every element below `fraction` * referenceVolume() into a neighbour, as after a cut.
@@ -118,6 +119,8 @@ class MeshEditor {
   PolyMesh release();
 
  private:
+  OperationReport cutInPlace(const Blade& blade, const CutOptions& options);
+
   struct State;
   std::unique_ptr<State> state_;
 };
