@@ -47,6 +47,16 @@ void MomentCache::sync() {
   for (std::size_t e = oldElements; e < ne; ++e) invalidateElement(ElementId(e));
 }
 
+void MomentCache::reserve(std::size_t faces, std::size_t elements) {
+  const std::size_t stride = static_cast<std::size_t>(stride_);
+  faceMoments_.reserve(faces * stride);
+  elementMoments_.reserve(elements * stride);
+  faceNormals_.raw().reserve(faces);
+  elementOrigins_.raw().reserve(elements);
+  faceDirty_.reserve(faces);
+  elementDirty_.reserve(elements);
+}
+
 void MomentCache::moveFace(FaceId from, FaceId to) {
   const std::size_t stride = static_cast<std::size_t>(stride_);
   if (from.index() >= faceNormals_.size() || faceDirty_[from.index()]) {

@@ -42,6 +42,9 @@ class MomentCache {
   // changed ones are recomputed. Ids at or past the cached size (appended since the last sync)
   // carry no moments: moving one marks the destination dirty.
 
+  /// Reserves room for this many faces and elements, so that growing the mesh in place does
+  /// not copy every moment.
+  void reserve(std::size_t faces, std::size_t elements);
   /// Face `from` was moved into slot `to`.
   void moveFace(FaceId from, FaceId to);
   /// Element `from` was moved into slot `to`.
