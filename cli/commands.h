@@ -16,6 +16,10 @@ void addCheckCommand(CLI::App& app, const CommonOptions& common, int& exitCode);
 void addMeshCommand(CLI::App& app, const CommonOptions& common, int& exitCode);
 void addSolveCommand(CLI::App& app, const CommonOptions& common, int& exitCode);
 void addBenchCommand(CLI::App& app, const CommonOptions& common, int& exitCode);
+/// `polydg run PIPELINE.json`: a JSON pipeline of steps on one input or many (cli/run.cpp).
+void addRunCommand(CLI::App& app, const CommonOptions& common, int& exitCode);
+/// `polydg cut MESH.vtu -o OUT.vtu --plane ...`: validated plane cuts in place (cli/cut.cpp).
+void addCutCommand(CLI::App& app, const CommonOptions& common, int& exitCode);
 
 /// True for files read as simulation meshes (VTU) rather than surfaces.
 bool isVolumeMeshPath(const std::string& path);

@@ -6,6 +6,8 @@
 //   polydg check mesh.vtu --report check.json
 //   polydg solve beam.vtu -o out.vtu --degree 2 --clamp x=0 --traction x=10:0,0,-1
 //   polydg bench --suite accuracy --out bench/
+//   polydg run testdata/pipeline.json --jobs 2 --out runs/
+//   polydg cut mesh.vtu -o half.vtu --plane "0,0,1,0.5" --remove-side + --report cut.json
 #include <cstdio>
 #include <exception>
 #include <iostream>
@@ -26,6 +28,8 @@ int main(int argc, char** argv) {
   polydg::cli::addCheckCommand(app, common, exitCode);
   polydg::cli::addSolveCommand(app, common, exitCode);
   polydg::cli::addBenchCommand(app, common, exitCode);
+  polydg::cli::addRunCommand(app, common, exitCode);
+  polydg::cli::addCutCommand(app, common, exitCode);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -34,9 +34,9 @@ MomentCache::MomentCache(const PolyMesh& mesh, int degree)
 }
 
 void MomentCache::sync() {
-  const std::size_t oldFaces = faceNormals_.size();
-  const std::size_t oldElements = elementOrigins_.size();
   const std::size_t nf = mesh_->numFaces(), ne = mesh_->numElements();
+  const std::size_t oldFaces = std::min(faceNormals_.size(), nf);
+  const std::size_t oldElements = std::min(elementOrigins_.size(), ne);
   faceMoments_.resize(nf * stride_, 0.0);
   elementMoments_.resize(ne * stride_, 0.0);
   faceNormals_.resize(nf, Vec3::Zero());
@@ -45,6 +45,47 @@ void MomentCache::sync() {
   elementDirty_.resize(ne, 0);
   for (std::size_t f = oldFaces; f < nf; ++f) invalidateFace(FaceId(f));
   for (std::size_t e = oldElements; e < ne; ++e) invalidateElement(ElementId(e));
+}
+
+void MomentCache::reserve(std::size_t faces, std::size_t elements) {
+  const std::size_t stride = static_cast<std::size_t>(stride_);
+  faceMoments_.reserve(faces * stride);
+  elementMoments_.reserve(elements * stride);
+  faceNormals_.raw().reserve(faces);
+  elementOrigins_.raw().reserve(elements);
+  faceDirty_.reserve(faces);
+  elementDirty_.reserve(elements);
+}
+
+void MomentCache::moveFace(FaceId from, FaceId to) {
+  const std::size_t stride = static_cast<std::size_t>(stride_);
+  if (from.index() >= faceNormals_.size() || faceDirty_[from.index()]) {
+    if (to.index() < faceNormals_.size() && !faceDirty_[to.index()]) {
+      faceDirty_[to.index()] = 1;
+      dirtyFaces_.push_back(to);
+    }
+    return;
+  }
+  std::copy_n(faceMoments_.begin() + from.index() * stride, stride,
+              faceMoments_.begin() + to.index() * stride);
+  faceNormals_[to] = faceNormals_[from];
+  faceDirty_[to.index()] = 0;  // a stale entry in dirtyFaces_ is skipped by update()
+}
+
+void MomentCache::moveElement(ElementId from, ElementId to) {
+  const std::size_t stride = static_cast<std::size_t>(stride_);
+  if (from.index() >= elementOrigins_.size() || elementDirty_[from.index()]) {
+    invalidateElement(to);
+    return;
+  }
+  std::copy_n(elementMoments_.begin() + from.index() * stride, stride,
+              elementMoments_.begin() + to.index() * stride);
+  elementOrigins_[to] = elementOrigins_[from];
+  elementDirty_[to.index()] = 0;
+}
+
+void MomentCache::reverseFace(FaceId f) {
+  if (f.index() < faceNormals_.size()) faceNormals_[f] = -faceNormals_[f];
 }
 
 void MomentCache::invalidateAll() {
@@ -72,6 +113,19 @@ void MomentCache::invalidateElement(ElementId e) {
 std::size_t MomentCache::update() {
   const PolyMesh& mesh = *mesh_;
   const std::size_t stride = static_cast<std::size_t>(stride_);
+  // Entries may be stale after moves and shrinking: keep each dirty id in range once.
+  auto prune = [](auto& list, auto& flags) {
+    std::size_t kept = 0;
+    for (auto id : list)
+      if (id.index() < flags.size() && flags[id.index()] == 1) {
+        flags[id.index()] = 2;
+        list[kept++] = id;
+      }
+    list.resize(kept);
+    for (auto id : list) flags[id.index()] = 1;
+  };
+  prune(dirtyFaces_, faceDirty_);
+  prune(dirtyElements_, elementDirty_);
 
   forEach(dirtyFaces_.size(), [&](std::size_t i) {
     const FaceId f = dirtyFaces_[i];

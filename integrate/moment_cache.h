@@ -33,8 +33,24 @@ class MomentCache {
   void invalidateElement(ElementId e);
   /// Marks every face and element, as after construction.
   void invalidateAll();
-  /// Picks up faces and elements appended to the mesh since the last call (marks them dirty).
+  /// Follows the mesh's size: picks up faces and elements appended since the last call (marks
+  /// them dirty) and drops those removed from the end.
   void sync();
+
+  // In-place edits (PolyMesh::removeFace / removeElement / reverseFace): call these right after
+  // the mesh's operation, so the moments move with their face or element and only new or
+  // changed ones are recomputed. Ids at or past the cached size (appended since the last sync)
+  // carry no moments: moving one marks the destination dirty.
+
+  /// Reserves room for this many faces and elements, so that growing the mesh in place does
+  /// not copy every moment.
+  void reserve(std::size_t faces, std::size_t elements);
+  /// Face `from` was moved into slot `to`.
+  void moveFace(FaceId from, FaceId to);
+  /// Element `from` was moved into slot `to`.
+  void moveElement(ElementId from, ElementId to);
+  /// Face f was reversed with its first vertex kept: same moments, opposite normal.
+  void reverseFace(FaceId f);
 
   std::span<const double> face(FaceId f) const {
     return {faceMoments_.data() + f.index() * stride_, static_cast<std::size_t>(stride_)};

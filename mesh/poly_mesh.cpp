@@ -193,6 +193,96 @@ void PolyMesh::mergeElementGroups(const std::vector<std::uint32_t>& group, std::
   openFacesStale_ = true;
 }
 
+void PolyMesh::detachFace(ElementId e, FaceId f) {
+  FaceList& uses = elements_[e].faces;
+  const auto it = std::find_if(uses.begin(), uses.end(),
+                               [&](const FaceUse& use) { return use.face == f; });
+  if (it == uses.end()) throw std::invalid_argument("detachFace: the element does not use the face");
+  Face& face = faces_[f];
+  (it->reversed ? face.back : face.front) = ElementId();
+  uses.erase(it);
+  openFacesStale_ = true;
+}
+
+void PolyMesh::attachFace(ElementId e, FaceUse use) {
+  Face& face = faces_[use.face];
+  ElementId& side = use.reversed ? face.back : face.front;
+  if (side.valid()) throw std::invalid_argument("attachFace: face side already used by an element");
+  side = e;
+  if (face.front.valid() && face.back.valid()) face.origin = FaceOrigin::Interior;
+  elements_[e].faces.push_back(use);
+  openFacesStale_ = true;
+}
+
+void PolyMesh::reverseFace(FaceId f) {
+  Face& face = faces_[f];
+  for (std::size_t k = 0; k < face.numLoops(); ++k) {
+    const std::size_t begin = k == 0 ? 0 : face.loopEnd[k - 1];
+    std::reverse(face.vertices.begin() + begin + 1, face.vertices.begin() + face.loopEnd[k]);
+  }
+  std::swap(face.front, face.back);
+  for (ElementId e : {face.front, face.back}) {
+    if (!e.valid()) continue;
+    for (FaceUse& use : elements_[e].faces)
+      if (use.face == f) use.reversed = !use.reversed;
+  }
+  openFacesStale_ = true;
+}
+
+FaceId PolyMesh::removeFace(FaceId f) {
+  if (faces_[f].front.valid() || faces_[f].back.valid())
+    throw std::invalid_argument("removeFace: the face is still used by an element");
+  const FaceId last(faces_.size() - 1);
+  openFacesStale_ = true;
+  if (f == last) {
+    faces_.raw().pop_back();
+    return FaceId();
+  }
+  faces_[f] = std::move(faces_[last]);
+  faces_.raw().pop_back();
+  for (ElementId e : {faces_[f].front, faces_[f].back}) {
+    if (!e.valid()) continue;
+    for (FaceUse& use : elements_[e].faces)
+      if (use.face == last) use.face = f;
+  }
+  return last;
+}
+
+ElementId PolyMesh::removeElement(ElementId e) {
+  if (!elements_[e].faces.empty())
+    throw std::invalid_argument("removeElement: the element still has faces");
+  const ElementId last(elements_.size() - 1);
+  if (e == last) {
+    elements_.raw().pop_back();
+    return ElementId();
+  }
+  elements_[e] = std::move(elements_[last]);
+  elements_.raw().pop_back();
+  for (const FaceUse& use : elements_[e].faces) {
+    Face& face = faces_[use.face];
+    (use.reversed ? face.back : face.front) = e;
+  }
+  return last;
+}
+
+bool PolyMesh::splitEdge(FaceId f, VertexId a, VertexId b, VertexId p) {
+  Face& face = faces_[f];
+  for (std::size_t k = 0; k < face.numLoops(); ++k) {
+    const std::size_t begin = k == 0 ? 0 : face.loopEnd[k - 1], end = face.loopEnd[k];
+    for (std::size_t i = begin; i < end; ++i) {
+      const std::size_t j = i + 1 == end ? begin : i + 1;
+      const VertexId u = face.vertices[i], w = face.vertices[j];
+      if (!((u == a && w == b) || (u == b && w == a))) continue;
+      // Insert after position i (at the loop's end when the edge closes the loop).
+      face.vertices.insert(face.vertices.begin() + static_cast<std::ptrdiff_t>(i + 1), p);
+      for (std::size_t m = k; m < face.loopEnd.size(); ++m) ++face.loopEnd[m];
+      openFacesStale_ = true;
+      return true;
+    }
+  }
+  return false;
+}
+
 ElementId PolyMesh::addElementFromFaces(std::span<const FaceUse> faces) {
   const ElementId e(elements_.size());
   // Check every face first, so a failure leaves the mesh unchanged.

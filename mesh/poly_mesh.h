@@ -144,6 +144,31 @@ class PolyMesh {
   /// their relative order). Vertices are unchanged.
   void mergeElementGroups(const std::vector<std::uint32_t>& group, std::size_t groups);
 
+  // --- in-place editing (cut/): each operation costs O(faces touched), never O(mesh) -------
+
+  /// Removes element e's use of face f and clears that side of f (f keeps its vertices and
+  /// origin; a face left with only a back element must be reversed or removed by the caller).
+  /// Throws std::invalid_argument if e does not use f.
+  void detachFace(ElementId e, FaceId f);
+  /// Appends `use` to element e's faces and sets that side of the face to e; a face then used
+  /// from both sides becomes `Interior`. Throws std::invalid_argument if the side is taken.
+  void attachFace(ElementId e, FaceUse use);
+  /// Reverses a face in place: every loop traversed the other way with its first vertex kept
+  /// first (so the face's reference point and area-positive moments are unchanged, its normal
+  /// flips), front and back swapped, and the `reversed` flag of each element's use flipped.
+  void reverseFace(FaceId f);
+  /// Removes an unused face (no front, no back) by moving the last face into its slot and
+  /// patching the uses of the moved face's elements. Returns the id the moved face had
+  /// (invalid if f was the last face): that face is now f.
+  FaceId removeFace(FaceId f);
+  /// Removes an element without faces (see detachFace) by moving the last element into its
+  /// slot and patching the front/back links of the moved element's faces. Returns the id the
+  /// moved element had (invalid if e was the last element): that element is now e.
+  ElementId removeElement(ElementId e);
+  /// Inserts vertex p between a and b wherever a and b follow each other (either way) in a
+  /// loop of face f: p must lie on that edge. Returns true if the face changed.
+  bool splitEdge(FaceId f, VertexId a, VertexId b, VertexId p);
+
  private:
 
   VertexData<Vec3> positions_;

@@ -74,7 +74,109 @@ bool isClosed(const PolyMesh& mesh, ElementId e) {
   return true;
 }
 
+/// True for the two sides of a cut: boundary faces tagged Cut with the same loops, reversed.
+/// They are one polygon, but deliberately not shared (the sides are not coupled).
+bool areCutSides(const PolyMesh& mesh, FaceId a, FaceId b) {
+  const Face& x = mesh.face(a);
+  const Face& y = mesh.face(b);
+  return x.origin == FaceOrigin::Cut && y.origin == FaceOrigin::Cut && x.isBoundary() &&
+         y.isBoundary() &&
+         isReverseOf(x, {y.vertices.data(), y.vertices.size()},
+                     {y.loopEnd.data(), y.loopEnd.size()});
+}
+
+/// Relative planarity error of a face beyond the tolerance, or 0 when it is planar enough.
+double planarityExcess(const PolyMesh& mesh, FaceId f, const ValidationOptions& options) {
+  const Box3 box = faceBounds(mesh, f);
+  const double deviation = planarityDeviation(mesh, f);
+  const double resolution = 16.0 * std::numeric_limits<double>::epsilon() *
+                            std::max(box.min().cwiseAbs().maxCoeff(), box.max().cwiseAbs().maxCoeff());
+  const double diameter = box.diagonal().norm();
+  return deviation > options.planarityTolerance * diameter + resolution ? deviation / diameter
+                                                                         : 0.0;
+}
+
 }  // namespace
+
+ValidationReport validateElements(const PolyMesh& mesh, std::span<const ElementId> elements,
+                                  const ValidationOptions& options) {
+  ValidationReport report;
+  Problems problems(report, options.maxMessages);
+  report.elements = elements.size();
+  std::vector<FaceId> faces;
+  for (ElementId e : elements) {
+    const Element& element = mesh.element(e);
+    if (element.faces.empty()) {
+      problems.add(report.emptyElements, describe("element without faces:", e.index()));
+      continue;
+    }
+    for (const FaceUse& use : element.faces) {
+      faces.push_back(use.face);
+      const Face& face = mesh.face(use.face);
+      if ((use.reversed ? face.back : face.front) != e)
+        problems.add(report.inconsistentFaces,
+                     "element " + std::to_string(e.index()) + " uses face " +
+                         std::to_string(use.face.value) + " but the face does not list it");
+    }
+    if (!isClosed(mesh, e))
+      problems.add(report.openElements,
+                   describe("element", e.index()) + " is not closed (an edge of its faces is "
+                                                    "not matched by the reverse edge of another)");
+    const double v = signedVolume(mesh, e);
+    report.volume += v;
+    if (!(v > 0.0)) {
+      std::ostringstream msg;
+      msg << "element " << e.index() << " has non-positive volume " << v;
+      problems.add(report.nonPositiveElements, msg.str());
+    }
+  }
+  std::sort(faces.begin(), faces.end());
+  faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+  report.faces = faces.size();
+  std::vector<std::pair<std::uint64_t, FaceId>> keys;
+  for (FaceId f : faces) {
+    const Face& face = mesh.face(f);
+    if (face.front.valid() && face.back.valid()) ++report.interiorFaces;
+    else ++report.boundaryFaces;
+    if (!face.front.valid())
+      problems.add(report.inconsistentFaces, describe("face used only from its back:", f.index()));
+    for (ElementId side : {face.front, face.back}) {
+      if (!side.valid()) continue;
+      const auto& uses = mesh.element(side).faces;
+      if (std::none_of(uses.begin(), uses.end(), [&](const FaceUse& u) { return u.face == f; }))
+        problems.add(report.inconsistentFaces,
+                     "face " + std::to_string(f.index()) + " lists element " +
+                         std::to_string(side.index()) + " which does not use it");
+    }
+    if (isDegenerate(mesh, f)) {
+      problems.add(report.degenerateFaces, describe("degenerate face", f.index()));
+    } else if (const double excess = planarityExcess(mesh, f, options); excess > 0) {
+      std::ostringstream msg;
+      msg << "face " << f.index() << " is not planar (relative error " << excess << ")";
+      problems.add(report.nonPlanarFaces, msg.str());
+    }
+    keys.emplace_back(vertexSetKey({face.vertices.data(), face.vertices.size()}), f);
+  }
+  std::sort(keys.begin(), keys.end());
+  auto sortedIds = [&](FaceId f) {
+    boost::container::small_vector<VertexId, 8> ids(mesh.face(f).vertices.begin(),
+                                                   mesh.face(f).vertices.end());
+    std::sort(ids.begin(), ids.end());
+    return ids;
+  };
+  for (std::size_t a = 0; a < keys.size(); ++a)
+    for (std::size_t b = a + 1; b < keys.size() && keys[b].first == keys[a].first; ++b)
+      if (sortedIds(keys[a].second) == sortedIds(keys[b].second) &&
+          !areCutSides(mesh, keys[a].second, keys[b].second))
+        problems.add(report.duplicateFaces, "faces " + std::to_string(keys[a].second.index()) +
+                                                " and " + std::to_string(keys[b].second.index()) +
+                                                " are the same polygon but not shared");
+  report.passed = report.openElements == 0 && report.nonPositiveElements == 0 &&
+                  report.nonPlanarFaces == 0 && report.degenerateFaces == 0 &&
+                  report.duplicateFaces == 0 && report.inconsistentFaces == 0 &&
+                  report.emptyElements == 0;
+  return report;
+}
 
 ElementData<std::uint32_t> connectedComponents(const PolyMesh& mesh, std::size_t& count) {
   const std::size_t n = mesh.numElements();
@@ -169,7 +271,8 @@ ValidationReport validate(const PolyMesh& mesh, const ValidationOptions& options
     while (b < byKey.size() && checks[byKey[b]].key == checks[byKey[a]].key) ++b;
     for (std::size_t x = a; x < b; ++x)
       for (std::size_t y = x + 1; y < b; ++y)
-        if (sortedIds(byKey[x]) == sortedIds(byKey[y]))
+        if (sortedIds(byKey[x]) == sortedIds(byKey[y]) &&
+            !areCutSides(mesh, FaceId(byKey[x]), FaceId(byKey[y])))
           problems.add(report.duplicateFaces,
                        "faces " + std::to_string(byKey[x]) + " and " + std::to_string(byKey[y]) +
                            " are the same polygon but not shared (a face used by more than two "

@@ -2,6 +2,7 @@
 // shared by at most two elements with opposite orientation, and connected components.
 #pragma once
 
+#include <span>
 #include <string>
 #include <vector>
 
@@ -36,7 +37,9 @@ struct ValidationReport {
   std::size_t nonPositiveElements = 0;  ///< volume <= 0 (inverted or flat)
   std::size_t nonPlanarFaces = 0;
   std::size_t degenerateFaces = 0;      ///< a loop with < 3 vertices, a repeated vertex, or zero area
-  std::size_t duplicateFaces = 0;       ///< the same polygon as another face (not shared)
+  /// The same polygon as another face, not shared (except the two sides of a cut: boundary
+  /// faces tagged Cut, one the other reversed).
+  std::size_t duplicateFaces = 0;
   std::size_t inconsistentFaces = 0;    ///< face/element links disagree, or unused face
   std::size_t emptyElements = 0;        ///< an element without faces
   std::vector<std::string> messages;    ///< the first few problems, one line each
@@ -44,6 +47,13 @@ struct ValidationReport {
 
 /// Runs every check over the whole mesh.
 ValidationReport validate(const PolyMesh& mesh, const ValidationOptions& options = {});
+
+/// The same checks restricted to `elements` and their faces, at a cost that grows with them:
+/// closure, volume, planarity and degeneracy of their faces, links between those faces and
+/// their elements, and duplicates among those faces. Components and the volume range are
+/// not computed (components = 0); `volume` is the sum over `elements`.
+ValidationReport validateElements(const PolyMesh& mesh, std::span<const ElementId> elements,
+                                  const ValidationOptions& options = {});
 
 /// Components of the mesh: component index per element (0-based, in order of first element),
 /// with elements connected when they share a face.

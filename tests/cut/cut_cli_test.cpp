@@ -1,0 +1,142 @@
+// `polydg cut` as users run it: the report's keys and figures, exit codes, one-line errors, and
+// no output (nor a changed input) when an argument or an operation's validation fails.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Result {
+  int exitCode = -1;
+  std::string out;  // stdout and stderr together
+};
+
+Result run(const std::string& arguments) {
+  const std::string command = std::string(POLYDG_BINARY) + " " + arguments + " 2>&1";
+  Result r;
+  FILE* pipe = popen(command.c_str(), "r");
+  if (!pipe) return r;
+  std::array<char, 4096> buffer;
+  while (std::fgets(buffer.data(), buffer.size(), pipe)) r.out += buffer.data();
+  const int status = pclose(pipe);
+  r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+std::size_t lines(const std::string& s) {
+  return static_cast<std::size_t>(std::count(s.begin(), s.end(), '\n'));
+}
+
+class CutCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("polydg_cut_cli_" +
+            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    // A 4 x 4 x 4 grid of the unit cube (cube.obj spans [0, 1]^3).
+    const Result mesh = run("mesh " + std::string(POLYDG_TESTDATA_DIR) + "/cube.obj --cells 4 -o " +
+                            path("cube.vtu") + " --quiet");
+    ASSERT_EQ(mesh.exitCode, 0) << mesh.out;
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  nlohmann::json readJson(const std::string& name) const {
+    std::ifstream in(path(name));
+    return nlohmann::json::parse(in);
+  }
+  std::string input() const { return path("cube.vtu"); }
+  fs::path dir_;
+};
+
+TEST_F(CutCli, ReportsEveryOperation) {
+  const Result r = run("cut " + input() + " -o " + path("out.vtu") +
+                       " --plane 0,0,1,0.3 --plane \"1,1,1,1.4\" --remove-side + --report " +
+                       path("r.json") + " --quiet");
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  EXPECT_TRUE(r.out.empty()) << r.out;
+  ASSERT_TRUE(fs::exists(path("out.vtu")));
+  const auto report = readJson("r.json");
+  ASSERT_EQ(report["operations"].size(), 2u);
+  for (const auto& op : report["operations"]) {
+    for (const char* key : {"op", "elements_split", "pieces_created", "elements_removed",
+                            "volume_removed", "slivers_merged", "isolated_slivers",
+                            "faces_reintegrated", "faces_total", "left_whole", "validation",
+                            "time_s"})
+      EXPECT_TRUE(op.contains(key)) << key;
+    for (const char* key : {"passed", "level", "elements_checked", "region_elements",
+                            "patch_test_error", "region_components", "zero_modes",
+                            "volume_rel_error", "failure"})
+      EXPECT_TRUE(op["validation"].contains(key)) << key;
+    EXPECT_TRUE(op["validation"]["passed"].get<bool>());
+    EXPECT_EQ(op["validation"]["level"], "local");
+  }
+  const auto& first = report["operations"][0];
+  EXPECT_EQ(first["op"], "cut");
+  EXPECT_EQ(first["elements_split"], 16);  // one layer of the 4^3 grid
+  EXPECT_NEAR(first["volume_removed"].get<double>(), 0.7, 1e-12);
+  const double removed = first["volume_removed"].get<double>() +
+                         report["operations"][1]["volume_removed"].get<double>();
+  EXPECT_NEAR(report["input"]["volume"].get<double>(), 1.0, 1e-12);
+  EXPECT_NEAR(report["output"]["volume"].get<double>() + removed, 1.0, 1e-12);
+  EXPECT_EQ(report["output"]["components"], 1);
+  const Result check = run("check " + path("out.vtu") + " --quiet");
+  EXPECT_EQ(check.exitCode, 0) << check.out;
+}
+
+TEST_F(CutCli, PolygonReportsElementsLeftWhole) {
+  const Result r = run("cut " + input() + " -o " + path("out.vtu") +
+                       " --polygon \"0.1,0.1,0.4;0.6,0.1,0.4;0.6,0.6,0.55;0.1,0.6,0.55\" --report " +
+                       path("r.json") + " --quiet");
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  const auto op = readJson("r.json")["operations"][0];
+  EXPECT_EQ(op["op"], "cut_polygon");
+  EXPECT_GT(op["elements_split"].get<int>(), 0);
+  EXPECT_GT(op["left_whole"]["count"].get<int>(), 0);
+  EXPECT_FALSE(op["left_whole"]["first_ids"].empty());
+}
+
+TEST_F(CutCli, BadArgumentsExitTwoWithOneLineAndNoOutput) {
+  for (const std::string& args :
+       {std::string("--plane 0,0,0,1"), std::string("--plane 0,0,1"),
+        std::string("--plane 0,0,x,1"), std::string("--polygon \"0,0,0;1,0,0;2,0,0\""),
+        std::string("--plane 0,0,1,0.5 --remove-side up"), std::string("--validate all --plane 0,0,1,0.5"),
+        std::string("")}) {
+    const Result r = run("cut " + input() + " -o " + path("out.vtu") + " " + args + " --report " +
+                         path("r.json"));
+    EXPECT_EQ(r.exitCode, 2) << args << ": " << r.out;
+    EXPECT_EQ(lines(r.out), 1u) << args << ": " << r.out;
+    EXPECT_FALSE(fs::exists(path("out.vtu"))) << args;
+    EXPECT_FALSE(fs::exists(path("r.json"))) << args;
+  }
+  const auto size = fs::file_size(input());
+  const Result same = run("cut " + input() + " -o " + input() + " --plane 0,0,1,0.5");
+  EXPECT_EQ(same.exitCode, 2) << same.out;
+  EXPECT_EQ(fs::file_size(input()), size);
+}
+
+TEST_F(CutCli, FailedValidationExitsOneAndWritesNoMesh) {
+  // Without sliver merging, the 1e-12 sheet between these planes is split into pieces far too
+  // thin for the DG patch test: the second operation fails and is named.
+  const Result r = run("cut " + input() + " -o " + path("out.vtu") +
+                       " --plane 0.2,0.3,1,0.61 --plane 0.2,0.3,1,0.610000000001 "
+                       "--merge-slivers 0 --report " + path("r.json"));
+  EXPECT_EQ(r.exitCode, 1) << r.out;
+  EXPECT_EQ(lines(r.out), 1u) << r.out;
+  EXPECT_NE(r.out.find("operation 2"), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(path("out.vtu")));
+  const auto report = readJson("r.json");
+  EXPECT_FALSE(report["passed"].get<bool>());
+  EXPECT_FALSE(report["operations"][1]["validation"]["passed"].get<bool>());
+}
+
+}  // namespace
