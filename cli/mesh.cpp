@@ -28,6 +28,10 @@ struct MeshCommandOptions {
   bool skipDg = false;
 };
 
+double secondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
 /// The local DG checks of the new mesh (degree 1) and their wall time with the moments.
 struct DgOutcome {
   LocalDgCheck check;
@@ -113,7 +117,9 @@ void addMeshCommand(CLI::App& app, const CommonOptions& common, int& exitCode) {
     requireDistinct(o->output, o->input);
     if (!o->report.empty()) requireDistinct(o->report, o->input);
 
+    const auto readStart = std::chrono::steady_clock::now();
     const TriangleSurface surface = readSurface(o->input);
+    const double readSeconds = secondsSince(readStart);
     MeshingOptions options;
     options.cellSize = o->cell;
     options.cellsAlongLongest = o->cells;
@@ -135,7 +141,10 @@ void addMeshCommand(CLI::App& app, const CommonOptions& common, int& exitCode) {
       result.report.timings.emplace_back("dg_checks", dg->seconds);
     }
     const bool passed = result.report.validation.passed && (!dg || dg->check.passed());
+    result.report.timings.insert(result.report.timings.begin(), {"read", readSeconds});
+    const auto writeStart = std::chrono::steady_clock::now();
     writeVtu(result.mesh, o->output);
+    result.report.timings.emplace_back("write", secondsSince(writeStart));
     if (!o->report.empty()) {
       nlohmann::json report = toJson(result.report);
       report["command"] = "mesh";
