@@ -146,10 +146,8 @@ struct Kernel {
     const FaceFrame fr = frame(mesh, moments, view.face);
     const Vec3 n = view.selfIsFront ? moments.faceNormal(view.face)
                                     : Vec3(-moments.faceNormal(view.face));
-    const double area = moments.area(view.face);
-    double inverseVolumes = 1.0 / moments.volume(view.self);
-    if (interior) inverseVolumes += 1.0 / moments.volume(view.other);
-    const double etaF = form.eta * area * inverseVolumes;
+    const double etaF = facePenalty(form, moments, view.face, view.self,
+                                    interior ? view.other : ElementId());
     const double w = interior ? 0.5 : 1.0;
     const double mu = form.mu, lambda = form.lambda;
     const bool ip = form.method == Method::IP;
@@ -234,6 +232,14 @@ void elementMass(const DgBasis& basis, const MomentCache& moments, ElementId e,
                  Eigen::MatrixXd& out) {
   detail::dispatchBasisDegree(basis.degree(),
                               [&](auto p) { Kernel<p()>::mass(basis, moments, e, out); });
+}
+
+double facePenalty(const FormCoefficients& form, const MomentCache& moments, FaceId f,
+                   ElementId self, ElementId other) {
+  auto eta = [&](ElementId e) { return form.elementEta ? (*form.elementEta)[e] : form.eta; };
+  double sum = eta(self) / moments.volume(self);
+  if (other.valid()) sum += eta(other) / moments.volume(other);
+  return moments.area(f) * sum;
 }
 
 void faceRows(const PolyMesh& mesh, const DgBasis& basis, const MomentCache& moments,

@@ -1,5 +1,6 @@
 #include "physics/static_solver.h"
 
+#include <algorithm>
 #include <chrono>
 #include <stdexcept>
 
@@ -41,7 +42,12 @@ void StaticSolver::assemble(const LoadCase& loads) {
   form_.method = disc.method;
   form_.mu = material_.mu();
   form_.lambda = material_.lambda();
-  report_.etaThreshold = penaltyThreshold(*mesh_, *basis_, *moments_, roles_);
+  elementEta_ = std::make_unique<ElementData<double>>(
+      elementPenaltyThresholds(*mesh_, *basis_, *moments_, roles_));
+  report_.etaThreshold = elementEta_->size() == 0
+                             ? 0.0
+                             : *std::max_element(elementEta_->begin(), elementEta_->end());
+  form_.elementEta = nullptr;
   const int quadrature =
       disc.quadratureDegree >= 0 ? disc.quadratureDegree : 2 * basis_->degree() + 2;
   system_.blockSize = 3 * basis_->size();
@@ -52,6 +58,11 @@ void StaticSolver::assemble(const LoadCase& loads) {
     case PenaltyRule::TraceBound:
       form_.eta = disc.penalty.safety * report_.etaThreshold;
       if (form_.eta <= 0.0) form_.eta = 1.0;  // no coupled faces: any positive value
+      if (disc.penalty.local) {
+        // Elements without coupled faces have no penalty terms; any positive value does.
+        for (double& eta : *elementEta_) eta = eta > 0.0 ? disc.penalty.safety * eta : form_.eta;
+        form_.elementEta = elementEta_.get();
+      }
       break;
     case PenaltyRule::Fixed:
       form_.eta = disc.penalty.eta;
