@@ -112,8 +112,12 @@ const Eigen::VectorXd& StaticSolver::solve() {
   const auto t0 = Clock::now();
   if (!factorized_) {
     solver_ = LinearSolver(options_.solver);
-    if (!solver_.compute(system_.matrix, system_.blockSize) &&
-        solver_.kind() == SolverKind::Cholesky)
+    // Cholesky and the p-multigrid's level-0 factorization detect an indefinite K; the
+    // block-Jacobi preconditioner falls back to diagonals and lets CG report the failure.
+    const bool definiteCheck =
+        solver_.kind() == SolverKind::Cholesky ||
+        options_.solver.preconditioner == CgPreconditioner::PMultigrid;
+    if (!solver_.compute(system_.matrix, system_.blockSize) && definiteCheck)
       throw std::runtime_error(
           "the stiffness matrix is not positive definite: is the body held by a Dirichlet "
           "condition (e.g. --clamp)?");

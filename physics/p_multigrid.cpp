@@ -1,0 +1,258 @@
+#include "physics/p_multigrid.h"
+
+#include <algorithm>
+#include <atomic>
+#include <stdexcept>
+
+#include <Eigen/CholmodSupport>
+#include <Eigen/Dense>
+#include <tbb/parallel_for.h>
+
+#include "integrate/monomials.h"
+
+namespace polydg {
+
+namespace {
+
+using SpMat = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
+
+/// Largest element block handled (3 numMonomials(3)).
+constexpr int kMaxBlock = 60;
+using BlockVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxBlock, 1>;
+
+/// One degree q: its matrix (the top level borrows K), functions per component and the
+/// inverses of its element diagonal blocks (bs x bs each, column-major).
+struct Level {
+  const SpMat* matrix = nullptr;
+  SpMat owned;
+  int n = 0, bs = 0;
+  std::vector<double> inverses;
+  // Scratch of apply(): right-hand side, solution and residual of this level.
+  mutable Eigen::VectorXd b, x, r;
+};
+
+/// The principal submatrix of `fine` (n functions per component) on the DOFs of the first
+/// `nc` functions of each component, renumbered (e, d, i) -> e 3 nc + d nc + i.
+SpMat restrictMatrix(const SpMat& fine, int n, int nc) {
+  const int bs = 3 * n, bsc = 3 * nc;
+  const Eigen::Index ne = fine.cols() / bs;
+  const Eigen::Index ncols = ne * bsc;
+  auto coarseIndex = [&](int dof) -> int {
+    const int e = dof / bs, local = dof % bs, d = local / n, i = local % n;
+    return i < nc ? e * bsc + d * nc + i : -1;
+  };
+  auto fineColumn = [&](Eigen::Index c) -> Eigen::Index {
+    const Eigen::Index e = c / bsc, local = c % bsc;
+    return e * bs + (local / nc) * n + local % nc;
+  };
+  const int* outer = fine.outerIndexPtr();
+  const int* inner = fine.innerIndexPtr();
+  const double* values = fine.valuePtr();
+  std::vector<int> counts(static_cast<std::size_t>(ncols) + 1, 0);
+  tbb::parallel_for(Eigen::Index(0), ncols, [&](Eigen::Index c) {
+    const Eigen::Index fc = fineColumn(c);
+    int count = 0;
+    for (int k = outer[fc]; k < outer[fc + 1]; ++k) count += coarseIndex(inner[k]) >= 0;
+    counts[static_cast<std::size_t>(c) + 1] = count;
+  });
+  for (std::size_t c = 1; c < counts.size(); ++c) counts[c] += counts[c - 1];
+  SpMat coarse(ncols, ncols);
+  coarse.resizeNonZeros(counts.back());
+  std::copy(counts.begin(), counts.end(), coarse.outerIndexPtr());
+  int* cinner = coarse.innerIndexPtr();
+  double* cvalues = coarse.valuePtr();
+  tbb::parallel_for(Eigen::Index(0), ncols, [&](Eigen::Index c) {
+    const Eigen::Index fc = fineColumn(c);
+    int pos = counts[static_cast<std::size_t>(c)];
+    // Fine rows are sorted and the renumbering is monotone: coarse rows come out sorted.
+    for (int k = outer[fc]; k < outer[fc + 1]; ++k) {
+      const int row = coarseIndex(inner[k]);
+      if (row < 0) continue;
+      cinner[pos] = row;
+      cvalues[pos++] = values[k];
+    }
+  });
+  return coarse;
+}
+
+/// Inverts the element diagonal blocks of `level`; false if one is not positive definite.
+bool invertBlocks(Level& level) {
+  const SpMat& a = *level.matrix;
+  const int bs = level.bs;
+  const Eigen::Index ne = a.cols() / bs;
+  level.inverses.assign(static_cast<std::size_t>(ne * bs * bs), 0.0);
+  std::atomic<bool> ok{true};
+  tbb::parallel_for(Eigen::Index(0), ne, [&](Eigen::Index e) {
+    const Eigen::Index base = e * bs;
+    Eigen::MatrixXd block = Eigen::MatrixXd::Zero(bs, bs);
+    for (int c = 0; c < bs; ++c)
+      for (SpMat::InnerIterator it(a, base + c); it; ++it)
+        if (it.row() >= base && it.row() < base + bs) block(it.row() - base, c) = it.value();
+    Eigen::LLT<Eigen::MatrixXd> llt(block);
+    if (llt.info() != Eigen::Success) {
+      ok = false;
+      return;
+    }
+    Eigen::Map<Eigen::MatrixXd>(level.inverses.data() + e * bs * bs, bs, bs) =
+        llt.solve(Eigen::MatrixXd::Identity(bs, bs));
+  });
+  return ok;
+}
+
+/// Greedy colouring of the element graph of `a` (elements sharing a nonzero block are
+/// neighbours): the elements of each colour, in increasing order.
+std::vector<std::vector<int>> colourElements(const SpMat& a, int bs) {
+  const int ne = static_cast<int>(a.cols() / bs);
+  std::vector<int> colour(static_cast<std::size_t>(ne), -1);
+  std::vector<int> seenBy;  // seenBy[c] == e: colour c is taken by a neighbour of e
+  std::vector<std::vector<int>> classes;
+  for (int e = 0; e < ne; ++e) {
+    // Column e bs holds a row of every neighbour block (BZ blocks included: component 0).
+    for (SpMat::InnerIterator it(a, static_cast<Eigen::Index>(e) * bs); it; ++it) {
+      const int c = colour[static_cast<std::size_t>(it.row() / bs)];
+      if (c >= 0) seenBy[static_cast<std::size_t>(c)] = e;
+    }
+    int c = 0;
+    while (c < static_cast<int>(seenBy.size()) && seenBy[static_cast<std::size_t>(c)] == e) ++c;
+    if (c == static_cast<int>(seenBy.size())) {
+      seenBy.push_back(-1);
+      classes.emplace_back();
+    }
+    colour[static_cast<std::size_t>(e)] = c;
+    classes[static_cast<std::size_t>(c)].push_back(e);
+  }
+  return classes;
+}
+
+/// Functions per component of degree `degree`: numMonomials, checked against the block size.
+int functionsOfBlock(int blockSize, int degree) {
+  const int n = numMonomials(degree);
+  if (blockSize != 3 * n || blockSize > kMaxBlock)
+    throw std::invalid_argument("PMultigrid: block size does not match the degree");
+  return n;
+}
+
+}  // namespace
+
+struct PMultigrid::Impl {
+  std::vector<Level> levels;  // levels[q]: degree q
+  std::vector<std::vector<int>> colours;
+  Eigen::CholmodSupernodalLLT<SpMat, Eigen::Lower> coarse;
+
+  /// One block Gauss-Seidel sweep on `level` for A x = b, colours in order or reversed.
+  void sweep(const Level& level, const Eigen::VectorXd& b, Eigen::VectorXd& x,
+             bool reverse) const {
+    const SpMat& a = *level.matrix;
+    const int* outer = a.outerIndexPtr();
+    const int* inner = a.innerIndexPtr();
+    const double* values = a.valuePtr();
+    const int bs = level.bs;
+    const std::size_t nc = colours.size();
+    for (std::size_t t = 0; t < nc; ++t) {
+      const std::vector<int>& cls = colours[reverse ? nc - 1 - t : t];
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cls.size(), 8),
+                        [&](const tbb::blocked_range<std::size_t>& range) {
+                          BlockVector s(bs);
+                          for (std::size_t j = range.begin(); j != range.end(); ++j) {
+                            const Eigen::Index e = cls[j], base = e * bs;
+                            // Column base + c of A is row base + c (symmetric storage).
+                            for (int c = 0; c < bs; ++c) {
+                              double sum = 0.0;
+                              for (int k = outer[base + c]; k < outer[base + c + 1]; ++k)
+                                sum += values[k] * x[inner[k]];
+                              s[c] = b[base + c] - sum;
+                            }
+                            x.segment(base, bs).noalias() +=
+                                Eigen::Map<const Eigen::MatrixXd>(
+                                    level.inverses.data() + e * bs * bs, bs, bs) *
+                                s;
+                          }
+                        });
+    }
+  }
+
+  /// r = b - A x on `level`.
+  static void residual(const Level& level, const Eigen::VectorXd& b, const Eigen::VectorXd& x,
+                       Eigen::VectorXd& r) {
+    const SpMat& a = *level.matrix;
+    const int* outer = a.outerIndexPtr();
+    const int* inner = a.innerIndexPtr();
+    const double* values = a.valuePtr();
+    r.resize(b.size());
+    tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, a.cols(), 512),
+                      [&](const tbb::blocked_range<Eigen::Index>& range) {
+                        for (Eigen::Index c = range.begin(); c != range.end(); ++c) {
+                          double sum = 0.0;
+                          for (int k = outer[c]; k < outer[c + 1]; ++k)
+                            sum += values[k] * x[inner[k]];
+                          r[c] = b[c] - sum;
+                        }
+                      });
+  }
+
+  /// x = V-cycle(q) applied to b, from x = 0.
+  void vcycle(int q, const Eigen::VectorXd& b, Eigen::VectorXd& x) const {
+    if (q == 0) {
+      x = coarse.solve(b);
+      return;
+    }
+    const Level& fine = levels[static_cast<std::size_t>(q)];
+    const Level& next = levels[static_cast<std::size_t>(q - 1)];
+    x.setZero(b.size());
+    sweep(fine, b, x, false);
+    residual(fine, b, x, fine.r);
+    const int n = fine.n, nc = next.n;
+    const Eigen::Index ne = b.size() / fine.bs;
+    next.b.resize(ne * next.bs);
+    tbb::parallel_for(Eigen::Index(0), ne, [&](Eigen::Index e) {
+      for (int d = 0; d < 3; ++d)
+        next.b.segment(e * next.bs + d * nc, nc) = fine.r.segment(e * fine.bs + d * n, nc);
+    });
+    vcycle(q - 1, next.b, next.x);
+    tbb::parallel_for(Eigen::Index(0), ne, [&](Eigen::Index e) {
+      for (int d = 0; d < 3; ++d)
+        x.segment(e * fine.bs + d * n, nc) += next.x.segment(e * next.bs + d * nc, nc);
+    });
+    sweep(fine, b, x, true);
+  }
+};
+
+PMultigrid::PMultigrid() : impl_(std::make_unique<Impl>()) {}
+PMultigrid::~PMultigrid() = default;
+PMultigrid::PMultigrid(PMultigrid&&) noexcept = default;
+PMultigrid& PMultigrid::operator=(PMultigrid&&) noexcept = default;
+
+int PMultigrid::levels() const { return static_cast<int>(impl_->levels.size()); }
+int PMultigrid::colours() const { return static_cast<int>(impl_->colours.size()); }
+
+bool PMultigrid::compute(const SpMat& matrix, int degree) {
+  Impl& m = *impl_;
+  m.levels.assign(static_cast<std::size_t>(degree) + 1, Level{});
+  Level& top = m.levels.back();
+  top.n = numMonomials(degree);
+  top.bs = 3 * top.n;
+  functionsOfBlock(top.bs, degree);
+  top.matrix = &matrix;
+  m.colours = colourElements(matrix, top.bs);
+  for (int q = degree - 1; q >= 0; --q) {
+    Level& fine = m.levels[static_cast<std::size_t>(q) + 1];
+    Level& level = m.levels[static_cast<std::size_t>(q)];
+    level.n = numMonomials(q);
+    level.bs = 3 * level.n;
+    level.owned = restrictMatrix(*fine.matrix, fine.n, level.n);
+    level.matrix = &level.owned;
+  }
+  std::atomic<bool> ok{true};
+  tbb::parallel_for(std::size_t(1), m.levels.size(), [&](std::size_t q) {
+    if (!invertBlocks(m.levels[q])) ok = false;
+  });
+  m.coarse.cholmod().print = 0;
+  m.coarse.compute(*m.levels.front().matrix);
+  return ok && m.coarse.info() == Eigen::Success;
+}
+
+void PMultigrid::apply(const Eigen::VectorXd& r, Eigen::VectorXd& z) const {
+  impl_->vcycle(static_cast<int>(impl_->levels.size()) - 1, r, z);
+}
+
+}  // namespace polydg
