@@ -137,7 +137,8 @@ int functionsOfBlock(int blockSize, int degree) {
 struct PMultigrid::Impl {
   std::vector<Level> levels;  // levels[q]: degree q
   std::vector<std::vector<int>> colours;
-  Eigen::CholmodSupernodalLLT<SpMat, Eigen::Lower> coarse;
+  /// CHOLMOD chooses simplicial (small levels: no BLAS start-up) or supernodal by the fill.
+  Eigen::CholmodDecomposition<SpMat, Eigen::Lower> coarse;
 
   /// One block Gauss-Seidel sweep on `level` for A x = b, colours in order or reversed.
   void sweep(const Level& level, const Eigen::VectorXd& b, Eigen::VectorXd& x,
@@ -171,23 +172,36 @@ struct PMultigrid::Impl {
     }
   }
 
-  /// r = b - A x on `level`.
-  static void residual(const Level& level, const Eigen::VectorXd& b, const Eigen::VectorXd& x,
-                       Eigen::VectorXd& r) {
+  /// r = b - A x on `level` right after a forward sweep: the rows of the last colour were
+  /// just solved with every neighbour final, so their residual is zero and is not computed.
+  void residualAfterSweep(const Level& level, const Eigen::VectorXd& b, const Eigen::VectorXd& x,
+                          Eigen::VectorXd& r) const {
     const SpMat& a = *level.matrix;
     const int* outer = a.outerIndexPtr();
     const int* inner = a.innerIndexPtr();
     const double* values = a.valuePtr();
+    const int bs = level.bs;
     r.resize(b.size());
-    tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, a.cols(), 512),
-                      [&](const tbb::blocked_range<Eigen::Index>& range) {
-                        for (Eigen::Index c = range.begin(); c != range.end(); ++c) {
-                          double sum = 0.0;
-                          for (int k = outer[c]; k < outer[c + 1]; ++k)
-                            sum += values[k] * x[inner[k]];
-                          r[c] = b[c] - sum;
-                        }
-                      });
+    for (std::size_t t = 0; t < colours.size(); ++t) {
+      const std::vector<int>& cls = colours[t];
+      const bool last = t + 1 == colours.size();
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cls.size(), 16),
+                        [&](const tbb::blocked_range<std::size_t>& range) {
+                          for (std::size_t j = range.begin(); j != range.end(); ++j) {
+                            const Eigen::Index base = static_cast<Eigen::Index>(cls[j]) * bs;
+                            if (last) {
+                              r.segment(base, bs).setZero();
+                              continue;
+                            }
+                            for (Eigen::Index c = base; c < base + bs; ++c) {
+                              double sum = 0.0;
+                              for (int k = outer[c]; k < outer[c + 1]; ++k)
+                                sum += values[k] * x[inner[k]];
+                              r[c] = b[c] - sum;
+                            }
+                          }
+                        });
+    }
   }
 
   /// x = V-cycle(q) applied to b, from x = 0.
@@ -200,7 +214,7 @@ struct PMultigrid::Impl {
     const Level& next = levels[static_cast<std::size_t>(q - 1)];
     x.setZero(b.size());
     sweep(fine, b, x, false);
-    residual(fine, b, x, fine.r);
+    residualAfterSweep(fine, b, x, fine.r);
     const int n = fine.n, nc = next.n;
     const Eigen::Index ne = b.size() / fine.bs;
     next.b.resize(ne * next.bs);
@@ -247,6 +261,10 @@ bool PMultigrid::compute(const SpMat& matrix, int degree) {
     if (!invertBlocks(m.levels[q])) ok = false;
   });
   m.coarse.cholmod().print = 0;
+  // The level-0 matrix is small (3 unknowns per element): AMD alone orders it well, without
+  // the METIS trial of CHOLMOD's default strategy.
+  m.coarse.cholmod().nmethods = 1;
+  m.coarse.cholmod().method[0].ordering = CHOLMOD_AMD;
   m.coarse.compute(*m.levels.front().matrix);
   return ok && m.coarse.info() == Eigen::Success;
 }

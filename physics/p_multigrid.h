@@ -36,8 +36,9 @@ class PMultigrid {
   /// Builds the levels of `matrix` (symmetric, both triangles stored, element e's DOFs the
   /// range [e bs, (e + 1) bs) in the order d n + i, bs = 3 n, n = numMonomials(degree) as in
   /// LinearSystem). `matrix` must stay alive while the preconditioner is used. Returns false
-  /// if a diagonal block or the level-0 matrix is not positive definite (e.g. no Dirichlet
-  /// condition holds the body).
+  /// if a diagonal block or the level-0 matrix is found not positive definite. A body held by
+  /// no Dirichlet condition makes level 0 exactly singular, which the factorization may miss
+  /// on rounding: CG then fails to converge and reports it (SolveReport::success).
   bool compute(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix, int degree);
 
   /// z = M^-1 r: one V-cycle for K z = r from z = 0.

@@ -98,6 +98,9 @@ class StaticSolver {
   StaticSolution release();
 
  private:
+  /// K of the current form into `matrix`, without copying it.
+  void assembleInto(Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix) const;
+
   const PolyMesh* mesh_;
   Material material_;
   StaticOptions options_;
