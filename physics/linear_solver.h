@@ -45,11 +45,11 @@ struct SolverOptions {
   std::size_t directLimitNonzeros = 40000000;
   CgPreconditioner preconditioner = CgPreconditioner::PMultigrid;
   /// CG stops when |F - K U| <= tolerance |F|. Measured on B2 against CHOLMOD's solution
-  /// (p-multigrid CG, p = 1 and 2): at 1e-8 the algebraic error is 2e-11 (l2) and 2e-10
-  /// (energy norm) relative, at 1e-6 still 3e-9 / 2e-8; discretization errors of these
-  /// problems are 1e-2 .. 1e-6 relative (B1), so 1e-8 keeps the algebraic error 4+ orders
-  /// below them. Each further decade costs 2-4 p-multigrid iterations.
-  double tolerance = 1e-8;
+  /// (p-multigrid CG, p = 1 and 2): at 1e-10 the algebraic error is 1e-12 (l2) and 3e-12
+  /// (energy norm) relative, at 1e-8 2e-11 / 2e-10; discretization errors of these problems
+  /// are 1e-2 .. 1e-6 relative (B1), so the algebraic error stays 6+ orders below them. Each
+  /// decade costs 2-4 p-multigrid iterations (B2, p = 1: 27 iterations at 1e-8, 31 at 1e-10).
+  double tolerance = 1e-10;
   int maxIterations = 20000;
 };
 
