@@ -27,6 +27,16 @@ struct Level {
   SpMat owned;
   int n = 0, bs = 0;
   std::vector<double> inverses;
+  /// The smoother's copy of the matrix in single precision, by element block rows: element
+  /// e's blocks are slots blockStart[e] .. blockStart[e + 1] - 1, slot k the bs x bs block
+  /// (column-major) against element blockElement[k]. Half the bytes of the CSR values and no
+  /// index per entry: the smoother is bound by memory bandwidth. Symmetric like the matrix,
+  /// so the V-cycle stays symmetric (it is the V-cycle of the rounded matrix).
+  /// Used when the blocks are mostly nonzero (IP); BZ's neighbour blocks couple equal
+  /// components only (a third nonzero) and its smoother reads the CSR matrix instead.
+  bool useBlocks = false;
+  std::vector<int> blockStart, blockElement;
+  std::vector<float> blockValues;
   // Scratch of apply(): right-hand side, solution and residual of this level.
   mutable Eigen::VectorXd b, x, r;
 };
@@ -75,6 +85,80 @@ SpMat restrictMatrix(const SpMat& fine, int n, int nc) {
   return coarse;
 }
 
+/// Fills the single-precision block rows of `level` from its matrix.
+void buildBlockRows(Level& level) {
+  const SpMat& a = *level.matrix;
+  const int bs = level.bs;
+  const int ne = static_cast<int>(a.cols() / bs);
+  // Column e bs holds a row of every neighbour block (BZ blocks included: component 0).
+  std::vector<std::vector<int>> neighbours(static_cast<std::size_t>(ne));
+  tbb::parallel_for(0, ne, [&](int e) {
+    std::vector<int>& nb = neighbours[static_cast<std::size_t>(e)];
+    for (SpMat::InnerIterator it(a, static_cast<Eigen::Index>(e) * bs); it; ++it) {
+      const int f = static_cast<int>(it.row() / bs);
+      if (nb.empty() || nb.back() != f) nb.push_back(f);  // rows are sorted
+    }
+  });
+  level.blockStart.assign(static_cast<std::size_t>(ne) + 1, 0);
+  for (int e = 0; e < ne; ++e)
+    level.blockStart[static_cast<std::size_t>(e) + 1] =
+        level.blockStart[static_cast<std::size_t>(e)] +
+        static_cast<int>(neighbours[static_cast<std::size_t>(e)].size());
+  const std::size_t slots = static_cast<std::size_t>(level.blockStart.back());
+  level.useBlocks = 2 * static_cast<std::size_t>(a.nonZeros()) >= slots * bs * bs;
+  if (!level.useBlocks) return;
+  level.blockElement.resize(slots);
+  level.blockValues.assign(slots * static_cast<std::size_t>(bs * bs), 0.0f);
+  tbb::parallel_for(0, ne, [&](int e) {
+    const std::vector<int>& nb = neighbours[static_cast<std::size_t>(e)];
+    const std::size_t first = static_cast<std::size_t>(level.blockStart[static_cast<std::size_t>(e)]);
+    std::copy(nb.begin(), nb.end(), level.blockElement.begin() + static_cast<std::ptrdiff_t>(first));
+    for (int c = 0; c < bs; ++c) {
+      std::size_t slot = first;
+      for (SpMat::InnerIterator it(a, static_cast<Eigen::Index>(e) * bs + c); it; ++it) {
+        const int f = static_cast<int>(it.row() / bs);
+        while (level.blockElement[slot] != f) ++slot;  // both sorted
+        // Entry (c, row % bs) of block (e, f), stored column-major.
+        level.blockValues[(slot * bs + static_cast<std::size_t>(it.row() % bs)) * bs +
+                          static_cast<std::size_t>(c)] = static_cast<float>(it.value());
+      }
+    }
+  });
+}
+
+/// s = b_e - (A x)_e for element e's rows, from the block rows of `level`.
+inline void blockResidual(const Level& level, int e, const Eigen::VectorXd& b,
+                          const Eigen::VectorXd& x, double* s) {
+  const int bs = level.bs;
+  const Eigen::Index base = static_cast<Eigen::Index>(e) * bs;
+  if (!level.useBlocks) {
+    const SpMat& a = *level.matrix;
+    const int* outer = a.outerIndexPtr();
+    const int* inner = a.innerIndexPtr();
+    const double* values = a.valuePtr();
+    // Column base + c of A is row base + c (symmetric storage).
+    for (int c = 0; c < bs; ++c) {
+      double sum = 0.0;
+      for (int k = outer[base + c]; k < outer[base + c + 1]; ++k) sum += values[k] * x[inner[k]];
+      s[c] = b[base + c] - sum;
+    }
+    return;
+  }
+  for (int c = 0; c < bs; ++c) s[c] = b[base + c];
+  for (int k = level.blockStart[static_cast<std::size_t>(e)];
+       k < level.blockStart[static_cast<std::size_t>(e) + 1]; ++k) {
+    const float* block = level.blockValues.data() + static_cast<std::size_t>(k) * bs * bs;
+    const double* xf =
+        x.data() + static_cast<Eigen::Index>(level.blockElement[static_cast<std::size_t>(k)]) * bs;
+    // Column by column: the inner loop has no reduction and vectorizes.
+    for (int d = 0; d < bs; ++d) {
+      const float* column = block + d * bs;
+      const double xd = xf[d];
+      for (int c = 0; c < bs; ++c) s[c] -= static_cast<double>(column[c]) * xd;
+    }
+  }
+}
+
 /// Inverts the element diagonal blocks of `level`; false if one is not positive definite.
 bool invertBlocks(Level& level) {
   const SpMat& a = *level.matrix;
@@ -87,7 +171,9 @@ bool invertBlocks(Level& level) {
     Eigen::MatrixXd block = Eigen::MatrixXd::Zero(bs, bs);
     for (int c = 0; c < bs; ++c)
       for (SpMat::InnerIterator it(a, base + c); it; ++it)
-        if (it.row() >= base && it.row() < base + bs) block(it.row() - base, c) = it.value();
+        if (it.row() >= base && it.row() < base + bs)
+          block(it.row() - base, c) = level.useBlocks ? static_cast<float>(it.value())  // as the
+                                                      : it.value();  // smoother sees it
     Eigen::LLT<Eigen::MatrixXd> llt(block);
     if (llt.info() != Eigen::Success) {
       ok = false;
@@ -143,10 +229,6 @@ struct PMultigrid::Impl {
   /// One block Gauss-Seidel sweep on `level` for A x = b, colours in order or reversed.
   void sweep(const Level& level, const Eigen::VectorXd& b, Eigen::VectorXd& x,
              bool reverse) const {
-    const SpMat& a = *level.matrix;
-    const int* outer = a.outerIndexPtr();
-    const int* inner = a.innerIndexPtr();
-    const double* values = a.valuePtr();
     const int bs = level.bs;
     const std::size_t nc = colours.size();
     for (std::size_t t = 0; t < nc; ++t) {
@@ -155,17 +237,12 @@ struct PMultigrid::Impl {
                         [&](const tbb::blocked_range<std::size_t>& range) {
                           BlockVector s(bs);
                           for (std::size_t j = range.begin(); j != range.end(); ++j) {
-                            const Eigen::Index e = cls[j], base = e * bs;
-                            // Column base + c of A is row base + c (symmetric storage).
-                            for (int c = 0; c < bs; ++c) {
-                              double sum = 0.0;
-                              for (int k = outer[base + c]; k < outer[base + c + 1]; ++k)
-                                sum += values[k] * x[inner[k]];
-                              s[c] = b[base + c] - sum;
-                            }
+                            const int e = cls[j];
+                            const Eigen::Index base = static_cast<Eigen::Index>(e) * bs;
+                            blockResidual(level, e, b, x, s.data());
                             x.segment(base, bs).noalias() +=
                                 Eigen::Map<const Eigen::MatrixXd>(
-                                    level.inverses.data() + e * bs * bs, bs, bs) *
+                                    level.inverses.data() + base * bs, bs, bs) *
                                 s;
                           }
                         });
@@ -176,10 +253,6 @@ struct PMultigrid::Impl {
   /// just solved with every neighbour final, so their residual is zero and is not computed.
   void residualAfterSweep(const Level& level, const Eigen::VectorXd& b, const Eigen::VectorXd& x,
                           Eigen::VectorXd& r) const {
-    const SpMat& a = *level.matrix;
-    const int* outer = a.outerIndexPtr();
-    const int* inner = a.innerIndexPtr();
-    const double* values = a.valuePtr();
     const int bs = level.bs;
     r.resize(b.size());
     for (std::size_t t = 0; t < colours.size(); ++t) {
@@ -188,17 +261,10 @@ struct PMultigrid::Impl {
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cls.size(), 16),
                         [&](const tbb::blocked_range<std::size_t>& range) {
                           for (std::size_t j = range.begin(); j != range.end(); ++j) {
-                            const Eigen::Index base = static_cast<Eigen::Index>(cls[j]) * bs;
-                            if (last) {
-                              r.segment(base, bs).setZero();
-                              continue;
-                            }
-                            for (Eigen::Index c = base; c < base + bs; ++c) {
-                              double sum = 0.0;
-                              for (int k = outer[c]; k < outer[c + 1]; ++k)
-                                sum += values[k] * x[inner[k]];
-                              r[c] = b[c] - sum;
-                            }
+                            const int e = cls[j];
+                            double* re = r.data() + static_cast<Eigen::Index>(e) * bs;
+                            if (last) std::fill(re, re + bs, 0.0);
+                            else blockResidual(level, e, b, x, re);
                           }
                         });
     }
@@ -258,6 +324,7 @@ bool PMultigrid::compute(const SpMat& matrix, int degree) {
   }
   std::atomic<bool> ok{true};
   tbb::parallel_for(std::size_t(1), m.levels.size(), [&](std::size_t q) {
+    buildBlockRows(m.levels[q]);
     if (!invertBlocks(m.levels[q])) ok = false;
   });
   m.coarse.cholmod().print = 0;
