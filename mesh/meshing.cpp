@@ -1,5 +1,8 @@
 #include "mesh/meshing.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
+
 #include <chrono>
 #include <cmath>
 #include <sstream>
@@ -184,11 +187,21 @@ MeshingResult meshSurface(const TriangleSurface& input, const MeshingOptions& op
   r.boundaryFaces = r.validation.boundaryFaces;
   r.outputVolume = r.validation.volume;
   r.volumeRelError = std::abs(r.outputVolume - r.inputVolume) / r.inputVolume;
-  for (std::size_t e = 0; e < mesh.numElements(); ++e) {
-    const bool hex = isGridHexahedron(mesh, ElementId(e));
-    r.hexahedra += hex;
-    if (!hex && !isConvex(mesh, ElementId(e))) ++r.nonconvex;
-  }
+  // Shape counts in parallel: (hexahedra, non-convex).
+  using Counts = std::pair<std::size_t, std::size_t>;
+  const Counts counts = tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, mesh.numElements(), 1024), Counts{0, 0},
+      [&](const tbb::blocked_range<std::size_t>& range, Counts c) {
+        for (std::size_t e = range.begin(); e != range.end(); ++e) {
+          const bool hex = isGridHexahedron(mesh, ElementId(e));
+          c.first += hex;
+          if (!hex && !isConvex(mesh, ElementId(e))) ++c.second;
+        }
+        return c;
+      },
+      [](Counts a, const Counts& b) { return Counts{a.first + b.first, a.second + b.second}; });
+  r.hexahedra = counts.first;
+  r.nonconvex = counts.second;
   r.polyhedra = r.elements - r.hexahedra;
   timer.done("validate");
   return result;

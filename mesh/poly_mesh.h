@@ -87,6 +87,17 @@ class PolyMesh {
     faces_.raw().reserve(faces);
     elements_.raw().reserve(elements);
   }
+  /// Replaces the whole mesh with prebuilt arrays, for builders that assemble a large mesh in
+  /// parallel. The caller guarantees consistency: face ids in elements in range, each face's
+  /// front/back the elements that use it unreversed/reversed (validate() checks a finished
+  /// mesh).
+  void assign(VertexData<Vec3> positions, FaceData<Face> faces, ElementData<Element> elements) {
+    positions_ = std::move(positions);
+    faces_ = std::move(faces);
+    elements_ = std::move(elements);
+    openFaces_.clear();
+    openFacesStale_ = true;
+  }
 
   // --- faces -------------------------------------------------------------------------------
   std::size_t numFaces() const { return faces_.size(); }

@@ -4,6 +4,8 @@
 #include <atomic>
 #include <chrono>
 #include <mutex>
+#include <numeric>
+#include <span>
 #include <tuple>
 #include <cmath>
 #include <limits>
@@ -13,7 +15,10 @@
 #include "mesh/plane_split.h"
 
 #include <boost/container/small_vector.hpp>
+#include <tbb/concurrent_vector.h>
+#include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
+#include <tbb/parallel_sort.h>
 
 namespace polydg {
 
@@ -41,14 +46,6 @@ Grid Grid::withCellsAlongLongest(const Box3& bounds, int cellsAlongLongest) {
 
 namespace {
 
-struct CellHash {
-  std::size_t operator()(const std::array<std::int64_t, 3>& c) const noexcept {
-    std::size_t h = 0;
-    for (std::int64_t x : c) h = h * 0x9E3779B97F4A7C15ull + static_cast<std::size_t>(x);
-    return h;
-  }
-};
-
 class Slicer {
  public:
   Slicer(const Grid& grid, std::vector<Vec3> points, const ProgressFn& progress)
@@ -69,7 +66,6 @@ class Slicer {
   }
 
   PolyMesh build(std::vector<std::array<int, 3>>* elementCell) {
-    PolyMesh mesh;
     const std::vector<Vec3> points = splitter_.points();
     // Points closer than the resolution of the coordinates are one point: 8 units in the last
     // place of the largest coordinate, in every coordinate. Such points are intersections that
@@ -81,82 +77,109 @@ class Slicer {
     double largest = 0.0;
     for (const Vec3& p : points) largest = std::max(largest, p.cwiseAbs().maxCoeff());
     const double resolution = 8.0 * std::numeric_limits<double>::epsilon() * largest;
-    std::size_t polygons = 0;
-    for (const Leaf& leaf : leaves_) polygons += leaf.piece.size();
-    mesh.reserve(points.size(), polygons, leaves_.size());
-    std::unordered_map<std::array<std::int64_t, 3>, std::vector<std::uint32_t>, CellHash> cells;
-    cells.reserve(points.size());
-    // Hash cells four times the weld distance: a point's search box [p - d, p + d] overlaps
-    // one or two cells per axis.
-    const double cellSize = 4.0 * resolution;
-    auto cellIndex = [&](double x) {
-      return cellSize > 0 ? static_cast<std::int64_t>(std::floor(x / cellSize)) : 0;
-    };
-    std::vector<std::uint32_t> remap(points.size(), 0xffffffffu);
-    auto vertexOf = [&](std::uint32_t v) {
-      if (remap[v] != 0xffffffffu) return VertexId(remap[v]);
-      const Vec3& p = points[v];
-      std::array<std::int64_t, 3> lo{}, hi{};
-      for (int i = 0; i < 3; ++i) {
-        lo[i] = cellIndex(p[i] - resolution);
-        hi[i] = cellIndex(p[i] + resolution);
-      }
-      for (std::int64_t x = lo[0]; x <= hi[0] && remap[v] == 0xffffffffu; ++x)
-        for (std::int64_t y = lo[1]; y <= hi[1] && remap[v] == 0xffffffffu; ++y)
-          for (std::int64_t z = lo[2]; z <= hi[2] && remap[v] == 0xffffffffu; ++z) {
-            auto it = cells.find({x, y, z});
-            if (it == cells.end()) continue;
-            for (std::uint32_t w : it->second)
-              if ((mesh.position(VertexId(w)) - p).cwiseAbs().maxCoeff() <= resolution) {
-                remap[v] = w;
-                ++stats.weldedPoints;
-                break;
-              }
+
+    // Points in order of first use, then welded; vertex ids follow that order.
+    constexpr std::uint32_t kNone = 0xffffffffu;
+    std::vector<std::uint32_t> rank(points.size(), kNone), used;
+    for (const Leaf& leaf : leaves_)
+      for (const PiecePolygon& polygon : leaf.piece)
+        for (std::uint32_t v : polygon.vertices)
+          if (rank[v] == kNone) {
+            rank[v] = static_cast<std::uint32_t>(used.size());
+            used.push_back(v);
           }
-      if (remap[v] == 0xffffffffu) {
-        remap[v] = mesh.addVertex(p).value;
-        cells[{cellIndex(p.x()), cellIndex(p.y()), cellIndex(p.z())}].push_back(remap[v]);
+    const std::vector<std::uint32_t> target = weldTargets(points, used, resolution);
+    VertexData<Vec3> positions;
+    positions.raw().reserve(used.size());
+    std::vector<std::uint32_t> vertexOfRank(used.size());
+    for (std::size_t i = 0; i < used.size(); ++i) {
+      if (target[i] == i) {
+        vertexOfRank[i] = static_cast<std::uint32_t>(positions.size());
+        positions.push_back(points[used[i]]);
+      } else {
+        vertexOfRank[i] = vertexOfRank[target[i]];
+        ++stats.weldedPoints;
       }
-      return VertexId(remap[v]);
-    };
-    // Caps (interior faces) are shared: the second element to use one finds it (reversed).
-    std::vector<FaceUse> uses;
-    for (const Leaf& leaf : leaves_) {
-      uses.clear();
-      for (const PiecePolygon& polygon : leaf.piece) {
-        boost::container::small_vector<VertexId, 8> vertices;
-        boost::container::small_vector<std::uint32_t, 2> loopEnd;
-        for (std::size_t k = 0; k < polygon.numLoops(); ++k) {
-          const std::size_t begin = vertices.size();
-          for (std::size_t i = polygon.loopBegin(k); i < polygon.loopEnd[k]; ++i) {
-            const VertexId v = vertexOf(polygon.vertices[i]);
-            if (vertices.size() == begin || vertices.back() != v) vertices.push_back(v);
-          }
-          while (vertices.size() > begin + 1 && vertices[begin] == vertices.back())
-            vertices.pop_back();
-          if (vertices.size() >= begin + 3) {
-            loopEnd.push_back(static_cast<std::uint32_t>(vertices.size()));
-          } else {
-            vertices.resize(begin);
-            if (k == 0) break;  // the outer boundary collapsed: the polygon is gone
-          }
-        }
-        if (loopEnd.empty()) {
-          ++stats.collapsedPolygons;
-          continue;
-        }
-        const std::span<const VertexId> vs(vertices.data(), vertices.size());
-        const std::span<const std::uint32_t> ends(loopEnd.data(), loopEnd.size());
-        if (polygon.origin != FaceOrigin::Interior) {
-          uses.push_back({mesh.addFace(vs, ends, polygon.origin), false});
-          continue;
-        }
-        uses.push_back(mesh.findOrCreateFace(vs, ends, FaceOrigin::Interior));
-      }
-      if (uses.empty()) continue;
-      mesh.addElementFromFaces(uses);
-      if (elementCell) elementCell->push_back(leaf.cell);
     }
+    auto vertexOf = [&](std::uint32_t v) { return VertexId(vertexOfRank[rank[v]]); };
+
+    // Each leaf's polygons as faces on the welded vertices (in parallel), with the vertex-set
+    // key of the caps (interior faces), which are shared with the neighbouring cell's leaf.
+    const std::size_t nl = leaves_.size();
+    std::vector<std::vector<Face>> faces(nl);
+    std::vector<std::vector<std::uint64_t>> keys(nl);
+    std::atomic<std::size_t> collapsed{0};
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nl, 64),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t l = r.begin(); l != r.end(); ++l) {
+        for (const PiecePolygon& polygon : leaves_[l].piece) {
+          Face face;
+          if (!weldPolygon(polygon, vertexOf, face)) {
+            ++collapsed;
+            continue;
+          }
+          face.origin = polygon.origin;
+          keys[l].push_back(polygon.origin == FaceOrigin::Interior
+                                ? vertexSetKey({face.vertices.data(), face.vertices.size()})
+                                : 0);
+          faces[l].push_back(std::move(face));
+        }
+      }
+    });
+    stats.collapsedPolygons = collapsed;
+
+    // Caps meet their other side: the later of two reversed, equal polygons uses the earlier's
+    // face (reversed), as findOrCreateFace would in leaf order.
+    const std::vector<std::vector<std::uint32_t>> sharesEarlier = matchCaps(faces, keys);
+
+    // Ids: elements for leaves that kept a polygon, faces for polygons that are not a later
+    // side, both in leaf order.
+    std::vector<std::uint32_t> elementOf(nl, kNone), faceBase(nl + 1, 0);
+    std::uint32_t elements = 0;
+    for (std::size_t l = 0; l < nl; ++l) {
+      if (!faces[l].empty()) elementOf[l] = elements++;
+      std::uint32_t created = 0;
+      for (std::uint32_t s : sharesEarlier[l]) created += s == kNone;
+      faceBase[l + 1] = faceBase[l] + created;
+    }
+    std::vector<std::vector<std::uint32_t>> faceId(nl);
+    FaceData<Face> meshFaces(faceBase[nl]);
+    ElementData<Element> meshElements(elements);
+    // New faces first (their ids are known per leaf) ...
+    tbb::parallel_for(std::size_t(0), nl, [&](std::size_t l) {
+      std::uint32_t next = faceBase[l];
+      faceId[l].resize(faces[l].size(), kNone);
+      for (std::size_t i = 0; i < faces[l].size(); ++i) {
+        if (sharesEarlier[l][i] != kNone) continue;
+        faceId[l][i] = next;
+        Face& f = meshFaces[FaceId(std::size_t(next++))];
+        f = std::move(faces[l][i]);
+        f.front = ElementId(std::size_t(elementOf[l]));
+      }
+    });
+    // ... then the later sides, which take the earlier side's face as its back.
+    tbb::parallel_for(std::size_t(0), nl, [&](std::size_t l) {
+      if (elementOf[l] == kNone) return;
+      const ElementId e(std::size_t(elementOf[l]));
+      FaceList& uses = meshElements[e].faces;
+      for (std::size_t i = 0; i < faces[l].size(); ++i) {
+        const std::uint32_t s = sharesEarlier[l][i];
+        if (s == kNone) {
+          uses.push_back({FaceId(std::size_t(faceId[l][i])), false});
+          continue;
+        }
+        const std::uint32_t earlierLeaf = matchLeaf_[s], earlierIndex = matchIndex_[s];
+        const FaceId f{static_cast<std::size_t>(faceId[earlierLeaf][earlierIndex])};
+        meshFaces[f].back = e;
+        meshFaces[f].origin = FaceOrigin::Interior;
+        uses.push_back({f, true});
+      }
+    });
+    if (elementCell)
+      for (std::size_t l = 0; l < nl; ++l)
+        if (elementOf[l] != kNone) elementCell->push_back(leaves_[l].cell);
+    PolyMesh mesh;
+    mesh.assign(std::move(positions), std::move(meshFaces), std::move(meshElements));
     return mesh;
   }
 
@@ -168,6 +191,130 @@ class Slicer {
     std::array<int, 3> cell;
     std::size_t part;  ///< index of the piece among its cell's connected pieces
   };
+
+  /// For used point i (in order of first use), the earliest kept point within `resolution`
+  /// (in every coordinate) before it, or i itself if there is none: i is then kept. Points are
+  /// bucketed in cells four times the resolution, so a point's search box meets one or two
+  /// cells per axis; the search runs in parallel, the rare welds are resolved in order.
+  static std::vector<std::uint32_t> weldTargets(const std::vector<Vec3>& points,
+                                                const std::vector<std::uint32_t>& used,
+                                                double resolution) {
+    using Cell = std::array<std::int64_t, 3>;
+    const double cellSize = 4.0 * resolution;
+    auto cellIndex = [&](double x) {
+      return cellSize > 0 ? static_cast<std::int64_t>(std::floor(x / cellSize)) : 0;
+    };
+    std::vector<std::pair<Cell, std::uint32_t>> sorted(used.size());
+    tbb::parallel_for(std::size_t(0), used.size(), [&](std::size_t i) {
+      const Vec3& p = points[used[i]];
+      sorted[i] = {{cellIndex(p.x()), cellIndex(p.y()), cellIndex(p.z())},
+                   static_cast<std::uint32_t>(i)};
+    });
+    tbb::parallel_sort(sorted.begin(), sorted.end());
+    tbb::concurrent_vector<std::pair<std::uint32_t, std::uint32_t>> near;  // (later, earlier)
+    tbb::parallel_for(std::size_t(0), used.size(), [&](std::size_t i) {
+      const Vec3& p = points[used[i]];
+      Cell lo, hi;
+      for (int a = 0; a < 3; ++a) {
+        lo[a] = cellIndex(p[a] - resolution);
+        hi[a] = cellIndex(p[a] + resolution);
+      }
+      for (std::int64_t x = lo[0]; x <= hi[0]; ++x)
+        for (std::int64_t y = lo[1]; y <= hi[1]; ++y)
+          for (std::int64_t z = lo[2]; z <= hi[2]; ++z) {
+            const Cell c{x, y, z};
+            auto it = std::lower_bound(sorted.begin(), sorted.end(), std::make_pair(c, 0u));
+            for (; it != sorted.end() && it->first == c && it->second < i; ++it)
+              if ((points[used[it->second]] - p).cwiseAbs().maxCoeff() <= resolution)
+                near.push_back({static_cast<std::uint32_t>(i), it->second});
+          }
+    });
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs(near.begin(), near.end());
+    std::sort(pairs.begin(), pairs.end());
+    std::vector<std::uint32_t> target(used.size());
+    std::iota(target.begin(), target.end(), 0u);
+    for (const auto& [later, earlier] : pairs)
+      if (target[later] == later && target[earlier] == earlier) target[later] = earlier;
+    return target;
+  }
+
+  /// `polygon` on welded vertices into `face` (vertices and loop ends): consecutive repeats
+  /// dropped, loops of fewer than 3 corners removed. False if the outer loop collapsed.
+  template <class VertexOf>
+  static bool weldPolygon(const PiecePolygon& polygon, const VertexOf& vertexOf, Face& face) {
+    auto& vertices = face.vertices;
+    for (std::size_t k = 0; k < polygon.numLoops(); ++k) {
+      const std::size_t begin = vertices.size();
+      for (std::size_t i = polygon.loopBegin(k); i < polygon.loopEnd[k]; ++i) {
+        const VertexId v = vertexOf(polygon.vertices[i]);
+        if (vertices.size() == begin || vertices.back() != v) vertices.push_back(v);
+      }
+      while (vertices.size() > begin + 1 && vertices[begin] == vertices.back())
+        vertices.pop_back();
+      if (vertices.size() >= begin + 3) {
+        face.loopEnd.push_back(static_cast<std::uint32_t>(vertices.size()));
+      } else {
+        vertices.resize(begin);
+        if (k == 0) break;  // the outer boundary collapsed: the polygon is gone
+      }
+    }
+    return !face.loopEnd.empty();
+  }
+
+  /// For each polygon of each leaf: kNone, or the index (into matchLeaf_/matchIndex_) of the
+  /// earlier cap whose face it shares. Caps are grouped by vertex-set key (sorted in parallel);
+  /// within a group, in leaf order, a cap takes the first earlier open cap that is its
+  /// reverse, and that cap is then closed.
+  std::vector<std::vector<std::uint32_t>> matchCaps(const std::vector<std::vector<Face>>& faces,
+                                                    const std::vector<std::vector<std::uint64_t>>& keys) {
+    constexpr std::uint32_t kNone = 0xffffffffu;
+    struct Cap {
+      std::uint64_t key;
+      std::uint32_t leaf, index;
+      bool operator<(const Cap& o) const {
+        return std::tie(key, leaf, index) < std::tie(o.key, o.leaf, o.index);
+      }
+    };
+    std::vector<Cap> caps;
+    std::vector<std::vector<std::uint32_t>> shares(faces.size());
+    for (std::size_t l = 0; l < faces.size(); ++l) {
+      shares[l].assign(faces[l].size(), kNone);
+      for (std::size_t i = 0; i < faces[l].size(); ++i)
+        if (faces[l][i].origin == FaceOrigin::Interior)
+          caps.push_back({keys[l][i], static_cast<std::uint32_t>(l), static_cast<std::uint32_t>(i)});
+    }
+    tbb::parallel_sort(caps.begin(), caps.end());
+    matchLeaf_.resize(caps.size());
+    matchIndex_.resize(caps.size());
+    for (std::size_t c = 0; c < caps.size(); ++c) {
+      matchLeaf_[c] = caps[c].leaf;
+      matchIndex_[c] = caps[c].index;
+    }
+    std::vector<std::size_t> groupStart;
+    for (std::size_t c = 0; c < caps.size(); ++c)
+      if (c == 0 || caps[c].key != caps[c - 1].key) groupStart.push_back(c);
+    groupStart.push_back(caps.size());
+    tbb::parallel_for(std::size_t(0), groupStart.size() - 1, [&](std::size_t g) {
+      boost::container::small_vector<std::size_t, 4> open;
+      for (std::size_t c = groupStart[g]; c < groupStart[g + 1]; ++c) {
+        const Face& face = faces[caps[c].leaf][caps[c].index];
+        const std::span<const VertexId> vs(face.vertices.data(), face.vertices.size());
+        const std::span<const std::uint32_t> ends(face.loopEnd.data(), face.loopEnd.size());
+        auto match = std::find_if(open.begin(), open.end(), [&](std::size_t o) {
+          return isReverseOf(faces[caps[o].leaf][caps[o].index], vs, ends);
+        });
+        if (match != open.end()) {
+          shares[caps[c].leaf][caps[c].index] = static_cast<std::uint32_t>(*match);
+          open.erase(match);
+        } else {
+          open.push_back(c);
+        }
+      }
+    });
+    return shares;
+  }
+
+  std::vector<std::uint32_t> matchLeaf_, matchIndex_;  ///< leaf and polygon of each cap
 
   /// Pieces with more polygons than this are split into two tasks.
   static constexpr std::size_t kParallelPolygons = 512;

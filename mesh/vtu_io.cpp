@@ -23,7 +23,9 @@
 #include <unordered_set>
 
 #include <zlib.h>
+#include <boost/container/small_vector.hpp>
 #include <pugixml.hpp>
+#include <tbb/parallel_for.h>
 
 #include "mesh/face_triangulation.h"
 #include "mesh/geometry.h"
@@ -42,6 +44,9 @@ constexpr std::string_view kFaceReversedArray = "polydg_face_reversed";
 /// order keeps cell data with its cells.
 constexpr std::string_view kElementArray = "polydg_element";
 constexpr std::string_view kFaceOriginArray = "polydg_face_origin";
+/// For each VTU point, the mesh vertex it is a copy of; written only when some vertex has
+/// several points (see incidencePoints).
+constexpr std::string_view kPointVertexArray = "polydg_point_vertex";
 
 // ============================================================================================
 // Base64
@@ -175,77 +180,198 @@ class ByteReader {
 // Writing
 // ============================================================================================
 
-/// The cell arrays of the file, with the polydg field data that goes with them.
+/// The cell arrays of the file, with the polydg field data that goes with them. Point ids are
+/// VTU points (see pointVertex), not mesh vertices.
 struct CellStreams {
   std::vector<std::int64_t> connectivity, offsets, types, faces, faceOffsets;
   std::vector<std::int64_t> faceGroup, faceReversed, faceOrigin;
   std::vector<std::int64_t> element;  ///< the element written as each cell, in file order
+  /// The mesh vertex of each VTU point: points 0 .. numVertices-1 are the vertices themselves,
+  /// later points are further copies of a vertex (one per extra group of its elements).
+  std::vector<std::int64_t> pointVertex;
 };
 
-/// Elements in increasing order of their number of distinct points (stable).
-std::vector<std::size_t> cellOrder(const PolyMesh& mesh) {
-  std::vector<std::size_t> points(mesh.numElements());
-  for (std::size_t e = 0; e < mesh.numElements(); ++e) {
-    std::vector<VertexId> ids;
-    for (const FaceUse& use : mesh.element(ElementId(e)).faces)
-      ids.insert(ids.end(), mesh.face(use.face).vertices.begin(), mesh.face(use.face).vertices.end());
-    std::sort(ids.begin(), ids.end());
-    points[e] = static_cast<std::size_t>(std::unique(ids.begin(), ids.end()) - ids.begin());
+/// The records (simple polygons) that stand for each face in the file, in the face's own
+/// orientation: the face's one loop, or the triangles of a face with holes.
+class FaceRecords {
+ public:
+  explicit FaceRecords(const PolyMesh& mesh) : mesh_(mesh), triangles_(mesh.numFaces()) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.numFaces(), 1024),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        for (std::size_t f = r.begin(); f != r.end(); ++f)
+                          if (mesh.face(FaceId(f)).numLoops() > 1)
+                            triangles_[FaceId(f)] = triangulateFace(mesh, FaceId(f));
+                      });
   }
-  std::vector<std::size_t> order(mesh.numElements());
-  std::iota(order.begin(), order.end(), 0);
-  std::stable_sort(order.begin(), order.end(),
-                   [&](std::size_t a, std::size_t b) { return points[a] < points[b]; });
-  return order;
+  std::size_t count(FaceId f) const {
+    return mesh_.face(f).numLoops() == 1 ? 1 : triangles_[f].size();
+  }
+  std::span<const VertexId> record(FaceId f, std::size_t k) const {
+    const Face& face = mesh_.face(f);
+    if (face.numLoops() == 1) return {face.vertices.data(), face.vertices.size()};
+    return {triangles_[f][k].data(), 3};
+  }
+
+ private:
+  const PolyMesh& mesh_;
+  FaceData<std::vector<std::array<VertexId, 3>>> triangles_;
+};
+
+/// Union-find over integers, with path halving.
+class DisjointSets {
+ public:
+  explicit DisjointSets(std::size_t n) : parent_(n) { std::iota(parent_.begin(), parent_.end(), 0); }
+  std::uint32_t find(std::uint32_t x) {
+    while (parent_[x] != x) x = parent_[x] = parent_[parent_[x]];
+    return x;
+  }
+  void unite(std::uint32_t a, std::uint32_t b) {
+    a = find(a);
+    b = find(b);
+    if (a != b) parent_[std::max(a, b)] = std::min(a, b);
+  }
+
+ private:
+  std::vector<std::uint32_t> parent_;
+};
+
+/// Each element's distinct vertices in order of first use by its records; element e's are
+/// vertices[begin[e] .. begin[e+1]). Entry i of that range is the incidence begin[e] + i.
+struct Incidences {
+  std::vector<std::size_t> begin;
+  std::vector<VertexId> vertices;
+
+  std::span<const VertexId> of(ElementId e) const {
+    return {vertices.data() + begin[e.index()], begin[e.index() + 1] - begin[e.index()]};
+  }
+  /// The incidence of vertex v in element e (v must be one of e's vertices).
+  std::uint32_t find(ElementId e, VertexId v) const {
+    const auto vs = of(e);
+    return static_cast<std::uint32_t>(begin[e.index()] +
+                                      (std::find(vs.begin(), vs.end(), v) - vs.begin()));
+  }
+};
+
+Incidences elementIncidences(const PolyMesh& mesh, const FaceRecords& records) {
+  const std::size_t ne = mesh.numElements();
+  std::vector<boost::container::small_vector<VertexId, 16>> perElement(ne);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ne, 512),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t e = r.begin(); e != r.end(); ++e) {
+                        auto& vs = perElement[e];
+                        for (const FaceUse& use : mesh.element(ElementId(e)).faces)
+                          for (std::size_t k = 0; k < records.count(use.face); ++k)
+                            for (VertexId v : records.record(use.face, k))
+                              if (std::find(vs.begin(), vs.end(), v) == vs.end()) vs.push_back(v);
+                      }
+                    });
+  Incidences inc;
+  inc.begin.resize(ne + 1, 0);
+  for (std::size_t e = 0; e < ne; ++e) inc.begin[e + 1] = inc.begin[e] + perElement[e].size();
+  inc.vertices.resize(inc.begin[ne]);
+  tbb::parallel_for(std::size_t(0), ne, [&](std::size_t e) {
+    std::copy(perElement[e].begin(), perElement[e].end(), inc.vertices.begin() + inc.begin[e]);
+  });
+  return inc;
+}
+
+/// The VTU point of every incidence. Per vertex, its elements are grouped by connectivity
+/// through the interior faces that contain the vertex, and each group gets its own point: the
+/// first group (in element order) the vertex's own id, further groups new points after all
+/// vertices (`pointVertex` receives their vertices). So elements coupled across interior faces
+/// share points, while the two sides of a cut, or pieces touching only at a vertex or an edge,
+/// are separate regions of the file.
+std::vector<std::uint32_t> incidencePoints(const PolyMesh& mesh, const Incidences& inc,
+                                           std::vector<std::int64_t>& pointVertex) {
+  DisjointSets groups(inc.vertices.size());
+  for (const Face& face : mesh.faces()) {
+    if (!face.front.valid() || !face.back.valid()) continue;
+    for (VertexId v : face.vertices) groups.unite(inc.find(face.front, v), inc.find(face.back, v));
+  }
+  const std::size_t nv = mesh.numVertices();
+  pointVertex.resize(nv);
+  std::iota(pointVertex.begin(), pointVertex.end(), std::int64_t{0});
+  std::vector<std::uint32_t> rootPoint(inc.vertices.size(), Id<VertexTag>::kInvalid);
+  std::vector<bool> vertexTaken(nv, false);
+  std::vector<std::uint32_t> point(inc.vertices.size());
+  for (std::size_t i = 0; i < inc.vertices.size(); ++i) {
+    const std::uint32_t root = groups.find(static_cast<std::uint32_t>(i));
+    if (rootPoint[root] == Id<VertexTag>::kInvalid) {
+      const VertexId v = inc.vertices[i];
+      if (!vertexTaken[v.index()]) {
+        vertexTaken[v.index()] = true;
+        rootPoint[root] = v.value;
+      } else {
+        rootPoint[root] = static_cast<std::uint32_t>(pointVertex.size());
+        pointVertex.push_back(v.value);
+      }
+    }
+    point[i] = rootPoint[root];
+  }
+  return point;
 }
 
 CellStreams buildCellStreams(const PolyMesh& mesh) {
-  // Records of each face in the face's own orientation, computed when first needed.
-  FaceData<std::vector<std::vector<VertexId>>> records(mesh.numFaces());
-  auto recordsOf = [&](FaceId f) -> const std::vector<std::vector<VertexId>>& {
-    auto& r = records[f];
-    if (r.empty()) {
-      const Face& face = mesh.face(f);
-      if (face.numLoops() == 1) {
-        r.emplace_back(face.vertices.begin(), face.vertices.end());
-      } else {
-        for (const auto& t : triangulateFace(mesh, f)) r.push_back({t[0], t[1], t[2]});
-      }
-    }
-    return r;
-  };
-
+  const std::size_t ne = mesh.numElements();
+  const FaceRecords records(mesh);
+  const Incidences inc = elementIncidences(mesh, records);
   CellStreams s;
-  VertexData<std::uint32_t> seenIn(mesh.numVertices(), Id<ElementTag>::kInvalid);
-  for (std::size_t e : cellOrder(mesh)) {
-    const ElementId element(e);
-    s.element.push_back(static_cast<std::int64_t>(e));
-    const std::size_t countAt = s.faces.size();
-    s.faces.push_back(0);
-    std::int64_t count = 0;
-    for (const FaceUse& use : mesh.element(element).faces) {
-      for (const auto& record : recordsOf(use.face)) {
-        const std::size_t n = record.size();
-        s.faces.push_back(static_cast<std::int64_t>(n));
-        for (std::size_t i = 0; i < n; ++i) {
-          // Backwards keeps the first vertex first: v0, v(n-1), ..., v1.
-          const VertexId v = use.reversed ? record[(n - i) % n] : record[i];
-          s.faces.push_back(v.value);
-          if (seenIn[v] != element.value) {
-            seenIn[v] = element.value;
-            s.connectivity.push_back(v.value);
-          }
-        }
-        s.faceGroup.push_back(use.face.value);
-        s.faceReversed.push_back(use.reversed ? 1 : 0);
-        ++count;
+  const std::vector<std::uint32_t> point = incidencePoints(mesh, inc, s.pointVertex);
+
+  // Cells in increasing order of their point count (stable), see kElementArray.
+  std::vector<std::size_t> order(ne);
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return inc.begin[a + 1] - inc.begin[a] < inc.begin[b + 1] - inc.begin[b];
+  });
+  // Sizes per cell, then running ends, then the streams filled in parallel.
+  std::vector<std::size_t> recordEnd(ne + 1, 0), faceEnd(ne + 1, 0);
+  for (std::size_t c = 0; c < ne; ++c) {
+    std::size_t recordsOfCell = 0, stream = 1;
+    for (const FaceUse& use : mesh.element(ElementId(order[c])).faces)
+      for (std::size_t k = 0; k < records.count(use.face); ++k) {
+        ++recordsOfCell;
+        stream += 1 + records.record(use.face, k).size();
       }
-    }
-    s.faces[countAt] = count;
-    s.faceOffsets.push_back(static_cast<std::int64_t>(s.faces.size()));
-    s.offsets.push_back(static_cast<std::int64_t>(s.connectivity.size()));
-    s.types.push_back(kVtkPolyhedron);
+    recordEnd[c + 1] = recordEnd[c] + recordsOfCell;
+    faceEnd[c + 1] = faceEnd[c] + stream;
   }
+  s.element.assign(order.begin(), order.end());
+  s.types.assign(ne, kVtkPolyhedron);
+  s.offsets.resize(ne);
+  s.faceOffsets.resize(ne);
+  s.connectivity.resize(inc.vertices.size());
+  s.faces.resize(faceEnd[ne]);
+  s.faceGroup.resize(recordEnd[ne]);
+  s.faceReversed.resize(recordEnd[ne]);
+  std::vector<std::size_t> connectivityEnd(ne + 1, 0);
+  for (std::size_t c = 0; c < ne; ++c)
+    connectivityEnd[c + 1] =
+        connectivityEnd[c] + inc.begin[order[c] + 1] - inc.begin[order[c]];
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ne, 256),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t c = r.begin(); c != r.end(); ++c) {
+      const ElementId e(order[c]);
+      const std::size_t first = inc.begin[e.index()];
+      for (std::size_t i = first; i < inc.begin[e.index() + 1]; ++i)
+        s.connectivity[connectivityEnd[c] + i - first] = point[i];
+      s.offsets[c] = static_cast<std::int64_t>(connectivityEnd[c + 1]);
+      std::size_t at = faceEnd[c], rec = recordEnd[c];
+      s.faces[at++] = static_cast<std::int64_t>(recordEnd[c + 1] - recordEnd[c]);
+      for (const FaceUse& use : mesh.element(e).faces)
+        for (std::size_t k = 0; k < records.count(use.face); ++k) {
+          const auto record = records.record(use.face, k);
+          const std::size_t n = record.size();
+          s.faces[at++] = static_cast<std::int64_t>(n);
+          // Backwards keeps the first vertex first: v0, v(n-1), ..., v1.
+          for (std::size_t i = 0; i < n; ++i)
+            s.faces[at++] = point[inc.find(e, use.reversed ? record[(n - i) % n] : record[i])];
+          s.faceGroup[rec] = use.face.value;
+          s.faceReversed[rec++] = use.reversed ? 1 : 0;
+        }
+      s.faceOffsets[c] = static_cast<std::int64_t>(faceEnd[c + 1]);
+    }
+  });
   for (const Face& face : mesh.faces())
     s.faceOrigin.push_back(static_cast<std::int64_t>(face.origin));
   return s;
@@ -285,103 +411,230 @@ std::string xmlEscape(std::string_view text) {
   return out;
 }
 
-template <class T>
-constexpr std::string_view vtkTypeName() {
-  if constexpr (std::is_same_v<T, double>)
-    return "Float64";
-  else
-    return "Int64";
+/// The type an array is stored as: doubles as Float64; integers (all non-negative here) in the
+/// smallest of UInt8, Int32 and Int64 that holds them (VTK and meshio convert on reading).
+enum class StoredType { Float64, UInt8, Int32, Int64 };
+
+std::string_view vtkTypeName(StoredType t) {
+  switch (t) {
+    case StoredType::Float64: return "Float64";
+    case StoredType::UInt8: return "UInt8";
+    case StoredType::Int32: return "Int32";
+    case StoredType::Int64: return "Int64";
+  }
+  return "Int64";
 }
 
-/// Writes one <DataArray> with its values; `tuples` is given for field data, which needs it.
-template <class T>
-void writeDataArray(std::ostream& os, std::string_view indent, std::string_view name,
-                    int components, std::span<const T> values, VtuEncoding encoding,
-                    std::optional<std::size_t> tuples = std::nullopt) {
-  os << indent << "<DataArray type=\"" << vtkTypeName<T>() << "\" Name=\"" << xmlEscape(name)
-     << '"';
+std::size_t storedSize(StoredType t) {
+  switch (t) {
+    case StoredType::UInt8: return 1;
+    case StoredType::Int32: return 4;
+    default: return 8;
+  }
+}
+
+/// One <DataArray> to write: its values (doubles or integers) and how to store them.
+struct ArrayOut {
+  std::string_view indent, name;
+  int components = 1;
+  bool withTuples = false;  ///< field data needs NumberOfTuples
+  std::span<const double> doubles;
+  std::span<const std::int64_t> integers;
+  StoredType stored = StoredType::Float64;
+
+  std::size_t size() const { return stored == StoredType::Float64 ? doubles.size() : integers.size(); }
+  std::size_t bytes() const { return size() * storedSize(stored); }
+};
+
+ArrayOut floatArray(std::string_view indent, std::string_view name, int components,
+                    std::span<const double> values) {
+  return {indent, name, components, false, values, {}, StoredType::Float64};
+}
+
+ArrayOut intArray(std::string_view indent, std::string_view name, std::span<const std::int64_t> values,
+                  bool withTuples = false) {
+  const std::int64_t largest = values.empty() ? 0 : *std::max_element(values.begin(), values.end());
+  const StoredType t = largest < 256 ? StoredType::UInt8
+                       : largest <= std::numeric_limits<std::int32_t>::max() ? StoredType::Int32
+                                                                              : StoredType::Int64;
+  return {indent, name, 1, withTuples, {}, values, t};
+}
+
+/// Appends values [begin, end) of `a`, as stored little-endian, to `out`.
+void storeValues(const ArrayOut& a, std::size_t begin, std::size_t end, std::vector<char>& out) {
+  const std::size_t at = out.size();
+  const std::size_t width = storedSize(a.stored);
+  out.resize(at + (end - begin) * width);
+  char* p = out.data() + at;
+  auto put = [&](auto value) {
+    auto bytes = std::bit_cast<std::array<char, sizeof value>>(value);
+    if constexpr (std::endian::native == std::endian::big) std::reverse(bytes.begin(), bytes.end());
+    std::memcpy(p, bytes.data(), bytes.size());
+    p += bytes.size();
+  };
+  for (std::size_t i = begin; i < end; ++i) {
+    switch (a.stored) {
+      case StoredType::Float64: put(a.doubles[i]); break;
+      case StoredType::UInt8: put(static_cast<std::uint8_t>(a.integers[i])); break;
+      case StoredType::Int32: put(static_cast<std::int32_t>(a.integers[i])); break;
+      case StoredType::Int64: put(a.integers[i]); break;
+    }
+  }
+}
+
+/// Writes the UInt64 byte count and the values of `a` as raw bytes, or through `base64`.
+template <class Sink>
+void writeBinary(const ArrayOut& a, Sink&& sink) {
+  constexpr std::size_t kChunk = 1 << 16;
+  std::vector<char> buffer;
+  auto count = std::bit_cast<std::array<char, 8>>(std::uint64_t{a.bytes()});
+  if constexpr (std::endian::native == std::endian::big) std::reverse(count.begin(), count.end());
+  sink(count.data(), count.size());
+  for (std::size_t begin = 0; begin < a.size(); begin += kChunk) {
+    buffer.clear();
+    storeValues(a, begin, std::min(a.size(), begin + kChunk), buffer);
+    sink(buffer.data(), buffer.size());
+  }
+}
+
+/// Writes one <DataArray>; in appended mode only the tag, with `offset` into the appended data.
+void writeDataArray(std::ostream& os, const ArrayOut& a, VtuEncoding encoding,
+                    std::size_t offset) {
+  os << a.indent << "<DataArray type=\"" << vtkTypeName(a.stored) << "\" Name=\""
+     << xmlEscape(a.name) << '"';
   // Like VTK, only for several components: meshio 5 turns any array that has the attribute
   // into a 2D one, which its polyhedron reader cannot take for 'faces'.
-  if (components != 1) os << " NumberOfComponents=\"" << components << '"';
-  if (tuples) os << " NumberOfTuples=\"" << *tuples << '"';
+  if (a.components != 1) os << " NumberOfComponents=\"" << a.components << '"';
+  if (a.withTuples) os << " NumberOfTuples=\"" << a.size() << '"';
+  if (encoding == VtuEncoding::Appended) {
+    os << " format=\"appended\" offset=\"" << offset << "\"/>\n";
+    return;
+  }
   os << " format=\"" << (encoding == VtuEncoding::Ascii ? "ascii" : "binary") << "\">\n"
-     << indent << "  ";
+     << a.indent << "  ";
   if (encoding == VtuEncoding::Ascii) {
     char buffer[64];
-    for (std::size_t i = 0; i < values.size(); ++i) {
+    for (std::size_t i = 0; i < a.size(); ++i) {
       if (i > 0 && i % 12 == 0)
-        os << '\n' << indent << "  ";
+        os << '\n' << a.indent << "  ";
       else if (i > 0)
         os << ' ';
-      const auto result = std::to_chars(buffer, buffer + sizeof buffer, values[i]);
+      const auto result = a.stored == StoredType::Float64
+                              ? std::to_chars(buffer, buffer + sizeof buffer, a.doubles[i])
+                              : std::to_chars(buffer, buffer + sizeof buffer, a.integers[i]);
       os.write(buffer, result.ptr - buffer);
     }
   } else {
     Base64Writer out(os);
-    auto writeLittleEndian = [&](auto value) {
-      auto bytes = std::bit_cast<std::array<unsigned char, sizeof value>>(value);
-      if constexpr (std::endian::native == std::endian::big)
-        std::reverse(bytes.begin(), bytes.end());
-      out.write(bytes.data(), bytes.size());
-    };
-    writeLittleEndian(std::uint64_t{values.size() * sizeof(T)});
-    for (const T& v : values) writeLittleEndian(v);
+    writeBinary(a, [&](const char* data, std::size_t n) { out.write(data, n); });
     out.finish();
   }
-  os << '\n' << indent << "</DataArray>\n";
+  os << '\n' << a.indent << "</DataArray>\n";
+}
+
+/// The point and cell values the file holds, in file order.
+struct FileValues {
+  std::vector<double> points;                   ///< 3 per VTU point
+  std::vector<std::vector<double>> pointArrays;  ///< pointData, copied to every VTU point
+  std::vector<double> volume;                   ///< per cell
+  std::vector<std::vector<double>> cellArrays;  ///< cellData, in cell order
+};
+
+FileValues fileValues(const PolyMesh& mesh, const CellStreams& s,
+                      const std::vector<CellArray>& cellData,
+                      const std::vector<PointArray>& pointData) {
+  FileValues v;
+  const std::size_t np = s.pointVertex.size(), ne = s.element.size();
+  v.points.resize(3 * np);
+  v.volume.resize(ne);
+  tbb::parallel_for(std::size_t(0), np, [&](std::size_t p) {
+    const Vec3& x = mesh.position(VertexId(static_cast<std::size_t>(s.pointVertex[p])));
+    for (int i = 0; i < 3; ++i) v.points[3 * p + i] = x[i];
+  });
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ne, 1024),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t c = r.begin(); c != r.end(); ++c)
+                        v.volume[c] = signedVolume(
+                            mesh, ElementId(static_cast<std::size_t>(s.element[c])));
+                    });
+  for (const PointArray& a : pointData) {
+    const auto k = static_cast<std::size_t>(a.components);
+    std::vector<double>& values = v.pointArrays.emplace_back(np * k);
+    for (std::size_t p = 0; p < np; ++p)
+      for (std::size_t i = 0; i < k; ++i)
+        values[p * k + i] = a.values[static_cast<std::size_t>(s.pointVertex[p]) * k + i];
+  }
+  for (const CellArray& a : cellData) {
+    const auto k = static_cast<std::size_t>(a.components);
+    std::vector<double>& values = v.cellArrays.emplace_back(ne * k);
+    for (std::size_t c = 0; c < ne; ++c)
+      for (std::size_t i = 0; i < k; ++i)
+        values[c * k + i] = a.values[static_cast<std::size_t>(s.element[c]) * k + i];
+  }
+  return v;
 }
 
 void writeContents(std::ostream& os, const PolyMesh& mesh, const CellStreams& s,
-                   const std::vector<CellArray>& cellData, const std::vector<PointArray>& pointData,
-                   VtuEncoding enc) {
+                   const FileValues& values, const std::vector<CellArray>& cellData,
+                   const std::vector<PointArray>& pointData, VtuEncoding enc) {
+  const std::string_view field = "      ", inner = "        ";
+  std::vector<ArrayOut> fieldArrays{
+      intArray(field, kFaceGroupArray, s.faceGroup, true),
+      intArray(field, kFaceReversedArray, s.faceReversed, true),
+      intArray(field, kFaceOriginArray, s.faceOrigin, true),
+      intArray(field, kElementArray, s.element, true)};
+  if (s.pointVertex.size() != mesh.numVertices())
+    fieldArrays.push_back(intArray(field, kPointVertexArray, s.pointVertex, true));
+  std::vector<ArrayOut> pointArrays, cellArrays;
+  for (std::size_t i = 0; i < pointData.size(); ++i)
+    pointArrays.push_back(
+        floatArray(inner, pointData[i].name, pointData[i].components, values.pointArrays[i]));
+  cellArrays.push_back(floatArray(inner, "volume", 1, values.volume));
+  for (std::size_t i = 0; i < cellData.size(); ++i)
+    cellArrays.push_back(
+        floatArray(inner, cellData[i].name, cellData[i].components, values.cellArrays[i]));
+  const ArrayOut points = floatArray(inner, "Points", 3, values.points);
+  const std::vector<ArrayOut> cells{intArray(inner, "connectivity", s.connectivity),
+                                    intArray(inner, "offsets", s.offsets),
+                                    intArray(inner, "types", s.types),
+                                    intArray(inner, "faces", s.faces),
+                                    intArray(inner, "faceoffsets", s.faceOffsets)};
+
+  std::size_t offset = 0;
+  std::vector<const ArrayOut*> appended;
+  auto put = [&](const ArrayOut& a) {
+    writeDataArray(os, a, enc, offset);
+    offset += 8 + a.bytes();
+    appended.push_back(&a);
+  };
   os << "<?xml version=\"1.0\"?>\n"
      << "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\""
         " header_type=\"UInt64\">\n"
      << "  <UnstructuredGrid>\n"
      << "    <FieldData>\n";
-  const std::string_view fieldIndent = "      ";
-  writeDataArray<std::int64_t>(os, fieldIndent, kFaceGroupArray, 1, s.faceGroup, enc,
-                               s.faceGroup.size());
-  writeDataArray<std::int64_t>(os, fieldIndent, kFaceReversedArray, 1, s.faceReversed, enc,
-                               s.faceReversed.size());
-  writeDataArray<std::int64_t>(os, fieldIndent, kFaceOriginArray, 1, s.faceOrigin, enc,
-                               s.faceOrigin.size());
-  writeDataArray<std::int64_t>(os, fieldIndent, kElementArray, 1, s.element, enc,
-                               s.element.size());
+  for (const ArrayOut& a : fieldArrays) put(a);
   os << "    </FieldData>\n"
-     << "    <Piece NumberOfPoints=\"" << mesh.numVertices() << "\" NumberOfCells=\""
+     << "    <Piece NumberOfPoints=\"" << s.pointVertex.size() << "\" NumberOfCells=\""
      << mesh.numElements() << "\">\n";
-
   os << "      <PointData>\n";
-  for (const PointArray& a : pointData)
-    writeDataArray<double>(os, "        ", a.name, a.components, a.values, enc);
+  for (const ArrayOut& a : pointArrays) put(a);
   os << "      </PointData>\n      <CellData>\n";
-  // Cell data in file (cell) order.
-  std::vector<double> volume(mesh.numElements());
-  for (std::size_t c = 0; c < s.element.size(); ++c)
-    volume[c] = signedVolume(mesh, ElementId(static_cast<std::size_t>(s.element[c])));
-  writeDataArray<double>(os, "        ", "volume", 1, volume, enc);
-  for (const CellArray& a : cellData) {
-    std::vector<double> values(a.values.size());
-    const auto k = static_cast<std::size_t>(a.components);
-    for (std::size_t c = 0; c < s.element.size(); ++c)
-      for (std::size_t i = 0; i < k; ++i)
-        values[c * k + i] = a.values[static_cast<std::size_t>(s.element[c]) * k + i];
-    writeDataArray<double>(os, "        ", a.name, a.components, values, enc);
-  }
+  for (const ArrayOut& a : cellArrays) put(a);
   os << "      </CellData>\n      <Points>\n";
-
-  std::vector<double> points;
-  points.reserve(3 * mesh.numVertices());
-  for (const Vec3& p : mesh.positions()) points.insert(points.end(), {p.x(), p.y(), p.z()});
-  writeDataArray<double>(os, "        ", "Points", 3, points, enc);
+  put(points);
   os << "      </Points>\n      <Cells>\n";
-  writeDataArray<std::int64_t>(os, "        ", "connectivity", 1, s.connectivity, enc);
-  writeDataArray<std::int64_t>(os, "        ", "offsets", 1, s.offsets, enc);
-  writeDataArray<std::int64_t>(os, "        ", "types", 1, s.types, enc);
-  writeDataArray<std::int64_t>(os, "        ", "faces", 1, s.faces, enc);
-  writeDataArray<std::int64_t>(os, "        ", "faceoffsets", 1, s.faceOffsets, enc);
-  os << "      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n";
+  for (const ArrayOut& a : cells) put(a);
+  os << "      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n";
+  if (enc == VtuEncoding::Appended) {
+    // Raw bytes after '_'; the newline before the closing tag is where meshio 5 ends the data.
+    os << "  <AppendedData encoding=\"raw\">\n   _";
+    for (const ArrayOut* a : appended)
+      writeBinary(*a, [&](const char* data, std::size_t n) {
+        os.write(data, static_cast<std::streamsize>(n));
+      });
+    os << "\n  </AppendedData>\n";
+  }
+  os << "</VTKFile>\n";
 }
 
 std::string errnoText(int error) { return error != 0 ? std::strerror(error) : "I/O error"; }
@@ -820,9 +1073,29 @@ void buildByMatching(PolyMesh& mesh, const CellFaces& cells) {
 
 /// The polydg field data of a file, if present.
 struct PolydgFields {
-  std::vector<std::int64_t> group, reversed, origin, element;
+  std::vector<std::int64_t> group, reversed, origin, element, pointVertex;
   bool hasReversed = false;
 };
+
+/// The vertex of each of `points` points: without polydg_point_vertex each point is its own
+/// vertex; with it, the leading points p with value p are the vertices and every later point
+/// names one of them. Empty if the array does not fit.
+std::optional<std::vector<std::size_t>> pointVertices(const PolydgFields& fields,
+                                                      std::size_t points) {
+  std::vector<std::size_t> vertexOf(points);
+  std::iota(vertexOf.begin(), vertexOf.end(), std::size_t{0});
+  if (fields.pointVertex.empty()) return vertexOf;
+  if (fields.pointVertex.size() != points) return std::nullopt;
+  std::size_t vertices = 0;
+  while (vertices < points && fields.pointVertex[vertices] == static_cast<std::int64_t>(vertices))
+    ++vertices;
+  for (std::size_t p = vertices; p < points; ++p) {
+    const std::int64_t v = fields.pointVertex[p];
+    if (v < 0 || static_cast<std::size_t>(v) >= vertices) return std::nullopt;
+    vertexOf[p] = static_cast<std::size_t>(v);
+  }
+  return vertexOf;
+}
 
 /// A mesh's faces and elements, ready to be added.
 struct FacePlan {
@@ -965,6 +1238,8 @@ std::optional<PolydgFields> readPolydgFields(pugi::xml_node grid, const FileLayo
   }
   if (const pugi::xml_node element = findArray(fieldData, kElementArray))
     fields.element = readArray<std::int64_t>(element, layout);
+  if (const pugi::xml_node pointVertex = findArray(fieldData, kPointVertexArray))
+    fields.pointVertex = readArray<std::int64_t>(pointVertex, layout);
   return fields;
 }
 
@@ -1043,13 +1318,25 @@ PolyMesh readVtuContents(const std::string& path) {
   }
   if (pieces == 0) throw VtuError("UnstructuredGrid has no Piece");
 
-  PolyMesh mesh;
-  for (const Vec3& p : points) mesh.addVertex(p);
   const std::optional<PolydgFields> fields =
       pieces == 1 ? readPolydgFields(grid, layout) : std::nullopt;
+  // With polydg's field data, copies of a vertex become that vertex again. Without it (or if it
+  // does not fit the cells), every point is a vertex and faces are matched: matching on the
+  // restored vertices would glue the two sides of a cut together.
+  PolyMesh mesh;
   std::optional<FacePlan> plan;
-  if (fields) plan = planFromFields(mesh, cells, *fields);
+  if (fields) {
+    if (const auto vertexOf = pointVertices(*fields, points.size())) {
+      for (std::size_t p = 0; p < points.size() && (*vertexOf)[p] == p; ++p)
+        mesh.addVertex(points[p]);
+      CellFaces restored = cells;
+      for (VertexId& v : restored.vertices) v = VertexId((*vertexOf)[v.index()]);
+      plan = planFromFields(mesh, restored, *fields);
+    }
+  }
   if (!plan) {
+    mesh = PolyMesh();
+    for (const Vec3& p : points) mesh.addVertex(p);
     buildByMatching(mesh, cells);
     return mesh;
   }
@@ -1086,6 +1373,7 @@ void writeVtu(const PolyMesh& mesh, const std::string& path, const VtuWriteOptio
   checkArrays(pointData, mesh.numVertices(), "point", pointNames);
   // Everything that can fail for reasons other than I/O happens before the file is opened.
   const CellStreams streams = buildCellStreams(mesh);
+  const FileValues values = fileValues(mesh, streams, cellData, pointData);
 
   const std::string tmp = path + ".tmp";
   auto fail = [&](int error) {
@@ -1097,7 +1385,7 @@ void writeVtu(const PolyMesh& mesh, const std::string& path, const VtuWriteOptio
     if (!os) fail(errno);
     errno = 0;
     try {
-      writeContents(os, mesh, streams, cellData, pointData, options.encoding);
+      writeContents(os, mesh, streams, values, cellData, pointData, options.encoding);
     } catch (...) {
       os.close();
       std::remove(tmp.c_str());

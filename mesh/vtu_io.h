@@ -10,12 +10,13 @@
 
 namespace polydg {
 
-/// How the writer stores numbers: readable text, or inline base64 of the raw little-endian bytes
-/// (uncompressed, each array preceded by a UInt64 byte count).
-enum class VtuEncoding { Ascii, Binary };
+/// How the writer stores numbers: readable text; inline base64 of the raw little-endian bytes;
+/// or those bytes raw in one AppendedData section after the XML (encoding "raw"), the smallest
+/// and fastest. Binary data is uncompressed, each array preceded by a UInt64 byte count.
+enum class VtuEncoding { Ascii, Binary, Appended };
 
 struct VtuWriteOptions {
-  VtuEncoding encoding = VtuEncoding::Binary;
+  VtuEncoding encoding = VtuEncoding::Appended;
 };
 
 /// A named array of doubles attached to the elements (`Tag = ElementTag`) or the vertices
@@ -32,21 +33,32 @@ using PointArray = VtuArray<VertexTag>;  ///< numVertices() * components values
 
 /// Writes `mesh` to `path` as a VTK XML UnstructuredGrid (version 1.0, UInt64 headers).
 ///
-/// Layout: the mesh's vertices are the points (Float64), in id order, shared by the cells; each
-/// element is one VTK_POLYHEDRON (type 42) cell, in id order. Cells/connectivity holds a cell's
-/// distinct point ids, Cells/faces per cell the number of face records and then, per record, its
-/// number of points and point ids; Cells/faceoffsets the end of each cell's run in `faces`. All
-/// of them are Int64. Every record is oriented so that its normal points out of the cell (the
-/// face's loop if the element uses it unreversed, the loop backwards otherwise). A face with one
-/// loop is one record, convex or not; a face with holes is written as the triangles of
-/// triangulateFace (one record each), which keeps the cell watertight.
+/// Layout: points (Float64) are the mesh's vertices in id order, followed by extra copies of
+/// vertices: per vertex, its elements are grouped by connectivity through the interior faces
+/// that contain the vertex, and each group has its own point (the first group, in element
+/// order, the vertex itself). So elements coupled across interior faces share points, while the
+/// two sides of a FaceOrigin::Cut face (boundary faces of both, on the same vertex ids) do not:
+/// VTK and meshio see them as separate regions, and a finite cut shares points only along its
+/// front. Each element is one VTK_POLYHEDRON (type 42) cell, cells ordered by point count (see
+/// polydg_element). Cells/connectivity holds a cell's distinct point ids, Cells/faces per cell
+/// the number of face records and then, per record, its number of points and point ids;
+/// Cells/faceoffsets the end of each cell's run in `faces`. Integer arrays are stored as UInt8,
+/// Int32 or Int64, the smallest that holds their values. Every record is oriented so that its
+/// normal points out of the cell (the face's loop if the element uses it unreversed, the loop
+/// backwards otherwise). A face with one loop is one record, convex or not; a face with holes
+/// is written as the triangles of triangulateFace (one record each), which keeps the cell
+/// watertight.
 ///
 /// Cell data: `volume` (signedVolume of each element) followed by `cellData`; point data:
-/// `pointData`. Field data lets readVtu restore the mesh exactly (all Int64):
+/// `pointData` (every copy of a vertex carries the vertex's value). Field data lets readVtu
+/// restore the mesh exactly:
 ///   - polydg_face_group: per face record, in file order, the id of the face it belongs to;
 ///   - polydg_face_reversed: per face record, 1 if it runs against its face's orientation
 ///     (written by the face's back element), 0 otherwise;
-///   - polydg_face_origin: per face, its FaceOrigin as an integer.
+///   - polydg_face_origin: per face, its FaceOrigin as an integer;
+///   - polydg_element: per cell, in file order, the element it is;
+///   - polydg_point_vertex: per point, the vertex it is a copy of (only when some vertex has
+///     several points).
 ///
 /// The file is written to `path + ".tmp"` and renamed over `path`, so `path` is never left
 /// half-written. Throws std::invalid_argument if an array has the wrong size, a component count
@@ -72,7 +84,8 @@ void writeVtu(const PolyMesh& mesh, const std::string& path, const VtuWriteOptio
 /// earlier cell; any other face (used a third time, or twice in the same orientation) stays a
 /// separate face, so that validate() reports the problem instead of the reader failing.
 /// Boundary faces are tagged FaceOrigin::Imported. If the file carries writeVtu's field data
-/// and it is consistent, faces are restored instead exactly as written: same face ids, the
+/// and it is consistent, the mesh is restored instead exactly as written: the copies of a
+/// vertex become that vertex again (same vertex ids), same face ids, the
 /// triangles of a face with holes merged back into its loops (outer loop first; holes may come
 /// back in another order, which does not change the face), the same front/back sides and
 /// origins. Point and cell data are not read.

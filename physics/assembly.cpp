@@ -102,13 +102,19 @@ int sideOf(const FaceRoles& roles, FaceId f, ElementId e) {
 
 double penaltyThreshold(const PolyMesh& mesh, const DgBasis& basis, const MomentCache& moments,
                         const FaceRoles& roles) {
+  const ElementData<double> required = elementPenaltyThresholds(mesh, basis, moments, roles);
+  return required.size() == 0 ? 0.0 : *std::max_element(required.begin(), required.end());
+}
+
+ElementData<double> elementPenaltyThresholds(const PolyMesh& mesh, const DgBasis& basis,
+                                             const MomentCache& moments, const FaceRoles& roles) {
   const std::size_t ne = mesh.numElements();
   const int n1 = basis.liftingSize();
   const int dim = 6 * n1;
   // Strain vector (e11, e22, e33, e12, e13, e23): |eps|^2 = e11^2 + e22^2 + e33^2 +
   // 2 (e12^2 + e13^2 + e23^2); W^(-1/2) turns it into the Euclidean norm.
   const double invSqrtW[6] = {1, 1, 1, 1 / std::sqrt(2.0), 1 / std::sqrt(2.0), 1 / std::sqrt(2.0)};
-  std::vector<double> required(ne, 0.0);
+  ElementData<double> required(ne, 0.0);
   tbb::parallel_for(std::size_t(0), ne, [&](std::size_t i) {
     const ElementId e(i);
     const double volume = moments.volume(e);
@@ -138,9 +144,9 @@ double penaltyThreshold(const PolyMesh& mesh, const DgBasis& basis, const Moment
     if (!any) return;
     Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(form, Eigen::EigenvaluesOnly);
     const double tau = eig.eigenvalues().maxCoeff();
-    required[i] = 2.0 * tau / kConsistencyEnergyShare;
+    required[e] = 2.0 * tau / kConsistencyEnergyShare;
   });
-  return required.empty() ? 0.0 : *std::max_element(required.begin(), required.end());
+  return required;
 }
 
 Eigen::SparseMatrix<double, Eigen::ColMajor, int> assembleStiffness(
@@ -288,7 +294,7 @@ Eigen::VectorXd assembleLoad(const PolyMesh& mesh, const DgBasis& basis,
       const VectorField& g = loads.dirichlet[roles.dirichlet[fid]].displacement;
       if (!g) continue;  // an empty field means g = 0: no right-hand side
       const Vec3 normal = use.reversed ? Vec3(-moments.faceNormal(fid)) : moments.faceNormal(fid);
-      const double etaF = form.eta * moments.area(fid) / moments.volume(e);
+      const double etaF = facePenalty(form, moments, fid, e, ElementId());
       const double mu = form.mu, lambda = form.lambda;
       const double cK = roles.coupledFaces[e];
       const auto rule = faceQuadrature(mesh, fid, quadratureDegree);

@@ -62,6 +62,14 @@ inline constexpr double kConsistencyEnergyShare = 0.9;
 double penaltyThreshold(const PolyMesh& mesh, const DgBasis& basis, const MomentCache& moments,
                         const FaceRoles& roles);
 
+/// The per-element bounds s_K = 2 tau_K / theta of penaltyThreshold() (0 for an element
+/// without coupled faces). The derivation there needs, face by face, only
+/// eta_F >= area(F) sum_{K of F} s_K / vol(K): with FormCoefficients::elementEta = s_K the IP
+/// form is coercive while each face's penalty follows its own two elements, not the worst
+/// element of the mesh (a sliced sphere's worst is ~800 against ~10 for a cube).
+ElementData<double> elementPenaltyThresholds(const PolyMesh& mesh, const DgBasis& basis,
+                                             const MomentCache& moments, const FaceRoles& roles);
+
 /// A symmetric sparse system K U = F. Element e's DOFs are the contiguous range
 /// [e * blockSize, (e + 1) * blockSize), in the order d * n + i (component d, function i).
 /// The matrix stores both triangles (column-major; by symmetry its columns are its rows).

@@ -8,6 +8,9 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
+#include "integrate/monomials.h"
+#include "physics/p_multigrid.h"
+
 namespace polydg {
 
 namespace {
@@ -82,8 +85,26 @@ struct LinearSolver::Impl {
   double factorSeconds = 0.0;
   std::unique_ptr<Eigen::CholmodSupernodalLLT<SpMat, Eigen::Lower>> cholesky;
   std::vector<Eigen::MatrixXd> blockInverses;
+  CgPreconditioner preconditioner = CgPreconditioner::BlockJacobi;
+  PMultigrid multigrid;
+
+  /// The basis degree p with blockSize = 3 numMonomials(p), or -1.
+  int degreeOfBlock() const {
+    for (int p = 0; p <= 3; ++p)
+      if (blockSize == 3 * numMonomials(p)) return p;
+    return -1;
+  }
 
   bool buildPreconditioner() {
+    preconditioner = options.preconditioner;
+    const int degree = degreeOfBlock();
+    if (preconditioner == CgPreconditioner::PMultigrid && degree >= 0)
+      return multigrid.compute(*matrix, degree);
+    preconditioner = CgPreconditioner::BlockJacobi;
+    return buildBlockJacobi();
+  }
+
+  bool buildBlockJacobi() {
     const Eigen::Index nb = matrix->rows() / blockSize;
     blockInverses.assign(static_cast<std::size_t>(nb), Eigen::MatrixXd());
     std::atomic<bool> ok{true};
@@ -106,6 +127,10 @@ struct LinearSolver::Impl {
   }
 
   void precondition(const Eigen::VectorXd& r, Eigen::VectorXd& z) const {
+    if (preconditioner == CgPreconditioner::PMultigrid) {
+      multigrid.apply(r, z);
+      return;
+    }
     z.resize(r.size());
     tbb::parallel_for(std::size_t(0), blockInverses.size(), [&](std::size_t b) {
       const Eigen::Index base = static_cast<Eigen::Index>(b) * blockSize;
@@ -177,6 +202,7 @@ Eigen::VectorXd LinearSolver::solve(const Eigen::VectorXd& rhs, SolveReport& rep
   Impl& m = *impl_;
   report = SolveReport{};
   report.used = m.kind;
+  report.preconditioner = m.preconditioner;
   report.factorSeconds = m.factorSeconds;
   const auto t0 = Clock::now();
   Eigen::VectorXd u;

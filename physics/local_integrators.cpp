@@ -10,7 +10,9 @@ namespace polydg {
 namespace {
 
 /// The degree-P kernels. Fixed-size matrices: N = numMonomials(P) functions per component,
-/// N1 = numMonomials(P - 1) lifting functions.
+/// N1 = numMonomials(P - 1) lifting functions. Products are lazyProduct(): coefficient-based
+/// and unrolled for these small fixed sizes, where Eigen's default GEMM path (packing, for
+/// sizes past its threshold of 20) spent a third of the assembly time.
 template <int P>
 struct Kernel {
   using Tab = detail::PolyTables<P>;
@@ -82,11 +84,11 @@ struct Kernel {
     Mat r[3];
     for (int k = 0; k < 3; ++k) r[k] = derive(t, k) / h;
     Mat rg[3];
-    for (int k = 0; k < 3; ++k) rg[k] = r[k] * g;
+    for (int k = 0; k < 3; ++k) rg[k] = r[k].lazyProduct(g);
     Mat gd[3][3];  // gd[k][l](i, j) = int d_k phi_i d_l phi_j
     for (int k = 0; k < 3; ++k)
       for (int l = k; l < 3; ++l) {
-        gd[k][l] = rg[k] * r[l].transpose();
+        gd[k][l] = rg[k].lazyProduct(r[l].transpose());
         if (l != k) gd[l][k] = gd[k][l].transpose();
       }
     const Mat lap = gd[0][0] + gd[1][1] + gd[2][2];
@@ -132,10 +134,10 @@ struct Kernel {
     const Mat s = shift(fr.h / h, (fr.origin - basis.centre(e)) / h);
     const Mat t = coefficients(basis, e);
     Side sd;
-    sd.p = t * s;
-    for (int k = 0; k < 3; ++k) sd.q[k] = (derive(t, k) / h) * s;
+    sd.p = t.lazyProduct(s);
+    for (int k = 0; k < 3; ++k) sd.q[k] = (derive(t, k) / h).lazyProduct(s);
     const Mat11 o(basis.liftingCoefficients(e));
-    sd.psi = o * s.template topRows<N1>();
+    sd.psi = o.lazyProduct(s.template topRows<N1>());
     return sd;
   }
 
@@ -146,10 +148,8 @@ struct Kernel {
     const FaceFrame fr = frame(mesh, moments, view.face);
     const Vec3 n = view.selfIsFront ? moments.faceNormal(view.face)
                                     : Vec3(-moments.faceNormal(view.face));
-    const double area = moments.area(view.face);
-    double inverseVolumes = 1.0 / moments.volume(view.self);
-    if (interior) inverseVolumes += 1.0 / moments.volume(view.other);
-    const double etaF = form.eta * area * inverseVolumes;
+    const double etaF = facePenalty(form, moments, view.face, view.self,
+                                    interior ? view.other : ElementId());
     const double w = interior ? 0.5 : 1.0;
     const double mu = form.mu, lambda = form.lambda;
     const bool ip = form.method == Method::IP;
@@ -157,18 +157,18 @@ struct Kernel {
     const Side sk = side(basis, fr, view.self);
     Side sl;
     if (interior) sl = side(basis, fr, view.other);
-    const Mat ck = fr.gram * sk.p.transpose();
+    const Mat ck = fr.gram.lazyProduct(sk.p.transpose());
     Mat cl;
-    if (interior) cl = fr.gram * sl.p.transpose();
-    const Mat ak = sk.p * fr.gram;
+    if (interior) cl = fr.gram.lazyProduct(sl.p.transpose());
+    const Mat ak = sk.p.lazyProduct(fr.gram);
     // Lifting face matrices psi_E against phi_X: mpsi[E][X] = psi_E G phi_X^T (N1 x N).
     Mat1 mkk = Mat1::Zero(), mkl = Mat1::Zero(), mlk = Mat1::Zero(), mll = Mat1::Zero();
     if (ip) {
-      mkk = sk.psi * ck;
+      mkk = sk.psi.lazyProduct(ck);
       if (interior) {
-        mkl = sk.psi * cl;
-        mlk = sl.psi * ck;
-        mll = sl.psi * cl;
+        mkl = sk.psi.lazyProduct(cl);
+        mlk = sl.psi.lazyProduct(ck);
+        mll = sl.psi.lazyProduct(cl);
       }
     }
     const double cK = view.selfCoupledFaces, cL = view.otherCoupledFaces;
@@ -176,20 +176,20 @@ struct Kernel {
     auto block = [&](const Side& b, const Mat& cb, double sb, const Mat1* liftK,
                      const Mat1* liftL, Eigen::MatrixXd& out) {
       out.setZero(3 * N, 3 * N);
-      const Mat m = sk.p * cb;
+      const Mat m = sk.p.lazyProduct(cb);
       for (int d = 0; d < 3; ++d)
         out.template block<N, N>(d * N, d * N) += (mu * etaF * sb) * m;
       if (!ip) return;
       Mat wk[3], vk[3];  // wk: int phi^K_i d_k phi^B_j; vk: int d_k phi^K_i phi^B_j
       for (int k = 0; k < 3; ++k) {
-        wk[k] = ak * b.q[k].transpose();
-        vk[k] = sk.q[k] * cb;
+        wk[k] = ak.lazyProduct(b.q[k].transpose());
+        vk[k] = sk.q[k].lazyProduct(cb);
       }
       const Mat wn = n.x() * wk[0] + n.y() * wk[1] + n.z() * wk[2];
       const Mat vn = n.x() * vk[0] + n.y() * vk[1] + n.z() * vk[2];
       // Lifting: sum_E c_E (psi_E phi_K)^T (psi_E phi_B).
-      Mat lift = cK * liftK[0].transpose() * liftK[1];
-      if (liftL) lift += cL * liftL[0].transpose() * liftL[1];
+      Mat lift = cK * liftK[0].transpose().lazyProduct(liftK[1]);
+      if (liftL) lift += cL * liftL[0].transpose().lazyProduct(liftL[1]);
       for (int d = 0; d < 3; ++d)
         for (int c = 0; c < 3; ++c) {
           Mat blk = (-w * mu * n[c]) * wk[d] + (-w * lambda * n[d]) * wk[c] +
@@ -234,6 +234,14 @@ void elementMass(const DgBasis& basis, const MomentCache& moments, ElementId e,
                  Eigen::MatrixXd& out) {
   detail::dispatchBasisDegree(basis.degree(),
                               [&](auto p) { Kernel<p()>::mass(basis, moments, e, out); });
+}
+
+double facePenalty(const FormCoefficients& form, const MomentCache& moments, FaceId f,
+                   ElementId self, ElementId other) {
+  auto eta = [&](ElementId e) { return form.elementEta ? (*form.elementEta)[e] : form.eta; };
+  double sum = eta(self) / moments.volume(self);
+  if (other.valid()) sum += eta(other) / moments.volume(other);
+  return moments.area(f) * sum;
 }
 
 void faceRows(const PolyMesh& mesh, const DgBasis& basis, const MomentCache& moments,

@@ -34,7 +34,17 @@ struct FormCoefficients {
   double mu = 0.0;      ///< shear modulus
   double lambda = 0.0;  ///< first Lame parameter
   double eta = 0.0;     ///< global penalty parameter of eq. (7)
+  /// Per-element penalties eta_K (one per element of the mesh), or null for the global eta.
+  /// With them a face's penalty is eta_F = area(F) (eta_K / vol(K) + eta_L / vol(L)) (one
+  /// side on the boundary) instead of eta area(F) (1/vol(K) + 1/vol(L)): the same coercivity
+  /// argument (penaltyThreshold() in physics/assembly.h) with each element's own bound, so a
+  /// badly shaped sliced element raises the penalty only on its own faces.
+  const ElementData<double>* elementEta = nullptr;
 };
+
+/// eta_F of face `f` between `self` and `other` (invalid on the boundary) under `form`.
+double facePenalty(const FormCoefficients& form, const MomentCache& moments, FaceId f,
+                   ElementId self, ElementId other);
 
 /// One face as seen from one of its elements (`self`), with what the face integrators need
 /// about both sides.
@@ -67,7 +77,8 @@ void elementMass(const DgBasis& basis, const MomentCache& moments, ElementId e,
 ///   - int_F ({sigma(v)} n) . [u]            symmetry, eq. (12)
 ///   + mu eta_F int_F [u] . [v]              stability, eq. (13) with eta_F of eq. (7)
 ///   + lambda sum_{E in {K,L}} c_E (R_E[u.n], R_E[v.n])_E                     (lambda term)
-/// eta_F = eta area(F) (1/vol(K) + 1/vol(L)) (one side on the boundary). The penalty scales
+/// eta_F = facePenalty(): eta area(F) (1/vol(K) + 1/vol(L)) (one side on the boundary), or
+/// with per-element eta_K (FormCoefficients::elementEta). The penalty scales
 /// with mu only: the lambda part of the consistency terms, -int {lambda div u}[v.n], is
 /// controlled instead by the local lifting R_E: P_{p-1}(E) <- face, (R_E w, q)_E =
 /// w_F int_F q w (w_F = 1/2 inside, 1 on the boundary), weighted by c_E = the number of faces

@@ -1,5 +1,6 @@
 #include "physics/static_solver.h"
 
+#include <algorithm>
 #include <chrono>
 #include <stdexcept>
 
@@ -41,7 +42,12 @@ void StaticSolver::assemble(const LoadCase& loads) {
   form_.method = disc.method;
   form_.mu = material_.mu();
   form_.lambda = material_.lambda();
-  report_.etaThreshold = penaltyThreshold(*mesh_, *basis_, *moments_, roles_);
+  elementEta_ = std::make_unique<ElementData<double>>(
+      elementPenaltyThresholds(*mesh_, *basis_, *moments_, roles_));
+  report_.etaThreshold = elementEta_->size() == 0
+                             ? 0.0
+                             : *std::max_element(elementEta_->begin(), elementEta_->end());
+  form_.elementEta = nullptr;
   const int quadrature =
       disc.quadratureDegree >= 0 ? disc.quadratureDegree : 2 * basis_->degree() + 2;
   system_.blockSize = 3 * basis_->size();
@@ -52,6 +58,11 @@ void StaticSolver::assemble(const LoadCase& loads) {
     case PenaltyRule::TraceBound:
       form_.eta = disc.penalty.safety * report_.etaThreshold;
       if (form_.eta <= 0.0) form_.eta = 1.0;  // no coupled faces: any positive value
+      if (disc.penalty.local) {
+        // Elements without coupled faces have no penalty terms; any positive value does.
+        for (double& eta : *elementEta_) eta = eta > 0.0 ? disc.penalty.safety * eta : form_.eta;
+        form_.elementEta = elementEta_.get();
+      }
       break;
     case PenaltyRule::Fixed:
       form_.eta = disc.penalty.eta;
@@ -61,7 +72,7 @@ void StaticSolver::assemble(const LoadCase& loads) {
       break;
   }
   if (!(form_.eta > 0.0)) throw std::invalid_argument("the penalty eta must be positive");
-  system_.matrix = assembleStiffness(*mesh_, *basis_, *moments_, roles_, form_);
+  assembleInto(system_.matrix);
 
   double searchSeconds = 0.0;
   if (disc.penalty.rule == PenaltyRule::Doubling) {
@@ -82,7 +93,7 @@ void StaticSolver::assemble(const LoadCase& loads) {
                                  "definite even at eta = " + std::to_string(form_.eta) +
                                  "; is a Dirichlet condition missing?");
       form_.eta *= 2.0;
-      system_.matrix = assembleStiffness(*mesh_, *basis_, *moments_, roles_, form_);
+      assembleInto(system_.matrix);
     }
   }
   report_.eta = form_.eta;
@@ -95,14 +106,26 @@ void StaticSolver::assemble(const LoadCase& loads) {
   report_.solveSeconds = searchSeconds;
 }
 
+void StaticSolver::assembleInto(Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix) const {
+  // Eigen 3.4's SparseMatrix has no move assignment: assigning the returned matrix would copy
+  // every nonzero (a third of the assembly time for p = 2); swap instead.
+  Eigen::SparseMatrix<double, Eigen::ColMajor, int> k =
+      assembleStiffness(*mesh_, *basis_, *moments_, roles_, form_);
+  matrix.swap(k);
+}
+
 const Eigen::VectorXd& StaticSolver::solve() {
   if (system_.matrix.rows() == 0 && mesh_->numElements() > 0)
     throw std::logic_error("StaticSolver::solve: call assemble() first");
   const auto t0 = Clock::now();
   if (!factorized_) {
     solver_ = LinearSolver(options_.solver);
-    if (!solver_.compute(system_.matrix, system_.blockSize) &&
-        solver_.kind() == SolverKind::Cholesky)
+    // Cholesky and the p-multigrid's level-0 factorization detect an indefinite K; the
+    // block-Jacobi preconditioner falls back to diagonals and lets CG report the failure.
+    const bool definiteCheck =
+        solver_.kind() == SolverKind::Cholesky ||
+        options_.solver.preconditioner == CgPreconditioner::PMultigrid;
+    if (!solver_.compute(system_.matrix, system_.blockSize) && definiteCheck)
       throw std::runtime_error(
           "the stiffness matrix is not positive definite: is the body held by a Dirichlet "
           "condition (e.g. --clamp)?");

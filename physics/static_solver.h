@@ -12,7 +12,9 @@ namespace polydg {
 
 /// How the global penalty eta of eq. (7) is chosen.
 enum class PenaltyRule {
-  /// eta = safety * penaltyThreshold(): guaranteed SPD, no trial factorizations.
+  /// eta = safety * the coercivity bound: guaranteed SPD, no trial factorizations. Per
+  /// element (elementPenaltyThresholds()) unless PenaltyOptions::local is false, then the
+  /// global penaltyThreshold().
   TraceBound,
   /// The paper's rule (section 10): start at `eta` and double until the Cholesky
   /// factorization succeeds. Costs one factorization per attempt.
@@ -25,6 +27,10 @@ struct PenaltyOptions {
   PenaltyRule rule = PenaltyRule::TraceBound;
   double eta = 1.0;     ///< Fixed: the value; Doubling: the first value tried
   double safety = 1.0;  ///< TraceBound: multiple of the threshold
+  /// TraceBound: each element's own bound eta_K (FormCoefficients::elementEta), so that a
+  /// badly shaped element does not raise the penalty, and spoil the accuracy, everywhere; false:
+  /// the largest bound for every face, as in the paper's global eta.
+  bool local = true;
 };
 
 struct DiscretizationOptions {
@@ -46,7 +52,7 @@ struct StaticReport {
   std::size_t elements = 0;
   std::size_t dofs = 0;
   std::size_t nonzeros = 0;    ///< stored entries of K (both triangles)
-  double eta = 0.0;            ///< the global penalty used
+  double eta = 0.0;            ///< the global penalty used (local: the largest eta_K)
   double etaThreshold = 0.0;   ///< penaltyThreshold() (the IP coercivity bound)
   int penaltyAttempts = 1;     ///< factorizations tried by PenaltyRule::Doubling
   std::size_t dirichletFaces = 0, tractionFaces = 0;
@@ -92,12 +98,17 @@ class StaticSolver {
   StaticSolution release();
 
  private:
+  /// K of the current form into `matrix`, without copying it.
+  void assembleInto(Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix) const;
+
   const PolyMesh* mesh_;
   Material material_;
   StaticOptions options_;
   std::unique_ptr<MomentCache> moments_;
   std::unique_ptr<DgBasis> basis_;
   FaceRoles roles_;
+  /// Per-element penalties that form_.elementEta points to (on the heap: stable under moves).
+  std::unique_ptr<ElementData<double>> elementEta_;
   FormCoefficients form_;
   LinearSystem system_;
   LinearSolver solver_;

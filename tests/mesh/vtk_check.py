@@ -4,6 +4,7 @@ files with VTK itself for polydg's reader.
 
 Sample runs (Debian's interpreter, which has python3-vtk9 and python3-meshio):
   /usr/bin/python3 tests/mesh/vtk_check.py out/grid.vtu 6.12 --cells 12
+  /usr/bin/python3 tests/mesh/vtk_check.py out/cut_boxes.vtu 2 --cells 2 --regions 2
   /usr/bin/python3 tests/mesh/vtk_check.py --write-vtk build/vtk_cells.vtu
 
 Check mode: opens FILE with VTK 9.1 (vtkXMLUnstructuredGridReader) and with meshio 5. Every cell
@@ -11,7 +12,10 @@ must be a polyhedron. With VTK, each cell's faces become a vtkPolyData, triangul
 vtkTriangleFilter, measured by vtkMassProperties (unsigned volume; the sign comes from its
 projected volume). With meshio, each cell's volume is the divergence theorem over its face
 lists (numpy). Each volume must match the file's `volume` cell data to 1e-9 relative, and the
-totals must match EXPECTED_TOTAL_VOLUME to 1e-9 relative. Exits 1 with a message otherwise.
+totals must match EXPECTED_TOTAL_VOLUME to 1e-9 relative. With --regions N, the cells must form
+N connected regions through shared points (VTK: vtkConnectivityFilter; meshio: cells joined by
+common point ids), which is how the two sides of a cut are told apart. Exits 1 with a message
+otherwise.
 
 --write-vtk OUT.vtu: writes, with vtkXMLUnstructuredGridWriter, a mesh of three polyhedra:
 cell 0 the unit cube, cell 1 an L-shaped (non-convex) prism of volume 3 sharing the cube's
@@ -166,7 +170,43 @@ def meshio_cell_volumes(path):
     return results
 
 
-def check(path, expected_total, expected_cells):
+def vtk_regions(path):
+    """Connected regions of the cells through shared points, with vtkConnectivityFilter."""
+    reader = vtk.vtkXMLUnstructuredGridReader()
+    reader.SetFileName(path)
+    connectivity = vtk.vtkConnectivityFilter()
+    connectivity.SetInputConnection(reader.GetOutputPort())
+    connectivity.SetExtractionModeToAllRegions()
+    connectivity.Update()
+    return connectivity.GetNumberOfExtractedRegions()
+
+
+def meshio_regions(path):
+    """Connected regions of the cells through shared point ids, read with meshio."""
+    import meshio
+
+    mesh = meshio.read(path, file_format="vtu")
+    parent = {}
+
+    def find(x):
+        while parent.setdefault(x, x) != x:
+            parent[x] = parent[parent[x]]
+            x = parent[x]
+        return x
+
+    cell = 0
+    for block in mesh.cells:
+        for faces in block.data:
+            for face in faces:
+                for p in np.asarray(face, dtype=np.int64):
+                    a, b = find(("cell", cell)), find(("point", int(p)))
+                    if a != b:
+                        parent[a] = b
+            cell += 1
+    return len({find(("cell", c)) for c in range(cell)})
+
+
+def check(path, expected_total, expected_cells, expected_regions=None):
     for reader, volumes in (("VTK", vtk_cell_volumes), ("meshio", meshio_cell_volumes)):
         results = volumes(path)
         if expected_cells is not None and len(results) != expected_cells:
@@ -179,6 +219,13 @@ def check(path, expected_total, expected_cells):
         if not close(total, expected_total, expected_total):
             raise CheckFailed(f"{reader}: total volume {total!r}, expected {expected_total!r}")
         print(f"vtk_check: {reader}: {len(results)} cells, total volume {total!r}: ok")
+    if expected_regions is not None:
+        for reader, regions in (("VTK", vtk_regions), ("meshio", meshio_regions)):
+            found = regions(path)
+            if found != expected_regions:
+                raise CheckFailed(f"{reader}: {found} connected regions, expected "
+                                  f"{expected_regions}")
+            print(f"vtk_check: {reader}: {found} connected regions: ok")
 
 
 # ---------------------------------------------------------------------------------------------
@@ -387,13 +434,15 @@ def main():
     parser.add_argument("file", nargs="?", help="VTU file to check")
     parser.add_argument("expected_total_volume", nargs="?", type=float)
     parser.add_argument("--cells", type=int, help="expected number of cells")
+    parser.add_argument("--regions", type=int,
+                        help="expected number of regions connected through shared points")
     parser.add_argument("--write-vtk", metavar="OUT.vtu", help="write test files with VTK")
     args = parser.parse_args()
     try:
         if args.write_vtk:
             write_vtk(args.write_vtk)
         elif args.file is not None and args.expected_total_volume is not None:
-            check(args.file, args.expected_total_volume, args.cells)
+            check(args.file, args.expected_total_volume, args.cells, args.regions)
         else:
             parser.error("give FILE and EXPECTED_TOTAL_VOLUME, or --write-vtk OUT.vtu")
     except CheckFailed as failure:

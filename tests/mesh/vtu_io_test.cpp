@@ -176,6 +176,65 @@ void expectSameMesh(const PolyMesh& expected, const PolyMesh& actual) {
   }
 }
 
+/// `mesh` with interior face `cut` split into two boundary faces tagged Cut, one per side, on
+/// the same vertex ids (as a plane cut leaves them); the back side's face is added last.
+PolyMesh cutAcross(const PolyMesh& mesh, FaceId cut) {
+  PolyMesh out;
+  for (const Vec3& p : mesh.positions()) out.addVertex(p);
+  auto loopsOf = [](const Face& f, bool reversed) {
+    std::vector<Loop> loops;
+    for (std::size_t k = 0; k < f.numLoops(); ++k) {
+      Loop loop(f.loop(k).begin(), f.loop(k).end());
+      if (reversed) std::reverse(loop.begin(), loop.end());
+      loops.push_back(loop);
+    }
+    return loops;
+  };
+  for (std::size_t i = 0; i < mesh.numFaces(); ++i) {
+    const Face& f = mesh.face(FaceId(i));
+    out.addFace(loopsOf(f, false), FaceId(i) == cut ? FaceOrigin::Cut : f.origin);
+  }
+  const FaceId backSide = out.addFace(loopsOf(mesh.face(cut), true), FaceOrigin::Cut);
+  for (const Element& element : mesh.elements()) {
+    FaceList uses = element.faces;
+    for (FaceUse& use : uses)
+      if (use.face == cut && use.reversed) use = {backSide, false};
+    out.addElementFromFaces(uses);
+  }
+  return out;
+}
+
+/// The interior face between elements a and b.
+FaceId faceBetween(const PolyMesh& mesh, ElementId a, ElementId b) {
+  for (std::size_t i = 0; i < mesh.numFaces(); ++i) {
+    const Face& f = mesh.face(FaceId(i));
+    if ((f.front == a && f.back == b) || (f.front == b && f.back == a)) return FaceId(i);
+  }
+  throw std::logic_error("no face between the elements");
+}
+
+/// Two unit boxes side by side, cut apart across their common face.
+PolyMesh cutBoxes() {
+  const PolyMesh grid = hexGridMesh(2, 1, 1, Box3(Vec3(0, 0, 0), Vec3(2, 1, 1)));
+  return cutAcross(grid, faceBetween(grid, ElementId(0), ElementId(1)));
+}
+
+/// A 2 x 2 x 1 grid of unit boxes with a finite cut between elements 0 and 1: its front, the
+/// edge x = 1, y = 1, is still shared with the other two elements.
+PolyMesh finitelyCutGrid() {
+  const PolyMesh grid = hexGridMesh(2, 2, 1, Box3(Vec3(0, 0, 0), Vec3(2, 2, 1)));
+  return cutAcross(grid, faceBetween(grid, ElementId(0), ElementId(1)));
+}
+
+/// The NumberOfPoints of the file's Piece.
+std::size_t pointsInFile(const fs::path& path) {
+  const std::string text = readText(path);
+  const std::string key = "NumberOfPoints=\"";
+  const auto at = text.find(key);
+  if (at == std::string::npos) return 0;
+  return std::stoul(text.substr(at + key.size()));
+}
+
 std::size_t countInteriorFaces(const PolyMesh& mesh) {
   return static_cast<std::size_t>(std::count_if(mesh.faces().begin(), mesh.faces().end(),
                                                 [](const Face& f) { return !f.isBoundary(); }));
@@ -325,7 +384,14 @@ INSTANTIATE_TEST_SUITE_P(
                       RoundTripCase{"HoledPrismAscii", holedPrism, VtuEncoding::Ascii},
                       RoundTripCase{"HoledPrismBinary", holedPrism, VtuEncoding::Binary},
                       RoundTripCase{"MixedCellsAscii", mixedCells, VtuEncoding::Ascii},
-                      RoundTripCase{"MixedCellsBinary", mixedCells, VtuEncoding::Binary}),
+                      RoundTripCase{"MixedCellsBinary", mixedCells, VtuEncoding::Binary},
+                      RoundTripCase{"HexGridAppended", skewGrid, VtuEncoding::Appended},
+                      RoundTripCase{"HoledPrismAppended", holedPrism, VtuEncoding::Appended},
+                      RoundTripCase{"MixedCellsAppended", mixedCells, VtuEncoding::Appended},
+                      RoundTripCase{"CutBoxesAppended", cutBoxes, VtuEncoding::Appended},
+                      RoundTripCase{"CutBoxesAscii", cutBoxes, VtuEncoding::Ascii},
+                      RoundTripCase{"FinitelyCutGridBinary", finitelyCutGrid,
+                                    VtuEncoding::Binary}),
     [](const auto& info) { return info.param.name; });
 
 TEST(VtuRoundTrip, InteriorFaceWhoseFrontIsTheLaterElement) {
@@ -346,6 +412,60 @@ TEST(VtuRoundTrip, InteriorFaceWhoseFrontIsTheLaterElement) {
   const fs::path path = testDir() / "swapped.vtu";
   writeVtu(swapped, path.string());
   expectSameMesh(swapped, readVtu(path.string()));
+}
+
+// --- cuts: the two sides of a Cut face have their own points ------------------------------
+
+TEST(VtuCut, TheTwoSidesOfACutGetTheirOwnPoints) {
+  const PolyMesh mesh = cutBoxes();
+  ASSERT_EQ(mesh.numVertices(), 12u);
+  ASSERT_EQ(countInteriorFaces(mesh), 0u);
+  const fs::path path = testDir() / "cut.vtu";
+  writeVtu(mesh, path.string());
+  // The four vertices of the cut polygon are written once per side.
+  EXPECT_EQ(pointsInFile(path), 16u);
+  const PolyMesh read = readVtu(path.string());
+  expectSameMesh(mesh, read);
+  std::size_t cutFaces = 0;
+  for (const Face& f : read.faces()) cutFaces += f.origin == FaceOrigin::Cut;
+  EXPECT_EQ(cutFaces, 2u);
+}
+
+TEST(VtuCut, AFiniteCutSharesPointsOnlyAlongItsFront) {
+  const PolyMesh mesh = finitelyCutGrid();
+  ASSERT_EQ(mesh.numVertices(), 18u);
+  const fs::path path = testDir() / "finite_cut.vtu";
+  writeVtu(mesh, path.string());
+  // Of the cut's four corners, the two on its front (x = 1, y = 1) stay shared by all four
+  // elements; the two at y = 0 touch only the two sides of the cut and are split.
+  EXPECT_EQ(pointsInFile(path), 20u);
+  expectSameMesh(mesh, readVtu(path.string()));
+}
+
+TEST(VtuCut, MeshesWithoutCutsWriteOnePointPerVertex) {
+  const PolyMesh mesh = skewGrid();
+  const fs::path path = testDir() / "grid.vtu";
+  writeVtu(mesh, path.string());
+  EXPECT_EQ(pointsInFile(path), mesh.numVertices());
+  EXPECT_EQ(readText(path).find("polydg_point_vertex"), std::string::npos);
+}
+
+TEST(VtuCut, WithoutFieldDataTheSidesStayApart) {
+  // Without polydg's field data every point is a vertex: the cut's sides are not matched.
+  const PolyMesh mesh = cutBoxes();
+  const fs::path path = testDir() / "cut.vtu";
+  writeVtu(mesh, path.string(), {.encoding = VtuEncoding::Ascii});
+  std::string text = readText(path);
+  const auto begin = text.find("<FieldData>");
+  const auto end = text.find("</FieldData>");
+  ASSERT_NE(begin, std::string::npos);
+  text.erase(begin, end + std::string("</FieldData>").size() - begin);
+  writeText(path, text);
+  const PolyMesh read = readVtu(path.string());
+  EXPECT_EQ(read.numVertices(), 16u);
+  EXPECT_EQ(countInteriorFaces(read), 0u);
+  EXPECT_NEAR(signedVolume(read, ElementId(0)) + signedVolume(read, ElementId(1)), 2.0,
+              kRelativeTolerance);
 }
 
 // --- writer --------------------------------------------------------------------------------
@@ -632,6 +752,8 @@ TEST(WriteForVtkCheck, HexGridHoledPrismAndMixedCells) {
   writeVtu(holedPrism(), (fs::path(dir) / "holed_prism_ascii.vtu").string(),
            {.encoding = VtuEncoding::Ascii});
   writeVtu(mixedCells(), (fs::path(dir) / "mixed_cells.vtu").string());
+  writeVtu(cutBoxes(), (fs::path(dir) / "cut_boxes.vtu").string());
+  writeVtu(finitelyCutGrid(), (fs::path(dir) / "finite_cut.vtu").string());
 }
 
 }  // namespace
