@@ -138,6 +138,10 @@ nlohmann::json reportJson(const StaticReport& r) {
             {"factorize", r.solver.factorSeconds}}},
           {"solver",
            {{"kind", toString(r.solver.used)},
+            {"preconditioner",
+             r.solver.used != SolverKind::ConjugateGradient ? "none"
+             : r.solver.preconditioner == CgPreconditioner::PMultigrid ? "p-multigrid"
+                                                                       : "block-jacobi"},
             {"success", r.solver.success},
             {"iterations", r.solver.iterations},
             {"residual", r.solver.residual}}},
