@@ -16,6 +16,8 @@
 //              1e-1 .. 1e-9), near-incompressible cantilever (nu 0.3 .. 0.4999, p = 1, 2),
 //              scale and position (B1 and B3 scaled by 1e-6, 1, 1e6, offsets 0 and
 //              (1e6, -1e6, 1e6), p = 2).
+//   cutting    plane cuts of growing size on a 47^3 hex grid (103,823 elements): time per cut
+//              against elements split, validation none and local, beside a full moment rebuild.
 //   meshing    the meshing pipeline and its validation (geometric, DG checks) for the bundled
 //              testdata/torus.obj and the generated sphere and torus knot at 16 .. 128 cells.
 #include <array>
@@ -35,7 +37,9 @@
 #include "cli/csv.h"
 #include "cli/plot.h"
 #include "cli/report.h"
+#include "cut/cut.h"
 #include "mesh/meshing.h"
+#include "mesh/primitives.h"
 #include "mesh/surface_io.h"
 #include "physics/benchmarks.h"
 #include "physics/stability.h"
@@ -542,6 +546,95 @@ SuiteOutput meshingSuite(const BenchOptions& o, bool quiet) {
   return s;
 }
 
+// --- cutting -------------------------------------------------------------------------------
+
+/// One cut of the cutting suite.
+struct CutRow {
+  Vec3 normal;
+  double offset;
+  std::string name;
+};
+
+/// Corner cuts of growing depth on a unit box (normal (+-1, +-1, +-1), each corner once, so the
+/// cuts never overlap and the mesh keeps its size), then one through the middle.
+std::vector<CutRow> cuttingRows(bool quick) {
+  const std::vector<double> depths = quick ? std::vector<double>{0.05, 0.3}
+                                           : std::vector<double>{0.01, 0.04, 0.1, 0.2, 0.35,
+                                                                 0.5, 0.7, 0.9};
+  std::vector<CutRow> rows;
+  for (std::size_t k = 0; k < depths.size(); ++k) {
+    const Vec3 s(k & 1 ? -1 : 1, k & 2 ? -1 : 1, k & 4 ? -1 : 1);
+    const Vec3 corner(k & 1 ? 1 : 0, k & 2 ? 1 : 0, k & 4 ? 1 : 0);
+    rows.push_back({s, s.dot(corner) + depths[k], "corner " + shortNumber(depths[k])});
+  }
+  const Vec3 n(1, 0.3, 0.1);
+  rows.push_back({n, n.dot(Vec3(0.5, 0.5, 0.5)), "middle"});
+  return rows;
+}
+
+/// Time per cut against the elements it splits on a ~100k-element grid, with validation
+/// `none` (the cut alone) and `local` (plus the checks of the touched region; only up to
+/// kLocalLimit split elements, whose region DG checks grow faster than the cut), beside a full
+/// rebuild of the moment cache (what a non-incremental tool would redo after every cut).
+SuiteOutput cuttingSuite(const BenchOptions& o, bool quiet) {
+  constexpr std::size_t kLocalLimit = 500;
+  const int n = o.quick ? 15 : 47;
+  SuiteOutput s{"cutting", nlohmann::json::object(), nlohmann::json::array(), {}};
+  SeriesSet time;
+  nlohmann::json runs = nlohmann::json::array();
+  for (ValidationLevel level : {ValidationLevel::None, ValidationLevel::Local}) {
+    const std::string levelName = level == ValidationLevel::None ? "none" : "local";
+    MeshEditor editor(hexGridMesh(n, n, n, Box3(Vec3(0, 0, 0), Vec3(1, 1, 1))));
+    const std::size_t elements0 = editor.mesh().numElements();
+    CutOptions options;
+    options.validation = level;
+    for (const CutRow& row : cuttingRows(o.quick)) {
+      if (level == ValidationLevel::Local && row.name == "middle") continue;
+      const OperationReport r = editor.cut(Blade::plane(row.normal, row.offset), options);
+      if (!r.validation.passed)
+        throw std::runtime_error("cutting suite: " + row.name + ": " + r.validation.failure);
+      const auto t0 = Clock::now();
+      MomentCache fresh(editor.mesh(), editor.moments().degree());
+      fresh.update();
+      const double rebuild = secondsSince(t0);
+      nlohmann::json j{{"grid", n},
+                       {"elements_before", elements0},
+                       {"cut", row.name},
+                       {"validation", levelName},
+                       {"elements_split", r.elementsSplit},
+                       {"pieces_created", r.piecesCreated},
+                       {"elements", editor.mesh().numElements()},
+                       {"faces_reintegrated", r.facesReintegrated},
+                       {"faces_total", r.facesTotal},
+                       {"t_cut", r.seconds},
+                       {"t_full_rebuild", rebuild},
+                       {"validation_passed", r.validation.passed}};
+      runs.push_back(j);
+      s.rows.push_back(j);
+      const double split = static_cast<double>(std::max<std::size_t>(r.elementsSplit, 1));
+      time.add("cut, validation " + levelName, split, r.seconds);
+      if (level == ValidationLevel::None) time.add("full moment rebuild (2 cores)", split, rebuild);
+      if (!quiet)
+        std::cout << "cut " << row.name << " (validation " << levelName << "): "
+                  << r.elementsSplit << " split, " << r.facesReintegrated << " of "
+                  << r.facesTotal << " faces integrated, " << r.seconds << " s; full rebuild "
+                  << rebuild << " s" << std::endl;
+      if (level == ValidationLevel::Local && r.elementsSplit > kLocalLimit) break;
+    }
+  }
+  s.json = {{"mesh", std::to_string(n) + "^3 hexahedra in the unit box"},
+            {"note", "each row cuts a corner off the same mesh; t_cut includes sliver merging "
+                     "and the validation named; t_full_rebuild integrates every face"},
+            {"runs", runs}};
+  s.plots.push_back({"cutting.svg",
+                     {"Plane cuts on " + std::to_string(n * n * n) +
+                          " hexahedra: time against elements split",
+                      {"elements split by the cut", AxisScale::Log},
+                      {"wall time [s]", AxisScale::Log},
+                      time.series()}});
+  return s;
+}
+
 void runBench(const BenchOptions& o, const CommonOptions& common) {
   std::error_code ec;
   fs::create_directories(o.out, ec);
@@ -558,6 +651,7 @@ void runBench(const BenchOptions& o, const CommonOptions& common) {
   if (all || o.suite == "table41") timed("table41", [&] { return table41Suite(common.quiet); });
   if (all || o.suite == "stability") timed("stability", [&] { return stabilitySuite(o, common.quiet); });
   if (all || o.suite == "meshing") timed("meshing", [&] { return meshingSuite(o, common.quiet); });
+  if (all || o.suite == "cutting") timed("cutting", [&] { return cuttingSuite(o, common.quiet); });
   if (!common.quiet && all) std::cout << "all suites: " << secondsSince(t0) << " s" << std::endl;
 }
 
@@ -567,10 +661,10 @@ void addBenchCommand(CLI::App& app, const CommonOptions& common, int& exitCode) 
   auto o = std::make_shared<BenchOptions>();
   CLI::App* cmd = app.add_subcommand(
       "bench", "Benchmark suites as JSON, CSV and SVG plots: accuracy (B1), table41 (B2), "
-               "stability (B4), meshing, or all");
-  cmd->add_option("--suite", o->suite, "accuracy, table41, stability, meshing or all")
+               "stability (B4), meshing, cutting, or all");
+  cmd->add_option("--suite", o->suite, "accuracy, table41, stability, meshing, cutting or all")
       ->required()
-      ->check(CLI::IsMember({"accuracy", "table41", "stability", "meshing", "all"}));
+      ->check(CLI::IsMember({"accuracy", "table41", "stability", "meshing", "cutting", "all"}));
   cmd->add_option("--out", o->out, "folder for NAME.json, NAME.csv and NAME*.svg")->required();
   cmd->add_flag("--skip-sliced", o->skipSliced, "accuracy: hex grids only");
   cmd->add_flag("--quick", o->quick,

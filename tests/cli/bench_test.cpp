@@ -235,6 +235,28 @@ TEST(BenchCommand, StabilitySuiteWritesJsonCsvAndPlots) {
   fs::remove_all(dir);
 }
 
+TEST(BenchCommand, CuttingSuiteReintegratesOnlyWhatEachCutTouched) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("polydg_bench_cutting_" + std::to_string(getpid()));
+  fs::remove_all(dir);
+  const Result r = run("bench --suite cutting --quick --quiet --out " + dir.string());
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  for (const char* file : {"cutting.json", "cutting.csv", "cutting.svg"})
+    EXPECT_TRUE(fs::exists(dir / file)) << file;
+  std::ifstream in(dir / "cutting.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  ASSERT_GE(j["runs"].size(), 4u);  // 3 cuts with validation none, at least 1 with local
+  for (const nlohmann::json& run : j["runs"]) {
+    EXPECT_TRUE(run["validation_passed"].get<bool>()) << run.dump();
+    EXPECT_GT(run["elements_split"].get<std::size_t>(), 0u) << run.dump();
+    // Each split element re-integrates its own faces only: far fewer than the mesh's faces.
+    EXPECT_LT(run["faces_reintegrated"].get<std::size_t>(),
+              run["faces_total"].get<std::size_t>() / 4)
+        << run.dump();
+  }
+  fs::remove_all(dir);
+}
+
 TEST(BenchCommand, UnknownSuiteIsRefusedWithOneLine) {
   const Result r = run("bench --suite nonsense --out " +
                        (fs::temp_directory_path() / "polydg_bench_unknown").string());
