@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.h"
+#include "cli/json_reports.h"
 #include "cli/progress.h"
 #include "cli/report.h"
 #include "cut/cut.h"
@@ -81,45 +82,6 @@ Blade parsePolygon(const std::string& text) {
   }
 }
 
-std::string levelName(ValidationLevel level) {
-  switch (level) {
-    case ValidationLevel::None: return "none";
-    case ValidationLevel::Local: return "local";
-    case ValidationLevel::Full: return "full";
-  }
-  return "unknown";
-}
-
-nlohmann::json toJson(const OperationReport& r) {
-  const OperationValidation& v = r.validation;
-  constexpr std::size_t kListedIds = 20;
-  std::vector<std::uint32_t> firstIds;
-  for (std::size_t i = 0; i < r.leftWhole.size() && i < kListedIds; ++i)
-    firstIds.push_back(r.leftWhole[i].value);
-  return {{"op", r.op},
-          {"elements_split", r.elementsSplit},
-          {"pieces_created", r.piecesCreated},
-          {"elements_removed", r.elementsRemoved},
-          {"volume_removed", r.volumeRemoved},
-          {"slivers", r.slivers},
-          {"slivers_merged", r.sliversMerged},
-          {"isolated_slivers", r.isolatedSlivers},
-          {"faces_reintegrated", r.facesReintegrated},
-          {"faces_total", r.facesTotal},
-          {"left_whole", {{"count", r.leftWhole.size()}, {"first_ids", firstIds}}},
-          {"validation",
-           {{"passed", v.passed},
-            {"level", levelName(v.level)},
-            {"elements_checked", v.elementsChecked},
-            {"region_elements", v.regionElements},
-            {"patch_test_error", v.patchTestError},
-            {"region_components", v.regionComponents},
-            {"zero_modes", v.zeroModes},
-            {"volume_rel_error", v.volumeRelError},
-            {"failure", v.failure}}},
-          {"time_s", r.seconds}};
-}
-
 std::string describe(const Blade& blade) {
   std::ostringstream s;
   if (blade.finite()) s << "polygon with " << blade.polygon.size() << " corners";
@@ -163,7 +125,7 @@ void run(const CutCommandOptions& o, bool quiet, int& exitCode) {
     progress.update(double(i + 1) / double(blades.size()));
     if (!r.validation.passed) {
       failure = "operation " + std::to_string(i + 1) + " (" + r.op + ", " + describe(blades[i]) +
-                ") failed its " + levelName(r.validation.level) + " validation: " +
+                ") failed its " + toString(r.validation.level) + " validation: " +
                 r.validation.failure;
       break;
     }

@@ -121,4 +121,43 @@ nlohmann::json toJson(const MeshingReport& r) {
       {"timings_s", timings}};
 }
 
+std::string toString(ValidationLevel level) {
+  switch (level) {
+    case ValidationLevel::None: return "none";
+    case ValidationLevel::Local: return "local";
+    case ValidationLevel::Full: return "full";
+  }
+  return "unknown";
+}
+
+nlohmann::json toJson(const OperationReport& r) {
+  const OperationValidation& v = r.validation;
+  constexpr std::size_t kListedIds = 20;
+  std::vector<std::uint32_t> firstIds;
+  for (std::size_t i = 0; i < r.leftWhole.size() && i < kListedIds; ++i)
+    firstIds.push_back(r.leftWhole[i].value);
+  return {{"op", r.op},
+          {"elements_split", r.elementsSplit},
+          {"pieces_created", r.piecesCreated},
+          {"elements_removed", r.elementsRemoved},
+          {"volume_removed", r.volumeRemoved},
+          {"slivers", r.slivers},
+          {"slivers_merged", r.sliversMerged},
+          {"isolated_slivers", r.isolatedSlivers},
+          {"faces_reintegrated", r.facesReintegrated},
+          {"faces_total", r.facesTotal},
+          {"left_whole", {{"count", r.leftWhole.size()}, {"first_ids", firstIds}}},
+          {"validation",
+           {{"passed", v.passed},
+            {"level", toString(v.level)},
+            {"elements_checked", v.elementsChecked},
+            {"region_elements", v.regionElements},
+            {"patch_test_error", v.patchTestError},
+            {"region_components", v.regionComponents},
+            {"zero_modes", v.zeroModes},
+            {"volume_rel_error", v.volumeRelError},
+            {"failure", v.failure}}},
+          {"time_s", r.seconds}};
+}
+
 }  // namespace polydg::cli

@@ -6,6 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cut/cut.h"
 #include "mesh/meshing.h"
 #include "mesh/validate.h"
 #include "physics/validation.h"
@@ -25,5 +26,13 @@ std::vector<std::string> failureMessages(const LocalDgCheck& c);
 nlohmann::json toJson(const Box3& box);
 /// The `polydg mesh` report: input, output, volume_rel_error, validation, timings_s.
 nlohmann::json toJson(const MeshingReport& r);
+/// "none", "local" or "full".
+std::string toString(ValidationLevel level);
+/// One cut or merge operation, as `polydg cut` and `polydg run` report it: op, elements_split,
+/// pieces_created, elements_removed, volume_removed, slivers, slivers_merged,
+/// isolated_slivers, faces_reintegrated, faces_total, left_whole {count, first_ids (at most
+/// 20)}, validation {passed, level, elements_checked, region_elements, patch_test_error,
+/// region_components, zero_modes, volume_rel_error, failure}, time_s.
+nlohmann::json toJson(const OperationReport& r);
 
 }  // namespace polydg::cli

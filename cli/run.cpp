@@ -404,41 +404,6 @@ std::string formatNumber(double x, int precision = 6) {
   return s.str();
 }
 
-std::string toString(ValidationLevel v) {
-  return v == ValidationLevel::None ? "none" : v == ValidationLevel::Local ? "local" : "full";
-}
-
-/// One cut or merge operation, in the form of `polydg cut`'s report (cli/cut.cpp).
-json operationJson(const OperationReport& r) {
-  const OperationValidation& v = r.validation;
-  constexpr std::size_t kListedIds = 20;
-  std::vector<std::uint32_t> firstIds;
-  for (std::size_t i = 0; i < r.leftWhole.size() && i < kListedIds; ++i)
-    firstIds.push_back(r.leftWhole[i].value);
-  return {{"op", r.op},
-          {"elements_split", r.elementsSplit},
-          {"pieces_created", r.piecesCreated},
-          {"elements_removed", r.elementsRemoved},
-          {"volume_removed", r.volumeRemoved},
-          {"slivers", r.slivers},
-          {"slivers_merged", r.sliversMerged},
-          {"isolated_slivers", r.isolatedSlivers},
-          {"faces_reintegrated", r.facesReintegrated},
-          {"faces_total", r.facesTotal},
-          {"left_whole", {{"count", r.leftWhole.size()}, {"first_ids", firstIds}}},
-          {"validation",
-           {{"passed", v.passed},
-            {"level", toString(v.level)},
-            {"elements_checked", v.elementsChecked},
-            {"region_elements", v.regionElements},
-            {"patch_test_error", v.patchTestError},
-            {"region_components", v.regionComponents},
-            {"zero_modes", v.zeroModes},
-            {"volume_rel_error", v.volumeRelError},
-            {"failure", v.failure}}},
-          {"time_s", r.seconds}};
-}
-
 /// Runs one input through the steps; every file goes into `folder`.
 class InputRun {
  public:
@@ -528,7 +493,7 @@ class InputRun {
 
   void apply(const CutStep& s, json& result) {
     const OperationReport r = work_->editor().cut(s.blade, s.options);
-    result["operations"] = json::array({operationJson(r)});
+    result["operations"] = json::array({toJson(r)});
     result["output"] = {{"elements", mesh().numElements()}, {"volume", work_->editor().volume()}};
     if (!r.validation.passed) throw StepFailure("the cut failed its validation: " + r.validation.failure);
     log("cut: " + std::to_string(r.elementsSplit) + " elements split, " +
@@ -538,7 +503,7 @@ class InputRun {
 
   void apply(const MergeStep& s, json& result) {
     const OperationReport r = work_->editor().mergeSlivers(s.fraction);
-    result["operations"] = json::array({operationJson(r)});
+    result["operations"] = json::array({toJson(r)});
     result["output"] = {{"elements", mesh().numElements()}, {"volume", work_->editor().volume()}};
     if (!r.validation.passed) throw StepFailure("merging failed its validation: " + r.validation.failure);
     log("merge: " + std::to_string(r.sliversMerged) + " slivers merged, " +
