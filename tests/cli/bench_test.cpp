@@ -20,6 +20,8 @@
 #include "cli/csv.h"
 #include "cli/plot.h"
 
+#include "tests/support/run_polydg.h"
+
 namespace polydg::cli {
 namespace {
 
@@ -179,22 +181,9 @@ TEST(Plot, EmptyPlotStillRenders) {
 
 // --- polydg bench ---------------------------------------------------------------------------
 
-struct Result {
-  int exitCode = -1;
-  std::string out;
-};
+using Result = polydg::testing::CommandResult;
 
-Result run(const std::string& arguments) {
-  const std::string command = std::string(POLYDG_BINARY) + " " + arguments + " 2>&1";
-  Result r;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (!pipe) return r;
-  std::array<char, 4096> buffer;
-  while (std::fgets(buffer.data(), buffer.size(), pipe)) r.out += buffer.data();
-  const int status = pclose(pipe);
-  r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
+Result run(const std::string& arguments) { return polydg::testing::runPolydg(arguments); }
 
 TEST(BenchCommand, StabilitySuiteWritesJsonCsvAndPlots) {
   // Unique per process: two test runs at once must not share (and delete) the folder.

@@ -12,6 +12,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "tests/support/run_polydg.h"
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -19,22 +21,9 @@ namespace fs = std::filesystem;
 /// Relative agreement of our enclosed volume with VTK's vtkMassProperties.
 constexpr double kVolumeAgreement = 1e-9;
 
-struct Result {
-  int exitCode = -1;
-  std::string out;  // stdout and stderr together
-};
+using Result = polydg::testing::CommandResult;
 
-Result run(const std::string& arguments) {
-  const std::string command = std::string(POLYDG_BINARY) + " " + arguments + " 2>&1";
-  Result r;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (!pipe) return r;
-  std::array<char, 4096> buffer;
-  while (std::fgets(buffer.data(), buffer.size(), pipe)) r.out += buffer.data();
-  const int status = pclose(pipe);
-  r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
+Result run(const std::string& arguments) { return polydg::testing::runPolydg(arguments); }
 
 std::string data(const std::string& name) { return std::string(POLYDG_TESTDATA_DIR) + "/" + name; }
 

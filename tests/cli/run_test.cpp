@@ -13,6 +13,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "tests/support/run_polydg.h"
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -22,22 +24,9 @@ using nlohmann::json;
 /// cut is exact, so only round-off separates them).
 constexpr double kVolumeTolerance = 1e-12;
 
-struct Result {
-  int exitCode = -1;
-  std::string out;  // stdout and stderr together
-};
+using Result = polydg::testing::CommandResult;
 
-Result run(const std::string& arguments) {
-  const std::string command = std::string(POLYDG_BINARY) + " " + arguments + " 2>&1";
-  Result r;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (!pipe) return r;
-  std::array<char, 4096> buffer;
-  while (std::fgets(buffer.data(), buffer.size(), pipe)) r.out += buffer.data();
-  const int status = pclose(pipe);
-  r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
+Result run(const std::string& arguments) { return polydg::testing::runPolydg(arguments); }
 
 std::string data(const std::string& name) { return std::string(POLYDG_TESTDATA_DIR) + "/" + name; }
 

@@ -10,26 +10,15 @@
 
 #include <nlohmann/json.hpp>
 
+#include "tests/support/run_polydg.h"
+
 namespace {
 
 namespace fs = std::filesystem;
 
-struct Result {
-  int exitCode = -1;
-  std::string out;  // stdout and stderr together
-};
+using Result = polydg::testing::CommandResult;
 
-Result run(const std::string& arguments) {
-  const std::string command = std::string(POLYDG_BINARY) + " " + arguments + " 2>&1";
-  Result r;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (!pipe) return r;
-  std::array<char, 4096> buffer;
-  while (std::fgets(buffer.data(), buffer.size(), pipe)) r.out += buffer.data();
-  const int status = pclose(pipe);
-  r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
+Result run(const std::string& arguments) { return polydg::testing::runPolydg(arguments); }
 
 std::size_t lines(const std::string& s) {
   return static_cast<std::size_t>(std::count(s.begin(), s.end(), '\n'));
