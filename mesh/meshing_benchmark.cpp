@@ -12,6 +12,23 @@ TriangleSurface benchmarkModel(const std::string& name) {
   throw std::invalid_argument("unknown benchmark model '" + name + "' (sphere, torus_knot)");
 }
 
+MeshingBenchmarkRun meshingBenchmarkRun(const std::string& model, const TriangleSurface& surface,
+                                        int cells, const MeshingReport& report) {
+  MeshingBenchmarkRun run;
+  run.model = model;
+  run.triangles = surface.triangles.size();
+  run.cells = cells;
+  run.elements = report.elements;
+  run.hexahedra = report.hexahedra;
+  run.polyhedra = report.polyhedra;
+  run.slivers_merged = report.slivers.merged;
+  run.volumeRelError = report.volumeRelError;
+  run.valid = report.validation.passed;
+  run.phases = report.timings;
+  for (const auto& [phase, seconds] : report.timings) run.secondsTotal += seconds;
+  return run;
+}
+
 std::vector<MeshingBenchmarkRun> runMeshingBenchmark(
     const std::vector<std::string>& models, const std::vector<int>& cellCounts,
     const std::function<void(const MeshingBenchmarkRun&)>& onRun) {
@@ -22,19 +39,7 @@ std::vector<MeshingBenchmarkRun> runMeshingBenchmark(
       MeshingOptions options;
       options.cellsAlongLongest = cells;
       const MeshingResult result = meshSurface(surface, options);
-      const MeshingReport& r = result.report;
-      MeshingBenchmarkRun run;
-      run.model = model;
-      run.triangles = surface.triangles.size();
-      run.cells = cells;
-      run.elements = r.elements;
-      run.hexahedra = r.hexahedra;
-      run.polyhedra = r.polyhedra;
-      run.slivers_merged = r.slivers.merged;
-      run.volumeRelError = r.volumeRelError;
-      run.valid = r.validation.passed;
-      run.phases = r.timings;
-      for (const auto& [phase, seconds] : r.timings) run.secondsTotal += seconds;
+      MeshingBenchmarkRun run = meshingBenchmarkRun(model, surface, cells, result.report);
       if (onRun) onRun(run);
       runs.push_back(std::move(run));
     }

@@ -25,6 +25,10 @@ struct MeshingBenchmarkRun {
 /// "torus_knot" ((2,3) knot tube, 100,000 triangles).
 TriangleSurface benchmarkModel(const std::string& name);
 
+/// The run of `model` (`surface`) meshed at `cells` cells, from the pipeline's report.
+MeshingBenchmarkRun meshingBenchmarkRun(const std::string& model, const TriangleSurface& surface,
+                                        int cells, const MeshingReport& report);
+
 /// Meshes each model at each cell count and reports one run per pair; `onRun` (optional) is
 /// called after each.
 std::vector<MeshingBenchmarkRun> runMeshingBenchmark(

@@ -184,23 +184,10 @@ MeshingCostRun runMeshingCostCase(const std::string& model, const TriangleSurfac
   MeshingOptions options;
   options.cellsAlongLongest = cells;
   const MeshingResult result = meshSurface(surface, options);
-  const MeshingReport& r = result.report;
   MeshingCostRun run;
-  MeshingBenchmarkRun& m = run.meshing;
-  m.model = model;
-  m.triangles = surface.triangles.size();
-  m.cells = cells;
-  m.elements = r.elements;
-  m.hexahedra = r.hexahedra;
-  m.polyhedra = r.polyhedra;
-  m.slivers_merged = r.slivers.merged;
-  m.volumeRelError = r.volumeRelError;
-  m.valid = r.validation.passed;
-  m.phases = r.timings;
-  for (const auto& [phase, seconds] : r.timings) {
-    m.secondsTotal += seconds;
+  run.meshing = meshingBenchmarkRun(model, surface, cells, result.report);
+  for (const auto& [phase, seconds] : result.report.timings)
     if (phase == "validate") run.geometricValidationSeconds += seconds;
-  }
   const auto t0 = std::chrono::steady_clock::now();
   LocalDgCheckOptions checks;
   MomentCache moments(result.mesh, 2 * checks.basis.degree);
