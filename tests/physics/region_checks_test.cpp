@@ -16,6 +16,7 @@
 #include "mesh/primitives.h"
 #include "mesh/slice.h"
 #include "mesh/surface_shapes.h"
+#include "tests/support/shapes.h"
 #include "mesh/validate.h"
 
 namespace polydg {
@@ -239,30 +240,7 @@ TEST(RegionChecks, SliversHangingByTheirThinFacesHaveSoftModes) {
   EXPECT_GT(hinged.zeroModes, 6u);
 }
 
-/// The mesh rebuilt from its elements' faces, with face `k` of element `bad` reversed (every
-/// face of `bad` when k is -1).
-PolyMesh withReversedFaces(const PolyMesh& mesh, ElementId bad, int k) {
-  PolyMesh out;
-  for (const Vec3& p : mesh.positions().raw()) out.addVertex(p);
-  for (std::size_t i = 0; i < mesh.numElements(); ++i) {
-    const Element& element = mesh.element(ElementId(i));
-    std::vector<std::vector<Loop>> boundary;
-    for (std::size_t j = 0; j < element.faces.size(); ++j) {
-      const FaceUse& use = element.faces[j];
-      const Face& face = mesh.face(use.face);
-      const bool flip = ElementId(i) == bad && (k < 0 || static_cast<int>(j) == k);
-      std::vector<Loop> loops;
-      for (std::size_t l = 0; l < face.numLoops(); ++l) {
-        Loop loop(face.loop(l).begin(), face.loop(l).end());
-        if (use.reversed != flip) std::reverse(loop.begin(), loop.end());
-        loops.push_back(loop);
-      }
-      boundary.push_back(loops);
-    }
-    out.addElement(boundary, FaceOrigin::Box);
-  }
-  return out;
-}
+using testing::withReversedFaces;
 
 TEST(RegionChecks, FailsOnAVertexOffItsFacesPlanes) {
   // Grid node (1, 1, 1) of the 4^3 grid moved off the planes of its faces by 1e-3 of a cell.

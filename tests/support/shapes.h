@@ -3,9 +3,11 @@
 // translating them by up to ~1e6 is exact in floating point.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <random>
+#include <vector>
 
 #include "mesh/primitives.h"
 #include "mesh/surface.h"
@@ -49,6 +51,31 @@ inline TriangleSurface randomStarSurface(int levels, std::mt19937& rng, double r
     p = Vec3(dyadic(r * p.x()), dyadic(r * p.y()), dyadic(r * p.z()));
   }
   return surface;
+}
+
+/// The mesh rebuilt from its elements' faces, with face `k` of element `bad` reversed (all of its
+/// loops), or every face of `bad` when k is -1.
+inline PolyMesh withReversedFaces(const PolyMesh& mesh, ElementId bad, int k) {
+  PolyMesh out;
+  for (const Vec3& p : mesh.positions().raw()) out.addVertex(p);
+  for (std::size_t i = 0; i < mesh.numElements(); ++i) {
+    const Element& element = mesh.element(ElementId(i));
+    std::vector<std::vector<Loop>> boundary;
+    for (std::size_t j = 0; j < element.faces.size(); ++j) {
+      const FaceUse& use = element.faces[j];
+      const Face& face = mesh.face(use.face);
+      const bool flip = ElementId(i) == bad && (k < 0 || static_cast<int>(j) == k);
+      std::vector<Loop> loops;
+      for (std::size_t l = 0; l < face.numLoops(); ++l) {
+        Loop loop(face.loop(l).begin(), face.loop(l).end());
+        if (use.reversed != flip) std::reverse(loop.begin(), loop.end());
+        loops.push_back(loop);
+      }
+      boundary.push_back(loops);
+    }
+    out.addElement(boundary, FaceOrigin::Box);
+  }
+  return out;
 }
 
 }  // namespace polydg::testing
