@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
 #include <vector>
 
 #include <Eigen/SparseCore>
@@ -79,9 +80,39 @@ struct LinearSystem {
   int blockSize = 0;
 };
 
-/// K from the element and face matrices of `form` (both IP and BZ). With BZ, blocks between
-/// neighbours couple equal components only and are stored so (the paper's sparser BZ
-/// matrices). Runs in parallel over elements.
+/// The element and face matrices of one form, precomputed as in the thesis (Kaufmann 2013,
+/// sec. 4.4, "Assembly": K_K per element and K_f per face, the transposed face blocks not
+/// stored): the thesis's "integration" phase, which assembleStiffness(const LocalMatrices&)
+/// then accumulates into K (its "assembly" phase). Per element e:
+///   - the diagonal block: element stiffness plus the self terms of e's coupled faces,
+///     3n x 3n column-major, symmetric;
+///   - for each neighbour f > e (coupled through interior faces), the coupling block of e's
+///     rows against f's columns, summed over their common faces, 3n x 3n row-major; the block
+///     of f's rows against e's columns is its transpose, never computed.
+struct LocalMatrices {
+  int blockSize = 0;
+  int functions = 0;  ///< n, functions per component
+  bool componentDiagonalCoupling = false;  ///< BZ: coupling blocks couple equal components only
+  /// Neighbours of each element through interior faces, sorted, the element itself included.
+  std::vector<std::vector<std::uint32_t>> neighbours;
+  std::vector<double> diagonal;  ///< element e's block at e * blockSize^2
+  /// Element e's coupling blocks, one per neighbour f > e in order, start at block
+  /// couplingStart[e] (each blockSize^2 values).
+  std::vector<std::size_t> couplingStart;
+  std::vector<double> coupling;
+};
+
+/// The element and face matrices of `form` (both IP and BZ), in parallel over elements.
+LocalMatrices localMatrices(const PolyMesh& mesh, const DgBasis& basis,
+                            const MomentCache& moments, const FaceRoles& roles,
+                            const FormCoefficients& form);
+
+/// K from the local matrices: both triangles, each column written once, in parallel over
+/// elements. With BZ, blocks between neighbours couple equal components only and are stored
+/// so (the paper's sparser BZ matrices).
+Eigen::SparseMatrix<double, Eigen::ColMajor, int> assembleStiffness(const LocalMatrices& local);
+
+/// K of `form`: localMatrices() then assembleStiffness().
 Eigen::SparseMatrix<double, Eigen::ColMajor, int> assembleStiffness(
     const PolyMesh& mesh, const DgBasis& basis, const MomentCache& moments,
     const FaceRoles& roles, const FormCoefficients& form);

@@ -129,21 +129,28 @@ struct Kernel {
     return fr;
   }
 
-  static Side side(const DgBasis& basis, const FaceFrame& fr, ElementId e) {
+  /// Which parts of a Side to compute: BZ needs the values only, the penalty bound the
+  /// lifting functions only (the derivatives were a third of BZ's assembly time).
+  enum Parts { kValues = 1, kDerivatives = 2, kLifting = 4, kAll = 7 };
+
+  static Side side(const DgBasis& basis, const FaceFrame& fr, ElementId e, int parts = kAll) {
     const double h = basis.scale(e);
     const Mat s = shift(fr.h / h, (fr.origin - basis.centre(e)) / h);
     const Mat t = coefficients(basis, e);
     Side sd;
-    sd.p = t.lazyProduct(s);
-    for (int k = 0; k < 3; ++k) sd.q[k] = (derive(t, k) / h).lazyProduct(s);
-    const Mat11 o(basis.liftingCoefficients(e));
-    sd.psi = o.lazyProduct(s.template topRows<N1>());
+    if (parts & kValues) sd.p = t.lazyProduct(s);
+    if (parts & kDerivatives)
+      for (int k = 0; k < 3; ++k) sd.q[k] = (derive(t, k) / h).lazyProduct(s);
+    if (parts & kLifting) {
+      const Mat11 o(basis.liftingCoefficients(e));
+      sd.psi = o.lazyProduct(s.template topRows<N1>());
+    }
     return sd;
   }
 
   static void faceRows(const PolyMesh& mesh, const DgBasis& basis, const MomentCache& moments,
                        const FaceView& view, const FormCoefficients& form,
-                       Eigen::MatrixXd& selfBlock, Eigen::MatrixXd& otherBlock) {
+                       Eigen::MatrixXd& selfBlock, Eigen::MatrixXd& otherBlock, bool withOther) {
     const bool interior = view.kind == FaceKind::Interior;
     const FaceFrame fr = frame(mesh, moments, view.face);
     const Vec3 n = view.selfIsFront ? moments.faceNormal(view.face)
@@ -154,13 +161,15 @@ struct Kernel {
     const double mu = form.mu, lambda = form.lambda;
     const bool ip = form.method == Method::IP;
 
-    const Side sk = side(basis, fr, view.self);
+    const int parts = ip ? kAll : kValues;
+    const Side sk = side(basis, fr, view.self, parts);
     Side sl;
-    if (interior) sl = side(basis, fr, view.other);
+    if (interior) sl = side(basis, fr, view.other, parts);
     const Mat ck = fr.gram.lazyProduct(sk.p.transpose());
     Mat cl;
     if (interior) cl = fr.gram.lazyProduct(sl.p.transpose());
-    const Mat ak = sk.p.lazyProduct(fr.gram);
+    Mat ak;
+    if (ip) ak = sk.p.lazyProduct(fr.gram);
     // Lifting face matrices psi_E against phi_X: mpsi[E][X] = psi_E G phi_X^T (N1 x N).
     Mat1 mkk = Mat1::Zero(), mkl = Mat1::Zero(), mlk = Mat1::Zero(), mll = Mat1::Zero();
     if (ip) {
@@ -204,9 +213,13 @@ struct Kernel {
     if (interior) {
       const Mat1 llk[2] = {mlk, mlk};
       block(sk, ck, 1.0, kk, llk, selfBlock);
-      const Mat1 kl[2] = {mkk, mkl};
-      const Mat1 ll[2] = {mlk, mll};
-      block(sl, cl, -1.0, kl, ll, otherBlock);
+      if (withOther) {
+        const Mat1 kl[2] = {mkk, mkl};
+        const Mat1 ll[2] = {mlk, mll};
+        block(sl, cl, -1.0, kl, ll, otherBlock);
+      } else {
+        otherBlock.resize(0, 0);
+      }
     } else {
       block(sk, ck, 1.0, kk, nullptr, selfBlock);
       otherBlock.resize(0, 0);
@@ -216,8 +229,9 @@ struct Kernel {
   static Eigen::MatrixXd liftingGram(const DgBasis& basis, const MomentCache& moments,
                                      const PolyMesh& mesh, FaceId f, ElementId e) {
     const FaceFrame fr = frame(mesh, moments, f);
-    const Side s = side(basis, fr, e);
-    return s.psi * fr.gram * s.psi.transpose();
+    const Side s = side(basis, fr, e, kLifting);
+    const Mat1 pg = s.psi.lazyProduct(fr.gram);
+    return Eigen::MatrixXd(pg.lazyProduct(s.psi.transpose()));
   }
 };
 
@@ -246,9 +260,9 @@ double facePenalty(const FormCoefficients& form, const MomentCache& moments, Fac
 
 void faceRows(const PolyMesh& mesh, const DgBasis& basis, const MomentCache& moments,
               const FaceView& view, const FormCoefficients& form, Eigen::MatrixXd& selfBlock,
-              Eigen::MatrixXd& otherBlock) {
+              Eigen::MatrixXd& otherBlock, bool withOther) {
   detail::dispatchBasisDegree(basis.degree(), [&](auto p) {
-    Kernel<p()>::faceRows(mesh, basis, moments, view, form, selfBlock, otherBlock);
+    Kernel<p()>::faceRows(mesh, basis, moments, view, form, selfBlock, otherBlock, withOther);
   });
 }
 

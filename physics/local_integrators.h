@@ -94,9 +94,11 @@ void elementMass(const DgBasis& basis, const MomentCache& moments, ElementId e,
 ///
 /// Dirichlet faces (u_L = g, v_L = 0, sigma_L = sigma_K) give the same terms with one side;
 /// their right-hand side is dirichletLoad().
+/// With `withOther` false, `otherBlock` is not computed (left empty): the assembly computes
+/// each coupling block once, from one side, and uses its transpose for the other.
 void faceRows(const PolyMesh& mesh, const DgBasis& basis, const MomentCache& moments,
               const FaceView& view, const FormCoefficients& form, Eigen::MatrixXd& selfBlock,
-              Eigen::MatrixXd& otherBlock);
+              Eigen::MatrixXd& otherBlock, bool withOther = true);
 
 /// int_F psi_q psi_r for element e's lifting basis psi (orthonormal on e, spanning the
 /// polynomials of degree <= p-1): liftingSize() x liftingSize(). Its largest eigenvalue is the

@@ -57,8 +57,10 @@ struct StaticReport {
   int penaltyAttempts = 1;     ///< factorizations tried by PenaltyRule::Doubling
   std::size_t dirichletFaces = 0, tractionFaces = 0;
   std::size_t basisFallbacks = 0;  ///< DgBasis::fallbackElements()
-  double integrateSeconds = 0.0;   ///< moments and bases
-  double assembleSeconds = 0.0;    ///< penalty, stiffness matrix and load vector
+  /// The thesis's phases (Kaufmann 2013, Table 4.1). Integration: moments, bases, face roles,
+  /// penalty bounds, and the element and face matrices (localMatrices()).
+  double integrateSeconds = 0.0;
+  double assembleSeconds = 0.0;    ///< accumulating K from them, and the load vector F
   double solveSeconds = 0.0;       ///< factorization (or preconditioner) and solve
   SolveReport solver;
   double energy = 0.0;  ///< U.F / 2: the strain energy U.K.U / 2 when prescribed displacements are 0
@@ -81,7 +83,8 @@ class StaticSolver {
 
   /// Moments up to degree 2p and the bases.
   void integrate();
-  /// Face roles, penalty, K and F for `loads` (calls integrate() first if needed). With
+  /// Face roles, penalty, element and face matrices (timed as integration), K and F for
+  /// `loads` (calls integrate() first if needed). With
   /// PenaltyRule::Doubling this factorizes K for each trial eta.
   void assemble(const LoadCase& loads);
   /// Factorizes K (unless done) and solves; throws std::runtime_error if K is not positive
@@ -98,8 +101,9 @@ class StaticSolver {
   StaticSolution release();
 
  private:
-  /// K of the current form into `matrix`, without copying it.
-  void assembleInto(Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix) const;
+  /// K from `local` into `matrix`, without copying it.
+  void assembleInto(const LocalMatrices& local,
+                    Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix) const;
 
   const PolyMesh* mesh_;
   Material material_;
@@ -113,6 +117,7 @@ class StaticSolver {
   LinearSystem system_;
   LinearSolver solver_;
   bool factorized_ = false;
+  double momentsSeconds_ = 0.0;  ///< integrate()'s share of StaticReport::integrateSeconds
   Eigen::VectorXd coefficients_;
   StaticReport report_;
 };
