@@ -9,13 +9,53 @@
 //   polydg run testdata/pipeline.json --jobs 2 --out runs/
 //   polydg cut mesh.vtu -o half.vtu --plane "0,0,1,0.5" --remove-side + --report cut.json
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <exception>
 #include <iostream>
+
+#include <dlfcn.h>
+#include <unistd.h>
 
 #include "cli/commands.h"
 #include "cli/report.h"
 
+namespace {
+
+/// Debian 12's OpenBLAS (0.3.21, DYNAMIC_ARCH) does not know recent Intel CPUs (this
+/// machine: family 6, model 207) and falls back to its Prescott (SSE3) kernels: CHOLMOD's
+/// supernodal factorizations, which the patch tests and rigid-mode checks of every command
+/// run, were then 1.5-2x slower. OpenBLAS reads OPENBLAS_CORETYPE only when it is loaded,
+/// before main(); so if OpenBLAS reports Prescott on a CPU with AVX-512 (or AVX2 and FMA),
+/// polydg starts itself again, once, with OPENBLAS_CORETYPE set to the matching kernels
+/// (SkylakeX, Haswell). A user's own OPENBLAS_CORETYPE is respected; another BLAS (no
+/// openblas_get_corename) is left alone; if the restart fails, polydg carries on as it is.
+void useMatchingBlasKernels(char** argv) {
+#if defined(__x86_64__) && defined(__GNUC__)
+  if (std::getenv("OPENBLAS_CORETYPE") != nullptr) return;
+  using CoreName = const char* (*)();
+  const auto corename = reinterpret_cast<CoreName>(dlsym(RTLD_DEFAULT, "openblas_get_corename"));
+  if (corename == nullptr || std::strcmp(corename(), "Prescott") != 0) return;
+  __builtin_cpu_init();
+  const char* kernels = nullptr;
+  if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
+      __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512vl"))
+    kernels = "SkylakeX";
+  else if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"))
+    kernels = "Haswell";
+  if (kernels == nullptr) return;
+  setenv("OPENBLAS_CORETYPE", kernels, 1);
+  execv("/proc/self/exe", argv);
+  unsetenv("OPENBLAS_CORETYPE");  // exec failed: go on with the kernels loaded
+#else
+  (void)argv;
+#endif
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
+  useMatchingBlasKernels(argv);
   CLI::App app{"polydg: turn surface meshes into polyhedral DG simulation meshes"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "polydg 0.1.0");
