@@ -11,6 +11,7 @@
 //              8, 12; p = 3: 2, 3, 4, 6, 8) and sliced cubes (p = 1: 4, 8, 12; p = 2: 2, 4, 8;
 //              p = 3: 2, 4, 6). Plot: L2 error against assembly + solve time.
 //   table41    B2 (10^3 hexahedra) with BZ and IP, degrees 1 and 2, beside the thesis's Table 4.1.
+//              Each case runs five times; the fastest run (by total time) is reported.
 //   stability  B4: sliver (volume ratio 1 .. 1e-12 by factors of 10, and 0.05 and 0.02 near
 //              the merge threshold; merged or not, p = 1, 2), thin neck (eps
 //              1e-1 .. 1e-9), near-incompressible cantilever (nu 0.3 .. 0.4999, p = 1, 2),
@@ -236,6 +237,9 @@ SuiteOutput accuracySuite(const BenchOptions& o, bool quiet) {
   return s;
 }
 
+/// Runs of each B2 case; the table reports the fastest.
+constexpr int kB2Repeats = 5;
+
 SuiteOutput table41Suite(bool quiet) {
   SuiteOutput s{"table41", nlohmann::json::array(), nlohmann::json::array(), {}};
   std::vector<PlotSeries> series;
@@ -244,7 +248,19 @@ SuiteOutput table41Suite(bool quiet) {
       StaticOptions so;
       so.discretization.method = method;
       so.discretization.basis.degree = p;
-      const BenchmarkRun r = runBenchmarkB2(so);
+      // The fastest of kB2Repeats runs (by total time): the first run of a process also pays
+      // for starting TBB's threads and faulting in fresh memory, and the machine may be busy.
+      BenchmarkRun r;
+      double best = std::numeric_limits<double>::infinity();
+      for (int repeat = 0; repeat < kB2Repeats; ++repeat) {
+        BenchmarkRun candidate = runBenchmarkB2(so);
+        const double total = candidate.report.integrateSeconds +
+                             candidate.report.assembleSeconds + candidate.report.solveSeconds;
+        if (total < best) {
+          best = total;
+          r = std::move(candidate);
+        }
+      }
       if (!quiet) printRun(r);
       s.json.push_back(runJson(r));
       s.rows.push_back(runJson(r));

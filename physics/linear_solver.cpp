@@ -9,6 +9,7 @@
 #include <tbb/parallel_reduce.h>
 
 #include "integrate/monomials.h"
+#include "physics/block_rows.h"
 #include "physics/p_multigrid.h"
 
 namespace polydg {
@@ -87,6 +88,24 @@ struct LinearSolver::Impl {
   std::vector<Eigen::MatrixXd> blockInverses;
   CgPreconditioner preconditioner = CgPreconditioner::BlockJacobi;
   PMultigrid multigrid;
+  /// K by element block rows in double precision for CG's product: two thirds of the CSR
+  /// matrix's bytes (no index per entry), when the blocks hold no more values than it has
+  /// nonzeros (B2, IP, p = 1: 0.31 -> 0.2 ms per product).
+  BlockRows<double> productBlocks;
+  bool useProductBlocks = false;
+
+  void product(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
+    if (!useProductBlocks) {
+      symmetricProduct(*matrix, x, y);
+      return;
+    }
+    y.resize(x.size());
+    const int ne = static_cast<int>(x.size() / blockSize);
+    tbb::parallel_for(tbb::blocked_range<int>(0, ne, 16), [&](const tbb::blocked_range<int>& r) {
+      for (int e = r.begin(); e != r.end(); ++e)
+        productBlocks.rowProduct(e, x.data(), y.data() + static_cast<Eigen::Index>(e) * blockSize);
+    });
+  }
 
   /// The basis degree p with blockSize = 3 numMonomials(p), or -1.
   int degreeOfBlock() const {
@@ -96,10 +115,11 @@ struct LinearSolver::Impl {
   }
 
   bool buildPreconditioner() {
+    useProductBlocks = blockSize % 3 == 0 && productBlocks.build(*matrix, blockSize / 3, 1.0);
     preconditioner = options.preconditioner;
     const int degree = degreeOfBlock();
     if (preconditioner == CgPreconditioner::PMultigrid && degree >= 0)
-      return multigrid.compute(*matrix, degree);
+      return multigrid.compute(*matrix, degree, useProductBlocks ? &productBlocks : nullptr);
     preconditioner = CgPreconditioner::BlockJacobi;
     return buildBlockJacobi();
   }
@@ -153,7 +173,7 @@ struct LinearSolver::Impl {
     int it = 0;
     double rNorm = fNorm;
     for (; it < options.maxIterations && rNorm > target; ++it) {
-      symmetricProduct(*matrix, p, q);
+      product(p, q);
       const double alpha = rz / parallelDot(p, q);
       u += alpha * p;
       r -= alpha * q;

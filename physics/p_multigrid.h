@@ -10,6 +10,9 @@
 
 namespace polydg {
 
+template <class T>
+struct BlockRows;
+
 /// The V-cycle as an SPD preconditioner for conjugate gradients.
 ///
 /// Levels. The DG bases are hierarchical (DgBasis: functions 0 .. numMonomials(q)-1 of each
@@ -39,7 +42,10 @@ class PMultigrid {
   /// if a diagonal block or the level-0 matrix is found not positive definite. A body held by
   /// no Dirichlet condition makes level 0 exactly singular, which the factorization may miss
   /// on rounding: CG then fails to converge and reports it (SolveReport::success).
-  bool compute(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix, int degree);
+  /// `matrixBlocks`, if given with values, is `matrix` by block rows (BlockRows): the top
+  /// level's smoother copy is then converted from it instead of built from the CSR matrix.
+  bool compute(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix, int degree,
+               const BlockRows<double>* matrixBlocks = nullptr);
 
   /// z = M^-1 r: one V-cycle for K z = r from z = 0.
   void apply(const Eigen::VectorXd& r, Eigen::VectorXd& z) const;
