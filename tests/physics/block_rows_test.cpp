@@ -10,21 +10,10 @@
 #include "physics/benchmarks.h"
 #include "physics/linear_solver.h"
 #include "physics/static_solver.h"
+#include "tests/support/dg_systems.h"
 
 namespace polydg {
 namespace {
-
-/// K of B1 on `mesh` (Dirichlet on the whole boundary).
-Eigen::SparseMatrix<double, Eigen::ColMajor, int> b1Matrix(const PolyMesh& mesh, Method method,
-                                                           int degree) {
-  const ManufacturedProblem problem = benchmarkB1Problem();
-  StaticOptions o;
-  o.discretization.method = method;
-  o.discretization.basis.degree = degree;
-  StaticSolver solver(mesh, problem.material, o);
-  solver.assemble(benchmarkB1Loads(problem));
-  return solver.system().matrix;
-}
 
 Eigen::VectorXd randomVector(Eigen::Index size) {
   std::mt19937 rng(20261123);
@@ -42,7 +31,7 @@ struct Comparison {
 };
 
 Comparison compare(const PolyMesh& mesh, Method method, int degree) {
-  const auto k = b1Matrix(mesh, method, degree);
+  const auto k = b1System(mesh, method, degree).matrix;
   const int n = static_cast<int>(k.rows() / mesh.numElements()) / 3;
   BlockRows<double> rows;
   EXPECT_TRUE(rows.build(k, n, 1.0));

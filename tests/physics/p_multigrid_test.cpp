@@ -10,6 +10,7 @@
 
 #include "physics/benchmarks.h"
 #include "physics/static_solver.h"
+#include "tests/support/dg_systems.h"
 
 namespace polydg {
 namespace {
@@ -19,17 +20,6 @@ constexpr double kCgTolerance = 1e-10;
 constexpr double kSolutionAgreement = 1e-7;
 /// Symmetry of the V-cycle: rounding only.
 constexpr double kSymmetryTolerance = 1e-12;
-
-/// K and F of B1 on `mesh` (Dirichlet on the whole boundary, so K is SPD).
-LinearSystem b1System(const PolyMesh& mesh, Method method, int degree) {
-  const ManufacturedProblem problem = benchmarkB1Problem();
-  StaticOptions o;
-  o.discretization.method = method;
-  o.discretization.basis.degree = degree;
-  StaticSolver solver(mesh, problem.material, o);
-  solver.assemble(benchmarkB1Loads(problem));
-  return solver.system();
-}
 
 struct Case {
   BenchmarkMesh mesh;
