@@ -119,7 +119,6 @@ std::uint32_t PlaneSplitter::edgePoint(std::uint32_t u, std::uint32_t v, const S
   decltype(edgePoints_)::accessor edge;
   if (!edgePoints_.insert(edge, EdgeKey{std::min(u, v), std::max(u, v), plane.id}))
     return edge->second;  // made already (we held no lock while another thread made it)
-  planes_.insert({plane.id, plane});
   const Vec3 p = records_[a].position, q = records_[b].position;
   Vec3 r;
   if (plane.axis >= 0) {
@@ -146,6 +145,11 @@ std::uint32_t PlaneSplitter::edgePoint(std::uint32_t u, std::uint32_t v, const S
   at->second = id;
   edge->second = id;
   return id;
+}
+
+void PlaneSplitter::rememberPlane(const SplitPlane& plane) {
+  decltype(planes_)::const_accessor known;
+  if (!planes_.find(known, plane.id)) planes_.insert({plane.id, plane});
 }
 
 Vec3 PlaneSplitter::polygonNormal(const PiecePolygon& polygon) const {
@@ -462,6 +466,7 @@ PieceSplit PlaneSplitter::split(Piece piece, const SplitPlane& plane, FaceOrigin
       (polygonNormal(polygon).dot(plane.normal) > 0 ? out.minus : out.plus)
           .push_back(std::move(polygon));
     else {
+      if (out.polygonsSplit == 0) rememberPlane(plane);
       splitPolygon(polygon, plane, out.minus, out.plus);
       ++out.polygonsSplit;
     }
@@ -469,7 +474,8 @@ PieceSplit PlaneSplitter::split(Piece piece, const SplitPlane& plane, FaceOrigin
   if (out.minus.empty() || out.plus.empty()) return out;
 
   // Caps: the minus side's edges in the plane that have no reverse within the minus side.
-  std::unordered_map<std::uint64_t, int> balance;
+  // Each such edge use as (undirected key, +1 if it runs from the lower id), summed per key.
+  std::vector<std::pair<std::uint64_t, int>> inPlane;
   for (const PiecePolygon& polygon : out.minus) {
     for (std::size_t k = 0; k < polygon.numLoops(); ++k) {
       const std::size_t begin = polygon.loopBegin(k), end = polygon.loopEnd[k];
@@ -477,16 +483,19 @@ PieceSplit PlaneSplitter::split(Piece piece, const SplitPlane& plane, FaceOrigin
         const std::uint32_t a = polygon.vertices[i];
         const std::uint32_t b = polygon.vertices[i + 1 == end ? begin : i + 1];
         if (side(a, plane) != 0 || side(b, plane) != 0) continue;
-        const std::uint64_t key = std::uint64_t(std::min(a, b)) << 32 | std::max(a, b);
-        balance[key] += a < b ? 1 : -1;
+        inPlane.emplace_back(std::uint64_t(std::min(a, b)) << 32 | std::max(a, b), a < b ? 1 : -1);
       }
     }
   }
+  std::sort(inPlane.begin(), inPlane.end());
   std::vector<DirectedEdge> capEdges;
-  for (const auto& [key, net] : balance) {
+  for (std::size_t i = 0; i < inPlane.size();) {
+    const std::uint64_t key = inPlane[i].first;
+    int net = 0;
+    for (; i < inPlane.size() && inPlane[i].first == key; ++i) net += inPlane[i].second;
     const auto lo = static_cast<std::uint32_t>(key >> 32);
     const auto hi = static_cast<std::uint32_t>(key & 0xffffffffu);
-    for (int i = 0; i < std::abs(net); ++i)
+    for (int j = 0; j < std::abs(net); ++j)
       capEdges.push_back(net > 0 ? DirectedEdge{hi, lo} : DirectedEdge{lo, hi});
   }
   if (capEdges.empty()) return out;
@@ -505,13 +514,15 @@ PieceSplit PlaneSplitter::split(Piece piece, const SplitPlane& plane, FaceOrigin
 
 std::vector<Piece> PlaneSplitter::components(Piece piece) {
   const std::size_t n = piece.size();
-  std::vector<std::size_t> parent(n);
-  std::iota(parent.begin(), parent.end(), 0);
-  auto find = [&](std::size_t i) {
+  std::vector<std::uint32_t> parent(n);
+  std::iota(parent.begin(), parent.end(), 0u);
+  auto find = [&](std::uint32_t i) {
     while (parent[i] != i) i = parent[i] = parent[parent[i]];
     return i;
   };
-  std::unordered_map<std::uint64_t, std::size_t> firstUse;
+  // Every edge with the polygon that uses it, sorted by edge: polygons on a run of equal edges
+  // are joined. Most pieces are a few dozen polygons, so the list lives on the stack.
+  boost::container::small_vector<std::pair<std::uint64_t, std::uint32_t>, 64> uses;
   for (std::size_t p = 0; p < n; ++p) {
     const PiecePolygon& polygon = piece[p];
     for (std::size_t k = 0; k < polygon.numLoops(); ++k) {
@@ -519,18 +530,35 @@ std::vector<Piece> PlaneSplitter::components(Piece piece) {
       for (std::size_t i = begin; i < end; ++i) {
         const std::uint32_t a = polygon.vertices[i];
         const std::uint32_t b = polygon.vertices[i + 1 == end ? begin : i + 1];
-        const std::uint64_t key = std::uint64_t(std::min(a, b)) << 32 | std::max(a, b);
-        auto [it, inserted] = firstUse.try_emplace(key, p);
-        if (!inserted) parent[find(p)] = find(it->second);
+        uses.emplace_back(std::uint64_t(std::min(a, b)) << 32 | std::max(a, b),
+                          static_cast<std::uint32_t>(p));
       }
     }
   }
+  std::sort(uses.begin(), uses.end());
+  for (std::size_t i = 1; i < uses.size(); ++i)
+    if (uses[i].first == uses[i - 1].first) parent[find(uses[i].second)] = find(uses[i - 1].second);
+  // Components in order of their first polygon, polygons in their order within the piece.
+  const std::uint32_t firstRoot = n ? find(0) : 0;
+  bool connected = true;
+  for (std::uint32_t p = 1; p < n && connected; ++p) connected = find(p) == firstRoot;
+  if (connected) {
+    std::vector<Piece> one;
+    if (n) one.push_back(std::move(piece));
+    // A piece kept as a leaf should not hold the room reserved for its parent's polygons.
+    if (n && one[0].capacity() > 2 * n) one[0].shrink_to_fit();
+    return one;
+  }
+  constexpr std::uint32_t kUnset = 0xffffffffu;
+  std::vector<std::uint32_t> index(n, kUnset);
   std::vector<Piece> out;
-  std::unordered_map<std::size_t, std::size_t> index;
   for (std::size_t p = 0; p < n; ++p) {
-    auto [it, inserted] = index.try_emplace(find(p), out.size());
-    if (inserted) out.emplace_back();
-    out[it->second].push_back(std::move(piece[p]));
+    std::uint32_t& slot = index[find(static_cast<std::uint32_t>(p))];
+    if (slot == kUnset) {
+      slot = static_cast<std::uint32_t>(out.size());
+      out.emplace_back();
+    }
+    out[slot].push_back(std::move(piece[p]));
   }
   return out;
 }

@@ -88,6 +88,8 @@ class PlaneSplitter {
   static constexpr std::uint32_t kNoPlane = 0xffffffffu;
 
   std::uint32_t edgePoint(std::uint32_t u, std::uint32_t v, const SplitPlane& plane);
+  /// Records `plane` under its id (for compareExactly) before points are made on it.
+  void rememberPlane(const SplitPlane& plane);
   void splitPolygon(const PiecePolygon& polygon, const SplitPlane& plane, Piece& minus,
                     Piece& plus);
   Vec3 polygonNormal(const PiecePolygon& polygon) const;

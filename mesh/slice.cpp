@@ -105,24 +105,33 @@ class Slicer {
 
     // Each leaf's polygons as faces on the welded vertices (in parallel), with the vertex-set
     // key of the caps (interior faces), which are shared with the neighbouring cell's leaf.
+    // Polygons are numbered across all leaves (polygon p of leaf l is polygonBase[l] + p), so
+    // that every per-polygon array is one flat vector.
     const std::size_t nl = leaves_.size();
-    std::vector<std::vector<Face>> faces(nl);
-    std::vector<std::vector<std::uint64_t>> keys(nl);
+    std::vector<std::uint32_t> polygonBase(nl + 1, 0);
+    for (std::size_t l = 0; l < nl; ++l)
+      polygonBase[l + 1] = polygonBase[l] + static_cast<std::uint32_t>(leaves_[l].piece.size());
+    const std::size_t np = polygonBase[nl];
+    std::vector<Face> faces(np);
+    std::vector<char> kept(np, 0);
+    std::vector<std::uint64_t> keys(np, 0);
     std::atomic<std::size_t> collapsed{0};
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nl, 64),
                       [&](const tbb::blocked_range<std::size_t>& r) {
       for (std::size_t l = r.begin(); l != r.end(); ++l) {
-        for (const PiecePolygon& polygon : leaves_[l].piece) {
-          Face face;
-          if (!weldPolygon(polygon, vertexOf, face)) {
+        const Piece& piece = leaves_[l].piece;
+        for (std::size_t i = 0; i < piece.size(); ++i) {
+          const std::size_t p = polygonBase[l] + i;
+          Face& face = faces[p];
+          if (!weldPolygon(piece[i], vertexOf, face)) {
             ++collapsed;
+            face = Face();
             continue;
           }
-          face.origin = polygon.origin;
-          keys[l].push_back(polygon.origin == FaceOrigin::Interior
-                                ? vertexSetKey({face.vertices.data(), face.vertices.size()})
-                                : 0);
-          faces[l].push_back(std::move(face));
+          kept[p] = 1;
+          face.origin = piece[i].origin;
+          if (face.origin == FaceOrigin::Interior)
+            keys[p] = vertexSetKey({face.vertices.data(), face.vertices.size()});
         }
       }
     });
@@ -130,49 +139,61 @@ class Slicer {
 
     // Caps meet their other side: the later of two reversed, equal polygons uses the earlier's
     // face (reversed), as findOrCreateFace would in leaf order.
-    const std::vector<std::vector<std::uint32_t>> sharesEarlier = matchCaps(faces, keys);
+    const std::vector<std::uint32_t> sharesEarlier = matchCaps(faces, kept, keys);
 
-    // Ids: elements for leaves that kept a polygon, faces for polygons that are not a later
-    // side, both in leaf order.
+    // Ids: elements for leaves that kept a polygon, faces for kept polygons that are not a
+    // later side, both in leaf order.
     std::vector<std::uint32_t> elementOf(nl, kNone), faceBase(nl + 1, 0);
+    tbb::parallel_for(std::size_t(0), nl, [&](std::size_t l) {
+      std::uint32_t created = 0, any = 0;
+      for (std::size_t p = polygonBase[l]; p < polygonBase[l + 1]; ++p) {
+        any += kept[p];
+        created += kept[p] && sharesEarlier[p] == kNone;
+      }
+      faceBase[l + 1] = created;
+      elementOf[l] = any ? 0 : kNone;
+    });
     std::uint32_t elements = 0;
     for (std::size_t l = 0; l < nl; ++l) {
-      if (!faces[l].empty()) elementOf[l] = elements++;
-      std::uint32_t created = 0;
-      for (std::uint32_t s : sharesEarlier[l]) created += s == kNone;
-      faceBase[l + 1] = faceBase[l] + created;
+      faceBase[l + 1] += faceBase[l];
+      if (elementOf[l] != kNone) elementOf[l] = elements++;
     }
-    std::vector<std::vector<std::uint32_t>> faceId(nl);
+    std::vector<std::uint32_t> faceId(np, kNone);
     FaceData<Face> meshFaces(faceBase[nl]);
     ElementData<Element> meshElements(elements);
     // New faces first (their ids are known per leaf) ...
-    tbb::parallel_for(std::size_t(0), nl, [&](std::size_t l) {
-      std::uint32_t next = faceBase[l];
-      faceId[l].resize(faces[l].size(), kNone);
-      for (std::size_t i = 0; i < faces[l].size(); ++i) {
-        if (sharesEarlier[l][i] != kNone) continue;
-        faceId[l][i] = next;
-        Face& f = meshFaces[FaceId(std::size_t(next++))];
-        f = std::move(faces[l][i]);
-        f.front = ElementId(std::size_t(elementOf[l]));
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nl, 64),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t l = r.begin(); l != r.end(); ++l) {
+        std::uint32_t next = faceBase[l];
+        for (std::size_t p = polygonBase[l]; p < polygonBase[l + 1]; ++p) {
+          if (!kept[p] || sharesEarlier[p] != kNone) continue;
+          faceId[p] = next;
+          Face& f = meshFaces[FaceId(std::size_t(next++))];
+          f = std::move(faces[p]);
+          f.front = ElementId(std::size_t(elementOf[l]));
+        }
       }
     });
     // ... then the later sides, which take the earlier side's face as its back.
-    tbb::parallel_for(std::size_t(0), nl, [&](std::size_t l) {
-      if (elementOf[l] == kNone) return;
-      const ElementId e(std::size_t(elementOf[l]));
-      FaceList& uses = meshElements[e].faces;
-      for (std::size_t i = 0; i < faces[l].size(); ++i) {
-        const std::uint32_t s = sharesEarlier[l][i];
-        if (s == kNone) {
-          uses.push_back({FaceId(std::size_t(faceId[l][i])), false});
-          continue;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nl, 64),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t l = r.begin(); l != r.end(); ++l) {
+        if (elementOf[l] == kNone) continue;
+        const ElementId e{std::size_t(elementOf[l])};
+        FaceList& uses = meshElements[e].faces;
+        for (std::size_t p = polygonBase[l]; p < polygonBase[l + 1]; ++p) {
+          if (!kept[p]) continue;
+          const std::uint32_t s = sharesEarlier[p];
+          if (s == kNone) {
+            uses.push_back({FaceId(std::size_t(faceId[p])), false});
+            continue;
+          }
+          const FaceId f{static_cast<std::size_t>(faceId[s])};
+          meshFaces[f].back = e;
+          meshFaces[f].origin = FaceOrigin::Interior;
+          uses.push_back({f, true});
         }
-        const std::uint32_t earlierLeaf = matchLeaf_[s], earlierIndex = matchIndex_[s];
-        const FaceId f{static_cast<std::size_t>(faceId[earlierLeaf][earlierIndex])};
-        meshFaces[f].back = e;
-        meshFaces[f].origin = FaceOrigin::Interior;
-        uses.push_back({f, true});
       }
     });
     if (elementCell)
@@ -194,15 +215,19 @@ class Slicer {
 
   /// For used point i (in order of first use), the earliest kept point within `resolution`
   /// (in every coordinate) before it, or i itself if there is none: i is then kept. Points are
-  /// bucketed in cells four times the resolution, so a point's search box meets one or two
-  /// cells per axis; the search runs in parallel, the rare welds are resolved in order.
+  /// bucketed in cells 64 times the resolution, offset by half a cell so that grid planes (at
+  /// dyadic multiples of the resolution) run through cell centres, and sorted by cell. A point's
+  /// search box meets
+  /// its own cell, whose earlier points sit just before it in that order, and only rarely (when
+  /// it lies within the resolution of a cell side) a neighbouring cell, found by binary search.
+  /// The search runs in parallel, the rare welds are resolved in order.
   static std::vector<std::uint32_t> weldTargets(const std::vector<Vec3>& points,
                                                 const std::vector<std::uint32_t>& used,
                                                 double resolution) {
     using Cell = std::array<std::int64_t, 3>;
-    const double cellSize = 4.0 * resolution;
+    const double cellSize = 64.0 * resolution;
     auto cellIndex = [&](double x) {
-      return cellSize > 0 ? static_cast<std::int64_t>(std::floor(x / cellSize)) : 0;
+      return cellSize > 0 ? static_cast<std::int64_t>(std::floor(x / cellSize + 0.5)) : 0;
     };
     std::vector<std::pair<Cell, std::uint32_t>> sorted(used.size());
     tbb::parallel_for(std::size_t(0), used.size(), [&](std::size_t i) {
@@ -211,24 +236,42 @@ class Slicer {
                    static_cast<std::uint32_t>(i)};
     });
     tbb::parallel_sort(sorted.begin(), sorted.end());
-    tbb::concurrent_vector<std::pair<std::uint32_t, std::uint32_t>> near;  // (later, earlier)
-    tbb::parallel_for(std::size_t(0), used.size(), [&](std::size_t i) {
-      const Vec3& p = points[used[i]];
-      Cell lo, hi;
-      for (int a = 0; a < 3; ++a) {
-        lo[a] = cellIndex(p[a] - resolution);
-        hi[a] = cellIndex(p[a] + resolution);
-      }
-      for (std::int64_t x = lo[0]; x <= hi[0]; ++x)
-        for (std::int64_t y = lo[1]; y <= hi[1]; ++y)
-          for (std::int64_t z = lo[2]; z <= hi[2]; ++z) {
-            const Cell c{x, y, z};
-            auto it = std::lower_bound(sorted.begin(), sorted.end(), std::make_pair(c, 0u));
-            for (; it != sorted.end() && it->first == c && it->second < i; ++it)
-              if ((points[used[it->second]] - p).cwiseAbs().maxCoeff() <= resolution)
-                near.push_back({static_cast<std::uint32_t>(i), it->second});
-          }
+    std::vector<std::uint32_t> position(used.size());
+    tbb::parallel_for(std::size_t(0), used.size(), [&](std::size_t s) {
+      position[sorted[s].second] = static_cast<std::uint32_t>(s);
     });
+    tbb::concurrent_vector<std::pair<std::uint32_t, std::uint32_t>> near;  // (later, earlier)
+    auto nearPoint = [&](std::size_t i, std::uint32_t j) {
+      if ((points[used[j]] - points[used[i]]).cwiseAbs().maxCoeff() <= resolution)
+        near.push_back({static_cast<std::uint32_t>(i), j});
+    };
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, used.size(), 4096),
+        [&](const tbb::blocked_range<std::size_t>& r) {
+          for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            const Vec3& p = points[used[i]];
+            const std::size_t at = position[i];
+            const Cell& own = sorted[at].first;
+            // Earlier points of the own cell: just before i in the sorted order.
+            for (std::size_t s = at; s > 0 && sorted[s - 1].first == own; --s)
+              nearPoint(i, sorted[s - 1].second);
+            Cell lo, hi;
+            for (int a = 0; a < 3; ++a) {
+              lo[a] = cellIndex(p[a] - resolution);
+              hi[a] = cellIndex(p[a] + resolution);
+            }
+            if (lo == own && hi == own) continue;
+            for (std::int64_t x = lo[0]; x <= hi[0]; ++x)
+              for (std::int64_t y = lo[1]; y <= hi[1]; ++y)
+                for (std::int64_t z = lo[2]; z <= hi[2]; ++z) {
+                  const Cell c{x, y, z};
+                  if (c == own) continue;
+                  auto it = std::lower_bound(sorted.begin(), sorted.end(), std::make_pair(c, 0u));
+                  for (; it != sorted.end() && it->first == c && it->second < i; ++it)
+                    nearPoint(i, it->second);
+                }
+          }
+        });
     std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs(near.begin(), near.end());
     std::sort(pairs.begin(), pairs.end());
     std::vector<std::uint32_t> target(used.size());
@@ -261,60 +304,72 @@ class Slicer {
     return !face.loopEnd.empty();
   }
 
-  /// For each polygon of each leaf: kNone, or the index (into matchLeaf_/matchIndex_) of the
-  /// earlier cap whose face it shares. Caps are grouped by vertex-set key (sorted in parallel);
-  /// within a group, in leaf order, a cap takes the first earlier open cap that is its
-  /// reverse, and that cap is then closed.
-  std::vector<std::vector<std::uint32_t>> matchCaps(const std::vector<std::vector<Face>>& faces,
-                                                    const std::vector<std::vector<std::uint64_t>>& keys) {
+  /// True if `b` is `a` reversed (isReverseOf), checked without allocating for the common
+  /// case of one loop: the same cycle, traversed the other way, from any start.
+  static bool isReversedPolygon(const Face& a, const Face& b) {
+    if (a.numLoops() != 1 || b.numLoops() != 1)
+      return isReverseOf(a, {b.vertices.data(), b.vertices.size()},
+                         {b.loopEnd.data(), b.loopEnd.size()});
+    const std::size_t n = a.vertices.size();
+    if (b.vertices.size() != n) return false;
+    for (std::size_t j = 0; j < n; ++j) {  // every start (a pinched loop repeats a vertex)
+      if (b.vertices[j] != a.vertices[0]) continue;
+      std::size_t i = 1;
+      while (i < n && a.vertices[i] == b.vertices[(j + n - i) % n]) ++i;
+      if (i == n) return true;
+    }
+    return false;
+  }
+
+  /// For each polygon (numbered across leaves): kNone, or the number of the earlier cap whose
+  /// face it shares. Kept caps are grouped by vertex-set key (sorted in parallel); within a
+  /// group, in leaf order, a cap takes the first earlier open cap that is its reverse, and that
+  /// cap is then closed.
+  static std::vector<std::uint32_t> matchCaps(const std::vector<Face>& faces,
+                                              const std::vector<char>& kept,
+                                              const std::vector<std::uint64_t>& keys) {
     constexpr std::uint32_t kNone = 0xffffffffu;
-    struct Cap {
-      std::uint64_t key;
-      std::uint32_t leaf, index;
-      bool operator<(const Cap& o) const {
-        return std::tie(key, leaf, index) < std::tie(o.key, o.leaf, o.index);
-      }
-    };
-    std::vector<Cap> caps;
-    std::vector<std::vector<std::uint32_t>> shares(faces.size());
-    for (std::size_t l = 0; l < faces.size(); ++l) {
-      shares[l].assign(faces[l].size(), kNone);
-      for (std::size_t i = 0; i < faces[l].size(); ++i)
-        if (faces[l][i].origin == FaceOrigin::Interior)
-          caps.push_back({keys[l][i], static_cast<std::uint32_t>(l), static_cast<std::uint32_t>(i)});
-    }
+    const std::size_t np = faces.size();
+    auto isCap = [&](std::size_t p) { return kept[p] && faces[p].origin == FaceOrigin::Interior; };
+    // Caps in polygon order (that is, leaf order), gathered in parallel blocks.
+    constexpr std::size_t kBlock = 16384;
+    const std::size_t blocks = (np + kBlock - 1) / kBlock;
+    std::vector<std::size_t> blockBase(blocks + 1, 0);
+    tbb::parallel_for(std::size_t(0), blocks, [&](std::size_t b) {
+      std::size_t count = 0;
+      for (std::size_t p = b * kBlock; p < std::min(np, (b + 1) * kBlock); ++p) count += isCap(p);
+      blockBase[b + 1] = count;
+    });
+    for (std::size_t b = 0; b < blocks; ++b) blockBase[b + 1] += blockBase[b];
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> caps(blockBase[blocks]);  // (key, p)
+    tbb::parallel_for(std::size_t(0), blocks, [&](std::size_t b) {
+      std::size_t next = blockBase[b];
+      for (std::size_t p = b * kBlock; p < std::min(np, (b + 1) * kBlock); ++p)
+        if (isCap(p)) caps[next++] = {keys[p], static_cast<std::uint32_t>(p)};
+    });
     tbb::parallel_sort(caps.begin(), caps.end());
-    matchLeaf_.resize(caps.size());
-    matchIndex_.resize(caps.size());
-    for (std::size_t c = 0; c < caps.size(); ++c) {
-      matchLeaf_[c] = caps[c].leaf;
-      matchIndex_[c] = caps[c].index;
-    }
-    std::vector<std::size_t> groupStart;
+    std::vector<std::uint32_t> groupStart;
     for (std::size_t c = 0; c < caps.size(); ++c)
-      if (c == 0 || caps[c].key != caps[c - 1].key) groupStart.push_back(c);
-    groupStart.push_back(caps.size());
+      if (c == 0 || caps[c].first != caps[c - 1].first) groupStart.push_back(static_cast<std::uint32_t>(c));
+    groupStart.push_back(static_cast<std::uint32_t>(caps.size()));
+    std::vector<std::uint32_t> shares(np, kNone);
     tbb::parallel_for(std::size_t(0), groupStart.size() - 1, [&](std::size_t g) {
-      boost::container::small_vector<std::size_t, 4> open;
+      boost::container::small_vector<std::uint32_t, 4> open;
       for (std::size_t c = groupStart[g]; c < groupStart[g + 1]; ++c) {
-        const Face& face = faces[caps[c].leaf][caps[c].index];
-        const std::span<const VertexId> vs(face.vertices.data(), face.vertices.size());
-        const std::span<const std::uint32_t> ends(face.loopEnd.data(), face.loopEnd.size());
-        auto match = std::find_if(open.begin(), open.end(), [&](std::size_t o) {
-          return isReverseOf(faces[caps[o].leaf][caps[o].index], vs, ends);
+        const Face& face = faces[caps[c].second];
+        auto match = std::find_if(open.begin(), open.end(), [&](std::uint32_t o) {
+          return isReversedPolygon(faces[o], face);
         });
         if (match != open.end()) {
-          shares[caps[c].leaf][caps[c].index] = static_cast<std::uint32_t>(*match);
+          shares[caps[c].second] = *match;
           open.erase(match);
         } else {
-          open.push_back(c);
+          open.push_back(caps[c].second);
         }
       }
     });
     return shares;
   }
-
-  std::vector<std::uint32_t> matchLeaf_, matchIndex_;  ///< leaf and polygon of each cap
 
   /// Pieces with more polygons than this are split into two tasks.
   static constexpr std::size_t kParallelPolygons = 512;
