@@ -1,10 +1,12 @@
 #include "mesh/meshing.h"
 
 #include <tbb/blocked_range.h>
+#include <tbb/parallel_invoke.h>
 #include <tbb/parallel_reduce.h>
 
 #include <chrono>
 #include <cmath>
+#include <exception>
 #include <sstream>
 
 #include "mesh/surface_repair.h"
@@ -100,7 +102,30 @@ MeshingResult meshSurface(const TriangleSurface& input, const MeshingOptions& op
   if (input.triangles.empty()) throw InputError("the surface has no triangles");
 
   TriangleSurface surface = input;
-  SurfaceDiagnosis d = diagnose(surface);
+  SurfaceDiagnosis d;
+  // A surface closed edge by edge, without degenerate triangles, is oriented while its
+  // self-intersection test runs: the two are independent, and the orientation is kept only if
+  // the diagnosis finds nothing to repair (otherwise the repaired surface is oriented below).
+  std::optional<TriangleSurface> oriented;
+  bool reoriented = false;
+  const SurfaceTopology topology = analyzeTopology(surface);
+  if (topology.boundaryEdges == 0 && topology.nonManifoldEdges == 0 &&
+      topology.degenerateTriangles == 0) {
+    std::exception_ptr orientFailure;
+    tbb::parallel_invoke([&] { d = diagnose(surface); },
+                         [&] {
+                           try {
+                             oriented = orientToBoundVolume(surface, reoriented, &r.shells,
+                                                            &r.cavities);
+                           } catch (...) {
+                             orientFailure = std::current_exception();
+                           }
+                         });
+    if (broken(d)) oriented.reset();
+    else if (orientFailure) std::rethrow_exception(orientFailure);
+  } else {
+    d = diagnose(surface);
+  }
   r.inputVertices = input.vertices.size();
   r.inputTriangles = input.triangles.size();
   r.inputClosed = d.topology.closed();
@@ -114,6 +139,7 @@ MeshingResult meshSurface(const TriangleSurface& input, const MeshingOptions& op
                        " triangles are degenerate (zero area); the surface encloses nothing");
     r.repairs.push_back("removed " + std::to_string(removed) + " degenerate triangles");
     d = diagnose(surface);
+    oriented.reset();
   }
   timer.done("check");
 
@@ -159,8 +185,12 @@ MeshingResult meshSurface(const TriangleSurface& input, const MeshingOptions& op
     timer.done("repair");
   }
 
-  bool reoriented = false;
-  surface = orientToBoundVolume(surface, reoriented, &r.shells, &r.cavities);
+  if (oriented) {
+    surface = std::move(*oriented);
+  } else {
+    reoriented = false;
+    surface = orientToBoundVolume(surface, reoriented, &r.shells, &r.cavities);
+  }
   if (reoriented) r.repairs.push_back("re-oriented the surface to bound its volume outward");
   r.inputVolume = enclosedVolume(surface);
   if (!(r.inputVolume > 0)) throw InputError("the surface encloses no volume");
