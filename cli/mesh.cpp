@@ -131,6 +131,7 @@ void addMeshCommand(CLI::App& app, const CommonOptions& common, int& exitCode) {
     options.cellsAlongLongest = o->cells;
     options.repair = o->repair;
     options.sliverTau = o->sliverTau;
+    options.validate = false;  // below, beside the writing
     ProgressBar bar("slicing", common.quiet);
     options.progress = [&bar](double f) { bar.update(f); };
     MeshingResult result;
@@ -140,26 +141,25 @@ void addMeshCommand(CLI::App& app, const CommonOptions& common, int& exitCode) {
       throw UserError(o->input + ": " + e.what());
     }
     bar.finish();
-    // The DG checks need a geometrically valid mesh (faces shared properly). They and the
-    // file writing only read the mesh, so they run side by side: the writer's serial part
+    // The file is written (whatever the checks find: a failed check exits 1 with the file
+    // there to look at) while the mesh is validated and then, if it is valid (faces shared
+    // properly), DG-checked. All of them only read the mesh; the writer's serial part
     // (formatting and I/O) overlaps the checks' parallel loops.
     result.report.timings.insert(result.report.timings.begin(), {"read", readSeconds});
     std::optional<DgOutcome> dg;
     double writeSeconds = 0.0;
-    const bool checkDg = !o->skipDg && result.report.validation.passed;
     tbb::task_group tasks;
     tasks.run([&] {
       const auto writeStart = std::chrono::steady_clock::now();
       writeVtu(result.mesh, o->output);
       writeSeconds = secondsSince(writeStart);
     });
-    if (checkDg) {
-      try {
-        dg = runDgChecks(result.mesh);
-      } catch (...) {
-        tasks.wait();
-        throw;
-      }
+    try {
+      validateMeshing(result);
+      if (!o->skipDg && result.report.validation.passed) dg = runDgChecks(result.mesh);
+    } catch (...) {
+      tasks.wait();
+      throw;
     }
     tasks.wait();
     // Phase times as measured; they overlap, so "total" adds up more than the wall time.

@@ -209,6 +209,13 @@ MeshingResult meshSurface(const TriangleSurface& input, const MeshingOptions& op
   }
   timer.done("merge_slivers");
 
+  if (options.validate) validateMeshing(result);
+  return result;
+}
+
+void validateMeshing(MeshingResult& result) {
+  const auto start = std::chrono::steady_clock::now();
+  MeshingReport& r = result.report;
   const PolyMesh& mesh = result.mesh;
   r.validation = validate(mesh);
   r.elements = mesh.numElements();
@@ -233,8 +240,8 @@ MeshingResult meshSurface(const TriangleSurface& input, const MeshingOptions& op
   r.hexahedra = counts.first;
   r.nonconvex = counts.second;
   r.polyhedra = r.elements - r.hexahedra;
-  timer.done("validate");
-  return result;
+  r.timings.emplace_back(
+      "validate", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
 }
 
 }  // namespace polydg
