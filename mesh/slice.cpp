@@ -55,7 +55,7 @@ class Slicer {
     totalCells_ = static_cast<double>(grid_.cells[0]) * grid_.cells[1] * grid_.cells[2];
     leaves_ = recurse(std::move(solid), {0, 0, 0}, grid_.cells);
     // Deterministic order whatever the schedule: by cell, then by piece within the cell.
-    std::sort(leaves_.begin(), leaves_.end(), [](const Leaf& a, const Leaf& b) {
+    tbb::parallel_sort(leaves_.begin(), leaves_.end(), [](const Leaf& a, const Leaf& b) {
       return std::tie(a.cell[2], a.cell[1], a.cell[0], a.part) <
              std::tie(b.cell[2], b.cell[1], b.cell[0], b.part);
     });
@@ -199,6 +199,13 @@ class Slicer {
     if (elementCell)
       for (std::size_t l = 0; l < nl; ++l)
         if (elementOf[l] != kNone) elementCell->push_back(leaves_[l].cell);
+    // The leaves are spent: their many small buffers are freed in parallel, not one by one
+    // when the slicer goes.
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nl, 256),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        for (std::size_t l = r.begin(); l != r.end(); ++l)
+                          Piece().swap(leaves_[l].piece);
+                      });
     PolyMesh mesh;
     mesh.assign(std::move(positions), std::move(meshFaces), std::move(meshElements));
     return mesh;
