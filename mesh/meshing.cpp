@@ -167,6 +167,12 @@ std::optional<MeshingResult> meshWhileDiagnosing(const TriangleSurface& input,
 }  // namespace
 
 MeshingResult meshSurface(const TriangleSurface& input, const MeshingOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  auto finish = [&](MeshingResult& result) {
+    result.report.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (options.validate) validateMeshing(result);
+  };
   if (input.triangles.empty()) throw InputError("the surface has no triangles");
   SurfaceDiagnosis d;
   bool diagnosed = false;
@@ -174,7 +180,7 @@ MeshingResult meshSurface(const TriangleSurface& input, const MeshingOptions& op
   if (topology.boundaryEdges == 0 && topology.nonManifoldEdges == 0 &&
       topology.degenerateTriangles == 0) {
     if (std::optional<MeshingResult> done = meshWhileDiagnosing(input, options, d)) {
-      if (options.validate) validateMeshing(*done);
+      finish(*done);
       return std::move(*done);
     }
     diagnosed = true;
@@ -239,7 +245,7 @@ MeshingResult meshSurface(const TriangleSurface& input, const MeshingOptions& op
   }
 
   orientAndSlice(surface, cellSize, options, result, timer);
-  if (options.validate) validateMeshing(result);
+  finish(result);
   return result;
 }
 
@@ -270,8 +276,10 @@ void validateMeshing(MeshingResult& result) {
   r.hexahedra = counts.first;
   r.nonconvex = counts.second;
   r.polyhedra = r.elements - r.hexahedra;
-  r.timings.emplace_back(
-      "validate", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  r.timings.emplace_back("validate", seconds);
+  r.seconds += seconds;
 }
 
 }  // namespace polydg

@@ -60,8 +60,11 @@ struct MeshingReport {
   double volumeRelError = 0.0;
   ValidationReport validation;
 
-  // Wall time per phase, seconds.
+  // Wall time per phase, seconds. Phases may overlap (the check runs beside the slicing of a
+  // closed surface), so they can add up to more than `seconds`.
   std::vector<std::pair<std::string, double>> timings;
+  /// Wall time of meshSurface() and validateMeshing() together, seconds.
+  double seconds = 0.0;
 };
 
 struct MeshingResult {

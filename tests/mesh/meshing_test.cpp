@@ -45,6 +45,8 @@ TEST(Meshing, ClosedSurfaceReportsItsDiagnosisAndEveryPhase) {
   EXPECT_LT(r.volumeRelError, kVolumeTolerance);
   for (const char* phase : {"check", "orient", "slice", "merge_slivers", "validate"})
     EXPECT_TRUE(hasPhase(r, phase)) << phase;
+  // The whole is at least as long as any phase inside it (phases may overlap).
+  for (const auto& [phase, seconds] : r.timings) EXPECT_GE(r.seconds, seconds) << phase;
 }
 
 TEST(Meshing, SelfIntersectingClosedSurfaceIsRefusedOrWrapped) {
