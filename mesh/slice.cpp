@@ -103,35 +103,50 @@ class Slicer {
     }
     auto vertexOf = [&](std::uint32_t v) { return VertexId(vertexOfRank[rank[v]]); };
 
-    // Each leaf's polygons as faces on the welded vertices (in parallel), with the vertex-set
-    // key of the caps (interior faces), which are shared with the neighbouring cell's leaf.
-    // Polygons are numbered across all leaves (polygon p of leaf l is polygonBase[l] + p), so
-    // that every per-polygon array is one flat vector.
+    // Each leaf's polygons on the welded vertices (in parallel), with the vertex-set key of the
+    // caps (interior faces), which are shared with the neighbouring cell's leaf. Polygons are
+    // numbered across all leaves (polygon i of leaf l is polygonBase[l] + i) and kept in flat
+    // arrays (WeldedPolygons): a Face is made only for each face of the mesh.
     const std::size_t nl = leaves_.size();
     std::vector<std::uint32_t> polygonBase(nl + 1, 0);
-    for (std::size_t l = 0; l < nl; ++l)
-      polygonBase[l + 1] = polygonBase[l] + static_cast<std::uint32_t>(leaves_[l].piece.size());
+    std::vector<std::size_t> cornerBase(nl + 1, 0), loopBase(nl + 1, 0);
+    tbb::parallel_for(std::size_t(0), nl, [&](std::size_t l) {
+      std::size_t corners = 0, loops = 0;
+      for (const PiecePolygon& polygon : leaves_[l].piece) {
+        corners += polygon.vertices.size();
+        loops += polygon.numLoops();
+      }
+      polygonBase[l + 1] = static_cast<std::uint32_t>(leaves_[l].piece.size());
+      cornerBase[l + 1] = corners;
+      loopBase[l + 1] = loops;
+    });
+    for (std::size_t l = 0; l < nl; ++l) {
+      polygonBase[l + 1] += polygonBase[l];
+      cornerBase[l + 1] += cornerBase[l];
+      loopBase[l + 1] += loopBase[l];
+    }
     const std::size_t np = polygonBase[nl];
-    std::vector<Face> faces(np);
+    WeldedPolygons welded(np, cornerBase[nl], loopBase[nl]);
     std::vector<char> kept(np, 0);
     std::vector<std::uint64_t> keys(np, 0);
+    std::vector<FaceOrigin> origin(np);
     std::atomic<std::size_t> collapsed{0};
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nl, 64),
                       [&](const tbb::blocked_range<std::size_t>& r) {
       for (std::size_t l = r.begin(); l != r.end(); ++l) {
         const Piece& piece = leaves_[l].piece;
+        std::size_t corner = cornerBase[l], loop = loopBase[l];
         for (std::size_t i = 0; i < piece.size(); ++i) {
           const std::size_t p = polygonBase[l] + i;
-          Face& face = faces[p];
-          if (!weldPolygon(piece[i], vertexOf, face)) {
+          origin[p] = piece[i].origin;
+          if (!welded.weld(p, corner, loop, piece[i], vertexOf)) {
             ++collapsed;
-            face = Face();
-            continue;
+          } else {
+            kept[p] = 1;
+            if (origin[p] == FaceOrigin::Interior) keys[p] = vertexSetKey(welded.corners(p));
           }
-          kept[p] = 1;
-          face.origin = piece[i].origin;
-          if (face.origin == FaceOrigin::Interior)
-            keys[p] = vertexSetKey({face.vertices.data(), face.vertices.size()});
+          corner += piece[i].vertices.size();
+          loop += piece[i].numLoops();
         }
       }
     });
@@ -139,7 +154,7 @@ class Slicer {
 
     // Caps meet their other side: the later of two reversed, equal polygons uses the earlier's
     // face (reversed), as findOrCreateFace would in leaf order.
-    const std::vector<std::uint32_t> sharesEarlier = matchCaps(faces, kept, keys);
+    const std::vector<std::uint32_t> sharesEarlier = matchCaps(welded, origin, kept, keys);
 
     // Ids: elements for leaves that kept a polygon, faces for kept polygons that are not a
     // later side, both in leaf order.
@@ -170,7 +185,8 @@ class Slicer {
           if (!kept[p] || sharesEarlier[p] != kNone) continue;
           faceId[p] = next;
           Face& f = meshFaces[FaceId(std::size_t(next++))];
-          f = std::move(faces[p]);
+          welded.copyTo(p, f);
+          f.origin = origin[p];
           f.front = ElementId(std::size_t(elementOf[l]));
         }
       }
@@ -288,41 +304,83 @@ class Slicer {
     return target;
   }
 
-  /// `polygon` on welded vertices into `face` (vertices and loop ends): consecutive repeats
-  /// dropped, loops of fewer than 3 corners removed. False if the outer loop collapsed.
-  template <class VertexOf>
-  static bool weldPolygon(const PiecePolygon& polygon, const VertexOf& vertexOf, Face& face) {
-    auto& vertices = face.vertices;
-    for (std::size_t k = 0; k < polygon.numLoops(); ++k) {
-      const std::size_t begin = vertices.size();
-      for (std::size_t i = polygon.loopBegin(k); i < polygon.loopEnd[k]; ++i) {
-        const VertexId v = vertexOf(polygon.vertices[i]);
-        if (vertices.size() == begin || vertices.back() != v) vertices.push_back(v);
-      }
-      while (vertices.size() > begin + 1 && vertices[begin] == vertices.back())
-        vertices.pop_back();
-      if (vertices.size() >= begin + 3) {
-        face.loopEnd.push_back(static_cast<std::uint32_t>(vertices.size()));
-      } else {
-        vertices.resize(begin);
-        if (k == 0) break;  // the outer boundary collapsed: the polygon is gone
-      }
-    }
-    return !face.loopEnd.empty();
-  }
+  /// Polygons on welded vertices, in flat arrays: polygon p's corners (all loops, concatenated)
+  /// start at cornerStart_[p], its loop ends (relative to its first corner) at loopStart_[p].
+  /// The room for each polygon is that of the polygon before welding (welding only drops
+  /// corners and loops), given by the caller.
+  class WeldedPolygons {
+   public:
+    WeldedPolygons(std::size_t polygons, std::size_t corners, std::size_t loops)
+        : cornerStart_(polygons), cornerCount_(polygons, 0), loopStart_(polygons),
+          loopCount_(polygons, 0), corners_(corners), loopEnds_(loops) {}
 
-  /// True if `b` is `a` reversed (isReverseOf), checked without allocating for the common
-  /// case of one loop: the same cycle, traversed the other way, from any start.
-  static bool isReversedPolygon(const Face& a, const Face& b) {
-    if (a.numLoops() != 1 || b.numLoops() != 1)
-      return isReverseOf(a, {b.vertices.data(), b.vertices.size()},
-                         {b.loopEnd.data(), b.loopEnd.size()});
-    const std::size_t n = a.vertices.size();
-    if (b.vertices.size() != n) return false;
+    /// `polygon` on welded vertices as polygon p, with room from `corner` and `loop` on:
+    /// consecutive repeats dropped, loops of fewer than 3 corners removed. False if the outer
+    /// loop collapsed (the polygon is gone).
+    template <class VertexOf>
+    bool weld(std::size_t p, std::size_t corner, std::size_t loop, const PiecePolygon& polygon,
+              const VertexOf& vertexOf) {
+      cornerStart_[p] = corner;
+      loopStart_[p] = loop;
+      VertexId* out = corners_.data() + corner;
+      std::uint32_t n = 0, loops = 0;
+      for (std::size_t k = 0; k < polygon.numLoops(); ++k) {
+        const std::uint32_t begin = n;
+        for (std::size_t i = polygon.loopBegin(k); i < polygon.loopEnd[k]; ++i) {
+          const VertexId v = vertexOf(polygon.vertices[i]);
+          if (n == begin || out[n - 1] != v) out[n++] = v;
+        }
+        while (n > begin + 1 && out[begin] == out[n - 1]) --n;
+        if (n >= begin + 3) {
+          loopEnds_[loop + loops++] = n;
+        } else {
+          n = begin;
+          if (k == 0) break;  // the outer boundary collapsed: the polygon is gone
+        }
+      }
+      cornerCount_[p] = n;
+      loopCount_[p] = loops;
+      return loops > 0;
+    }
+
+    std::span<const VertexId> corners(std::size_t p) const {
+      return {corners_.data() + cornerStart_[p], cornerCount_[p]};
+    }
+    std::span<const std::uint32_t> loopEnds(std::size_t p) const {
+      return {loopEnds_.data() + loopStart_[p], loopCount_[p]};
+    }
+    /// Polygon p's loops into `face` (vertices and loop ends).
+    void copyTo(std::size_t p, Face& face) const {
+      const auto c = corners(p);
+      const auto e = loopEnds(p);
+      face.vertices.assign(c.begin(), c.end());
+      face.loopEnd.assign(e.begin(), e.end());
+    }
+
+   private:
+    std::vector<std::size_t> cornerStart_;
+    std::vector<std::uint32_t> cornerCount_;
+    std::vector<std::size_t> loopStart_;
+    std::vector<std::uint32_t> loopCount_;
+    std::vector<VertexId> corners_;
+    std::vector<std::uint32_t> loopEnds_;
+  };
+
+  /// True if polygon b is polygon a reversed (isReverseOf), checked without allocating for
+  /// the common case of one loop: the same cycle, traversed the other way, from any start.
+  static bool isReversedPolygon(const WeldedPolygons& welded, std::size_t a, std::size_t b) {
+    const auto x = welded.corners(a), y = welded.corners(b);
+    if (welded.loopEnds(a).size() != 1 || welded.loopEnds(b).size() != 1) {
+      Face face;
+      welded.copyTo(a, face);
+      return isReverseOf(face, y, welded.loopEnds(b));
+    }
+    const std::size_t n = x.size();
+    if (y.size() != n) return false;
     for (std::size_t j = 0; j < n; ++j) {  // every start (a pinched loop repeats a vertex)
-      if (b.vertices[j] != a.vertices[0]) continue;
+      if (y[j] != x[0]) continue;
       std::size_t i = 1;
-      while (i < n && a.vertices[i] == b.vertices[(j + n - i) % n]) ++i;
+      while (i < n && x[i] == y[(j + n - i) % n]) ++i;
       if (i == n) return true;
     }
     return false;
@@ -332,12 +390,13 @@ class Slicer {
   /// face it shares. Kept caps are grouped by vertex-set key (sorted in parallel); within a
   /// group, in leaf order, a cap takes the first earlier open cap that is its reverse, and that
   /// cap is then closed.
-  static std::vector<std::uint32_t> matchCaps(const std::vector<Face>& faces,
+  static std::vector<std::uint32_t> matchCaps(const WeldedPolygons& welded,
+                                              const std::vector<FaceOrigin>& origin,
                                               const std::vector<char>& kept,
                                               const std::vector<std::uint64_t>& keys) {
     constexpr std::uint32_t kNone = 0xffffffffu;
-    const std::size_t np = faces.size();
-    auto isCap = [&](std::size_t p) { return kept[p] && faces[p].origin == FaceOrigin::Interior; };
+    const std::size_t np = kept.size();
+    auto isCap = [&](std::size_t p) { return kept[p] && origin[p] == FaceOrigin::Interior; };
     // Caps in polygon order (that is, leaf order), gathered in parallel blocks.
     constexpr std::size_t kBlock = 16384;
     const std::size_t blocks = (np + kBlock - 1) / kBlock;
@@ -363,9 +422,8 @@ class Slicer {
     tbb::parallel_for(std::size_t(0), groupStart.size() - 1, [&](std::size_t g) {
       boost::container::small_vector<std::uint32_t, 4> open;
       for (std::size_t c = groupStart[g]; c < groupStart[g + 1]; ++c) {
-        const Face& face = faces[caps[c].second];
         auto match = std::find_if(open.begin(), open.end(), [&](std::uint32_t o) {
-          return isReversedPolygon(faces[o], face);
+          return isReversedPolygon(welded, o, caps[c].second);
         });
         if (match != open.end()) {
           shares[caps[c].second] = *match;
