@@ -311,13 +311,14 @@ std::vector<Vec3> toVec3(const std::vector<Point>& points) {
   return out;
 }
 
-/// The whitespace-separated words of `line`.
-std::vector<std::string_view> words(std::string_view line) {
-  std::vector<std::string_view> out;
+/// The space-separated words of `line`, into `out` (cleared first, so that one buffer serves
+/// every line of a file).
+void splitWords(std::string_view line, std::vector<std::string_view>& out) {
+  out.clear();
   std::size_t i = 0;
   while (true) {
     while (i < line.size() && line[i] == ' ') ++i;
-    if (i == line.size()) return out;
+    if (i == line.size()) return;
     const std::size_t start = i;
     while (i < line.size() && line[i] != ' ') ++i;
     out.push_back(line.substr(start, i - start));
@@ -348,6 +349,7 @@ std::variant<ObjScan, Reason> scanObj(const std::string& path) {
   bool materialCounted = false;  // `material` is in scan.materials already
   std::size_t lineNumber = 0;
   std::string line;  // one buffer for every line
+  std::vector<std::string_view> w;  // and one for its words
   for (std::size_t begin = 0; begin < text.size();) {
     std::size_t end = text.find('\n', begin);
     if (end == std::string::npos) end = text.size();
@@ -360,7 +362,7 @@ std::variant<ObjScan, Reason> scanObj(const std::string& path) {
     if (const std::size_t hash = line.find('#'); hash != std::string::npos) line.resize(hash);
     while (!line.empty() && line.back() == ' ') line.pop_back();
     if (!line.empty() && line.back() == '\\') return where() + "line continuation";
-    const std::vector<std::string_view> w = words(line);
+    splitWords(line, w);
     if (w.empty()) {
       scan.text += '\n';
       continue;
