@@ -9,6 +9,7 @@
 #include <tuple>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <stdexcept>
 #include <unordered_map>
 
@@ -19,6 +20,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
 #include <tbb/parallel_sort.h>
+#include <tbb/task_group.h>
 
 namespace polydg {
 
@@ -49,7 +51,8 @@ namespace {
 class Slicer {
  public:
   Slicer(const Grid& grid, std::vector<Vec3> points, const ProgressFn& progress)
-      : grid_(grid), splitter_(std::move(points)), progress_(progress) {}
+      : grid_(grid), splitter_(std::make_unique<PlaneSplitter>(std::move(points))),
+        progress_(progress) {}
 
   void run(Piece solid) {
     totalCells_ = static_cast<double>(grid_.cells[0]) * grid_.cells[1] * grid_.cells[2];
@@ -66,7 +69,11 @@ class Slicer {
   }
 
   PolyMesh build(std::vector<std::array<int, 3>>* elementCell) {
-    const std::vector<Vec3> points = splitter_.points();
+    const std::vector<Vec3> points = splitter_->points();
+    // The splitter's maps of shared points (hundreds of thousands of nodes) are not needed any
+    // more: they are freed beside the build, not after it.
+    tbb::task_group release;
+    release.run([this] { splitter_.reset(); });
     // Points closer than the resolution of the coordinates are one point: 8 units in the last
     // place of the largest coordinate, in every coordinate. Such points are intersections that
     // are the same point mathematically but were built along different paths (or a surface
@@ -222,6 +229,7 @@ class Slicer {
                         for (std::size_t l = r.begin(); l != r.end(); ++l)
                           Piece().swap(leaves_[l].piece);
                       });
+    release.wait();
     PolyMesh mesh;
     mesh.assign(std::move(positions), std::move(meshFaces), std::move(meshElements));
     return mesh;
@@ -445,7 +453,7 @@ class Slicer {
       const int mid = (lo[axis] + hi[axis]) / 2;
       const auto id = static_cast<std::uint32_t>(axis * ((1 << 20) + 1) + mid);
       const SplitPlane plane = SplitPlane::axisAligned(axis, grid_.plane(axis, mid), id);
-      PieceSplit s = splitter_.split(std::move(piece), plane, FaceOrigin::Interior);
+      PieceSplit s = splitter_->split(std::move(piece), plane, FaceOrigin::Interior);
       ++splits_;
       polygonsSplit_ += s.polygonsSplit;
       std::array<int, 3> hiMinus = hi, loPlus = lo;
@@ -487,7 +495,7 @@ class Slicer {
   }
 
   const Grid& grid_;
-  PlaneSplitter splitter_;
+  std::unique_ptr<PlaneSplitter> splitter_;
   const ProgressFn& progress_;
   std::vector<Leaf> leaves_;
   double totalCells_ = 1.0;
