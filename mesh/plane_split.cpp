@@ -37,6 +37,12 @@ struct DirectedEdge {
   std::uint32_t from, to;
 };
 
+// Scratch containers of one split: most hold a handful of entries, kept inline (no allocation).
+template <class T, std::size_t N = 16>
+using Small = boost::container::small_vector<T, N>;
+using EdgeList = Small<DirectedEdge>;
+using LoopList = Small<Small<std::uint32_t>, 2>;
+
 /// Exact point-in-loop test in 2D: 1 inside, 0 outside, -1 on the boundary.
 int locate(const Point2& p, const std::vector<Point2>& loop) {
   bool inside = false;
@@ -171,10 +177,8 @@ namespace {
 /// the first one clockwise from the reversed incoming edge, so the region to the left of each
 /// loop is a proper face (the loops at a pinch are kept apart). `normal` orients the plane.
 template <class PointOf>
-std::vector<std::vector<std::uint32_t>> traceLoops(const std::vector<DirectedEdge>& edges,
-                                                   const PointOf& points,
-                                                   const Vec3& normal) {
-  std::vector<std::size_t> order(edges.size());
+LoopList traceLoops(const EdgeList& edges, const PointOf& points, const Vec3& normal) {
+  Small<std::size_t> order(edges.size());
   std::iota(order.begin(), order.end(), 0);
   std::sort(order.begin(), order.end(),
             [&](std::size_t i, std::size_t j) { return edges[i].from < edges[j].from; });
@@ -195,11 +199,11 @@ std::vector<std::vector<std::uint32_t>> traceLoops(const std::vector<DirectedEdg
     return a;
   };
 
-  std::vector<char> used(edges.size(), 0);
-  std::vector<std::vector<std::uint32_t>> loops;
+  Small<char> used(edges.size(), 0);
+  LoopList loops;
   for (std::size_t start : order) {
     if (used[start]) continue;
-    std::vector<std::uint32_t> loop{edges[start].from};
+    Small<std::uint32_t> loop{edges[start].from};
     used[start] = 1;
     std::size_t current = start;
     for (std::size_t guard = 0;; ++guard) {
@@ -233,11 +237,10 @@ std::vector<std::vector<std::uint32_t>> traceLoops(const std::vector<DirectedEdg
 /// rounded area is zero (its points collapsed by rounding) stays a polygon of its own: it is
 /// needed to keep the piece closed, and welding identical points removes it later.
 template <class PointOf>
-std::vector<PiecePolygon> groupLoops(std::vector<std::vector<std::uint32_t>> loops,
-                                     const PointOf& points, const Vec3& normal,
-                                     FaceOrigin origin) {
+Small<PiecePolygon, 2> groupLoops(const LoopList& loops, const PointOf& points,
+                                  const Vec3& normal, FaceOrigin origin) {
   const Vec3 n = normal.normalized();
-  std::vector<double> area(loops.size());
+  Small<double, 4> area(loops.size());
   for (std::size_t k = 0; k < loops.size(); ++k) {
     const auto& loop = loops[k];
     const Vec3& c = points(loop[0]);
@@ -246,12 +249,12 @@ std::vector<PiecePolygon> groupLoops(std::vector<std::vector<std::uint32_t>> loo
       a += (points(loop[i]) - c).cross(points(loop[i + 1]) - c);
     area[k] = 0.5 * a.dot(n);
   }
-  std::vector<std::size_t> outers, holes;
+  Small<std::size_t, 4> outers, holes;
   for (std::size_t k = 0; k < loops.size(); ++k) {
     if (loops[k].size() < 3) continue;
     (area[k] >= 0 ? outers : holes).push_back(k);
   }
-  std::vector<PiecePolygon> polygons(outers.size());
+  Small<PiecePolygon, 2> polygons(outers.size());
   for (std::size_t i = 0; i < outers.size(); ++i) {
     polygons[i].vertices.assign(loops[outers[i]].begin(), loops[outers[i]].end());
     polygons[i].loopEnd = {static_cast<std::uint32_t>(loops[outers[i]].size())};
@@ -300,7 +303,7 @@ void PlaneSplitter::splitPolygon(const PiecePolygon& polygon, const SplitPlane& 
     std::uint32_t v;
     int side;
   };
-  std::vector<std::vector<Corner>> loops(polygon.numLoops());
+  Small<Small<Corner>, 2> loops(polygon.numLoops());
   for (std::size_t k = 0; k < polygon.numLoops(); ++k) {
     const std::size_t begin = polygon.loopBegin(k), end = polygon.loopEnd[k];
     for (std::size_t i = begin; i < end; ++i) {
@@ -353,9 +356,9 @@ void PlaneSplitter::splitPolygon(const PiecePolygon& polygon, const SplitPlane& 
 
   // 3. Points on L, and parity toggles where the boundary crosses L (a run of on-L corners
   //    entered from one side and left to the other).
-  std::vector<std::pair<double, std::uint32_t>> onLine;
-  std::vector<std::uint32_t> toggles;  // ids of the points where the boundary crosses L
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> alongLine;  // boundary edges on L
+  Small<std::pair<double, std::uint32_t>> onLine;
+  Small<std::uint32_t> toggles;  // ids of the points where the boundary crosses L
+  Small<std::pair<std::uint32_t, std::uint32_t>> alongLine;  // boundary edges on L
   for (const auto& loop : loops) {
     const std::size_t m = loop.size();
     std::size_t start = m;
@@ -417,7 +420,7 @@ void PlaneSplitter::splitPolygon(const PiecePolygon& polygon, const SplitPlane& 
   std::sort(alongLine.begin(), alongLine.end());
 
   // 4. Directed edges of each side: boundary pieces plus closing segments along L.
-  std::vector<DirectedEdge> minusEdges, plusEdges;
+  EdgeList minusEdges, plusEdges;
   for (const auto& loop : loops) {
     const std::size_t m = loop.size();
     for (std::size_t i = 0; i < m; ++i) {
@@ -475,7 +478,7 @@ PieceSplit PlaneSplitter::split(Piece piece, const SplitPlane& plane, FaceOrigin
 
   // Caps: the minus side's edges in the plane that have no reverse within the minus side.
   // Each such edge use as (undirected key, +1 if it runs from the lower id), summed per key.
-  std::vector<std::pair<std::uint64_t, int>> inPlane;
+  Small<std::pair<std::uint64_t, int>, 32> inPlane;
   for (const PiecePolygon& polygon : out.minus) {
     for (std::size_t k = 0; k < polygon.numLoops(); ++k) {
       const std::size_t begin = polygon.loopBegin(k), end = polygon.loopEnd[k];
@@ -488,7 +491,7 @@ PieceSplit PlaneSplitter::split(Piece piece, const SplitPlane& plane, FaceOrigin
     }
   }
   std::sort(inPlane.begin(), inPlane.end());
-  std::vector<DirectedEdge> capEdges;
+  EdgeList capEdges;
   for (std::size_t i = 0; i < inPlane.size();) {
     const std::uint64_t key = inPlane[i].first;
     int net = 0;
