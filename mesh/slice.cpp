@@ -16,6 +16,7 @@
 
 #include <boost/container/small_vector.hpp>
 #include <tbb/concurrent_vector.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
 #include <tbb/parallel_sort.h>
@@ -55,7 +56,15 @@ class Slicer {
 
   void run(Piece solid) {
     totalCells_ = static_cast<double>(grid_.cells[0]) * grid_.cells[1] * grid_.cells[2];
-    leaves_ = recurse(std::move(solid), {0, 0, 0}, grid_.cells);
+    recurse(std::move(solid), {0, 0, 0}, grid_.cells);
+    std::size_t count = 0;
+    for (const std::vector<Leaf>& list : threadLeaves_) count += list.size();
+    leaves_.reserve(count);
+    for (std::vector<Leaf>& list : threadLeaves_) {
+      leaves_.insert(leaves_.end(), std::make_move_iterator(list.begin()),
+                     std::make_move_iterator(list.end()));
+      std::vector<Leaf>().swap(list);
+    }
     // Deterministic order whatever the schedule: by cell, then by piece within the cell.
     tbb::parallel_sort(leaves_.begin(), leaves_.end(), [](const Leaf& a, const Leaf& b) {
       return std::tie(a.cell[2], a.cell[1], a.cell[0], a.part) <
@@ -446,7 +455,9 @@ class Slicer {
   /// Pieces with more polygons than this are split into two tasks.
   static constexpr std::size_t kParallelPolygons = 512;
 
-  std::vector<Leaf> recurse(Piece piece, std::array<int, 3> lo, std::array<int, 3> hi) {
+  /// Splits `piece` (the part of the solid in cells lo .. hi - 1) down to single cells, whose
+  /// connected pieces go to this thread's list of leaves (their order is fixed by run()).
+  void recurse(Piece piece, std::array<int, 3> lo, std::array<int, 3> hi) {
     for (int axis = 0; axis < 3; ++axis) {
       if (hi[axis] - lo[axis] <= 1) continue;
       const int mid = (lo[axis] + hi[axis]) / 2;
@@ -458,33 +469,29 @@ class Slicer {
       std::array<int, 3> hiMinus = hi, loPlus = lo;
       hiMinus[axis] = mid;
       loPlus[axis] = mid;
-      std::vector<Leaf> minus, plus;
       auto doMinus = [&] {
         if (s.minus.empty()) reportDone(lo, hiMinus);
-        else minus = recurse(std::move(s.minus), lo, hiMinus);
+        else recurse(std::move(s.minus), lo, hiMinus);
       };
       auto doPlus = [&] {
         if (s.plus.empty()) reportDone(loPlus, hi);
-        else plus = recurse(std::move(s.plus), loPlus, hi);
+        else recurse(std::move(s.plus), loPlus, hi);
       };
       if (s.minus.size() + s.plus.size() > kParallelPolygons) tbb::parallel_invoke(doMinus, doPlus);
       else {
         doMinus();
         doPlus();
       }
-      if (minus.empty()) return plus;
-      minus.insert(minus.end(), std::make_move_iterator(plus.begin()),
-                   std::make_move_iterator(plus.end()));
-      return minus;
+      return;
     }
     ++leafCells_;
     std::vector<Piece> parts = PlaneSplitter::components(std::move(piece));
     if (parts.size() > 1) ++multiPieceCells_;
-    std::vector<Leaf> leaves;
+    std::vector<Leaf>& leaves = threadLeaves_.local();
     for (std::size_t i = 0; i < parts.size(); ++i) leaves.push_back({std::move(parts[i]), lo, i});
     reportDone(lo, hi);
-    return leaves;
   }
+
 
   void reportDone(const std::array<int, 3>& lo, const std::array<int, 3>& hi) {
     if (!progress_) return;
@@ -495,6 +502,7 @@ class Slicer {
 
   const Grid& grid_;
   std::unique_ptr<PlaneSplitter> splitter_;
+  tbb::enumerable_thread_specific<std::vector<Leaf>> threadLeaves_;  ///< leaves, per thread
   const ProgressFn& progress_;
   std::vector<Leaf> leaves_;
   double totalCells_ = 1.0;
