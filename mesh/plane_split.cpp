@@ -68,6 +68,12 @@ PlaneSplitter::PlaneSplitter(const std::vector<Vec3>& points) {
   for (const Vec3& p : points) records_.push_back({p, kNoPlane, 0, 0});
 }
 
+void PlaneSplitter::reserve(std::size_t points) {
+  records_.reserve(points);
+  edgePoints_.rehash(points);
+  byPosition_.rehash(points);
+}
+
 std::vector<Vec3> PlaneSplitter::points() const {
   std::vector<Vec3> out;
   out.reserve(records_.size());

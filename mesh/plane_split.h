@@ -66,6 +66,10 @@ class PlaneSplitter {
  public:
   explicit PlaneSplitter(const std::vector<Vec3>& points);
 
+  /// Sizes the point array and the tables of shared points for about `points` points in all
+  /// (a hint: they grow as needed either way, but growing them costs time).
+  void reserve(std::size_t points);
+
   std::size_t numPoints() const { return records_.size(); }
   const Vec3& point(std::uint32_t v) const { return records_[v].position; }
   /// A copy of all points, in id order.

@@ -76,6 +76,9 @@ class Slicer {
     stats.multiPieceCells = multiPieceCells_;
   }
 
+  /// Sizes the splitter for about `points` points.
+  void reserve(std::size_t points) { splitter_->reserve(points); }
+
   PolyMesh build(std::vector<std::array<int, 3>>* elementCell) {
     const std::vector<Vec3> points = splitter_->points();
     // The splitter's maps of shared points (hundreds of thousands of nodes) are not needed any
@@ -513,6 +516,31 @@ class Slicer {
 
 }  // namespace
 
+namespace {
+
+/// About how many points slicing `surface` with `grid` makes, to size the splitter's tables:
+/// the surface's vertices, a grid node per cell inside, a point where a surface edge crosses a
+/// grid plane, and one where a grid line crosses the surface (the projected areas over a
+/// cell face). At most 2^22: beyond that the tables grow as they go.
+std::size_t expectedPoints(const TriangleSurface& surface, const Grid& grid) {
+  const double h = grid.cellSize;
+  double crossings = 0.0, lines = 0.0;
+  for (const auto& t : surface.triangles) {
+    const Vec3& a = surface.vertices[t[0]];
+    const Vec3& b = surface.vertices[t[1]];
+    const Vec3& c = surface.vertices[t[2]];
+    // Each edge is shared by two triangles: half of it here.
+    crossings += 0.5 * ((b - a).cwiseAbs().sum() + (c - b).cwiseAbs().sum() +
+                        (a - c).cwiseAbs().sum()) / h;
+    lines += 0.5 * (b - a).cross(c - a).cwiseAbs().sum() / (h * h);
+  }
+  const double inside = std::abs(enclosedVolume(surface)) / (h * h * h);
+  const double total = static_cast<double>(surface.vertices.size()) + inside + crossings + lines;
+  return static_cast<std::size_t>(std::min(total, double(1 << 22)));
+}
+
+}  // namespace
+
 PolyMesh sliceSurface(const TriangleSurface& surface, const Grid& grid, SliceStats* stats,
                       std::vector<std::array<int, 3>>* elementCell, const ProgressFn& progress) {
   Piece solid;
@@ -527,6 +555,7 @@ PolyMesh sliceSurface(const TriangleSurface& surface, const Grid& grid, SliceSta
   }
   const auto start = std::chrono::steady_clock::now();
   Slicer slicer(grid, surface.vertices, progress);
+  slicer.reserve(expectedPoints(surface, grid));
   slicer.run(std::move(solid));
   const auto split = std::chrono::steady_clock::now();
   if (elementCell) elementCell->clear();
