@@ -1,10 +1,12 @@
 // polydg mesh: a surface file in, a polyhedral DG simulation mesh (VTU) out, checked
 // geometrically and by the element-local DG checks (degree 1).
 #include <chrono>
+#include <exception>
 #include <iostream>
 #include <optional>
 
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 #include <tbb/task_group.h>
 
 #include "cli/commands.h"
@@ -43,7 +45,8 @@ struct DgOutcome {
 
 /// Checks every element except whole grid cells, of which one stands for all: they are
 /// congruent boxes bounded by exact axis-aligned squares, so their local equations are the
-/// same up to translation (the geometric validation still covers each one).
+/// same up to translation (the geometric validation still covers each one). Moments are
+/// computed for the checked elements and their neighbours only.
 DgOutcome runDgChecks(const PolyMesh& mesh) {
   const auto t0 = std::chrono::steady_clock::now();
   LocalDgCheckOptions options;
@@ -59,10 +62,8 @@ DgOutcome runDgChecks(const PolyMesh& mesh) {
       options.only[e] = 1;
       break;
     }
-  MomentCache moments(mesh, 2 * options.basis.degree);
-  moments.update();
   DgOutcome out;
-  out.check = localDgChecks(mesh, moments, options);
+  out.check = localDgChecksOfSelection(mesh, options);
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return out;
 }
@@ -132,6 +133,7 @@ void addMeshCommand(CLI::App& app, const CommonOptions& common, int& exitCode) {
     options.cellsAlongLongest = o->cells;
     options.repair = o->repair;
     options.sliverTau = o->sliverTau;
+    options.validate = false;  // below, beside the writing
     ProgressBar bar("slicing", common.quiet);
     options.progress = [&bar](double f) { bar.update(f); };
     MeshingResult result;
@@ -141,28 +143,38 @@ void addMeshCommand(CLI::App& app, const CommonOptions& common, int& exitCode) {
       throw UserError(o->input + ": " + e.what());
     }
     bar.finish();
-    // The DG checks need a geometrically valid mesh (faces shared properly). They and the
-    // file writing only read the mesh, so they run side by side: the writer's serial part
-    // (formatting and I/O) overlaps the checks' parallel loops.
+    // The file is written (whatever the checks find: a failed check exits 1 with the file
+    // there to look at) while the mesh is validated and DG-checked, the three side by side:
+    // they only read the mesh, and the writer's serial part (formatting and I/O) fills the
+    // gaps of the checks' parallel loops. The DG checks presume a geometrically valid mesh
+    // (faces shared properly), so their outcome counts only if the validation passed.
     result.report.timings.insert(result.report.timings.begin(), {"read", readSeconds});
     std::optional<DgOutcome> dg;
     double writeSeconds = 0.0;
-    const bool checkDg = !o->skipDg && result.report.validation.passed;
     tbb::task_group tasks;
     tasks.run([&] {
       const auto writeStart = std::chrono::steady_clock::now();
       writeVtu(result.mesh, o->output);
       writeSeconds = secondsSince(writeStart);
     });
-    if (checkDg) {
-      try {
-        dg = runDgChecks(result.mesh);
-      } catch (...) {
-        tasks.wait();
-        throw;
-      }
+    std::exception_ptr dgFailure;
+    try {
+      tbb::parallel_invoke([&] { validateMeshing(result); },
+                           [&] {
+                             if (o->skipDg) return;
+                             try {
+                               dg = runDgChecks(result.mesh);
+                             } catch (...) {
+                               dgFailure = std::current_exception();
+                             }
+                           });
+    } catch (...) {
+      tasks.wait();
+      throw;
     }
     tasks.wait();
+    if (!result.report.validation.passed) dg.reset();
+    else if (dgFailure) std::rethrow_exception(dgFailure);
     // Phase times as measured; they overlap, so "total" adds up more than the wall time.
     if (dg) result.report.timings.emplace_back("dg_checks", dg->seconds);
     result.report.timings.emplace_back("write", writeSeconds);

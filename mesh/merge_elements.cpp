@@ -13,8 +13,45 @@ namespace polydg {
 
 PolyMesh mergeElements(const PolyMesh& mesh, const std::vector<std::uint32_t>& group,
                        std::size_t groups) {
-  PolyMesh out = mesh;
-  out.mergeElementGroups(group, groups);
+  if (group.size() != mesh.numElements())
+    throw std::invalid_argument("mergeElements: one group per element is needed");
+  const std::size_t nf = mesh.numFaces();
+  auto inside = [&](const Face& face) {
+    return face.front.valid() && face.back.valid() &&
+           group[face.front.index()] == group[face.back.index()];
+  };
+  // Kept faces numbered in order: counts per block, running starts, then ids (in parallel).
+  constexpr std::size_t kBlock = 8192;
+  const std::size_t blocks = (nf + kBlock - 1) / kBlock;
+  std::vector<std::size_t> blockStart(blocks + 1, 0);
+  tbb::parallel_for(std::size_t(0), blocks, [&](std::size_t b) {
+    for (std::size_t f = b * kBlock; f < std::min(nf, (b + 1) * kBlock); ++f)
+      blockStart[b + 1] += !inside(mesh.face(FaceId(f)));
+  });
+  for (std::size_t b = 0; b < blocks; ++b) blockStart[b + 1] += blockStart[b];
+  std::vector<FaceId> newId(nf);
+  FaceData<Face> faces(blockStart[blocks]);
+  auto regrouped = [&](ElementId e) { return e.valid() ? ElementId(group[e.index()]) : e; };
+  tbb::parallel_for(std::size_t(0), blocks, [&](std::size_t b) {
+    std::size_t next = blockStart[b];
+    for (std::size_t f = b * kBlock; f < std::min(nf, (b + 1) * kBlock); ++f) {
+      const Face& face = mesh.face(FaceId(f));
+      if (inside(face)) continue;
+      newId[f] = FaceId(next);
+      Face& kept = faces[FaceId(next++)];
+      kept = face;
+      kept.front = regrouped(face.front);
+      kept.back = regrouped(face.back);
+    }
+  });
+  // Each group's face uses: its members' in element order (a short serial pass).
+  ElementData<Element> elements(groups);
+  for (std::size_t e = 0; e < mesh.numElements(); ++e)
+    for (const FaceUse& use : mesh.element(ElementId(e)).faces)
+      if (newId[use.face.index()].valid())
+        elements[ElementId(group[e])].faces.push_back({newId[use.face.index()], use.reversed});
+  PolyMesh out;
+  out.assign(mesh.positions(), std::move(faces), std::move(elements));
   return out;
 }
 
@@ -50,25 +87,30 @@ PolyMesh mergeSlivers(PolyMesh mesh, double volumeThreshold, SliverMergeReport* 
     while (parent[i] != i) i = parent[i] = parent[parent[i]];
     return i;
   };
-  // Members of each current group, to find its neighbours.
+  // Members of each group that took in another (a group never merged is its element alone).
   std::vector<std::vector<std::size_t>> members(n);
-  for (std::size_t e = 0; e < n; ++e) members[e] = {e};
 
   SliverMergeReport r;
   r.threshold = volumeThreshold;
-  std::vector<std::size_t> order(n);
-  std::iota(order.begin(), order.end(), 0);
+  // Only slivers start merging (volumes only grow), smallest first.
+  std::vector<std::size_t> order;
+  for (std::size_t e = 0; e < n; ++e)
+    if (volume[e] < volumeThreshold) order.push_back(e);
   std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
     return volume[a] != volume[b] ? volume[a] < volume[b] : a < b;
   });
-  for (std::size_t e : order) r.slivers += volume[e] < volumeThreshold;
+  r.slivers = order.size();
+  auto membersOf = [&](std::size_t g) -> std::vector<std::size_t>& {
+    if (members[g].empty()) members[g].push_back(g);
+    return members[g];
+  };
 
   for (std::size_t e : order) {
     std::size_t g = find(e);
     while (volume[g] < volumeThreshold) {
       // Shared area with each neighbouring group.
       std::map<std::size_t, double> shared;
-      for (std::size_t m : members[g])
+      for (std::size_t m : membersOf(g))
         for (const FaceUse& use : mesh.element(ElementId(m)).faces) {
           const Face& face = mesh.face(use.face);
           if (!face.front.valid() || !face.back.valid()) continue;
@@ -76,7 +118,7 @@ PolyMesh mergeSlivers(PolyMesh mesh, double volumeThreshold, SliverMergeReport* 
           if (other != g) shared[other] += faceArea(use.face.index());
         }
       if (shared.empty()) {
-        if (members[g].size() == 1) ++r.isolated;
+        if (membersOf(g).size() == 1) ++r.isolated;
         break;
       }
       const auto best = std::max_element(shared.begin(), shared.end(), [](auto& a, auto& b) {
@@ -85,7 +127,9 @@ PolyMesh mergeSlivers(PolyMesh mesh, double volumeThreshold, SliverMergeReport* 
       const std::size_t target = best->first;
       parent[g] = target;
       volume[target] += volume[g];
-      members[target].insert(members[target].end(), members[g].begin(), members[g].end());
+      std::vector<std::size_t>& into = membersOf(target);
+      const std::vector<std::size_t>& from = membersOf(g);
+      into.insert(into.end(), from.begin(), from.end());
       members[g].clear();
       ++r.merged;
       g = target;
@@ -100,9 +144,9 @@ PolyMesh mergeSlivers(PolyMesh mesh, double volumeThreshold, SliverMergeReport* 
     if (label[root] == 0xffffffffu) label[root] = groups++;
     r.group[e] = label[root];
   }
-  if (groups != n) mesh.mergeElementGroups(r.group, groups);
+  PolyMesh out = groups == n ? std::move(mesh) : mergeElements(mesh, r.group, groups);
   if (report) *report = std::move(r);
-  return mesh;
+  return out;
 }
 
 }  // namespace polydg

@@ -11,7 +11,8 @@ namespace polydg {
 
 /// A new mesh in which the elements of each group form one element: `group[e]` is element e's
 /// group, 0 .. groups-1, and new element g is group g. Faces between members of a group are
-/// removed; all other faces are kept as they are. Vertices are kept (same ids).
+/// removed; all other faces are kept as they are, in their order. Vertices are kept (same ids).
+/// The same mesh as PolyMesh::mergeElementGroups on a copy, built in parallel.
 PolyMesh mergeElements(const PolyMesh& mesh, const std::vector<std::uint32_t>& group,
                        std::size_t groups);
 

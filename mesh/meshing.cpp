@@ -2,9 +2,11 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_reduce.h>
+#include <tbb/task_group.h>
 
 #include <chrono>
 #include <cmath>
+#include <exception>
 #include <sstream>
 
 #include "mesh/surface_repair.h"
@@ -93,20 +95,103 @@ bool isConvex(const PolyMesh& mesh, ElementId e, double relativeTolerance) {
   return true;
 }
 
-MeshingResult meshSurface(const TriangleSurface& input, const MeshingOptions& options) {
-  MeshingResult result;
-  MeshingReport& r = result.report;
-  PhaseTimer timer(r.timings);
-  if (input.triangles.empty()) throw InputError("the surface has no triangles");
+namespace {
 
-  TriangleSurface surface = input;
-  SurfaceDiagnosis d = diagnose(surface);
+/// The input part of the report from the diagnosis of the surface as read.
+void recordDiagnosis(const TriangleSurface& input, const SurfaceDiagnosis& d, MeshingReport& r) {
   r.inputVertices = input.vertices.size();
   r.inputTriangles = input.triangles.size();
   r.inputClosed = d.topology.closed();
   r.inputManifold = d.manifold();
   r.selfIntersections = d.selfIntersections;
   r.selfIntersectionsChecked = d.checkedSelfIntersections;
+}
+
+/// Orients a closed manifold surface, slices it with the grid of `cellSize` and merges slivers
+/// into `result`, timing the phases "orient", "slice" and "merge_slivers".
+void orientAndSlice(const TriangleSurface& closed, double cellSize, const MeshingOptions& options,
+                    MeshingResult& result, PhaseTimer& timer) {
+  MeshingReport& r = result.report;
+  bool reoriented = false;
+  const TriangleSurface surface = orientToBoundVolume(closed, reoriented, &r.shells, &r.cavities);
+  if (reoriented) r.repairs.push_back("re-oriented the surface to bound its volume outward");
+  r.inputVolume = enclosedVolume(surface);
+  if (!(r.inputVolume > 0)) throw InputError("the surface encloses no volume");
+  timer.done("orient");
+
+  r.grid = Grid::covering(bounds(surface), cellSize);
+  PolyMesh sliced = sliceSurface(surface, r.grid, &r.slice, nullptr, options.progress);
+  timer.done("slice");
+
+  if (options.sliverTau > 0) {
+    SliverMergeReport merge;
+    result.mesh = mergeSlivers(std::move(sliced), options.sliverTau * r.grid.cellVolume(), &merge);
+    r.slivers = {merge.threshold, merge.slivers, merge.merged, merge.isolated};
+  } else {
+    result.mesh = std::move(sliced);
+  }
+  timer.done("merge_slivers");
+}
+
+/// meshSurface() for a surface closed edge by edge without degenerate triangles, the usual
+/// input: the self-intersection test (the costly, serial part of the diagnosis) runs while the
+/// surface is oriented and sliced. The result, if the test finds no defect; otherwise nothing
+/// (the slicing is dropped, and the caller repairs or refuses the surface from `d`).
+std::optional<MeshingResult> meshWhileDiagnosing(const TriangleSurface& input,
+                                                 const MeshingOptions& options,
+                                                 SurfaceDiagnosis& d) {
+  MeshingResult result;
+  PhaseTimer timer(result.report.timings);
+  double checkSeconds = 0.0;
+  tbb::task_group diagnosis;
+  diagnosis.run([&] {
+    const auto start = std::chrono::steady_clock::now();
+    d = diagnose(input);
+    checkSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  });
+  std::exception_ptr failure;  // of the slicing; it matters only if the surface is sound
+  try {
+    orientAndSlice(input, cellSizeFor(bounds(input), options), options, result, timer);
+  } catch (...) {
+    failure = std::current_exception();
+  }
+  diagnosis.wait();
+  if (broken(d)) return std::nullopt;
+  if (failure) std::rethrow_exception(failure);
+  recordDiagnosis(input, d, result.report);
+  // Measured beside the other phases: "total" then adds up more than the wall time.
+  result.report.timings.insert(result.report.timings.begin(), {"check", checkSeconds});
+  return result;
+}
+
+}  // namespace
+
+MeshingResult meshSurface(const TriangleSurface& input, const MeshingOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  auto finish = [&](MeshingResult& result) {
+    result.report.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (options.validate) validateMeshing(result);
+  };
+  if (input.triangles.empty()) throw InputError("the surface has no triangles");
+  SurfaceDiagnosis d;
+  bool diagnosed = false;
+  const SurfaceTopology topology = analyzeTopology(input);
+  if (topology.boundaryEdges == 0 && topology.nonManifoldEdges == 0 &&
+      topology.degenerateTriangles == 0) {
+    if (std::optional<MeshingResult> done = meshWhileDiagnosing(input, options, d)) {
+      finish(*done);
+      return std::move(*done);
+    }
+    diagnosed = true;
+  }
+
+  MeshingResult result;
+  MeshingReport& r = result.report;
+  PhaseTimer timer(r.timings);
+  TriangleSurface surface = input;
+  if (!diagnosed) d = diagnose(surface);
+  recordDiagnosis(input, d, r);
   if (d.topology.degenerateTriangles > 0) {
     const std::size_t removed = removeDegenerateTriangles(surface);
     if (surface.triangles.empty())
@@ -159,26 +244,14 @@ MeshingResult meshSurface(const TriangleSurface& input, const MeshingOptions& op
     timer.done("repair");
   }
 
-  bool reoriented = false;
-  surface = orientToBoundVolume(surface, reoriented, &r.shells, &r.cavities);
-  if (reoriented) r.repairs.push_back("re-oriented the surface to bound its volume outward");
-  r.inputVolume = enclosedVolume(surface);
-  if (!(r.inputVolume > 0)) throw InputError("the surface encloses no volume");
-  timer.done("orient");
+  orientAndSlice(surface, cellSize, options, result, timer);
+  finish(result);
+  return result;
+}
 
-  r.grid = Grid::covering(bounds(surface), cellSize);
-  PolyMesh sliced = sliceSurface(surface, r.grid, &r.slice, nullptr, options.progress);
-  timer.done("slice");
-
-  if (options.sliverTau > 0) {
-    SliverMergeReport merge;
-    result.mesh = mergeSlivers(std::move(sliced), options.sliverTau * r.grid.cellVolume(), &merge);
-    r.slivers = {merge.threshold, merge.slivers, merge.merged, merge.isolated};
-  } else {
-    result.mesh = std::move(sliced);
-  }
-  timer.done("merge_slivers");
-
+void validateMeshing(MeshingResult& result) {
+  const auto start = std::chrono::steady_clock::now();
+  MeshingReport& r = result.report;
   const PolyMesh& mesh = result.mesh;
   r.validation = validate(mesh);
   r.elements = mesh.numElements();
@@ -203,8 +276,10 @@ MeshingResult meshSurface(const TriangleSurface& input, const MeshingOptions& op
   r.hexahedra = counts.first;
   r.nonconvex = counts.second;
   r.polyhedra = r.elements - r.hexahedra;
-  timer.done("validate");
-  return result;
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  r.timings.emplace_back("validate", seconds);
+  r.seconds += seconds;
 }
 
 }  // namespace polydg

@@ -31,6 +31,10 @@ struct MeshingOptions {
   /// leaving nearly every boundary element as sliced. 0 disables merging.
   double sliverTau = 0.01;
   ProgressFn progress;
+  /// Validate the result and count its shapes at the end of meshSurface(). A caller that
+  /// overlaps that work with something else (writing the mesh) turns this off and calls
+  /// validateMeshing() itself.
+  bool validate = true;
 };
 
 struct MeshingReport {
@@ -56,8 +60,11 @@ struct MeshingReport {
   double volumeRelError = 0.0;
   ValidationReport validation;
 
-  // Wall time per phase, seconds.
+  // Wall time per phase, seconds. Phases may overlap (the check runs beside the slicing of a
+  // closed surface), so they can add up to more than `seconds`.
   std::vector<std::pair<std::string, double>> timings;
+  /// Wall time of meshSurface() and validateMeshing() together, seconds.
+  double seconds = 0.0;
 };
 
 struct MeshingResult {
@@ -68,6 +75,11 @@ struct MeshingResult {
 /// Runs the pipeline on a surface as read from a file. Throws InputError for input it refuses
 /// (open, non-manifold or self-intersecting without a repair mode; empty; a repair that failed).
 MeshingResult meshSurface(const TriangleSurface& surface, const MeshingOptions& options);
+
+/// The geometric validation of `result.mesh` and the output part of its report (elements,
+/// faces, volume and its error, hexahedra, polyhedra, non-convex), timed as phase "validate".
+/// meshSurface() ends with it unless MeshingOptions::validate is false.
+void validateMeshing(MeshingResult& result);
 
 /// True for an element that is a whole grid cell: six faces, each a single quadrilateral with
 /// an exactly axis-aligned normal. All such elements of one grid are congruent boxes.

@@ -37,6 +37,12 @@ struct DirectedEdge {
   std::uint32_t from, to;
 };
 
+// Scratch containers of one split: most hold a handful of entries, kept inline (no allocation).
+template <class T, std::size_t N = 16>
+using Small = boost::container::small_vector<T, N>;
+using EdgeList = Small<DirectedEdge>;
+using LoopList = Small<Small<std::uint32_t>, 2>;
+
 /// Exact point-in-loop test in 2D: 1 inside, 0 outside, -1 on the boundary.
 int locate(const Point2& p, const std::vector<Point2>& loop) {
   bool inside = false;
@@ -60,6 +66,12 @@ int locate(const Point2& p, const std::vector<Point2>& loop) {
 PlaneSplitter::PlaneSplitter(const std::vector<Vec3>& points) {
   records_.reserve(2 * points.size());
   for (const Vec3& p : points) records_.push_back({p, kNoPlane, 0, 0});
+}
+
+void PlaneSplitter::reserve(std::size_t points) {
+  records_.reserve(points);
+  edgePoints_.rehash(points);
+  byPosition_.rehash(points);
 }
 
 std::vector<Vec3> PlaneSplitter::points() const {
@@ -119,7 +131,6 @@ std::uint32_t PlaneSplitter::edgePoint(std::uint32_t u, std::uint32_t v, const S
   decltype(edgePoints_)::accessor edge;
   if (!edgePoints_.insert(edge, EdgeKey{std::min(u, v), std::max(u, v), plane.id}))
     return edge->second;  // made already (we held no lock while another thread made it)
-  planes_.insert({plane.id, plane});
   const Vec3 p = records_[a].position, q = records_[b].position;
   Vec3 r;
   if (plane.axis >= 0) {
@@ -148,6 +159,11 @@ std::uint32_t PlaneSplitter::edgePoint(std::uint32_t u, std::uint32_t v, const S
   return id;
 }
 
+void PlaneSplitter::rememberPlane(const SplitPlane& plane) {
+  decltype(planes_)::const_accessor known;
+  if (!planes_.find(known, plane.id)) planes_.insert({plane.id, plane});
+}
+
 Vec3 PlaneSplitter::polygonNormal(const PiecePolygon& polygon) const {
   const Vec3& c = point(polygon.vertices.front());
   Vec3 n = Vec3::Zero();
@@ -167,10 +183,8 @@ namespace {
 /// the first one clockwise from the reversed incoming edge, so the region to the left of each
 /// loop is a proper face (the loops at a pinch are kept apart). `normal` orients the plane.
 template <class PointOf>
-std::vector<std::vector<std::uint32_t>> traceLoops(const std::vector<DirectedEdge>& edges,
-                                                   const PointOf& points,
-                                                   const Vec3& normal) {
-  std::vector<std::size_t> order(edges.size());
+LoopList traceLoops(const EdgeList& edges, const PointOf& points, const Vec3& normal) {
+  Small<std::size_t> order(edges.size());
   std::iota(order.begin(), order.end(), 0);
   std::sort(order.begin(), order.end(),
             [&](std::size_t i, std::size_t j) { return edges[i].from < edges[j].from; });
@@ -191,11 +205,11 @@ std::vector<std::vector<std::uint32_t>> traceLoops(const std::vector<DirectedEdg
     return a;
   };
 
-  std::vector<char> used(edges.size(), 0);
-  std::vector<std::vector<std::uint32_t>> loops;
+  Small<char> used(edges.size(), 0);
+  LoopList loops;
   for (std::size_t start : order) {
     if (used[start]) continue;
-    std::vector<std::uint32_t> loop{edges[start].from};
+    Small<std::uint32_t> loop{edges[start].from};
     used[start] = 1;
     std::size_t current = start;
     for (std::size_t guard = 0;; ++guard) {
@@ -229,11 +243,10 @@ std::vector<std::vector<std::uint32_t>> traceLoops(const std::vector<DirectedEdg
 /// rounded area is zero (its points collapsed by rounding) stays a polygon of its own: it is
 /// needed to keep the piece closed, and welding identical points removes it later.
 template <class PointOf>
-std::vector<PiecePolygon> groupLoops(std::vector<std::vector<std::uint32_t>> loops,
-                                     const PointOf& points, const Vec3& normal,
-                                     FaceOrigin origin) {
+Small<PiecePolygon, 2> groupLoops(const LoopList& loops, const PointOf& points,
+                                  const Vec3& normal, FaceOrigin origin) {
   const Vec3 n = normal.normalized();
-  std::vector<double> area(loops.size());
+  Small<double, 4> area(loops.size());
   for (std::size_t k = 0; k < loops.size(); ++k) {
     const auto& loop = loops[k];
     const Vec3& c = points(loop[0]);
@@ -242,12 +255,12 @@ std::vector<PiecePolygon> groupLoops(std::vector<std::vector<std::uint32_t>> loo
       a += (points(loop[i]) - c).cross(points(loop[i + 1]) - c);
     area[k] = 0.5 * a.dot(n);
   }
-  std::vector<std::size_t> outers, holes;
+  Small<std::size_t, 4> outers, holes;
   for (std::size_t k = 0; k < loops.size(); ++k) {
     if (loops[k].size() < 3) continue;
     (area[k] >= 0 ? outers : holes).push_back(k);
   }
-  std::vector<PiecePolygon> polygons(outers.size());
+  Small<PiecePolygon, 2> polygons(outers.size());
   for (std::size_t i = 0; i < outers.size(); ++i) {
     polygons[i].vertices.assign(loops[outers[i]].begin(), loops[outers[i]].end());
     polygons[i].loopEnd = {static_cast<std::uint32_t>(loops[outers[i]].size())};
@@ -296,7 +309,7 @@ void PlaneSplitter::splitPolygon(const PiecePolygon& polygon, const SplitPlane& 
     std::uint32_t v;
     int side;
   };
-  std::vector<std::vector<Corner>> loops(polygon.numLoops());
+  Small<Small<Corner>, 2> loops(polygon.numLoops());
   for (std::size_t k = 0; k < polygon.numLoops(); ++k) {
     const std::size_t begin = polygon.loopBegin(k), end = polygon.loopEnd[k];
     for (std::size_t i = begin; i < end; ++i) {
@@ -349,9 +362,9 @@ void PlaneSplitter::splitPolygon(const PiecePolygon& polygon, const SplitPlane& 
 
   // 3. Points on L, and parity toggles where the boundary crosses L (a run of on-L corners
   //    entered from one side and left to the other).
-  std::vector<std::pair<double, std::uint32_t>> onLine;
-  std::vector<std::uint32_t> toggles;  // ids of the points where the boundary crosses L
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> alongLine;  // boundary edges on L
+  Small<std::pair<double, std::uint32_t>> onLine;
+  Small<std::uint32_t> toggles;  // ids of the points where the boundary crosses L
+  Small<std::pair<std::uint32_t, std::uint32_t>> alongLine;  // boundary edges on L
   for (const auto& loop : loops) {
     const std::size_t m = loop.size();
     std::size_t start = m;
@@ -413,7 +426,7 @@ void PlaneSplitter::splitPolygon(const PiecePolygon& polygon, const SplitPlane& 
   std::sort(alongLine.begin(), alongLine.end());
 
   // 4. Directed edges of each side: boundary pieces plus closing segments along L.
-  std::vector<DirectedEdge> minusEdges, plusEdges;
+  EdgeList minusEdges, plusEdges;
   for (const auto& loop : loops) {
     const std::size_t m = loop.size();
     for (std::size_t i = 0; i < m; ++i) {
@@ -462,6 +475,7 @@ PieceSplit PlaneSplitter::split(Piece piece, const SplitPlane& plane, FaceOrigin
       (polygonNormal(polygon).dot(plane.normal) > 0 ? out.minus : out.plus)
           .push_back(std::move(polygon));
     else {
+      if (out.polygonsSplit == 0) rememberPlane(plane);
       splitPolygon(polygon, plane, out.minus, out.plus);
       ++out.polygonsSplit;
     }
@@ -469,7 +483,8 @@ PieceSplit PlaneSplitter::split(Piece piece, const SplitPlane& plane, FaceOrigin
   if (out.minus.empty() || out.plus.empty()) return out;
 
   // Caps: the minus side's edges in the plane that have no reverse within the minus side.
-  std::unordered_map<std::uint64_t, int> balance;
+  // Each such edge use as (undirected key, +1 if it runs from the lower id), summed per key.
+  Small<std::pair<std::uint64_t, int>, 32> inPlane;
   for (const PiecePolygon& polygon : out.minus) {
     for (std::size_t k = 0; k < polygon.numLoops(); ++k) {
       const std::size_t begin = polygon.loopBegin(k), end = polygon.loopEnd[k];
@@ -477,16 +492,19 @@ PieceSplit PlaneSplitter::split(Piece piece, const SplitPlane& plane, FaceOrigin
         const std::uint32_t a = polygon.vertices[i];
         const std::uint32_t b = polygon.vertices[i + 1 == end ? begin : i + 1];
         if (side(a, plane) != 0 || side(b, plane) != 0) continue;
-        const std::uint64_t key = std::uint64_t(std::min(a, b)) << 32 | std::max(a, b);
-        balance[key] += a < b ? 1 : -1;
+        inPlane.emplace_back(std::uint64_t(std::min(a, b)) << 32 | std::max(a, b), a < b ? 1 : -1);
       }
     }
   }
-  std::vector<DirectedEdge> capEdges;
-  for (const auto& [key, net] : balance) {
+  std::sort(inPlane.begin(), inPlane.end());
+  EdgeList capEdges;
+  for (std::size_t i = 0; i < inPlane.size();) {
+    const std::uint64_t key = inPlane[i].first;
+    int net = 0;
+    for (; i < inPlane.size() && inPlane[i].first == key; ++i) net += inPlane[i].second;
     const auto lo = static_cast<std::uint32_t>(key >> 32);
     const auto hi = static_cast<std::uint32_t>(key & 0xffffffffu);
-    for (int i = 0; i < std::abs(net); ++i)
+    for (int j = 0; j < std::abs(net); ++j)
       capEdges.push_back(net > 0 ? DirectedEdge{hi, lo} : DirectedEdge{lo, hi});
   }
   if (capEdges.empty()) return out;
@@ -505,13 +523,15 @@ PieceSplit PlaneSplitter::split(Piece piece, const SplitPlane& plane, FaceOrigin
 
 std::vector<Piece> PlaneSplitter::components(Piece piece) {
   const std::size_t n = piece.size();
-  std::vector<std::size_t> parent(n);
-  std::iota(parent.begin(), parent.end(), 0);
-  auto find = [&](std::size_t i) {
+  std::vector<std::uint32_t> parent(n);
+  std::iota(parent.begin(), parent.end(), 0u);
+  auto find = [&](std::uint32_t i) {
     while (parent[i] != i) i = parent[i] = parent[parent[i]];
     return i;
   };
-  std::unordered_map<std::uint64_t, std::size_t> firstUse;
+  // Every edge with the polygon that uses it, sorted by edge: polygons on a run of equal edges
+  // are joined. Most pieces are a few dozen polygons, so the list lives on the stack.
+  boost::container::small_vector<std::pair<std::uint64_t, std::uint32_t>, 64> uses;
   for (std::size_t p = 0; p < n; ++p) {
     const PiecePolygon& polygon = piece[p];
     for (std::size_t k = 0; k < polygon.numLoops(); ++k) {
@@ -519,18 +539,35 @@ std::vector<Piece> PlaneSplitter::components(Piece piece) {
       for (std::size_t i = begin; i < end; ++i) {
         const std::uint32_t a = polygon.vertices[i];
         const std::uint32_t b = polygon.vertices[i + 1 == end ? begin : i + 1];
-        const std::uint64_t key = std::uint64_t(std::min(a, b)) << 32 | std::max(a, b);
-        auto [it, inserted] = firstUse.try_emplace(key, p);
-        if (!inserted) parent[find(p)] = find(it->second);
+        uses.emplace_back(std::uint64_t(std::min(a, b)) << 32 | std::max(a, b),
+                          static_cast<std::uint32_t>(p));
       }
     }
   }
+  std::sort(uses.begin(), uses.end());
+  for (std::size_t i = 1; i < uses.size(); ++i)
+    if (uses[i].first == uses[i - 1].first) parent[find(uses[i].second)] = find(uses[i - 1].second);
+  // Components in order of their first polygon, polygons in their order within the piece.
+  const std::uint32_t firstRoot = n ? find(0) : 0;
+  bool connected = true;
+  for (std::uint32_t p = 1; p < n && connected; ++p) connected = find(p) == firstRoot;
+  if (connected) {
+    std::vector<Piece> one;
+    if (n) one.push_back(std::move(piece));
+    // A piece kept as a leaf should not hold the room reserved for its parent's polygons.
+    if (n && one[0].capacity() > 2 * n) one[0].shrink_to_fit();
+    return one;
+  }
+  constexpr std::uint32_t kUnset = 0xffffffffu;
+  std::vector<std::uint32_t> index(n, kUnset);
   std::vector<Piece> out;
-  std::unordered_map<std::size_t, std::size_t> index;
   for (std::size_t p = 0; p < n; ++p) {
-    auto [it, inserted] = index.try_emplace(find(p), out.size());
-    if (inserted) out.emplace_back();
-    out[it->second].push_back(std::move(piece[p]));
+    std::uint32_t& slot = index[find(static_cast<std::uint32_t>(p))];
+    if (slot == kUnset) {
+      slot = static_cast<std::uint32_t>(out.size());
+      out.emplace_back();
+    }
+    out[slot].push_back(std::move(piece[p]));
   }
   return out;
 }

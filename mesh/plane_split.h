@@ -66,6 +66,10 @@ class PlaneSplitter {
  public:
   explicit PlaneSplitter(const std::vector<Vec3>& points);
 
+  /// Sizes the point array and the tables of shared points for about `points` points in all
+  /// (a hint: they grow as needed either way, but growing them costs time).
+  void reserve(std::size_t points);
+
   std::size_t numPoints() const { return records_.size(); }
   const Vec3& point(std::uint32_t v) const { return records_[v].position; }
   /// A copy of all points, in id order.
@@ -88,6 +92,8 @@ class PlaneSplitter {
   static constexpr std::uint32_t kNoPlane = 0xffffffffu;
 
   std::uint32_t edgePoint(std::uint32_t u, std::uint32_t v, const SplitPlane& plane);
+  /// Records `plane` under its id (for compareExactly) before points are made on it.
+  void rememberPlane(const SplitPlane& plane);
   void splitPolygon(const PiecePolygon& polygon, const SplitPlane& plane, Piece& minus,
                     Piece& plus);
   Vec3 polygonNormal(const PiecePolygon& polygon) const;

@@ -9,16 +9,18 @@
 #include <tuple>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <stdexcept>
-#include <unordered_map>
 
 #include "mesh/plane_split.h"
 
 #include <boost/container/small_vector.hpp>
 #include <tbb/concurrent_vector.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
 #include <tbb/parallel_sort.h>
+#include <tbb/task_group.h>
 
 namespace polydg {
 
@@ -49,13 +51,22 @@ namespace {
 class Slicer {
  public:
   Slicer(const Grid& grid, std::vector<Vec3> points, const ProgressFn& progress)
-      : grid_(grid), splitter_(std::move(points)), progress_(progress) {}
+      : grid_(grid), splitter_(std::make_unique<PlaneSplitter>(std::move(points))),
+        progress_(progress) {}
 
   void run(Piece solid) {
     totalCells_ = static_cast<double>(grid_.cells[0]) * grid_.cells[1] * grid_.cells[2];
-    leaves_ = recurse(std::move(solid), {0, 0, 0}, grid_.cells);
+    recurse(std::move(solid), {0, 0, 0}, grid_.cells);
+    std::size_t count = 0;
+    for (const std::vector<Leaf>& list : threadLeaves_) count += list.size();
+    leaves_.reserve(count);
+    for (std::vector<Leaf>& list : threadLeaves_) {
+      leaves_.insert(leaves_.end(), std::make_move_iterator(list.begin()),
+                     std::make_move_iterator(list.end()));
+      std::vector<Leaf>().swap(list);
+    }
     // Deterministic order whatever the schedule: by cell, then by piece within the cell.
-    std::sort(leaves_.begin(), leaves_.end(), [](const Leaf& a, const Leaf& b) {
+    tbb::parallel_sort(leaves_.begin(), leaves_.end(), [](const Leaf& a, const Leaf& b) {
       return std::tie(a.cell[2], a.cell[1], a.cell[0], a.part) <
              std::tie(b.cell[2], b.cell[1], b.cell[0], b.part);
     });
@@ -65,8 +76,15 @@ class Slicer {
     stats.multiPieceCells = multiPieceCells_;
   }
 
+  /// Sizes the splitter for about `points` points.
+  void reserve(std::size_t points) { splitter_->reserve(points); }
+
   PolyMesh build(std::vector<std::array<int, 3>>* elementCell) {
-    const std::vector<Vec3> points = splitter_.points();
+    const std::vector<Vec3> points = splitter_->points();
+    // The splitter's maps of shared points (hundreds of thousands of nodes) are not needed any
+    // more: they are freed beside the build, not after it.
+    tbb::task_group release;
+    release.run([this] { splitter_.reset(); });
     // Points closer than the resolution of the coordinates are one point: 8 units in the last
     // place of the largest coordinate, in every coordinate. Such points are intersections that
     // are the same point mathematically but were built along different paths (or a surface
@@ -103,26 +121,50 @@ class Slicer {
     }
     auto vertexOf = [&](std::uint32_t v) { return VertexId(vertexOfRank[rank[v]]); };
 
-    // Each leaf's polygons as faces on the welded vertices (in parallel), with the vertex-set
-    // key of the caps (interior faces), which are shared with the neighbouring cell's leaf.
+    // Each leaf's polygons on the welded vertices (in parallel), with the vertex-set key of the
+    // caps (interior faces), which are shared with the neighbouring cell's leaf. Polygons are
+    // numbered across all leaves (polygon i of leaf l is polygonBase[l] + i) and kept in flat
+    // arrays (WeldedPolygons): a Face is made only for each face of the mesh.
     const std::size_t nl = leaves_.size();
-    std::vector<std::vector<Face>> faces(nl);
-    std::vector<std::vector<std::uint64_t>> keys(nl);
+    std::vector<std::uint32_t> polygonBase(nl + 1, 0);
+    std::vector<std::size_t> cornerBase(nl + 1, 0), loopBase(nl + 1, 0);
+    tbb::parallel_for(std::size_t(0), nl, [&](std::size_t l) {
+      std::size_t corners = 0, loops = 0;
+      for (const PiecePolygon& polygon : leaves_[l].piece) {
+        corners += polygon.vertices.size();
+        loops += polygon.numLoops();
+      }
+      polygonBase[l + 1] = static_cast<std::uint32_t>(leaves_[l].piece.size());
+      cornerBase[l + 1] = corners;
+      loopBase[l + 1] = loops;
+    });
+    for (std::size_t l = 0; l < nl; ++l) {
+      polygonBase[l + 1] += polygonBase[l];
+      cornerBase[l + 1] += cornerBase[l];
+      loopBase[l + 1] += loopBase[l];
+    }
+    const std::size_t np = polygonBase[nl];
+    WeldedPolygons welded(np, cornerBase[nl], loopBase[nl]);
+    std::vector<char> kept(np, 0);
+    std::vector<std::uint64_t> keys(np, 0);
+    std::vector<FaceOrigin> origin(np);
     std::atomic<std::size_t> collapsed{0};
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nl, 64),
                       [&](const tbb::blocked_range<std::size_t>& r) {
       for (std::size_t l = r.begin(); l != r.end(); ++l) {
-        for (const PiecePolygon& polygon : leaves_[l].piece) {
-          Face face;
-          if (!weldPolygon(polygon, vertexOf, face)) {
+        const Piece& piece = leaves_[l].piece;
+        std::size_t corner = cornerBase[l], loop = loopBase[l];
+        for (std::size_t i = 0; i < piece.size(); ++i) {
+          const std::size_t p = polygonBase[l] + i;
+          origin[p] = piece[i].origin;
+          if (!welded.weld(p, corner, loop, piece[i], vertexOf)) {
             ++collapsed;
-            continue;
+          } else {
+            kept[p] = 1;
+            if (origin[p] == FaceOrigin::Interior) keys[p] = vertexSetKey(welded.corners(p));
           }
-          face.origin = polygon.origin;
-          keys[l].push_back(polygon.origin == FaceOrigin::Interior
-                                ? vertexSetKey({face.vertices.data(), face.vertices.size()})
-                                : 0);
-          faces[l].push_back(std::move(face));
+          corner += piece[i].vertices.size();
+          loop += piece[i].numLoops();
         }
       }
     });
@@ -130,54 +172,75 @@ class Slicer {
 
     // Caps meet their other side: the later of two reversed, equal polygons uses the earlier's
     // face (reversed), as findOrCreateFace would in leaf order.
-    const std::vector<std::vector<std::uint32_t>> sharesEarlier = matchCaps(faces, keys);
+    const std::vector<std::uint32_t> sharesEarlier = matchCaps(welded, origin, kept, keys);
 
-    // Ids: elements for leaves that kept a polygon, faces for polygons that are not a later
-    // side, both in leaf order.
+    // Ids: elements for leaves that kept a polygon, faces for kept polygons that are not a
+    // later side, both in leaf order.
     std::vector<std::uint32_t> elementOf(nl, kNone), faceBase(nl + 1, 0);
+    tbb::parallel_for(std::size_t(0), nl, [&](std::size_t l) {
+      std::uint32_t created = 0, any = 0;
+      for (std::size_t p = polygonBase[l]; p < polygonBase[l + 1]; ++p) {
+        any += kept[p];
+        created += kept[p] && sharesEarlier[p] == kNone;
+      }
+      faceBase[l + 1] = created;
+      elementOf[l] = any ? 0 : kNone;
+    });
     std::uint32_t elements = 0;
     for (std::size_t l = 0; l < nl; ++l) {
-      if (!faces[l].empty()) elementOf[l] = elements++;
-      std::uint32_t created = 0;
-      for (std::uint32_t s : sharesEarlier[l]) created += s == kNone;
-      faceBase[l + 1] = faceBase[l] + created;
+      faceBase[l + 1] += faceBase[l];
+      if (elementOf[l] != kNone) elementOf[l] = elements++;
     }
-    std::vector<std::vector<std::uint32_t>> faceId(nl);
+    std::vector<std::uint32_t> faceId(np, kNone);
     FaceData<Face> meshFaces(faceBase[nl]);
     ElementData<Element> meshElements(elements);
     // New faces first (their ids are known per leaf) ...
-    tbb::parallel_for(std::size_t(0), nl, [&](std::size_t l) {
-      std::uint32_t next = faceBase[l];
-      faceId[l].resize(faces[l].size(), kNone);
-      for (std::size_t i = 0; i < faces[l].size(); ++i) {
-        if (sharesEarlier[l][i] != kNone) continue;
-        faceId[l][i] = next;
-        Face& f = meshFaces[FaceId(std::size_t(next++))];
-        f = std::move(faces[l][i]);
-        f.front = ElementId(std::size_t(elementOf[l]));
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nl, 64),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t l = r.begin(); l != r.end(); ++l) {
+        std::uint32_t next = faceBase[l];
+        for (std::size_t p = polygonBase[l]; p < polygonBase[l + 1]; ++p) {
+          if (!kept[p] || sharesEarlier[p] != kNone) continue;
+          faceId[p] = next;
+          Face& f = meshFaces[FaceId(std::size_t(next++))];
+          welded.copyTo(p, f);
+          f.origin = origin[p];
+          f.front = ElementId(std::size_t(elementOf[l]));
+        }
       }
     });
     // ... then the later sides, which take the earlier side's face as its back.
-    tbb::parallel_for(std::size_t(0), nl, [&](std::size_t l) {
-      if (elementOf[l] == kNone) return;
-      const ElementId e(std::size_t(elementOf[l]));
-      FaceList& uses = meshElements[e].faces;
-      for (std::size_t i = 0; i < faces[l].size(); ++i) {
-        const std::uint32_t s = sharesEarlier[l][i];
-        if (s == kNone) {
-          uses.push_back({FaceId(std::size_t(faceId[l][i])), false});
-          continue;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nl, 64),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t l = r.begin(); l != r.end(); ++l) {
+        if (elementOf[l] == kNone) continue;
+        const ElementId e{std::size_t(elementOf[l])};
+        FaceList& uses = meshElements[e].faces;
+        for (std::size_t p = polygonBase[l]; p < polygonBase[l + 1]; ++p) {
+          if (!kept[p]) continue;
+          const std::uint32_t s = sharesEarlier[p];
+          if (s == kNone) {
+            uses.push_back({FaceId(std::size_t(faceId[p])), false});
+            continue;
+          }
+          const FaceId f{static_cast<std::size_t>(faceId[s])};
+          meshFaces[f].back = e;
+          meshFaces[f].origin = FaceOrigin::Interior;
+          uses.push_back({f, true});
         }
-        const std::uint32_t earlierLeaf = matchLeaf_[s], earlierIndex = matchIndex_[s];
-        const FaceId f{static_cast<std::size_t>(faceId[earlierLeaf][earlierIndex])};
-        meshFaces[f].back = e;
-        meshFaces[f].origin = FaceOrigin::Interior;
-        uses.push_back({f, true});
       }
     });
     if (elementCell)
       for (std::size_t l = 0; l < nl; ++l)
         if (elementOf[l] != kNone) elementCell->push_back(leaves_[l].cell);
+    // The leaves are spent: their many small buffers are freed in parallel, not one by one
+    // when the slicer goes.
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nl, 256),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        for (std::size_t l = r.begin(); l != r.end(); ++l)
+                          Piece().swap(leaves_[l].piece);
+                      });
+    release.wait();
     PolyMesh mesh;
     mesh.assign(std::move(positions), std::move(meshFaces), std::move(meshElements));
     return mesh;
@@ -194,15 +257,19 @@ class Slicer {
 
   /// For used point i (in order of first use), the earliest kept point within `resolution`
   /// (in every coordinate) before it, or i itself if there is none: i is then kept. Points are
-  /// bucketed in cells four times the resolution, so a point's search box meets one or two
-  /// cells per axis; the search runs in parallel, the rare welds are resolved in order.
+  /// bucketed in cells 64 times the resolution, offset by half a cell so that grid planes (at
+  /// dyadic multiples of the resolution) run through cell centres, and sorted by cell. A point's
+  /// search box meets
+  /// its own cell, whose earlier points sit just before it in that order, and only rarely (when
+  /// it lies within the resolution of a cell side) a neighbouring cell, found by binary search.
+  /// The search runs in parallel, the rare welds are resolved in order.
   static std::vector<std::uint32_t> weldTargets(const std::vector<Vec3>& points,
                                                 const std::vector<std::uint32_t>& used,
                                                 double resolution) {
     using Cell = std::array<std::int64_t, 3>;
-    const double cellSize = 4.0 * resolution;
+    const double cellSize = 64.0 * resolution;
     auto cellIndex = [&](double x) {
-      return cellSize > 0 ? static_cast<std::int64_t>(std::floor(x / cellSize)) : 0;
+      return cellSize > 0 ? static_cast<std::int64_t>(std::floor(x / cellSize + 0.5)) : 0;
     };
     std::vector<std::pair<Cell, std::uint32_t>> sorted(used.size());
     tbb::parallel_for(std::size_t(0), used.size(), [&](std::size_t i) {
@@ -211,24 +278,42 @@ class Slicer {
                    static_cast<std::uint32_t>(i)};
     });
     tbb::parallel_sort(sorted.begin(), sorted.end());
-    tbb::concurrent_vector<std::pair<std::uint32_t, std::uint32_t>> near;  // (later, earlier)
-    tbb::parallel_for(std::size_t(0), used.size(), [&](std::size_t i) {
-      const Vec3& p = points[used[i]];
-      Cell lo, hi;
-      for (int a = 0; a < 3; ++a) {
-        lo[a] = cellIndex(p[a] - resolution);
-        hi[a] = cellIndex(p[a] + resolution);
-      }
-      for (std::int64_t x = lo[0]; x <= hi[0]; ++x)
-        for (std::int64_t y = lo[1]; y <= hi[1]; ++y)
-          for (std::int64_t z = lo[2]; z <= hi[2]; ++z) {
-            const Cell c{x, y, z};
-            auto it = std::lower_bound(sorted.begin(), sorted.end(), std::make_pair(c, 0u));
-            for (; it != sorted.end() && it->first == c && it->second < i; ++it)
-              if ((points[used[it->second]] - p).cwiseAbs().maxCoeff() <= resolution)
-                near.push_back({static_cast<std::uint32_t>(i), it->second});
-          }
+    std::vector<std::uint32_t> position(used.size());
+    tbb::parallel_for(std::size_t(0), used.size(), [&](std::size_t s) {
+      position[sorted[s].second] = static_cast<std::uint32_t>(s);
     });
+    tbb::concurrent_vector<std::pair<std::uint32_t, std::uint32_t>> near;  // (later, earlier)
+    auto nearPoint = [&](std::size_t i, std::uint32_t j) {
+      if ((points[used[j]] - points[used[i]]).cwiseAbs().maxCoeff() <= resolution)
+        near.push_back({static_cast<std::uint32_t>(i), j});
+    };
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, used.size(), 4096),
+        [&](const tbb::blocked_range<std::size_t>& r) {
+          for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            const Vec3& p = points[used[i]];
+            const std::size_t at = position[i];
+            const Cell& own = sorted[at].first;
+            // Earlier points of the own cell: just before i in the sorted order.
+            for (std::size_t s = at; s > 0 && sorted[s - 1].first == own; --s)
+              nearPoint(i, sorted[s - 1].second);
+            Cell lo, hi;
+            for (int a = 0; a < 3; ++a) {
+              lo[a] = cellIndex(p[a] - resolution);
+              hi[a] = cellIndex(p[a] + resolution);
+            }
+            if (lo == own && hi == own) continue;
+            for (std::int64_t x = lo[0]; x <= hi[0]; ++x)
+              for (std::int64_t y = lo[1]; y <= hi[1]; ++y)
+                for (std::int64_t z = lo[2]; z <= hi[2]; ++z) {
+                  const Cell c{x, y, z};
+                  if (c == own) continue;
+                  auto it = std::lower_bound(sorted.begin(), sorted.end(), std::make_pair(c, 0u));
+                  for (; it != sorted.end() && it->first == c && it->second < i; ++it)
+                    nearPoint(i, it->second);
+                }
+          }
+        });
     std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs(near.begin(), near.end());
     std::sort(pairs.begin(), pairs.end());
     std::vector<std::uint32_t> target(used.size());
@@ -238,126 +323,178 @@ class Slicer {
     return target;
   }
 
-  /// `polygon` on welded vertices into `face` (vertices and loop ends): consecutive repeats
-  /// dropped, loops of fewer than 3 corners removed. False if the outer loop collapsed.
-  template <class VertexOf>
-  static bool weldPolygon(const PiecePolygon& polygon, const VertexOf& vertexOf, Face& face) {
-    auto& vertices = face.vertices;
-    for (std::size_t k = 0; k < polygon.numLoops(); ++k) {
-      const std::size_t begin = vertices.size();
-      for (std::size_t i = polygon.loopBegin(k); i < polygon.loopEnd[k]; ++i) {
-        const VertexId v = vertexOf(polygon.vertices[i]);
-        if (vertices.size() == begin || vertices.back() != v) vertices.push_back(v);
+  /// Polygons on welded vertices, in flat arrays: polygon p's corners (all loops, concatenated)
+  /// start at cornerStart_[p], its loop ends (relative to its first corner) at loopStart_[p].
+  /// The room for each polygon is that of the polygon before welding (welding only drops
+  /// corners and loops), given by the caller.
+  class WeldedPolygons {
+   public:
+    WeldedPolygons(std::size_t polygons, std::size_t corners, std::size_t loops)
+        : cornerStart_(polygons), cornerCount_(polygons, 0), loopStart_(polygons),
+          loopCount_(polygons, 0), corners_(corners), loopEnds_(loops) {}
+
+    /// `polygon` on welded vertices as polygon p, with room from `corner` and `loop` on:
+    /// consecutive repeats dropped, loops of fewer than 3 corners removed. False if the outer
+    /// loop collapsed (the polygon is gone).
+    template <class VertexOf>
+    bool weld(std::size_t p, std::size_t corner, std::size_t loop, const PiecePolygon& polygon,
+              const VertexOf& vertexOf) {
+      cornerStart_[p] = corner;
+      loopStart_[p] = loop;
+      VertexId* out = corners_.data() + corner;
+      std::uint32_t n = 0, loops = 0;
+      for (std::size_t k = 0; k < polygon.numLoops(); ++k) {
+        const std::uint32_t begin = n;
+        for (std::size_t i = polygon.loopBegin(k); i < polygon.loopEnd[k]; ++i) {
+          const VertexId v = vertexOf(polygon.vertices[i]);
+          if (n == begin || out[n - 1] != v) out[n++] = v;
+        }
+        while (n > begin + 1 && out[begin] == out[n - 1]) --n;
+        if (n >= begin + 3) {
+          loopEnds_[loop + loops++] = n;
+        } else {
+          n = begin;
+          if (k == 0) break;  // the outer boundary collapsed: the polygon is gone
+        }
       }
-      while (vertices.size() > begin + 1 && vertices[begin] == vertices.back())
-        vertices.pop_back();
-      if (vertices.size() >= begin + 3) {
-        face.loopEnd.push_back(static_cast<std::uint32_t>(vertices.size()));
-      } else {
-        vertices.resize(begin);
-        if (k == 0) break;  // the outer boundary collapsed: the polygon is gone
-      }
+      cornerCount_[p] = n;
+      loopCount_[p] = loops;
+      return loops > 0;
     }
-    return !face.loopEnd.empty();
+
+    std::span<const VertexId> corners(std::size_t p) const {
+      return {corners_.data() + cornerStart_[p], cornerCount_[p]};
+    }
+    std::span<const std::uint32_t> loopEnds(std::size_t p) const {
+      return {loopEnds_.data() + loopStart_[p], loopCount_[p]};
+    }
+    /// Polygon p's loops into `face` (vertices and loop ends).
+    void copyTo(std::size_t p, Face& face) const {
+      const auto c = corners(p);
+      const auto e = loopEnds(p);
+      face.vertices.assign(c.begin(), c.end());
+      face.loopEnd.assign(e.begin(), e.end());
+    }
+
+   private:
+    std::vector<std::size_t> cornerStart_;
+    std::vector<std::uint32_t> cornerCount_;
+    std::vector<std::size_t> loopStart_;
+    std::vector<std::uint32_t> loopCount_;
+    std::vector<VertexId> corners_;
+    std::vector<std::uint32_t> loopEnds_;
+  };
+
+  /// True if polygon b is polygon a reversed (isReverseOf), checked without allocating for
+  /// the common case of one loop: the same cycle, traversed the other way, from any start.
+  static bool isReversedPolygon(const WeldedPolygons& welded, std::size_t a, std::size_t b) {
+    const auto x = welded.corners(a), y = welded.corners(b);
+    if (welded.loopEnds(a).size() != 1 || welded.loopEnds(b).size() != 1) {
+      Face face;
+      welded.copyTo(a, face);
+      return isReverseOf(face, y, welded.loopEnds(b));
+    }
+    const std::size_t n = x.size();
+    if (y.size() != n) return false;
+    for (std::size_t j = 0; j < n; ++j) {  // every start (a pinched loop repeats a vertex)
+      if (y[j] != x[0]) continue;
+      std::size_t i = 1;
+      while (i < n && x[i] == y[(j + n - i) % n]) ++i;
+      if (i == n) return true;
+    }
+    return false;
   }
 
-  /// For each polygon of each leaf: kNone, or the index (into matchLeaf_/matchIndex_) of the
-  /// earlier cap whose face it shares. Caps are grouped by vertex-set key (sorted in parallel);
-  /// within a group, in leaf order, a cap takes the first earlier open cap that is its
-  /// reverse, and that cap is then closed.
-  std::vector<std::vector<std::uint32_t>> matchCaps(const std::vector<std::vector<Face>>& faces,
-                                                    const std::vector<std::vector<std::uint64_t>>& keys) {
+  /// For each polygon (numbered across leaves): kNone, or the number of the earlier cap whose
+  /// face it shares. Kept caps are grouped by vertex-set key (sorted in parallel); within a
+  /// group, in leaf order, a cap takes the first earlier open cap that is its reverse, and that
+  /// cap is then closed.
+  static std::vector<std::uint32_t> matchCaps(const WeldedPolygons& welded,
+                                              const std::vector<FaceOrigin>& origin,
+                                              const std::vector<char>& kept,
+                                              const std::vector<std::uint64_t>& keys) {
     constexpr std::uint32_t kNone = 0xffffffffu;
-    struct Cap {
-      std::uint64_t key;
-      std::uint32_t leaf, index;
-      bool operator<(const Cap& o) const {
-        return std::tie(key, leaf, index) < std::tie(o.key, o.leaf, o.index);
-      }
-    };
-    std::vector<Cap> caps;
-    std::vector<std::vector<std::uint32_t>> shares(faces.size());
-    for (std::size_t l = 0; l < faces.size(); ++l) {
-      shares[l].assign(faces[l].size(), kNone);
-      for (std::size_t i = 0; i < faces[l].size(); ++i)
-        if (faces[l][i].origin == FaceOrigin::Interior)
-          caps.push_back({keys[l][i], static_cast<std::uint32_t>(l), static_cast<std::uint32_t>(i)});
-    }
+    const std::size_t np = kept.size();
+    auto isCap = [&](std::size_t p) { return kept[p] && origin[p] == FaceOrigin::Interior; };
+    // Caps in polygon order (that is, leaf order), gathered in parallel blocks.
+    constexpr std::size_t kBlock = 16384;
+    const std::size_t blocks = (np + kBlock - 1) / kBlock;
+    std::vector<std::size_t> blockBase(blocks + 1, 0);
+    tbb::parallel_for(std::size_t(0), blocks, [&](std::size_t b) {
+      std::size_t count = 0;
+      for (std::size_t p = b * kBlock; p < std::min(np, (b + 1) * kBlock); ++p) count += isCap(p);
+      blockBase[b + 1] = count;
+    });
+    for (std::size_t b = 0; b < blocks; ++b) blockBase[b + 1] += blockBase[b];
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> caps(blockBase[blocks]);  // (key, p)
+    tbb::parallel_for(std::size_t(0), blocks, [&](std::size_t b) {
+      std::size_t next = blockBase[b];
+      for (std::size_t p = b * kBlock; p < std::min(np, (b + 1) * kBlock); ++p)
+        if (isCap(p)) caps[next++] = {keys[p], static_cast<std::uint32_t>(p)};
+    });
     tbb::parallel_sort(caps.begin(), caps.end());
-    matchLeaf_.resize(caps.size());
-    matchIndex_.resize(caps.size());
-    for (std::size_t c = 0; c < caps.size(); ++c) {
-      matchLeaf_[c] = caps[c].leaf;
-      matchIndex_[c] = caps[c].index;
-    }
-    std::vector<std::size_t> groupStart;
+    std::vector<std::uint32_t> groupStart;
     for (std::size_t c = 0; c < caps.size(); ++c)
-      if (c == 0 || caps[c].key != caps[c - 1].key) groupStart.push_back(c);
-    groupStart.push_back(caps.size());
+      if (c == 0 || caps[c].first != caps[c - 1].first) groupStart.push_back(static_cast<std::uint32_t>(c));
+    groupStart.push_back(static_cast<std::uint32_t>(caps.size()));
+    std::vector<std::uint32_t> shares(np, kNone);
     tbb::parallel_for(std::size_t(0), groupStart.size() - 1, [&](std::size_t g) {
-      boost::container::small_vector<std::size_t, 4> open;
+      boost::container::small_vector<std::uint32_t, 4> open;
       for (std::size_t c = groupStart[g]; c < groupStart[g + 1]; ++c) {
-        const Face& face = faces[caps[c].leaf][caps[c].index];
-        const std::span<const VertexId> vs(face.vertices.data(), face.vertices.size());
-        const std::span<const std::uint32_t> ends(face.loopEnd.data(), face.loopEnd.size());
-        auto match = std::find_if(open.begin(), open.end(), [&](std::size_t o) {
-          return isReverseOf(faces[caps[o].leaf][caps[o].index], vs, ends);
+        auto match = std::find_if(open.begin(), open.end(), [&](std::uint32_t o) {
+          return isReversedPolygon(welded, o, caps[c].second);
         });
         if (match != open.end()) {
-          shares[caps[c].leaf][caps[c].index] = static_cast<std::uint32_t>(*match);
+          shares[caps[c].second] = *match;
           open.erase(match);
         } else {
-          open.push_back(c);
+          open.push_back(caps[c].second);
         }
       }
     });
     return shares;
   }
 
-  std::vector<std::uint32_t> matchLeaf_, matchIndex_;  ///< leaf and polygon of each cap
-
   /// Pieces with more polygons than this are split into two tasks.
   static constexpr std::size_t kParallelPolygons = 512;
 
-  std::vector<Leaf> recurse(Piece piece, std::array<int, 3> lo, std::array<int, 3> hi) {
+  /// Splits `piece` (the part of the solid in cells lo .. hi - 1) down to single cells, whose
+  /// connected pieces go to this thread's list of leaves (their order is fixed by run()).
+  void recurse(Piece piece, std::array<int, 3> lo, std::array<int, 3> hi) {
     for (int axis = 0; axis < 3; ++axis) {
       if (hi[axis] - lo[axis] <= 1) continue;
       const int mid = (lo[axis] + hi[axis]) / 2;
       const auto id = static_cast<std::uint32_t>(axis * ((1 << 20) + 1) + mid);
       const SplitPlane plane = SplitPlane::axisAligned(axis, grid_.plane(axis, mid), id);
-      PieceSplit s = splitter_.split(std::move(piece), plane, FaceOrigin::Interior);
+      PieceSplit s = splitter_->split(std::move(piece), plane, FaceOrigin::Interior);
       ++splits_;
       polygonsSplit_ += s.polygonsSplit;
       std::array<int, 3> hiMinus = hi, loPlus = lo;
       hiMinus[axis] = mid;
       loPlus[axis] = mid;
-      std::vector<Leaf> minus, plus;
       auto doMinus = [&] {
         if (s.minus.empty()) reportDone(lo, hiMinus);
-        else minus = recurse(std::move(s.minus), lo, hiMinus);
+        else recurse(std::move(s.minus), lo, hiMinus);
       };
       auto doPlus = [&] {
         if (s.plus.empty()) reportDone(loPlus, hi);
-        else plus = recurse(std::move(s.plus), loPlus, hi);
+        else recurse(std::move(s.plus), loPlus, hi);
       };
       if (s.minus.size() + s.plus.size() > kParallelPolygons) tbb::parallel_invoke(doMinus, doPlus);
       else {
         doMinus();
         doPlus();
       }
-      if (minus.empty()) return plus;
-      minus.insert(minus.end(), std::make_move_iterator(plus.begin()),
-                   std::make_move_iterator(plus.end()));
-      return minus;
+      return;
     }
     ++leafCells_;
     std::vector<Piece> parts = PlaneSplitter::components(std::move(piece));
     if (parts.size() > 1) ++multiPieceCells_;
-    std::vector<Leaf> leaves;
+    std::vector<Leaf>& leaves = threadLeaves_.local();
     for (std::size_t i = 0; i < parts.size(); ++i) leaves.push_back({std::move(parts[i]), lo, i});
     reportDone(lo, hi);
-    return leaves;
   }
+
 
   void reportDone(const std::array<int, 3>& lo, const std::array<int, 3>& hi) {
     if (!progress_) return;
@@ -367,7 +504,8 @@ class Slicer {
   }
 
   const Grid& grid_;
-  PlaneSplitter splitter_;
+  std::unique_ptr<PlaneSplitter> splitter_;
+  tbb::enumerable_thread_specific<std::vector<Leaf>> threadLeaves_;  ///< leaves, per thread
   const ProgressFn& progress_;
   std::vector<Leaf> leaves_;
   double totalCells_ = 1.0;
@@ -375,6 +513,31 @@ class Slicer {
   std::mutex progressMutex_;
   std::atomic<std::size_t> splits_{0}, polygonsSplit_{0}, leafCells_{0}, multiPieceCells_{0};
 };
+
+}  // namespace
+
+namespace {
+
+/// About how many points slicing `surface` with `grid` makes, to size the splitter's tables:
+/// the surface's vertices, a grid node per cell inside, a point where a surface edge crosses a
+/// grid plane, and one where a grid line crosses the surface (the projected areas over a
+/// cell face). At most 2^22: beyond that the tables grow as they go.
+std::size_t expectedPoints(const TriangleSurface& surface, const Grid& grid) {
+  const double h = grid.cellSize;
+  double crossings = 0.0, lines = 0.0;
+  for (const auto& t : surface.triangles) {
+    const Vec3& a = surface.vertices[t[0]];
+    const Vec3& b = surface.vertices[t[1]];
+    const Vec3& c = surface.vertices[t[2]];
+    // Each edge is shared by two triangles: half of it here.
+    crossings += 0.5 * ((b - a).cwiseAbs().sum() + (c - b).cwiseAbs().sum() +
+                        (a - c).cwiseAbs().sum()) / h;
+    lines += 0.5 * (b - a).cross(c - a).cwiseAbs().sum() / (h * h);
+  }
+  const double inside = std::abs(enclosedVolume(surface)) / (h * h * h);
+  const double total = static_cast<double>(surface.vertices.size()) + inside + crossings + lines;
+  return static_cast<std::size_t>(std::min(total, double(1 << 22)));
+}
 
 }  // namespace
 
@@ -392,6 +555,7 @@ PolyMesh sliceSurface(const TriangleSurface& surface, const Grid& grid, SliceSta
   }
   const auto start = std::chrono::steady_clock::now();
   Slicer slicer(grid, surface.vertices, progress);
+  slicer.reserve(expectedPoints(surface, grid));
   slicer.run(std::move(solid));
   const auto split = std::chrono::steady_clock::now();
   if (elementCell) elementCell->clear();

@@ -311,13 +311,14 @@ std::vector<Vec3> toVec3(const std::vector<Point>& points) {
   return out;
 }
 
-/// The whitespace-separated words of `line`.
-std::vector<std::string_view> words(std::string_view line) {
-  std::vector<std::string_view> out;
+/// The space-separated words of `line`, into `out` (cleared first, so that one buffer serves
+/// every line of a file).
+void splitWords(std::string_view line, std::vector<std::string_view>& out) {
+  out.clear();
   std::size_t i = 0;
   while (true) {
     while (i < line.size() && line[i] == ' ') ++i;
-    if (i == line.size()) return out;
+    if (i == line.size()) return;
     const std::size_t start = i;
     while (i < line.size() && line[i] != ' ') ++i;
     out.push_back(line.substr(start, i - start));
@@ -345,20 +346,23 @@ std::variant<ObjScan, Reason> scanObj(const std::string& path) {
   ObjScan scan;
   scan.text.reserve(text.size());
   std::string material;  // the default material until the first usemtl
+  bool materialCounted = false;  // `material` is in scan.materials already
   std::size_t lineNumber = 0;
+  std::string line;  // one buffer for every line
+  std::vector<std::string_view> w;  // and one for its words
   for (std::size_t begin = 0; begin < text.size();) {
     std::size_t end = text.find('\n', begin);
     if (end == std::string::npos) end = text.size();
-    std::string line = text.substr(begin, end - begin);
+    line.assign(text, begin, end - begin);
     begin = end + 1;
     ++lineNumber;
-    const std::string where = "line " + std::to_string(lineNumber) + ": ";
+    const auto where = [&] { return "line " + std::to_string(lineNumber) + ": "; };
     for (char& c : line)
       if (c == '\t' || c == '\r' || c == '\v' || c == '\f') c = ' ';
     if (const std::size_t hash = line.find('#'); hash != std::string::npos) line.resize(hash);
     while (!line.empty() && line.back() == ' ') line.pop_back();
-    if (!line.empty() && line.back() == '\\') return where + "line continuation";
-    const std::vector<std::string_view> w = words(line);
+    if (!line.empty() && line.back() == '\\') return where() + "line continuation";
+    splitWords(line, w);
     if (w.empty()) {
       scan.text += '\n';
       continue;
@@ -370,14 +374,15 @@ std::variant<ObjScan, Reason> scanObj(const std::string& path) {
         const std::string weight(w[4]);
         char* stop = nullptr;
         const double value = std::strtod(weight.c_str(), &stop);
-        if (*stop != '\0' || value != 1.0) return where + "homogeneous vertex (w != 1)";
+        if (*stop != '\0' || value != 1.0) return where() + "homogeneous vertex (w != 1)";
       }
       scan.text += line;
     } else if (keyword == "f" && w.size() == 1) {
       // An empty face, which assimp skips too; CGAL would keep it as a face of no corners.
     } else if (keyword == "f") {
       ++scan.faces;
-      scan.materials.insert(material);
+      if (!materialCounted) scan.materials.insert(material);
+      materialCounted = true;
       std::string face = "f";
       for (std::size_t k = 1; k < w.size(); ++k) {
         // An index: [+-]digits, optionally followed by /texture/normal.
@@ -390,7 +395,7 @@ std::variant<ObjScan, Reason> scanObj(const std::string& path) {
         if (digits == first || digits - first > 9 ||
             (digits < token.size() && token[digits] != '/') ||
             number.find_first_not_of("+-0") == std::string_view::npos)
-          return where + "face index '" + std::string(token) + "' is not a nonzero integer";
+          return where() + "face index '" + std::string(token) + "' is not a nonzero integer";
         face += ' ';
         face += number;
       }
@@ -405,6 +410,7 @@ std::variant<ObjScan, Reason> scanObj(const std::string& path) {
       if (keyword == "usemtl") {
         const std::size_t start = line.find("usemtl") + 6;
         material = line.substr(std::min(line.size(), line.find_first_not_of(' ', start)));
+        materialCounted = false;
       }
       scan.text += line;
     }

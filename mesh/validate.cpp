@@ -5,6 +5,7 @@
 
 #include <boost/container/small_vector.hpp>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
 #include <cstdio>
 #include <limits>
 #include <map>
@@ -255,26 +256,27 @@ ValidationReport validate(const PolyMesh& mesh, const ValidationOptions& options
     }
   }
   // Duplicates: faces with equal vertex-set hashes, confirmed by comparing the sets.
-  std::vector<std::size_t> byKey(mesh.numFaces());
-  std::iota(byKey.begin(), byKey.end(), 0);
-  std::sort(byKey.begin(), byKey.end(), [&](std::size_t a, std::size_t b) {
-    return checks[a].key != checks[b].key ? checks[a].key < checks[b].key : a < b;
-  });
+  // (key, face) pairs sorted in parallel: faces with equal keys end up adjacent, by id.
+  std::vector<std::pair<std::uint64_t, std::size_t>> keyed(mesh.numFaces());
+  tbb::parallel_for(std::size_t(0), mesh.numFaces(),
+                    [&](std::size_t i) { keyed[i] = {checks[i].key, i}; });
+  tbb::parallel_sort(keyed.begin(), keyed.end());
   auto sortedIds = [&](std::size_t f) {
     boost::container::small_vector<VertexId, 8> ids(mesh.face(FaceId(f)).vertices.begin(),
                                                    mesh.face(FaceId(f)).vertices.end());
     std::sort(ids.begin(), ids.end());
     return ids;
   };
-  for (std::size_t a = 0; a < byKey.size();) {
+  for (std::size_t a = 0; a < keyed.size();) {
     std::size_t b = a + 1;
-    while (b < byKey.size() && checks[byKey[b]].key == checks[byKey[a]].key) ++b;
+    while (b < keyed.size() && keyed[b].first == keyed[a].first) ++b;
     for (std::size_t x = a; x < b; ++x)
       for (std::size_t y = x + 1; y < b; ++y)
-        if (sortedIds(byKey[x]) == sortedIds(byKey[y]) &&
-            !areCutSides(mesh, FaceId(byKey[x]), FaceId(byKey[y])))
+        if (sortedIds(keyed[x].second) == sortedIds(keyed[y].second) &&
+            !areCutSides(mesh, FaceId(keyed[x].second), FaceId(keyed[y].second)))
           problems.add(report.duplicateFaces,
-                       "faces " + std::to_string(byKey[x]) + " and " + std::to_string(byKey[y]) +
+                       "faces " + std::to_string(keyed[x].second) + " and " +
+                           std::to_string(keyed[y].second) +
                            " are the same polygon but not shared (a face used by more than two "
                            "elements, or twice with the same orientation)");
     a = b;

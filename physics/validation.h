@@ -160,4 +160,13 @@ struct LocalDgCheck {
 LocalDgCheck localDgChecks(const PolyMesh& mesh, const MomentCache& moments,
                            const LocalDgCheckOptions& options = {});
 
+/// localDgChecks() of the elements selected by `options.only` (one entry per element, not
+/// empty), with moments computed here for those elements and their face neighbours only: the
+/// checks read nothing else. The same checks and the same numbers as localDgChecks() on the
+/// whole mesh (the patch field uses the whole mesh's bounding box; the neighbours keep every
+/// face, so their coupling counts are unchanged), at a cost that grows with the selection, not
+/// the mesh: `polydg mesh` selects the 12% of a sliced sphere's elements that are not whole
+/// grid cells. Element ids in the result refer to `mesh`.
+LocalDgCheck localDgChecksOfSelection(const PolyMesh& mesh, const LocalDgCheckOptions& options);
+
 }  // namespace polydg

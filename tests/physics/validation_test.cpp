@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "mesh/primitives.h"
 #include "mesh/slice.h"
@@ -244,6 +245,50 @@ TEST(PhysicsValidation, LocalChecksFailOnAnInvertedElement) {
   EXPECT_FALSE(c.passed());
   EXPECT_EQ(c.elementsWithWrongRigidModes, 1u);
   EXPECT_EQ(c.firstWrongRigidModeElement, ElementId(0));
+}
+
+/// Every k-th element of `mesh`, starting at `first`.
+std::vector<char> everyKth(const PolyMesh& mesh, std::size_t k, std::size_t first) {
+  std::vector<char> only(mesh.numElements(), 0);
+  for (std::size_t e = first; e < only.size(); e += k) only[e] = 1;
+  return only;
+}
+
+TEST(PhysicsValidation, LocalChecksOfASelectionEqualThoseOnTheWholeMesh) {
+  // Moments of the selection and its neighbours only give the very numbers of the whole mesh.
+  const TriangleSurface sphere = icosphere(Vec3(0.1, -0.2, 0.05), 1.0, 3);
+  const PolyMesh mesh = sliceSurface(sphere, Grid::withCellsAlongLongest(bounds(sphere), 6));
+  ASSERT_GT(mesh.numElements(), 100u);
+  for (int degree : {1, 2}) {
+    MomentCache moments(mesh, 2 * degree);
+    moments.update();
+    LocalDgCheckOptions options;
+    options.basis.degree = degree;
+    options.only = everyKth(mesh, 5, 2);
+    const LocalDgCheck whole = localDgChecks(mesh, moments, options);
+    const LocalDgCheck selection = localDgChecksOfSelection(mesh, options);
+    EXPECT_EQ(selection.elements, whole.elements) << degree;
+    EXPECT_GT(selection.elements, 20u) << degree;
+    EXPECT_EQ(selection.maxPatchTestError, whole.maxPatchTestError) << degree;
+    EXPECT_EQ(selection.worstPatchTestElement, whole.worstPatchTestElement) << degree;
+    EXPECT_TRUE(selection.passed()) << degree;
+  }
+}
+
+TEST(PhysicsValidation, LocalChecksOfASelectionNameTheCorruptedElement) {
+  const PolyMesh grid = hexGridMesh(3, 3, 3, Box3(Vec3::Zero(), Vec3::Ones()));
+  const ElementId bad(13 - 9);  // on the boundary z = 0, in the middle
+  const PolyMesh mesh = withReversedFaces(grid, bad, boundaryFaceOf(grid, bad));
+  LocalDgCheckOptions options;
+  options.only = everyKth(mesh, 2, 0);  // elements 0, 2, 4, ...: 4 is the corrupted one
+  const LocalDgCheck c = localDgChecksOfSelection(mesh, options);
+  EXPECT_EQ(c.elements, 14u);
+  EXPECT_FALSE(c.passed());
+  EXPECT_GT(c.maxPatchTestError, kCorruptionMargin * kLocalPatchTestTolerance);
+  EXPECT_EQ(c.worstPatchTestElement, bad);
+  // Left out, the corrupted element is only a neighbour: its linear trace is still exact.
+  options.only = everyKth(mesh, 2, 1);
+  EXPECT_TRUE(localDgChecksOfSelection(mesh, options).passed());
 }
 
 }  // namespace

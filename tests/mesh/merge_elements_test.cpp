@@ -1,0 +1,103 @@
+// Merging elements: mergeElements builds the same mesh as PolyMesh::mergeElementGroups, and
+// sliver merging keeps a sliced sphere valid and its volume, leaving no sliver that has a
+// neighbour.
+#include "mesh/merge_elements.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "mesh/geometry.h"
+#include "mesh/primitives.h"
+#include "mesh/slice.h"
+#include "mesh/surface_shapes.h"
+#include "mesh/validate.h"
+
+namespace polydg {
+namespace {
+
+/// Relative volume change allowed by merging: only the summation order of the cones changes.
+constexpr double kVolumeTolerance = 1e-12;
+
+void expectSameMesh(const PolyMesh& a, const PolyMesh& b) {
+  ASSERT_EQ(a.numVertices(), b.numVertices());
+  ASSERT_EQ(a.numFaces(), b.numFaces());
+  ASSERT_EQ(a.numElements(), b.numElements());
+  for (std::size_t i = 0; i < a.numFaces(); ++i) {
+    const Face& x = a.face(FaceId(i));
+    const Face& y = b.face(FaceId(i));
+    EXPECT_TRUE(std::equal(x.vertices.begin(), x.vertices.end(), y.vertices.begin(),
+                           y.vertices.end()))
+        << "face " << i;
+    EXPECT_TRUE(std::equal(x.loopEnd.begin(), x.loopEnd.end(), y.loopEnd.begin(), y.loopEnd.end()))
+        << "face " << i;
+    EXPECT_EQ(x.front, y.front) << "face " << i;
+    EXPECT_EQ(x.back, y.back) << "face " << i;
+    EXPECT_EQ(x.origin, y.origin) << "face " << i;
+  }
+  for (std::size_t e = 0; e < a.numElements(); ++e) {
+    const FaceList& x = a.element(ElementId(e)).faces;
+    const FaceList& y = b.element(ElementId(e)).faces;
+    ASSERT_EQ(x.size(), y.size()) << "element " << e;
+    for (std::size_t j = 0; j < x.size(); ++j) {
+      EXPECT_EQ(x[j].face, y[j].face) << "element " << e;
+      EXPECT_EQ(x[j].reversed, y[j].reversed) << "element " << e;
+    }
+  }
+}
+
+TEST(MergeElements, BuildsTheMeshOfMergeElementGroups) {
+  // Grids of 4^3 and 24^3 cells (the larger one has faces for several parallel blocks): a
+  // pair, a triple, and a group of two cells far apart, the others alone.
+  for (int n : {4, 24}) {
+    const PolyMesh grid = hexGridMesh(n, n, n, Box3(Vec3::Zero(), Vec3::Ones()));
+    const std::size_t ne = grid.numElements();
+    std::vector<std::size_t> target(ne);
+    for (std::size_t e = 0; e < ne; ++e) target[e] = e;
+    const auto m = static_cast<std::size_t>(n);
+    target[1] = 0;              // pair (0, 1)
+    target[m + 1] = m;          // triple (n, n + 1, 2n + 1)
+    target[2 * m + 1] = m;
+    target[ne - 1] = 2;         // two cells far apart
+    std::vector<std::uint32_t> group(ne), label(ne, 0xffffffffu);
+    std::uint32_t groups = 0;
+    for (std::size_t e = 0; e < ne; ++e) {
+      const std::size_t root = target[e];
+      if (label[root] == 0xffffffffu) label[root] = groups++;
+      group[e] = label[root];
+    }
+    PolyMesh expected = grid;
+    expected.mergeElementGroups(group, groups);
+    const PolyMesh merged = mergeElements(grid, group, groups);
+    expectSameMesh(merged, expected);
+    EXPECT_EQ(merged.numElements(), ne - 4);
+  }
+}
+
+TEST(MergeElements, SliverMergingKeepsASlicedSphereValid) {
+  const TriangleSurface sphere = icosphere(Vec3(0.013, -0.021, 0.007), 1.0, 4);
+  const Grid grid = Grid::withCellsAlongLongest(bounds(sphere), 10);
+  const PolyMesh sliced = sliceSurface(sphere, grid);
+  const ValidationReport before = validate(sliced);
+  ASSERT_TRUE(before.passed);
+  const double threshold = 0.05 * grid.cellVolume();
+  SliverMergeReport report;
+  const PolyMesh merged = mergeSlivers(sliced, threshold, &report);
+  const ValidationReport after = validate(merged);
+  EXPECT_TRUE(after.passed);
+  EXPECT_GT(report.merged, 0u);
+  EXPECT_LE(report.merged + report.isolated, report.slivers);
+  EXPECT_EQ(merged.numElements(), sliced.numElements() - report.merged);
+  EXPECT_LT(std::abs(after.volume - before.volume) / before.volume, kVolumeTolerance);
+  // No element below the threshold is left with a neighbour.
+  for (std::size_t e = 0; e < merged.numElements(); ++e) {
+    if (signedVolume(merged, ElementId(e)) >= threshold) continue;
+    for (const FaceUse& use : merged.element(ElementId(e)).faces)
+      EXPECT_TRUE(merged.face(use.face).isBoundary()) << "element " << e;
+  }
+}
+
+}  // namespace
+}  // namespace polydg

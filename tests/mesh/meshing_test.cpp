@@ -1,0 +1,102 @@
+// The meshing pipeline (meshSurface): a closed surface is sliced while its self-intersection
+// test runs, and the result is kept only if the test finds nothing; a self-intersecting closed
+// surface is refused (or wrapped with RepairMode::Wrap), an inward one re-oriented, and the
+// report holds the diagnosis and every phase either way.
+#include "mesh/meshing.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "mesh/surface_shapes.h"
+
+namespace polydg {
+namespace {
+
+/// Volume kept by slicing: the exact polyhedral volume up to round-off (issue 3).
+constexpr double kVolumeTolerance = 1e-10;
+
+bool hasPhase(const MeshingReport& r, const std::string& phase) {
+  return std::any_of(r.timings.begin(), r.timings.end(),
+                     [&](const auto& t) { return t.first == phase; });
+}
+
+MeshingOptions cells(int n) {
+  MeshingOptions o;
+  o.cellsAlongLongest = n;
+  return o;
+}
+
+TEST(Meshing, ClosedSurfaceReportsItsDiagnosisAndEveryPhase) {
+  const TriangleSurface sphere = icosphere(Vec3(0.1, 0.2, -0.3), 1.0, 3);
+  const MeshingResult m = meshSurface(sphere, cells(8));
+  const MeshingReport& r = m.report;
+  EXPECT_TRUE(r.validation.passed);
+  EXPECT_EQ(r.inputTriangles, sphere.triangles.size());
+  EXPECT_EQ(r.inputVertices, sphere.vertices.size());
+  EXPECT_TRUE(r.inputClosed);
+  EXPECT_TRUE(r.inputManifold);
+  EXPECT_TRUE(r.selfIntersectionsChecked);
+  EXPECT_EQ(r.selfIntersections, 0u);
+  EXPECT_EQ(r.shells, 1u);
+  EXPECT_TRUE(r.repairs.empty());
+  EXPECT_LT(r.volumeRelError, kVolumeTolerance);
+  for (const char* phase : {"check", "orient", "slice", "merge_slivers", "validate"})
+    EXPECT_TRUE(hasPhase(r, phase)) << phase;
+  // The whole is at least as long as any phase inside it (phases may overlap).
+  for (const auto& [phase, seconds] : r.timings) EXPECT_GE(r.seconds, seconds) << phase;
+}
+
+TEST(Meshing, SelfIntersectingClosedSurfaceIsRefusedOrWrapped) {
+  // Two overlapping spheres: closed and manifold edge by edge, so they are sliced while the
+  // self-intersection test runs; the test's verdict wins.
+  const TriangleSurface overlapping =
+      combine(icosphere(Vec3::Zero(), 1.0, 2), icosphere(Vec3(0.8, 0.0, 0.0), 1.0, 2));
+  try {
+    meshSurface(overlapping, cells(8));
+    ADD_FAILURE() << "a self-intersecting surface was meshed";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("self-intersecting ("), std::string::npos) << e.what();
+  }
+  MeshingOptions wrap = cells(8);
+  wrap.repair = RepairMode::Wrap;
+  const MeshingResult m = meshSurface(overlapping, wrap);
+  EXPECT_TRUE(m.report.validation.passed);
+  EXPECT_GT(m.report.selfIntersections, 0u);
+  ASSERT_FALSE(m.report.repairs.empty());
+  EXPECT_NE(m.report.repairs[0].find("alpha-wrapped"), std::string::npos);
+  EXPECT_LT(m.report.volumeRelError, kVolumeTolerance);
+}
+
+TEST(Meshing, InwardSurfaceIsReorientedAndKeepsItsVolume) {
+  const TriangleSurface sphere = icosphere(Vec3(0.1, 0.2, -0.3), 1.0, 3);
+  const MeshingResult outward = meshSurface(sphere, cells(8));
+  const MeshingResult inward = meshSurface(reversedSurface(sphere), cells(8));
+  EXPECT_TRUE(inward.report.validation.passed);
+  ASSERT_EQ(inward.report.repairs.size(), 1u);
+  EXPECT_NE(inward.report.repairs[0].find("re-oriented"), std::string::npos);
+  EXPECT_EQ(inward.report.elements, outward.report.elements);
+  EXPECT_LT(std::abs(inward.report.outputVolume - outward.report.outputVolume) /
+                outward.report.outputVolume,
+            kVolumeTolerance);
+}
+
+TEST(Meshing, ValidationCanBeLeftToTheCaller) {
+  const TriangleSurface sphere = icosphere(Vec3::Zero(), 1.0, 2);
+  MeshingOptions later = cells(6);
+  later.validate = false;
+  MeshingResult m = meshSurface(sphere, later);
+  EXPECT_FALSE(hasPhase(m.report, "validate"));
+  EXPECT_EQ(m.report.elements, 0u);
+  validateMeshing(m);
+  EXPECT_TRUE(hasPhase(m.report, "validate"));
+  EXPECT_TRUE(m.report.validation.passed);
+  EXPECT_EQ(m.report.elements, m.mesh.numElements());
+  EXPECT_EQ(m.report.hexahedra + m.report.polyhedra, m.report.elements);
+  EXPECT_LT(m.report.volumeRelError, kVolumeTolerance);
+}
+
+}  // namespace
+}  // namespace polydg
