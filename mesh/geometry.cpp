@@ -21,11 +21,14 @@ Vec3 areaVector(const PolyMesh& mesh, FaceId f) {
   return 0.5 * twiceArea;
 }
 
-Vec3 unitNormal(const PolyMesh& mesh, FaceId f) {
-  const Vec3 a = areaVector(mesh, f);
+namespace {
+Vec3 normalized(const Vec3& a) {
   const double norm = a.norm();
   return norm > 0.0 ? Vec3(a / norm) : Vec3::Zero();
 }
+}  // namespace
+
+Vec3 unitNormal(const PolyMesh& mesh, FaceId f) { return normalized(areaVector(mesh, f)); }
 
 Box3 faceBounds(const PolyMesh& mesh, FaceId f) {
   Box3 box;
@@ -44,6 +47,19 @@ Vec3 elementReferencePoint(const PolyMesh& mesh, ElementId e) {
   return 0.5 * (box.min() + box.max());
 }
 
+double signedVolume(const PolyMesh& mesh, ElementId e, const FaceData<Vec3>& areaVectors,
+                    const FaceData<Box3>& faceBoxes) {
+  Box3 box;
+  for (const FaceUse& use : mesh.element(e).faces) box.extend(faceBoxes[use.face]);
+  const Vec3 o = 0.5 * (box.min() + box.max());
+  double threeVolume = 0.0;
+  for (const FaceUse& use : mesh.element(e).faces) {
+    const double h = areaVectors[use.face].dot(faceReferencePoint(mesh, use.face) - o);
+    threeVolume += use.reversed ? -h : h;
+  }
+  return threeVolume / 3.0;
+}
+
 double signedVolume(const PolyMesh& mesh, ElementId e) {
   const Vec3 o = elementReferencePoint(mesh, e);
   // Cone volume = height * area / 3, and a.dot(c - o) = area * height.
@@ -57,8 +73,12 @@ double signedVolume(const PolyMesh& mesh, ElementId e) {
 }
 
 double planarityDeviation(const PolyMesh& mesh, FaceId f) {
+  return planarityDeviation(mesh, f, areaVector(mesh, f));
+}
+
+double planarityDeviation(const PolyMesh& mesh, FaceId f, const Vec3& areaVector) {
   const Face& face = mesh.face(f);
-  const Vec3 n = unitNormal(mesh, f);
+  const Vec3 n = normalized(areaVector);
   const Vec3& c = faceReferencePoint(mesh, f);
   Vec3 mean = Vec3::Zero();
   for (VertexId v : face.vertices) mean += mesh.position(v) - c;

@@ -38,15 +38,20 @@ std::string describe(const char* what, std::size_t index) {
   return std::string(what) + " " + std::to_string(index);
 }
 
-/// Checks a face's loops: each has >= 3 vertices and no vertex appears twice in the face.
-bool isDegenerate(const PolyMesh& mesh, FaceId f) {
+/// Checks a face's loops: each has >= 3 vertices and no vertex appears twice in the face; and
+/// its area vector (`area`, areaVector()) is not zero.
+bool isDegenerate(const PolyMesh& mesh, FaceId f, const Vec3& area) {
   const Face& face = mesh.face(f);
   for (std::size_t k = 0; k < face.numLoops(); ++k)
     if (face.loop(k).size() < 3) return true;
   boost::container::small_vector<VertexId, 8> sorted(face.vertices.begin(), face.vertices.end());
   std::sort(sorted.begin(), sorted.end());
   if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) return true;
-  return areaVector(mesh, f).squaredNorm() == 0.0;
+  return area.squaredNorm() == 0.0;
+}
+
+bool isDegenerate(const PolyMesh& mesh, FaceId f) {
+  return isDegenerate(mesh, f, areaVector(mesh, f));
 }
 
 /// True if every directed edge of the element's oriented faces is matched by its reverse:
@@ -217,6 +222,9 @@ ValidationReport validate(const PolyMesh& mesh, const ValidationOptions& options
     std::uint64_t key = 0;   ///< hash of the sorted vertex ids
   };
   std::vector<FaceCheck> checks(mesh.numFaces());
+  // Each face's area vector and bounds, once: the elements' volumes below reuse them.
+  FaceData<Vec3> areaVectors(mesh.numFaces());
+  FaceData<Box3> faceBoxes(mesh.numFaces());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.numFaces(), 1024),
                     [&](const tbb::blocked_range<std::size_t>& r) {
                       for (std::size_t i = r.begin(); i != r.end(); ++i) {
@@ -224,10 +232,12 @@ ValidationReport validate(const PolyMesh& mesh, const ValidationOptions& options
                         FaceCheck& c = checks[i];
                         const Face& face = mesh.face(f);
                         c.key = vertexSetKey({face.vertices.data(), face.vertices.size()});
-                        c.degenerate = isDegenerate(mesh, f);
+                        areaVectors[f] = areaVector(mesh, f);
+                        faceBoxes[f] = faceBounds(mesh, f);
+                        c.degenerate = isDegenerate(mesh, f, areaVectors[f]);
                         if (c.degenerate) continue;
-                        const Box3 box = faceBounds(mesh, f);
-                        const double deviation = planarityDeviation(mesh, f);
+                        const Box3& box = faceBoxes[f];
+                        const double deviation = planarityDeviation(mesh, f, areaVectors[f]);
                         const double resolution =
                             16.0 * std::numeric_limits<double>::epsilon() *
                             std::max(box.min().cwiseAbs().maxCoeff(), box.max().cwiseAbs().maxCoeff());
@@ -290,7 +300,7 @@ ValidationReport validate(const PolyMesh& mesh, const ValidationOptions& options
                     [&](const tbb::blocked_range<std::size_t>& r) {
                       for (std::size_t i = r.begin(); i != r.end(); ++i) {
                         closed[i] = isClosed(mesh, ElementId(i));
-                        volumes[i] = signedVolume(mesh, ElementId(i));
+                        volumes[i] = signedVolume(mesh, ElementId(i), areaVectors, faceBoxes);
                       }
                     });
   bool first = true;
