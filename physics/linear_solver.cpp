@@ -45,8 +45,10 @@ void setOrdering(Solver& solver, CholeskyOrdering ordering) {
   }
 }
 
+/// a.b, summed in the same order on every run (parallel_deterministic_reduce): a solve
+/// repeated on the same system takes the same iterations to the same bits.
 double parallelDot(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
-  return tbb::parallel_reduce(
+  return tbb::parallel_deterministic_reduce(
       tbb::blocked_range<Eigen::Index>(0, a.size(), 8192), 0.0,
       [&](const tbb::blocked_range<Eigen::Index>& r, double s) {
         return s + a.segment(r.begin(), r.size()).dot(b.segment(r.begin(), r.size()));
@@ -94,17 +96,25 @@ struct LinearSolver::Impl {
   BlockRows<double> productBlocks;
   bool useProductBlocks = false;
 
-  void product(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
+  /// y = K x; returns x.y. One pass (and one hand-off between threads) with the block rows.
+  double productDot(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
     if (!useProductBlocks) {
       symmetricProduct(*matrix, x, y);
-      return;
+      return parallelDot(x, y);
     }
     y.resize(x.size());
     const int ne = static_cast<int>(x.size() / blockSize);
-    tbb::parallel_for(tbb::blocked_range<int>(0, ne, 16), [&](const tbb::blocked_range<int>& r) {
-      for (int e = r.begin(); e != r.end(); ++e)
-        productBlocks.rowProduct(e, x.data(), y.data() + static_cast<Eigen::Index>(e) * blockSize);
-    });
+    return tbb::parallel_deterministic_reduce(
+        tbb::blocked_range<int>(0, ne, 64), 0.0,
+        [&](const tbb::blocked_range<int>& r, double sum) {
+          for (int e = r.begin(); e != r.end(); ++e) {
+            const Eigen::Index base = static_cast<Eigen::Index>(e) * blockSize;
+            productBlocks.rowProduct(e, x.data(), y.data() + base);
+            sum += x.segment(base, blockSize).dot(y.segment(base, blockSize));
+          }
+          return sum;
+        },
+        std::plus<double>());
   }
 
   /// The basis degree p with blockSize = 3 numMonomials(p), or -1.
@@ -172,12 +182,20 @@ struct LinearSolver::Impl {
     const double target = options.tolerance * fNorm;
     int it = 0;
     double rNorm = fNorm;
-    for (; it < options.maxIterations && rNorm > target; ++it) {
-      product(p, q);
-      const double alpha = rz / parallelDot(p, q);
-      u += alpha * p;
-      r -= alpha * q;
-      rNorm = std::sqrt(parallelDot(r, r));
+    while (it < options.maxIterations && rNorm > target) {
+      ++it;
+      const double alpha = rz / productDot(p, q);
+      // u += alpha p, r -= alpha q and |r|^2 in one pass.
+      rNorm = std::sqrt(tbb::parallel_deterministic_reduce(
+          tbb::blocked_range<Eigen::Index>(0, u.size(), 8192), 0.0,
+          [&](const tbb::blocked_range<Eigen::Index>& range, double sum) {
+            const Eigen::Index first = range.begin(), size = range.size();
+            u.segment(first, size) += alpha * p.segment(first, size);
+            r.segment(first, size) -= alpha * q.segment(first, size);
+            return sum + r.segment(first, size).squaredNorm();
+          },
+          std::plus<double>()));
+      if (rNorm <= target) break;  // converged: no preconditioner for a next step
       precondition(r, z);
       const double rzNew = parallelDot(r, z);
       p = z + (rzNew / rz) * p;

@@ -39,8 +39,8 @@ struct Level {
   /// at most twice the matrix's nonzeros; otherwise the smoother reads the CSR matrix.
   bool useBlocks = false;
   BlockRows<float> blocks;
-  // Scratch of apply(): right-hand side, solution and residual of this level.
-  mutable Eigen::VectorXd b, x, r;
+  // Scratch of apply(): right-hand side and solution of this level.
+  mutable Eigen::VectorXd b, x;
 };
 
 /// The principal submatrix of `fine` (n functions per component) on the DOFs of the first
@@ -267,6 +267,7 @@ bool splitComponents(const SpMat& a, std::vector<SpMat>& parts) {
 struct PMultigrid::Impl {
   std::vector<Level> levels;  // levels[q]: degree q
   std::vector<std::vector<int>> colours;
+  std::vector<std::uint8_t> inLastColour;  ///< per element: 1 if in colours.back()
   /// Level 0's factorization: of the whole matrix, or, when its displacement components are
   /// uncoupled (splitComponents()), of each component's matrix, factorized side by side, or
   /// of the one matrix S of all three (a = I_3 (x) S: three right-hand sides, a third of the
@@ -356,25 +357,29 @@ struct PMultigrid::Impl {
     }
   }
 
-  /// r = b - A x on `level` right after a forward sweep: the rows of the last colour were
-  /// just solved with every neighbour final, so their residual is zero and is not computed.
-  void residualAfterSweep(const Level& level, const Eigen::VectorXd& b, const Eigen::VectorXd& x,
-                          Eigen::VectorXd& r) const {
-    const int bs = level.bs;
-    r.resize(b.size());
-    for (std::size_t t = 0; t < colours.size(); ++t) {
-      const std::vector<int>& cls = colours[t];
-      const bool last = t + 1 == colours.size();
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cls.size(), 16),
-                        [&](const tbb::blocked_range<std::size_t>& range) {
-                          for (std::size_t j = range.begin(); j != range.end(); ++j) {
-                            const int e = cls[j];
-                            double* re = r.data() + static_cast<Eigen::Index>(e) * bs;
-                            if (last) std::fill(re, re + bs, 0.0);
-                            else blockResidual(level, e, b, x, re);
+  /// The coarse right-hand side right after a forward sweep on `fine`: the residual
+  /// b - A x restricted to the degree of `next`, in one pass over the elements. The rows of the
+  /// last colour were just solved with every neighbour final, so their residual is zero and
+  /// is not computed.
+  void restrictedResidual(const Level& fine, const Level& next, const Eigen::VectorXd& b,
+                          const Eigen::VectorXd& x) const {
+    const int n = fine.n, nc = next.n;
+    const Eigen::Index ne = b.size() / fine.bs;
+    next.b.resize(ne * next.bs);
+    tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, ne, 16),
+                      [&](const tbb::blocked_range<Eigen::Index>& range) {
+                        double s[kMaxBlock];
+                        for (Eigen::Index e = range.begin(); e != range.end(); ++e) {
+                          double* coarse = next.b.data() + e * next.bs;
+                          if (inLastColour[static_cast<std::size_t>(e)]) {
+                            std::fill(coarse, coarse + next.bs, 0.0);
+                            continue;
                           }
-                        });
-    }
+                          blockResidual(fine, static_cast<int>(e), b, x, s);
+                          for (int d = 0; d < 3; ++d)
+                            std::copy(s + d * n, s + d * n + nc, coarse + d * nc);
+                        }
+                      });
   }
 
   /// x = V-cycle(q) applied to b, from x = 0.
@@ -387,14 +392,9 @@ struct PMultigrid::Impl {
     const Level& next = levels[static_cast<std::size_t>(q - 1)];
     x.setZero(b.size());
     sweep(fine, b, x, false, true);
-    residualAfterSweep(fine, b, x, fine.r);
+    restrictedResidual(fine, next, b, x);
     const int n = fine.n, nc = next.n;
     const Eigen::Index ne = b.size() / fine.bs;
-    next.b.resize(ne * next.bs);
-    tbb::parallel_for(Eigen::Index(0), ne, [&](Eigen::Index e) {
-      for (int d = 0; d < 3; ++d)
-        next.b.segment(e * next.bs + d * nc, nc) = fine.r.segment(e * fine.bs + d * n, nc);
-    });
     vcycle(q - 1, next.b, next.x);
     tbb::parallel_for(Eigen::Index(0), ne, [&](Eigen::Index e) {
       for (int d = 0; d < 3; ++d)
@@ -421,6 +421,9 @@ bool PMultigrid::compute(const SpMat& matrix, int degree, const BlockRows<double
   functionsOfBlock(top.bs, degree);
   top.matrix = &matrix;
   m.colours = colourElements(matrix, top.bs);
+  m.inLastColour.assign(static_cast<std::size_t>(matrix.cols() / top.bs), 0);
+  if (!m.colours.empty())
+    for (int e : m.colours.back()) m.inLastColour[static_cast<std::size_t>(e)] = 1;
   for (int q = degree - 1; q >= 0; --q) {
     Level& fine = m.levels[static_cast<std::size_t>(q) + 1];
     Level& level = m.levels[static_cast<std::size_t>(q)];
