@@ -140,20 +140,7 @@ TEST(RegionChecks, DisconnectedRegionsCountTheirComponents) {
 
 TEST(RegionChecks, WholeMeshAgreesWithTheGlobalChecks) {
   // The two-block mesh of two components and the 4^3 grid.
-  PolyMesh two = hexGridMesh(2, 1, 1, Box3(Vec3::Zero(), Vec3(2, 1, 1)));
-  {
-    const PolyMesh other = hexGridMesh(1, 1, 1, Box3(Vec3(3, 0, 0), Vec3(4, 1, 1)));
-    const std::size_t base = two.numVertices();
-    for (const Vec3& p : other.positions().raw()) two.addVertex(p);
-    std::vector<std::vector<Loop>> boundary;
-    for (const FaceUse& use : other.element(ElementId(0)).faces) {
-      Loop loop;
-      for (VertexId v : other.face(use.face).vertices) loop.push_back(VertexId(v.index() + base));
-      if (use.reversed) std::reverse(loop.begin(), loop.end());
-      boundary.push_back({loop});
-    }
-    two.addElement(boundary, FaceOrigin::Box);
-  }
+  const PolyMesh two = testing::twoSeparateBlocks();
   for (const PolyMesh& m : {two, grid4()}) {
     for (int degree : {1, 2}) {
       PhysicsCheckOptions global;

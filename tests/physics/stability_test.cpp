@@ -36,6 +36,18 @@ std::vector<double> volumes(const PolyMesh& mesh) {
   return v;
 }
 
+/// K and F of the sliver mesh of ratio r, IP of `degree`, u = 0 on the whole boundary.
+LinearSystem clampedSliverSystem(double r, int degree) {
+  StaticOptions options;
+  options.discretization.basis.degree = degree;
+  LoadCase loads;
+  loads.dirichlet.push_back({FaceSelector::allBoundary(), {}});
+  const PolyMesh mesh = sliverMesh(r);
+  StaticSolver solver(mesh, Material{}, options);
+  solver.assemble(loads);
+  return solver.system();
+}
+
 double totalVolume(const PolyMesh& mesh) {
   double v = 0.0;
   for (double x : volumes(mesh)) v += x;
@@ -45,14 +57,7 @@ double totalVolume(const PolyMesh& mesh) {
 TEST(ConditionEstimate, MatchesDenseEigenvalues) {
   const StabilityConditionRun run = runSliverCase(1e-2, false, 1);
   // Rebuild the same matrix densely through the public path and compare.
-  StaticOptions options;
-  options.discretization.basis.degree = 1;
-  LoadCase loads;
-  loads.dirichlet.push_back({FaceSelector::allBoundary(), {}});
-  const PolyMesh mesh = sliverMesh(1e-2);
-  StaticSolver solver(mesh, Material{}, options);
-  solver.assemble(loads);
-  const Eigen::MatrixXd dense(solver.system().matrix);
+  const Eigen::MatrixXd dense(clampedSliverSystem(1e-2, 1).matrix);
   const Eigen::VectorXd eig = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(dense).eigenvalues();
   std::printf("sliver 1e-2 p=1: lambda %.6e .. %.6e (dense %.6e .. %.6e), cond %.4e\n",
               run.estimate.lambdaMin, run.estimate.lambdaMax, eig(0), eig(eig.size() - 1),
@@ -77,19 +82,13 @@ TEST(ConditionEstimate, NotPositiveDefiniteWithoutBoundaryConditions) {
 }
 
 TEST(ConditionEstimate, JacobiScalingHasUnitDiagonalAndSameDefiniteness) {
-  StaticOptions options;
-  options.discretization.basis.degree = 2;
-  LoadCase loads;
-  loads.dirichlet.push_back({FaceSelector::allBoundary(), {}});
-  const PolyMesh mesh = sliverMesh(1e-3);
-  StaticSolver solver(mesh, Material{}, options);
-  solver.assemble(loads);
-  const auto scaled = jacobiScaled(solver.system().matrix);
+  const LinearSystem system = clampedSliverSystem(1e-3, 2);
+  const auto scaled = jacobiScaled(system.matrix);
   EXPECT_NEAR((scaled.diagonal().array() - 1.0).abs().maxCoeff(), 0.0, 1e-15);
   const Eigen::MatrixXd dense(scaled);
   // K is symmetric to the round-off of its assembly; the scaled matrix (|entries| <= 1) too.
   EXPECT_LT((dense - dense.transpose()).cwiseAbs().maxCoeff(), kAssemblySymmetryTolerance);
-  EXPECT_TRUE(conditionEstimate(scaled, solver.system().blockSize).positiveDefinite);
+  EXPECT_TRUE(conditionEstimate(scaled, system.blockSize).positiveDefinite);
 }
 
 TEST(StabilityMeshes, SliverMeshIsValidWithExactVolumes) {

@@ -74,21 +74,7 @@ std::vector<NamedMesh> corpus() {
   meshes.push_back({"scaled 1e6", transformed(grid, 1e6, Vec3::Zero())});
   meshes.push_back({"L prism scaled 1e-6", transformed(lPrism(), 1e-6, Vec3::Zero())});
   // Two separate blocks: two components, twelve zero modes.
-  PolyMesh two = hexGridMesh(2, 1, 1, Box3(Vec3::Zero(), Vec3(2, 1, 1)));
-  {
-    const PolyMesh other = hexGridMesh(1, 1, 1, Box3(Vec3(3, 0, 0), Vec3(4, 1, 1)));
-    const std::size_t base = two.numVertices();
-    for (const Vec3& p : other.positions().raw()) two.addVertex(p);
-    // Rebuild the second block's single element from its faces' loops.
-    std::vector<std::vector<Loop>> boundary;
-    for (const FaceUse& use : other.element(ElementId(0)).faces) {
-      Loop loop;
-      for (VertexId v : other.face(use.face).vertices) loop.push_back(VertexId(v.index() + base));
-      if (use.reversed) std::reverse(loop.begin(), loop.end());
-      boundary.push_back({loop});
-    }
-    two.addElement(boundary, FaceOrigin::Box);
-  }
+  const PolyMesh two = testing::twoSeparateBlocks();
   meshes.push_back({"two components", two});
   return meshes;
 }

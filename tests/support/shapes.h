@@ -78,4 +78,23 @@ inline PolyMesh withReversedFaces(const PolyMesh& mesh, ElementId bad, int k) {
   return out;
 }
 
+/// Two unit cubes apart: a 2 x 1 x 1 hex grid on [0,2] x [0,1]^2 and one cube on [3,4] x [0,1]^2,
+/// two connected components (twelve zero modes without boundary conditions).
+inline PolyMesh twoSeparateBlocks() {
+  PolyMesh two = hexGridMesh(2, 1, 1, Box3(Vec3::Zero(), Vec3(2, 1, 1)));
+  const PolyMesh other = hexGridMesh(1, 1, 1, Box3(Vec3(3, 0, 0), Vec3(4, 1, 1)));
+  const std::size_t base = two.numVertices();
+  for (const Vec3& p : other.positions().raw()) two.addVertex(p);
+  // The second block's single element, rebuilt from its faces' loops.
+  std::vector<std::vector<Loop>> boundary;
+  for (const FaceUse& use : other.element(ElementId(0)).faces) {
+    Loop loop;
+    for (VertexId v : other.face(use.face).vertices) loop.push_back(VertexId(v.index() + base));
+    if (use.reversed) std::reverse(loop.begin(), loop.end());
+    boundary.push_back({loop});
+  }
+  two.addElement(boundary, FaceOrigin::Box);
+  return two;
+}
+
 }  // namespace polydg::testing
