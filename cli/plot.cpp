@@ -7,6 +7,8 @@
 #include <limits>
 #include <sstream>
 
+#include "mesh/xml_escape.h"
+
 namespace polydg::cli {
 
 namespace {
@@ -18,19 +20,6 @@ constexpr std::array<const char*, 10> kColours{"#1f77b4", "#ff7f0e", "#2ca02c", 
 constexpr int kMarkerShapes = 5;
 constexpr double kMarkerRadius = 4.0;
 
-std::string escape(const std::string& text) {
-  std::string out;
-  for (char c : text) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
 
 std::string fixed(double v) {
   char buf[32];
@@ -188,7 +177,8 @@ std::string renderSvg(const Plot& plot, const PlotLayout& l) {
       << "\" font-family=\"DejaVu Sans, Arial, sans-serif\" font-size=\"12\">\n"
       << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n"
       << "<text class=\"title\" x=\"" << fixed(l.left + w / 2) << "\" y=\"" << fixed(l.top / 2 + 5)
-      << "\" text-anchor=\"middle\" font-size=\"15\" font-weight=\"bold\">" << escape(plot.title)
+      << "\" text-anchor=\"middle\" font-size=\"15\" font-weight=\"bold\">"
+      << xmlEscape(plot.title)
       << "</text>\n";
   // Grid and ticks.
   svg << "<g class=\"grid\" stroke=\"#dddddd\" stroke-width=\"1\">\n";
@@ -200,7 +190,7 @@ std::string renderSvg(const Plot& plot, const PlotLayout& l) {
   }
   auto xTickLabel = [&](double t) {
     if (plot.x.categories.empty()) return tickLabel(t, plot.x.scale);
-    return escape(plot.x.categories[static_cast<std::size_t>(t) - 1]);
+    return xmlEscape(plot.x.categories[static_cast<std::size_t>(t) - 1]);
   };
   for (double t : xt)
     svg << "<line x1=\"" << fixed(px(t)) << "\" y1=\"" << fixed(l.top) << "\" x2=\"" << fixed(px(t))
@@ -218,9 +208,9 @@ std::string renderSvg(const Plot& plot, const PlotLayout& l) {
         << "\" text-anchor=\"end\">" << tickLabel(t, plot.y.scale) << "</text>\n";
   svg << "<text class=\"x-label\" x=\"" << fixed(l.left + w / 2) << "\" y=\""
       << fixed(l.height - 14) << "\" text-anchor=\"middle\" font-size=\"13\">"
-      << escape(plot.x.label) << "</text>\n"
+      << xmlEscape(plot.x.label) << "</text>\n"
       << "<text class=\"y-label\" transform=\"translate(18," << fixed(l.top + h / 2)
-      << ") rotate(-90)\" text-anchor=\"middle\" font-size=\"13\">" << escape(plot.y.label)
+      << ") rotate(-90)\" text-anchor=\"middle\" font-size=\"13\">" << xmlEscape(plot.y.label)
       << "</text>\n";
   // Series, clipped to the frame.
   svg << "<clipPath id=\"frame\"><rect x=\"" << fixed(l.left - kMarkerRadius) << "\" y=\""
@@ -230,7 +220,8 @@ std::string renderSvg(const Plot& plot, const PlotLayout& l) {
     const PlotSeries& s = plot.series[k];
     const char* colour = kColours[k % kColours.size()];
     const int shape = markerShape(k);
-    svg << "<g class=\"series\" data-label=\"" << escape(s.label) << "\" clip-path=\"url(#frame)\">\n";
+    svg << "<g class=\"series\" data-label=\"" << xmlEscape(s.label)
+        << "\" clip-path=\"url(#frame)\">\n";
     std::ostringstream line, markers;
     for (std::size_t i = 0; i < std::min(s.x.size(), s.y.size()); ++i) {
       if (!usable(s.x[i], plot.x.scale) || !usable(s.y[i], plot.y.scale)) continue;
@@ -253,7 +244,7 @@ std::string renderSvg(const Plot& plot, const PlotLayout& l) {
         << "\" x2=\"" << fixed(lx + 26) << "\" y2=\"" << fixed(y) << "\" stroke=\"" << colour
         << "\" stroke-width=\"1.8\"" << dash(k) << "/><path d=\"" << markerPath(markerShape(k), lx + 13, y)
         << "\" fill=\"" << colour << "\"/><text x=\"" << fixed(lx + 32) << "\" y=\""
-        << fixed(y + 4) << "\" font-size=\"11\">" << escape(plot.series[k].label)
+        << fixed(y + 4) << "\" font-size=\"11\">" << xmlEscape(plot.series[k].label)
         << "</text></g>\n";
   }
   svg << "</svg>\n";

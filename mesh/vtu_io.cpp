@@ -29,6 +29,7 @@
 
 #include "mesh/face_triangulation.h"
 #include "mesh/geometry.h"
+#include "mesh/xml_escape.h"
 
 namespace polydg {
 
@@ -396,20 +397,6 @@ void checkArrays(const std::vector<VtuArray<Tag>>& arrays, std::size_t count, co
   }
 }
 
-std::string xmlEscape(std::string_view text) {
-  std::string out;
-  for (char c : text) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&apos;"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
 
 /// The type an array is stored as: doubles as Float64; integers (all non-negative here) in the
 /// smallest of UInt8, Int32 and Int64 that holds them (VTK and meshio convert on reading).
@@ -540,6 +527,18 @@ struct FileValues {
   std::vector<std::vector<double>> cellArrays;  ///< cellData, in cell order
 };
 
+/// The rows of `values` (`components` values per row) in the order `rows` lists them: an
+/// array per mesh entity becomes one per file entity (VTU point or cell).
+std::vector<double> gatherRows(const std::vector<double>& values, int components,
+                               const std::vector<std::int64_t>& rows) {
+  const auto k = static_cast<std::size_t>(components);
+  std::vector<double> out(rows.size() * k);
+  for (std::size_t r = 0; r < rows.size(); ++r)
+    for (std::size_t i = 0; i < k; ++i)
+      out[r * k + i] = values[static_cast<std::size_t>(rows[r]) * k + i];
+  return out;
+}
+
 FileValues fileValues(const PolyMesh& mesh, const CellStreams& s,
                       const std::vector<CellArray>& cellData,
                       const std::vector<PointArray>& pointData) {
@@ -557,20 +556,10 @@ FileValues fileValues(const PolyMesh& mesh, const CellStreams& s,
                         v.volume[c] = signedVolume(
                             mesh, ElementId(static_cast<std::size_t>(s.element[c])));
                     });
-  for (const PointArray& a : pointData) {
-    const auto k = static_cast<std::size_t>(a.components);
-    std::vector<double>& values = v.pointArrays.emplace_back(np * k);
-    for (std::size_t p = 0; p < np; ++p)
-      for (std::size_t i = 0; i < k; ++i)
-        values[p * k + i] = a.values[static_cast<std::size_t>(s.pointVertex[p]) * k + i];
-  }
-  for (const CellArray& a : cellData) {
-    const auto k = static_cast<std::size_t>(a.components);
-    std::vector<double>& values = v.cellArrays.emplace_back(ne * k);
-    for (std::size_t c = 0; c < ne; ++c)
-      for (std::size_t i = 0; i < k; ++i)
-        values[c * k + i] = a.values[static_cast<std::size_t>(s.element[c]) * k + i];
-  }
+  for (const PointArray& a : pointData)
+    v.pointArrays.push_back(gatherRows(a.values, a.components, s.pointVertex));
+  for (const CellArray& a : cellData)
+    v.cellArrays.push_back(gatherRows(a.values, a.components, s.element));
   return v;
 }
 
