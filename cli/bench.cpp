@@ -37,6 +37,7 @@
 
 #include "cli/commands.h"
 #include "cli/csv.h"
+#include "cli/json_reports.h"
 #include "cli/plot.h"
 #include "cli/report.h"
 #include "cut/cut.h"
@@ -69,18 +70,9 @@ struct BenchOptions {
   std::string dataDir = POLYDG_TESTDATA_DIR;
 };
 
-std::string methodName(Method m) { return m == Method::IP ? "ip" : "bz"; }
 std::string upper(std::string s) {
   for (char& c : s) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
   return s;
-}
-std::string solverName(SolverKind k) {
-  switch (k) {
-    case SolverKind::Cholesky: return "cholesky";
-    case SolverKind::ConjugateGradient: return "cg";
-    case SolverKind::Auto: break;
-  }
-  return "auto";
 }
 std::string shortNumber(double v) {
   char buf[32];
@@ -136,7 +128,7 @@ class SeriesSet {
 // --- accuracy and table41 ------------------------------------------------------------------
 
 nlohmann::json runJson(const BenchmarkRun& r) {
-  return {{"method", methodName(r.method)},
+  return {{"method", toString(r.method)},
           {"degree", r.degree},
           {"mesh", r.mesh == BenchmarkMesh::Hex ? "hex" : "sliced"},
           {"n", r.n},
@@ -150,7 +142,7 @@ nlohmann::json runJson(const BenchmarkRun& r) {
           {"l2_error", r.l2Error},
           {"h1_error", r.h1Error},
           {"eta", r.report.eta},
-          {"solver", solverName(r.report.solver.used)},
+          {"solver", toString(r.report.solver.used)},
           {"iterations", r.report.solver.iterations},
           {"residual", r.report.solver.residual}};
 }
@@ -173,7 +165,7 @@ std::vector<int> accuracySizes(int degree, BenchmarkMesh mesh, bool quick) {
 }
 
 void printRun(const BenchmarkRun& r) {
-  std::cout << methodName(r.method) << " p=" << r.degree << ' '
+  std::cout << toString(r.method) << " p=" << r.degree << ' '
             << (r.mesh == BenchmarkMesh::Hex ? "hex" : "sliced") << " n=" << r.n << ": "
             << r.report.dofs << " DOFs, integrate " << r.report.integrateSeconds
             << " s, assemble " << r.report.assembleSeconds << " s, solve "
@@ -197,7 +189,7 @@ SuiteOutput accuracySuite(const BenchOptions& o, bool quiet) {
   for (BenchmarkMesh mesh : meshes)
     for (Method method : {Method::IP, Method::BZ})
       for (int p = 1; p <= maxDegree; ++p) {
-        const std::string key = upper(methodName(method)) + " p=" + std::to_string(p) + " " +
+        const std::string key = upper(toString(method)) + " p=" + std::to_string(p) + " " +
                                 (mesh == BenchmarkMesh::Hex ? "hex" : "sliced");
         std::optional<BenchmarkRun> previous;
         double lastRate = std::numeric_limits<double>::quiet_NaN();
@@ -275,7 +267,7 @@ SuiteOutput table41Suite(bool quiet) {
                         {"t_solve", first.report.solveSeconds}};
       s.json.push_back(j);
       s.rows.push_back(row);
-      series.push_back({"polydg " + upper(methodName(method)) + (p == 1 ? " lin" : " quad"),
+      series.push_back({"polydg " + upper(toString(method)) + (p == 1 ? " lin" : " quad"),
                         {1, 2, 3},
                         {r.report.integrateSeconds, r.report.assembleSeconds,
                          r.report.solveSeconds}});

@@ -130,6 +130,17 @@ std::string toString(ValidationLevel level) {
   return "unknown";
 }
 
+std::string toString(Method method) { return method == Method::IP ? "ip" : "bz"; }
+
+std::string toString(SolverKind kind) {
+  switch (kind) {
+    case SolverKind::Cholesky: return "cholesky";
+    case SolverKind::ConjugateGradient: return "cg";
+    case SolverKind::Auto: break;
+  }
+  return "auto";
+}
+
 nlohmann::json toJson(const OperationReport& r) {
   const OperationValidation& v = r.validation;
   constexpr std::size_t kListedIds = 20;

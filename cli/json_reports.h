@@ -9,6 +9,8 @@
 #include "cut/cut.h"
 #include "mesh/meshing.h"
 #include "mesh/validate.h"
+#include "physics/linear_solver.h"
+#include "physics/local_integrators.h"
 #include "physics/validation.h"
 
 namespace polydg::cli {
@@ -28,6 +30,10 @@ nlohmann::json toJson(const Box3& box);
 nlohmann::json toJson(const MeshingReport& r);
 /// "none", "local" or "full".
 std::string toString(ValidationLevel level);
+/// "ip" or "bz", as `--method` takes them.
+std::string toString(Method method);
+/// "auto", "cholesky" or "cg", as `--solver` takes them.
+std::string toString(SolverKind kind);
 /// One cut or merge operation, as `polydg cut` and `polydg run` report it: op, elements_split,
 /// pieces_created, elements_removed, volume_removed, slivers, slivers_merged,
 /// isolated_slivers, faces_reintegrated, faces_total, left_whole {count, first_ids (at most

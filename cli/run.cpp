@@ -571,7 +571,7 @@ class InputRun {
     const VertexData<Vec3> vertexU = vertexDisplacements(mesh(), solver.basis(), u);
     double maxDisplacement = 0.0;
     for (const Vec3& v : vertexU) maxDisplacement = std::max(maxDisplacement, v.norm());
-    result.update({{"method", s.method == Method::IP ? "ip" : "bz"},
+    result.update({{"method", toString(s.method)},
                    {"degree", s.degree},
                    {"dofs", r.dofs},
                    {"nonzeros", r.nonzeros},

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.h"
+#include "cli/json_reports.h"
 #include "cli/report.h"
 #include "mesh/validate.h"
 #include "mesh/vtu_io.h"
@@ -101,15 +102,8 @@ const std::map<std::string, SolverKind> kSolvers{{"auto", SolverKind::Auto},
 const std::map<std::string, PenaltyRule> kPenalties{{"bound", PenaltyRule::TraceBound},
                                                     {"doubling", PenaltyRule::Doubling}};
 
-std::string toString(Method m) { return m == Method::IP ? "ip" : "bz"; }
-std::string toString(SolverKind k) {
-  switch (k) {
-    case SolverKind::Cholesky: return "cholesky";
-    case SolverKind::ConjugateGradient: return "cg";
-    case SolverKind::Auto: break;
-  }
-  return "auto";
-}
+// The overload below would hide the shared ones (cli/json_reports.h) from this namespace.
+using cli::toString;
 std::string toString(PenaltyRule r) {
   switch (r) {
     case PenaltyRule::TraceBound: return "bound";
