@@ -25,26 +25,13 @@ using Result = polydg::testing::CommandResult;
 
 Result run(const std::string& arguments) { return polydg::testing::runPolydg(arguments); }
 
-std::string data(const std::string& name) { return std::string(POLYDG_TESTDATA_DIR) + "/" + name; }
+std::string data(const std::string& name) { return polydg::testing::testData(name); }
 
-class Cli : public ::testing::Test {
+class Cli : public polydg::testing::CommandTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("polydg_cli_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
   std::size_t filesInDir() const {
     return static_cast<std::size_t>(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()));
   }
-  nlohmann::json readJson(const std::string& name) const {
-    std::ifstream in(path(name));
-    return nlohmann::json::parse(in);
-  }
-  fs::path dir_;
 };
 
 /// One line of output, mentioning `what`.

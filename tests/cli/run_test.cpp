@@ -28,22 +28,10 @@ using Result = polydg::testing::CommandResult;
 
 Result run(const std::string& arguments) { return polydg::testing::runPolydg(arguments); }
 
-std::string data(const std::string& name) { return std::string(POLYDG_TESTDATA_DIR) + "/" + name; }
+std::string data(const std::string& name) { return polydg::testing::testData(name); }
 
-class Run : public ::testing::Test {
+class Run : public polydg::testing::CommandTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("polydg_run_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
-  json readJson(const std::string& name) const {
-    std::ifstream in(path(name));
-    return json::parse(in);
-  }
   std::string write(const std::string& name, const std::string& text) const {
     std::ofstream(path(name)) << text;
     return path(name);
@@ -55,7 +43,6 @@ class Run : public ::testing::Test {
     std::sort(out.begin(), out.end());
     return out;
   }
-  fs::path dir_;
 };
 
 /// Exit 2 and one line naming `what`.

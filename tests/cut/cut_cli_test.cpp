@@ -24,27 +24,16 @@ std::size_t lines(const std::string& s) {
   return static_cast<std::size_t>(std::count(s.begin(), s.end(), '\n'));
 }
 
-class CutCli : public ::testing::Test {
+class CutCli : public polydg::testing::CommandTest {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("polydg_cut_cli_" +
-            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    CommandTest::SetUp();
     // A 4 x 4 x 4 grid of the unit cube (cube.obj spans [0, 1]^3).
-    const Result mesh = run("mesh " + std::string(POLYDG_TESTDATA_DIR) + "/cube.obj --cells 4 -o " +
+    const Result mesh = run("mesh " + polydg::testing::testData("cube.obj") + " --cells 4 -o " +
                             path("cube.vtu") + " --quiet");
     ASSERT_EQ(mesh.exitCode, 0) << mesh.out;
   }
-  void TearDown() override { fs::remove_all(dir_); }
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
-  nlohmann::json readJson(const std::string& name) const {
-    std::ifstream in(path(name));
-    return nlohmann::json::parse(in);
-  }
   std::string input() const { return path("cube.vtu"); }
-  fs::path dir_;
 };
 
 TEST_F(CutCli, ReportsEveryOperation) {
