@@ -121,16 +121,26 @@ BenchmarkRun runBenchmarkB1(int n, const StaticOptions& options, BenchmarkMesh k
   return run;
 }
 
-BenchmarkRun runBenchmarkB2(const StaticOptions& options) {
-  const PolyMesh mesh = hexGridMesh(10, 10, 10, Box3(Vec3::Zero(), Vec3::Ones()));
+PolyMesh benchmarkB2Mesh() { return hexGridMesh(10, 10, 10, Box3(Vec3::Zero(), Vec3::Ones())); }
+
+Material benchmarkB2Material() {
   Material material;
   material.youngsModulus = 1000.0;
   material.poissonRatio = 0.3;
   material.density = 1.0;
+  return material;
+}
+
+LoadCase benchmarkB2Loads() {
   LoadCase loads;
   loads.dirichlet.push_back({FaceSelector::plane(0, 0.0), {}});
   loads.gravity = Vec3(0, 0, -1);
-  const StaticSolution s = solveStatic(mesh, material, loads, options);
+  return loads;
+}
+
+BenchmarkRun runBenchmarkB2(const StaticOptions& options) {
+  const PolyMesh mesh = benchmarkB2Mesh();
+  const StaticSolution s = solveStatic(mesh, benchmarkB2Material(), benchmarkB2Loads(), options);
   return makeRun(options, 10, s.report);
 }
 

@@ -63,7 +63,10 @@ BenchmarkRun runBenchmarkB1(int n, const StaticOptions& options,
                             const DomainTransform& transform = {});
 
 /// B2: 10 x 10 x 10 unit cube, clamped on x = 0, gravity (0, 0, -1), density 1, E = 1000,
-/// nu = 0.3.
+/// nu = 0.3. Its mesh, material and loads:
+PolyMesh benchmarkB2Mesh();
+Material benchmarkB2Material();
+LoadCase benchmarkB2Loads();
 BenchmarkRun runBenchmarkB2(const StaticOptions& options);
 
 /// B3: beam [0,10] x [0,1] x [0,1] on an nx x ny x nz hex grid, E = 1000, clamped on x = 0,

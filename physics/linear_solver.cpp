@@ -124,12 +124,13 @@ struct LinearSolver::Impl {
     return -1;
   }
 
-  bool buildPreconditioner() {
+  bool buildPreconditioner(const ElementFrames* frames) {
     useProductBlocks = blockSize % 3 == 0 && productBlocks.build(*matrix, blockSize / 3, 1.0);
     preconditioner = options.preconditioner;
     const int degree = degreeOfBlock();
     if (preconditioner == CgPreconditioner::PMultigrid && degree >= 0)
-      return multigrid.compute(*matrix, degree, useProductBlocks ? &productBlocks : nullptr);
+      return multigrid.compute(*matrix, degree, useProductBlocks ? &productBlocks : nullptr,
+                               frames);
     preconditioner = CgPreconditioner::BlockJacobi;
     return buildBlockJacobi();
   }
@@ -216,7 +217,7 @@ LinearSolver& LinearSolver::operator=(LinearSolver&&) noexcept = default;
 
 SolverKind LinearSolver::kind() const { return impl_->kind; }
 
-bool LinearSolver::compute(const SpMat& matrix, int blockSize) {
+bool LinearSolver::compute(const SpMat& matrix, int blockSize, const ElementFrames* frames) {
   Impl& m = *impl_;
   m.matrix = &matrix;
   m.blockSize = blockSize;
@@ -230,7 +231,7 @@ bool LinearSolver::compute(const SpMat& matrix, int blockSize) {
     m.cholesky->compute(matrix);
     ok = m.cholesky->info() == Eigen::Success;
   } else {
-    ok = m.buildPreconditioner();
+    ok = m.buildPreconditioner(frames);
   }
   m.factorSeconds = secondsSince(t0);
   return ok;

@@ -10,6 +10,8 @@
 
 namespace polydg {
 
+struct ElementFrames;
+
 enum class SolverKind {
   Auto,               ///< Cholesky up to SolverOptions::directLimitDofs DOFs, else CG
   Cholesky,           ///< CHOLMOD supernodal LL^T
@@ -18,9 +20,9 @@ enum class SolverKind {
 
 /// Preconditioner of SolverKind::ConjugateGradient.
 enum class CgPreconditioner {
-  /// One symmetric V-cycle over the degrees p, ..., 0 (PMultigrid): B2 needs 31-49
-  /// iterations to 1e-10 against 140-260 with block Jacobi (dependence on the mesh size not
-  /// measured). Needs the hierarchical DG basis layout; other block sizes use BlockJacobi.
+  /// One symmetric V-cycle over the degrees p, ..., 1 and agglomerates of elements (or over
+  /// p, ..., 0 without element frames; PMultigrid). Needs the hierarchical DG basis layout;
+  /// other block sizes use BlockJacobi.
   PMultigrid,
   BlockJacobi,  ///< inverses of the per-element diagonal blocks
 };
@@ -79,8 +81,10 @@ class LinearSolver {
   /// Factorizes (Cholesky) or builds the preconditioner (CG) for `matrix`, which must stay
   /// alive while the solver is used; `blockSize` is the DOFs per element. Returns false if the
   /// Cholesky factorization finds the matrix not positive definite (or a preconditioner block
-  /// is not).
-  bool compute(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix, int blockSize);
+  /// is not). `frames` (optional, one per element, used during the call only) let the
+  /// p-multigrid build its agglomeration levels.
+  bool compute(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix, int blockSize,
+               const ElementFrames* frames = nullptr);
   /// Solves K U = F; fills `report` (times of this solve; factorSeconds from compute()).
   Eigen::VectorXd solve(const Eigen::VectorXd& rhs, SolveReport& report);
 

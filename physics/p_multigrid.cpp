@@ -1,8 +1,10 @@
 #include "physics/p_multigrid.h"
 
 #include <algorithm>
+#include <cmath>
 #include <atomic>
 #include <cstdint>
+#include <limits>
 #include <stdexcept>
 
 #include <Eigen/CholmodSupport>
@@ -12,6 +14,7 @@
 
 #include "integrate/monomials.h"
 #include "physics/block_rows.h"
+#include "physics/agglomeration.h"
 
 namespace polydg {
 
@@ -19,14 +22,37 @@ namespace {
 
 using SpMat = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
 
-/// Level-0 unknowns up to which CHOLMOD factorizes it simplicially (see compute()).
+/// Unknowns up to which CHOLMOD factorizes the coarsest level simplicially (see
+/// factorizeCoarse()): a degree-0 level, and an agglomeration level (denser: 12 x 12 blocks).
 constexpr Eigen::Index kSimplicialCoarseLimit = 30000;
+constexpr Eigen::Index kSimplicialAggregateLimit = 1000;
 
 /// Largest element block handled (3 numMonomials(3)).
 constexpr int kMaxBlock = 60;
 
-/// One degree q: its matrix (the top level borrows K), functions per component and the
-/// inverses of its element diagonal blocks (bs x bs each, column-major).
+/// When agglomeration stops. The coarsest level is factorized once and solved once per
+/// V-cycle; its factorization should cost about one V-cycle on K. A coarse matrix with 12 x 12
+/// blocks on a 3D mesh factorizes in about 13 N^2 flops for N unknowns (B2: 28.7 MFlop at
+/// 1,500 unknowns, 0.9 at 324), about what a V-cycle costs at 13 flops per nonzero of K when
+/// N^2 = nnz(K). So agglomeration continues while N^2 > nnz(K), and at least down to
+/// kCoarseUnknowns. On B2 this keeps the 1,500 unknowns of the first agglomeration level
+/// exact for p = 2 (nnz(K) = 2.5e6 for BZ: 25 instead of 34 iterations, 94 instead of 120 ms)
+/// and agglomerates once more for p = 1 (nnz(K) = 4.0e5 for BZ: 24 instead of 21 iterations,
+/// but 0.7 instead of 10-13 ms of factorization).
+constexpr Eigen::Index kCoarseUnknowns = 600;
+
+/// Functions per component of an agglomeration level: the linear polynomials.
+constexpr int kLinear = 4;
+
+/// How a level's unknowns reach the next coarser level.
+enum class Transfer {
+  Degree,     ///< the first numMonomials(q) functions of each element (index maps)
+  Aggregate,  ///< linear functions of groups of blocks (weights per block)
+};
+
+/// One level: its matrix (the top level borrows K), functions per component, the inverses of
+/// its diagonal blocks (bs x bs each, column-major), its colouring and its transfer to the
+/// next coarser level.
 struct Level {
   const SpMat* matrix = nullptr;
   SpMat owned;
@@ -39,6 +65,21 @@ struct Level {
   /// at most twice the matrix's nonzeros; otherwise the smoother reads the CSR matrix.
   bool useBlocks = false;
   BlockRows<float> blocks;
+  /// The matrix by block rows in double precision, for a level that is agglomerated: the
+  /// Galerkin product reads it (the top level's copy is the caller's, `source`).
+  BlockRows<double> exact;
+  const BlockRows<double>* source = nullptr;
+  /// Blocks of each colour, in increasing order; inLastColour[b] = 1 for the last colour's.
+  std::vector<std::vector<int>> colours;
+  std::vector<std::uint8_t> inLastColour;
+  /// Gauss-Seidel sweeps before (and, reversed, after) the coarse correction.
+  int sweeps = 1;
+  Transfer transfer = Transfer::Degree;
+  /// Aggregate transfer: the groups of this level's blocks that are the next level's blocks.
+  Agglomeration groups;
+  /// Agglomerated levels: each block's centre and length scale.
+  std::vector<Eigen::Vector3d> centres;
+  std::vector<double> scales;
   // Scratch of apply(): right-hand side and solution of this level.
   mutable Eigen::VectorXd b, x;
 };
@@ -101,11 +142,6 @@ SpMat restrictMatrix(const SpMat& fine, int n, int nc) {
     }
   });
   return coarse;
-}
-
-/// Fills the single-precision block rows of `level` from its matrix.
-void buildBlockRows(Level& level) {
-  level.useBlocks = level.blocks.build(*level.matrix, level.n, 2.0);
 }
 
 /// s = b_e - (A x)_e for element e's rows, from the block rows of `level`.
@@ -265,17 +301,17 @@ bool splitComponents(const SpMat& a, std::vector<SpMat>& parts) {
 }  // namespace
 
 struct PMultigrid::Impl {
-  std::vector<Level> levels;  // levels[q]: degree q
-  std::vector<std::vector<int>> colours;
-  std::vector<std::uint8_t> inLastColour;  ///< per element: 1 if in colours.back()
-  /// Level 0's factorization: of the whole matrix, or, when its displacement components are
-  /// uncoupled (splitComponents()), of each component's matrix, factorized side by side, or
-  /// of the one matrix S of all three (a = I_3 (x) S: three right-hand sides, a third of the
-  /// unknowns; B2 with BZ: 1.5 instead of 4.5 ms of factorization).
+  std::vector<Level> levels;  ///< levels[0] is K (degree p), each next one coarser
+  /// The coarsest level's factorization: of the whole matrix, or, for a degree-0 level whose
+  /// displacement components are uncoupled (splitComponents()), of each component's matrix,
+  /// factorized side by side, or of the one matrix S of all three (a = I_3 (x) S: three
+  /// right-hand sides, a third of the unknowns).
   using Cholesky = Eigen::CholmodDecomposition<SpMat, Eigen::Lower>;
   std::vector<std::unique_ptr<Cholesky>> coarse;
   std::vector<SpMat> coarseParts;
   mutable Eigen::MatrixXd coarseRhs, coarseSolution;
+
+  const Level& coarsest() const { return levels.back(); }
 
   void coarseSolve(const Eigen::VectorXd& b, Eigen::VectorXd& x) const {
     if (coarseParts.empty()) {
@@ -295,10 +331,13 @@ struct PMultigrid::Impl {
     Eigen::Map<Eigen::Matrix<double, 3, Eigen::Dynamic>>(x.data(), 3, ne) = coarseSolution.transpose();
   }
 
-  /// Factorizes level 0 (or its components' matrices). False if one is not positive definite.
+  /// Factorizes the coarsest level (or its components' matrices). False if one is not
+  /// positive definite.
   bool factorizeCoarse() {
-    const SpMat& a = *levels.front().matrix;
-    splitComponents(a, coarseParts);
+    const Level& level = coarsest();
+    const SpMat& a = *level.matrix;
+    coarseParts.clear();
+    if (level.bs == 3) splitComponents(a, coarseParts);
     const std::size_t count = coarseParts.empty() ? 1 : coarseParts.size();
     coarse.clear();
     for (std::size_t i = 0; i < count; ++i) coarse.push_back(std::make_unique<Cholesky>());
@@ -307,14 +346,16 @@ struct PMultigrid::Impl {
       const SpMat& factored = coarseParts.empty() ? a : coarseParts[i];
       Cholesky& c = *coarse[i];
       c.cholmod().print = 0;
-      // Small level 0: simplicial. The supernodal solve calls the threaded BLAS twice per
-      // V-cycle and its thread hand-offs cost more than the solve (B2, 3000 unknowns: 42
-      // instead of 70 ms of CG iterations for p = 1, factorization 4 ms slower); large ones
-      // keep the supernodal factorization, whose BLAS speed dominates (the limit is a
-      // judgement, not a measurement).
-      if (factored.rows() <= kSimplicialCoarseLimit) c.setMode(Eigen::CholmodSimplicialLLt);
-      // The level-0 matrix is small (3 unknowns per element): AMD alone orders it well,
-      // without the METIS trial of CHOLMOD's default strategy.
+      // Small coarse levels: simplicial. The supernodal solve calls the threaded BLAS twice
+      // per V-cycle and its thread hand-offs cost more than the solve (B2, 3000 unknowns of
+      // degree 0: 42 instead of 70 ms of CG iterations for p = 1, factorization 4 ms slower).
+      // Agglomeration levels have dense 12 x 12 blocks, where the supernodal factorization
+      // wins sooner (B2: 324 unknowns 0.7 ms simplicial, 1.2 supernodal; 1,500 unknowns 13.7
+      // and 9.5-11 ms, the solves equally fast).
+      const Eigen::Index simplicialLimit = level.bs == 3 ? kSimplicialCoarseLimit : kSimplicialAggregateLimit;
+      if (factored.rows() <= simplicialLimit) c.setMode(Eigen::CholmodSimplicialLLt);
+      // The coarse level is small: AMD alone orders it well, without the METIS trial of
+      // CHOLMOD's default strategy.
       c.cholmod().nmethods = 1;
       c.cholmod().method[0].ordering = CHOLMOD_AMD;
       c.compute(factored);
@@ -323,12 +364,58 @@ struct PMultigrid::Impl {
     return ok;
   }
 
+  /// Colours, smoother blocks and block inverses of a level that is smoothed.
+  bool prepareSmoother(Level& level, const BlockRows<double>* matrixBlocks) {
+    if (level.colours.empty()) level.colours = colourElements(*level.matrix, level.bs);
+    level.inLastColour.assign(static_cast<std::size_t>(level.matrix->cols() / level.bs), 0);
+    if (!level.colours.empty())
+      for (int e : level.colours.back()) level.inLastColour[static_cast<std::size_t>(e)] = 1;
+    if (matrixBlocks == nullptr) matrixBlocks = level.source;
+    if (matrixBlocks != nullptr && !matrixBlocks->values.empty()) {
+      level.blocks.convertFrom(*matrixBlocks);
+      level.useBlocks = true;
+    } else {
+      level.useBlocks = level.blocks.build(*level.matrix, level.n, 2.0);
+    }
+    return invertBlocks(level);
+  }
+
+  /// Appends the agglomeration level of levels.back() (4 functions per component, its
+  /// centres and scales set; `linear`, for the element level, the frames' T_e).
+  void addAggregateLevel(const std::vector<Eigen::Matrix4d>* linear) {
+    Level& fine = levels.back();
+    fine.transfer = Transfer::Aggregate;
+    fine.groups = agglomerate(*fine.matrix, fine.bs, fine.centres, fine.scales, linear);
+    if (fine.source == nullptr) {
+      fine.exact.build(*fine.matrix, kLinear, std::numeric_limits<double>::infinity());
+      fine.source = &fine.exact;
+    }
+    Level level;
+    level.n = kLinear;
+    level.bs = 3 * kLinear;
+    level.centres = fine.groups.centres;
+    level.scales = fine.groups.scales;
+    level.owned = galerkinMatrix(fine.groups, *fine.source);
+    push(std::move(level));
+  }
+
+  /// Appends a coarser level that owns its matrix. Re-points every owned matrix: the vector
+  /// may have moved the levels.
+  void push(Level&& level) {
+    levels.push_back(std::move(level));
+    for (std::size_t k = 0; k < levels.size(); ++k) {
+      if (k > 0) levels[k].matrix = &levels[k].owned;
+      if (!levels[k].exact.values.empty()) levels[k].source = &levels[k].exact;
+    }
+  }
+
   /// One block Gauss-Seidel sweep on `level` for A x = b, colours in order or reversed. With
   /// `fromZero` (x = 0 on entry, forward sweep) the first colour's residual is b itself and
   /// is not computed: a sixth less smoother work per V-cycle with two colours.
   void sweep(const Level& level, const Eigen::VectorXd& b, Eigen::VectorXd& x, bool reverse,
              bool fromZero = false) const {
     const int bs = level.bs;
+    const std::vector<std::vector<int>>& colours = level.colours;
     const std::size_t nc = colours.size();
     for (std::size_t t = 0; t < nc; ++t) {
       const std::vector<int>& cls = colours[reverse ? nc - 1 - t : t];
@@ -358,49 +445,91 @@ struct PMultigrid::Impl {
   }
 
   /// The coarse right-hand side right after a forward sweep on `fine`: the residual
-  /// b - A x restricted to the degree of `next`, in one pass over the elements. The rows of the
-  /// last colour were just solved with every neighbour final, so their residual is zero and
-  /// is not computed.
+  /// b - A x restricted to `next`, in one pass. The rows of the last colour were just solved
+  /// with every neighbour final, so their residual is zero and is not computed.
   void restrictedResidual(const Level& fine, const Level& next, const Eigen::VectorXd& b,
                           const Eigen::VectorXd& x) const {
     const int n = fine.n, nc = next.n;
-    const Eigen::Index ne = b.size() / fine.bs;
-    next.b.resize(ne * next.bs);
-    tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, ne, 16),
+    const Eigen::Index coarseBlocks = next.matrix->cols() / next.bs;
+    next.b.resize(coarseBlocks * next.bs);
+    if (fine.transfer == Transfer::Degree) {
+      tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, coarseBlocks, 16),
+                        [&](const tbb::blocked_range<Eigen::Index>& range) {
+                          double s[kMaxBlock];
+                          for (Eigen::Index e = range.begin(); e != range.end(); ++e) {
+                            double* coarse = next.b.data() + e * next.bs;
+                            if (fine.inLastColour[static_cast<std::size_t>(e)]) {
+                              std::fill(coarse, coarse + next.bs, 0.0);
+                              continue;
+                            }
+                            blockResidual(fine, static_cast<int>(e), b, x, s);
+                            for (int d = 0; d < 3; ++d)
+                              std::copy(s + d * n, s + d * n + nc, coarse + d * nc);
+                          }
+                        });
+      return;
+    }
+    // Aggregate: coarse block c gathers W_e^T (residual of e) over its blocks e.
+    tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, coarseBlocks, 4),
                       [&](const tbb::blocked_range<Eigen::Index>& range) {
                         double s[kMaxBlock];
-                        for (Eigen::Index e = range.begin(); e != range.end(); ++e) {
-                          double* coarse = next.b.data() + e * next.bs;
-                          if (inLastColour[static_cast<std::size_t>(e)]) {
-                            std::fill(coarse, coarse + next.bs, 0.0);
-                            continue;
+                        for (Eigen::Index c = range.begin(); c != range.end(); ++c) {
+                          double* coarse = next.b.data() + c * next.bs;
+                          std::fill(coarse, coarse + next.bs, 0.0);
+                          const Agglomeration& groups = fine.groups;
+                          for (int k = groups.childStart[static_cast<std::size_t>(c)];
+                               k < groups.childStart[static_cast<std::size_t>(c) + 1]; ++k) {
+                            const int e = groups.children[static_cast<std::size_t>(k)];
+                            if (fine.inLastColour[static_cast<std::size_t>(e)]) continue;
+                            blockResidual(fine, e, b, x, s);
+                            const double* w = groups.weights.data() + 16 * static_cast<std::size_t>(e);
+                            for (int d = 0; d < 3; ++d)
+                              for (int j = 0; j < kLinear; ++j) {
+                                double sum = 0.0;
+                                for (int i = 0; i < kLinear; ++i) sum += w[i + 4 * j] * s[d * kLinear + i];
+                                coarse[d * kLinear + j] += sum;
+                              }
                           }
-                          blockResidual(fine, static_cast<int>(e), b, x, s);
-                          for (int d = 0; d < 3; ++d)
-                            std::copy(s + d * n, s + d * n + nc, coarse + d * nc);
                         }
                       });
   }
 
-  /// x = V-cycle(q) applied to b, from x = 0.
-  void vcycle(int q, const Eigen::VectorXd& b, Eigen::VectorXd& x) const {
-    if (q == 0) {
+  /// x += P (next.x): the coarse correction in `fine`'s unknowns.
+  void prolongate(const Level& fine, const Level& next, Eigen::VectorXd& x) const {
+    const int n = fine.n, nc = next.n;
+    const Eigen::Index nb = x.size() / fine.bs;
+    tbb::parallel_for(Eigen::Index(0), nb, [&](Eigen::Index e) {
+      double* xe = x.data() + e * fine.bs;
+      if (fine.transfer == Transfer::Degree) {
+        const double* xc = next.x.data() + e * next.bs;
+        for (int d = 0; d < 3; ++d)
+          for (int i = 0; i < nc; ++i) xe[d * n + i] += xc[d * nc + i];
+        return;
+      }
+      const double* xc = next.x.data() + static_cast<Eigen::Index>(fine.groups.parent[static_cast<std::size_t>(e)]) * next.bs;
+      const double* w = fine.groups.weights.data() + 16 * e;
+      for (int d = 0; d < 3; ++d)
+        for (int j = 0; j < kLinear; ++j) {
+          const double v = xc[d * kLinear + j];
+          for (int i = 0; i < kLinear; ++i) xe[d * kLinear + i] += w[i + 4 * j] * v;
+        }
+    });
+  }
+
+  /// x = V-cycle from level k applied to b, from x = 0.
+  void vcycle(std::size_t k, const Eigen::VectorXd& b, Eigen::VectorXd& x) const {
+    if (k + 1 == levels.size()) {
       coarseSolve(b, x);
       return;
     }
-    const Level& fine = levels[static_cast<std::size_t>(q)];
-    const Level& next = levels[static_cast<std::size_t>(q - 1)];
+    const Level& fine = levels[k];
+    const Level& next = levels[k + 1];
     x.setZero(b.size());
-    sweep(fine, b, x, false, true);
+    for (int s = 0; s < fine.sweeps; ++s) sweep(fine, b, x, false, s == 0);
     restrictedResidual(fine, next, b, x);
-    const int n = fine.n, nc = next.n;
-    const Eigen::Index ne = b.size() / fine.bs;
-    vcycle(q - 1, next.b, next.x);
-    tbb::parallel_for(Eigen::Index(0), ne, [&](Eigen::Index e) {
-      for (int d = 0; d < 3; ++d)
-        x.segment(e * fine.bs + d * n, nc) += next.x.segment(e * next.bs + d * nc, nc);
-    });
-    sweep(fine, b, x, true);
+    vcycle(k + 1, next.b, next.x);
+    prolongate(fine, next, x);
+    for (int s = 0; s < fine.sweeps; ++s) sweep(fine, b, x, true);
   }
 };
 
@@ -410,49 +539,74 @@ PMultigrid::PMultigrid(PMultigrid&&) noexcept = default;
 PMultigrid& PMultigrid::operator=(PMultigrid&&) noexcept = default;
 
 int PMultigrid::levels() const { return static_cast<int>(impl_->levels.size()); }
-int PMultigrid::colours() const { return static_cast<int>(impl_->colours.size()); }
+int PMultigrid::colours() const {
+  return impl_->levels.empty() ? 0 : static_cast<int>(impl_->levels.front().colours.size());
+}
+Eigen::Index PMultigrid::coarseUnknowns() const {
+  return impl_->levels.empty() ? 0 : impl_->levels.back().matrix->rows();
+}
 
-bool PMultigrid::compute(const SpMat& matrix, int degree, const BlockRows<double>* matrixBlocks) {
+bool PMultigrid::compute(const SpMat& matrix, int degree, const BlockRows<double>* matrixBlocks,
+                         const ElementFrames* frames) {
   Impl& m = *impl_;
-  m.levels.assign(static_cast<std::size_t>(degree) + 1, Level{});
+  m.levels.clear();
+  m.levels.emplace_back();
   Level& top = m.levels.back();
   top.n = numMonomials(degree);
   top.bs = 3 * top.n;
   functionsOfBlock(top.bs, degree);
   top.matrix = &matrix;
-  m.colours = colourElements(matrix, top.bs);
-  m.inLastColour.assign(static_cast<std::size_t>(matrix.cols() / top.bs), 0);
-  if (!m.colours.empty())
-    for (int e : m.colours.back()) m.inLastColour[static_cast<std::size_t>(e)] = 1;
-  for (int q = degree - 1; q >= 0; --q) {
-    Level& fine = m.levels[static_cast<std::size_t>(q) + 1];
-    Level& level = m.levels[static_cast<std::size_t>(q)];
+  top.colours = colourElements(matrix, top.bs);
+  const Eigen::Index ne = matrix.cols() / top.bs;
+  const bool agglomerate = frames != nullptr && degree >= 1 &&
+                           frames->centres.size() == static_cast<std::size_t>(ne) &&
+                           frames->scales.size() == static_cast<std::size_t>(ne) &&
+                           frames->linear.size() == static_cast<std::size_t>(ne);
+  // Degree levels down to 1 with frames (then agglomerates), else down to 0.
+  for (int q = degree - 1; q >= (agglomerate ? 1 : 0); --q) {
+    Level& fine = m.levels.back();
+    Level level;
     level.n = numMonomials(q);
     level.bs = 3 * level.n;
     level.owned = restrictMatrix(*fine.matrix, fine.n, level.n);
-    level.matrix = &level.owned;
+    level.colours = fine.colours;  // the same element graph
+    m.push(std::move(level));
   }
-  // Level 0 couples elements through the penalty, mu eta_F [u].[v], which couples equal
-  // components only, and (IP) the lifting of the normal jump, which couples components
-  // through n n^T. K stores the element blocks whole, so level 0 inherits explicit zeros
-  // that would make CHOLMOD factorize a coupled pattern: on B2 (3000 unknowns) 62 MFlop and
-  // 30-50 ms, against 7 MFlop and 5 ms once exact zeros are dropped (the three components
-  // then separate wherever the normals are axis-aligned, and for BZ everywhere).
-  if (degree > 0)
-    m.levels.front().owned.prune([](Eigen::Index, Eigen::Index, double v) { return v != 0.0; });
+  if (agglomerate) {
+    Level& elements = m.levels.back();
+    if (m.levels.size() == 1 && matrixBlocks != nullptr && !matrixBlocks->values.empty())
+      elements.source = matrixBlocks;
+    elements.centres = frames->centres;
+    elements.scales = frames->scales;
+    m.addAggregateLevel(&frames->linear);
+    // Further levels while the coarsest is large and grouping still shrinks it. Their
+    // smoothing is cheap (an eighth of the blocks each), so they sweep twice: a V-cycle with
+    // two agglomeration levels then needs about as many iterations as one with an exact
+    // first agglomeration level.
+    const double limit = std::max(static_cast<double>(kCoarseUnknowns),
+                                  std::sqrt(static_cast<double>(matrix.nonZeros())));
+    while (static_cast<double>(m.levels.back().matrix->rows()) > limit) {
+      const Eigen::Index before = m.levels.back().matrix->rows();
+      m.levels.back().sweeps = 2;
+      m.addAggregateLevel(nullptr);
+      if (m.levels.back().matrix->rows() * 4 > before * 3) break;  // grouping stalled
+    }
+  } else if (degree > 0) {
+    // Level 0 couples elements through the penalty, mu eta_F [u].[v], which couples equal
+    // components only, and (IP) the lifting of the normal jump, which couples components
+    // through n n^T. K stores the element blocks whole, so level 0 inherits explicit zeros
+    // that would make CHOLMOD factorize a coupled pattern: on B2 (3000 unknowns) 62 MFlop and
+    // 30-50 ms, against 7 MFlop and 5 ms once exact zeros are dropped (the three components
+    // then separate wherever the normals are axis-aligned, and for BZ everywhere).
+    m.levels.back().owned.prune([](Eigen::Index, Eigen::Index, double v) { return v != 0.0; });
+  }
   std::atomic<bool> ok{true};
-  // The smoother's blocks and the level-0 factorization (serial in CHOLMOD) side by side.
+  // The smoothers' blocks and the coarsest level's factorization (serial in CHOLMOD) side by
+  // side.
   tbb::parallel_invoke(
       [&] {
-        tbb::parallel_for(std::size_t(1), m.levels.size(), [&](std::size_t q) {
-          Level& level = m.levels[q];
-          if (q + 1 == m.levels.size() && matrixBlocks != nullptr && !matrixBlocks->values.empty()) {
-            level.blocks.convertFrom(*matrixBlocks);
-            level.useBlocks = true;
-          } else {
-            buildBlockRows(level);
-          }
-          if (!invertBlocks(level)) ok = false;
+        tbb::parallel_for(std::size_t(0), m.levels.size() - 1, [&](std::size_t k) {
+          if (!m.prepareSmoother(m.levels[k], k == 0 ? matrixBlocks : nullptr)) ok = false;
         });
       },
       [&] {
@@ -462,7 +616,7 @@ bool PMultigrid::compute(const SpMat& matrix, int degree, const BlockRows<double
 }
 
 void PMultigrid::apply(const Eigen::VectorXd& r, Eigen::VectorXd& z) const {
-  impl_->vcycle(static_cast<int>(impl_->levels.size()) - 1, r, z);
+  impl_->vcycle(0, r, z);
 }
 
 }  // namespace polydg

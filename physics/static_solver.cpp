@@ -4,6 +4,8 @@
 #include <chrono>
 #include <stdexcept>
 
+#include "physics/agglomeration.h"
+
 namespace polydg {
 
 namespace {
@@ -127,12 +129,16 @@ const Eigen::VectorXd& StaticSolver::solve() {
   const auto t0 = Clock::now();
   if (!factorized_) {
     solver_ = LinearSolver(options_.solver);
-    // Cholesky and the p-multigrid's level-0 factorization detect an indefinite K; the
+    const bool direct = chooseSolver(system_.matrix, options_.solver) == SolverKind::Cholesky;
+    // Cholesky and the p-multigrid's coarsest factorization detect an indefinite K; the
     // block-Jacobi preconditioner falls back to diagonals and lets CG report the failure.
     const bool definiteCheck =
-        solver_.kind() == SolverKind::Cholesky ||
-        options_.solver.preconditioner == CgPreconditioner::PMultigrid;
-    if (!solver_.compute(system_.matrix, system_.blockSize) && definiteCheck)
+        direct || options_.solver.preconditioner == CgPreconditioner::PMultigrid;
+    // The element frames let the p-multigrid coarsen by agglomerating elements (the linear
+    // displacements of groups of elements, rotations included).
+    const ElementFrames frames = direct ? ElementFrames{} : elementFrames(*basis_);
+    if (!solver_.compute(system_.matrix, system_.blockSize, direct ? nullptr : &frames) &&
+        definiteCheck)
       throw std::runtime_error(
           "the stiffness matrix is not positive definite: is the body held by a Dirichlet "
           "condition (e.g. --clamp)?");

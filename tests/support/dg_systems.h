@@ -1,20 +1,46 @@
-// DG systems for solver tests: K and F of benchmark B1 on a given mesh.
+// DG systems for solver tests: K and F of benchmarks B1 and B2, with the element frames the
+// p-multigrid's agglomeration levels need.
 #pragma once
 
+#include "physics/agglomeration.h"
 #include "physics/benchmarks.h"
 #include "physics/static_solver.h"
 
 namespace polydg {
 
-/// K and F of B1 on `mesh` (Dirichlet on the whole boundary, so K is SPD).
-inline LinearSystem b1System(const PolyMesh& mesh, Method method, int degree) {
-  const ManufacturedProblem problem = benchmarkB1Problem();
+/// K, F and the frames of the basis (physics/agglomeration.h).
+struct FramedSystem {
+  LinearSystem system;
+  ElementFrames frames;
+};
+
+/// K, F and frames of `loads` on `mesh`.
+inline FramedSystem framedSystem(const PolyMesh& mesh, const Material& material,
+                                 const LoadCase& loads, Method method, int degree) {
   StaticOptions o;
   o.discretization.method = method;
   o.discretization.basis.degree = degree;
-  StaticSolver solver(mesh, problem.material, o);
-  solver.assemble(benchmarkB1Loads(problem));
-  return solver.system();
+  StaticSolver solver(mesh, material, o);
+  solver.assemble(loads);
+  return {solver.system(), elementFrames(solver.basis())};
+}
+
+/// K, F and frames of B1 on `mesh` (Dirichlet on the whole boundary, so K is SPD).
+inline FramedSystem b1FramedSystem(const PolyMesh& mesh, Method method, int degree) {
+  const ManufacturedProblem problem = benchmarkB1Problem();
+  return framedSystem(mesh, problem.material, benchmarkB1Loads(problem), method, degree);
+}
+
+/// K and F of B1 on `mesh`.
+inline LinearSystem b1System(const PolyMesh& mesh, Method method, int degree) {
+  return b1FramedSystem(mesh, method, degree).system;
+}
+
+/// K, F and frames of B2 (the clamped cube under gravity: it bends, so rotations dominate
+/// the smooth part of the error).
+inline FramedSystem b2FramedSystem(Method method, int degree) {
+  return framedSystem(benchmarkB2Mesh(), benchmarkB2Material(), benchmarkB2Loads(), method,
+                      degree);
 }
 
 }  // namespace polydg

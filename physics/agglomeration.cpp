@@ -1,0 +1,283 @@
+#include "physics/agglomeration.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+
+#include <Eigen/Dense>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include "physics/block_rows.h"
+#include "physics/dg_basis.h"
+
+namespace polydg {
+
+namespace {
+
+using SpMat = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
+
+/// Functions per component of a group: the linear polynomials.
+constexpr int kLinear = 4;
+
+/// The blocks coupled with each block of `a` (block size bs), itself excluded, in order.
+std::vector<std::vector<int>> blockNeighbours(const SpMat& a, int bs) {
+  const int nb = static_cast<int>(a.cols() / bs);
+  std::vector<std::vector<int>> neighbours(static_cast<std::size_t>(nb));
+  tbb::parallel_for(0, nb, [&](int b) {
+    // Column b bs has a nonzero in every neighbour block (see colourElements()).
+    const Eigen::Index column = static_cast<Eigen::Index>(b) * bs;
+    int blockEnd = 0;
+    for (SpMat::InnerIterator it(a, column); it; ++it)
+      if (it.row() >= blockEnd) {
+        const int f = static_cast<int>(it.row() / bs);
+        blockEnd = (f + 1) * bs;
+        if (f != b) neighbours[static_cast<std::size_t>(b)].push_back(f);
+      }
+  });
+  return neighbours;
+}
+
+/// Smallest |cos| of the angle between the axis and the line joining two centres for a pair
+/// to form along that axis (60 degrees).
+constexpr double kMinAlignment = 0.5;
+
+/// Groups the blocks into agglomerates: three rounds of greedy pairing of neighbours (blocks,
+/// then pairs, then pairs of pairs), round k pairing along axis k, each group with its
+/// unpaired neighbour best aligned with the axis (at least kMinAlignment; groups in order,
+/// ties to the first neighbour). On a hex grid: 2 x 2 x 2 blocks. Groups are centred at the
+/// mean of their blocks' centres. Returns each block's agglomerate; `count` their number.
+std::vector<int> pairAlongAxes(const std::vector<std::vector<int>>& neighbours,
+                               const std::vector<Eigen::Vector3d>& centres, int& count) {
+  const int nb = static_cast<int>(neighbours.size());
+  std::vector<int> group(static_cast<std::size_t>(nb));
+  for (int b = 0; b < nb; ++b) group[static_cast<std::size_t>(b)] = b;
+  std::vector<Eigen::Vector3d> centre = centres;
+  std::vector<int> weight(static_cast<std::size_t>(nb), 1);
+  int groups = nb;
+  for (int axis = 0; axis < 3; ++axis) {
+    std::vector<std::vector<int>> adjacent(static_cast<std::size_t>(groups));
+    for (int b = 0; b < nb; ++b)
+      for (int f : neighbours[static_cast<std::size_t>(b)])
+        if (group[static_cast<std::size_t>(f)] != group[static_cast<std::size_t>(b)])
+          adjacent[static_cast<std::size_t>(group[static_cast<std::size_t>(b)])].push_back(
+              group[static_cast<std::size_t>(f)]);
+    std::vector<int> merged(static_cast<std::size_t>(groups), -1);
+    std::vector<Eigen::Vector3d> nextCentre;
+    std::vector<int> nextWeight;
+    for (int g = 0; g < groups; ++g) {
+      if (merged[static_cast<std::size_t>(g)] >= 0) continue;
+      std::vector<int>& adj = adjacent[static_cast<std::size_t>(g)];
+      std::sort(adj.begin(), adj.end());
+      int best = -1;
+      double bestAlignment = kMinAlignment;
+      for (std::size_t k = 0; k < adj.size(); ++k) {
+        const int h = adj[k];
+        if ((k > 0 && adj[k - 1] == h) || merged[static_cast<std::size_t>(h)] >= 0) continue;
+        const Eigen::Vector3d v = centre[static_cast<std::size_t>(h)] - centre[static_cast<std::size_t>(g)];
+        const double length = v.norm();
+        if (!(length > 0.0)) continue;
+        const double alignment = std::abs(v[axis]) / length;
+        if (alignment >= bestAlignment && (best < 0 || alignment > bestAlignment)) {
+          best = h;
+          bestAlignment = alignment;
+        }
+      }
+      const int id = static_cast<int>(nextCentre.size());
+      merged[static_cast<std::size_t>(g)] = id;
+      Eigen::Vector3d sum = weight[static_cast<std::size_t>(g)] * centre[static_cast<std::size_t>(g)];
+      int w = weight[static_cast<std::size_t>(g)];
+      if (best >= 0) {
+        merged[static_cast<std::size_t>(best)] = id;
+        sum += weight[static_cast<std::size_t>(best)] * centre[static_cast<std::size_t>(best)];
+        w += weight[static_cast<std::size_t>(best)];
+      }
+      nextCentre.push_back(sum / w);
+      nextWeight.push_back(w);
+    }
+    for (int& g : group) g = merged[static_cast<std::size_t>(g)];
+    centre = std::move(nextCentre);
+    weight = std::move(nextWeight);
+    groups = static_cast<int>(centre.size());
+  }
+  count = groups;
+  return group;
+}
+
+/// Column j of the result: the coarse monomial j of a group centred at C with scale H
+/// (1, (x - C) / H, ...) in the scaled monomials of a block centred at c with scale h.
+Eigen::Matrix4d linearChange(const Eigen::Vector3d& c, double h, const Eigen::Vector3d& C, double H) {
+  Eigen::Matrix4d m = Eigen::Matrix4d::Zero();
+  m(0, 0) = 1.0;
+  for (int l = 0; l < 3; ++l) {
+    m(0, 1 + l) = (c[l] - C[l]) / H;
+    m(1 + l, 1 + l) = h / H;
+  }
+  return m;
+}
+
+}  // namespace
+
+SpMat galerkinMatrix(const Agglomeration& fine, const BlockRows<double>& rows) {
+  const int coarseBlocks = fine.groups();
+  constexpr int n = kLinear, bs = 3 * n, bs2 = bs * bs;
+  using Mat4 = Eigen::Matrix4d;
+  using Block = Eigen::Matrix<double, bs, bs>;
+  // Per coarse row block C: its coarse column blocks B <= C (in order met) and P_CB.
+  struct Row {
+    std::vector<int> columns;
+    std::vector<double> panel;  // block k at 144 k, column-major
+  };
+  std::vector<Row> panels(static_cast<std::size_t>(coarseBlocks));
+  tbb::enumerable_thread_specific<std::vector<int>> slots(
+      std::vector<int>(static_cast<std::size_t>(coarseBlocks), -1));
+  tbb::parallel_for(0, coarseBlocks, [&](int cc) {
+    std::vector<int>& slot = slots.local();
+    Row& row = panels[static_cast<std::size_t>(cc)];
+    row.columns.reserve(8);
+    row.panel.reserve(8 * bs2);
+    for (int k = fine.childStart[static_cast<std::size_t>(cc)];
+         k < fine.childStart[static_cast<std::size_t>(cc) + 1]; ++k) {
+      const int e = fine.children[static_cast<std::size_t>(k)];
+      const Eigen::Map<const Mat4> we(fine.weights.data() + 16 * static_cast<std::size_t>(e));
+      for (int t = rows.start[static_cast<std::size_t>(e)]; t < rows.start[static_cast<std::size_t>(e) + 1]; ++t) {
+        const std::size_t sl = static_cast<std::size_t>(t);
+        const int f = rows.element[sl];
+        const int cb = fine.parent[static_cast<std::size_t>(f)];
+        if (cb > cc) continue;  // upper triangle: mirrored later
+        int s = slot[static_cast<std::size_t>(cb)];
+        if (s < 0) {
+          s = static_cast<int>(row.columns.size());
+          slot[static_cast<std::size_t>(cb)] = s;
+          row.columns.push_back(cb);
+          row.panel.resize(row.panel.size() + bs2, 0.0);
+        }
+        const Eigen::Map<const Mat4> wf(fine.weights.data() + 16 * static_cast<std::size_t>(f));
+        Eigen::Map<Block> target(row.panel.data() + static_cast<std::size_t>(s) * bs2);
+        const double* values = rows.values.data() + rows.offset[sl];
+        if (rows.diagonal[sl]) {
+          for (int d = 0; d < 3; ++d)
+            target.block<n, n>(d * n, d * n).noalias() +=
+                we.transpose() * (Eigen::Map<const Mat4>(values + d * n * n) * wf);
+          continue;
+        }
+        const Eigen::Map<const Block> block(values);
+        for (int dr = 0; dr < 3; ++dr)
+          for (int dc = 0; dc < 3; ++dc)
+            target.block<n, n>(dr * n, dc * n).noalias() +=
+                we.transpose() * (block.block<n, n>(dr * n, dc * n) * wf);
+      }
+    }
+    for (int c : row.columns) slot[static_cast<std::size_t>(c)] = -1;
+  });
+  // The upper triangle by columns: column block C holds (B, C) = P_CB^T for B <= C, in order;
+  // coupled or component-diagonal blocks.
+  const Eigen::Index size = static_cast<Eigen::Index>(coarseBlocks) * bs;
+  std::vector<int> counts(static_cast<std::size_t>(size) + 1, 0);
+  std::vector<std::vector<std::pair<int, int>>> order(static_cast<std::size_t>(coarseBlocks));
+  tbb::parallel_for(0, coarseBlocks, [&](int cc) {
+    const Row& row = panels[static_cast<std::size_t>(cc)];
+    // (coarse block B, slot), sorted; the slot coded -1 - slot if component-diagonal.
+    std::vector<std::pair<int, int>>& blocks = order[static_cast<std::size_t>(cc)];
+    for (std::size_t s = 0; s < row.columns.size(); ++s) {
+      const double* block = row.panel.data() + s * bs2;
+      bool coupled = row.columns[s] == cc;
+      for (int c = 0; c < bs && !coupled; ++c)
+        for (int r = 0; r < bs; ++r)
+          if (r / n != c / n && block[c * bs + r] != 0.0) coupled = true;
+      blocks.emplace_back(row.columns[s], coupled ? static_cast<int>(s) : -1 - static_cast<int>(s));
+    }
+    std::sort(blocks.begin(), blocks.end());
+    for (int c = 0; c < bs; ++c) {
+      int count = 0;
+      for (const auto& [cb, code] : blocks)
+        count += cb == cc ? c + 1 : code >= 0 ? bs : n;  // diagonal block: rows <= c
+      counts[static_cast<std::size_t>(cc * bs + c) + 1] = count;
+    }
+  });
+  for (std::size_t c = 1; c < counts.size(); ++c) counts[c] += counts[c - 1];
+  SpMat upper(size, size);
+  upper.resizeNonZeros(counts.back());
+  std::copy(counts.begin(), counts.end(), upper.outerIndexPtr());
+  int* rowIndex = upper.innerIndexPtr();
+  double* entry = upper.valuePtr();
+  tbb::parallel_for(0, coarseBlocks, [&](int cc) {
+    const Row& row = panels[static_cast<std::size_t>(cc)];
+    for (int c = 0; c < bs; ++c) {
+      int pos = counts[static_cast<std::size_t>(cc * bs + c)];
+      for (const auto& [cb, code] : order[static_cast<std::size_t>(cc)]) {
+        const bool coupled = code >= 0;
+        const std::size_t s = static_cast<std::size_t>(coupled ? code : -1 - code);
+        // Entry (r, c) of block (B, C) is entry (c, r) of P_CB.
+        const double* block = row.panel.data() + s * bs2;
+        const int first = coupled || cb == cc ? 0 : (c / n) * n;
+        const int last = cb == cc ? c + 1 : coupled ? bs : first + n;
+        for (int r = first; r < last; ++r) {
+          rowIndex[pos] = cb * bs + r;
+          entry[pos++] = block[r * bs + c];
+        }
+      }
+    }
+  });
+  SpMat full = upper.selfadjointView<Eigen::Upper>();
+  return full;
+}
+
+ElementFrames elementFrames(const DgBasis& basis) {
+  ElementFrames frames;
+  const std::size_t ne = basis.numElements();
+  frames.centres.resize(ne);
+  frames.scales.resize(ne);
+  frames.linear.resize(ne);
+  for (std::size_t e = 0; e < ne; ++e) {
+    const ElementId id(e);
+    frames.centres[e] = basis.centre(id);
+    frames.scales[e] = basis.scale(id);
+    frames.linear[e] = basis.coefficients(id).topLeftCorner<4, 4>();
+  }
+  return frames;
+}
+
+Agglomeration agglomerate(const SpMat& matrix, int bs, const std::vector<Eigen::Vector3d>& centres,
+                          const std::vector<double>& scales,
+                          const std::vector<Eigen::Matrix4d>* linear) {
+  const int nb = static_cast<int>(matrix.cols() / bs);
+  Agglomeration a;
+  int count = 0;
+  a.parent = pairAlongAxes(blockNeighbours(matrix, bs), centres, count);
+  a.childStart.assign(static_cast<std::size_t>(count) + 1, 0);
+  for (int g : a.parent) ++a.childStart[static_cast<std::size_t>(g) + 1];
+  for (std::size_t g = 0; g < static_cast<std::size_t>(count); ++g) a.childStart[g + 1] += a.childStart[g];
+  a.children.resize(static_cast<std::size_t>(nb));
+  std::vector<int> next(a.childStart.begin(), a.childStart.end() - 1);
+  for (int b = 0; b < nb; ++b)
+    a.children[static_cast<std::size_t>(next[static_cast<std::size_t>(a.parent[static_cast<std::size_t>(b)])]++)] = b;
+  a.centres.assign(static_cast<std::size_t>(count), Eigen::Vector3d::Zero());
+  a.scales.assign(static_cast<std::size_t>(count), 0.0);
+  for (std::size_t g = 0; g < static_cast<std::size_t>(count); ++g) {
+    const int first = a.childStart[g], last = a.childStart[g + 1];
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (int k = first; k < last; ++k) sum += centres[static_cast<std::size_t>(a.children[static_cast<std::size_t>(k)])];
+    a.centres[g] = sum / (last - first);
+    for (int k = first; k < last; ++k) {
+      const std::size_t b = static_cast<std::size_t>(a.children[static_cast<std::size_t>(k)]);
+      a.scales[g] = std::max(a.scales[g], (centres[b] - a.centres[g]).norm() + scales[b]);
+    }
+  }
+  a.weights.resize(16 * static_cast<std::size_t>(nb));
+  tbb::parallel_for(0, nb, [&](int b) {
+    const std::size_t i = static_cast<std::size_t>(b);
+    const std::size_t g = static_cast<std::size_t>(a.parent[i]);
+    const Eigen::Matrix4d change = linearChange(centres[i], scales[i], a.centres[g], a.scales[g]);
+    // phi = T m: the group function sum_a change(a, j) m_a is sum_i W(i, j) phi_i with
+    // T^T W = change (T lower triangular).
+    Eigen::Map<Eigen::Matrix4d> w(a.weights.data() + 16 * i);
+    if (linear != nullptr)
+      w = (*linear)[i].transpose().triangularView<Eigen::Upper>().solve(change);
+    else
+      w = change;
+  });
+  return a;
+}
+
+}  // namespace polydg
