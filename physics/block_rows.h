@@ -58,52 +58,16 @@ struct BlockRows {
     for (int c = 0; c < bs; ++c) out[c] = -out[c];
   }
 
-  /// out -= (A x)_e, the rows of element e (bs values).
-  void subtractRowProduct(int e, const double* x, double* out) const {
-    // Compile-time sizes for the DG degrees (n = 1, 4, 10, 20): the short column loops unroll
-    // and vectorize; B2, p = 1: ... faster than with the sizes known at run time.
-    switch (n) {
-      case 1: return subtractRowProductOf<1>(e, x, out);
-      case 4: return subtractRowProductOf<4>(e, x, out);
-      case 10: return subtractRowProductOf<10>(e, x, out);
-      case 20: return subtractRowProductOf<20>(e, x, out);
-      default: return subtractRowProductOf<0>(e, x, out);
-    }
-  }
-
- private:
-  /// subtractRowProduct() with N functions per component (0: n, known at run time only).
-  template <int N>
-  void subtractRowProductOf(int e, const double* x, double* out) const {
-    const int nn = N > 0 ? N : n, bb = 3 * nn;
-    for (int k = start[static_cast<std::size_t>(e)]; k < start[static_cast<std::size_t>(e) + 1];
-         ++k) {
-      const std::size_t slot = static_cast<std::size_t>(k);
-      const T* block = values.data() + offset[slot];
-      const double* xf = x + static_cast<std::ptrdiff_t>(element[slot]) * bb;
-      // Column by column: the inner loop has no reduction and vectorizes.
-      if (diagonal[slot]) {
-        for (int d = 0; d < 3; ++d)
-          for (int j = 0; j < nn; ++j) {
-            const T* column = block + (d * nn + j) * nn;
-            const double xj = xf[d * nn + j];
-            double* od = out + d * nn;
-            for (int i = 0; i < nn; ++i) od[i] -= static_cast<double>(column[i]) * xj;
-          }
-        continue;
-      }
-      for (int d = 0; d < bb; ++d) {
-        const T* column = block + d * bb;
-        const double xd = xf[d];
-        for (int c = 0; c < bb; ++c) out[c] -= static_cast<double>(column[c]) * xd;
-      }
-    }
-  }
-
- public:
+  /// out -= (A x)_e, the rows of element e (bs values). Compiled for the block sizes of the
+  /// DG degrees and for the CPU's vector instructions (see block_rows.cpp).
+  void subtractRowProduct(int e, const double* x, double* out) const;
 };
 
 extern template struct BlockRows<float>;
 extern template struct BlockRows<double>;
+
+/// x += M s for a dense bs x bs column-major M (an element's inverse diagonal block in the
+/// p-multigrid smoother), compiled like BlockRows::subtractRowProduct.
+void addDenseProduct(int bs, const double* matrix, const double* s, double* x);
 
 }  // namespace polydg
