@@ -50,7 +50,8 @@ struct SolverOptions {
   /// (p-multigrid CG, p = 1 and 2): at 1e-10 the algebraic error is 1e-12 (l2) and 3e-12
   /// (energy norm) relative, at 1e-8 2e-11 / 2e-10; discretization errors of these problems
   /// are 1e-2 .. 1e-6 relative (B1), so the algebraic error stays 6+ orders below them. Each
-  /// decade costs 2-4 p-multigrid iterations (B2, p = 1: 27 iterations at 1e-8, 31 at 1e-10).
+  /// decade costs 2-4 p-multigrid iterations (B2, p = 1, with the piecewise constants as coarse
+  /// level: 27 iterations at 1e-8, 31 at 1e-10).
   double tolerance = 1e-10;
   int maxIterations = 20000;
 };
