@@ -211,7 +211,7 @@ TEST(BenchCommand, StabilitySuiteWritesJsonCsvAndPlots) {
     EXPECT_TRUE(s.contains("tip") && s.contains("reference") && s.contains("nu"));
   EXPECT_EQ(j["scale"].size(), 12u);  // B1 and B3, 3 scales, 2 offsets
   // Round-off: the coordinates' relative resolution amplified by the stiffness's condition
-  // number, an order-of-magnitude bound (its constant is not known; the full suite reaches 1.6).
+  // number, an order-of-magnitude bound (its constant is not known; the full suite reaches 2.6).
   constexpr double kRoundoffBoundFactor = 10.0;
   for (const nlohmann::json& s : j["scale"])
     EXPECT_LE(s["change"].get<double>(), kRoundoffBoundFactor * s["roundoff_bound"].get<double>())
