@@ -14,6 +14,7 @@
 #include "physics/linear_solver.h"
 #include "physics/static_solver.h"
 #include "tests/support/dg_systems.h"
+#include "tests/support/shapes.h"
 
 namespace polydg {
 namespace {
@@ -98,6 +99,29 @@ TEST(PMultigrid, AgglomeratesNeedFewerIterationsThanConstantsOnTheBentCube) {
     // Measured 38 -> 24 (BZ) and 31 -> 24 (IP).
     EXPECT_LT(iterations[1], iterations[0] * 0.8);
   }
+}
+
+TEST(PMultigrid, AgglomeratesOfTwoSeparateBodies) {
+  // Two bodies (two elements and one): groups never join them; the lone element is a group of
+  // its own. CG still reproduces Cholesky's solution.
+  const FramedSystem s = b1FramedSystem(testing::twoSeparateBlocks(), Method::IP, 2);
+  SolverOptions direct;
+  direct.kind = SolverKind::Cholesky;
+  SolveReport directReport;
+  const Eigen::VectorXd reference = solveLinearSystem(s.system.matrix, s.system.rhs,
+                                                      s.system.blockSize, direct, directReport);
+  ASSERT_TRUE(directReport.success);
+  PMultigrid mg;
+  ASSERT_TRUE(mg.compute(s.system.matrix, 2, nullptr, &s.frames));
+  EXPECT_EQ(mg.coarseUnknowns(), 2 * 12);
+  SolverOptions cg;
+  cg.kind = SolverKind::ConjugateGradient;
+  LinearSolver solver(cg);
+  ASSERT_TRUE(solver.compute(s.system.matrix, s.system.blockSize, &s.frames));
+  SolveReport report;
+  const Eigen::VectorXd u = solver.solve(s.system.rhs, report);
+  EXPECT_TRUE(report.success);
+  EXPECT_LE((u - reference).norm(), kSolutionAgreement * reference.norm());
 }
 
 TEST(PMultigrid, AgglomerationLevelsOfTheHexCube) {
