@@ -568,9 +568,8 @@ class InputRun {
     const Eigen::VectorXd& u = solver.solve();
     const StaticReport& r = solver.report();
     if (!r.solver.success) throw StepFailure("the linear solver failed (is every piece clamped?)");
-    const VertexData<Vec3> vertexU = vertexDisplacements(mesh(), solver.basis(), u);
-    double maxDisplacement = 0.0;
-    for (const Vec3& v : vertexU) maxDisplacement = std::max(maxDisplacement, v.norm());
+    const CornerValues corners = cornerDisplacements(mesh(), solver.basis(), u);
+    const double maxDisplacement = corners.largestNorm();
     result.update({{"method", toString(s.method)},
                    {"degree", s.degree},
                    {"dofs", r.dofs},
@@ -590,9 +589,7 @@ class InputRun {
       const std::string file = (folder_ / substituteStem(s.output, stem_)).string();
       fs::create_directories(fs::path(file).parent_path());
       CellArray vonMises{"von_mises", 1, fields.vonMises.raw()};
-      PointArray displacement{"displacement", 3, {}};
-      for (const Vec3& v : vertexU) displacement.values.insert(displacement.values.end(), {v.x(), v.y(), v.z()});
-      writeVtu(mesh(), file, {}, {vonMises}, {displacement});
+      writeVtu(mesh(), file, {}, {vonMises}, {}, {displacementPointData(corners)});
       result["output"] = substituteStem(s.output, stem_);
     }
     log("solve: " + std::to_string(r.dofs) + " DOFs, max |u| " + formatNumber(maxDisplacement));

@@ -196,16 +196,16 @@ void runSolve(const SolveOptions& o, const CommonOptions& common) {
   const StaticReport& report = solver.report();
 
   const auto tw = Clock::now();
-  const VertexData<Vec3> vertexU = vertexDisplacements(mesh, solver.basis(), u);
+  const CornerValues corners = cornerDisplacements(mesh, solver.basis(), u);
   const ElementFields fields = elementFields(mesh, solver.basis(), solver.moments(), u, o.material);
   std::vector<CellArray> cells{vectorArray("mean_displacement", fields.meanDisplacement),
                                CellArray{"von_mises", 1, fields.vonMises.raw()},
                                CellArray{"largest_jump", 1, fields.largestJump.raw()}};
-  writeVtu(mesh, o.output, {}, cells, {vectorArray("displacement", vertexU)});
+  writeVtu(mesh, o.output, {}, cells, {}, {displacementPointData(corners)});
   const double writeSeconds = secondsSince(tw);
 
-  double maxDisplacement = 0.0, maxJump = 0.0, maxVonMises = 0.0;
-  for (const Vec3& v : vertexU) maxDisplacement = std::max(maxDisplacement, v.norm());
+  const double maxDisplacement = corners.largestNorm();
+  double maxJump = 0.0, maxVonMises = 0.0;
   for (double j : fields.largestJump) maxJump = std::max(maxJump, j);
   for (double s : fields.vonMises) maxVonMises = std::max(maxVonMises, s);
 

@@ -190,6 +190,11 @@ struct CellStreams {
   /// The mesh vertex of each VTU point: points 0 .. numVertices-1 are the vertices themselves,
   /// later points are further copies of a vertex (one per extra group of its elements).
   std::vector<std::int64_t> pointVertex;
+  /// Element e's corners (distinct vertices) are incidences cornerBegin[e] .. cornerBegin[e+1]:
+  /// vertex cornerVertex[i], written as point cornerPoint[i].
+  std::vector<std::size_t> cornerBegin;
+  std::vector<VertexId> cornerVertex;
+  std::vector<std::uint32_t> cornerPoint;
 };
 
 /// The records (simple polygons) that stand for each face in the file, in the face's own
@@ -318,6 +323,9 @@ CellStreams buildCellStreams(const PolyMesh& mesh) {
   const Incidences inc = elementIncidences(mesh, records);
   CellStreams s;
   const std::vector<std::uint32_t> point = incidencePoints(mesh, inc, s.pointVertex);
+  s.cornerBegin = inc.begin;
+  s.cornerVertex = inc.vertices;
+  s.cornerPoint = point;
 
   // Cells in increasing order of their point count (stable), see kElementArray.
   std::vector<std::size_t> order(ne);
@@ -378,18 +386,25 @@ CellStreams buildCellStreams(const PolyMesh& mesh) {
   return s;
 }
 
+/// An array's name (non-empty, unused so far among `names`, then recorded) and component count
+/// (1 or 3).
+void checkName(const std::string& name, int components, const char* kind,
+               std::unordered_set<std::string>& names) {
+  if (name.empty())
+    throw std::invalid_argument(std::string("writeVtu: a ") + kind + " array has no name");
+  if (!names.insert(name).second)
+    throw std::invalid_argument(std::string("writeVtu: ") + kind + " array name '" + name +
+                                "' is used twice");
+  if (components != 1 && components != 3)
+    throw std::invalid_argument("writeVtu: array '" + name + "' has " +
+                                std::to_string(components) + " components; use 1 or 3");
+}
+
 template <class Tag>
 void checkArrays(const std::vector<VtuArray<Tag>>& arrays, std::size_t count, const char* kind,
                  std::unordered_set<std::string>& names) {
   for (const auto& a : arrays) {
-    if (a.name.empty())
-      throw std::invalid_argument(std::string("writeVtu: a ") + kind + " array has no name");
-    if (!names.insert(a.name).second)
-      throw std::invalid_argument(std::string("writeVtu: ") + kind + " array name '" + a.name +
-                                  "' is used twice");
-    if (a.components != 1 && a.components != 3)
-      throw std::invalid_argument("writeVtu: array '" + a.name + "' has " +
-                                  std::to_string(a.components) + " components; use 1 or 3");
+    checkName(a.name, a.components, kind, names);
     if (a.values.size() != count * static_cast<std::size_t>(a.components))
       throw std::invalid_argument("writeVtu: array '" + a.name + "' has " +
                                   std::to_string(a.values.size()) + " values, expected " +
@@ -523,6 +538,7 @@ void writeDataArray(std::ostream& os, const ArrayOut& a, VtuEncoding encoding,
 struct FileValues {
   std::vector<double> points;                   ///< 3 per VTU point
   std::vector<std::vector<double>> pointArrays;  ///< pointData, copied to every VTU point
+  std::vector<std::vector<double>> cornerArrays;  ///< cornerData, the mean per VTU point
   std::vector<double> volume;                   ///< per cell
   std::vector<std::vector<double>> cellArrays;  ///< cellData, in cell order
 };
@@ -539,9 +555,34 @@ std::vector<double> gatherRows(const std::vector<double>& values, int components
   return out;
 }
 
+/// The mean of `a`'s corner values over the corners written as each VTU point.
+std::vector<double> cornerMeans(const CellStreams& s, const CornerArray& a) {
+  const auto k = static_cast<std::size_t>(a.components);
+  const std::size_t ne = s.cornerBegin.size() - 1;
+  std::vector<double> corner(s.cornerVertex.size() * k);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ne, 256),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t e = r.begin(); e != r.end(); ++e)
+                        for (std::size_t i = s.cornerBegin[e]; i < s.cornerBegin[e + 1]; ++i)
+                          a.value(ElementId(e), s.cornerVertex[i], corner.data() + i * k);
+                    });
+  std::vector<double> mean(s.pointVertex.size() * k, 0.0);
+  std::vector<std::uint32_t> count(s.pointVertex.size(), 0);
+  for (std::size_t i = 0; i < s.cornerPoint.size(); ++i) {
+    const std::size_t p = s.cornerPoint[i];
+    ++count[p];
+    for (std::size_t c = 0; c < k; ++c) mean[p * k + c] += corner[i * k + c];
+  }
+  for (std::size_t p = 0; p < count.size(); ++p)
+    for (std::size_t c = 0; c < k; ++c)
+      if (count[p] > 0) mean[p * k + c] /= count[p];  // a vertex of no element keeps 0
+  return mean;
+}
+
 FileValues fileValues(const PolyMesh& mesh, const CellStreams& s,
                       const std::vector<CellArray>& cellData,
-                      const std::vector<PointArray>& pointData) {
+                      const std::vector<PointArray>& pointData,
+                      const std::vector<CornerArray>& cornerData) {
   FileValues v;
   const std::size_t np = s.pointVertex.size(), ne = s.element.size();
   v.points.resize(3 * np);
@@ -558,6 +599,7 @@ FileValues fileValues(const PolyMesh& mesh, const CellStreams& s,
                     });
   for (const PointArray& a : pointData)
     v.pointArrays.push_back(gatherRows(a.values, a.components, s.pointVertex));
+  for (const CornerArray& a : cornerData) v.cornerArrays.push_back(cornerMeans(s, a));
   for (const CellArray& a : cellData)
     v.cellArrays.push_back(gatherRows(a.values, a.components, s.element));
   return v;
@@ -565,7 +607,8 @@ FileValues fileValues(const PolyMesh& mesh, const CellStreams& s,
 
 void writeContents(std::ostream& os, const PolyMesh& mesh, const CellStreams& s,
                    const FileValues& values, const std::vector<CellArray>& cellData,
-                   const std::vector<PointArray>& pointData, VtuEncoding enc) {
+                   const std::vector<PointArray>& pointData,
+                   const std::vector<CornerArray>& cornerData, VtuEncoding enc) {
   const std::string_view field = "      ", inner = "        ";
   std::vector<ArrayOut> fieldArrays{
       intArray(field, kFaceGroupArray, s.faceGroup, true),
@@ -578,6 +621,9 @@ void writeContents(std::ostream& os, const PolyMesh& mesh, const CellStreams& s,
   for (std::size_t i = 0; i < pointData.size(); ++i)
     pointArrays.push_back(
         floatArray(inner, pointData[i].name, pointData[i].components, values.pointArrays[i]));
+  for (std::size_t i = 0; i < cornerData.size(); ++i)
+    pointArrays.push_back(floatArray(inner, cornerData[i].name, cornerData[i].components,
+                                     values.cornerArrays[i]));
   cellArrays.push_back(floatArray(inner, "volume", 1, values.volume));
   for (std::size_t i = 0; i < cellData.size(); ++i)
     cellArrays.push_back(
@@ -1356,13 +1402,19 @@ PolyMesh readVtuContents(const std::string& path) {
 // ============================================================================================
 
 void writeVtu(const PolyMesh& mesh, const std::string& path, const VtuWriteOptions& options,
-              const std::vector<CellArray>& cellData, const std::vector<PointArray>& pointData) {
+              const std::vector<CellArray>& cellData, const std::vector<PointArray>& pointData,
+              const std::vector<CornerArray>& cornerData) {
   std::unordered_set<std::string> cellNames{"volume"}, pointNames;
   checkArrays(cellData, mesh.numElements(), "cell", cellNames);
   checkArrays(pointData, mesh.numVertices(), "point", pointNames);
+  for (const CornerArray& a : cornerData) {
+    checkName(a.name, a.components, "point", pointNames);
+    if (!a.value)
+      throw std::invalid_argument("writeVtu: corner array '" + a.name + "' has no value function");
+  }
   // Everything that can fail for reasons other than I/O happens before the file is opened.
   const CellStreams streams = buildCellStreams(mesh);
-  const FileValues values = fileValues(mesh, streams, cellData, pointData);
+  const FileValues values = fileValues(mesh, streams, cellData, pointData, cornerData);
 
   const std::string tmp = path + ".tmp";
   auto fail = [&](int error) {
@@ -1374,7 +1426,7 @@ void writeVtu(const PolyMesh& mesh, const std::string& path, const VtuWriteOptio
     if (!os) fail(errno);
     errno = 0;
     try {
-      writeContents(os, mesh, streams, values, cellData, pointData, options.encoding);
+      writeContents(os, mesh, streams, values, cellData, pointData, cornerData, options.encoding);
     } catch (...) {
       os.close();
       std::remove(tmp.c_str());

@@ -2,6 +2,7 @@
 // the layout read by VTK 9.1, ParaView 5.11 and meshio 5.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -31,6 +32,18 @@ struct VtuArray {
 using CellArray = VtuArray<ElementTag>;  ///< numElements() * components values
 using PointArray = VtuArray<VertexTag>;  ///< numVertices() * components values
 
+/// Point data given per element corner: value(e, v, out) writes element e's `components`
+/// values at its vertex v. Each point of the file gets the mean over the elements it stands
+/// for: a vertex has one point per group of its elements joined by interior faces (see
+/// writeVtu), so the two sides of a cut keep their own means (paper eq. 17 per side) where a
+/// PointArray would give both the same value. value is called once per element and vertex,
+/// from several threads at once.
+struct CornerArray {
+  std::string name;
+  int components = 1;
+  std::function<void(ElementId, VertexId, double*)> value;
+};
+
 /// Writes `mesh` to `path` as a VTK XML UnstructuredGrid (version 1.0, UInt64 headers).
 ///
 /// Layout: points (Float64) are the mesh's vertices in id order, followed by extra copies of
@@ -50,7 +63,8 @@ using PointArray = VtuArray<VertexTag>;  ///< numVertices() * components values
 /// watertight.
 ///
 /// Cell data: `volume` (signedVolume of each element) followed by `cellData`; point data:
-/// `pointData` (every copy of a vertex carries the vertex's value). Field data lets readVtu
+/// `pointData` (every copy of a vertex carries the vertex's value), then `cornerData` (each
+/// point the mean of its elements' values). Field data lets readVtu
 /// restore the mesh exactly:
 ///   - polydg_face_group: per face record, in file order, the id of the face it belongs to;
 ///   - polydg_face_reversed: per face record, 1 if it runs against its face's orientation
@@ -67,7 +81,8 @@ using PointArray = VtuArray<VertexTag>;  ///< numVertices() * components values
 /// std::runtime_error if a face with holes cannot be triangulated.
 void writeVtu(const PolyMesh& mesh, const std::string& path, const VtuWriteOptions& options = {},
               const std::vector<CellArray>& cellData = {},
-              const std::vector<PointArray>& pointData = {});
+              const std::vector<PointArray>& pointData = {},
+              const std::vector<CornerArray>& cornerData = {});
 
 /// Reads a VTK XML UnstructuredGrid file into a PolyMesh.
 ///

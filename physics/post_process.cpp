@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include <Eigen/Cholesky>
 #include <tbb/parallel_for.h>
@@ -40,28 +41,53 @@ Eigen::Matrix3d displacementGradientAt(const DgBasis& basis, const Eigen::Vector
   return g;
 }
 
-VertexData<Vec3> vertexDisplacements(const PolyMesh& mesh, const DgBasis& basis,
-                                     const Eigen::VectorXd& coefficients) {
-  VertexData<Vec3> sum(mesh.numVertices(), Vec3::Zero());
-  VertexData<int> count(mesh.numVertices(), 0);
-  std::vector<VertexId> vertices;
-  for (std::size_t i = 0; i < mesh.numElements(); ++i) {
-    const ElementId e(i);
-    vertices.clear();
-    for (const FaceUse& use : mesh.element(e).faces)
-      for (VertexId v : mesh.face(use.face).vertices) vertices.push_back(v);
-    std::sort(vertices.begin(), vertices.end());
-    vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
-    for (VertexId v : vertices) {
-      sum[v] += displacementAt(basis, coefficients, e, mesh.position(v));
-      ++count[v];
+const Vec3& CornerValues::at(ElementId e, VertexId v) const {
+  const auto first = vertices.begin() + static_cast<std::ptrdiff_t>(begin[e.index()]);
+  const auto last = vertices.begin() + static_cast<std::ptrdiff_t>(begin[e.index() + 1]);
+  const auto it = std::lower_bound(first, last, v);
+  if (it == last || *it != v) throw std::logic_error("CornerValues::at: not a vertex of the element");
+  return values[static_cast<std::size_t>(it - vertices.begin())];
+}
+
+double CornerValues::largestNorm() const {
+  double largest = 0.0;
+  for (const Vec3& u : values) largest = std::max(largest, u.norm());
+  return largest;
+}
+
+CornerValues cornerDisplacements(const PolyMesh& mesh, const DgBasis& basis,
+                                 const Eigen::VectorXd& coefficients) {
+  const std::size_t ne = mesh.numElements();
+  std::vector<std::vector<VertexId>> perElement(ne);
+  tbb::parallel_for(std::size_t(0), ne, [&](std::size_t i) {
+    std::vector<VertexId>& vs = perElement[i];
+    for (const FaceUse& use : mesh.element(ElementId(i)).faces)
+      for (VertexId v : mesh.face(use.face).vertices) vs.push_back(v);
+    std::sort(vs.begin(), vs.end());
+    vs.erase(std::unique(vs.begin(), vs.end()), vs.end());
+  });
+  CornerValues c;
+  c.begin.assign(ne + 1, 0);
+  for (std::size_t i = 0; i < ne; ++i) c.begin[i + 1] = c.begin[i] + perElement[i].size();
+  c.vertices.resize(c.begin[ne]);
+  c.values.resize(c.begin[ne]);
+  tbb::parallel_for(std::size_t(0), ne, [&](std::size_t i) {
+    for (std::size_t k = 0; k < perElement[i].size(); ++k) {
+      const VertexId v = perElement[i][k];
+      c.vertices[c.begin[i] + k] = v;
+      c.values[c.begin[i] + k] = displacementAt(basis, coefficients, ElementId(i), mesh.position(v));
     }
-  }
-  for (std::size_t i = 0; i < mesh.numVertices(); ++i) {
-    const VertexId v(i);
-    if (count[v] > 0) sum[v] /= count[v];
-  }
-  return sum;
+  });
+  return c;
+}
+
+CornerArray displacementPointData(const CornerValues& corners, std::string name) {
+  return CornerArray{std::move(name), 3, [&corners](ElementId e, VertexId v, double* out) {
+                       const Vec3& u = corners.at(e, v);
+                       out[0] = u.x();
+                       out[1] = u.y();
+                       out[2] = u.z();
+                     }};
 }
 
 ElementFields elementFields(const PolyMesh& mesh, const DgBasis& basis,

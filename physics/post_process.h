@@ -1,12 +1,15 @@
-// Quantities derived from a DG solution: point values and gradients, the averaged vertex
-// displacements of eq. (17), per-element mean displacement, von Mises stress and largest jump,
+// Quantities derived from a DG solution: point values and gradients, the corner values that
+// eq. (17) averages at the vertices, per-element mean displacement, von Mises stress and largest jump,
 // and error norms against a known solution.
 #pragma once
 
 #include <functional>
+#include <string>
+#include <vector>
 
 #include <Eigen/Core>
 
+#include "mesh/vtu_io.h"
 #include "physics/dg_basis.h"
 #include "physics/material.h"
 
@@ -20,10 +23,27 @@ Vec3 displacementAt(const DgBasis& basis, const Eigen::VectorXd& coefficients, E
 Eigen::Matrix3d displacementGradientAt(const DgBasis& basis, const Eigen::VectorXd& coefficients,
                                        ElementId e, const Vec3& x);
 
-/// Paper eq. (17): at each vertex, the mean of u|_K(vertex) over the elements K having it as
-/// a face vertex (zero for a vertex used by no element).
-VertexData<Vec3> vertexDisplacements(const PolyMesh& mesh, const DgBasis& basis,
-                                     const Eigen::VectorXd& coefficients);
+/// u|_K(v) at every corner (element K, vertex v of K): the values that paper eq. (17) averages
+/// at each vertex. Element e's distinct face vertices are vertices[begin[e] .. begin[e + 1]),
+/// in increasing order, with their values alongside.
+struct CornerValues {
+  std::vector<std::size_t> begin;
+  std::vector<VertexId> vertices;
+  std::vector<Vec3> values;
+
+  /// u|_e(v); throws std::logic_error if v is not a vertex of e.
+  const Vec3& at(ElementId e, VertexId v) const;
+  /// The largest |u|_K(v)| over all corners (0 without elements).
+  double largestNorm() const;
+};
+
+CornerValues cornerDisplacements(const PolyMesh& mesh, const DgBasis& basis,
+                                 const Eigen::VectorXd& coefficients);
+
+/// Paper eq. (17) as VTU point data named `name`: each point written for a vertex holds the
+/// mean of u|_K(vertex) over the elements K it stands for, so the two sides of a cut keep
+/// their own means (mesh/vtu_io.h, CornerArray). `corners` must outlive the write.
+CornerArray displacementPointData(const CornerValues& corners, std::string name = "displacement");
 
 struct ElementFields {
   ElementData<Vec3> meanDisplacement;  ///< (1/vol) int_K u_h

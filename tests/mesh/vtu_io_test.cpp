@@ -449,6 +449,49 @@ TEST(VtuCut, AFiniteCutSharesPointsOnlyAlongItsFront) {
   expectSameMesh(mesh, readVtu(path.string()));
 }
 
+/// The values of an ascii DataArray named `name` in `text`.
+std::vector<double> asciiValues(const std::string& text, const std::string& name) {
+  const std::size_t at = text.find("Name=\"" + name + "\"");
+  if (at == std::string::npos) return {};
+  const std::size_t first = text.find('>', at) + 1, last = text.find("</DataArray>", first);
+  std::istringstream in(text.substr(first, last - first));
+  std::vector<double> values;
+  for (double v; in >> v;) values.push_back(v);
+  return values;
+}
+
+TEST(VtuCut, CornerDataIsAveragedPerSideOfACut) {
+  // Each element's value is its index. The cut's two corners at y = 0 are written once per
+  // side: one point holds element 0's value, the other element 1's. The corners on the cut's
+  // front (x = 1, y = 1) stay one point per vertex, the mean of all four elements.
+  const PolyMesh mesh = finitelyCutGrid();
+  const CornerArray index{"element_index", 1, [](ElementId e, VertexId, double* out) {
+                            out[0] = static_cast<double>(e.index());
+                          }};
+  const fs::path path = testDir() / "corners.vtu";
+  writeVtu(mesh, path.string(), {.encoding = VtuEncoding::Ascii}, {}, {}, {index});
+  const std::string text = readText(path);
+  const std::vector<double> points = asciiValues(text, "Points");
+  const std::vector<double> values = asciiValues(text, "element_index");
+  ASSERT_EQ(points.size(), 3 * 20u);
+  ASSERT_EQ(values.size(), 20u);
+  std::vector<double> cutCorner, front;
+  for (std::size_t p = 0; p < 20; ++p) {
+    const Vec3 x(points[3 * p], points[3 * p + 1], points[3 * p + 2]);
+    if (x.x() == 1.0 && x.y() == 0.0) cutCorner.push_back(values[p]);
+    if (x.x() == 1.0 && x.y() == 1.0) front.push_back(values[p]);
+    if (x.x() == 0.0 && x.y() == 0.0) EXPECT_EQ(values[p], 0.0);  // element 0's alone
+  }
+  std::sort(cutCorner.begin(), cutCorner.end());
+  EXPECT_EQ(cutCorner, (std::vector<double>{0.0, 0.0, 1.0, 1.0}));  // z = 0 and z = 1
+  EXPECT_EQ(front, (std::vector<double>{1.5, 1.5}));
+  // A corner array is checked like the others.
+  EXPECT_THROW(writeVtu(mesh, path.string(), {}, {}, {}, {CornerArray{"volume_like", 2, index.value}}),
+               std::invalid_argument);
+  EXPECT_THROW(writeVtu(mesh, path.string(), {}, {}, {}, {CornerArray{"no_function", 1, {}}}),
+               std::invalid_argument);
+}
+
 TEST(VtuCut, MeshesWithoutCutsWriteOnePointPerVertex) {
   const PolyMesh mesh = skewGrid();
   const fs::path path = testDir() / "grid.vtu";
