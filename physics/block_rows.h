@@ -6,10 +6,15 @@
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 namespace polydg {
 
@@ -19,13 +24,36 @@ namespace polydg {
 /// column-major) or, when the block couples equal displacement components only (BZ's
 /// neighbour blocks), component-diagonal: its three n x n diagonal blocks one after the other,
 /// each column-major (a third of the values).
+/// An allocator whose value-less construct() default-initializes: resize() of a vector of
+/// numbers leaves them unset, where std::allocator zeroes them in one serial pass. For arrays
+/// that are filled right after, in parallel (at 1.3 million DOFs the zeroing of the block rows
+/// was a serial pass over 1.3 GB).
+template <class T>
+struct UninitializedAllocator : std::allocator<T> {
+  template <class U>
+  struct rebind {
+    using other = UninitializedAllocator<U>;
+  };
+  UninitializedAllocator() = default;
+  template <class U>
+  UninitializedAllocator(const UninitializedAllocator<U>&) noexcept {}
+  template <class U>
+  void construct(U* p) noexcept(std::is_nothrow_default_constructible_v<U>) {
+    ::new (static_cast<void*>(p)) U;
+  }
+  template <class U, class... Args>
+  void construct(U* p, Args&&... args) {
+    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+  }
+};
+
 template <class T>
 struct BlockRows {
   int bs = 0, n = 0;
   std::vector<int> start, element;
   std::vector<std::size_t> offset;
   std::vector<std::uint8_t> diagonal;  ///< 1: component-diagonal slot
-  std::vector<T> values;
+  std::vector<T, UninitializedAllocator<T>> values;
 
   /// Builds the rows of `a` (symmetric, both triangles stored, columns sorted) with n
   /// functions per component. Returns false, and keeps no values, if the blocks would store
@@ -44,8 +72,11 @@ struct BlockRows {
     offset = other.offset;
     diagonal = other.diagonal;
     values.resize(other.values.size());
-    std::transform(other.values.begin(), other.values.end(), values.begin(),
-                   [](U v) { return static_cast<T>(v); });
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, values.size(), 1 << 16),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        for (std::size_t i = r.begin(); i != r.end(); ++i)
+                          values[i] = static_cast<T>(other.values[i]);
+                      });
   }
 
   /// The diagonal block of element e, bs x bs column-major (a full slot).
