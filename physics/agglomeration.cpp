@@ -20,24 +20,6 @@ using SpMat = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
 /// Functions per component of a group: the linear polynomials.
 constexpr int kLinear = 4;
 
-/// The blocks coupled with each block of `a` (block size bs), itself excluded, in order.
-std::vector<std::vector<int>> blockNeighbours(const SpMat& a, int bs) {
-  const int nb = static_cast<int>(a.cols() / bs);
-  std::vector<std::vector<int>> neighbours(static_cast<std::size_t>(nb));
-  tbb::parallel_for(0, nb, [&](int b) {
-    // Column b bs has a nonzero in every neighbour block (see colourElements()).
-    const Eigen::Index column = static_cast<Eigen::Index>(b) * bs;
-    int blockEnd = 0;
-    for (SpMat::InnerIterator it(a, column); it; ++it)
-      if (it.row() >= blockEnd) {
-        const int f = static_cast<int>(it.row() / bs);
-        blockEnd = (f + 1) * bs;
-        if (f != b) neighbours[static_cast<std::size_t>(b)].push_back(f);
-      }
-  });
-  return neighbours;
-}
-
 /// Smallest |cos| of the angle between the axis and the line joining two centres for a pair
 /// to form along that axis (60 degrees).
 constexpr double kMinAlignment = 0.5;
@@ -47,9 +29,9 @@ constexpr double kMinAlignment = 0.5;
 /// unpaired neighbour best aligned with the axis (at least kMinAlignment; groups in order,
 /// ties to the first neighbour). On a hex grid: 2 x 2 x 2 blocks. Groups are centred at the
 /// mean of their blocks' centres. Returns each block's agglomerate; `count` their number.
-std::vector<int> pairAlongAxes(const std::vector<std::vector<int>>& neighbours,
+std::vector<int> pairAlongAxes(const BlockRows<double>& rows,
                                const std::vector<Eigen::Vector3d>& centres, int& count) {
-  const int nb = static_cast<int>(neighbours.size());
+  const int nb = static_cast<int>(rows.start.size()) - 1;
   std::vector<int> group(static_cast<std::size_t>(nb));
   for (int b = 0; b < nb; ++b) group[static_cast<std::size_t>(b)] = b;
   std::vector<Eigen::Vector3d> centre = centres;
@@ -58,8 +40,9 @@ std::vector<int> pairAlongAxes(const std::vector<std::vector<int>>& neighbours,
   for (int axis = 0; axis < 3; ++axis) {
     std::vector<std::vector<int>> adjacent(static_cast<std::size_t>(groups));
     for (int b = 0; b < nb; ++b)
-      for (int f : neighbours[static_cast<std::size_t>(b)])
-        if (group[static_cast<std::size_t>(f)] != group[static_cast<std::size_t>(b)])
+      for (int k = rows.start[static_cast<std::size_t>(b)]; k < rows.start[static_cast<std::size_t>(b) + 1]; ++k)
+        if (const int f = rows.element[static_cast<std::size_t>(k)];
+            group[static_cast<std::size_t>(f)] != group[static_cast<std::size_t>(b)])
           adjacent[static_cast<std::size_t>(group[static_cast<std::size_t>(b)])].push_back(
               group[static_cast<std::size_t>(f)]);
     std::vector<int> merged(static_cast<std::size_t>(groups), -1);
@@ -238,13 +221,13 @@ ElementFrames elementFrames(const DgBasis& basis) {
   return frames;
 }
 
-Agglomeration agglomerate(const SpMat& matrix, int bs, const std::vector<Eigen::Vector3d>& centres,
+Agglomeration agglomerate(const BlockRows<double>& rows, const std::vector<Eigen::Vector3d>& centres,
                           const std::vector<double>& scales,
                           const std::vector<Eigen::Matrix4d>* linear) {
-  const int nb = static_cast<int>(matrix.cols() / bs);
+  const int nb = static_cast<int>(rows.start.size()) - 1;
   Agglomeration a;
   int count = 0;
-  a.parent = pairAlongAxes(blockNeighbours(matrix, bs), centres, count);
+  a.parent = pairAlongAxes(rows, centres, count);
   a.childStart.assign(static_cast<std::size_t>(count) + 1, 0);
   for (int g : a.parent) ++a.childStart[static_cast<std::size_t>(g) + 1];
   for (std::size_t g = 0; g < static_cast<std::size_t>(count); ++g) a.childStart[g + 1] += a.childStart[g];

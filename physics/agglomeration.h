@@ -44,16 +44,15 @@ struct Agglomeration {
   int groups() const { return static_cast<int>(centres.size()); }
 };
 
-/// Groups the blocks of a symmetric block matrix (block size bs = 3 n, both triangles
-/// stored; blocks are neighbours if they share a nonzero block) by three rounds of greedy
-/// pairing: blocks, then pairs, then pairs of pairs, round k pairing each group with its
-/// unpaired neighbour best aligned with axis k (the line between their centres at most 60
-/// degrees from the axis; groups in order). On a hex grid this gives 2 x 2 x 2 blocks; on a
-/// sliced mesh, groups of up to 8 face neighbours. `centres` and `scales` are the blocks'
-/// frames; `linear` their T (ElementFrames::linear), or nullptr when the blocks' functions
-/// are the scaled monomials themselves (groups of a finer agglomeration).
-Agglomeration agglomerate(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix, int bs,
-                          const std::vector<Eigen::Vector3d>& centres,
+/// Groups the blocks of a symmetric block matrix, given by block rows (neighbours: blocks that
+/// share a stored block), by three rounds of greedy pairing: blocks, then pairs, then pairs of
+/// pairs, round k pairing each group with its unpaired neighbour best aligned with axis k (the
+/// line between their centres at most 60 degrees from the axis; groups in order). On a hex
+/// grid this gives 2 x 2 x 2 blocks; on a sliced mesh, groups of up to 8 face neighbours.
+/// `centres` and `scales` are the blocks' frames; `linear` their T (ElementFrames::linear), or
+/// nullptr when the blocks' functions are the scaled monomials themselves (groups of a finer
+/// agglomeration).
+Agglomeration agglomerate(const BlockRows<double>& rows, const std::vector<Eigen::Vector3d>& centres,
                           const std::vector<double>& scales,
                           const std::vector<Eigen::Matrix4d>* linear);
 

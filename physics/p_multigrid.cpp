@@ -66,7 +66,8 @@ struct Level {
   bool useBlocks = false;
   BlockRows<float> blocks;
   /// The matrix by block rows in double precision, for a level that is agglomerated: the
-  /// Galerkin product reads it (the top level's copy is the caller's, `source`).
+  /// grouping reads its block graph and the Galerkin product its values (the top level's copy
+  /// is the caller's, `source`).
   BlockRows<double> exact;
   const BlockRows<double>* source = nullptr;
   /// Blocks of each colour, in increasing order; inLastColour[b] = 1 for the last colour's.
@@ -77,9 +78,6 @@ struct Level {
   Transfer transfer = Transfer::Degree;
   /// Aggregate transfer: the groups of this level's blocks that are the next level's blocks.
   Agglomeration groups;
-  /// Agglomerated levels: each block's centre and length scale.
-  std::vector<Eigen::Vector3d> centres;
-  std::vector<double> scales;
   // Scratch of apply(): right-hand side and solution of this level.
   mutable Eigen::VectorXd b, x;
 };
@@ -380,21 +378,23 @@ struct PMultigrid::Impl {
     return invertBlocks(level);
   }
 
-  /// Appends the agglomeration level of levels.back() (4 functions per component, its
-  /// centres and scales set; `linear`, for the element level, the frames' T_e).
-  void addAggregateLevel(const std::vector<Eigen::Matrix4d>* linear) {
+  /// Appends the agglomeration level of levels.back(), whose blocks have the given centres and
+  /// scales (the frames for the element level, then the groups of the level before); `linear`,
+  /// for the element level, the frames' T_e. The centres and scales are read before the levels
+  /// grow (they may belong to a level).
+  void addAggregateLevel(const std::vector<Eigen::Vector3d>& centres,
+                         const std::vector<double>& scales,
+                         const std::vector<Eigen::Matrix4d>* linear) {
     Level& fine = levels.back();
     fine.transfer = Transfer::Aggregate;
-    fine.groups = agglomerate(*fine.matrix, fine.bs, fine.centres, fine.scales, linear);
     if (fine.source == nullptr) {
       fine.exact.build(*fine.matrix, kLinear, std::numeric_limits<double>::infinity());
       fine.source = &fine.exact;
     }
+    fine.groups = agglomerate(*fine.source, centres, scales, linear);
     Level level;
     level.n = kLinear;
     level.bs = 3 * kLinear;
-    level.centres = fine.groups.centres;
-    level.scales = fine.groups.scales;
     level.owned = galerkinMatrix(fine.groups, *fine.source);
     push(std::move(level));
   }
@@ -570,9 +570,7 @@ bool PMultigrid::compute(const SpMat& matrix, int degree, const BlockRows<double
     Level& elements = m.levels.back();
     if (m.levels.size() == 1 && matrixBlocks != nullptr && !matrixBlocks->values.empty())
       elements.source = matrixBlocks;
-    elements.centres = frames->centres;
-    elements.scales = frames->scales;
-    m.addAggregateLevel(&frames->linear);
+    m.addAggregateLevel(frames->centres, frames->scales, &frames->linear);
     // Further levels while the coarsest is large and grouping still shrinks it. Their
     // smoothing is cheap (an eighth of the blocks each), so they sweep twice: a V-cycle with
     // two agglomeration levels then needs about as many iterations as one with an exact
@@ -582,7 +580,9 @@ bool PMultigrid::compute(const SpMat& matrix, int degree, const BlockRows<double
     while (static_cast<double>(m.levels.back().matrix->rows()) > limit) {
       const Eigen::Index before = m.levels.back().matrix->rows();
       m.levels.back().sweeps = 2;
-      m.addAggregateLevel(nullptr);
+      // The blocks of the last level are the groups of the one before.
+      const Agglomeration& blocks = m.levels[m.levels.size() - 2].groups;
+      m.addAggregateLevel(blocks.centres, blocks.scales, nullptr);
       if (m.levels.back().matrix->rows() * 4 > before * 3) break;  // grouping stalled
     }
   } else if (degree > 0) {

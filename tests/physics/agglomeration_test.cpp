@@ -35,10 +35,19 @@ SpMat prolongation(const Agglomeration& groups, int n) {
   return p;
 }
 
+/// `k` (n functions per component) by block rows in double precision, as the p-multigrid
+/// hands it to agglomerate() and galerkinMatrix().
+BlockRows<double> blockRows(const SpMat& k, int n) {
+  BlockRows<double> rows;
+  EXPECT_TRUE(rows.build(k, n, 1.0));  // every stored value a nonzero of k
+  return rows;
+}
+
 TEST(Agglomeration, GroupsAHexGridIntoCubesOfEight) {
   const FramedSystem s = b2FramedSystem(Method::BZ, 1);
-  const Agglomeration groups = agglomerate(s.system.matrix, 12, s.frames.centres,
-                                           s.frames.scales, &s.frames.linear);
+  const BlockRows<double> rows = blockRows(s.system.matrix, 4);
+  const Agglomeration groups =
+      agglomerate(rows, s.frames.centres, s.frames.scales, &s.frames.linear);
   ASSERT_EQ(groups.groups(), 125);
   for (int g = 0; g < groups.groups(); ++g) {
     const int first = groups.childStart[static_cast<std::size_t>(g)];
@@ -54,12 +63,9 @@ TEST(Agglomeration, GroupsAHexGridIntoCubesOfEight) {
     EXPECT_LT(((hi - lo) - Eigen::Vector3d::Constant(0.1)).cwiseAbs().maxCoeff(), 1e-12);
   }
   // Grouping the groups: 5 per axis pair into 3 (two pairs and one left alone).
-  const SpMat coarse = galerkinMatrix(groups, [&] {
-    BlockRows<double> rows;
-    rows.build(s.system.matrix, 4, 1.0);
-    return rows;
-  }());
-  const Agglomeration next = agglomerate(coarse, 12, groups.centres, groups.scales, nullptr);
+  const SpMat coarse = galerkinMatrix(groups, rows);
+  const Agglomeration next =
+      agglomerate(blockRows(coarse, 4), groups.centres, groups.scales, nullptr);
   EXPECT_EQ(next.groups(), 27);
 }
 
@@ -77,7 +83,7 @@ TEST(Agglomeration, CoarseFunctionsAreTheLinearDisplacementsOfEachGroup) {
   const ElementFrames frames = elementFrames(basis);
   const int n = basis.size();
   const Agglomeration groups =
-      agglomerate(solver.system().matrix, 3 * n, frames.centres, frames.scales, &frames.linear);
+      agglomerate(blockRows(solver.system().matrix, n), frames.centres, frames.scales, &frames.linear);
   EXPECT_LT(groups.groups(), static_cast<int>(mesh.numElements()) / 3);
   // u(x) = a + B x, as each group's coefficients: u(C) and H grad u.
   const Eigen::Vector3d a(0.3, -1.2, 2.0);
@@ -115,10 +121,9 @@ TEST(Agglomeration, CoarseFunctionsAreTheLinearDisplacementsOfEachGroup) {
 /// galerkinMatrix against P^T K P of Eigen's sparse products, and its exact symmetry.
 void expectGalerkinProduct(const FramedSystem& s) {
   const SpMat& k = s.system.matrix;
+  const BlockRows<double> rows = blockRows(k, 4);
   const Agglomeration groups =
-      agglomerate(k, 12, s.frames.centres, s.frames.scales, &s.frames.linear);
-  BlockRows<double> rows;
-  ASSERT_TRUE(rows.build(k, 4, 1.0));
+      agglomerate(rows, s.frames.centres, s.frames.scales, &s.frames.linear);
   const SpMat coarse = galerkinMatrix(groups, rows);
   const SpMat p = prolongation(groups, 4);
   const SpMat expected = SpMat(p.transpose() * k * p);
@@ -136,10 +141,9 @@ TEST(Agglomeration, GalerkinMatrixIsPTransposeKPForBzWithComponentDiagonalBlocks
   expectGalerkinProduct(s);
   // BZ couples components only inside elements: the coarse blocks between two groups keep
   // only their three diagonal 4 x 4 parts.
+  const BlockRows<double> rows = blockRows(s.system.matrix, 4);
   const Agglomeration groups =
-      agglomerate(s.system.matrix, 12, s.frames.centres, s.frames.scales, &s.frames.linear);
-  BlockRows<double> rows;
-  ASSERT_TRUE(rows.build(s.system.matrix, 4, 1.0));
+      agglomerate(rows, s.frames.centres, s.frames.scales, &s.frames.linear);
   const SpMat coarse = galerkinMatrix(groups, rows);
   std::size_t crossComponent = 0;
   for (int c = 0; c < coarse.cols(); ++c)
