@@ -42,6 +42,15 @@ Box3 elementBounds(const PolyMesh& mesh, ElementId e) {
   return box;
 }
 
+std::vector<VertexId> elementVertices(const PolyMesh& mesh, ElementId e) {
+  std::vector<VertexId> vertices;
+  for (const FaceUse& use : mesh.element(e).faces)
+    for (VertexId v : mesh.face(use.face).vertices) vertices.push_back(v);
+  std::sort(vertices.begin(), vertices.end());
+  vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+  return vertices;
+}
+
 Vec3 elementReferencePoint(const PolyMesh& mesh, ElementId e) {
   const Box3 box = elementBounds(mesh, e);
   return 0.5 * (box.min() + box.max());

@@ -2,6 +2,8 @@
 // bounding boxes, signed volumes. Higher moments live in integrate/.
 #pragma once
 
+#include <vector>
+
 #include <Eigen/Geometry>
 
 #include "mesh/poly_mesh.h"
@@ -28,6 +30,9 @@ Box3 faceBounds(const PolyMesh& mesh, FaceId f);
 
 /// Bounding box of the element's vertices.
 Box3 elementBounds(const PolyMesh& mesh, ElementId e);
+
+/// The element's distinct vertices (those of its faces' loops), in increasing order.
+std::vector<VertexId> elementVertices(const PolyMesh& mesh, ElementId e);
 
 /// The element's reference point (local origin): the centre of its bounding box. Element moments
 /// are taken about it. Exact in floating point for dyadic coordinates.

@@ -76,11 +76,7 @@ bool isGridHexahedron(const PolyMesh& mesh, ElementId e) {
 bool isConvex(const PolyMesh& mesh, ElementId e, double relativeTolerance) {
   const Box3 box = elementBounds(mesh, e);
   const double tolerance = relativeTolerance * box.diagonal().norm();
-  std::vector<VertexId> vertices;
-  for (const FaceUse& use : mesh.element(e).faces)
-    for (VertexId v : mesh.face(use.face).vertices) vertices.push_back(v);
-  std::sort(vertices.begin(), vertices.end());
-  vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+  const std::vector<VertexId> vertices = elementVertices(mesh, e);
   for (const FaceUse& use : mesh.element(e).faces) {
     // A face narrower than the tolerance (area / diameter) cannot show non-convexity at that
     // tolerance, and the normal of a face of round-off width means nothing.

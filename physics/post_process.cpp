@@ -9,6 +9,7 @@
 #include <tbb/parallel_reduce.h>
 
 #include "integrate/quadrature.h"
+#include "mesh/geometry.h"
 #include "physics/local_integrators.h"
 
 namespace polydg {
@@ -59,13 +60,8 @@ CornerValues cornerDisplacements(const PolyMesh& mesh, const DgBasis& basis,
                                  const Eigen::VectorXd& coefficients) {
   const std::size_t ne = mesh.numElements();
   std::vector<std::vector<VertexId>> perElement(ne);
-  tbb::parallel_for(std::size_t(0), ne, [&](std::size_t i) {
-    std::vector<VertexId>& vs = perElement[i];
-    for (const FaceUse& use : mesh.element(ElementId(i)).faces)
-      for (VertexId v : mesh.face(use.face).vertices) vs.push_back(v);
-    std::sort(vs.begin(), vs.end());
-    vs.erase(std::unique(vs.begin(), vs.end()), vs.end());
-  });
+  tbb::parallel_for(std::size_t(0), ne,
+                    [&](std::size_t i) { perElement[i] = elementVertices(mesh, ElementId(i)); });
   CornerValues c;
   c.begin.assign(ne + 1, 0);
   for (std::size_t i = 0; i < ne; ++i) c.begin[i + 1] = c.begin[i] + perElement[i].size();
