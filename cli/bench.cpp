@@ -40,12 +40,12 @@
 #include "cli/json_reports.h"
 #include "cli/plot.h"
 #include "cli/report.h"
-#include "cut/cut.h"
-#include "mesh/meshing.h"
-#include "mesh/primitives.h"
-#include "mesh/surface_io.h"
-#include "physics/benchmarks.h"
-#include "physics/stability.h"
+#include "polydg/cut/cut.h"
+#include "polydg/mesh/meshing.h"
+#include "polydg/mesh/primitives.h"
+#include "polydg/mesh/surface_io.h"
+#include "polydg/physics/benchmarks.h"
+#include "polydg/physics/stability.h"
 
 #ifndef POLYDG_TESTDATA_DIR
 #define POLYDG_TESTDATA_DIR "testdata"

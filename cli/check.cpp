@@ -11,9 +11,9 @@
 #include "cli/commands.h"
 #include "cli/json_reports.h"
 #include "cli/report.h"
-#include "mesh/validate.h"
-#include "mesh/vtu_io.h"
-#include "physics/validation.h"
+#include "polydg/mesh/validate.h"
+#include "polydg/mesh/vtu_io.h"
+#include "polydg/physics/validation.h"
 
 namespace polydg::cli {
 

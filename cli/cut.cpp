@@ -13,9 +13,9 @@
 #include "cli/json_reports.h"
 #include "cli/progress.h"
 #include "cli/report.h"
-#include "cut/cut.h"
-#include "mesh/validate.h"
-#include "mesh/vtu_io.h"
+#include "polydg/cut/cut.h"
+#include "polydg/mesh/validate.h"
+#include "polydg/mesh/vtu_io.h"
 
 namespace polydg::cli {
 

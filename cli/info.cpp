@@ -5,11 +5,11 @@
 
 #include "cli/commands.h"
 #include "cli/report.h"
-#include "integrate/moment_cache.h"
-#include "mesh/surface.h"
-#include "mesh/surface_io.h"
-#include "mesh/validate.h"
-#include "mesh/vtu_io.h"
+#include "polydg/integrate/moment_cache.h"
+#include "polydg/mesh/surface.h"
+#include "polydg/mesh/surface_io.h"
+#include "polydg/mesh/validate.h"
+#include "polydg/mesh/vtu_io.h"
 
 namespace polydg::cli {
 

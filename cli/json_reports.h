@@ -6,12 +6,12 @@
 
 #include <nlohmann/json.hpp>
 
-#include "cut/cut.h"
-#include "mesh/meshing.h"
-#include "mesh/validate.h"
-#include "physics/linear_solver.h"
-#include "physics/local_integrators.h"
-#include "physics/validation.h"
+#include "polydg/cut/cut.h"
+#include "polydg/mesh/meshing.h"
+#include "polydg/mesh/validate.h"
+#include "polydg/physics/linear_solver.h"
+#include "polydg/physics/local_integrators.h"
+#include "polydg/physics/validation.h"
 
 namespace polydg::cli {
 

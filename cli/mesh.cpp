@@ -13,10 +13,10 @@
 #include "cli/json_reports.h"
 #include "cli/progress.h"
 #include "cli/report.h"
-#include "mesh/meshing.h"
-#include "mesh/surface_io.h"
-#include "mesh/vtu_io.h"
-#include "physics/validation.h"
+#include "polydg/mesh/meshing.h"
+#include "polydg/mesh/surface_io.h"
+#include "polydg/mesh/vtu_io.h"
+#include "polydg/physics/validation.h"
 
 namespace polydg::cli {
 

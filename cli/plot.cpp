@@ -7,7 +7,7 @@
 #include <limits>
 #include <sstream>
 
-#include "mesh/xml_escape.h"
+#include "polydg/mesh/xml_escape.h"
 
 namespace polydg::cli {
 

@@ -14,10 +14,10 @@
 #include "cli/commands.h"
 #include "cli/json_reports.h"
 #include "cli/report.h"
-#include "mesh/validate.h"
-#include "mesh/vtu_io.h"
-#include "physics/post_process.h"
-#include "physics/static_solver.h"
+#include "polydg/mesh/validate.h"
+#include "polydg/mesh/vtu_io.h"
+#include "polydg/physics/post_process.h"
+#include "polydg/physics/static_solver.h"
 
 namespace polydg::cli {
 

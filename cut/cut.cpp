@@ -1,4 +1,4 @@
-#include "cut/cut.h"
+#include "polydg/cut/cut.h"
 
 #include <algorithm>
 #include <array>
@@ -15,10 +15,10 @@
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Exact_rational.h>
 
-#include "cut/element_grid.h"
-#include "mesh/plane_split.h"
-#include "mesh/validate.h"
-#include "physics/region_checks.h"
+#include "polydg/cut/element_grid.h"
+#include "polydg/mesh/plane_split.h"
+#include "polydg/mesh/validate.h"
+#include "polydg/physics/region_checks.h"
 
 namespace polydg {
 

@@ -1,4 +1,4 @@
-#include "cut/element_grid.h"
+#include "polydg/cut/element_grid.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "integrate/moment_cache.h"
+#include "polydg/integrate/moment_cache.h"
 
 #include <algorithm>
 #include <stdexcept>

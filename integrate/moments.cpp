@@ -1,4 +1,4 @@
-#include "integrate/moments.h"
+#include "polydg/integrate/moments.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "integrate/quadrature.h"
+#include "polydg/integrate/quadrature.h"
 
 #include <cmath>
 #include <numbers>

@@ -1,4 +1,4 @@
-#include "mesh/face_triangulation.h"
+#include "polydg/mesh/face_triangulation.h"
 
 #include <cmath>
 #include <stdexcept>
@@ -11,7 +11,7 @@
 #include <CGAL/Triangulation_face_base_with_info_2.h>
 #include <CGAL/Triangulation_vertex_base_with_info_2.h>
 
-#include "mesh/geometry.h"
+#include "polydg/mesh/geometry.h"
 
 namespace polydg {
 

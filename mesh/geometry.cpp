@@ -1,4 +1,4 @@
-#include "mesh/geometry.h"
+#include "polydg/mesh/geometry.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,11 +1,11 @@
-#include "mesh/merge_elements.h"
+#include "polydg/mesh/merge_elements.h"
 
 #include <algorithm>
 #include <map>
 #include <numeric>
 #include <stdexcept>
 
-#include "mesh/geometry.h"
+#include "polydg/mesh/geometry.h"
 
 #include <tbb/parallel_for.h>
 

@@ -1,4 +1,4 @@
-#include "mesh/meshing.h"
+#include "polydg/mesh/meshing.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_reduce.h>
@@ -9,7 +9,7 @@
 #include <exception>
 #include <sstream>
 
-#include "mesh/surface_repair.h"
+#include "polydg/mesh/surface_repair.h"
 
 namespace polydg {
 

@@ -1,8 +1,8 @@
-#include "mesh/meshing_benchmark.h"
+#include "polydg/mesh/meshing_benchmark.h"
 
 #include <stdexcept>
 
-#include "mesh/surface_shapes.h"
+#include "polydg/mesh/surface_shapes.h"
 
 namespace polydg {
 

@@ -1,4 +1,4 @@
-#include "mesh/plane_split.h"
+#include "polydg/mesh/plane_split.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "mesh/poly_mesh.h"
+#include "polydg/mesh/poly_mesh.h"
 
 #include <algorithm>
 #include <stdexcept>

@@ -1,4 +1,4 @@
-#include "mesh/primitives.h"
+#include "polydg/mesh/primitives.h"
 
 #include <stdexcept>
 

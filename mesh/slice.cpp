@@ -1,4 +1,4 @@
-#include "mesh/slice.h"
+#include "polydg/mesh/slice.h"
 
 #include <algorithm>
 #include <atomic>
@@ -12,7 +12,7 @@
 #include <memory>
 #include <stdexcept>
 
-#include "mesh/plane_split.h"
+#include "polydg/mesh/plane_split.h"
 
 #include <boost/container/small_vector.hpp>
 #include <tbb/concurrent_vector.h>

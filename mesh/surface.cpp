@@ -1,4 +1,4 @@
-#include "mesh/surface.h"
+#include "polydg/mesh/surface.h"
 
 #include <algorithm>
 #include <map>

@@ -2,7 +2,7 @@
 // CGAL's polygon-soup readers (after checks for what they misread) and everything else, or what
 // CGAL cannot read, through assimp with transforms baked in; then weld by exact position and
 // triangulate polygons exactly.
-#include "mesh/surface_io.h"
+#include "polydg/mesh/surface_io.h"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/IO/OBJ.h>
@@ -39,7 +39,7 @@
 #include <variant>
 #include <vector>
 
-#include "mesh/face_triangulation.h"
+#include "polydg/mesh/face_triangulation.h"
 
 namespace polydg {
 

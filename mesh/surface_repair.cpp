@@ -1,4 +1,4 @@
-#include "mesh/surface_repair.h"
+#include "polydg/mesh/surface_repair.h"
 
 #include <stdexcept>
 #include <vector>

@@ -1,4 +1,4 @@
-#include "mesh/surface_shapes.h"
+#include "polydg/mesh/surface_shapes.h"
 
 #include <cmath>
 #include <map>

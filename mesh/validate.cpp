@@ -1,4 +1,4 @@
-#include "mesh/validate.h"
+#include "polydg/mesh/validate.h"
 
 #include <algorithm>
 #include <unordered_map>
@@ -13,7 +13,7 @@
 #include <set>
 #include <sstream>
 
-#include "mesh/geometry.h"
+#include "polydg/mesh/geometry.h"
 
 namespace polydg {
 

@@ -1,4 +1,4 @@
-#include "mesh/vtu_io.h"
+#include "polydg/mesh/vtu_io.h"
 
 #include <algorithm>
 #include <numeric>
@@ -27,9 +27,9 @@
 #include <pugixml.hpp>
 #include <tbb/parallel_for.h>
 
-#include "mesh/face_triangulation.h"
-#include "mesh/geometry.h"
-#include "mesh/xml_escape.h"
+#include "polydg/mesh/face_triangulation.h"
+#include "polydg/mesh/geometry.h"
+#include "polydg/mesh/xml_escape.h"
 
 namespace polydg {
 

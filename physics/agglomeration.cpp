@@ -1,4 +1,4 @@
-#include "physics/agglomeration.h"
+#include "polydg/physics/agglomeration.h"
 
 #include <algorithm>
 #include <cmath>
@@ -8,8 +8,8 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
-#include "physics/block_rows.h"
-#include "physics/dg_basis.h"
+#include "polydg/physics/block_rows.h"
+#include "polydg/physics/dg_basis.h"
 
 namespace polydg {
 

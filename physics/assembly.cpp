@@ -1,4 +1,4 @@
-#include "physics/assembly.h"
+#include "polydg/physics/assembly.h"
 
 #include <algorithm>
 #include <cmath>
@@ -14,8 +14,8 @@
 #include <sys/mman.h>
 #endif
 
-#include "integrate/quadrature.h"
-#include "physics/face_quadrature.h"
+#include "polydg/integrate/quadrature.h"
+#include "polydg/physics/face_quadrature.h"
 
 namespace polydg {
 

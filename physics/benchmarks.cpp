@@ -1,15 +1,15 @@
-#include "physics/benchmarks.h"
+#include "polydg/physics/benchmarks.h"
 
 #include <chrono>
 #include <cmath>
 #include <numbers>
 
-#include "mesh/merge_elements.h"
-#include "mesh/meshing.h"
-#include "mesh/primitives.h"
-#include "mesh/slice.h"
-#include "mesh/surface_shapes.h"
-#include "physics/face_quadrature.h"
+#include "polydg/mesh/merge_elements.h"
+#include "polydg/mesh/meshing.h"
+#include "polydg/mesh/primitives.h"
+#include "polydg/mesh/slice.h"
+#include "polydg/mesh/surface_shapes.h"
+#include "polydg/physics/face_quadrature.h"
 
 namespace polydg {
 

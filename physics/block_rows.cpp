@@ -1,4 +1,4 @@
-#include "physics/block_rows.h"
+#include "polydg/physics/block_rows.h"
 
 #include <algorithm>
 

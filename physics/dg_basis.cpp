@@ -1,4 +1,4 @@
-#include "physics/dg_basis.h"
+#include "polydg/physics/dg_basis.h"
 
 #include <cmath>
 #include <stdexcept>
@@ -6,7 +6,7 @@
 #include <Eigen/Cholesky>
 #include <tbb/parallel_for.h>
 
-#include "physics/polynomial_tables.h"
+#include "polydg/physics/polynomial_tables.h"
 
 namespace polydg {
 

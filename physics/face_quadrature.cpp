@@ -1,4 +1,4 @@
-#include "physics/face_quadrature.h"
+#include "polydg/physics/face_quadrature.h"
 
 namespace polydg {
 

@@ -1,4 +1,4 @@
-#include "physics/linear_solver.h"
+#include "polydg/physics/linear_solver.h"
 
 #include <chrono>
 #include <cmath>
@@ -8,9 +8,9 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
-#include "integrate/monomials.h"
-#include "physics/block_rows.h"
-#include "physics/p_multigrid.h"
+#include "polydg/integrate/monomials.h"
+#include "polydg/physics/block_rows.h"
+#include "polydg/physics/p_multigrid.h"
 
 namespace polydg {
 

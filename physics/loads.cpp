@@ -1,4 +1,4 @@
-#include "physics/loads.h"
+#include "polydg/physics/loads.h"
 
 #include <cmath>
 

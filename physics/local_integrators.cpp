@@ -1,9 +1,9 @@
-#include "physics/local_integrators.h"
+#include "polydg/physics/local_integrators.h"
 
 #include <cmath>
 
 
-#include "physics/polynomial_tables.h"
+#include "polydg/physics/polynomial_tables.h"
 
 namespace polydg {
 

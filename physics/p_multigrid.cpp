@@ -1,4 +1,4 @@
-#include "physics/p_multigrid.h"
+#include "polydg/physics/p_multigrid.h"
 
 #include <algorithm>
 #include <cmath>
@@ -12,9 +12,9 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
 
-#include "integrate/monomials.h"
-#include "physics/block_rows.h"
-#include "physics/agglomeration.h"
+#include "polydg/integrate/monomials.h"
+#include "polydg/physics/block_rows.h"
+#include "polydg/physics/agglomeration.h"
 
 namespace polydg {
 

@@ -1,4 +1,4 @@
-#include "physics/post_process.h"
+#include "polydg/physics/post_process.h"
 
 #include <algorithm>
 #include <cmath>
@@ -8,9 +8,9 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
-#include "integrate/quadrature.h"
-#include "mesh/geometry.h"
-#include "physics/local_integrators.h"
+#include "polydg/integrate/quadrature.h"
+#include "polydg/mesh/geometry.h"
+#include "polydg/physics/local_integrators.h"
 
 namespace polydg {
 

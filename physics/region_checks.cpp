@@ -1,4 +1,4 @@
-#include "physics/region_checks.h"
+#include "polydg/physics/region_checks.h"
 
 #include <algorithm>
 #include <chrono>
@@ -9,12 +9,12 @@
 
 #include <Eigen/SparseCore>
 
-#include "integrate/monomials.h"
-#include "mesh/geometry.h"
-#include "physics/assembly.h"
-#include "physics/face_quadrature.h"
-#include "physics/linear_solver.h"
-#include "physics/post_process.h"
+#include "polydg/integrate/monomials.h"
+#include "polydg/mesh/geometry.h"
+#include "polydg/physics/assembly.h"
+#include "polydg/physics/face_quadrature.h"
+#include "polydg/physics/linear_solver.h"
+#include "polydg/physics/post_process.h"
 
 namespace polydg {
 

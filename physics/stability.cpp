@@ -1,4 +1,4 @@
-#include "physics/stability.h"
+#include "polydg/physics/stability.h"
 
 #include <algorithm>
 #include <array>
@@ -10,8 +10,8 @@
 #include <Spectra/MatOp/SparseSymMatProd.h>
 #include <Spectra/SymEigsSolver.h>
 
-#include "mesh/merge_elements.h"
-#include "mesh/primitives.h"
+#include "polydg/mesh/merge_elements.h"
+#include "polydg/mesh/primitives.h"
 
 namespace polydg {
 

@@ -1,10 +1,10 @@
-#include "physics/static_solver.h"
+#include "polydg/physics/static_solver.h"
 
 #include <algorithm>
 #include <chrono>
 #include <stdexcept>
 
-#include "physics/agglomeration.h"
+#include "polydg/physics/agglomeration.h"
 
 namespace polydg {
 

@@ -1,4 +1,4 @@
-#include "physics/validation.h"
+#include "polydg/physics/validation.h"
 
 #include <algorithm>
 #include <array>
@@ -14,10 +14,10 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
-#include "integrate/moments.h"
-#include "mesh/validate.h"
-#include "physics/polynomial_tables.h"
-#include "physics/post_process.h"
+#include "polydg/integrate/moments.h"
+#include "polydg/mesh/validate.h"
+#include "polydg/physics/polynomial_tables.h"
+#include "polydg/physics/post_process.h"
 
 namespace polydg {
 

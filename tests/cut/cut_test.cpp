@@ -1,16 +1,16 @@
 // Plane cuts in place: degenerate positions of the plane (through vertices, along edges, in
 // existing faces, grazing a vertex), repeated and nearly coincident cuts, removal of either
 // side, finite polygon blades, and incremental moments against moments from scratch.
-#include "cut/cut.h"
+#include "polydg/cut/cut.h"
 
 #include <cmath>
 #include <random>
 
 #include <gtest/gtest.h>
 
-#include "mesh/primitives.h"
-#include "mesh/validate.h"
-#include "physics/validation.h"
+#include "polydg/mesh/primitives.h"
+#include "polydg/mesh/validate.h"
+#include "polydg/physics/validation.h"
 
 namespace polydg {
 namespace {

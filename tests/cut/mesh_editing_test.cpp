@@ -3,9 +3,9 @@
 // changed is integrated again.
 #include <gtest/gtest.h>
 
-#include "integrate/moment_cache.h"
-#include "mesh/primitives.h"
-#include "mesh/validate.h"
+#include "polydg/integrate/moment_cache.h"
+#include "polydg/mesh/primitives.h"
+#include "polydg/mesh/validate.h"
 
 namespace polydg {
 namespace {

@@ -11,10 +11,10 @@
 
 #include <gtest/gtest.h>
 
-#include "cut/cut.h"
-#include "mesh/meshing.h"
-#include "mesh/surface_shapes.h"
-#include "mesh/validate.h"
+#include "polydg/cut/cut.h"
+#include "polydg/mesh/meshing.h"
+#include "polydg/mesh/surface_shapes.h"
+#include "polydg/mesh/validate.h"
 
 namespace polydg {
 namespace {

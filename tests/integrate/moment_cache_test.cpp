@@ -1,10 +1,10 @@
 // The per-face moment cache: each face integrated once for both of its elements, element
 // moments equal to one-shot integration, and invalidation recomputing only what it names.
-#include "integrate/moment_cache.h"
+#include "polydg/integrate/moment_cache.h"
 
 #include <gtest/gtest.h>
 
-#include "mesh/primitives.h"
+#include "polydg/mesh/primitives.h"
 
 namespace polydg {
 namespace {

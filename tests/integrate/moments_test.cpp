@@ -1,7 +1,7 @@
 // Exact moments against closed forms (boxes, tetrahedra, L-prism, cube with a tunnel), against
 // an independent quadrature on random non-convex polyhedra, additivity over a split, and
 // invariance of normalized moments under translation and scaling.
-#include "integrate/moments.h"
+#include "polydg/integrate/moments.h"
 
 #include <gtest/gtest.h>
 
@@ -9,9 +9,9 @@
 #include <map>
 #include <random>
 
-#include "integrate/quadrature.h"
-#include "mesh/primitives.h"
-#include "mesh/surface.h"
+#include "polydg/integrate/quadrature.h"
+#include "polydg/mesh/primitives.h"
+#include "polydg/mesh/surface.h"
 #include "tests/support/shapes.h"
 
 namespace polydg {

@@ -1,12 +1,12 @@
 // Quadrature rules: exactness of Gauss-Legendre and of the tetrahedron rule, and the signed
 // cone decomposition of a non-convex element.
-#include "integrate/quadrature.h"
+#include "polydg/integrate/quadrature.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "mesh/primitives.h"
+#include "polydg/mesh/primitives.h"
 
 namespace polydg {
 namespace {

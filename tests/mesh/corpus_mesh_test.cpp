@@ -7,8 +7,8 @@
 #include <iostream>
 #include <map>
 
-#include "mesh/meshing.h"
-#include "mesh/surface_io.h"
+#include "polydg/mesh/meshing.h"
+#include "polydg/mesh/surface_io.h"
 #include "tests/support/assimp_models.h"
 
 namespace polydg {

@@ -1,7 +1,7 @@
 // Merging elements: mergeElements builds the same mesh as PolyMesh::mergeElementGroups, and
 // sliver merging keeps a sliced sphere valid and its volume, leaving no sliver that has a
 // neighbour.
-#include "mesh/merge_elements.h"
+#include "polydg/mesh/merge_elements.h"
 
 #include <gtest/gtest.h>
 
@@ -9,11 +9,11 @@
 #include <cmath>
 #include <vector>
 
-#include "mesh/geometry.h"
-#include "mesh/primitives.h"
-#include "mesh/slice.h"
-#include "mesh/surface_shapes.h"
-#include "mesh/validate.h"
+#include "polydg/mesh/geometry.h"
+#include "polydg/mesh/primitives.h"
+#include "polydg/mesh/slice.h"
+#include "polydg/mesh/surface_shapes.h"
+#include "polydg/mesh/validate.h"
 
 namespace polydg {
 namespace {

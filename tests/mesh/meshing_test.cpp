@@ -2,7 +2,7 @@
 // test runs, and the result is kept only if the test finds nothing; a self-intersecting closed
 // surface is refused (or wrapped with RepairMode::Wrap), an inward one re-oriented, and the
 // report holds the diagnosis and every phase either way.
-#include "mesh/meshing.h"
+#include "polydg/mesh/meshing.h"
 
 #include <gtest/gtest.h>
 
@@ -10,7 +10,7 @@
 #include <cmath>
 #include <string>
 
-#include "mesh/surface_shapes.h"
+#include "polydg/mesh/surface_shapes.h"
 
 namespace polydg {
 namespace {

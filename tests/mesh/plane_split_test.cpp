@@ -1,13 +1,13 @@
 // Splitting closed pieces by planes in the degenerate cases that are normal cases here: planes
 // through vertices, along edges, containing faces, touching a single vertex; non-convex faces,
 // faces with holes, and pieces falling apart into several components.
-#include "mesh/plane_split.h"
+#include "polydg/mesh/plane_split.h"
 
 #include <gtest/gtest.h>
 
 #include <map>
 
-#include "mesh/primitives.h"
+#include "polydg/mesh/primitives.h"
 
 namespace polydg {
 namespace {

@@ -1,10 +1,10 @@
 // Face sharing and orientation in PolyMesh, and the generated shapes of mesh/primitives.h.
-#include "mesh/poly_mesh.h"
+#include "polydg/mesh/poly_mesh.h"
 
 #include <gtest/gtest.h>
 
-#include "mesh/primitives.h"
-#include "mesh/surface.h"
+#include "polydg/mesh/primitives.h"
+#include "polydg/mesh/surface.h"
 
 namespace polydg {
 namespace {

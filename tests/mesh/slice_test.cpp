@@ -1,13 +1,13 @@
 // Hexahedral slicing of generated shapes whose exact polyhedral volume is known: the elements
 // fill the input's volume, every element is valid, and components come out right, also for
 // faces on grid planes, thin plates, nearby shells, cavities, and far from the origin.
-#include "mesh/slice.h"
+#include "polydg/mesh/slice.h"
 
 #include <gtest/gtest.h>
 
-#include "integrate/moment_cache.h"
-#include "mesh/surface_shapes.h"
-#include "mesh/validate.h"
+#include "polydg/integrate/moment_cache.h"
+#include "polydg/mesh/surface_shapes.h"
+#include "polydg/mesh/validate.h"
 
 namespace polydg {
 namespace {

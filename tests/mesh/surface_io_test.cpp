@@ -3,7 +3,7 @@
 // welding, degenerate and point/line handling; one-line errors; no crash and no output over
 // assimp's own test models; agreement with meshio's and VTK's volumes
 // (tests/mesh/surface_volume.py).
-#include "mesh/surface_io.h"
+#include "polydg/mesh/surface_io.h"
 #include "tests/support/assimp_models.h"
 
 #include <gtest/gtest.h>

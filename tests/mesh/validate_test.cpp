@@ -1,12 +1,12 @@
 // Geometric validation accepts valid meshes (hex grids, non-convex elements, faces with holes)
 // and names each kind of defect: open, inverted, non-planar, duplicated, disconnected.
-#include "mesh/validate.h"
+#include "polydg/mesh/validate.h"
 
 #include <gtest/gtest.h>
 
-#include "mesh/geometry.h"
-#include "mesh/primitives.h"
-#include "mesh/surface.h"
+#include "polydg/mesh/geometry.h"
+#include "polydg/mesh/primitives.h"
+#include "polydg/mesh/surface.h"
 
 namespace polydg {
 namespace {

@@ -5,7 +5,7 @@
 //     --write-vtk), read back with known exact volumes;
 //   POLYDG_VTU_OUT_DIR=DIR: writes polydg files into DIR for vtk_check.py to open with VTK and
 //     meshio.
-#include "mesh/vtu_io.h"
+#include "polydg/mesh/vtu_io.h"
 
 #include <algorithm>
 #include <cstdlib>
@@ -20,9 +20,9 @@
 
 #include <gtest/gtest.h>
 
-#include "mesh/face_triangulation.h"
-#include "mesh/geometry.h"
-#include "mesh/primitives.h"
+#include "polydg/mesh/face_triangulation.h"
+#include "polydg/mesh/geometry.h"
+#include "polydg/mesh/primitives.h"
 
 namespace polydg {
 namespace {

@@ -2,15 +2,15 @@
 // coarse functions are exactly the linear displacements of each group, on non-convex sliced
 // elements too; the Galerkin matrix equals P^T K P formed explicitly and is exactly
 // symmetric, for IP's coupled and BZ's component-diagonal blocks.
-#include "physics/agglomeration.h"
+#include "polydg/physics/agglomeration.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <vector>
 
-#include "physics/block_rows.h"
-#include "physics/dg_basis.h"
+#include "polydg/physics/block_rows.h"
+#include "polydg/physics/dg_basis.h"
 #include "tests/support/dg_systems.h"
 
 namespace polydg {

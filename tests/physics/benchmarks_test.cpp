@@ -2,7 +2,7 @@
 // (L2 ~ h^(p+1), broken H1 ~ h^p) on small hex grids, BZ's inconsistency, B3's cantilever tip
 // deflection and its locking-free behaviour as nu -> 1/2. Figures only; timings are in
 // `polydg bench`.
-#include "physics/benchmarks.h"
+#include "polydg/physics/benchmarks.h"
 
 #include <gtest/gtest.h>
 

@@ -1,15 +1,15 @@
 // BlockRows (physics/block_rows.h): the element block rows of a DG matrix give the same
 // product as the CSR matrix, store BZ's neighbour blocks component-diagonal and IP's whole,
 // and refuse a pattern too sparse for blocks.
-#include "physics/block_rows.h"
+#include "polydg/physics/block_rows.h"
 
 #include <gtest/gtest.h>
 
 #include <random>
 
-#include "physics/benchmarks.h"
-#include "physics/linear_solver.h"
-#include "physics/static_solver.h"
+#include "polydg/physics/benchmarks.h"
+#include "polydg/physics/linear_solver.h"
+#include "polydg/physics/static_solver.h"
 #include "tests/support/dg_systems.h"
 
 namespace polydg {

@@ -2,15 +2,15 @@
 // motions in its kernel and the energy of a known strain, face matrices that fit together
 // symmetrically, exact face quadrature on non-convex faces with holes, and the penalty
 // threshold's independence of scale and material.
-#include "physics/local_integrators.h"
+#include "polydg/physics/local_integrators.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "mesh/primitives.h"
-#include "physics/assembly.h"
-#include "physics/face_quadrature.h"
+#include "polydg/mesh/primitives.h"
+#include "polydg/physics/assembly.h"
+#include "polydg/physics/face_quadrature.h"
 
 namespace polydg {
 namespace {

@@ -3,16 +3,16 @@
 // meshes for IP and BZ, with piecewise constants or agglomerates as coarse levels, the
 // agglomerates need fewer iterations where the body bends (B2), and it reports a body held by
 // no Dirichlet condition.
-#include "physics/p_multigrid.h"
+#include "polydg/physics/p_multigrid.h"
 
 #include <gtest/gtest.h>
 
 #include <cstdio>
 #include <random>
 
-#include "physics/benchmarks.h"
-#include "physics/linear_solver.h"
-#include "physics/static_solver.h"
+#include "polydg/physics/benchmarks.h"
+#include "polydg/physics/linear_solver.h"
+#include "polydg/physics/static_solver.h"
 #include "tests/support/dg_systems.h"
 #include "tests/support/shapes.h"
 

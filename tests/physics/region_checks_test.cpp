@@ -3,7 +3,7 @@
 // grid with a sliver and a grid translated by 1e6; the same answer as the global checks on the
 // whole mesh; failures on a vertex moved off its faces' planes, a reversed face, an inverted
 // element and a stale moment cache, and none for a region away from a defect.
-#include "physics/region_checks.h"
+#include "polydg/physics/region_checks.h"
 
 #include <gtest/gtest.h>
 
@@ -12,12 +12,12 @@
 #include <string>
 #include <vector>
 
-#include "mesh/geometry.h"
-#include "mesh/primitives.h"
-#include "mesh/slice.h"
-#include "mesh/surface_shapes.h"
+#include "polydg/mesh/geometry.h"
+#include "polydg/mesh/primitives.h"
+#include "polydg/mesh/slice.h"
+#include "polydg/mesh/surface_shapes.h"
 #include "tests/support/shapes.h"
-#include "mesh/validate.h"
+#include "polydg/mesh/validate.h"
 
 namespace polydg {
 namespace {

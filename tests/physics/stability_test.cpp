@@ -2,7 +2,7 @@
 // eigenvalues, the box-cell and thin-neck meshes (valid, exact volumes), the regular grid's
 // condition (finite, > 1), the sliver grid with merging within 100x of it, the thin neck
 // bounded as eps -> 0, and scale invariance of B1.
-#include "physics/stability.h"
+#include "polydg/physics/stability.h"
 
 #include <gtest/gtest.h>
 
@@ -13,8 +13,8 @@
 
 #include <Eigen/Eigenvalues>
 
-#include "integrate/moment_cache.h"
-#include "mesh/validate.h"
+#include "polydg/integrate/moment_cache.h"
+#include "polydg/mesh/validate.h"
 
 namespace polydg {
 namespace {

@@ -2,9 +2,9 @@
 // p-multigrid's agglomeration levels need.
 #pragma once
 
-#include "physics/agglomeration.h"
-#include "physics/benchmarks.h"
-#include "physics/static_solver.h"
+#include "polydg/physics/agglomeration.h"
+#include "polydg/physics/benchmarks.h"
+#include "polydg/physics/static_solver.h"
 
 namespace polydg {
 

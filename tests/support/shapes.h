@@ -9,9 +9,9 @@
 #include <random>
 #include <vector>
 
-#include "mesh/primitives.h"
-#include "mesh/surface.h"
-#include "mesh/surface_shapes.h"
+#include "polydg/mesh/primitives.h"
+#include "polydg/mesh/surface.h"
+#include "polydg/mesh/surface_shapes.h"
 
 namespace polydg::testing {
 

@@ -1,0 +1,128 @@
+// Plane cutting of a polyhedral mesh in place, without remeshing (paper section 10,
+// "Cutting"; thesis Fig. 4.1). Every element the blade crosses is split into its connected
+// pieces on each side; the new faces in the plane are boundary faces tagged `Cut` (the two
+// sides are no longer coupled there); a face shared with a neighbour that the blade crosses is
+// split so that both sides still share identical sub-faces; slivers are merged into a
+// neighbour; only the faces an operation created or changed are re-integrated; and every
+// operation is validated on the region it touched.
+#pragma once
+
+#include <cstddef>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "polydg/integrate/moment_cache.h"
+#include "polydg/mesh/poly_mesh.h"
+
+namespace polydg {
+
+/// The blade of a cut: the plane {x : normal . x = offset} (normal need not be unit length;
+/// its minus side is normal . x < offset), or, when `polygon` is not empty, the convex planar
+/// polygon with those corners, which lies in that plane.
+struct Blade {
+  Vec3 normal = Vec3::UnitX();
+  double offset = 0.0;
+  std::vector<Vec3> polygon;  ///< empty: the whole plane
+
+  /// Throws std::invalid_argument for a zero or non-finite normal or a non-finite offset.
+  static Blade plane(const Vec3& normal, double offset);
+  /// The plane of the corners with the polygon as blade. Throws std::invalid_argument if there
+  /// are fewer than 3 corners, or they are not coplanar, not convex or degenerate.
+  static Blade fromPolygon(std::vector<Vec3> corners);
+  bool finite() const { return !polygon.empty(); }
+};
+
+/// How much checking follows each operation.
+enum class ValidationLevel {
+  None,   ///< volume bookkeeping only
+  Local,  ///< geometric checks of the touched elements; DG patch test and rigid-mode count on
+          ///< the touched elements plus one ring of neighbours; global volume balance
+  Full,   ///< geometric validation of the whole mesh; global patch test and rigid modes
+};
+
+/// Default sliver fraction, shared with meshing (MeshingOptions::sliverTau).
+inline constexpr double kDefaultSliverFraction = 0.01;
+
+struct CutOptions {
+  /// +1: delete the pieces on the plus side (normal . x > offset) of the cut, -1: the minus
+  /// side, 0: keep both. With a finite blade only pieces of split elements are removed.
+  int removeSide = 0;
+  /// Pieces smaller than sliverFraction * the editor's reference volume are merged into the
+  /// neighbour across their largest shared face (0: no merging).
+  double sliverFraction = kDefaultSliverFraction;
+  ValidationLevel validation = ValidationLevel::Local;
+  /// Degree of the DG basis used by the DG checks.
+  int validationDegree = 1;
+};
+
+/// The outcome of the checks after one operation.
+struct OperationValidation {
+  ValidationLevel level = ValidationLevel::None;
+  bool passed = true;
+  std::size_t elementsChecked = 0;  ///< geometric checks
+  std::size_t regionElements = 0;   ///< DG region (touched elements plus one ring)
+  double patchTestError = 0.0;      ///< relative, over the region (or the mesh, Full)
+  std::size_t regionComponents = 0;
+  std::size_t zeroModes = 0;        ///< expected: 6 * regionComponents
+  double volumeRelError = 0.0;      ///< |V_before - V_removed - V_after| / V_before
+  std::string failure;              ///< first failed check, one line; empty when passed
+};
+
+/// What one operation did.
+struct OperationReport {
+  std::string op;  ///< "cut", "cut_polygon" or "merge"
+  std::size_t elementsSplit = 0;   ///< elements the blade divided
+  std::size_t piecesCreated = 0;   ///< elements made from them (before sliver merging)
+  std::size_t elementsRemoved = 0; ///< pieces deleted by removeSide
+  double volumeRemoved = 0.0;
+  std::size_t slivers = 0, sliversMerged = 0, isolatedSlivers = 0;
+  std::size_t facesReintegrated = 0;  ///< faces whose moments this operation computed
+  std::size_t facesTotal = 0;         ///< faces of the mesh after it
+  /// Finite blade: elements the blade's plane crosses at the polygon's edge, left whole.
+  std::vector<ElementId> leftWhole;
+  OperationValidation validation;
+  double seconds = 0.0;
+};
+
+/// Owns a mesh and its moment cache and applies operations to them in place. Element and face
+/// ids may change with each operation (removed ones are replaced by the last ones); ids stay
+/// dense, so FaceData / ElementData keep working on the result.
+class MeshEditor {
+ public:
+  /// Takes a valid mesh and integrates all its faces once. `referenceVolume` is the volume that
+  /// sliver fractions multiply (the grid cell volume of a sliced mesh); 0: the median element
+  /// volume of `mesh`.
+  explicit MeshEditor(PolyMesh mesh, double referenceVolume = 0.0);
+  ~MeshEditor();
+  MeshEditor(MeshEditor&&) noexcept;
+  MeshEditor& operator=(MeshEditor&&) noexcept;
+
+  const PolyMesh& mesh() const;
+  /// Moments up to degree 2 * the largest validation degree used so far (at least 2).
+  const MomentCache& moments() const;
+  double referenceVolume() const;
+  /// Total volume, kept up to date incrementally.
+  double volume() const;
+
+  /// Cuts with `blade`. When validation fails the report says so (validation.passed == false,
+  /// validation.failure names the check; "split: ..." when a piece could not be closed) and
+  /// the mesh must not be used further: callers stop and leave their input untouched.
+  /// Throws std::invalid_argument for invalid options.
+  OperationReport cut(const Blade& blade, const CutOptions& options = {});
+
+  /// Merges every element below `fraction` * referenceVolume() into a neighbour, as after a cut.
+  OperationReport mergeSlivers(double fraction, ValidationLevel validation = ValidationLevel::Local,
+                               int validationDegree = 1);
+
+  /// Gives the mesh back (the editor is empty afterwards).
+  PolyMesh release();
+
+ private:
+  OperationReport cutInPlace(const Blade& blade, const CutOptions& options);
+
+  struct State;
+  std::unique_ptr<State> state_;
+};
+
+}  // namespace polydg

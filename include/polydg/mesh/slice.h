@@ -1,0 +1,55 @@
+// Hexahedral slicing (Kaufmann et al. 2008, section 10): the exact intersection of a closed
+// surface's solid with a regular grid. Cells inside are hexahedra, cells at the surface
+// polyhedra (convex or not), and each connected piece of a cell is its own element.
+#pragma once
+
+#include <array>
+#include <functional>
+
+#include "polydg/mesh/surface.h"
+
+namespace polydg {
+
+/// A regular grid: cells[axis] cells of edge `cellSize`, centred on `centre`.
+struct Grid {
+  Vec3 centre = Vec3::Zero();
+  double cellSize = 1.0;
+  std::array<int, 3> cells{1, 1, 1};
+
+  /// Coordinate of the plane with index i (0..cells[axis]) along `axis`: centre + (i - n/2) h,
+  /// so planes sit symmetrically about the centre (the middle plane, for even n, exactly on it).
+  double plane(int axis, int i) const {
+    return centre[axis] + (i - 0.5 * cells[axis]) * cellSize;
+  }
+  /// The grid's lowest corner.
+  Vec3 origin() const { return Vec3(plane(0, 0), plane(1, 0), plane(2, 0)); }
+  double cellVolume() const { return cellSize * cellSize * cellSize; }
+
+  /// The grid of cells of edge `cellSize` covering `bounds`, centred on it.
+  static Grid covering(const Box3& bounds, double cellSize);
+  /// About `cellsAlongLongest` cells along the longest side of `bounds`.
+  static Grid withCellsAlongLongest(const Box3& bounds, int cellsAlongLongest);
+};
+
+struct SliceStats {
+  std::size_t splits = 0;          ///< plane splits of a piece
+  std::size_t polygonsSplit = 0;   ///< polygons cut in two or more
+  std::size_t leafCells = 0;       ///< cells that hold part of the solid
+  std::size_t multiPieceCells = 0; ///< cells holding two or more disconnected pieces
+  std::size_t collapsedPolygons = 0;  ///< polygons removed when rounding made points equal
+  std::size_t weldedPoints = 0;       ///< points within coordinate resolution of another
+  double secondsSplitting = 0.0;   ///< wall time of the recursive plane splits
+  double secondsBuilding = 0.0;    ///< wall time of welding and assembling the PolyMesh
+};
+
+/// Progress callback: fraction done in [0, 1].
+using ProgressFn = std::function<void(double)>;
+
+/// Slices the solid bounded by `surface` (closed, manifold, outward-oriented; several shells
+/// and cavities are fine) with `grid`. Faces on the surface are tagged `Surface`, faces between
+/// cells are interior. `elementCell` (optional) receives each element's cell index (i, j, k).
+PolyMesh sliceSurface(const TriangleSurface& surface, const Grid& grid, SliceStats* stats = nullptr,
+                      std::vector<std::array<int, 3>>* elementCell = nullptr,
+                      const ProgressFn& progress = {});
+
+}  // namespace polydg

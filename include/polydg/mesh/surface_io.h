@@ -1,0 +1,87 @@
+// Reads a triangle surface from OBJ, OFF, PLY and STL files in double precision (CGAL's
+// polygon-soup readers) and from any other format assimp understands (glTF, 3DS, FBX, ...) with
+// node transforms baked in; polygons are triangulated exactly and vertices welded by exact
+// position across all meshes.
+#pragma once
+
+#include <cstddef>
+#include <string>
+
+#include "polydg/mesh/surface.h"
+
+namespace polydg {
+
+/// What readSurface() found and did. For files read by assimp, counts are over the whole scene
+/// after node transforms are applied (a mesh used by two nodes counts twice). For files read by
+/// CGAL, `meshes` is the number of distinct OBJ materials (`usemtl` names, faces before the first
+/// one counting as one default material) used by faces, points and lines, and 1 for OFF, PLY
+/// and STL; `inputVertices` is the number of vertex records in the file (OBJ `v` lines, OFF and
+/// PLY vertices, three corners per STL facet).
+struct SurfaceReadInfo {
+  std::size_t meshes = 0;             ///< meshes in the scene (assimp joins them per material)
+  std::size_t inputVertices = 0;      ///< vertices over all meshes, before welding
+  std::size_t weldedVertices = 0;     ///< vertices of the result (distinct positions)
+  std::size_t triangles = 0;          ///< triangles of the result
+  std::size_t polygons = 0;           ///< faces of four or more corners, triangulated here
+  std::size_t fannedPolygons = 0;     ///< of those, split into a fan: zero area or self-crossing
+  std::size_t droppedDegenerate = 0;  ///< triangles dropped: two corners at one position
+  std::size_t ignoredPoints = 0;      ///< point primitives skipped
+  std::size_t ignoredLines = 0;       ///< line primitives skipped
+  /// The library that parsed the file: "cgal" (double precision) or "assimp" (single precision).
+  std::string reader;
+};
+
+/// Reads the triangles of the surface in the file at `path`.
+///
+/// Readers. A file whose extension is .obj, .off, .ply or .stl (any letter case) is read by
+/// CGAL's polygon-soup readers (CGAL/IO/OBJ.h, OFF.h, PLY.h, STL.h), which parse coordinates
+/// into doubles, correctly rounded from the text (binary STL and PLY float32 values are widened
+/// exactly). Before CGAL sees a file it is checked for what CGAL would misread or crash on
+/// (OBJ: face indices that are zero or not integers, homogeneous `v` coordinates with w != 1,
+/// line continuations, binary content; PLY: property types CGAL does not know, 32-bit list
+/// counts, x/y/z that are not float or double, elements CGAL or assimp give another meaning;
+/// OFF: headers other than [ST][C][N][4]OFF with ASCII counts; STL: neither 84 + 50 n bytes
+/// (binary) nor starting with "solid" (ASCII)), and after CGAL it is checked that every face
+/// index names a vertex. OBJ `p` and `l` lines are counted here and removed before CGAL parses
+/// the rest. If CGAL cannot read such a file (an OBJ keyword it does not know, an STL facet of
+/// four corners, PLY indices of 8 or 16 bits, ...), or the file fails one of the checks, or CGAL
+/// finds no vertex, assimp reads it instead, in single precision as for every other format:
+/// `info->reader` says which did. An OBJ file with `v` lines but no `f` line is reported as
+/// holding only points/lines without asking assimp.
+///
+/// For assimp, every node's transform is applied to the meshes it references (instanced meshes
+/// appear once per instance). For CGAL, faces are taken in file order.
+///
+/// Corners are welded across all meshes: two corners become one vertex exactly
+/// when their coordinates are bitwise equal, -0.0 counting as 0.0. Attributes (normals, texture
+/// coordinates, materials) play no part. A face of four or more corners is replaced by the
+/// exact constrained triangulation of its projection onto the coordinate plane where it is
+/// largest (triangulateFace, mesh/face_triangulation.h): n - 2 triangles over its own corners,
+/// wound like the face, non-convex faces included. assimp's aiProcess_Triangulate is not used:
+/// its ear clipping returns overlapping triangles for some non-convex faces. A face of zero area
+/// or with crossing edges has no such triangulation and becomes a fan from its first corner.
+/// A triangle with two corners at one position is dropped and counted; every other triangle is
+/// kept as it is, with the winding the file gives it (no reorientation, no removal of zero-area
+/// or duplicate triangles). Point and line primitives (OBJ `p`, `l` and faces of one or two
+/// corners) are skipped and counted.
+///
+/// Before an OFF or PLY file is read, its header's vertex, face and element counts are checked
+/// against the file size: both readers allocate what they declare before reading the data.
+///
+/// The result holds only vertices used by a kept triangle, numbered in order of first use
+/// (meshes in scene order, triangles in mesh order, corners in triangle order); coordinates are
+/// those of the file as parsed (double precision by CGAL; single precision by assimp, widened
+/// exactly to double), with -0.0 stored as 0.0.
+///
+/// If `info` is not null it receives the counts above. Throws std::runtime_error with a
+/// one-line message naming the file when the file is missing, its header declares more items
+/// than it can hold, neither reader can read it (quoting assimp's reason and, for the CGAL
+/// formats, CGAL's), it holds no meshes or only points and lines, no triangle survives welding,
+/// or a used vertex has a non-finite coordinate. Nothing is printed: polydg never creates
+/// assimp's DefaultLogger, so assimp logs to its null logger unless the application installs
+/// one itself; CGAL's readers run in verbose mode with std::cout, std::cerr and std::clog
+/// redirected to a buffer (their last error line becomes the CGAL reason), so output that
+/// another thread writes to those streams during a CGAL read is swallowed too.
+TriangleSurface readSurface(const std::string& path, SurfaceReadInfo* info = nullptr);
+
+}  // namespace polydg

@@ -1,0 +1,52 @@
+// Checks of an input surface before slicing (closed, manifold, self-intersections, degenerate
+// triangles, orientation, shells and cavities) and repairs of broken surfaces, with CGAL.
+#pragma once
+
+#include <string>
+
+#include "polydg/mesh/surface.h"
+
+namespace polydg {
+
+/// What is wrong with a surface, as counts.
+struct SurfaceDiagnosis {
+  SurfaceTopology topology;
+  std::size_t selfIntersections = 0;  ///< pairs of triangles that intersect improperly
+  bool checkedSelfIntersections = false;  ///< only possible on a manifold (orientable) soup
+  std::size_t shells = 0;             ///< connected components (see orientToBoundVolume)
+
+  bool closed() const { return topology.closed() || misorientedOnly(); }
+  bool manifold() const { return topology.nonManifoldEdges == 0; }
+  /// Closed except for inconsistent orientation, which re-orientation fixes.
+  bool misorientedOnly() const {
+    return topology.boundaryEdges == 0 && topology.nonManifoldEdges == 0 &&
+           topology.misorientedEdges > 0;
+  }
+};
+
+/// Counts the defects of `surface`. Self-intersections are looked for when the surface can be
+/// made a manifold mesh (that is, when every edge has at most two triangles).
+SurfaceDiagnosis diagnose(const TriangleSurface& surface);
+
+/// Orients a closed, manifold, non-self-intersecting surface so that it bounds a volume: outer
+/// shells outward, cavities inward (CGAL's orient_to_bound_a_volume, after making the
+/// orientation consistent). `changed` says whether any triangle was flipped; `shells` and
+/// `cavities` (optional) receive the number of closed components and of those nested at odd
+/// depth (holes in the solid).
+TriangleSurface orientToBoundVolume(const TriangleSurface& surface, bool& changed,
+                                    std::size_t* shells = nullptr,
+                                    std::size_t* cavities = nullptr);
+
+/// Removes triangles with repeated vertices or zero area, welding their edges away (CGAL's
+/// remove_degenerate_faces on the soup made into a mesh). Returns how many were removed.
+std::size_t removeDegenerateTriangles(TriangleSurface& surface);
+
+/// Closes the holes of an orientable surface by triangulating each boundary loop (CGAL's hole
+/// filling). Throws if the surface is non-manifold. `filled` receives the number of holes.
+TriangleSurface fillHoles(const TriangleSurface& surface, std::size_t& filled);
+
+/// CGAL's 3D alpha wrapping of any triangle soup: a closed, manifold, watertight surface that
+/// encloses the input at distance `offset`, with no cavity narrower than about `alpha`.
+TriangleSurface alphaWrap(const TriangleSurface& surface, double alpha, double offset);
+
+}  // namespace polydg

@@ -1,0 +1,110 @@
+// Local integrators of the DG elasticity forms (Kaufmann et al. 2008, sections 4-5): the
+// element stiffness and mass matrices and the face matrices of the IP and BZ methods, all from
+// the exact cached moments (no quadrature: every integrand is a polynomial).
+//
+// Notation. On element K the displacement is u = sum_{d,i} U(d n + i) phi_i e_d (DgBasis,
+// n = basis size); local matrices are 3n x 3n in that order, rows the test function v, columns
+// the trial function u. On a face F between K (this side) and L (the other side) n is the unit
+// normal pointing out of K, [u] = u_K - u_L the jump (paper: [[u]] = [u] (x) n) and
+// {s} = (s_K + s_L)/2 the average; on a Dirichlet boundary face u_L = g, {s} = s_K.
+#pragma once
+
+#include <Eigen/Core>
+
+#include "polydg/physics/dg_basis.h"
+
+namespace polydg {
+
+/// The DG method (paper section 4).
+enum class Method {
+  IP,  ///< symmetric interior penalty, eq. (8): consistent, converges at the optimal rate
+  BZ,  ///< Babuska-Zlamal penalty, eq. (6): only the jump penalty; inconsistent
+};
+
+/// How an element sees one of its faces.
+enum class FaceKind {
+  Interior,   ///< shared with another element
+  Dirichlet,  ///< boundary face with a weakly prescribed displacement
+  Free,       ///< boundary face without a displacement condition: no face terms
+};
+
+/// The coefficients of the bilinear form.
+struct FormCoefficients {
+  Method method = Method::IP;
+  double mu = 0.0;      ///< shear modulus
+  double lambda = 0.0;  ///< first Lame parameter
+  double eta = 0.0;     ///< global penalty parameter of eq. (7)
+  /// Per-element penalties eta_K (one per element of the mesh), or null for the global eta.
+  /// With them a face's penalty is eta_F = area(F) (eta_K / vol(K) + eta_L / vol(L)) (one
+  /// side on the boundary) instead of eta area(F) (1/vol(K) + 1/vol(L)): the same coercivity
+  /// argument (penaltyThreshold() in physics/assembly.h) with each element's own bound, so a
+  /// badly shaped sliced element raises the penalty only on its own faces.
+  const ElementData<double>* elementEta = nullptr;
+};
+
+/// eta_F of face `f` between `self` and `other` (invalid on the boundary) under `form`.
+double facePenalty(const FormCoefficients& form, const MomentCache& moments, FaceId f,
+                   ElementId self, ElementId other);
+
+/// One face as seen from one of its elements (`self`), with what the face integrators need
+/// about both sides.
+struct FaceView {
+  FaceId face;
+  FaceKind kind = FaceKind::Interior;
+  ElementId self;
+  ElementId other;               ///< Interior only
+  bool selfIsFront = true;       ///< the face's own normal points out of `self`
+  int selfCoupledFaces = 0;      ///< faces of `self` with face terms (Interior or Dirichlet)
+  int otherCoupledFaces = 0;     ///< the same for `other`
+};
+
+/// Element stiffness K_K = int_K B^T C B = int_K sigma(u) : eps(v), paper eq. (10), with
+/// sigma = 2 mu eps + lambda tr(eps) I. 3n x 3n, symmetric positive semi-definite, with the
+/// six rigid motions in its kernel.
+void elementStiffness(const DgBasis& basis, const MomentCache& moments, ElementId e, double mu,
+                      double lambda, Eigen::MatrixXd& out);
+
+/// Element mass int_K phi_i phi_j, n x n (the identity for an orthonormal basis); the 3n x 3n
+/// mass matrix is its Kronecker product with I_3 (times the density).
+void elementMass(const DgBasis& basis, const MomentCache& moments, ElementId e,
+                 Eigen::MatrixXd& out);
+
+/// The face's contribution to the rows of `self`: `selfBlock` (columns of self, 3n x 3n) and,
+/// for interior faces, `otherBlock` (columns of other, 3n x 3n). Both are overwritten.
+///
+/// IP (paper eq. 8 with eqs. 11-13, penalty eq. 7), for test v and trial u:
+///   - int_F ({sigma(u)} n) . [v]            consistency, eq. (11)
+///   - int_F ({sigma(v)} n) . [u]            symmetry, eq. (12)
+///   + mu eta_F int_F [u] . [v]              stability, eq. (13) with eta_F of eq. (7)
+///   + lambda sum_{E in {K,L}} c_E (R_E[u.n], R_E[v.n])_E                     (lambda term)
+/// eta_F = facePenalty(): eta area(F) (1/vol(K) + 1/vol(L)) (one side on the boundary), or
+/// with per-element eta_K (FormCoefficients::elementEta). The penalty scales
+/// with mu only: the lambda part of the consistency terms, -int {lambda div u}[v.n], is
+/// controlled instead by the local lifting R_E: P_{p-1}(E) <- face, (R_E w, q)_E =
+/// w_F int_F q w (w_F = 1/2 inside, 1 on the boundary), weighted by c_E = the number of faces
+/// of E with face terms. Then the lambda part of the form,
+/// lambda sum_K (|div u|^2 - 2 (div u, sum_F R_F u) + c_K sum_F |R_F u|^2) >= 0, is positive
+/// semi-definite for every lambda and constrains only the degree <= p-1 moments of the
+/// normal jumps: the method stays locking-free as nu -> 1/2 (Hansbo and Larson 2002 scale the
+/// normal penalty with lambda; the lifting keeps that consistent without over-constraining).
+/// The IP stability threshold then depends on the mu part only: see penaltyThreshold()
+/// (physics/assembly.h).
+///
+/// BZ (paper eq. 6): only mu eta_F int_F [u] . [v]; positive definite for every eta > 0.
+///
+/// Dirichlet faces (u_L = g, v_L = 0, sigma_L = sigma_K) give the same terms with one side;
+/// their right-hand side is dirichletLoad().
+/// With `withOther` false, `otherBlock` is not computed (left empty): the assembly computes
+/// each coupling block once, from one side, and uses its transpose for the other.
+void faceRows(const PolyMesh& mesh, const DgBasis& basis, const MomentCache& moments,
+              const FaceView& view, const FormCoefficients& form, Eigen::MatrixXd& selfBlock,
+              Eigen::MatrixXd& otherBlock, bool withOther = true);
+
+/// int_F psi_q psi_r for element e's lifting basis psi (orthonormal on e, spanning the
+/// polynomials of degree <= p-1): liftingSize() x liftingSize(). Its largest eigenvalue is the
+/// discrete trace inverse constant max_{q in P_{p-1}} |q|^2_F / |q|^2_K (area(F)/vol(K) for
+/// p = 1, the factor of eq. 7).
+Eigen::MatrixXd liftingFaceGram(const DgBasis& basis, const MomentCache& moments,
+                                const PolyMesh& mesh, FaceId f, ElementId e);
+
+}  // namespace polydg

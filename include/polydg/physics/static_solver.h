@@ -1,0 +1,129 @@
+// Static linear elasticity on a polyhedral mesh with the DG methods: the pipeline
+// moments -> basis -> penalty -> assembly -> solve, as a stateful StaticSolver that keeps
+// every stage (and the factorization) and as the one-shot solveStatic().
+#pragma once
+
+#include <memory>
+
+#include "polydg/physics/assembly.h"
+#include "polydg/physics/linear_solver.h"
+
+namespace polydg {
+
+/// How the global penalty eta of eq. (7) is chosen.
+enum class PenaltyRule {
+  /// eta = safety * the coercivity bound: guaranteed SPD, no trial factorizations. Per
+  /// element (elementPenaltyThresholds()) unless PenaltyOptions::local is false, then the
+  /// global penaltyThreshold().
+  TraceBound,
+  /// The paper's rule (section 10): start at `eta` and double until the Cholesky
+  /// factorization succeeds. Costs one factorization per attempt.
+  Doubling,
+  /// eta = `eta` as given.
+  Fixed,
+};
+
+struct PenaltyOptions {
+  PenaltyRule rule = PenaltyRule::TraceBound;
+  double eta = 1.0;     ///< Fixed: the value; Doubling: the first value tried
+  double safety = 1.0;  ///< TraceBound: multiple of the threshold
+  /// TraceBound: each element's own bound eta_K (FormCoefficients::elementEta), so that a
+  /// badly shaped element does not raise the penalty, and spoil the accuracy, everywhere; false:
+  /// the largest bound for every face, as in the paper's global eta.
+  bool local = true;
+};
+
+struct DiscretizationOptions {
+  Method method = Method::IP;
+  BasisOptions basis;
+  PenaltyOptions penalty;
+  /// Degree of exactness of the quadrature for non-polynomial loads (body force function,
+  /// Dirichlet data); -1 picks 2p + 2.
+  int quadratureDegree = -1;
+};
+
+struct StaticOptions {
+  DiscretizationOptions discretization;
+  SolverOptions solver;
+};
+
+/// Figures of one static solve. Times are wall seconds.
+struct StaticReport {
+  std::size_t elements = 0;
+  std::size_t dofs = 0;
+  std::size_t nonzeros = 0;    ///< stored entries of K (both triangles)
+  double eta = 0.0;            ///< the global penalty used (local: the largest eta_K)
+  double etaThreshold = 0.0;   ///< penaltyThreshold() (the IP coercivity bound)
+  int penaltyAttempts = 1;     ///< factorizations tried by PenaltyRule::Doubling
+  std::size_t dirichletFaces = 0, tractionFaces = 0;
+  std::size_t basisFallbacks = 0;  ///< DgBasis::fallbackElements()
+  /// The thesis's phases (Kaufmann 2013, Table 4.1). Integration: moments, bases, face roles,
+  /// penalty bounds, and the element and face matrices (localMatrices()).
+  double integrateSeconds = 0.0;
+  double assembleSeconds = 0.0;    ///< accumulating K from them, and the load vector F
+  double solveSeconds = 0.0;       ///< factorization (or preconditioner) and solve
+  SolveReport solver;
+  double energy = 0.0;  ///< U.F / 2: the strain energy U.K.U / 2 when prescribed displacements are 0
+};
+
+/// A solved problem: the bases and the DG coefficients (see LinearSystem for the layout).
+struct StaticSolution {
+  std::unique_ptr<MomentCache> moments;
+  std::unique_ptr<DgBasis> basis;
+  Eigen::VectorXd coefficients;
+  StaticReport report;
+};
+
+/// The stages of a static solve, each callable again (e.g. assemble() with new loads reuses
+/// the moments and bases; solve() reuses the factorization when only F changed).
+class StaticSolver {
+ public:
+  /// `mesh` must outlive the solver.
+  StaticSolver(const PolyMesh& mesh, const Material& material, const StaticOptions& options);
+
+  /// Moments up to degree 2p and the bases.
+  void integrate();
+  /// Face roles, penalty, element and face matrices (timed as integration), K and F for
+  /// `loads` (calls integrate() first if needed). With
+  /// PenaltyRule::Doubling this factorizes K for each trial eta.
+  void assemble(const LoadCase& loads);
+  /// Factorizes K (unless done) and solves; throws std::runtime_error if K is not positive
+  /// definite (e.g. no Dirichlet condition: rigid motions are free).
+  const Eigen::VectorXd& solve();
+
+  const MomentCache& moments() const { return *moments_; }
+  const DgBasis& basis() const { return *basis_; }
+  const LinearSystem& system() const { return system_; }
+  const FaceRoles& roles() const { return roles_; }
+  const FormCoefficients& form() const { return form_; }
+  const StaticReport& report() const { return report_; }
+  /// Moves the results out (the solver is then spent).
+  StaticSolution release();
+
+ private:
+  /// K from `local` into `matrix`, without copying it.
+  void assembleInto(const LocalMatrices& local,
+                    Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix) const;
+
+  const PolyMesh* mesh_;
+  Material material_;
+  StaticOptions options_;
+  std::unique_ptr<MomentCache> moments_;
+  std::unique_ptr<DgBasis> basis_;
+  FaceRoles roles_;
+  /// Per-element penalties that form_.elementEta points to (on the heap: stable under moves).
+  std::unique_ptr<ElementData<double>> elementEta_;
+  FormCoefficients form_;
+  LinearSystem system_;
+  LinearSolver solver_;
+  bool factorized_ = false;
+  double momentsSeconds_ = 0.0;  ///< integrate()'s share of StaticReport::integrateSeconds
+  Eigen::VectorXd coefficients_;
+  StaticReport report_;
+};
+
+/// One-shot: integrate, assemble and solve.
+StaticSolution solveStatic(const PolyMesh& mesh, const Material& material,
+                           const LoadCase& loads, const StaticOptions& options = {});
+
+}  // namespace polydg
