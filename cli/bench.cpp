@@ -167,9 +167,8 @@ std::vector<int> accuracySizes(int degree, BenchmarkMesh mesh, bool quick) {
 void printRun(const BenchmarkRun& r) {
   std::cout << toString(r.method) << " p=" << r.degree << ' '
             << (r.mesh == BenchmarkMesh::Hex ? "hex" : "sliced") << " n=" << r.n << ": "
-            << r.report.dofs << " DOFs, integrate " << r.report.integrateSeconds
-            << " s, assemble " << r.report.assembleSeconds << " s, solve "
-            << r.report.solveSeconds << " s";
+            << r.report.dofs << " DOFs, integrate " << r.report.integrateSeconds << " s, assemble "
+            << r.report.assembleSeconds << " s, solve " << r.report.solveSeconds << " s";
   if (r.l2Error > 0) std::cout << ", L2 " << r.l2Error;
   std::cout << std::endl;
 }
@@ -208,8 +207,7 @@ SuiteOutput accuracySuite(const BenchOptions& o, bool quiet) {
           }
           s.json.push_back(j);
           s.rows.push_back(j);
-          l2.add(key,
-                 r.report.integrateSeconds + r.report.assembleSeconds + r.report.solveSeconds,
+          l2.add(key, r.report.integrateSeconds + r.report.assembleSeconds + r.report.solveSeconds,
                  r.l2Error);
           previous = r;
         }
@@ -250,8 +248,8 @@ SuiteOutput table41Suite(bool quiet) {
       for (int repeat = 0; repeat < kB2Repeats; ++repeat) {
         BenchmarkRun candidate = runBenchmarkB2(so);
         if (repeat == 0) first = candidate;
-        const double total = candidate.report.integrateSeconds +
-                             candidate.report.assembleSeconds + candidate.report.solveSeconds;
+        const double total = candidate.report.integrateSeconds + candidate.report.assembleSeconds +
+                             candidate.report.solveSeconds;
         if (total < best) {
           best = total;
           r = std::move(candidate);
@@ -267,10 +265,10 @@ SuiteOutput table41Suite(bool quiet) {
                         {"t_solve", first.report.solveSeconds}};
       s.json.push_back(j);
       s.rows.push_back(row);
-      series.push_back({"polydg " + upper(toString(method)) + (p == 1 ? " lin" : " quad"),
-                        {1, 2, 3},
-                        {r.report.integrateSeconds, r.report.assembleSeconds,
-                         r.report.solveSeconds}});
+      series.push_back(
+          {"polydg " + upper(toString(method)) + (p == 1 ? " lin" : " quad"),
+           {1, 2, 3},
+           {r.report.integrateSeconds, r.report.assembleSeconds, r.report.solveSeconds}});
     }
   // The thesis's Table 4.1 (Core2 Duo 2.4 GHz, 2008), ms.
   const std::vector<std::pair<std::string, std::array<double, 3>>> thesis{
@@ -310,17 +308,20 @@ nlohmann::json conditionJson(const StabilityConditionRun& r) {
 SuiteOutput stabilitySuite(const BenchOptions& o, bool quiet) {
   SuiteOutput s{"stability", nlohmann::json::object(), nlohmann::json::array(), {}};
   s.json["cond_method"] = kConditionMethod;
-  s.json["setup"] = {
-      {"sliver", "3x3x3 unit cubes, centre cell split at x = 1 + volume_ratio; IP, E = 1, "
-                 "nu = 0.3, u = 0 weakly on the whole boundary; merged: mergeSlivers with "
-                 "threshold 0.01 of a cell (the meshing default)"},
-      {"thin_neck", "one element: blocks [0,1]^3 and [2,3]x[0,1]^2 joined by the neck "
-                    "[1,2]x[0,eps]x[0,1]; IP, clamped on x = 0"},
-      {"incompressible", "B3 on the locking-test meshes: p = 1 160x4x8 with penalty doubling, "
-                         "p = 2 40x4x4; reference = Euler-Bernoulli + Timoshenko shear at nu"},
-      {"scale", "B1 (n = 4 hex, p = 2; rel_error = L2 error / L2 norm of u) and B3 (40x4x4, "
-                "p = 2; rel_error = tip / (scale * unscaled tip) - 1), lengths times scale, "
-                "translated by offset"}};
+  s.json["setup"] = {{"sliver",
+                      "3x3x3 unit cubes, centre cell split at x = 1 + volume_ratio; IP, E = 1, "
+                      "nu = 0.3, u = 0 weakly on the whole boundary; merged: mergeSlivers with "
+                      "threshold 0.01 of a cell (the meshing default)"},
+                     {"thin_neck",
+                      "one element: blocks [0,1]^3 and [2,3]x[0,1]^2 joined by the neck "
+                      "[1,2]x[0,eps]x[0,1]; IP, clamped on x = 0"},
+                     {"incompressible",
+                      "B3 on the locking-test meshes: p = 1 160x4x8 with penalty doubling, "
+                      "p = 2 40x4x4; reference = Euler-Bernoulli + Timoshenko shear at nu"},
+                     {"scale",
+                      "B1 (n = 4 hex, p = 2; rel_error = L2 error / L2 norm of u) and B3 (40x4x4, "
+                      "p = 2; rel_error = tip / (scale * unscaled tip) - 1), lengths times scale, "
+                      "translated by offset"}};
   const double eps = std::numeric_limits<double>::epsilon();
   auto log = [&](const std::string& line) {
     if (!quiet) std::cout << line << std::endl;
@@ -329,7 +330,7 @@ SuiteOutput stabilitySuite(const BenchOptions& o, bool quiet) {
   // Sliver.
   const std::vector<double> ratios =
       o.quick ? std::vector<double>{1, 1e-4, 1e-12}
-              : std::vector<double>{1, 1e-1, 5e-2, 2e-2, 1e-2, 1e-3, 1e-4, 1e-5,
+              : std::vector<double>{1,    1e-1, 5e-2, 2e-2, 1e-2,  1e-3,  1e-4, 1e-5,
                                     1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12};
   nlohmann::json sliver = nlohmann::json::array(), regular = nlohmann::json::object();
   SeriesSet sliverPlot;
@@ -396,24 +397,25 @@ SuiteOutput stabilitySuite(const BenchOptions& o, bool quiet) {
       const IncompressibleRun run = runIncompressibleCase(nu, p, o.quick);
       if (nu == 0.3) tip03 = run.tip;
       const LockingSetup setup = lockingSetup(p, o.quick);
-      nlohmann::json j{{"nu", nu},
-                       {"degree", p},
-                       {"mesh", std::to_string(setup.mesh.nx) + "x" + std::to_string(setup.mesh.ny) +
-                                    "x" + std::to_string(setup.mesh.nz)},
-                       {"dofs", run.report.dofs},
-                       {"eta", run.report.eta},
-                       {"tip", run.tip},
-                       {"reference", run.reference},
-                       {"rel_error", run.relError},
-                       {"tip_over_nu_0_3", run.tip / tip03},
-                       {"within_5_percent", std::abs(run.relError) <= 0.05},
-                       {"t_solve", run.report.solveSeconds}};
+      nlohmann::json j{
+          {"nu", nu},
+          {"degree", p},
+          {"mesh", std::to_string(setup.mesh.nx) + "x" + std::to_string(setup.mesh.ny) + "x" +
+                       std::to_string(setup.mesh.nz)},
+          {"dofs", run.report.dofs},
+          {"eta", run.report.eta},
+          {"tip", run.tip},
+          {"reference", run.reference},
+          {"rel_error", run.relError},
+          {"tip_over_nu_0_3", run.tip / tip03},
+          {"within_5_percent", std::abs(run.relError) <= 0.05},
+          {"t_solve", run.report.solveSeconds}};
       incompressible.push_back(j);
       j["case"] = "incompressible";
       s.rows.push_back(j);
       worstTip = std::max(worstTip, std::abs(run.relError));
-      tipPlot.add("IP p=" + std::to_string(p) + " (" + j["mesh"].get<std::string>() + ")",
-                  0.5 - nu, run.tip);
+      tipPlot.add("IP p=" + std::to_string(p) + " (" + j["mesh"].get<std::string>() + ")", 0.5 - nu,
+                  run.tip);
       tipPlot.add("reference (Timoshenko)", 0.5 - nu, run.reference);
       log("incompressible p=" + std::to_string(p) + " nu " + shortNumber(nu) + ": tip " +
           shortNumber(run.tip) + " (reference " + shortNumber(run.reference) + ")");
@@ -449,8 +451,8 @@ SuiteOutput stabilitySuite(const BenchOptions& o, bool quiet) {
         j["case"] = "scale";
         s.rows.push_back(j);
         worstChange = std::max(worstChange, change);
-        worstChangeOverBound =
-            std::max(worstChangeOverBound, change / (cond * std::max(run.coordinateResolution, eps)));
+        worstChangeOverBound = std::max(worstChangeOverBound,
+                                        change / (cond * std::max(run.coordinateResolution, eps)));
         scalePlot.add(name + (offset.isZero() ? ", offset 0" : ", offset (1e6,-1e6,1e6)"), sc,
                       std::max(change, eps));
         log("scale " + name + " x" + shortNumber(sc) + " offset " + shortNumber(offset.x()) +
@@ -504,7 +506,8 @@ SuiteOutput meshingSuite(const BenchOptions& o, bool quiet) {
     models.emplace_back("sphere", benchmarkModel("sphere"));
     models.emplace_back("torus_knot", benchmarkModel("torus_knot"));
   }
-  const std::vector<int> cells = o.quick ? std::vector<int>{8, 16} : std::vector<int>{16, 32, 64, 128};
+  const std::vector<int> cells =
+      o.quick ? std::vector<int>{8, 16} : std::vector<int>{16, 32, 64, 128};
   SeriesSet time, elements, volume;
   for (const auto& [name, surface] : models)
     for (int n : cells) {
@@ -577,9 +580,9 @@ struct CutRow {
 /// Corner cuts of growing depth on a unit box (normal (+-1, +-1, +-1), each corner once, so the
 /// cuts never overlap and the mesh keeps its size), then one through the middle.
 std::vector<CutRow> cuttingRows(bool quick) {
-  const std::vector<double> depths = quick ? std::vector<double>{0.05, 0.3}
-                                           : std::vector<double>{0.01, 0.04, 0.1, 0.2, 0.35,
-                                                                 0.5, 0.7, 0.9};
+  const std::vector<double> depths =
+      quick ? std::vector<double>{0.05, 0.3}
+            : std::vector<double>{0.01, 0.04, 0.1, 0.2, 0.35, 0.5, 0.7, 0.9};
   std::vector<CutRow> rows;
   for (std::size_t k = 0; k < depths.size(); ++k) {
     const Vec3 s(k & 1 ? -1 : 1, k & 2 ? -1 : 1, k & 4 ? -1 : 1);
@@ -634,23 +637,24 @@ SuiteOutput cuttingSuite(const BenchOptions& o, bool quiet) {
       time.add("cut, validation " + levelName, split, r.seconds);
       if (level == ValidationLevel::None) time.add("full moment rebuild (2 cores)", split, rebuild);
       if (!quiet)
-        std::cout << "cut " << row.name << " (validation " << levelName << "): "
-                  << r.elementsSplit << " split, " << r.facesReintegrated << " of "
-                  << r.facesTotal << " faces integrated, " << r.seconds << " s; full rebuild "
-                  << rebuild << " s" << std::endl;
+        std::cout << "cut " << row.name << " (validation " << levelName << "): " << r.elementsSplit
+                  << " split, " << r.facesReintegrated << " of " << r.facesTotal
+                  << " faces integrated, " << r.seconds << " s; full rebuild " << rebuild << " s"
+                  << std::endl;
       if (level == ValidationLevel::Local && r.elementsSplit > kLocalLimit) break;
     }
   }
   s.json = {{"mesh", std::to_string(n) + "^3 hexahedra in the unit box"},
-            {"note", "each row cuts a corner off the same mesh; t_cut includes sliver merging "
-                     "and the validation named; t_full_rebuild integrates every face"},
+            {"note",
+             "each row cuts a corner off the same mesh; t_cut includes sliver merging "
+             "and the validation named; t_full_rebuild integrates every face"},
             {"runs", runs}};
-  s.plots.push_back({"cutting.svg",
-                     {"Plane cuts on " + std::to_string(n * n * n) +
-                          " hexahedra: time against elements split",
-                      {"elements split by the cut", AxisScale::Log},
-                      {"wall time [s]", AxisScale::Log},
-                      time.series()}});
+  s.plots.push_back(
+      {"cutting.svg",
+       {"Plane cuts on " + std::to_string(n * n * n) + " hexahedra: time against elements split",
+        {"elements split by the cut", AxisScale::Log},
+        {"wall time [s]", AxisScale::Log},
+        time.series()}});
   return s;
 }
 
@@ -666,9 +670,11 @@ void runBench(const BenchOptions& o, const CommonOptions& common) {
     if (!common.quiet)
       std::cout << "suite " << name << ": " << secondsSince(ts) << " s" << std::endl;
   };
-  if (all || o.suite == "accuracy") timed("accuracy", [&] { return accuracySuite(o, common.quiet); });
+  if (all || o.suite == "accuracy")
+    timed("accuracy", [&] { return accuracySuite(o, common.quiet); });
   if (all || o.suite == "table41") timed("table41", [&] { return table41Suite(common.quiet); });
-  if (all || o.suite == "stability") timed("stability", [&] { return stabilitySuite(o, common.quiet); });
+  if (all || o.suite == "stability")
+    timed("stability", [&] { return stabilitySuite(o, common.quiet); });
   if (all || o.suite == "meshing") timed("meshing", [&] { return meshingSuite(o, common.quiet); });
   if (all || o.suite == "cutting") timed("cutting", [&] { return cuttingSuite(o, common.quiet); });
   if (!common.quiet && all) std::cout << "all suites: " << secondsSince(t0) << " s" << std::endl;
@@ -679,8 +685,9 @@ void runBench(const BenchOptions& o, const CommonOptions& common) {
 void addBenchCommand(CLI::App& app, const CommonOptions& common, int& exitCode) {
   auto o = std::make_shared<BenchOptions>();
   CLI::App* cmd = app.add_subcommand(
-      "bench", "Benchmark suites as JSON, CSV and SVG plots: accuracy (B1), table41 (B2), "
-               "stability (B4), meshing, cutting, or all");
+      "bench",
+      "Benchmark suites as JSON, CSV and SVG plots: accuracy (B1), table41 (B2), "
+      "stability (B4), meshing, cutting, or all");
   cmd->add_option("--suite", o->suite, "accuracy, table41, stability, meshing, cutting or all")
       ->required()
       ->check(CLI::IsMember({"accuracy", "table41", "stability", "meshing", "cutting", "all"}));

@@ -142,8 +142,9 @@ void printDg(const DgChecks& dg) {
 void addCheckCommand(CLI::App& app, const CommonOptions& common, int& exitCode) {
   auto options = std::make_shared<CheckOptions>();
   CLI::App* cmd = app.add_subcommand(
-      "check", "Validate a simulation mesh: closed, positive, planar, properly shared elements, "
-               "and the DG patch test and rigid modes on it");
+      "check",
+      "Validate a simulation mesh: closed, positive, planar, properly shared elements, "
+      "and the DG patch test and rigid modes on it");
   cmd->add_option("mesh", options->input, "simulation mesh (.vtu)")
       ->required()
       ->check(CLI::ExistingFile);
@@ -175,10 +176,9 @@ void addCheckCommand(CLI::App& app, const CommonOptions& common, int& exitCode) 
       writeReport(options->report, report);
     }
     if (!common.quiet) {
-      std::cout << options->input << ": " << (passed ? "valid" : "INVALID") << ", "
-                << r.elements << " elements, " << r.faces << " faces (" << r.interiorFaces
-                << " interior), " << r.components << " component(s), volume " << r.volume
-                << '\n';
+      std::cout << options->input << ": " << (passed ? "valid" : "INVALID") << ", " << r.elements
+                << " elements, " << r.faces << " faces (" << r.interiorFaces << " interior), "
+                << r.components << " component(s), volume " << r.volume << '\n';
       for (const std::string& m : r.messages) std::cout << "  " << m << '\n';
       printDg(dg);
       if (dg.local)

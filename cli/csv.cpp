@@ -21,7 +21,8 @@ void flatten(const nlohmann::json& value, const std::string& prefix,
     text = value.get<std::string>();
   } else if (value.is_array()) {
     for (std::size_t i = 0; i < value.size(); ++i)
-      text += (i ? ";" : "") + (value[i].is_string() ? value[i].get<std::string>() : value[i].dump());
+      text +=
+          (i ? ";" : "") + (value[i].is_string() ? value[i].get<std::string>() : value[i].dump());
   } else if (!value.is_null()) {
     text = value.dump();  // numbers in shortest round-trip form, booleans as true/false
   }

@@ -84,9 +84,11 @@ Blade parsePolygon(const std::string& text) {
 
 std::string describe(const Blade& blade) {
   std::ostringstream s;
-  if (blade.finite()) s << "polygon with " << blade.polygon.size() << " corners";
-  else s << "plane " << blade.normal.x() << "," << blade.normal.y() << "," << blade.normal.z()
-         << "," << blade.offset;
+  if (blade.finite())
+    s << "polygon with " << blade.polygon.size() << " corners";
+  else
+    s << "plane " << blade.normal.x() << "," << blade.normal.y() << "," << blade.normal.z() << ","
+      << blade.offset;
   return s.str();
 }
 
@@ -108,14 +110,14 @@ void run(const CutCommandOptions& o, bool quiet, int& exitCode) {
   PolyMesh input = readVtu(o.input);
   const ValidationReport before = validate(input);
   if (!before.passed)
-    throw UserError(o.input + ": the mesh is invalid (" +
-                    (before.messages.empty() ? std::string("see polydg check")
-                                             : before.messages.front()) +
-                    "); run 'polydg check' on it");
+    throw UserError(
+        o.input + ": the mesh is invalid (" +
+        (before.messages.empty() ? std::string("see polydg check") : before.messages.front()) +
+        "); run 'polydg check' on it");
   MeshEditor editor(std::move(input));
-  nlohmann::json report{{"command", "cut"},
-                        {"input", {{"path", o.input}, {"elements", before.elements},
-                                   {"volume", before.volume}}}};
+  nlohmann::json report{
+      {"command", "cut"},
+      {"input", {{"path", o.input}, {"elements", before.elements}, {"volume", before.volume}}}};
   report["operations"] = nlohmann::json::array();
   ProgressBar progress("cutting", quiet || blades.size() < 2);
   std::string failure;
@@ -125,8 +127,8 @@ void run(const CutCommandOptions& o, bool quiet, int& exitCode) {
     progress.update(double(i + 1) / double(blades.size()));
     if (!r.validation.passed) {
       failure = "operation " + std::to_string(i + 1) + " (" + r.op + ", " + describe(blades[i]) +
-                ") failed its " + toString(r.validation.level) + " validation: " +
-                r.validation.failure;
+                ") failed its " + toString(r.validation.level) +
+                " validation: " + r.validation.failure;
       break;
     }
   }
@@ -148,8 +150,8 @@ void run(const CutCommandOptions& o, bool quiet, int& exitCode) {
   writeVtu(editor.mesh(), o.output);
   if (!quiet)
     std::cout << o.output << ": " << editor.mesh().numElements() << " elements, " << components
-              << " component(s), volume " << editor.volume() << " (input " << before.volume
-              << "), " << blades.size() << " operation(s)\n";
+              << " component(s), volume " << editor.volume() << " (input " << before.volume << "), "
+              << blades.size() << " operation(s)\n";
   exitCode = 0;
 }
 
@@ -158,12 +160,14 @@ void run(const CutCommandOptions& o, bool quiet, int& exitCode) {
 void addCutCommand(CLI::App& app, const CommonOptions& common, int& exitCode) {
   auto o = std::make_shared<CutCommandOptions>();
   CLI::App* cmd = app.add_subcommand(
-      "cut", "Cut a simulation mesh with planes or a convex polygon, in place, validating each "
-             "operation");
+      "cut",
+      "Cut a simulation mesh with planes or a convex polygon, in place, validating each "
+      "operation");
   cmd->add_option("mesh", o->input, "simulation mesh (.vtu)")->required()->check(CLI::ExistingFile);
   cmd->add_option("-o,--output", o->output, "output mesh (.vtu)")->required();
-  cmd->add_option("--plane", o->planes,
-                  "the plane {x : n.x = d} as \"nx,ny,nz,d\"; repeat to cut several times, in order");
+  cmd->add_option(
+      "--plane", o->planes,
+      "the plane {x : n.x = d} as \"nx,ny,nz,d\"; repeat to cut several times, in order");
   cmd->add_option("--polygon", o->polygon,
                   "a convex planar polygon blade \"x1,y1,z1;x2,y2,z2;...\" (after the planes)");
   cmd->add_option("--remove-side", o->removeSide,

@@ -100,8 +100,8 @@ void addInfoCommand(CLI::App& app, const CommonOptions& common, int& exitCode) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--report", options->report, "write the figures as JSON to this file");
   cmd->callback([options, &common, &exitCode] {
-    const nlohmann::json j = isVolumeMeshPath(options->input) ? meshInfo(options->input)
-                                                               : surfaceInfo(options->input);
+    const nlohmann::json j =
+        isVolumeMeshPath(options->input) ? meshInfo(options->input) : surfaceInfo(options->input);
     if (!options->report.empty()) {
       requireDistinct(options->report, options->input);
       nlohmann::json report = j;

@@ -99,8 +99,8 @@ void addMeshCommand(CLI::App& app, const CommonOptions& common, int& exitCode) {
       ->required()
       ->check(CLI::ExistingFile);
   cmd->add_option("-o,--output", o->output, "output simulation mesh (.vtu)")->required();
-  auto* cell = cmd->add_option("--cell", o->cell, "grid cell edge length")
-                   ->check(CLI::PositiveNumber);
+  auto* cell =
+      cmd->add_option("--cell", o->cell, "grid cell edge length")->check(CLI::PositiveNumber);
   auto* cells = cmd->add_option("--cells", o->cells,
                                 "about N cells along the longest side of the bounding box")
                     ->check(CLI::Range(1, 4096));
@@ -108,8 +108,9 @@ void addMeshCommand(CLI::App& app, const CommonOptions& common, int& exitCode) {
   cmd->add_option("--report", o->report, "write a JSON report to this file");
   const std::map<std::string, RepairMode> repairs{
       {"none", RepairMode::None}, {"fill", RepairMode::Fill}, {"wrap", RepairMode::Wrap}};
-  cmd->add_option("--repair", o->repair, "repair broken input: none, fill (close holes), wrap "
-                                         "(alpha wrap any soup)")
+  cmd->add_option("--repair", o->repair,
+                  "repair broken input: none, fill (close holes), wrap "
+                  "(alpha wrap any soup)")
       ->transform(CLI::CheckedTransformer(repairs, CLI::ignore_case));
   cmd->add_option("--merge-slivers", o->sliverTau,
                   "merge elements smaller than TAU x cell volume into a neighbour (0: off)")
@@ -117,8 +118,7 @@ void addMeshCommand(CLI::App& app, const CommonOptions& common, int& exitCode) {
       ->capture_default_str();
   cmd->add_flag("--no-dg", o->skipDg, "skip the DG checks (patch test, rigid modes) of the result");
   cmd->callback([o, &common, &exitCode, cmd] {
-    if (!o->cell && o->cells == 0)
-      throw UserError("polydg mesh needs --cell H or --cells N");
+    if (!o->cell && o->cells == 0) throw UserError("polydg mesh needs --cell H or --cells N");
     if (!isVolumeMeshPath(o->output))
       throw UserError(o->output + ": the output must be a .vtu file");
     requireDistinct(o->output, o->input);
@@ -173,8 +173,10 @@ void addMeshCommand(CLI::App& app, const CommonOptions& common, int& exitCode) {
       throw;
     }
     tasks.wait();
-    if (!result.report.validation.passed) dg.reset();
-    else if (dgFailure) std::rethrow_exception(dgFailure);
+    if (!result.report.validation.passed)
+      dg.reset();
+    else if (dgFailure)
+      std::rethrow_exception(dgFailure);
     // Phase times as measured; they overlap, so "total" adds up more than the wall time.
     if (dg) result.report.timings.emplace_back("dg_checks", dg->seconds);
     result.report.timings.emplace_back("write", writeSeconds);
@@ -195,8 +197,7 @@ void addMeshCommand(CLI::App& app, const CommonOptions& common, int& exitCode) {
       validation["dg_checked"] = dg.has_value();
       if (dg) {
         validation.update(toJson(dg->check, dg->seconds));
-        for (const std::string& m : failureMessages(dg->check))
-          validation["messages"].push_back(m);
+        for (const std::string& m : failureMessages(dg->check)) validation["messages"].push_back(m);
       } else {
         validation["patch_test_error"] = nullptr;
         validation["rigid_mode_failures"] = nullptr;

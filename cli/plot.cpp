@@ -20,7 +20,6 @@ constexpr std::array<const char*, 10> kColours{"#1f77b4", "#ff7f0e", "#2ca02c", 
 constexpr int kMarkerShapes = 5;
 constexpr double kMarkerRadius = 4.0;
 
-
 std::string fixed(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.2f", v);
@@ -43,7 +42,8 @@ std::array<double, 2> axisRange(const std::vector<double>& values, AxisScale sca
   if (scale == AxisScale::Log) {
     if (!(lo <= hi)) return {1.0, 10.0};
     // The nearest values 1, 2 or 5 times a power of ten around the data.
-    const double a = std::pow(10.0, std::floor(std::log10(lo))), b = std::pow(10.0, std::ceil(std::log10(hi)));
+    const double a = std::pow(10.0, std::floor(std::log10(lo))),
+                 b = std::pow(10.0, std::ceil(std::log10(hi)));
     double from = a, to = b;
     for (double m : {2.0, 5.0})
       if (m * a <= lo) from = m * a;
@@ -103,8 +103,8 @@ std::string markerPath(int shape, double x, double y) {
       break;
     case 3:  // diamond
       d << "M" << fixed(x) << ',' << fixed(y - r * 1.3) << " L" << fixed(x + r) << ',' << fixed(y)
-        << " L" << fixed(x) << ',' << fixed(y + r * 1.3) << " L" << fixed(x - r) << ','
-        << fixed(y) << " Z";
+        << " L" << fixed(x) << ',' << fixed(y + r * 1.3) << " L" << fixed(x - r) << ',' << fixed(y)
+        << " Z";
       break;
     default:  // inverted triangle
       d << "M" << fixed(x) << ',' << fixed(y + r * 1.2) << " L" << fixed(x + r * 1.1) << ','
@@ -115,7 +115,9 @@ std::string markerPath(int shape, double x, double y) {
 
 /// Series k's marker: after every ten series (one cycle of colours) the shapes shift by one,
 /// so that colour and shape together stay distinct for 50 series.
-int markerShape(std::size_t k) { return static_cast<int>((k + k / kColours.size()) % kMarkerShapes); }
+int markerShape(std::size_t k) {
+  return static_cast<int>((k + k / kColours.size()) % kMarkerShapes);
+}
 /// Series of the second, fourth, ... colour cycle are dashed.
 std::string dash(std::size_t k) {
   return (k / kColours.size()) % 2 ? " stroke-dasharray=\"7,3\"" : "";
@@ -177,8 +179,7 @@ std::string renderSvg(const Plot& plot, const PlotLayout& l) {
       << "\" font-family=\"DejaVu Sans, Arial, sans-serif\" font-size=\"12\">\n"
       << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n"
       << "<text class=\"title\" x=\"" << fixed(l.left + w / 2) << "\" y=\"" << fixed(l.top / 2 + 5)
-      << "\" text-anchor=\"middle\" font-size=\"15\" font-weight=\"bold\">"
-      << xmlEscape(plot.title)
+      << "\" text-anchor=\"middle\" font-size=\"15\" font-weight=\"bold\">" << xmlEscape(plot.title)
       << "</text>\n";
   // Grid and ticks.
   svg << "<g class=\"grid\" stroke=\"#dddddd\" stroke-width=\"1\">\n";
@@ -242,10 +243,10 @@ std::string renderSvg(const Plot& plot, const PlotLayout& l) {
     const char* colour = kColours[k % kColours.size()];
     svg << "<g class=\"legend-entry\"><line x1=\"" << fixed(lx) << "\" y1=\"" << fixed(y)
         << "\" x2=\"" << fixed(lx + 26) << "\" y2=\"" << fixed(y) << "\" stroke=\"" << colour
-        << "\" stroke-width=\"1.8\"" << dash(k) << "/><path d=\"" << markerPath(markerShape(k), lx + 13, y)
-        << "\" fill=\"" << colour << "\"/><text x=\"" << fixed(lx + 32) << "\" y=\""
-        << fixed(y + 4) << "\" font-size=\"11\">" << xmlEscape(plot.series[k].label)
-        << "</text></g>\n";
+        << "\" stroke-width=\"1.8\"" << dash(k) << "/><path d=\""
+        << markerPath(markerShape(k), lx + 13, y) << "\" fill=\"" << colour << "\"/><text x=\""
+        << fixed(lx + 32) << "\" y=\"" << fixed(y + 4) << "\" font-size=\"11\">"
+        << xmlEscape(plot.series[k].label) << "</text></g>\n";
   }
   svg << "</svg>\n";
   return svg.str();

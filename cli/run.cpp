@@ -108,7 +108,8 @@ const char* stepName(const Step& s) {
 /// refuses keys it was not asked about.
 class ObjectReader {
  public:
-  ObjectReader(const json& j, std::string path, std::string file) : j_(j), path_(std::move(path)), file_(std::move(file)) {
+  ObjectReader(const json& j, std::string path, std::string file)
+      : j_(j), path_(std::move(path)), file_(std::move(file)) {
     if (!j.is_object()) fail(path_, "expected an object");
   }
 
@@ -134,7 +135,8 @@ class ObjectReader {
   int integer(const std::string& key, int lo, int hi) {
     const json& v = get(key);
     if (!v.is_number_integer() || v.get<long long>() < lo || v.get<long long>() > hi)
-      fail(at(key), "expected an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+      fail(at(key),
+           "expected an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
     return v.get<int>();
   }
   std::string string(const std::string& key) {
@@ -187,7 +189,8 @@ class ObjectReader {
 
 int parseAxis(ObjectReader& r, const json& v, const std::string& where) {
   static const std::map<std::string, int> axes{{"x", 0}, {"y", 1}, {"z", 2}};
-  if (!v.is_string() || !axes.count(v.get<std::string>())) r.fail(where, "expected \"x\", \"y\" or \"z\"");
+  if (!v.is_string() || !axes.count(v.get<std::string>()))
+    r.fail(where, "expected \"x\", \"y\" or \"z\"");
   return axes.at(v.get<std::string>());
 }
 
@@ -219,7 +222,7 @@ std::string parseOutputPath(ObjectReader& r, const std::string& key) {
 
 Step parseStep(const json& j, const std::string& where, const std::string& file) {
   ObjectReader r(j, where, file);
-  static const std::map<std::string, int> kinds{{"mesh", 0}, {"cut", 1},   {"merge", 2},
+  static const std::map<std::string, int> kinds{{"mesh", 0},  {"cut", 1},   {"merge", 2},
                                                 {"check", 3}, {"solve", 4}, {"write", 5}};
   const int kind = r.choice("step", kinds);
   Step step;
@@ -232,7 +235,8 @@ Step parseStep(const json& j, const std::string& where, const std::string& file)
       if (cells) s.cells = r.integer("cells", 1, 4096);
       if (r.has("repair"))
         s.repair = r.choice<RepairMode>(
-            "repair", {{"none", RepairMode::None}, {"fill", RepairMode::Fill}, {"wrap", RepairMode::Wrap}});
+            "repair",
+            {{"none", RepairMode::None}, {"fill", RepairMode::Fill}, {"wrap", RepairMode::Wrap}});
       if (r.has("merge_slivers")) s.sliverTau = r.number("merge_slivers", 0.0, 1.0);
       step = s;
       break;
@@ -240,7 +244,8 @@ Step parseStep(const json& j, const std::string& where, const std::string& file)
     case 1: {
       CutStep s;
       const bool plane = r.has("plane"), polygon = r.has("polygon");
-      if (plane == polygon) r.fail(where, "a cut step needs exactly one of \"plane\" and \"polygon\"");
+      if (plane == polygon)
+        r.fail(where, "a cut step needs exactly one of \"plane\" and \"polygon\"");
       try {
         if (plane) {
           const auto v = r.numbers(r.get("plane"), r.at("plane"), 4);
@@ -259,11 +264,12 @@ Step parseStep(const json& j, const std::string& where, const std::string& file)
       if (r.has("remove_side"))
         s.options.removeSide = r.choice<int>("remove_side", {{"+", 1}, {"-", -1}, {"none", 0}});
       if (r.has("validate"))
-        s.options.validation = r.choice<ValidationLevel>(
-            "validate", {{"none", ValidationLevel::None},
-                         {"local", ValidationLevel::Local},
-                         {"full", ValidationLevel::Full}});
-      if (r.has("sliver_fraction")) s.options.sliverFraction = r.number("sliver_fraction", 0.0, 1.0);
+        s.options.validation =
+            r.choice<ValidationLevel>("validate", {{"none", ValidationLevel::None},
+                                                   {"local", ValidationLevel::Local},
+                                                   {"full", ValidationLevel::Full}});
+      if (r.has("sliver_fraction"))
+        s.options.sliverFraction = r.number("sliver_fraction", 0.0, 1.0);
       step = s;
       break;
     }
@@ -281,7 +287,8 @@ Step parseStep(const json& j, const std::string& where, const std::string& file)
     }
     case 4: {
       SolveStep s;
-      if (r.has("method")) s.method = r.choice<Method>("method", {{"ip", Method::IP}, {"bz", Method::BZ}});
+      if (r.has("method"))
+        s.method = r.choice<Method>("method", {{"ip", Method::IP}, {"bz", Method::BZ}});
       if (r.has("degree")) s.degree = r.integer("degree", 1, 3);
       if (r.has("material")) {
         ObjectReader m(r.get("material"), r.at("material"), file);
@@ -300,7 +307,8 @@ Step parseStep(const json& j, const std::string& where, const std::string& file)
               .push_back(parsePlaneLoad(list[k], r.at(key) + "[" + std::to_string(k) + "]", file,
                                         key != std::string("clamp")));
       }
-      if (s.clamps.empty()) r.fail(r.at("clamp"), "nothing holds the body: give at least one clamp");
+      if (s.clamps.empty())
+        r.fail(r.at("clamp"), "nothing holds the body: give at least one clamp");
       if (r.has("output")) s.output = parseOutputPath(r, "output");
       step = s;
       break;
@@ -340,7 +348,8 @@ Pipeline readPipeline(const std::string& file) {
     }
   }
   const json& steps = r.get("steps");
-  if (!steps.is_array() || steps.empty()) r.fail(r.at("steps"), "expected a non-empty list of steps");
+  if (!steps.is_array() || steps.empty())
+    r.fail(r.at("steps"), "expected a non-empty list of steps");
   for (std::size_t k = 0; k < steps.size(); ++k) {
     p.steps.push_back(parseStep(steps[k], "steps[" + std::to_string(k) + "]", file));
     if (std::holds_alternative<MeshStep>(p.steps.back()) && k != 0)
@@ -392,7 +401,8 @@ double medianVolume(const PolyMesh& mesh) {
 
 std::string substituteStem(const std::string& path, const std::string& stem) {
   std::string out = path;
-  for (std::size_t at = out.find("{stem}"); at != std::string::npos; at = out.find("{stem}", at + stem.size()))
+  for (std::size_t at = out.find("{stem}"); at != std::string::npos;
+       at = out.find("{stem}", at + stem.size()))
     out.replace(at, 6, stem);
   return out;
 }
@@ -408,7 +418,10 @@ std::string formatNumber(double x, int precision = 6) {
 class InputRun {
  public:
   InputRun(const Pipeline& pipeline, std::string input, std::string stem, fs::path folder)
-      : pipeline_(pipeline), input_(std::move(input)), stem_(std::move(stem)), folder_(std::move(folder)) {}
+      : pipeline_(pipeline),
+        input_(std::move(input)),
+        stem_(std::move(stem)),
+        folder_(std::move(folder)) {}
 
   /// Runs every step; throws on the first failure (the report keeps the steps done so far).
   void run() {
@@ -419,12 +432,15 @@ class InputRun {
       PolyMesh mesh = readVtu(input_);
       const double reference = medianVolume(mesh);
       work_.emplace(std::move(mesh), reference);
-      steps_.push_back({{"step", "read"}, {"file", input_}, {"elements", work_->mesh().numElements()},
+      steps_.push_back({{"step", "read"},
+                        {"file", input_},
+                        {"elements", work_->mesh().numElements()},
                         {"time_s", secondsSince(t0)}});
       log("read " + std::to_string(work_->mesh().numElements()) + " elements");
       if (!pipeline_.steps.empty() && std::holds_alternative<MeshStep>(pipeline_.steps.front()))
         first = 1;  // a simulation mesh needs no meshing
-    } else if (pipeline_.steps.empty() || !std::holds_alternative<MeshStep>(pipeline_.steps.front())) {
+    } else if (pipeline_.steps.empty() ||
+               !std::holds_alternative<MeshStep>(pipeline_.steps.front())) {
       throw StepFailure(input_ + ": a surface needs a mesh step first (or give a .vtu mesh)");
     }
     for (std::size_t k = first; k < pipeline_.steps.size(); ++k) {
@@ -447,7 +463,8 @@ class InputRun {
         result["time_s"] = secondsSince(t0);
         result["error"] = "an unknown error";
         steps_.push_back(result);
-        throw StepFailure("step " + std::to_string(k) + " (" + stepName(step) + "): an unknown error");
+        throw StepFailure("step " + std::to_string(k) + " (" + stepName(step) +
+                          "): an unknown error");
       }
       result["time_s"] = secondsSince(t0);
       steps_.push_back(result);
@@ -484,7 +501,8 @@ class InputRun {
       throw StepFailure("the new mesh is invalid (" +
                         (meshed.report.validation.messages.empty()
                              ? std::string("see the report")
-                             : meshed.report.validation.messages.front()) + ")");
+                             : meshed.report.validation.messages.front()) +
+                        ")");
     const double cell = meshed.report.grid.cellSize;
     log("meshed: " + std::to_string(meshed.report.elements) + " elements, volume " +
         formatNumber(meshed.report.outputVolume));
@@ -495,7 +513,8 @@ class InputRun {
     const OperationReport r = work_->editor().cut(s.blade, s.options);
     result["operations"] = json::array({toJson(r)});
     result["output"] = {{"elements", mesh().numElements()}, {"volume", work_->editor().volume()}};
-    if (!r.validation.passed) throw StepFailure("the cut failed its validation: " + r.validation.failure);
+    if (!r.validation.passed)
+      throw StepFailure("the cut failed its validation: " + r.validation.failure);
     log("cut: " + std::to_string(r.elementsSplit) + " elements split, " +
         std::to_string(r.elementsRemoved) + " removed, " + std::to_string(mesh().numElements()) +
         " elements");
@@ -505,7 +524,8 @@ class InputRun {
     const OperationReport r = work_->editor().mergeSlivers(s.fraction);
     result["operations"] = json::array({toJson(r)});
     result["output"] = {{"elements", mesh().numElements()}, {"volume", work_->editor().volume()}};
-    if (!r.validation.passed) throw StepFailure("merging failed its validation: " + r.validation.failure);
+    if (!r.validation.passed)
+      throw StepFailure("merging failed its validation: " + r.validation.failure);
     log("merge: " + std::to_string(r.sliversMerged) + " slivers merged, " +
         std::to_string(mesh().numElements()) + " elements");
   }
@@ -514,9 +534,10 @@ class InputRun {
     const ValidationReport geometry = validate(mesh());
     result["validation"] = toJson(geometry);
     if (!geometry.passed)
-      throw StepFailure("the mesh is invalid (" +
-                        (geometry.messages.empty() ? std::string("see the report")
-                                                   : geometry.messages.front()) + ")");
+      throw StepFailure(
+          "the mesh is invalid (" +
+          (geometry.messages.empty() ? std::string("see the report") : geometry.messages.front()) +
+          ")");
     auto t0 = Clock::now();
     LocalDgCheckOptions local;
     local.basis.degree = s.degree;
@@ -543,16 +564,18 @@ class InputRun {
     result["validation"]["passed"] = passed;
     if (!passed) {
       const auto messages = failureMessages(dg);
-      throw StepFailure(messages.empty() ? "the global stiffness does not have 6 zero modes per component"
-                                         : messages.front());
+      throw StepFailure(messages.empty()
+                            ? "the global stiffness does not have 6 zero modes per component"
+                            : messages.front());
     }
-    log("check: valid, " + std::to_string(geometry.components) + " component(s), patch test error " +
-        formatNumber(dg.maxPatchTestError, 3));
+    log("check: valid, " + std::to_string(geometry.components) +
+        " component(s), patch test error " + formatNumber(dg.maxPatchTestError, 3));
   }
 
   void apply(const SolveStep& s, json& result) {
     LoadCase loads;
-    for (const PlaneLoad& c : s.clamps) loads.dirichlet.push_back({FaceSelector::plane(c.axis, c.value), {}});
+    for (const PlaneLoad& c : s.clamps)
+      loads.dirichlet.push_back({FaceSelector::plane(c.axis, c.value), {}});
     for (const PlaneLoad& t : s.tractions)
       loads.tractions.push_back({FaceSelector::plane(t.axis, t.value), t.traction});
     loads.gravity = s.gravity;
@@ -585,7 +608,8 @@ class InputRun {
                      {"assemble", r.assembleSeconds},
                      {"solve", r.solveSeconds}}}});
     if (!s.output.empty()) {
-      const ElementFields fields = elementFields(mesh(), solver.basis(), solver.moments(), u, s.material);
+      const ElementFields fields =
+          elementFields(mesh(), solver.basis(), solver.moments(), u, s.material);
       const std::string file = (folder_ / substituteStem(s.output, stem_)).string();
       fs::create_directories(fs::path(file).parent_path());
       CellArray vonMises{"von_mises", 1, fields.vonMises.raw()};
@@ -693,16 +717,19 @@ InputOutcome runInput(const Pipeline& pipeline, const std::string& input, const 
   writeReport(staging / "report.json", o.report);
   fs::remove_all(final, ec);
   fs::rename(staging, final, ec);
-  if (ec) throw UserError("cannot move " + staging.string() + " to " + final.string() + ": " + ec.message());
+  if (ec)
+    throw UserError("cannot move " + staging.string() + " to " + final.string() + ": " +
+                    ec.message());
   return o;
 }
 
 void printSummary(const std::vector<InputOutcome>& outcomes, std::ostream& out) {
   std::size_t width = 5;
   for (const InputOutcome& o : outcomes) width = std::max(width, o.input.size());
-  out << std::left << std::setw(static_cast<int>(width)) << "input" << "  " << std::setw(6)
-      << "status" << std::right << std::setw(10) << "elements" << std::setw(14) << "volume"
-      << std::setw(10) << "time_s" << "  first error\n";
+  out << std::left << std::setw(static_cast<int>(width)) << "input"
+      << "  " << std::setw(6) << "status" << std::right << std::setw(10) << "elements"
+      << std::setw(14) << "volume" << std::setw(10) << "time_s"
+      << "  first error\n";
   for (const InputOutcome& o : outcomes) {
     out << std::left << std::setw(static_cast<int>(width)) << o.input << "  " << std::setw(6)
         << (o.passed ? "ok" : "FAILED") << std::right << std::setw(10)
@@ -726,8 +753,8 @@ void refuseInputsInOutputs(const std::vector<std::string>& inputs,
   for (const std::string& input : inputs)
     for (const std::string& stem : stems)
       if (isWithin(input, out / stem))
-        throw UserError("the input " + input + " lies in the output folder " + (out / stem).string() +
-                        ", which the run replaces; choose another --out");
+        throw UserError("the input " + input + " lies in the output folder " +
+                        (out / stem).string() + ", which the run replaces; choose another --out");
 }
 
 void runPipeline(const RunOptions& o, const CommonOptions& common, int& exitCode) {
@@ -735,7 +762,8 @@ void runPipeline(const RunOptions& o, const CommonOptions& common, int& exitCode
   if (!o.inputs.empty()) pipeline.inputs = o.inputs;
   if (pipeline.inputs.empty())
     throw UserError(o.pipeline + ": no inputs; list them under \"inputs\" or give --inputs");
-  const fs::path out = o.out.empty() ? fs::path(fs::path(o.pipeline).stem().string() + "-out") : fs::path(o.out);
+  const fs::path out =
+      o.out.empty() ? fs::path(fs::path(o.pipeline).stem().string() + "-out") : fs::path(o.out);
   const std::vector<std::string> stems = uniqueStems(pipeline.inputs);
   refuseInputsInOutputs(pipeline.inputs, stems, out);
   std::error_code ec;
@@ -782,9 +810,10 @@ void runPipeline(const RunOptions& o, const CommonOptions& common, int& exitCode
   json inputs = json::array();
   for (const InputOutcome& outcome : outcomes) {
     failed += !outcome.passed;
-    inputs.push_back(outcome.report.is_null()
-                         ? json{{"input", outcome.input}, {"status", "failed"}, {"error", outcome.error}}
-                         : outcome.report);
+    inputs.push_back(
+        outcome.report.is_null()
+            ? json{{"input", outcome.input}, {"status", "failed"}, {"error", outcome.error}}
+            : outcome.report);
   }
   if (!o.report.empty())
     writeReport(o.report, {{"command", "run"},
@@ -798,7 +827,8 @@ void runPipeline(const RunOptions& o, const CommonOptions& common, int& exitCode
     printSummary(outcomes, std::cout);
   } else {
     for (const InputOutcome& outcome : outcomes)
-      if (!outcome.passed) std::cerr << "polydg: " << outcome.input << ": " << outcome.error << '\n';
+      if (!outcome.passed)
+        std::cerr << "polydg: " << outcome.input << ": " << outcome.error << '\n';
   }
   exitCode = failed == 0 ? 0 : 1;
 }
@@ -816,7 +846,8 @@ void addRunCommand(CLI::App& app, const CommonOptions& common, int& exitCode) {
   cmd->add_option("--jobs", o->jobs, "inputs run at the same time")
       ->check(CLI::Range(1, 256))
       ->capture_default_str();
-  cmd->add_option("--out", o->out, "output folder: one subfolder per input (default: PIPELINE-out)");
+  cmd->add_option("--out", o->out,
+                  "output folder: one subfolder per input (default: PIPELINE-out)");
   cmd->add_option("--report", o->report, "write every input's report and the summary as JSON");
   cmd->callback([o, &common, &exitCode] { runPipeline(*o, common, exitCode); });
 }

@@ -21,7 +21,6 @@
 
 namespace polydg::cli {
 
-
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -132,10 +131,10 @@ nlohmann::json reportJson(const StaticReport& r) {
             {"factorize", r.solver.factorSeconds}}},
           {"solver",
            {{"kind", toString(r.solver.used)},
-            {"preconditioner",
-             r.solver.used != SolverKind::ConjugateGradient ? "none"
-             : r.solver.preconditioner == CgPreconditioner::PMultigrid ? "p-multigrid"
-                                                                       : "block-jacobi"},
+            {"preconditioner", r.solver.used != SolverKind::ConjugateGradient ? "none"
+                               : r.solver.preconditioner == CgPreconditioner::PMultigrid
+                                   ? "p-multigrid"
+                                   : "block-jacobi"},
             {"success", r.solver.success},
             {"iterations", r.solver.iterations},
             {"residual", r.solver.residual}}},
@@ -152,7 +151,8 @@ VtuArray<Tag> vectorArray(const std::string& name, const IndexedData<Tag, Vec3>&
 
 void runSolve(const SolveOptions& o, const CommonOptions& common) {
   if (!isVolumeMeshPath(o.input))
-    throw UserError(o.input + ": solve reads simulation meshes (.vtu); make one with 'polydg mesh'");
+    throw UserError(o.input +
+                    ": solve reads simulation meshes (.vtu); make one with 'polydg mesh'");
   requireDistinct(o.output, o.input);
   if (!o.report.empty()) requireDistinct(o.report, o.input);
   try {
@@ -165,10 +165,10 @@ void runSolve(const SolveOptions& o, const CommonOptions& common) {
   const double readSeconds = secondsSince(t0);
   const ValidationReport valid = validate(mesh);
   if (!valid.passed)
-    throw UserError(o.input + ": the mesh is invalid (" +
-                    (valid.messages.empty() ? std::string("see 'polydg check'")
-                                            : valid.messages.front()) +
-                    "); run 'polydg check' for details");
+    throw UserError(
+        o.input + ": the mesh is invalid (" +
+        (valid.messages.empty() ? std::string("see 'polydg check'") : valid.messages.front()) +
+        "); run 'polydg check' for details");
   if (o.clamps.empty())
     throw UserError("nothing holds the body: add at least one --clamp AXIS=VALUE");
 
@@ -190,8 +190,9 @@ void runSolve(const SolveOptions& o, const CommonOptions& common) {
   solver.integrate();
   solver.assemble(loads);
   if (solver.report().dirichletFaces == 0)
-    throw UserError("no boundary face lies in a --clamp plane; check the planes against the "
-                    "mesh's bounding box ('polydg info')");
+    throw UserError(
+        "no boundary face lies in a --clamp plane; check the planes against the "
+        "mesh's bounding box ('polydg info')");
   const Eigen::VectorXd& u = solver.solve();
   const StaticReport& report = solver.report();
 
@@ -229,15 +230,15 @@ void runSolve(const SolveOptions& o, const CommonOptions& common) {
     writeReport(o.report, j);
   }
   if (!common.quiet) {
-    std::cout << o.input << ": " << toString(o.method) << " p=" << o.degree << ", "
-              << report.dofs << " DOFs, " << report.nonzeros << " nonzeros, eta " << report.eta
-              << ", " << toString(report.solver.used) << " (residual " << report.solver.residual
-              << (report.solver.iterations ? ", " + std::to_string(report.solver.iterations) +
-                                                 " iterations"
-                                           : std::string())
+    std::cout << o.input << ": " << toString(o.method) << " p=" << o.degree << ", " << report.dofs
+              << " DOFs, " << report.nonzeros << " nonzeros, eta " << report.eta << ", "
+              << toString(report.solver.used) << " (residual " << report.solver.residual
+              << (report.solver.iterations
+                      ? ", " + std::to_string(report.solver.iterations) + " iterations"
+                      : std::string())
               << ")\n  integrate " << report.integrateSeconds << " s, assemble "
-              << report.assembleSeconds << " s, solve " << report.solveSeconds
-              << " s; max |u| " << maxDisplacement << ", energy " << report.energy << '\n'
+              << report.assembleSeconds << " s, solve " << report.solveSeconds << " s; max |u| "
+              << maxDisplacement << ", energy " << report.energy << '\n'
               << "  wrote " << o.output << '\n';
   }
 }
@@ -268,7 +269,8 @@ void addSolveCommand(CLI::App& app, const CommonOptions& common, int& exitCode) 
   cmd->add_option_function<std::string>(
          "--gravity",
          [o](const std::string& s) {
-           if (auto e = parseVector(s, o->gravity); !e.empty()) throw CLI::ValidationError("--gravity", e);
+           if (auto e = parseVector(s, o->gravity); !e.empty())
+             throw CLI::ValidationError("--gravity", e);
          },
          "gravitational acceleration GX,GY,GZ")
       ->type_name("GX,GY,GZ");

@@ -164,8 +164,8 @@ Blade Blade::fromPolygon(std::vector<Vec3> corners) {
   const PolygonTest test(b);
   const std::size_t m = test.corners.size();
   for (std::size_t i = 0; i < m; ++i) {
-    const auto o = CGAL::orientation(test.corners[i], test.corners[(i + 1) % m],
-                                     test.corners[(i + 2) % m]);
+    const auto o =
+        CGAL::orientation(test.corners[i], test.corners[(i + 1) % m], test.corners[(i + 2) % m]);
     if (test.sign * static_cast<int>(o) <= 0)
       throw std::invalid_argument(
           "the polygon blade is not strictly convex (corners must turn the same way, none "
@@ -373,15 +373,16 @@ class VertexSides {
  public:
   VertexSides(const PolyMesh& mesh, const Blade& blade, const std::vector<PlaneTags>& tags,
               std::uint32_t planeId)
-      : mesh_(mesh), plane_(blade.normal.x(), blade.normal.y(), blade.normal.z(), -blade.offset),
-        tags_(tags), planeId_(planeId) {}
+      : mesh_(mesh),
+        plane_(blade.normal.x(), blade.normal.y(), blade.normal.z(), -blade.offset),
+        tags_(tags),
+        planeId_(planeId) {}
   int operator()(VertexId v) {
     const auto [it, inserted] = sides_.try_emplace(v.value, 0);
     if (inserted) {
       const bool onThisPlane =
-          v.index() < tags_.size() &&
-          std::find(tags_[v.index()].begin(), tags_[v.index()].end(), planeId_) !=
-              tags_[v.index()].end();
+          v.index() < tags_.size() && std::find(tags_[v.index()].begin(), tags_[v.index()].end(),
+                                                planeId_) != tags_[v.index()].end();
       it->second = onThisPlane ? 0 : exactSide(plane_, mesh_.position(v));
     }
     return it->second;
@@ -418,9 +419,9 @@ class VertexSides {
 /// or a cap in the plane.
 struct Part {
   enum class Kind { Whole, Sub, Cap } kind = Kind::Whole;
-  FaceUse use;             ///< Whole: the face and orientation; Sub: the split face and the
-                           ///< piece's orientation of it
-  std::size_t index = 0;   ///< Sub: index among the split face's parts on this side; Cap: cap
+  FaceUse use;            ///< Whole: the face and orientation; Sub: the split face and the
+                          ///< piece's orientation of it
+  std::size_t index = 0;  ///< Sub: index among the split face's parts on this side; Cap: cap
   const PiecePolygon* polygon = nullptr;  ///< Sub, Cap: loops in local point ids
 };
 
@@ -430,7 +431,11 @@ class Splitter {
  public:
   Splitter(Edit& edit, VertexSides& sides, const Blade& blade, std::vector<PlaneTags>& tags,
            std::uint32_t planeId)
-      : edit_(edit), mesh_(edit.mesh()), sides_(sides), blade_(blade), tags_(tags),
+      : edit_(edit),
+        mesh_(edit.mesh()),
+        sides_(sides),
+        blade_(blade),
+        tags_(tags),
         planeId_(planeId) {
     plane_.normal = blade.normal;
     plane_.offset = blade.offset;
@@ -447,7 +452,8 @@ class Splitter {
         for (VertexId v : mesh_.face(use.face).vertices)
           if (local_.try_emplace(v.value, static_cast<std::uint32_t>(points.size())).second) {
             const Vec3& p = mesh_.position(v);
-            byPosition_.try_emplace({p.x(), p.y(), p.z()}, static_cast<std::uint32_t>(points.size()));
+            byPosition_.try_emplace({p.x(), p.y(), p.z()},
+                                    static_cast<std::uint32_t>(points.size()));
             points.push_back(p);
             meshOf_.push_back(v);
           }
@@ -585,8 +591,7 @@ class Splitter {
               // An original vertex on the plane starts or ends segments along the cut line,
               // not pieces of its face's edges.
               const bool uOld = u < meshOf_.size(), wOld = w < meshOf_.size();
-              if ((uOld && sides_(meshOf_[u]) == 0) || (wOld && sides_(meshOf_[w]) == 0))
-                continue;
+              if ((uOld && sides_(meshOf_[u]) == 0) || (wOld && sides_(meshOf_[w]) == 0)) continue;
               if (uOld && !wOld) {
                 const VertexId x = meshOf_[u], y = neighbour(x, 1), q = meshVertex(w);
                 if (y.valid() && q != x && q != y) out[key(x, y)] = q;
@@ -602,7 +607,7 @@ class Splitter {
 
   /// Faces split by this cut, for the neighbours that keep them whole.
   struct FaceParts {
-    Piece minus, plus;                      ///< in the face's own orientation, local ids
+    Piece minus, plus;                          ///< in the face's own orientation, local ids
     std::vector<FaceId> minusFaces, plusFaces;  ///< mesh faces made from them (lazily)
   };
   std::map<std::uint32_t, FaceParts>& splitFaces() { return faces_; }
@@ -812,9 +817,8 @@ void mergeSliverPieces(Edit& edit, std::vector<ElementId> candidates, double thr
         if (!merged) ++report.isolatedSlivers;
         break;
       }
-      const auto best = std::max_element(shared.begin(), shared.end(), [](auto& a, auto& b) {
-        return a.second < b.second;
-      });
+      const auto best = std::max_element(shared.begin(), shared.end(),
+                                         [](auto& a, auto& b) { return a.second < b.second; });
       const ElementId target(best->first);
       edit.merge(g, target);
       dead.insert(g.value);
@@ -931,8 +935,8 @@ void validateOperation(const PolyMesh& mesh, const MomentCache& moments,
     if (!dg.passed()) {
       std::ostringstream msg;
       msg << "DG region check: patch test error " << dg.patchTestError << ", " << dg.zeroModes
-          << " zero modes for " << dg.components << " components (expected "
-          << 6 * dg.components << ")";
+          << " zero modes for " << dg.components << " components (expected " << 6 * dg.components
+          << ")";
       fail(msg.str());
     }
     return;
@@ -940,8 +944,8 @@ void validateOperation(const PolyMesh& mesh, const MomentCache& moments,
   const ValidationReport geometry = validate(mesh);
   v.elementsChecked = mesh.numElements();
   if (!geometry.passed)
-    fail("geometry: " + (geometry.messages.empty() ? std::string("invalid mesh")
-                                                   : geometry.messages.front()));
+    fail("geometry: " +
+         (geometry.messages.empty() ? std::string("invalid mesh") : geometry.messages.front()));
   if (!geometry.passed) return;
   PhysicsCheckOptions options;
   options.basis.degree = degree;
@@ -1045,9 +1049,8 @@ OperationReport MeshEditor::cutInPlace(const Blade& blade, const CutOptions& opt
       if (face.isBoundary()) continue;
       const auto [lo, hi] = sides.range(use.face);
       if (lo != 0 || hi != 0) continue;
-      if (polygon && !std::all_of(face.vertices.begin(), face.vertices.end(), [&](VertexId v) {
-            return polygon->inside(s.mesh.position(v));
-          }))
+      if (polygon && !std::all_of(face.vertices.begin(), face.vertices.end(),
+                                  [&](VertexId v) { return polygon->inside(s.mesh.position(v)); }))
         continue;
       decouple(edit, use.face);
     }
@@ -1165,8 +1168,7 @@ OperationReport MeshEditor::cutInPlace(const Blade& blade, const CutOptions& opt
   // 5. Slivers among the new pieces.
   if (options.sliverFraction > 0.0) {
     std::vector<ElementId> alive = edit.created().sorted();
-    mergeSliverPieces(edit, std::move(alive), options.sliverFraction * s.referenceVolume,
-                      report);
+    mergeSliverPieces(edit, std::move(alive), options.sliverFraction * s.referenceVolume, report);
   }
 
   // 6. Compaction, the grid, the volume.
@@ -1197,8 +1199,7 @@ OperationReport MeshEditor::cutInPlace(const Blade& blade, const CutOptions& opt
     if (v.passed) v.failure = msg.str();
     v.passed = false;
   }
-  report.seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return report;
 }
 
@@ -1221,8 +1222,7 @@ OperationReport MeshEditor::mergeSlivers(double fraction, ValidationLevel valida
   Edit edit(s.mesh, *s.moments, s.grid);
   std::vector<ElementId> all(s.mesh.numElements());
   for (std::size_t e = 0; e < all.size(); ++e) all[e] = ElementId(e);
-  if (fraction > 0.0)
-    mergeSliverPieces(edit, std::move(all), fraction * s.referenceVolume, report);
+  if (fraction > 0.0) mergeSliverPieces(edit, std::move(all), fraction * s.referenceVolume, report);
   report.facesReintegrated += edit.updateMoments();
   const double oldVolume = edit.oldVolume();
   edit.compact();
@@ -1239,12 +1239,11 @@ OperationReport MeshEditor::mergeSlivers(double fraction, ValidationLevel valida
   report.validation.volumeRelError = std::abs(volumeBefore - s.volume) / std::abs(volumeBefore);
   if (!(report.validation.volumeRelError <= kVolumeBalanceTolerance)) {
     if (report.validation.passed)
-      report.validation.failure = "volume balance: relative error " +
-                                  std::to_string(report.validation.volumeRelError);
+      report.validation.failure =
+          "volume balance: relative error " + std::to_string(report.validation.volumeRelError);
     report.validation.passed = false;
   }
-  report.seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return report;
 }
 

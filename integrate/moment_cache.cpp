@@ -142,8 +142,8 @@ std::size_t MomentCache::update() {
     double scratch[numMonomials(kMaxMomentDegree)];
     for (const FaceUse& use : mesh.element(e).faces) {
       accumulateElementMoments(degree_, face(use.face), faceReferencePoint(mesh, use.face),
-                               faceNormals_[use.face], use.reversed, origin,
-                               {scratch, stride}, out);
+                               faceNormals_[use.face], use.reversed, origin, {scratch, stride},
+                               out);
     }
   });
 

@@ -49,8 +49,8 @@ decltype(auto) dispatchDegree(int degree, F&& f) {
     case 7: return f(std::integral_constant<int, 7>{});
     case 8: return f(std::integral_constant<int, 8>{});
     default:
-      throw std::invalid_argument("moment degree " + std::to_string(degree) +
-                                  " is outside 0.." + std::to_string(kMaxMomentDegree));
+      throw std::invalid_argument("moment degree " + std::to_string(degree) + " is outside 0.." +
+                                  std::to_string(kMaxMomentDegree));
   }
 }
 static_assert(kMaxMomentDegree == 8, "dispatchDegree lists every degree up to the maximum");
@@ -200,8 +200,7 @@ void requireSize(std::span<const double> s, int degree, const char* what) {
 
 }  // namespace
 
-void faceMoments(const PolyMesh& mesh, FaceId f, int degree, std::span<double> out,
-                 Vec3& normal) {
+void faceMoments(const PolyMesh& mesh, FaceId f, int degree, std::span<double> out, Vec3& normal) {
   requireSize(out, degree, "faceMoments");
   dispatchDegree(degree, [&](auto k) { faceMomentsK<k()>(mesh, f, out.data(), normal); });
 }
@@ -219,8 +218,7 @@ void accumulateElementMoments(int degree, std::span<const double> faceMom, const
   requireSize(scratch, degree, "accumulateElementMoments");
   requireSize(out, degree, "accumulateElementMoments");
   dispatchDegree(degree, [&](auto k) {
-    accumulateK<k()>(faceMom.data(), faceRef, normal, reversed, origin, scratch.data(),
-                     out.data());
+    accumulateK<k()>(faceMom.data(), faceRef, normal, reversed, origin, scratch.data(), out.data());
   });
 }
 
@@ -231,8 +229,8 @@ std::vector<double> elementMoments(const PolyMesh& mesh, ElementId e, int degree
   for (const FaceUse& use : mesh.element(e).faces) {
     Vec3 normal;
     faceMoments(mesh, use.face, degree, face, normal);
-    accumulateElementMoments(degree, face, faceReferencePoint(mesh, use.face), normal,
-                             use.reversed, origin, scratch, out);
+    accumulateElementMoments(degree, face, faceReferencePoint(mesh, use.face), normal, use.reversed,
+                             origin, scratch, out);
   }
   return out;
 }
@@ -241,8 +239,7 @@ std::vector<double> elementMoments(const PolyMesh& mesh, ElementId e, int degree
   return elementMoments(mesh, e, degree, elementReferencePoint(mesh, e));
 }
 
-std::vector<double> normalizedMoments(std::span<const double> moments, int degree,
-                                      double length) {
+std::vector<double> normalizedMoments(std::span<const double> moments, int degree, double length) {
   const int n = numMonomials(degree);
   std::vector<double> out(static_cast<std::size_t>(n));
   const double volume = moments[0];

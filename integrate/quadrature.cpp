@@ -73,8 +73,10 @@ std::vector<QuadraturePoint> elementQuadrature(const PolyMesh& mesh, ElementId e
         const Vec3& q = mesh.position(loop[(i + 1) % loop.size()]);
         // Tetrahedron (o, c, p, q) is positively oriented when the face normal points away
         // from o; a reversed face swaps p and q.
-        if (use.reversed) appendTetrahedronRule(o, c, q, p, degree, rule);
-        else appendTetrahedronRule(o, c, p, q, degree, rule);
+        if (use.reversed)
+          appendTetrahedronRule(o, c, q, p, degree, rule);
+        else
+          appendTetrahedronRule(o, c, p, q, degree, rule);
       }
     }
   }

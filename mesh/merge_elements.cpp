@@ -66,19 +66,18 @@ PolyMesh mergeSlivers(PolyMesh mesh, double volumeThreshold, SliverMergeReport* 
                         area[f] = areaVector(mesh, FaceId(f));
                     });
   std::vector<double> volume(n);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 512),
-                    [&](const tbb::blocked_range<std::size_t>& r) {
-                      for (std::size_t e = r.begin(); e != r.end(); ++e) {
-                        const Vec3 o = elementReferencePoint(mesh, ElementId(e));
-                        double threeVolume = 0.0;
-                        for (const FaceUse& use : mesh.element(ElementId(e)).faces) {
-                          const double h = area[use.face.index()].dot(
-                              faceReferencePoint(mesh, use.face) - o);
-                          threeVolume += use.reversed ? -h : h;
-                        }
-                        volume[e] = threeVolume / 3.0;
-                      }
-                    });
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, n, 512), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t e = r.begin(); e != r.end(); ++e) {
+          const Vec3 o = elementReferencePoint(mesh, ElementId(e));
+          double threeVolume = 0.0;
+          for (const FaceUse& use : mesh.element(ElementId(e)).faces) {
+            const double h = area[use.face.index()].dot(faceReferencePoint(mesh, use.face) - o);
+            threeVolume += use.reversed ? -h : h;
+          }
+          volume[e] = threeVolume / 3.0;
+        }
+      });
   auto faceArea = [&](std::size_t f) { return area[f].norm(); };
 
   std::vector<std::size_t> parent(n);
@@ -121,9 +120,8 @@ PolyMesh mergeSlivers(PolyMesh mesh, double volumeThreshold, SliverMergeReport* 
         if (membersOf(g).size() == 1) ++r.isolated;
         break;
       }
-      const auto best = std::max_element(shared.begin(), shared.end(), [](auto& a, auto& b) {
-        return a.second < b.second;
-      });
+      const auto best = std::max_element(shared.begin(), shared.end(),
+                                         [](auto& a, auto& b) { return a.second < b.second; });
       const std::size_t target = best->first;
       parent[g] = target;
       volume[target] += volume[g];

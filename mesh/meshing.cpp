@@ -33,7 +33,8 @@ class PhaseTimer {
 std::string describeDefects(const SurfaceDiagnosis& d) {
   std::vector<std::string> parts;
   const SurfaceTopology& t = d.topology;
-  if (t.boundaryEdges) parts.push_back("open (" + std::to_string(t.boundaryEdges) + " boundary edges)");
+  if (t.boundaryEdges)
+    parts.push_back("open (" + std::to_string(t.boundaryEdges) + " boundary edges)");
   if (t.nonManifoldEdges)
     parts.push_back("non-manifold (" + std::to_string(t.nonManifoldEdges) +
                     " edges with more than two triangles)");
@@ -268,7 +269,9 @@ void validateMeshing(MeshingResult& result) {
         }
         return c;
       },
-      [](Counts a, const Counts& b) { return Counts{a.first + b.first, a.second + b.second}; });
+      [](Counts a, const Counts& b) {
+        return Counts{a.first + b.first, a.second + b.second};
+      });
   r.hexahedra = counts.first;
   r.nonconvex = counts.second;
   r.polyhedra = r.elements - r.hexahedra;

@@ -124,9 +124,9 @@ std::uint32_t PlaneSplitter::edgePoint(std::uint32_t u, std::uint32_t v, const S
   // edge's geometry and the plane (not on ids or the order of calls).
   const Vec3& pu = records_[u].position;
   const Vec3& pv = records_[v].position;
-  const bool uFirst = std::lexicographical_compare(pu.data(), pu.data() + 3, pv.data(),
-                                                   pv.data() + 3) ||
-                      (pu == pv && u < v);
+  const bool uFirst =
+      std::lexicographical_compare(pu.data(), pu.data() + 3, pv.data(), pv.data() + 3) ||
+      (pu == pv && u < v);
   const std::uint32_t a = uFirst ? u : v, b = uFirst ? v : u;
   decltype(edgePoints_)::accessor edge;
   if (!edgePoints_.insert(edge, EdgeKey{std::min(u, v), std::max(u, v), plane.id}))
@@ -152,8 +152,8 @@ std::uint32_t PlaneSplitter::edgePoint(std::uint32_t u, std::uint32_t v, const S
     edge->second = at->second;
     return at->second;
   }
-  const auto id = static_cast<std::uint32_t>(records_.push_back({r, plane.id, a, b}) -
-                                             records_.begin());
+  const auto id =
+      static_cast<std::uint32_t>(records_.push_back({r, plane.id, a, b}) - records_.begin());
   at->second = id;
   edge->second = id;
   return id;
@@ -243,8 +243,8 @@ LoopList traceLoops(const EdgeList& edges, const PointOf& points, const Vec3& no
 /// rounded area is zero (its points collapsed by rounding) stays a polygon of its own: it is
 /// needed to keep the piece closed, and welding identical points removes it later.
 template <class PointOf>
-Small<PiecePolygon, 2> groupLoops(const LoopList& loops, const PointOf& points,
-                                  const Vec3& normal, FaceOrigin origin) {
+Small<PiecePolygon, 2> groupLoops(const LoopList& loops, const PointOf& points, const Vec3& normal,
+                                  FaceOrigin origin) {
   const Vec3 n = normal.normalized();
   Small<double, 4> area(loops.size());
   for (std::size_t k = 0; k < loops.size(); ++k) {
@@ -302,8 +302,8 @@ PiecePolygon reversed(const PiecePolygon& p) {
 
 }  // namespace
 
-void PlaneSplitter::splitPolygon(const PiecePolygon& polygon, const SplitPlane& plane,
-                                 Piece& minus, Piece& plus) {
+void PlaneSplitter::splitPolygon(const PiecePolygon& polygon, const SplitPlane& plane, Piece& minus,
+                                 Piece& plus) {
   // 1. The loops with every crossing edge subdivided at its intersection point.
   struct Corner {
     std::uint32_t v;
@@ -390,8 +390,7 @@ void PlaneSplitter::splitPolygon(const PiecePolygon& polygon, const SplitPlane& 
           const Corner& cr = loop[(start + r) % m];
           onLine.emplace_back(key(cr.v), cr.v);
           const Corner& cn = loop[(start + r + 1) % m];
-          if (cn.side == 0)
-            alongLine.emplace_back(std::min(cr.v, cn.v), std::max(cr.v, cn.v));
+          if (cn.side == 0) alongLine.emplace_back(std::min(cr.v, cn.v), std::max(cr.v, cn.v));
         }
         step = run;
       } else {
@@ -433,14 +432,18 @@ void PlaneSplitter::splitPolygon(const PiecePolygon& polygon, const SplitPlane& 
       const Corner& a = loop[i];
       const Corner& b = loop[(i + 1) % m];
       const DirectedEdge e{a.v, b.v};
-      if (a.side < 0 || b.side < 0) minusEdges.push_back(e);
-      else if (a.side > 0 || b.side > 0) plusEdges.push_back(e);
-      else (key(b.v) > key(a.v) ? minusEdges : plusEdges).push_back(e);
+      if (a.side < 0 || b.side < 0)
+        minusEdges.push_back(e);
+      else if (a.side > 0 || b.side > 0)
+        plusEdges.push_back(e);
+      else
+        (key(b.v) > key(a.v) ? minusEdges : plusEdges).push_back(e);
     }
   }
   std::size_t crossings = 0;
   for (std::size_t i = 0; i + 1 < onLine.size(); ++i) {
-    crossings += static_cast<std::size_t>(std::count(toggles.begin(), toggles.end(), onLine[i].second));
+    crossings +=
+        static_cast<std::size_t>(std::count(toggles.begin(), toggles.end(), onLine[i].second));
     if (crossings % 2 == 0) continue;  // outside the polygon
     const std::uint32_t a = onLine[i].second, b = onLine[i + 1].second;
     if (std::binary_search(alongLine.begin(), alongLine.end(),
@@ -469,8 +472,10 @@ PieceSplit PlaneSplitter::split(Piece piece, const SplitPlane& plane, FaceOrigin
       lo = std::min(lo, s);
       hi = std::max(hi, s);
     }
-    if (hi <= 0 && lo < 0) out.minus.push_back(std::move(polygon));
-    else if (lo >= 0 && hi > 0) out.plus.push_back(std::move(polygon));
+    if (hi <= 0 && lo < 0)
+      out.minus.push_back(std::move(polygon));
+    else if (lo >= 0 && hi > 0)
+      out.plus.push_back(std::move(polygon));
     else if (lo == 0 && hi == 0)  // in the plane: it bounds the side it faces away from
       (polygonNormal(polygon).dot(plane.normal) > 0 ? out.minus : out.plus)
           .push_back(std::move(polygon));

@@ -93,8 +93,8 @@ FaceId PolyMesh::addFace(std::vector<Loop> loops, FaceOrigin origin) {
   return addFace(flat.vertices, flat.loopEnd, origin);
 }
 
-FaceId PolyMesh::addFace(std::span<const VertexId> vertices,
-                         std::span<const std::uint32_t> loopEnd, FaceOrigin origin) {
+FaceId PolyMesh::addFace(std::span<const VertexId> vertices, std::span<const std::uint32_t> loopEnd,
+                         FaceOrigin origin) {
   if (loopEnd.empty()) throw std::invalid_argument("addFace: a face needs at least one loop");
   std::uint32_t begin = 0;
   for (std::uint32_t end : loopEnd) {
@@ -195,9 +195,10 @@ void PolyMesh::mergeElementGroups(const std::vector<std::uint32_t>& group, std::
 
 void PolyMesh::detachFace(ElementId e, FaceId f) {
   FaceList& uses = elements_[e].faces;
-  const auto it = std::find_if(uses.begin(), uses.end(),
-                               [&](const FaceUse& use) { return use.face == f; });
-  if (it == uses.end()) throw std::invalid_argument("detachFace: the element does not use the face");
+  const auto it =
+      std::find_if(uses.begin(), uses.end(), [&](const FaceUse& use) { return use.face == f; });
+  if (it == uses.end())
+    throw std::invalid_argument("detachFace: the element does not use the face");
   Face& face = faces_[f];
   (it->reversed ? face.back : face.front) = ElementId();
   uses.erase(it);

@@ -3,24 +3,24 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
-#include <mutex>
-#include <numeric>
-#include <span>
-#include <tuple>
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <mutex>
+#include <numeric>
+#include <span>
 #include <stdexcept>
+#include <tuple>
 
 #include "polydg/mesh/plane_split.h"
 
-#include <boost/container/small_vector.hpp>
 #include <tbb/concurrent_vector.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
 #include <tbb/parallel_sort.h>
 #include <tbb/task_group.h>
+#include <boost/container/small_vector.hpp>
 
 namespace polydg {
 
@@ -51,7 +51,8 @@ namespace {
 class Slicer {
  public:
   Slicer(const Grid& grid, std::vector<Vec3> points, const ProgressFn& progress)
-      : grid_(grid), splitter_(std::make_unique<PlaneSplitter>(std::move(points))),
+      : grid_(grid),
+        splitter_(std::make_unique<PlaneSplitter>(std::move(points))),
         progress_(progress) {}
 
   void run(Piece solid) {
@@ -151,23 +152,24 @@ class Slicer {
     std::atomic<std::size_t> collapsed{0};
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nl, 64),
                       [&](const tbb::blocked_range<std::size_t>& r) {
-      for (std::size_t l = r.begin(); l != r.end(); ++l) {
-        const Piece& piece = leaves_[l].piece;
-        std::size_t corner = cornerBase[l], loop = loopBase[l];
-        for (std::size_t i = 0; i < piece.size(); ++i) {
-          const std::size_t p = polygonBase[l] + i;
-          origin[p] = piece[i].origin;
-          if (!welded.weld(p, corner, loop, piece[i], vertexOf)) {
-            ++collapsed;
-          } else {
-            kept[p] = 1;
-            if (origin[p] == FaceOrigin::Interior) keys[p] = vertexSetKey(welded.corners(p));
-          }
-          corner += piece[i].vertices.size();
-          loop += piece[i].numLoops();
-        }
-      }
-    });
+                        for (std::size_t l = r.begin(); l != r.end(); ++l) {
+                          const Piece& piece = leaves_[l].piece;
+                          std::size_t corner = cornerBase[l], loop = loopBase[l];
+                          for (std::size_t i = 0; i < piece.size(); ++i) {
+                            const std::size_t p = polygonBase[l] + i;
+                            origin[p] = piece[i].origin;
+                            if (!welded.weld(p, corner, loop, piece[i], vertexOf)) {
+                              ++collapsed;
+                            } else {
+                              kept[p] = 1;
+                              if (origin[p] == FaceOrigin::Interior)
+                                keys[p] = vertexSetKey(welded.corners(p));
+                            }
+                            corner += piece[i].vertices.size();
+                            loop += piece[i].numLoops();
+                          }
+                        }
+                      });
     stats.collapsedPolygons = collapsed;
 
     // Caps meet their other side: the later of two reversed, equal polygons uses the earlier's
@@ -197,39 +199,39 @@ class Slicer {
     // New faces first (their ids are known per leaf) ...
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nl, 64),
                       [&](const tbb::blocked_range<std::size_t>& r) {
-      for (std::size_t l = r.begin(); l != r.end(); ++l) {
-        std::uint32_t next = faceBase[l];
-        for (std::size_t p = polygonBase[l]; p < polygonBase[l + 1]; ++p) {
-          if (!kept[p] || sharesEarlier[p] != kNone) continue;
-          faceId[p] = next;
-          Face& f = meshFaces[FaceId(std::size_t(next++))];
-          welded.copyTo(p, f);
-          f.origin = origin[p];
-          f.front = ElementId(std::size_t(elementOf[l]));
-        }
-      }
-    });
+                        for (std::size_t l = r.begin(); l != r.end(); ++l) {
+                          std::uint32_t next = faceBase[l];
+                          for (std::size_t p = polygonBase[l]; p < polygonBase[l + 1]; ++p) {
+                            if (!kept[p] || sharesEarlier[p] != kNone) continue;
+                            faceId[p] = next;
+                            Face& f = meshFaces[FaceId(std::size_t(next++))];
+                            welded.copyTo(p, f);
+                            f.origin = origin[p];
+                            f.front = ElementId(std::size_t(elementOf[l]));
+                          }
+                        }
+                      });
     // ... then the later sides, which take the earlier side's face as its back.
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nl, 64),
                       [&](const tbb::blocked_range<std::size_t>& r) {
-      for (std::size_t l = r.begin(); l != r.end(); ++l) {
-        if (elementOf[l] == kNone) continue;
-        const ElementId e{std::size_t(elementOf[l])};
-        FaceList& uses = meshElements[e].faces;
-        for (std::size_t p = polygonBase[l]; p < polygonBase[l + 1]; ++p) {
-          if (!kept[p]) continue;
-          const std::uint32_t s = sharesEarlier[p];
-          if (s == kNone) {
-            uses.push_back({FaceId(std::size_t(faceId[p])), false});
-            continue;
-          }
-          const FaceId f{static_cast<std::size_t>(faceId[s])};
-          meshFaces[f].back = e;
-          meshFaces[f].origin = FaceOrigin::Interior;
-          uses.push_back({f, true});
-        }
-      }
-    });
+                        for (std::size_t l = r.begin(); l != r.end(); ++l) {
+                          if (elementOf[l] == kNone) continue;
+                          const ElementId e{std::size_t(elementOf[l])};
+                          FaceList& uses = meshElements[e].faces;
+                          for (std::size_t p = polygonBase[l]; p < polygonBase[l + 1]; ++p) {
+                            if (!kept[p]) continue;
+                            const std::uint32_t s = sharesEarlier[p];
+                            if (s == kNone) {
+                              uses.push_back({FaceId(std::size_t(faceId[p])), false});
+                              continue;
+                            }
+                            const FaceId f{static_cast<std::size_t>(faceId[s])};
+                            meshFaces[f].back = e;
+                            meshFaces[f].origin = FaceOrigin::Interior;
+                            uses.push_back({f, true});
+                          }
+                        }
+                      });
     if (elementCell)
       for (std::size_t l = 0; l < nl; ++l)
         if (elementOf[l] != kNone) elementCell->push_back(leaves_[l].cell);
@@ -287,33 +289,33 @@ class Slicer {
       if ((points[used[j]] - points[used[i]]).cwiseAbs().maxCoeff() <= resolution)
         near.push_back({static_cast<std::uint32_t>(i), j});
     };
-    tbb::parallel_for(
-        tbb::blocked_range<std::size_t>(0, used.size(), 4096),
-        [&](const tbb::blocked_range<std::size_t>& r) {
-          for (std::size_t i = r.begin(); i != r.end(); ++i) {
-            const Vec3& p = points[used[i]];
-            const std::size_t at = position[i];
-            const Cell& own = sorted[at].first;
-            // Earlier points of the own cell: just before i in the sorted order.
-            for (std::size_t s = at; s > 0 && sorted[s - 1].first == own; --s)
-              nearPoint(i, sorted[s - 1].second);
-            Cell lo, hi;
-            for (int a = 0; a < 3; ++a) {
-              lo[a] = cellIndex(p[a] - resolution);
-              hi[a] = cellIndex(p[a] + resolution);
-            }
-            if (lo == own && hi == own) continue;
-            for (std::int64_t x = lo[0]; x <= hi[0]; ++x)
-              for (std::int64_t y = lo[1]; y <= hi[1]; ++y)
-                for (std::int64_t z = lo[2]; z <= hi[2]; ++z) {
-                  const Cell c{x, y, z};
-                  if (c == own) continue;
-                  auto it = std::lower_bound(sorted.begin(), sorted.end(), std::make_pair(c, 0u));
-                  for (; it != sorted.end() && it->first == c && it->second < i; ++it)
-                    nearPoint(i, it->second);
-                }
-          }
-        });
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, used.size(), 4096),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                          const Vec3& p = points[used[i]];
+                          const std::size_t at = position[i];
+                          const Cell& own = sorted[at].first;
+                          // Earlier points of the own cell: just before i in the sorted order.
+                          for (std::size_t s = at; s > 0 && sorted[s - 1].first == own; --s)
+                            nearPoint(i, sorted[s - 1].second);
+                          Cell lo, hi;
+                          for (int a = 0; a < 3; ++a) {
+                            lo[a] = cellIndex(p[a] - resolution);
+                            hi[a] = cellIndex(p[a] + resolution);
+                          }
+                          if (lo == own && hi == own) continue;
+                          for (std::int64_t x = lo[0]; x <= hi[0]; ++x)
+                            for (std::int64_t y = lo[1]; y <= hi[1]; ++y)
+                              for (std::int64_t z = lo[2]; z <= hi[2]; ++z) {
+                                const Cell c{x, y, z};
+                                if (c == own) continue;
+                                auto it = std::lower_bound(sorted.begin(), sorted.end(),
+                                                           std::make_pair(c, 0u));
+                                for (; it != sorted.end() && it->first == c && it->second < i; ++it)
+                                  nearPoint(i, it->second);
+                              }
+                        }
+                      });
     std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs(near.begin(), near.end());
     std::sort(pairs.begin(), pairs.end());
     std::vector<std::uint32_t> target(used.size());
@@ -330,8 +332,12 @@ class Slicer {
   class WeldedPolygons {
    public:
     WeldedPolygons(std::size_t polygons, std::size_t corners, std::size_t loops)
-        : cornerStart_(polygons), cornerCount_(polygons, 0), loopStart_(polygons),
-          loopCount_(polygons, 0), corners_(corners), loopEnds_(loops) {}
+        : cornerStart_(polygons),
+          cornerCount_(polygons, 0),
+          loopStart_(polygons),
+          loopCount_(polygons, 0),
+          corners_(corners),
+          loopEnds_(loops) {}
 
     /// `polygon` on welded vertices as polygon p, with room from `corner` and `loop` on:
     /// consecutive repeats dropped, loops of fewer than 3 corners removed. False if the outer
@@ -435,7 +441,8 @@ class Slicer {
     tbb::parallel_sort(caps.begin(), caps.end());
     std::vector<std::uint32_t> groupStart;
     for (std::size_t c = 0; c < caps.size(); ++c)
-      if (c == 0 || caps[c].first != caps[c - 1].first) groupStart.push_back(static_cast<std::uint32_t>(c));
+      if (c == 0 || caps[c].first != caps[c - 1].first)
+        groupStart.push_back(static_cast<std::uint32_t>(c));
     groupStart.push_back(static_cast<std::uint32_t>(caps.size()));
     std::vector<std::uint32_t> shares(np, kNone);
     tbb::parallel_for(std::size_t(0), groupStart.size() - 1, [&](std::size_t g) {
@@ -473,14 +480,19 @@ class Slicer {
       hiMinus[axis] = mid;
       loPlus[axis] = mid;
       auto doMinus = [&] {
-        if (s.minus.empty()) reportDone(lo, hiMinus);
-        else recurse(std::move(s.minus), lo, hiMinus);
+        if (s.minus.empty())
+          reportDone(lo, hiMinus);
+        else
+          recurse(std::move(s.minus), lo, hiMinus);
       };
       auto doPlus = [&] {
-        if (s.plus.empty()) reportDone(loPlus, hi);
-        else recurse(std::move(s.plus), loPlus, hi);
+        if (s.plus.empty())
+          reportDone(loPlus, hi);
+        else
+          recurse(std::move(s.plus), loPlus, hi);
       };
-      if (s.minus.size() + s.plus.size() > kParallelPolygons) tbb::parallel_invoke(doMinus, doPlus);
+      if (s.minus.size() + s.plus.size() > kParallelPolygons)
+        tbb::parallel_invoke(doMinus, doPlus);
       else {
         doMinus();
         doPlus();
@@ -494,7 +506,6 @@ class Slicer {
     for (std::size_t i = 0; i < parts.size(); ++i) leaves.push_back({std::move(parts[i]), lo, i});
     reportDone(lo, hi);
   }
-
 
   void reportDone(const std::array<int, 3>& lo, const std::array<int, 3>& hi) {
     if (!progress_) return;
@@ -530,8 +541,8 @@ std::size_t expectedPoints(const TriangleSurface& surface, const Grid& grid) {
     const Vec3& b = surface.vertices[t[1]];
     const Vec3& c = surface.vertices[t[2]];
     // Each edge is shared by two triangles: half of it here.
-    crossings += 0.5 * ((b - a).cwiseAbs().sum() + (c - b).cwiseAbs().sum() +
-                        (a - c).cwiseAbs().sum()) / h;
+    crossings +=
+        0.5 * ((b - a).cwiseAbs().sum() + (c - b).cwiseAbs().sum() + (a - c).cwiseAbs().sum()) / h;
     lines += 0.5 * (b - a).cross(c - a).cwiseAbs().sum() / (h * h);
   }
   const double inside = std::abs(enclosedVolume(surface)) / (h * h * h);

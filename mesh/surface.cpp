@@ -41,17 +41,22 @@ SurfaceTopology analyzeTopology(const TriangleSurface& surface) {
     for (int k = 0; k < 3; ++k) {
       const std::uint32_t u = tri[k], v = tri[(k + 1) % 3];
       auto [it, inserted] = edges.try_emplace({std::min(u, v), std::max(u, v)});
-      if (inserted) it->second.firstTriangle = t;
-      else components.unite(t, it->second.firstTriangle);
+      if (inserted)
+        it->second.firstTriangle = t;
+      else
+        components.unite(t, it->second.firstTriangle);
       (u < v ? it->second.forward : it->second.backward)++;
     }
   }
   topo.edges = edges.size();
   for (const auto& [key, use] : edges) {
     const std::uint32_t total = use.forward + use.backward;
-    if (total == 1) ++topo.boundaryEdges;
-    else if (total > 2) ++topo.nonManifoldEdges;
-    else if (use.forward != 1) ++topo.misorientedEdges;
+    if (total == 1)
+      ++topo.boundaryEdges;
+    else if (total > 2)
+      ++topo.nonManifoldEdges;
+    else if (use.forward != 1)
+      ++topo.misorientedEdges;
   }
   std::vector<bool> isRoot(surface.triangles.size(), false);
   for (std::size_t t = 0; t < surface.triangles.size(); ++t) {
@@ -98,9 +103,8 @@ PolyMesh singleElementMesh(const TriangleSurface& surface) {
   std::vector<FaceUse> uses;
   uses.reserve(surface.triangles.size());
   for (const auto& tri : surface.triangles) {
-    const FaceId f =
-        mesh.addFace({Loop{VertexId(tri[0]), VertexId(tri[1]), VertexId(tri[2])}},
-                     FaceOrigin::Surface);
+    const FaceId f = mesh.addFace({Loop{VertexId(tri[0]), VertexId(tri[1]), VertexId(tri[2])}},
+                                  FaceOrigin::Surface);
     uses.push_back({f, false});
   }
   mesh.addElementFromFaces(uses);

@@ -9,10 +9,10 @@
 #include <CGAL/IO/OFF.h>
 #include <CGAL/IO/PLY.h>
 #include <CGAL/IO/STL.h>
-#include <assimp/Importer.hpp>
 #include <assimp/config.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
+#include <assimp/Importer.hpp>
 
 #include <algorithm>
 #include <array>
@@ -213,8 +213,8 @@ struct PolygonSoup {
   std::vector<SoupPolygon> polygons;
   std::size_t meshes = 1;
   std::size_t inputVertices = 0;
-  std::size_t ignoredPoints = 0;  ///< OBJ `p` indices, removed before CGAL parsed the file
-  std::size_t ignoredLines = 0;   ///< OBJ `l` segments, removed likewise
+  std::size_t ignoredPoints = 0;   ///< OBJ `p` indices, removed before CGAL parsed the file
+  std::size_t ignoredLines = 0;    ///< OBJ `l` segments, removed likewise
   bool onlyPointsOrLines = false;  ///< an OBJ file with vertices and no `f` line
 };
 
@@ -345,10 +345,10 @@ std::variant<ObjScan, Reason> scanObj(const std::string& path) {
   if (text.find('\0') != std::string::npos) return Reason("the file is not text (NUL bytes)");
   ObjScan scan;
   scan.text.reserve(text.size());
-  std::string material;  // the default material until the first usemtl
+  std::string material;          // the default material until the first usemtl
   bool materialCounted = false;  // `material` is in scan.materials already
   std::size_t lineNumber = 0;
-  std::string line;  // one buffer for every line
+  std::string line;                 // one buffer for every line
   std::vector<std::string_view> w;  // and one for its words
   for (std::size_t begin = 0; begin < text.size();) {
     std::size_t end = text.find('\n', begin);
@@ -462,10 +462,9 @@ struct PlyElement {
 /// reads "vertices"/"faces"/"halfedge" elements its own way, and ignores the triangle strips and
 /// range grids that assimp reads.
 Reason plyHeaderProblem(const std::string& head) {
-  static const std::set<std::string> kScalar = {"char",  "int8",  "uchar",   "uint8",
-                                                "short", "int16", "ushort",  "uint16",
-                                                "int",   "int32", "uint",    "uint32",
-                                                "float", "float32", "double", "float64"};
+  static const std::set<std::string> kScalar = {
+      "char", "int8",  "uchar", "uint8",  "short", "int16",   "ushort", "uint16",
+      "int",  "int32", "uint",  "uint32", "float", "float32", "double", "float64"};
   static const std::set<std::string> kListCount = {"char",  "int8",  "uchar",  "uint8",
                                                    "short", "int16", "ushort", "uint16"};
   static const std::set<std::string> kReal = {"float", "float32", "double", "float64"};
@@ -564,7 +563,8 @@ Reason readStl(const std::string& path, const std::string& head, std::vector<Stl
   const bool binary = size >= 84 && size == 84 + 50 * std::uintmax_t{facets};
   const std::size_t word = head.find_first_not_of(" \t\r\n\v\f");
   if (!binary && (word == std::string::npos || head.compare(word, 5, "solid") != 0))
-    return "neither binary (" + std::to_string(size) + " bytes, not 84 + 50 x its facet count) "
+    return "neither binary (" + std::to_string(size) +
+           " bytes, not 84 + 50 x its facet count) "
            "nor ASCII (no 'solid' first)";
   std::ifstream in(path, std::ios::binary);
   return runCgal([&] {

@@ -108,8 +108,7 @@ TriangleSurface orientToBoundVolume(const TriangleSurface& surface, bool& change
   TriangleSurface out = fromMesh(mesh);
   // Compare triangle by triangle: the conversion keeps vertex and face order when no vertex
   // was duplicated, so a flipped triangle is one whose cyclic order changed.
-  changed = out.vertices.size() != surface.vertices.size() ||
-            out.triangles.size() != before.size();
+  changed = out.vertices.size() != surface.vertices.size() || out.triangles.size() != before.size();
   for (std::size_t i = 0; !changed && i < before.size(); ++i) {
     const auto& t = out.triangles[i];
     const auto& b = before[i];

@@ -25,12 +25,12 @@ void addTorusGrid(TriangleSurface& s, std::uint32_t first, int nu, int nv) {
 
 TriangleSurface icosphere(const Vec3& centre, double radius, int levels) {
   const double t = (1.0 + std::sqrt(5.0)) / 2.0;
-  std::vector<Vec3> v = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
-                         {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+  std::vector<Vec3> v = {{-1, t, 0},  {1, t, 0},  {-1, -t, 0}, {1, -t, 0}, {0, -1, t},  {0, 1, t},
+                         {0, -1, -t}, {0, 1, -t}, {t, 0, -1},  {t, 0, 1},  {-t, 0, -1}, {-t, 0, 1}};
   std::vector<std::array<std::uint32_t, 3>> f = {
-      {0, 11, 5}, {0, 5, 1}, {0, 1, 7}, {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
-      {11, 10, 2}, {10, 7, 6}, {7, 1, 8}, {3, 9, 4}, {3, 4, 2}, {3, 2, 6}, {3, 6, 8},
-      {3, 8, 9}, {4, 9, 5}, {2, 4, 11}, {6, 2, 10}, {8, 6, 7}, {9, 8, 1}};
+      {0, 11, 5},  {0, 5, 1},  {0, 1, 7},  {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+      {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
+      {3, 8, 9},   {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
   for (Vec3& p : v) p.normalize();
   for (int level = 0; level < levels; ++level) {
     std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> mid;
@@ -132,15 +132,12 @@ TriangleSurface boxSurface(const Box3& box) {
   for (int k = 0; k < 2; ++k)
     for (int j = 0; j < 2; ++j)
       for (int i = 0; i < 2; ++i)
-        s.vertices.emplace_back(i ? box.max().x() : box.min().x(), j ? box.max().y() : box.min().y(),
+        s.vertices.emplace_back(i ? box.max().x() : box.min().x(),
+                                j ? box.max().y() : box.min().y(),
                                 k ? box.max().z() : box.min().z());
   // Corner index i + 2j + 4k; quads outward, split into two triangles.
-  const std::array<std::array<std::uint32_t, 4>, 6> quads = {{{0, 4, 6, 2},
-                                                              {1, 3, 7, 5},
-                                                              {0, 1, 5, 4},
-                                                              {2, 6, 7, 3},
-                                                              {0, 2, 3, 1},
-                                                              {4, 5, 7, 6}}};
+  const std::array<std::array<std::uint32_t, 4>, 6> quads = {
+      {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}}};
   for (const auto& q : quads) {
     s.triangles.push_back({q[0], q[1], q[2]});
     s.triangles.push_back({q[0], q[2], q[3]});
@@ -152,7 +149,8 @@ TriangleSurface combine(const TriangleSurface& a, const TriangleSurface& b) {
   TriangleSurface s = a;
   const auto offset = static_cast<std::uint32_t>(a.vertices.size());
   s.vertices.insert(s.vertices.end(), b.vertices.begin(), b.vertices.end());
-  for (const auto& t : b.triangles) s.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+  for (const auto& t : b.triangles)
+    s.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
   return s;
 }
 

@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <unordered_map>
 
-#include <boost/container/small_vector.hpp>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_sort.h>
+#include <boost/container/small_vector.hpp>
 #include <cstdio>
 #include <limits>
 #include <map>
@@ -95,11 +95,12 @@ bool areCutSides(const PolyMesh& mesh, FaceId a, FaceId b) {
 double planarityExcess(const PolyMesh& mesh, FaceId f, const ValidationOptions& options) {
   const Box3 box = faceBounds(mesh, f);
   const double deviation = planarityDeviation(mesh, f);
-  const double resolution = 16.0 * std::numeric_limits<double>::epsilon() *
-                            std::max(box.min().cwiseAbs().maxCoeff(), box.max().cwiseAbs().maxCoeff());
+  const double resolution =
+      16.0 * std::numeric_limits<double>::epsilon() *
+      std::max(box.min().cwiseAbs().maxCoeff(), box.max().cwiseAbs().maxCoeff());
   const double diameter = box.diagonal().norm();
   return deviation > options.planarityTolerance * diameter + resolution ? deviation / diameter
-                                                                         : 0.0;
+                                                                        : 0.0;
 }
 
 }  // namespace
@@ -120,14 +121,14 @@ ValidationReport validateElements(const PolyMesh& mesh, std::span<const ElementI
       faces.push_back(use.face);
       const Face& face = mesh.face(use.face);
       if ((use.reversed ? face.back : face.front) != e)
-        problems.add(report.inconsistentFaces,
-                     "element " + std::to_string(e.index()) + " uses face " +
-                         std::to_string(use.face.value) + " but the face does not list it");
+        problems.add(report.inconsistentFaces, "element " + std::to_string(e.index()) +
+                                                   " uses face " + std::to_string(use.face.value) +
+                                                   " but the face does not list it");
     }
     if (!isClosed(mesh, e))
-      problems.add(report.openElements,
-                   describe("element", e.index()) + " is not closed (an edge of its faces is "
-                                                    "not matched by the reverse edge of another)");
+      problems.add(report.openElements, describe("element", e.index()) +
+                                            " is not closed (an edge of its faces is "
+                                            "not matched by the reverse edge of another)");
     const double v = signedVolume(mesh, e);
     report.volume += v;
     if (!(v > 0.0)) {
@@ -142,8 +143,10 @@ ValidationReport validateElements(const PolyMesh& mesh, std::span<const ElementI
   std::vector<std::pair<std::uint64_t, FaceId>> keys;
   for (FaceId f : faces) {
     const Face& face = mesh.face(f);
-    if (face.front.valid() && face.back.valid()) ++report.interiorFaces;
-    else ++report.boundaryFaces;
+    if (face.front.valid() && face.back.valid())
+      ++report.interiorFaces;
+    else
+      ++report.boundaryFaces;
     if (!face.front.valid())
       problems.add(report.inconsistentFaces, describe("face used only from its back:", f.index()));
     for (ElementId side : {face.front, face.back}) {
@@ -166,7 +169,7 @@ ValidationReport validateElements(const PolyMesh& mesh, std::span<const ElementI
   std::sort(keys.begin(), keys.end());
   auto sortedIds = [&](FaceId f) {
     boost::container::small_vector<VertexId, 8> ids(mesh.face(f).vertices.begin(),
-                                                   mesh.face(f).vertices.end());
+                                                    mesh.face(f).vertices.end());
     std::sort(ids.begin(), ids.end());
     return ids;
   };
@@ -223,7 +226,7 @@ ValidationReport validate(const PolyMesh& mesh, const ValidationOptions& options
   };
   std::vector<FaceCheck> checks(mesh.numFaces());
   // Each face's area vector and bounds, once: the elements' volumes below reuse them.
-  FaceData<Vec3> areaVectors(mesh.numFaces());
+  FaceData<Vec3> areaVectors(mesh.numFaces(), Vec3::Zero());
   FaceData<Box3> faceBoxes(mesh.numFaces());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.numFaces(), 1024),
                     [&](const tbb::blocked_range<std::size_t>& r) {
@@ -238,9 +241,9 @@ ValidationReport validate(const PolyMesh& mesh, const ValidationOptions& options
                         if (c.degenerate) continue;
                         const Box3& box = faceBoxes[f];
                         const double deviation = planarityDeviation(mesh, f, areaVectors[f]);
-                        const double resolution =
-                            16.0 * std::numeric_limits<double>::epsilon() *
-                            std::max(box.min().cwiseAbs().maxCoeff(), box.max().cwiseAbs().maxCoeff());
+                        const double resolution = 16.0 * std::numeric_limits<double>::epsilon() *
+                                                  std::max(box.min().cwiseAbs().maxCoeff(),
+                                                           box.max().cwiseAbs().maxCoeff());
                         const double diameter = box.diagonal().norm();
                         if (deviation > options.planarityTolerance * diameter + resolution)
                           c.planarity = deviation / diameter;
@@ -248,8 +251,10 @@ ValidationReport validate(const PolyMesh& mesh, const ValidationOptions& options
                     });
   for (std::size_t i = 0; i < mesh.numFaces(); ++i) {
     const Face& face = mesh.face(FaceId(i));
-    if (face.front.valid() && face.back.valid()) ++report.interiorFaces;
-    else if (face.front.valid() || face.back.valid()) ++report.boundaryFaces;
+    if (face.front.valid() && face.back.valid())
+      ++report.interiorFaces;
+    else if (face.front.valid() || face.back.valid())
+      ++report.boundaryFaces;
     if (checks[i].degenerate) {
       problems.add(report.degenerateFaces, describe("degenerate face", i));
     } else if (checks[i].planarity > 0) {
@@ -268,12 +273,13 @@ ValidationReport validate(const PolyMesh& mesh, const ValidationOptions& options
   // Duplicates: faces with equal vertex-set hashes, confirmed by comparing the sets.
   // (key, face) pairs sorted in parallel: faces with equal keys end up adjacent, by id.
   std::vector<std::pair<std::uint64_t, std::size_t>> keyed(mesh.numFaces());
-  tbb::parallel_for(std::size_t(0), mesh.numFaces(),
-                    [&](std::size_t i) { keyed[i] = {checks[i].key, i}; });
+  tbb::parallel_for(std::size_t(0), mesh.numFaces(), [&](std::size_t i) {
+    keyed[i] = {checks[i].key, i};
+  });
   tbb::parallel_sort(keyed.begin(), keyed.end());
   auto sortedIds = [&](std::size_t f) {
     boost::container::small_vector<VertexId, 8> ids(mesh.face(FaceId(f)).vertices.begin(),
-                                                   mesh.face(FaceId(f)).vertices.end());
+                                                    mesh.face(FaceId(f)).vertices.end());
     std::sort(ids.begin(), ids.end());
     return ids;
   };
@@ -314,13 +320,13 @@ ValidationReport validate(const PolyMesh& mesh, const ValidationOptions& options
     for (const FaceUse& use : element.faces) {
       const Face& face = mesh.face(use.face);
       if ((use.reversed ? face.back : face.front) != e)
-        problems.add(report.inconsistentFaces,
-                     "element " + std::to_string(i) + " uses face " +
-                         std::to_string(use.face.value) + " but the face does not list it");
+        problems.add(report.inconsistentFaces, "element " + std::to_string(i) + " uses face " +
+                                                   std::to_string(use.face.value) +
+                                                   " but the face does not list it");
     }
     if (!closed[i])
-      problems.add(report.openElements,
-                   describe("element", i) + " is not closed (an edge of its faces is not "
+      problems.add(report.openElements, describe("element", i) +
+                                            " is not closed (an edge of its faces is not "
                                             "matched by the reverse edge of another)");
     const double v = volumes[i];
     report.volume += v;

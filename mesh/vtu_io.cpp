@@ -1,7 +1,6 @@
 #include "polydg/mesh/vtu_io.h"
 
 #include <algorithm>
-#include <numeric>
 #include <array>
 #include <bit>
 #include <cerrno>
@@ -14,6 +13,7 @@
 #include <fstream>
 #include <limits>
 #include <new>
+#include <numeric>
 #include <optional>
 #include <ostream>
 #include <span>
@@ -22,10 +22,10 @@
 #include <unordered_map>
 #include <unordered_set>
 
+#include <tbb/parallel_for.h>
 #include <zlib.h>
 #include <boost/container/small_vector.hpp>
 #include <pugixml.hpp>
-#include <tbb/parallel_for.h>
 
 #include "polydg/mesh/face_triangulation.h"
 #include "polydg/mesh/geometry.h"
@@ -226,7 +226,9 @@ class FaceRecords {
 /// Union-find over integers, with path halving.
 class DisjointSets {
  public:
-  explicit DisjointSets(std::size_t n) : parent_(n) { std::iota(parent_.begin(), parent_.end(), 0); }
+  explicit DisjointSets(std::size_t n) : parent_(n) {
+    std::iota(parent_.begin(), parent_.end(), 0);
+  }
   std::uint32_t find(std::uint32_t x) {
     while (parent_[x] != x) x = parent_[x] = parent_[parent_[x]];
     return x;
@@ -355,32 +357,31 @@ CellStreams buildCellStreams(const PolyMesh& mesh) {
   s.faceReversed.resize(recordEnd[ne]);
   std::vector<std::size_t> connectivityEnd(ne + 1, 0);
   for (std::size_t c = 0; c < ne; ++c)
-    connectivityEnd[c + 1] =
-        connectivityEnd[c] + inc.begin[order[c] + 1] - inc.begin[order[c]];
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ne, 256),
-                    [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t c = r.begin(); c != r.end(); ++c) {
-      const ElementId e(order[c]);
-      const std::size_t first = inc.begin[e.index()];
-      for (std::size_t i = first; i < inc.begin[e.index() + 1]; ++i)
-        s.connectivity[connectivityEnd[c] + i - first] = point[i];
-      s.offsets[c] = static_cast<std::int64_t>(connectivityEnd[c + 1]);
-      std::size_t at = faceEnd[c], rec = recordEnd[c];
-      s.faces[at++] = static_cast<std::int64_t>(recordEnd[c + 1] - recordEnd[c]);
-      for (const FaceUse& use : mesh.element(e).faces)
-        for (std::size_t k = 0; k < records.count(use.face); ++k) {
-          const auto record = records.record(use.face, k);
-          const std::size_t n = record.size();
-          s.faces[at++] = static_cast<std::int64_t>(n);
-          // Backwards keeps the first vertex first: v0, v(n-1), ..., v1.
-          for (std::size_t i = 0; i < n; ++i)
-            s.faces[at++] = point[inc.find(e, use.reversed ? record[(n - i) % n] : record[i])];
-          s.faceGroup[rec] = use.face.value;
-          s.faceReversed[rec++] = use.reversed ? 1 : 0;
+    connectivityEnd[c + 1] = connectivityEnd[c] + inc.begin[order[c] + 1] - inc.begin[order[c]];
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, ne, 256), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t c = r.begin(); c != r.end(); ++c) {
+          const ElementId e(order[c]);
+          const std::size_t first = inc.begin[e.index()];
+          for (std::size_t i = first; i < inc.begin[e.index() + 1]; ++i)
+            s.connectivity[connectivityEnd[c] + i - first] = point[i];
+          s.offsets[c] = static_cast<std::int64_t>(connectivityEnd[c + 1]);
+          std::size_t at = faceEnd[c], rec = recordEnd[c];
+          s.faces[at++] = static_cast<std::int64_t>(recordEnd[c + 1] - recordEnd[c]);
+          for (const FaceUse& use : mesh.element(e).faces)
+            for (std::size_t k = 0; k < records.count(use.face); ++k) {
+              const auto record = records.record(use.face, k);
+              const std::size_t n = record.size();
+              s.faces[at++] = static_cast<std::int64_t>(n);
+              // Backwards keeps the first vertex first: v0, v(n-1), ..., v1.
+              for (std::size_t i = 0; i < n; ++i)
+                s.faces[at++] = point[inc.find(e, use.reversed ? record[(n - i) % n] : record[i])];
+              s.faceGroup[rec] = use.face.value;
+              s.faceReversed[rec++] = use.reversed ? 1 : 0;
+            }
+          s.faceOffsets[c] = static_cast<std::int64_t>(faceEnd[c + 1]);
         }
-      s.faceOffsets[c] = static_cast<std::int64_t>(faceEnd[c + 1]);
-    }
-  });
+      });
   for (const Face& face : mesh.faces())
     s.faceOrigin.push_back(static_cast<std::int64_t>(face.origin));
   return s;
@@ -396,8 +397,8 @@ void checkName(const std::string& name, int components, const char* kind,
     throw std::invalid_argument(std::string("writeVtu: ") + kind + " array name '" + name +
                                 "' is used twice");
   if (components != 1 && components != 3)
-    throw std::invalid_argument("writeVtu: array '" + name + "' has " +
-                                std::to_string(components) + " components; use 1 or 3");
+    throw std::invalid_argument("writeVtu: array '" + name + "' has " + std::to_string(components) +
+                                " components; use 1 or 3");
 }
 
 template <class Tag>
@@ -411,7 +412,6 @@ void checkArrays(const std::vector<VtuArray<Tag>>& arrays, std::size_t count, co
                                   std::to_string(count * a.components));
   }
 }
-
 
 /// The type an array is stored as: doubles as Float64; integers (all non-negative here) in the
 /// smallest of UInt8, Int32 and Int64 that holds them (VTK and meshio convert on reading).
@@ -444,7 +444,9 @@ struct ArrayOut {
   std::span<const std::int64_t> integers;
   StoredType stored = StoredType::Float64;
 
-  std::size_t size() const { return stored == StoredType::Float64 ? doubles.size() : integers.size(); }
+  std::size_t size() const {
+    return stored == StoredType::Float64 ? doubles.size() : integers.size();
+  }
   std::size_t bytes() const { return size() * storedSize(stored); }
 };
 
@@ -453,12 +455,12 @@ ArrayOut floatArray(std::string_view indent, std::string_view name, int componen
   return {indent, name, components, false, values, {}, StoredType::Float64};
 }
 
-ArrayOut intArray(std::string_view indent, std::string_view name, std::span<const std::int64_t> values,
-                  bool withTuples = false) {
+ArrayOut intArray(std::string_view indent, std::string_view name,
+                  std::span<const std::int64_t> values, bool withTuples = false) {
   const std::int64_t largest = values.empty() ? 0 : *std::max_element(values.begin(), values.end());
-  const StoredType t = largest < 256 ? StoredType::UInt8
+  const StoredType t = largest < 256                                         ? StoredType::UInt8
                        : largest <= std::numeric_limits<std::int32_t>::max() ? StoredType::Int32
-                                                                              : StoredType::Int64;
+                                                                             : StoredType::Int64;
   return {indent, name, 1, withTuples, {}, values, t};
 }
 
@@ -500,8 +502,7 @@ void writeBinary(const ArrayOut& a, Sink&& sink) {
 }
 
 /// Writes one <DataArray>; in appended mode only the tag, with `offset` into the appended data.
-void writeDataArray(std::ostream& os, const ArrayOut& a, VtuEncoding encoding,
-                    std::size_t offset) {
+void writeDataArray(std::ostream& os, const ArrayOut& a, VtuEncoding encoding, std::size_t offset) {
   os << a.indent << "<DataArray type=\"" << vtkTypeName(a.stored) << "\" Name=\""
      << xmlEscape(a.name) << '"';
   // Like VTK, only for several components: meshio 5 turns any array that has the attribute
@@ -536,11 +537,11 @@ void writeDataArray(std::ostream& os, const ArrayOut& a, VtuEncoding encoding,
 
 /// The point and cell values the file holds, in file order.
 struct FileValues {
-  std::vector<double> points;                   ///< 3 per VTU point
-  std::vector<std::vector<double>> pointArrays;  ///< pointData, copied to every VTU point
+  std::vector<double> points;                     ///< 3 per VTU point
+  std::vector<std::vector<double>> pointArrays;   ///< pointData, copied to every VTU point
   std::vector<std::vector<double>> cornerArrays;  ///< cornerData, the mean per VTU point
-  std::vector<double> volume;                   ///< per cell
-  std::vector<std::vector<double>> cellArrays;  ///< cellData, in cell order
+  std::vector<double> volume;                     ///< per cell
+  std::vector<std::vector<double>> cellArrays;    ///< cellData, in cell order
 };
 
 /// The rows of `values` (`components` values per row) in the order `rows` lists them: an
@@ -591,12 +592,11 @@ FileValues fileValues(const PolyMesh& mesh, const CellStreams& s,
     const Vec3& x = mesh.position(VertexId(static_cast<std::size_t>(s.pointVertex[p])));
     for (int i = 0; i < 3; ++i) v.points[3 * p + i] = x[i];
   });
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ne, 1024),
-                    [&](const tbb::blocked_range<std::size_t>& r) {
-                      for (std::size_t c = r.begin(); c != r.end(); ++c)
-                        v.volume[c] = signedVolume(
-                            mesh, ElementId(static_cast<std::size_t>(s.element[c])));
-                    });
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, ne, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t c = r.begin(); c != r.end(); ++c)
+          v.volume[c] = signedVolume(mesh, ElementId(static_cast<std::size_t>(s.element[c])));
+      });
   for (const PointArray& a : pointData)
     v.pointArrays.push_back(gatherRows(a.values, a.components, s.pointVertex));
   for (const CornerArray& a : cornerData) v.cornerArrays.push_back(cornerMeans(s, a));
@@ -610,11 +610,10 @@ void writeContents(std::ostream& os, const PolyMesh& mesh, const CellStreams& s,
                    const std::vector<PointArray>& pointData,
                    const std::vector<CornerArray>& cornerData, VtuEncoding enc) {
   const std::string_view field = "      ", inner = "        ";
-  std::vector<ArrayOut> fieldArrays{
-      intArray(field, kFaceGroupArray, s.faceGroup, true),
-      intArray(field, kFaceReversedArray, s.faceReversed, true),
-      intArray(field, kFaceOriginArray, s.faceOrigin, true),
-      intArray(field, kElementArray, s.element, true)};
+  std::vector<ArrayOut> fieldArrays{intArray(field, kFaceGroupArray, s.faceGroup, true),
+                                    intArray(field, kFaceReversedArray, s.faceReversed, true),
+                                    intArray(field, kFaceOriginArray, s.faceOrigin, true),
+                                    intArray(field, kElementArray, s.element, true)};
   if (s.pointVertex.size() != mesh.numVertices())
     fieldArrays.push_back(intArray(field, kPointVertexArray, s.pointVertex, true));
   std::vector<ArrayOut> pointArrays, cellArrays;
@@ -622,18 +621,17 @@ void writeContents(std::ostream& os, const PolyMesh& mesh, const CellStreams& s,
     pointArrays.push_back(
         floatArray(inner, pointData[i].name, pointData[i].components, values.pointArrays[i]));
   for (std::size_t i = 0; i < cornerData.size(); ++i)
-    pointArrays.push_back(floatArray(inner, cornerData[i].name, cornerData[i].components,
-                                     values.cornerArrays[i]));
+    pointArrays.push_back(
+        floatArray(inner, cornerData[i].name, cornerData[i].components, values.cornerArrays[i]));
   cellArrays.push_back(floatArray(inner, "volume", 1, values.volume));
   for (std::size_t i = 0; i < cellData.size(); ++i)
     cellArrays.push_back(
         floatArray(inner, cellData[i].name, cellData[i].components, values.cellArrays[i]));
   const ArrayOut points = floatArray(inner, "Points", 3, values.points);
-  const std::vector<ArrayOut> cells{intArray(inner, "connectivity", s.connectivity),
-                                    intArray(inner, "offsets", s.offsets),
-                                    intArray(inner, "types", s.types),
-                                    intArray(inner, "faces", s.faces),
-                                    intArray(inner, "faceoffsets", s.faceOffsets)};
+  const std::vector<ArrayOut> cells{
+      intArray(inner, "connectivity", s.connectivity), intArray(inner, "offsets", s.offsets),
+      intArray(inner, "types", s.types), intArray(inner, "faces", s.faces),
+      intArray(inner, "faceoffsets", s.faceOffsets)};
 
   std::size_t offset = 0;
   std::vector<const ArrayOut*> appended;
@@ -1074,7 +1072,6 @@ void readPiece(pugi::xml_node piece, const FileLayout& layout, std::vector<Vec3>
 // ============================================================================================
 // Reading: faces from records
 // ============================================================================================
-
 
 /// Builds faces by matching: a record whose vertex set and reversed cycle equal those of an
 /// open face of an earlier cell shares it; any other record becomes a new face.

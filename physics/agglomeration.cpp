@@ -4,9 +4,9 @@
 #include <cmath>
 #include <cstdint>
 
-#include <Eigen/Dense>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+#include <Eigen/Dense>
 
 #include "polydg/physics/block_rows.h"
 #include "polydg/physics/dg_basis.h"
@@ -40,7 +40,8 @@ std::vector<int> pairAlongAxes(const BlockRows<double>& rows,
   for (int axis = 0; axis < 3; ++axis) {
     std::vector<std::vector<int>> adjacent(static_cast<std::size_t>(groups));
     for (int b = 0; b < nb; ++b)
-      for (int k = rows.start[static_cast<std::size_t>(b)]; k < rows.start[static_cast<std::size_t>(b) + 1]; ++k)
+      for (int k = rows.start[static_cast<std::size_t>(b)];
+           k < rows.start[static_cast<std::size_t>(b) + 1]; ++k)
         if (const int f = rows.element[static_cast<std::size_t>(k)];
             group[static_cast<std::size_t>(f)] != group[static_cast<std::size_t>(b)])
           adjacent[static_cast<std::size_t>(group[static_cast<std::size_t>(b)])].push_back(
@@ -57,7 +58,8 @@ std::vector<int> pairAlongAxes(const BlockRows<double>& rows,
       for (std::size_t k = 0; k < adj.size(); ++k) {
         const int h = adj[k];
         if ((k > 0 && adj[k - 1] == h) || merged[static_cast<std::size_t>(h)] >= 0) continue;
-        const Eigen::Vector3d v = centre[static_cast<std::size_t>(h)] - centre[static_cast<std::size_t>(g)];
+        const Eigen::Vector3d v =
+            centre[static_cast<std::size_t>(h)] - centre[static_cast<std::size_t>(g)];
         const double length = v.norm();
         if (!(length > 0.0)) continue;
         const double alignment = std::abs(v[axis]) / length;
@@ -68,7 +70,8 @@ std::vector<int> pairAlongAxes(const BlockRows<double>& rows,
       }
       const int id = static_cast<int>(nextCentre.size());
       merged[static_cast<std::size_t>(g)] = id;
-      Eigen::Vector3d sum = weight[static_cast<std::size_t>(g)] * centre[static_cast<std::size_t>(g)];
+      Eigen::Vector3d sum =
+          weight[static_cast<std::size_t>(g)] * centre[static_cast<std::size_t>(g)];
       int w = weight[static_cast<std::size_t>(g)];
       if (best >= 0) {
         merged[static_cast<std::size_t>(best)] = id;
@@ -89,7 +92,8 @@ std::vector<int> pairAlongAxes(const BlockRows<double>& rows,
 
 /// Column j of the result: the coarse monomial j of a group centred at C with scale H
 /// (1, (x - C) / H, ...) in the scaled monomials of a block centred at c with scale h.
-Eigen::Matrix4d linearChange(const Eigen::Vector3d& c, double h, const Eigen::Vector3d& C, double H) {
+Eigen::Matrix4d linearChange(const Eigen::Vector3d& c, double h, const Eigen::Vector3d& C,
+                             double H) {
   Eigen::Matrix4d m = Eigen::Matrix4d::Zero();
   m(0, 0) = 1.0;
   for (int l = 0; l < 3; ++l) {
@@ -123,7 +127,8 @@ SpMat galerkinMatrix(const Agglomeration& fine, const BlockRows<double>& rows) {
          k < fine.childStart[static_cast<std::size_t>(cc) + 1]; ++k) {
       const int e = fine.children[static_cast<std::size_t>(k)];
       const Eigen::Map<const Mat4> we(fine.weights.data() + 16 * static_cast<std::size_t>(e));
-      for (int t = rows.start[static_cast<std::size_t>(e)]; t < rows.start[static_cast<std::size_t>(e) + 1]; ++t) {
+      for (int t = rows.start[static_cast<std::size_t>(e)];
+           t < rows.start[static_cast<std::size_t>(e) + 1]; ++t) {
         const std::size_t sl = static_cast<std::size_t>(t);
         const int f = rows.element[sl];
         const int cb = fine.parent[static_cast<std::size_t>(f)];
@@ -221,7 +226,8 @@ ElementFrames elementFrames(const DgBasis& basis) {
   return frames;
 }
 
-Agglomeration agglomerate(const BlockRows<double>& rows, const std::vector<Eigen::Vector3d>& centres,
+Agglomeration agglomerate(const BlockRows<double>& rows,
+                          const std::vector<Eigen::Vector3d>& centres,
                           const std::vector<double>& scales,
                           const std::vector<Eigen::Matrix4d>* linear) {
   const int nb = static_cast<int>(rows.start.size()) - 1;
@@ -230,17 +236,20 @@ Agglomeration agglomerate(const BlockRows<double>& rows, const std::vector<Eigen
   a.parent = pairAlongAxes(rows, centres, count);
   a.childStart.assign(static_cast<std::size_t>(count) + 1, 0);
   for (int g : a.parent) ++a.childStart[static_cast<std::size_t>(g) + 1];
-  for (std::size_t g = 0; g < static_cast<std::size_t>(count); ++g) a.childStart[g + 1] += a.childStart[g];
+  for (std::size_t g = 0; g < static_cast<std::size_t>(count); ++g)
+    a.childStart[g + 1] += a.childStart[g];
   a.children.resize(static_cast<std::size_t>(nb));
   std::vector<int> next(a.childStart.begin(), a.childStart.end() - 1);
   for (int b = 0; b < nb; ++b)
-    a.children[static_cast<std::size_t>(next[static_cast<std::size_t>(a.parent[static_cast<std::size_t>(b)])]++)] = b;
+    a.children[static_cast<std::size_t>(
+        next[static_cast<std::size_t>(a.parent[static_cast<std::size_t>(b)])]++)] = b;
   a.centres.assign(static_cast<std::size_t>(count), Eigen::Vector3d::Zero());
   a.scales.assign(static_cast<std::size_t>(count), 0.0);
   for (std::size_t g = 0; g < static_cast<std::size_t>(count); ++g) {
     const int first = a.childStart[g], last = a.childStart[g + 1];
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    for (int k = first; k < last; ++k) sum += centres[static_cast<std::size_t>(a.children[static_cast<std::size_t>(k)])];
+    for (int k = first; k < last; ++k)
+      sum += centres[static_cast<std::size_t>(a.children[static_cast<std::size_t>(k)])];
     a.centres[g] = sum / (last - first);
     for (int k = first; k < last; ++k) {
       const std::size_t b = static_cast<std::size_t>(a.children[static_cast<std::size_t>(k)]);

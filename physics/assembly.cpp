@@ -7,8 +7,8 @@
 #include <stdexcept>
 #include <string>
 
-#include <Eigen/Eigenvalues>
 #include <tbb/parallel_for.h>
+#include <Eigen/Eigenvalues>
 
 #ifdef __linux__
 #include <sys/mman.h>
@@ -170,8 +170,8 @@ ElementData<double> elementPenaltyThresholds(const PolyMesh& mesh, const DgBasis
       if (!(area > 0.0)) continue;
       any = true;
       const double w2 = kind == FaceKind::Interior ? 0.25 : 1.0;
-      const Vec3 nrm = use.reversed ? Vec3(-moments.faceNormal(use.face))
-                                    : moments.faceNormal(use.face);
+      const Vec3 nrm =
+          use.reversed ? Vec3(-moments.faceNormal(use.face)) : moments.faceNormal(use.face);
       // N: strain vector -> eps n, scaled by W^(-1/2).
       Eigen::Matrix<double, 3, 6> nmap;
       nmap << nrm.x(), 0, 0, nrm.y(), nrm.z(), 0,  //
@@ -191,9 +191,8 @@ ElementData<double> elementPenaltyThresholds(const PolyMesh& mesh, const DgBasis
   return required;
 }
 
-LocalMatrices localMatrices(const PolyMesh& mesh, const DgBasis& basis,
-                            const MomentCache& moments, const FaceRoles& roles,
-                            const FormCoefficients& form) {
+LocalMatrices localMatrices(const PolyMesh& mesh, const DgBasis& basis, const MomentCache& moments,
+                            const FaceRoles& roles, const FormCoefficients& form) {
   const std::size_t ne = mesh.numElements();
   LocalMatrices local;
   local.functions = basis.size();
@@ -219,8 +218,8 @@ LocalMatrices localMatrices(const PolyMesh& mesh, const DgBasis& basis,
   local.couplingStart.assign(ne + 1, 0);
   for (std::size_t i = 0; i < ne; ++i) {
     const auto& b = local.neighbours[i];
-    const std::size_t greater =
-        static_cast<std::size_t>(b.end() - std::upper_bound(b.begin(), b.end(), static_cast<std::uint32_t>(i)));
+    const std::size_t greater = static_cast<std::size_t>(
+        b.end() - std::upper_bound(b.begin(), b.end(), static_cast<std::uint32_t>(i)));
     local.couplingStart[i + 1] = local.couplingStart[i] + greater;
   }
   local.diagonal.resize(ne * bb);
@@ -234,7 +233,8 @@ LocalMatrices localMatrices(const PolyMesh& mesh, const DgBasis& basis,
           const auto& b = local.neighbours[i];
           const auto firstGreater = std::upper_bound(b.begin(), b.end(), e.value);
           double* coupling = local.coupling.data() + local.couplingStart[i] * bb;
-          std::fill(coupling, coupling + (local.couplingStart[i + 1] - local.couplingStart[i]) * bb, 0.0);
+          std::fill(coupling, coupling + (local.couplingStart[i + 1] - local.couplingStart[i]) * bb,
+                    0.0);
           elementStiffness(basis, moments, e, form.mu, form.lambda, self);
           for (const FaceUse& use : mesh.element(e).faces) {
             const FaceKind kind = roles.kind[use.face];
@@ -318,9 +318,11 @@ Eigen::SparseMatrix<double, Eigen::ColMajor, int> assembleStiffness(const LocalM
                         static_cast<std::size_t>(bs), 1, base};
             } else {
               const auto& bf = local.neighbours[f];
-              const auto firstGreater = std::upper_bound(bf.begin(), bf.end(), static_cast<std::uint32_t>(f));
+              const auto firstGreater =
+                  std::upper_bound(bf.begin(), bf.end(), static_cast<std::uint32_t>(f));
               const std::size_t slot = static_cast<std::size_t>(
-                  std::lower_bound(firstGreater, bf.end(), static_cast<std::uint32_t>(i)) - firstGreater);
+                  std::lower_bound(firstGreater, bf.end(), static_cast<std::uint32_t>(i)) -
+                  firstGreater);
               src[t] = {local.coupling.data() + (local.couplingStart[f] + slot) * bb, 1,
                         static_cast<std::size_t>(bs), base};
             }
@@ -346,16 +348,18 @@ Eigen::SparseMatrix<double, Eigen::ColMajor, int> assembleStiffness(const LocalM
   return k;
 }
 
-Eigen::SparseMatrix<double, Eigen::ColMajor, int> assembleStiffness(
-    const PolyMesh& mesh, const DgBasis& basis, const MomentCache& moments,
-    const FaceRoles& roles, const FormCoefficients& form) {
+Eigen::SparseMatrix<double, Eigen::ColMajor, int> assembleStiffness(const PolyMesh& mesh,
+                                                                    const DgBasis& basis,
+                                                                    const MomentCache& moments,
+                                                                    const FaceRoles& roles,
+                                                                    const FormCoefficients& form) {
   return assembleStiffness(localMatrices(mesh, basis, moments, roles, form));
 }
 
-Eigen::VectorXd assembleLoad(const PolyMesh& mesh, const DgBasis& basis,
-                             const MomentCache& moments, const FaceRoles& roles,
-                             const FormCoefficients& form, const Material& material,
-                             const LoadCase& loads, int quadratureDegree) {
+Eigen::VectorXd assembleLoad(const PolyMesh& mesh, const DgBasis& basis, const MomentCache& moments,
+                             const FaceRoles& roles, const FormCoefficients& form,
+                             const Material& material, const LoadCase& loads,
+                             int quadratureDegree) {
   const std::size_t ne = mesh.numElements();
   const int n = basis.size();
   const int n1 = basis.liftingSize();

@@ -58,7 +58,9 @@ ManufacturedProblem benchmarkB1Problem(const DomainTransform& t) {
   p.displacement = [u = unit.displacement, s, o](const Vec3& x) -> Vec3 {
     return s * u((x - o) / s);
   };
-  p.gradient = [g = unit.gradient, s, o](const Vec3& x) -> Eigen::Matrix3d { return g((x - o) / s); };
+  p.gradient = [g = unit.gradient, s, o](const Vec3& x) -> Eigen::Matrix3d {
+    return g((x - o) / s);
+  };
   p.bodyForce = [f = unit.bodyForce, s, o](const Vec3& x) -> Vec3 { return f((x - o) / s) / s; };
   return p;
 }

@@ -14,7 +14,8 @@ namespace {
 /// anywhere. On this machine (AVX-512), B2 with IP: the solve took 22.8-23.1 instead of
 /// 26.0 ms for p = 1, 148-161 instead of 169 ms for p = 2.
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-#define POLYDG_SIMD_CLONES __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
+#define POLYDG_SIMD_CLONES \
+  __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
 #else
 #define POLYDG_SIMD_CLONES
 #endif
@@ -63,13 +64,13 @@ POLYDG_INLINE void subtractRowsOfSize(const BlockRows<T>& a, int e, const double
   }
 }
 
-POLYDG_SIMD_CLONES void subtractRowProductKernel(const BlockRows<float>& a, int e,
-                                                 const double* x, double* out) {
+POLYDG_SIMD_CLONES void subtractRowProductKernel(const BlockRows<float>& a, int e, const double* x,
+                                                 double* out) {
   subtractRowsOfSize(a, e, x, out);
 }
 
-POLYDG_SIMD_CLONES void subtractRowProductKernel(const BlockRows<double>& a, int e,
-                                                 const double* x, double* out) {
+POLYDG_SIMD_CLONES void subtractRowProductKernel(const BlockRows<double>& a, int e, const double* x,
+                                                 double* out) {
   subtractRowsOfSize(a, e, x, out);
 }
 
@@ -101,8 +102,8 @@ void BlockRows<T>::subtractRowProduct(int e, const double* x, double* out) const
 }
 
 template <class T>
-bool BlockRows<T>::build(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& a,
-                         int functions, double maxRatio) {
+bool BlockRows<T>::build(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& a, int functions,
+                         double maxRatio) {
   n = functions;
   bs = 3 * n;
   const int ne = static_cast<int>(a.cols() / bs);

@@ -3,8 +3,8 @@
 #include <cmath>
 #include <stdexcept>
 
-#include <Eigen/Cholesky>
 #include <tbb/parallel_for.h>
+#include <Eigen/Cholesky>
 
 #include "polydg/physics/polynomial_tables.h"
 
@@ -61,9 +61,12 @@ void scaledMonomials(int degree, const Vec3& y, std::span<double> out) {
   for (int a = 1; a < n; ++a) {
     const Exponents e = monomialExponents(a);
     // Multiply a predecessor by one variable: the first variable with a positive power.
-    if (e.a > 0) out[a] = out[monomialIndex(e.a - 1, e.b, e.c)] * y.x();
-    else if (e.b > 0) out[a] = out[monomialIndex(e.a, e.b - 1, e.c)] * y.y();
-    else out[a] = out[monomialIndex(e.a, e.b, e.c - 1)] * y.z();
+    if (e.a > 0)
+      out[a] = out[monomialIndex(e.a - 1, e.b, e.c)] * y.x();
+    else if (e.b > 0)
+      out[a] = out[monomialIndex(e.a, e.b - 1, e.c)] * y.y();
+    else
+      out[a] = out[monomialIndex(e.a, e.b, e.c - 1)] * y.z();
   }
 }
 

@@ -3,10 +3,10 @@
 #include <chrono>
 #include <cmath>
 
-#include <Eigen/CholmodSupport>
-#include <Eigen/Dense>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
+#include <Eigen/CholmodSupport>
+#include <Eigen/Dense>
 
 #include "polydg/integrate/monomials.h"
 #include "polydg/physics/block_rows.h"
@@ -144,7 +144,8 @@ struct LinearSolver::Impl {
       Eigen::MatrixXd block = Eigen::MatrixXd::Zero(blockSize, blockSize);
       for (int c = 0; c < blockSize; ++c)
         for (SpMat::InnerIterator it(*matrix, base + c); it; ++it)
-          if (it.row() >= base && it.row() < base + blockSize) block(it.row() - base, c) = it.value();
+          if (it.row() >= base && it.row() < base + blockSize)
+            block(it.row() - base, c) = it.value();
       Eigen::LLT<Eigen::MatrixXd> llt(block);
       if (llt.info() != Eigen::Success) {
         ok = false;

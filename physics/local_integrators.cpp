@@ -2,7 +2,6 @@
 
 #include <cmath>
 
-
 #include "polydg/physics/polynomial_tables.h"
 
 namespace polydg {
@@ -63,21 +62,21 @@ struct Kernel {
         double v = 1.0;
         for (int k = 0; k < 3 && v != 0.0; ++k) {
           const int pa = Tab::power[k][a], pb = Tab::power[k][b];
-          if (pb > pa) v = 0.0;
-          else v *= Tab::binomial[pa][pb] * sp[pb] * dp[k][pa - pb];
+          if (pb > pa)
+            v = 0.0;
+          else
+            v *= Tab::binomial[pa][pb] * sp[pb] * dp[k][pa - pb];
         }
         s(a, b) = v;
       }
     return s;
   }
 
-  static Mat coefficients(const DgBasis& basis, ElementId e) {
-    return Mat(basis.coefficients(e));
-  }
+  static Mat coefficients(const DgBasis& basis, ElementId e) { return Mat(basis.coefficients(e)); }
 
   // --- elements ------------------------------------------------------------------------
-  static void stiffness(const DgBasis& basis, const MomentCache& moments, ElementId e,
-                        double mu, double lambda, Eigen::MatrixXd& out) {
+  static void stiffness(const DgBasis& basis, const MomentCache& moments, ElementId e, double mu,
+                        double lambda, Eigen::MatrixXd& out) {
     const double h = basis.scale(e);
     const Mat g = gram(moments.element(e), h);
     const Mat t = coefficients(basis, e);
@@ -110,9 +109,9 @@ struct Kernel {
   // --- faces ---------------------------------------------------------------------------
   /// One element's functions expressed in the face's scaled monomials y^b.
   struct Side {
-    Mat p;      ///< phi_i = sum_b p(i, b) y^b
-    Mat q[3];   ///< d phi_i / dx_k = sum_b q[k](i, b) y^b
-    Mat1 psi;   ///< lifting functions psi_q = sum_b psi(q, b) y^b
+    Mat p;     ///< phi_i = sum_b p(i, b) y^b
+    Mat q[3];  ///< d phi_i / dx_k = sum_b q[k](i, b) y^b
+    Mat1 psi;  ///< lifting functions psi_q = sum_b psi(q, b) y^b
   };
 
   struct FaceFrame {
@@ -153,10 +152,10 @@ struct Kernel {
                        Eigen::MatrixXd& selfBlock, Eigen::MatrixXd& otherBlock, bool withOther) {
     const bool interior = view.kind == FaceKind::Interior;
     const FaceFrame fr = frame(mesh, moments, view.face);
-    const Vec3 n = view.selfIsFront ? moments.faceNormal(view.face)
-                                    : Vec3(-moments.faceNormal(view.face));
-    const double etaF = facePenalty(form, moments, view.face, view.self,
-                                    interior ? view.other : ElementId());
+    const Vec3 n =
+        view.selfIsFront ? moments.faceNormal(view.face) : Vec3(-moments.faceNormal(view.face));
+    const double etaF =
+        facePenalty(form, moments, view.face, view.self, interior ? view.other : ElementId());
     const double w = interior ? 0.5 : 1.0;
     const double mu = form.mu, lambda = form.lambda;
     const bool ip = form.method == Method::IP;
@@ -182,12 +181,11 @@ struct Kernel {
     }
     const double cK = view.selfCoupledFaces, cL = view.otherCoupledFaces;
 
-    auto block = [&](const Side& b, const Mat& cb, double sb, const Mat1* liftK,
-                     const Mat1* liftL, Eigen::MatrixXd& out) {
+    auto block = [&](const Side& b, const Mat& cb, double sb, const Mat1* liftK, const Mat1* liftL,
+                     Eigen::MatrixXd& out) {
       out.setZero(3 * N, 3 * N);
       const Mat m = sk.p.lazyProduct(cb);
-      for (int d = 0; d < 3; ++d)
-        out.template block<N, N>(d * N, d * N) += (mu * etaF * sb) * m;
+      for (int d = 0; d < 3; ++d) out.template block<N, N>(d * N, d * N) += (mu * etaF * sb) * m;
       if (!ip) return;
       Mat wk[3], vk[3];  // wk: int phi^K_i d_k phi^B_j; vk: int d_k phi^K_i phi^B_j
       for (int k = 0; k < 3; ++k) {
@@ -239,9 +237,8 @@ struct Kernel {
 
 void elementStiffness(const DgBasis& basis, const MomentCache& moments, ElementId e, double mu,
                       double lambda, Eigen::MatrixXd& out) {
-  detail::dispatchBasisDegree(basis.degree(), [&](auto p) {
-    Kernel<p()>::stiffness(basis, moments, e, mu, lambda, out);
-  });
+  detail::dispatchBasisDegree(
+      basis.degree(), [&](auto p) { Kernel<p()>::stiffness(basis, moments, e, mu, lambda, out); });
 }
 
 void elementMass(const DgBasis& basis, const MomentCache& moments, ElementId e,
@@ -268,9 +265,8 @@ void faceRows(const PolyMesh& mesh, const DgBasis& basis, const MomentCache& mom
 
 Eigen::MatrixXd liftingFaceGram(const DgBasis& basis, const MomentCache& moments,
                                 const PolyMesh& mesh, FaceId f, ElementId e) {
-  return detail::dispatchBasisDegree(basis.degree(), [&](auto p) {
-    return Kernel<p()>::liftingGram(basis, moments, mesh, f, e);
-  });
+  return detail::dispatchBasisDegree(
+      basis.degree(), [&](auto p) { return Kernel<p()>::liftingGram(basis, moments, mesh, f, e); });
 }
 
 }  // namespace polydg

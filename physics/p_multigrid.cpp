@@ -1,20 +1,20 @@
 #include "polydg/physics/p_multigrid.h"
 
 #include <algorithm>
-#include <cmath>
 #include <atomic>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <stdexcept>
 
-#include <Eigen/CholmodSupport>
-#include <Eigen/Dense>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
+#include <Eigen/CholmodSupport>
+#include <Eigen/Dense>
 
 #include "polydg/integrate/monomials.h"
-#include "polydg/physics/block_rows.h"
 #include "polydg/physics/agglomeration.h"
+#include "polydg/physics/block_rows.h"
 
 namespace polydg {
 
@@ -90,7 +90,8 @@ SpMat restrictMatrix(const SpMat& fine, int n, int nc) {
   const Eigen::Index ncols = ne * bsc;
   // Local fine index -> local coarse index (or -1), and coarse -> fine: no integer division
   // per nonzero (the walks below were division-bound).
-  std::vector<int> toCoarse(static_cast<std::size_t>(bs), -1), toFine(static_cast<std::size_t>(bsc));
+  std::vector<int> toCoarse(static_cast<std::size_t>(bs), -1),
+      toFine(static_cast<std::size_t>(bsc));
   for (int d = 0; d < 3; ++d)
     for (int i = 0; i < nc; ++i) {
       toCoarse[static_cast<std::size_t>(d * n + i)] = d * nc + i;
@@ -210,7 +211,8 @@ bool invertBlocks(Level& level) {
     } else {
       for (int c = 0; c < bs; ++c)
         for (SpMat::InnerIterator it(a, base + c); it; ++it)
-          if (it.row() >= base && it.row() < base + bs) block[c * bs + (it.row() - base)] = it.value();
+          if (it.row() >= base && it.row() < base + bs)
+            block[c * bs + (it.row() - base)] = it.value();
     }
     if (!invertBlock(bs, block, level.inverses.data() + e * bs * bs)) ok = false;
   });
@@ -318,15 +320,18 @@ struct PMultigrid::Impl {
     }
     const Eigen::Index ne = b.size() / 3;
     // b as an ne x 3 matrix: row e holds element e's components (a transposed view).
-    coarseRhs = Eigen::Map<const Eigen::Matrix<double, 3, Eigen::Dynamic>>(b.data(), 3, ne).transpose();
+    coarseRhs =
+        Eigen::Map<const Eigen::Matrix<double, 3, Eigen::Dynamic>>(b.data(), 3, ne).transpose();
     if (coarse.size() == 1) {
       coarseSolution = coarse.front()->solve(coarseRhs);
     } else {
       coarseSolution.resize(ne, 3);
-      for (int d = 0; d < 3; ++d) coarseSolution.col(d) = coarse[static_cast<std::size_t>(d)]->solve(coarseRhs.col(d));
+      for (int d = 0; d < 3; ++d)
+        coarseSolution.col(d) = coarse[static_cast<std::size_t>(d)]->solve(coarseRhs.col(d));
     }
     x.resize(b.size());
-    Eigen::Map<Eigen::Matrix<double, 3, Eigen::Dynamic>>(x.data(), 3, ne) = coarseSolution.transpose();
+    Eigen::Map<Eigen::Matrix<double, 3, Eigen::Dynamic>>(x.data(), 3, ne) =
+        coarseSolution.transpose();
   }
 
   /// Factorizes the coarsest level (or its components' matrices). False if one is not
@@ -350,7 +355,8 @@ struct PMultigrid::Impl {
       // Agglomeration levels have dense 12 x 12 blocks, where the supernodal factorization
       // wins sooner (B2: 324 unknowns 0.7 ms simplicial, 1.2 supernodal; 1,500 unknowns 13.7
       // and 9.5-11 ms, the solves equally fast).
-      const Eigen::Index simplicialLimit = level.bs == 3 ? kSimplicialCoarseLimit : kSimplicialAggregateLimit;
+      const Eigen::Index simplicialLimit =
+          level.bs == 3 ? kSimplicialCoarseLimit : kSimplicialAggregateLimit;
       if (factored.rows() <= simplicialLimit) c.setMode(Eigen::CholmodSimplicialLLt);
       // The coarse level is small: AMD alone orders it well, without the METIS trial of
       // CHOLMOD's default strategy.
@@ -476,11 +482,13 @@ struct PMultigrid::Impl {
                             const int e = groups.children[static_cast<std::size_t>(k)];
                             if (fine.inLastColour[static_cast<std::size_t>(e)]) continue;
                             blockResidual(fine, e, b, x, s);
-                            const double* w = groups.weights.data() + 16 * static_cast<std::size_t>(e);
+                            const double* w =
+                                groups.weights.data() + 16 * static_cast<std::size_t>(e);
                             for (int d = 0; d < 3; ++d)
                               for (int j = 0; j < kLinear; ++j) {
                                 double sum = 0.0;
-                                for (int i = 0; i < kLinear; ++i) sum += w[i + 4 * j] * s[d * kLinear + i];
+                                for (int i = 0; i < kLinear; ++i)
+                                  sum += w[i + 4 * j] * s[d * kLinear + i];
                                 coarse[d * kLinear + j] += sum;
                               }
                           }
@@ -500,7 +508,9 @@ struct PMultigrid::Impl {
           for (int i = 0; i < nc; ++i) xe[d * n + i] += xc[d * nc + i];
         return;
       }
-      const double* xc = next.x.data() + static_cast<Eigen::Index>(fine.groups.parent[static_cast<std::size_t>(e)]) * next.bs;
+      const double* xc =
+          next.x.data() +
+          static_cast<Eigen::Index>(fine.groups.parent[static_cast<std::size_t>(e)]) * next.bs;
       const double* w = fine.groups.weights.data() + 16 * e;
       for (int d = 0; d < 3; ++d)
         for (int j = 0; j < kLinear; ++j) {

@@ -4,9 +4,9 @@
 #include <cmath>
 #include <stdexcept>
 
-#include <Eigen/Cholesky>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
+#include <Eigen/Cholesky>
 
 #include "polydg/integrate/quadrature.h"
 #include "polydg/mesh/geometry.h"
@@ -29,8 +29,8 @@ Vec3 displacementAt(const DgBasis& basis, const Eigen::VectorXd& u, ElementId e,
   return v;
 }
 
-Eigen::Matrix3d displacementGradientAt(const DgBasis& basis, const Eigen::VectorXd& u,
-                                       ElementId e, const Vec3& x) {
+Eigen::Matrix3d displacementGradientAt(const DgBasis& basis, const Eigen::VectorXd& u, ElementId e,
+                                       const Vec3& x) {
   const int n = basis.size();
   double grad[3 * kMaxFunctions];
   basis.gradients(e, x, {grad, static_cast<std::size_t>(3 * n)});
@@ -46,7 +46,8 @@ const Vec3& CornerValues::at(ElementId e, VertexId v) const {
   const auto first = vertices.begin() + static_cast<std::ptrdiff_t>(begin[e.index()]);
   const auto last = vertices.begin() + static_cast<std::ptrdiff_t>(begin[e.index() + 1]);
   const auto it = std::lower_bound(first, last, v);
-  if (it == last || *it != v) throw std::logic_error("CornerValues::at: not a vertex of the element");
+  if (it == last || *it != v)
+    throw std::logic_error("CornerValues::at: not a vertex of the element");
   return values[static_cast<std::size_t>(it - vertices.begin())];
 }
 
@@ -71,7 +72,8 @@ CornerValues cornerDisplacements(const PolyMesh& mesh, const DgBasis& basis,
     for (std::size_t k = 0; k < perElement[i].size(); ++k) {
       const VertexId v = perElement[i][k];
       c.vertices[c.begin[i] + k] = v;
-      c.values[c.begin[i] + k] = displacementAt(basis, coefficients, ElementId(i), mesh.position(v));
+      c.values[c.begin[i] + k] =
+          displacementAt(basis, coefficients, ElementId(i), mesh.position(v));
     }
   });
   return c;
@@ -86,9 +88,8 @@ CornerArray displacementPointData(const CornerValues& corners, std::string name)
                      }};
 }
 
-ElementFields elementFields(const PolyMesh& mesh, const DgBasis& basis,
-                            const MomentCache& moments, const Eigen::VectorXd& coefficients,
-                            const Material& material) {
+ElementFields elementFields(const PolyMesh& mesh, const DgBasis& basis, const MomentCache& moments,
+                            const Eigen::VectorXd& coefficients, const Material& material) {
   const std::size_t ne = mesh.numElements();
   ElementFields out;
   out.meanDisplacement.resize(ne, Vec3::Zero());
@@ -108,7 +109,8 @@ ElementFields elementFields(const PolyMesh& mesh, const DgBasis& basis,
     grad /= volume;
     out.meanDisplacement[e] = mean;
     const Eigen::Matrix3d eps = 0.5 * (grad + grad.transpose());
-    const Eigen::Matrix3d sigma = 2.0 * mu * eps + lambda * eps.trace() * Eigen::Matrix3d::Identity();
+    const Eigen::Matrix3d sigma =
+        2.0 * mu * eps + lambda * eps.trace() * Eigen::Matrix3d::Identity();
     const Eigen::Matrix3d dev = sigma - sigma.trace() / 3.0 * Eigen::Matrix3d::Identity();
     out.vonMises[e] = std::sqrt(1.5 * dev.squaredNorm());
   });
@@ -147,7 +149,8 @@ ErrorNorms errorNorms(const PolyMesh& mesh, const DgBasis& basis,
           for (const QuadraturePoint& q : elementQuadrature(mesh, e, quadratureDegree)) {
             const Vec3 u = exact(q.point);
             const Eigen::Matrix3d g = exactGradient(q.point);
-            acc.l2 += q.weight * (u - displacementAt(basis, coefficients, e, q.point)).squaredNorm();
+            acc.l2 +=
+                q.weight * (u - displacementAt(basis, coefficients, e, q.point)).squaredNorm();
             acc.h1 += q.weight *
                       (g - displacementGradientAt(basis, coefficients, e, q.point)).squaredNorm();
             acc.l2e += q.weight * u.squaredNorm();
@@ -167,12 +170,11 @@ ErrorNorms errorNorms(const PolyMesh& mesh, const DgBasis& basis,
           std::sqrt(std::max(0.0, s.l2e)), std::sqrt(std::max(0.0, s.h1e))};
 }
 
-Eigen::VectorXd projectField(const PolyMesh& mesh, const DgBasis& basis,
-                             const MomentCache& moments,
-                             const std::function<Vec3(const Vec3&)>& field,
-                             int quadratureDegree) {
+Eigen::VectorXd projectField(const PolyMesh& mesh, const DgBasis& basis, const MomentCache& moments,
+                             const std::function<Vec3(const Vec3&)>& field, int quadratureDegree) {
   const int n = basis.size();
-  Eigen::VectorXd out = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(mesh.numElements() * 3 * n));
+  Eigen::VectorXd out =
+      Eigen::VectorXd::Zero(static_cast<Eigen::Index>(mesh.numElements() * 3 * n));
   tbb::parallel_for(std::size_t(0), mesh.numElements(), [&](std::size_t i) {
     const ElementId e(i);
     Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(n, 3), mass;

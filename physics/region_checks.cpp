@@ -48,7 +48,8 @@ class SubMesh {
   /// Copies element `e` of the source (its faces and vertices if not copied yet).
   ElementId add(ElementId e) {
     FaceList uses;
-    for (const FaceUse& use : source_.element(e).faces) uses.push_back({copyFace(use.face), use.reversed});
+    for (const FaceUse& use : source_.element(e).faces)
+      uses.push_back({copyFace(use.face), use.reversed});
     const ElementId local = mesh_.addElementFromFaces(uses);
     global_.push_back(e);
     elements_.emplace(e.value, local.value);
@@ -163,8 +164,12 @@ SpMat freeRegionStiffness(const SubMesh& sub, const DgBasis& basis, const Moment
     for (const FaceUse& use : mesh.element(e).faces) {
       const ElementId other = across(mesh, use.face, e);
       if (!other.valid()) continue;
-      const FaceView view{.face = use.face, .kind = FaceKind::Interior, .self = e, .other = other,
-                          .selfIsFront = !use.reversed, .selfCoupledFaces = coupled[i],
+      const FaceView view{.face = use.face,
+                          .kind = FaceKind::Interior,
+                          .self = e,
+                          .other = other,
+                          .selfIsFront = !use.reversed,
+                          .selfCoupledFaces = coupled[i],
                           .otherCoupledFaces = coupled[other.index()]};
       faceRows(mesh, basis, moments, view, form, selfBlock, otherBlock);
       addBlock(triplets, i, i, selfBlock);
@@ -231,11 +236,12 @@ double regionPatchTest(const SubMesh& sub, std::size_t regionSize, const DgBasis
       addBlock(triplets, i, i, selfBlock);
       if (other.valid()) {
         r.noalias() += selfBlock * ue;
-        r.noalias() += otherBlock * exact.segment(static_cast<Eigen::Index>(other.index()) * bs, bs);
+        r.noalias() +=
+            otherBlock * exact.segment(static_cast<Eigen::Index>(other.index()) * bs, bs);
         if (other.index() < regionSize) addBlock(triplets, i, other.index(), otherBlock);
       } else {
-        const Vec3 normal = use.reversed ? Vec3(-moments.faceNormal(use.face))
-                                         : moments.faceNormal(use.face);
+        const Vec3 normal =
+            use.reversed ? Vec3(-moments.faceNormal(use.face)) : moments.faceNormal(use.face);
         const Vec3 traction = stress * normal;
         const Eigen::VectorXd integrals = faceIntegrals(mesh, basis, use.face, e);
         for (int d = 0; d < 3; ++d) r.segment(d * n, n) -= traction[d] * integrals;
@@ -287,7 +293,8 @@ RegionDgCheck regionDgChecks(const PolyMesh& mesh, const MomentCache& moments,
       if (region[i]) sub.add(ElementId(i));
   } catch (const std::exception& e) {
     throw std::invalid_argument(std::string("regionDgChecks: the region's faces are not used "
-                                            "consistently (") + e.what() + ")");
+                                            "consistently (") +
+                                e.what() + ")");
   }
   const std::size_t regionSize = sub.size();
   c.elements = regionSize;

@@ -91,8 +91,7 @@ ConditionEstimate conditionEstimate(const SparseMatrix& matrix, int blockSize) {
   c.matrixProducts += inverse.products;
   c.positiveDefinite = inverseMax > 0.0;
   c.lambdaMin = c.positiveDefinite ? 1.0 / inverseMax : 0.0;
-  c.cond = c.positiveDefinite ? c.lambdaMax / c.lambdaMin
-                              : std::numeric_limits<double>::infinity();
+  c.cond = c.positiveDefinite ? c.lambdaMax / c.lambdaMin : std::numeric_limits<double>::infinity();
   return c;
 }
 
@@ -131,11 +130,16 @@ Loop tileLoop(const Tile& t, const std::map<Key, VertexId>& vertices, bool flip)
     if (a < t.lo[0] || a > t.hi[0] || b < t.lo[1] || b > t.hi[1]) continue;
     // Perimeter parameter, starting at (lo, lo): bottom, right, top, left.
     double s;
-    if (b == t.lo[1]) s = a - t.lo[0];
-    else if (a == t.hi[0]) s = lu + (b - t.lo[1]);
-    else if (b == t.hi[1]) s = lu + lw + (t.hi[0] - a);
-    else if (a == t.lo[0]) s = 2 * lu + lw + (t.hi[1] - b);
-    else continue;  // inside the tile: not on its boundary
+    if (b == t.lo[1])
+      s = a - t.lo[0];
+    else if (a == t.hi[0])
+      s = lu + (b - t.lo[1]);
+    else if (b == t.hi[1])
+      s = lu + lw + (t.hi[0] - a);
+    else if (a == t.lo[0])
+      s = 2 * lu + lw + (t.hi[1] - b);
+    else
+      continue;  // inside the tile: not on its boundary
     onBoundary.emplace_back(s, id);
   }
   std::sort(onBoundary.begin(), onBoundary.end());
@@ -190,7 +194,8 @@ PolyMesh boxCellsMesh(const std::vector<Box3>& boxes) {
           tiles.push_back(t);
         }
         const double area = (whole.hi[0] - whole.lo[0]) * (whole.hi[1] - whole.lo[1]);
-        if (tiles.empty()) tiles.push_back(whole);
+        if (tiles.empty())
+          tiles.push_back(whole);
         else if (std::abs(covered - area) > 1e-12 * area)
           throw std::invalid_argument("boxCellsMesh: a box side is only partly covered");
         for (const Tile& t : tiles) boundary.push_back({tileLoop(t, vertices, side == 0)});

@@ -47,9 +47,8 @@ void StaticSolver::assemble(const LoadCase& loads) {
   form_.lambda = material_.lambda();
   elementEta_ = std::make_unique<ElementData<double>>(
       elementPenaltyThresholds(*mesh_, *basis_, *moments_, roles_));
-  report_.etaThreshold = elementEta_->size() == 0
-                             ? 0.0
-                             : *std::max_element(elementEta_->begin(), elementEta_->end());
+  report_.etaThreshold =
+      elementEta_->size() == 0 ? 0.0 : *std::max_element(elementEta_->begin(), elementEta_->end());
   form_.elementEta = nullptr;
   const int quadrature =
       disc.quadratureDegree >= 0 ? disc.quadratureDegree : 2 * basis_->degree() + 2;
@@ -67,12 +66,8 @@ void StaticSolver::assemble(const LoadCase& loads) {
         form_.elementEta = elementEta_.get();
       }
       break;
-    case PenaltyRule::Fixed:
-      form_.eta = disc.penalty.eta;
-      break;
-    case PenaltyRule::Doubling:
-      form_.eta = disc.penalty.eta;
-      break;
+    case PenaltyRule::Fixed: form_.eta = disc.penalty.eta; break;
+    case PenaltyRule::Doubling: form_.eta = disc.penalty.eta; break;
   }
   if (!(form_.eta > 0.0)) throw std::invalid_argument("the penalty eta must be positive");
   // The thesis's phases (Table 4.1): "integration" computes the element and face matrices,
@@ -97,16 +92,17 @@ void StaticSolver::assemble(const LoadCase& loads) {
         break;
       }
       if (attempt == kMaxDoublings)
-        throw std::runtime_error("penalty doubling: the stiffness matrix is not positive "
-                                 "definite even at eta = " + std::to_string(form_.eta) +
-                                 "; is a Dirichlet condition missing?");
+        throw std::runtime_error(
+            "penalty doubling: the stiffness matrix is not positive "
+            "definite even at eta = " +
+            std::to_string(form_.eta) + "; is a Dirichlet condition missing?");
       form_.eta *= 2.0;
       assembleInto(localMatrices(*mesh_, *basis_, *moments_, roles_, form_), system_.matrix);
     }
   }
   report_.eta = form_.eta;
-  system_.rhs = assembleLoad(*mesh_, *basis_, *moments_, roles_, form_, material_, loads,
-                             quadrature);
+  system_.rhs =
+      assembleLoad(*mesh_, *basis_, *moments_, roles_, form_, material_, loads, quadrature);
   report_.dofs = static_cast<std::size_t>(system_.matrix.rows());
   report_.nonzeros = static_cast<std::size_t>(system_.matrix.nonZeros());
   // Trial factorizations belong to the solve phase; the one that succeeded is reused.
@@ -159,8 +155,8 @@ StaticSolution StaticSolver::release() {
   return s;
 }
 
-StaticSolution solveStatic(const PolyMesh& mesh, const Material& material,
-                           const LoadCase& loads, const StaticOptions& options) {
+StaticSolution solveStatic(const PolyMesh& mesh, const Material& material, const LoadCase& loads,
+                           const StaticOptions& options) {
   StaticSolver solver(mesh, material, options);
   solver.integrate();
   solver.assemble(loads);

@@ -8,11 +8,11 @@
 #include <random>
 #include <span>
 
-#include <Eigen/CholmodSupport>
-#include <Eigen/Dense>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
+#include <Eigen/CholmodSupport>
+#include <Eigen/Dense>
 
 #include "polydg/integrate/moments.h"
 #include "polydg/mesh/validate.h"
@@ -357,8 +357,7 @@ struct LocalCheckKernel {
     double inversePowers[P + 1] = {1.0}, scaled[N], shifted[N];
     for (int k = 1; k <= P; ++k) inversePowers[k] = inversePowers[k - 1] / h;
     for (int a = 0; a < N; ++a) scaled[a] = fm[a] * inversePowers[monomialExponents(a).degree()];
-    shiftMoments(P, (faceReferencePoint(mesh, f) - basis.centre(e)) / h, {scaled, N},
-                 {shifted, N});
+    shiftMoments(P, (faceReferencePoint(mesh, f) - basis.centre(e)) / h, {scaled, N}, {shifted, N});
     return MatN(basis.coefficients(e)) * Eigen::Map<const VecN>(shifted);
   }
 
@@ -372,10 +371,9 @@ struct LocalCheckKernel {
       if (!(area > 0.0)) continue;
       const double w2 = kind == FaceKind::Interior ? 0.25 : 1.0;
       // Degree 1: the lifting space is the constants, psi = 1 / sqrt(vol), trace = area / vol.
-      const double trace =
-          P == 1 ? 1.0
-                 : moments.volume(e) / area *
-                       liftingFaceGram(basis, moments, mesh, use.face, e).trace();
+      const double trace = P == 1 ? 1.0
+                                  : moments.volume(e) / area *
+                                        liftingFaceGram(basis, moments, mesh, use.face, e).trace();
       sum += w2 * trace;
     }
     return 2.0 * sum / kConsistencyEnergyShare;
@@ -434,8 +432,8 @@ struct LocalCheckKernel {
         r.noalias() += Eigen::Map<const Mat>(otherBlock.data()) * exact[view.other];
       } else {
         dirichlet += s;
-        const Vec3 n = view.selfIsFront ? moments.faceNormal(use.face)
-                                        : Vec3(-moments.faceNormal(use.face));
+        const Vec3 n =
+            view.selfIsFront ? moments.faceNormal(use.face) : Vec3(-moments.faceNormal(use.face));
         const Vec3 traction = stress * n;
         const VecN integrals = faceIntegrals(use.face, e);
         for (int d = 0; d < 3; ++d) r.template segment<N>(d * N) -= traction[d] * integrals;
@@ -554,9 +552,10 @@ LocalDgCheck localDgChecks(const PolyMesh& mesh, const MomentCache& moments,
 
   LocalDgCheck c;
   c.degree = basis.degree();
-  c.elements = options.only.empty()
-                   ? mesh.numElements()
-                   : static_cast<std::size_t>(std::count(options.only.begin(), options.only.end(), 1));
+  c.elements =
+      options.only.empty()
+          ? mesh.numElements()
+          : static_cast<std::size_t>(std::count(options.only.begin(), options.only.end(), 1));
   c.maxPatchTestError = std::max(totals.maxError, 0.0);
   c.worstPatchTestElement = totals.worst;
   c.patchTestFailures = totals.patchFailures;
@@ -604,8 +603,9 @@ PolyMesh selectionWithNeighbours(const PolyMesh& mesh, const std::vector<char>& 
       original.push_back(ElementId(e));
     }
   auto mapped = [&](ElementId e) {
-    return e.valid() && newElement[e.index()] != kNone ? ElementId(std::size_t(newElement[e.index()]))
-                                                       : ElementId();
+    return e.valid() && newElement[e.index()] != kNone
+               ? ElementId(std::size_t(newElement[e.index()]))
+               : ElementId();
   };
   // Faces of taken elements, in their order in `mesh`.
   auto inSub = [&](const Face& face) {

@@ -8,7 +8,7 @@ packages=(
   libcgal-dev libeigen3-dev libpugixml-dev zlib1g-dev libopenvdb-dev libassimp-dev
   libsuitesparse-dev libopenblas0-pthread libopenblas-pthread-dev
   libtbb-dev libcli11-dev nlohmann-json3-dev
-  libgtest-dev libgmock-dev libbenchmark-dev libspectra-dev
+  libgtest-dev libgmock-dev libbenchmark-dev libspectra-dev clang-format
   python3-vtk9 python3-meshio python3-numpy assimp-testmodels
 )
 

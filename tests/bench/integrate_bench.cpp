@@ -48,7 +48,8 @@ const PolyMesh& nonConvexSet() {
     for (int i = 0; i < 2000; ++i) {
       const PolyMesh one = testing::randomStarPrism(18 + i % 11, rng);
       const std::size_t first = all.numVertices();
-      for (const Vec3& p : one.positions()) all.addVertex(p + Vec3(3.0 * (i % 50), 3.0 * (i / 50), 0));
+      for (const Vec3& p : one.positions())
+        all.addVertex(p + Vec3(3.0 * (i % 50), 3.0 * (i / 50), 0));
       std::vector<std::vector<Loop>> boundary;
       for (const FaceUse& use : one.element(ElementId(0)).faces) {
         const Face& face = one.face(use.face);

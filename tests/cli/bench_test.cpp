@@ -193,9 +193,9 @@ TEST(BenchCommand, StabilitySuiteWritesJsonCsvAndPlots) {
   const Result r = run("bench --suite stability --quick --quiet --out " + dir.string());
   ASSERT_EQ(r.exitCode, 0) << r.out;
   EXPECT_TRUE(r.out.empty()) << r.out;  // --quiet
-  for (const char* file : {"stability.json", "stability.csv", "stability_sliver.svg",
-                           "stability_thin_neck.svg", "stability_incompressible.svg",
-                           "stability_scale.svg"})
+  for (const char* file :
+       {"stability.json", "stability.csv", "stability_sliver.svg", "stability_thin_neck.svg",
+        "stability_incompressible.svg", "stability_scale.svg"})
     EXPECT_TRUE(fs::exists(dir / file)) << file;
   std::ifstream in(dir / "stability.json");
   const nlohmann::json j = nlohmann::json::parse(in);
@@ -203,7 +203,9 @@ TEST(BenchCommand, StabilitySuiteWritesJsonCsvAndPlots) {
   ASSERT_FALSE(j["sliver"].empty());
   for (const nlohmann::json& s : j["sliver"]) {
     ASSERT_TRUE(s.contains("volume_ratio") && s.contains("merged") && s.contains("cond"));
-    if (s["merged"].get<bool>()) EXPECT_LE(s["cond_over_regular"].get<double>(), 100.0);
+    if (s["merged"].get<bool>()) {
+      EXPECT_LE(s["cond_over_regular"].get<double>(), 100.0);
+    }
   }
   for (const nlohmann::json& s : j["thin_neck"]) EXPECT_TRUE(s["positive_definite"].get<bool>());
   EXPECT_EQ(j["incompressible"].size(), 8u);  // 4 values of nu, p = 1 and 2

@@ -30,7 +30,8 @@ std::string data(const std::string& name) { return polydg::testing::testData(nam
 class Cli : public polydg::testing::CommandTest {
  protected:
   std::size_t filesInDir() const {
-    return static_cast<std::size_t>(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()));
+    return static_cast<std::size_t>(
+        std::distance(fs::directory_iterator(dir_), fs::directory_iterator()));
   }
 };
 
@@ -91,14 +92,14 @@ TEST_F(Cli, MeshRefusesOpenSurfaceWithoutRepairAndLeavesNothing) {
                                      "f 1 2 6\nf 1 6 5\nf 2 3 7\nf 2 7 6\nf 3 4 8\nf 3 8 7\n"
                                      "f 4 1 5\n";
   const Result refused = run("mesh " + path("open.obj") + " --cells 4 -o " + path("out.vtu") +
-                          " --report " + path("r.json"));
+                             " --report " + path("r.json"));
   expectOneLineError(refused, "open (3 boundary edges)");
   EXPECT_NE(refused.out.find("--repair"), std::string::npos);
   EXPECT_FALSE(fs::exists(path("out.vtu")));
   EXPECT_FALSE(fs::exists(path("r.json")));
 
   const Result filled = run("mesh " + path("open.obj") + " --cells 4 --repair fill -o " +
-                         path("out.vtu") + " --report " + path("r.json") + " --quiet");
+                            path("out.vtu") + " --report " + path("r.json") + " --quiet");
   ASSERT_EQ(filled.exitCode, 0) << filled.out;
   const auto j = readJson("r.json");
   EXPECT_EQ(j["input"]["closed"], false);
@@ -109,13 +110,14 @@ TEST_F(Cli, MeshRefusesOpenSurfaceWithoutRepairAndLeavesNothing) {
 
 TEST_F(Cli, MeshWritesAValidMeshAndReport) {
   const Result r = run("mesh " + data("torus.obj") + " --cells 12 -o " + path("t.vtu") +
-                    " --report " + path("t.json") + " --quiet");
+                       " --report " + path("t.json") + " --quiet");
   ASSERT_EQ(r.exitCode, 0) << r.out;
   EXPECT_TRUE(r.out.empty()) << r.out;  // --quiet
   const auto j = readJson("t.json");
   for (const char* key : {"input", "output", "volume_rel_error", "validation", "timings_s"})
     EXPECT_TRUE(j.contains(key)) << key;
-  for (const char* key : {"vertices", "triangles", "closed", "self_intersecting", "volume", "repairs"})
+  for (const char* key :
+       {"vertices", "triangles", "closed", "self_intersecting", "volume", "repairs"})
     EXPECT_TRUE(j["input"].contains(key)) << key;
   for (const char* key : {"elements", "hexahedra", "polyhedra", "nonconvex", "faces",
                           "interior_faces", "boundary_faces", "volume", "slivers_merged"})
@@ -141,7 +143,8 @@ TEST_F(Cli, MeshWritesAValidMeshAndReport) {
 constexpr double kPatchTolerance = 1e-9;
 
 TEST_F(Cli, CheckReportsTheDgValidation) {
-  ASSERT_EQ(run("mesh " + data("torus.obj") + " --cells 8 -o " + path("t.vtu") + " --quiet").exitCode, 0);
+  ASSERT_EQ(
+      run("mesh " + data("torus.obj") + " --cells 8 -o " + path("t.vtu") + " --quiet").exitCode, 0);
   const Result r = run("check " + path("t.vtu") + " --report " + path("c.json"));
   ASSERT_EQ(r.exitCode, 0) << r.out;
   EXPECT_NE(r.out.find("local patch test error"), std::string::npos) << r.out;
@@ -164,14 +167,16 @@ TEST_F(Cli, CheckReportsTheDgValidation) {
   EXPECT_EQ(v["rigid_modes_global"], v["rigid_modes"]);
   EXPECT_EQ(v["rigid_modes_expected"].get<int>(), 6 * components);
 
-  const Result p2 = run("check " + path("t.vtu") + " --degree 2 --quiet --report " + path("c2.json"));
+  const Result p2 =
+      run("check " + path("t.vtu") + " --degree 2 --quiet --report " + path("c2.json"));
   ASSERT_EQ(p2.exitCode, 0) << p2.out;
   const auto c2 = readJson("c2.json")["validation"];
   EXPECT_EQ(c2["dg_degree"], 2);
   EXPECT_LT(c2["patch_test_error"].get<double>(), kPatchTolerance);
   EXPECT_EQ(c2["rigid_modes"].get<int>(), 6 * components);
 
-  const Result skipped = run("check " + path("t.vtu") + " --no-dg --quiet --report " + path("c3.json"));
+  const Result skipped =
+      run("check " + path("t.vtu") + " --no-dg --quiet --report " + path("c3.json"));
   ASSERT_EQ(skipped.exitCode, 0) << skipped.out;
   const auto c3 = readJson("c3.json")["validation"];
   EXPECT_EQ(c3["passed"], true);
@@ -202,8 +207,8 @@ TEST_F(Cli, CheckFailsTheDgChecksOnANonPlanarFace) {
          "type=\"Int32\" Name=\"offsets\" format=\"ascii\">8 16</DataArray>\n<DataArray "
          "type=\"UInt8\" Name=\"types\" format=\"ascii\">12 12</DataArray>\n</Cells></Piece>"
          "</UnstructuredGrid></VTKFile>\n";
-  const Result loose = run("check " + path("bent.vtu") + " --planarity-tolerance 0.01 --report " +
-                           path("c.json"));
+  const Result loose =
+      run("check " + path("bent.vtu") + " --planarity-tolerance 0.01 --report " + path("c.json"));
   EXPECT_EQ(loose.exitCode, 1) << loose.out;
   EXPECT_NE(loose.out.find("INVALID"), std::string::npos) << loose.out;
   EXPECT_NE(loose.out.find("local patch test"), std::string::npos) << loose.out;

@@ -39,7 +39,8 @@ class Run : public polydg::testing::CommandTest {
   /// Names in folder `name` (files and folders).
   std::vector<std::string> listing(const std::string& name) const {
     std::vector<std::string> out;
-    for (const auto& entry : fs::directory_iterator(path(name))) out.push_back(entry.path().filename().string());
+    for (const auto& entry : fs::directory_iterator(path(name)))
+      out.push_back(entry.path().filename().string());
     std::sort(out.begin(), out.end());
     return out;
   }
@@ -133,19 +134,21 @@ const char* kBatchPipeline = R"({
 TEST_F(Run, BrokenInputsFailAloneAndTheOthersSucceed) {
   const std::string pipeline = write("batch.json", kBatchPipeline);
   // An open surface: the unit cube without its top.
-  const std::string open = write("open.obj",
-                                 "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
-                                 "f 1 4 3 2\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n");
+  const std::string open =
+      write("open.obj",
+            "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
+            "f 1 4 3 2\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n");
   const std::string missing = path("missing.obj");
   for (int jobs : {1, 2}) {
     const std::string out = "out" + std::to_string(jobs);
-    const Result r = run("run " + pipeline + " --inputs " + data("cube.obj") + " " + missing + " " +
-                         open + " " + data("torus.obj") + " " + data("cube.obj") + " --jobs " +
-                         std::to_string(jobs) + " --out " + path(out) + " --report " +
-                         path(out + ".json"));
+    const Result r =
+        run("run " + pipeline + " --inputs " + data("cube.obj") + " " + missing + " " + open + " " +
+            data("torus.obj") + " " + data("cube.obj") + " --jobs " + std::to_string(jobs) +
+            " --out " + path(out) + " --report " + path(out + ".json"));
     EXPECT_EQ(r.exitCode, 1) << r.out;
     // Every input has its folder, nothing is left half-written, a repeated stem gets _2.
-    EXPECT_EQ(listing(out), (std::vector<std::string>{"cube", "cube_2", "missing", "open", "torus"}))
+    EXPECT_EQ(listing(out),
+              (std::vector<std::string>{"cube", "cube_2", "missing", "open", "torus"}))
         << r.out;
     for (const std::string stem : {"cube", "cube_2", "torus"}) {
       EXPECT_EQ(listing(out + "/" + stem), (std::vector<std::string>{"meshes", "report.json"}));
@@ -192,7 +195,8 @@ TEST_F(Run, ASolverFailureLeavesOnlyTheReport) {
     {"step": "cut", "plane": [1, 0, 0, 0.5]},
     {"step": "write", "path": "{stem}.vtu"},
     {"step": "solve", "clamp": [{"axis": "x", "value": 0}], "output": "{stem}_u.vtu"}]})");
-  const Result r = run("run " + pipeline + " --inputs " + data("cube.obj") + " --out " + path("out"));
+  const Result r =
+      run("run " + pipeline + " --inputs " + data("cube.obj") + " --out " + path("out"));
   EXPECT_EQ(r.exitCode, 1) << r.out;
   EXPECT_EQ(listing("out/cube"), std::vector<std::string>{"report.json"});
   const json report = readJson("out/cube/report.json");
@@ -206,9 +210,12 @@ TEST_F(Run, ASolverFailureLeavesOnlyTheReport) {
 }
 
 TEST_F(Run, SimulationMeshInputsSkipTheMeshStep) {
-  ASSERT_EQ(run("mesh " + data("cube.obj") + " --cells 4 -o " + path("cube4.vtu") + " --quiet").exitCode, 0);
+  ASSERT_EQ(
+      run("mesh " + data("cube.obj") + " --cells 4 -o " + path("cube4.vtu") + " --quiet").exitCode,
+      0);
   const std::string pipeline = write("batch.json", kBatchPipeline);
-  const Result r = run("run " + pipeline + " --inputs " + path("cube4.vtu") + " --out " + path("out") + " --quiet");
+  const Result r = run("run " + pipeline + " --inputs " + path("cube4.vtu") + " --out " +
+                       path("out") + " --quiet");
   ASSERT_EQ(r.exitCode, 0) << r.out;
   EXPECT_TRUE(r.out.empty()) << r.out;
   const json report = readJson("out/cube4/report.json");
@@ -217,8 +224,9 @@ TEST_F(Run, SimulationMeshInputsSkipTheMeshStep) {
   EXPECT_NEAR(report["volume"].get<double>(), 0.9, kVolumeTolerance);
   EXPECT_TRUE(fs::exists(path("out/cube4/meshes/cube4_trimmed.vtu")));
   // The cut is reported with the keys of `polydg cut`'s report, and the same figures.
-  const Result cut = run("cut " + path("cube4.vtu") + " -o " + path("cut.vtu") +
-                         " --plane 0,0,1,0.1 --remove-side - --report " + path("cut.json") + " --quiet");
+  const Result cut =
+      run("cut " + path("cube4.vtu") + " -o " + path("cut.vtu") +
+          " --plane 0,0,1,0.1 --remove-side - --report " + path("cut.json") + " --quiet");
   ASSERT_EQ(cut.exitCode, 0) << cut.out;
   const json a = readJson("cut.json")["operations"][0], b = report["steps"][1]["operations"][0];
   const auto keys = [](const json& j) {
@@ -238,7 +246,8 @@ TEST_F(Run, SimulationMeshInputsSkipTheMeshStep) {
   EXPECT_TRUE(fs::exists(path("out/cube4/cube4.vtu")));
   EXPECT_TRUE(fs::exists(path("out/cube4/meshes/cube4_trimmed.vtu")));
   // The same pipeline with --quiet and a failure: one line on stderr, exit 1.
-  const Result bad = run("run " + pipeline + " --inputs " + path("nothing.vtu") + " --out " + path("out") + " --quiet");
+  const Result bad = run("run " + pipeline + " --inputs " + path("nothing.vtu") + " --out " +
+                         path("out") + " --quiet");
   EXPECT_EQ(bad.exitCode, 1) << bad.out;
   EXPECT_EQ(std::count(bad.out.begin(), bad.out.end(), '\n'), 1) << bad.out;
   EXPECT_NE(bad.out.find("nothing.vtu"), std::string::npos) << bad.out;
@@ -250,22 +259,35 @@ TEST_F(Run, InvalidPipelinesAreRefusedUpFront) {
   expectRefused(run("run " + write("b.json", R"({"steps": [{"step": "slice"}]})") + inputs),
                 "steps[0].step: 'slice' is not one of");
   expectRefused(run("run " + write("c.json", R"({"steps": [{"step": "mesh", "cells": 4},
-      {"step": "cut", "plnae": [0, 0, 1, 0]}]})") + inputs),
+      {"step": "cut", "plnae": [0, 0, 1, 0]}]})") +
+                    inputs),
                 "steps[1]: a cut step needs exactly one of");
   expectRefused(run("run " + write("d.json", R"({"steps": [{"step": "mesh", "cells": 4,
-      "cels": 3}]})") + inputs), "steps[0].cels: unknown key");
-  expectRefused(run("run " + write("e.json", R"({"step": []})") + inputs), "pipeline.steps: missing");
+      "cels": 3}]})") +
+                    inputs),
+                "steps[0].cels: unknown key");
+  expectRefused(run("run " + write("e.json", R"({"step": []})") + inputs),
+                "pipeline.steps: missing");
   expectRefused(run("run " + write("f.json", R"({"steps": [{"step": "mesh", "cells": 4},
-      {"step": "write", "path": "../escape.vtu"}]})") + inputs), "steps[1].path: '..'");
+      {"step": "write", "path": "../escape.vtu"}]})") +
+                    inputs),
+                "steps[1].path: '..'");
   expectRefused(run("run " + write("g.json", R"({"steps": [{"step": "mesh", "cells": 4},
-      {"step": "cut", "plane": [0, 0, 0, 1]}]})") + inputs), "steps[1].plane");
+      {"step": "cut", "plane": [0, 0, 0, 1]}]})") +
+                    inputs),
+                "steps[1].plane");
   expectRefused(run("run " + write("h.json", R"({"steps": [{"step": "mesh", "cells": 4},
-      {"step": "solve", "material": {"nu": 0.7}, "clamp": [{"axis": "z", "value": 0}]}]})") + inputs),
+      {"step": "solve", "material": {"nu": 0.7}, "clamp": [{"axis": "z", "value": 0}]}]})") +
+                    inputs),
                 "steps[1].material.nu");
-  expectRefused(run("run " + write("i.json", R"({"steps": [{"step": "check"}, {"step": "mesh", "cells": 4}]})") + inputs),
-                "steps[1]: the mesh step must be the first step");
-  expectRefused(run("run " + write("j.json", R"({"steps": [{"step": "check"}]})") + " --out " + path("out")),
-                "no inputs");
+  expectRefused(
+      run("run " +
+          write("i.json", R"({"steps": [{"step": "check"}, {"step": "mesh", "cells": 4}]})") +
+          inputs),
+      "steps[1]: the mesh step must be the first step");
+  expectRefused(
+      run("run " + write("j.json", R"({"steps": [{"step": "check"}]})") + " --out " + path("out")),
+      "no inputs");
   EXPECT_FALSE(fs::exists(path("out")));
 }
 

@@ -46,14 +46,14 @@ TEST_F(CutCli, ReportsEveryOperation) {
   const auto report = readJson("r.json");
   ASSERT_EQ(report["operations"].size(), 2u);
   for (const auto& op : report["operations"]) {
-    for (const char* key : {"op", "elements_split", "pieces_created", "elements_removed",
-                            "volume_removed", "slivers_merged", "isolated_slivers",
-                            "faces_reintegrated", "faces_total", "left_whole", "validation",
-                            "time_s"})
+    for (const char* key :
+         {"op", "elements_split", "pieces_created", "elements_removed", "volume_removed",
+          "slivers_merged", "isolated_slivers", "faces_reintegrated", "faces_total", "left_whole",
+          "validation", "time_s"})
       EXPECT_TRUE(op.contains(key)) << key;
-    for (const char* key : {"passed", "level", "elements_checked", "region_elements",
-                            "patch_test_error", "region_components", "zero_modes",
-                            "volume_rel_error", "failure"})
+    for (const char* key :
+         {"passed", "level", "elements_checked", "region_elements", "patch_test_error",
+          "region_components", "zero_modes", "volume_rel_error", "failure"})
       EXPECT_TRUE(op["validation"].contains(key)) << key;
     EXPECT_TRUE(op["validation"]["passed"].get<bool>());
     EXPECT_EQ(op["validation"]["level"], "local");
@@ -72,9 +72,10 @@ TEST_F(CutCli, ReportsEveryOperation) {
 }
 
 TEST_F(CutCli, PolygonReportsElementsLeftWhole) {
-  const Result r = run("cut " + input() + " -o " + path("out.vtu") +
-                       " --polygon \"0.1,0.1,0.4;0.6,0.1,0.4;0.6,0.6,0.55;0.1,0.6,0.55\" --report " +
-                       path("r.json") + " --quiet");
+  const Result r =
+      run("cut " + input() + " -o " + path("out.vtu") +
+          " --polygon \"0.1,0.1,0.4;0.6,0.1,0.4;0.6,0.6,0.55;0.1,0.6,0.55\" --report " +
+          path("r.json") + " --quiet");
   ASSERT_EQ(r.exitCode, 0) << r.out;
   const auto op = readJson("r.json")["operations"][0];
   EXPECT_EQ(op["op"], "cut_polygon");
@@ -87,8 +88,8 @@ TEST_F(CutCli, BadArgumentsExitTwoWithOneLineAndNoOutput) {
   for (const std::string& args :
        {std::string("--plane 0,0,0,1"), std::string("--plane 0,0,1"),
         std::string("--plane 0,0,x,1"), std::string("--polygon \"0,0,0;1,0,0;2,0,0\""),
-        std::string("--plane 0,0,1,0.5 --remove-side up"), std::string("--validate all --plane 0,0,1,0.5"),
-        std::string("")}) {
+        std::string("--plane 0,0,1,0.5 --remove-side up"),
+        std::string("--validate all --plane 0,0,1,0.5"), std::string("")}) {
     const Result r = run("cut " + input() + " -o " + path("out.vtu") + " " + args + " --report " +
                          path("r.json"));
     EXPECT_EQ(r.exitCode, 2) << args << ": " << r.out;
@@ -107,7 +108,8 @@ TEST_F(CutCli, FailedValidationExitsOneAndWritesNoMesh) {
   // thin for the DG patch test: the second operation fails and is named.
   const Result r = run("cut " + input() + " -o " + path("out.vtu") +
                        " --plane 0.2,0.3,1,0.61 --plane 0.2,0.3,1,0.610000000001 "
-                       "--merge-slivers 0 --report " + path("r.json"));
+                       "--merge-slivers 0 --report " +
+                       path("r.json"));
   EXPECT_EQ(r.exitCode, 1) << r.out;
   EXPECT_EQ(lines(r.out), 1u) << r.out;
   EXPECT_NE(r.out.find("operation 2"), std::string::npos) << r.out;

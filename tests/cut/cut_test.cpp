@@ -62,7 +62,6 @@ TEST(Cut, ObliquePlaneSplitsCrossedElements) {
   EXPECT_EQ(components, 2u);
 }
 
-
 CutOptions noMerging() {
   CutOptions options;
   options.sliverFraction = 0.0;
@@ -230,7 +229,9 @@ TEST(Cut, RemovingEachSideLeavesComplementaryVolumes) {
     kept[side < 0 ? 0 : 1] = editor.volume();
     expectConsistent(editor, editor.volume());
     for (const Face& f : editor.mesh().faces())  // the cut surface is all that is new
-      if (f.origin == FaceOrigin::Cut) EXPECT_TRUE(f.isBoundary());
+      if (f.origin == FaceOrigin::Cut) {
+        EXPECT_TRUE(f.isBoundary());
+      }
   }
   EXPECT_NEAR(kept[0] + kept[1], 1.0, kVolumeTolerance);
 }
@@ -297,7 +298,7 @@ TEST(Cut, LocalValidationCoversTheTouchedRegion) {
   const auto r = editor.cut(Blade::plane(Vec3(0, 1, 0), 0.6), noMerging());
   ASSERT_TRUE(r.validation.passed) << r.validation.failure;
   EXPECT_EQ(r.elementsSplit, 16u);
-  EXPECT_EQ(r.validation.elementsChecked, 32u);          // the pieces
+  EXPECT_EQ(r.validation.elementsChecked, 32u);             // the pieces
   EXPECT_EQ(r.validation.regionElements, 32u + 16u + 16u);  // and one ring on each side
   EXPECT_EQ(r.validation.regionComponents, 2u);
   EXPECT_EQ(r.validation.zeroModes, 12u);
@@ -323,9 +324,10 @@ TEST(MergeSlivers, MergesSmallPiecesIntoNeighbours) {
         if (!editor.mesh().face(use.face).isBoundary()) return true;
       return false;
     }();
-    if (hasNeighbour)
+    if (hasNeighbour) {
       EXPECT_GE(editor.moments().volume(ElementId(e)),
                 kDefaultSliverFraction * editor.referenceVolume());
+    }
   }
 }
 

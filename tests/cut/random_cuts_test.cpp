@@ -1,12 +1,12 @@
-// 1000 random plane cuts through sliced spheres (sequences of 10): after every cut the mesh validates, the
-// volume is conserved, the component count matches independent counts, and the operation's
-// own (local) validation passes.
+// 1000 random plane cuts through sliced spheres (sequences of 10): after every cut the mesh
+// validates, the volume is conserved, the component count matches independent counts, and the
+// operation's own (local) validation passes.
 #include <chrono>
 #include <cstdio>
-#include <random>
-#include <unordered_map>
 #include <numeric>
+#include <random>
 #include <string>
+#include <unordered_map>
 #include <unordered_set>
 
 #include <gtest/gtest.h>
@@ -106,9 +106,10 @@ TEST(RandomCuts, ThousandCutsThroughSlicedSpheres) {
   }
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  std::printf("%d cuts in %.2f s (largest mesh %zu elements): %zu splits, %zu slivers merged, "
-              "%zu isolated; faces re-integrated %zu of %zu (summed over cuts)\n",
-              kCuts, seconds, largest, split, merged, isolated, reintegrated, total);
+  std::printf(
+      "%d cuts in %.2f s (largest mesh %zu elements): %zu splits, %zu slivers merged, "
+      "%zu isolated; faces re-integrated %zu of %zu (summed over cuts)\n",
+      kCuts, seconds, largest, split, merged, isolated, reintegrated, total);
 }
 
 }  // namespace

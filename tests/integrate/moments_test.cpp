@@ -121,12 +121,12 @@ TEST(Moments, BoxMatchesClosedForm) {
   const PolyMesh mesh = boxMesh(box);
   const ElementId e(0);
   const Vec3 o = elementReferencePoint(mesh, e);
-  expectMomentsNear(elementMoments(mesh, e, kDegree), boxMoments(box, o, kDegree),
-                    box.volume(), box.diagonal().norm());
+  expectMomentsNear(elementMoments(mesh, e, kDegree), boxMoments(box, o, kDegree), box.volume(),
+                    box.diagonal().norm());
   // About another point too (exercises every shift term).
   const Vec3 q(0.1, 0.2, -0.3);
-  expectMomentsNear(elementMoments(mesh, e, kDegree, q), boxMoments(box, q, kDegree),
-                    box.volume(), 3.0);
+  expectMomentsNear(elementMoments(mesh, e, kDegree, q), boxMoments(box, q, kDegree), box.volume(),
+                    3.0);
 }
 
 TEST(Moments, FaceMomentsOfSquareMatchClosedForm) {
@@ -256,19 +256,19 @@ TEST(Moments, NormalizedMomentsAreInvariantUnderTranslationAndScale) {
     PolyMesh base = trial % 2 == 0 ? testing::randomStarPrism(20, rng)
                                    : singleElementMesh(testing::randomStarSurface(1, rng));
     const ElementId e(0);
-    const auto reference = normalizedMoments(elementMoments(base, e, kDegree), kDegree,
-                                             diagonal(base, e));
+    const auto reference =
+        normalizedMoments(elementMoments(base, e, kDegree), kDegree, diagonal(base, e));
     struct Case {
       double scale;
       Vec3 offset;
     };
-    for (const Case& c : {Case{1.0, Vec3(1e6, -1e6, 1e6)}, Case{1e-6, Vec3::Zero()},
-                          Case{1e6, Vec3::Zero()}, Case{1e6, Vec3(1e6, -1e6, 1e6)},
-                          Case{1e-6, Vec3(1.0, -1.0, 1.0) * 0x1p-20}}) {
+    for (const Case& c :
+         {Case{1.0, Vec3(1e6, -1e6, 1e6)}, Case{1e-6, Vec3::Zero()}, Case{1e6, Vec3::Zero()},
+          Case{1e6, Vec3(1e6, -1e6, 1e6)}, Case{1e-6, Vec3(1.0, -1.0, 1.0) * 0x1p-20}}) {
       PolyMesh moved = base;
       transform(moved, c.scale, c.offset);
-      const auto m = normalizedMoments(elementMoments(moved, e, kDegree), kDegree,
-                                       diagonal(moved, e));
+      const auto m =
+          normalizedMoments(elementMoments(moved, e, kDegree), kDegree, diagonal(moved, e));
       for (std::size_t i = 0; i < m.size(); ++i)
         EXPECT_NEAR(m[i], reference[i], kInvariance * std::max(1.0, std::abs(reference[i])))
             << "scale " << c.scale << " offset " << c.offset.transpose() << " monomial " << i;

@@ -28,11 +28,14 @@ TEST(Quadrature, GaussLegendreIsExactToDegree2nMinus1) {
 
 TEST(Quadrature, TetrahedronRuleIntegratesMonomialsOfUnitSimplex) {
   // int over the unit simplex of x^a y^b z^c = a! b! c! / (a+b+c+3)!.
-  auto fact = [](int n) { double f = 1; for (int i = 2; i <= n; ++i) f *= i; return f; };
+  auto fact = [](int n) {
+    double f = 1;
+    for (int i = 2; i <= n; ++i) f *= i;
+    return f;
+  };
   for (int degree = 0; degree <= 8; ++degree) {
     std::vector<QuadraturePoint> rule;
-    appendTetrahedronRule(Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1), degree,
-                          rule);
+    appendTetrahedronRule(Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1), degree, rule);
     for (int a = 0; a <= degree; ++a)
       for (int b = 0; a + b <= degree; ++b) {
         const int c = degree - a - b;

@@ -48,7 +48,8 @@ Result meshModel(const std::string& path) {
     EXPECT_TRUE(why.find("open (") != std::string::npos ||
                 why.find("non-manifold (") != std::string::npos ||
                 why.find("self-intersecting (") != std::string::npos ||
-                why.find("degenerate") != std::string::npos || why.find("no volume") != std::string::npos)
+                why.find("degenerate") != std::string::npos ||
+                why.find("no volume") != std::string::npos)
         << path << ": the refusal names no defect: " << why;
     options.repair = RepairMode::Wrap;
     try {
@@ -83,8 +84,9 @@ TEST(CorpusMeshing, EveryModelMeshesOrIsRefusedWithOneLine) {
     if (r.elements) std::cout << ", " << r.elements << " elements";
     if (!r.detail.empty()) std::cout << " (" << r.detail << ")";
     std::cout << ", " << seconds << " s" << std::endl;
-    if (r.outcome == Outcome::Unreadable || r.outcome == Outcome::Refused)
+    if (r.outcome == Outcome::Unreadable || r.outcome == Outcome::Refused) {
       EXPECT_TRUE(oneLine(r.detail)) << model;
+    }
   }
   std::cout << models.size() << " models: " << counts[Outcome::Direct] << " meshed directly, "
             << counts[Outcome::Wrapped] << " after --repair wrap, " << counts[Outcome::Refused]

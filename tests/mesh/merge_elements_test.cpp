@@ -28,8 +28,8 @@ void expectSameMesh(const PolyMesh& a, const PolyMesh& b) {
   for (std::size_t i = 0; i < a.numFaces(); ++i) {
     const Face& x = a.face(FaceId(i));
     const Face& y = b.face(FaceId(i));
-    EXPECT_TRUE(std::equal(x.vertices.begin(), x.vertices.end(), y.vertices.begin(),
-                           y.vertices.end()))
+    EXPECT_TRUE(
+        std::equal(x.vertices.begin(), x.vertices.end(), y.vertices.begin(), y.vertices.end()))
         << "face " << i;
     EXPECT_TRUE(std::equal(x.loopEnd.begin(), x.loopEnd.end(), y.loopEnd.begin(), y.loopEnd.end()))
         << "face " << i;
@@ -57,10 +57,10 @@ TEST(MergeElements, BuildsTheMeshOfMergeElementGroups) {
     std::vector<std::size_t> target(ne);
     for (std::size_t e = 0; e < ne; ++e) target[e] = e;
     const auto m = static_cast<std::size_t>(n);
-    target[1] = 0;              // pair (0, 1)
-    target[m + 1] = m;          // triple (n, n + 1, 2n + 1)
+    target[1] = 0;      // pair (0, 1)
+    target[m + 1] = m;  // triple (n, n + 1, 2n + 1)
     target[2 * m + 1] = m;
-    target[ne - 1] = 2;         // two cells far apart
+    target[ne - 1] = 2;  // two cells far apart
     std::vector<std::uint32_t> group(ne), label(ne, 0xffffffffu);
     std::uint32_t groups = 0;
     for (std::size_t e = 0; e < ne; ++e) {

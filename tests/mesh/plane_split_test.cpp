@@ -78,8 +78,8 @@ SplitPlane generalPlane(const Vec3& n, double d, std::uint32_t id) {
 TEST(PlaneSplit, CubeThroughItsMiddle) {
   const PolyMesh cube = boxMesh(Box3(Vec3(0, 0, 0), Vec3(1, 1, 1)));
   PlaneSplitter splitter(pointsOf(cube));
-  const PieceSplit s = splitter.split(toPiece(cube), SplitPlane::axisAligned(0, 0.25, 1),
-                                      FaceOrigin::Interior);
+  const PieceSplit s =
+      splitter.split(toPiece(cube), SplitPlane::axisAligned(0, 0.25, 1), FaceOrigin::Interior);
   EXPECT_EQ(s.polygonsSplit, 4u);
   EXPECT_EQ(s.capPolygons, 1u);
   EXPECT_TRUE(closed(s.minus));
@@ -107,10 +107,10 @@ TEST(PlaneSplit, DiagonalPlaneAlongEdgesAndThroughVertices) {
   // x + y = 1 contains the vertical edges at (1,0) and (0,1): two triangular prisms.
   const PolyMesh cube = boxMesh(Box3(Vec3(0, 0, 0), Vec3(1, 1, 1)));
   PlaneSplitter splitter(pointsOf(cube));
-  const PieceSplit s = splitter.split(toPiece(cube), generalPlane(Vec3(1, 1, 0), 1.0, 3),
-                                      FaceOrigin::Cut);
+  const PieceSplit s =
+      splitter.split(toPiece(cube), generalPlane(Vec3(1, 1, 0), 1.0, 3), FaceOrigin::Cut);
   EXPECT_EQ(splitter.numPoints(), 8u);  // no new point: the plane passes through vertices
-  EXPECT_EQ(s.polygonsSplit, 2u);           // top and bottom
+  EXPECT_EQ(s.polygonsSplit, 2u);       // top and bottom
   EXPECT_TRUE(closed(s.minus));
   EXPECT_TRUE(closed(s.plus));
   EXPECT_NEAR(volume(s.minus, splitter.points()), 0.5, kTolerance);
@@ -121,8 +121,8 @@ TEST(PlaneSplit, DiagonalPlaneAlongEdgesAndThroughVertices) {
 TEST(PlaneSplit, PlaneGrazingOneVertex) {
   const PolyMesh cube = boxMesh(Box3(Vec3(0, 0, 0), Vec3(1, 1, 1)));
   PlaneSplitter splitter(pointsOf(cube));
-  const PieceSplit s = splitter.split(toPiece(cube), generalPlane(Vec3(1, 1, 1), 0.0, 4),
-                                      FaceOrigin::Cut);
+  const PieceSplit s =
+      splitter.split(toPiece(cube), generalPlane(Vec3(1, 1, 1), 0.0, 4), FaceOrigin::Cut);
   EXPECT_TRUE(s.minus.empty());
   EXPECT_EQ(s.plus.size(), 6u);
   EXPECT_EQ(s.capPolygons, 0u);
@@ -133,8 +133,8 @@ TEST(PlaneSplit, UShapeFallsApartIntoTwoArms) {
   u.outer = {{0, 0}, {3, 0}, {3, 2}, {2, 2}, {2, 1}, {1, 1}, {1, 2}, {0, 2}};
   const PolyMesh prism = prismMesh(u, 0.0, 1.0);
   PlaneSplitter splitter(pointsOf(prism));
-  const PieceSplit s = splitter.split(toPiece(prism), SplitPlane::axisAligned(1, 1.5, 5),
-                                      FaceOrigin::Interior);
+  const PieceSplit s =
+      splitter.split(toPiece(prism), SplitPlane::axisAligned(1, 1.5, 5), FaceOrigin::Interior);
   EXPECT_TRUE(closed(s.minus));
   EXPECT_TRUE(closed(s.plus));
   EXPECT_NEAR(volume(s.minus, splitter.points()), 4.0, kTolerance);
@@ -150,8 +150,8 @@ TEST(PlaneSplit, PlaneThroughTheNotchOfAnL) {
   l.outer = {{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}};
   const PolyMesh prism = prismMesh(l, 0.0, 1.0);
   PlaneSplitter splitter(pointsOf(prism));
-  const PieceSplit s = splitter.split(toPiece(prism), SplitPlane::axisAligned(1, 1.0, 6),
-                                      FaceOrigin::Interior);
+  const PieceSplit s =
+      splitter.split(toPiece(prism), SplitPlane::axisAligned(1, 1.0, 6), FaceOrigin::Interior);
   EXPECT_TRUE(closed(s.minus));
   EXPECT_TRUE(closed(s.plus));
   EXPECT_NEAR(volume(s.minus, splitter.points()), 2.0, kTolerance);
@@ -166,24 +166,24 @@ TEST(PlaneSplit, FaceWithHoleSplitThroughTheHole) {
   const PolyMesh prism = prismMesh(p, 0.0, 1.0);
   PlaneSplitter splitter(pointsOf(prism));
   // Through the hole: the holed caps become U shapes; each side stays one component.
-  const PieceSplit s = splitter.split(toPiece(prism), SplitPlane::axisAligned(0, 1.5, 7),
-                                      FaceOrigin::Interior);
+  const PieceSplit s =
+      splitter.split(toPiece(prism), SplitPlane::axisAligned(0, 1.5, 7), FaceOrigin::Interior);
   EXPECT_TRUE(closed(s.minus));
   EXPECT_TRUE(closed(s.plus));
   EXPECT_NEAR(volume(s.minus, splitter.points()), 4.0, kTolerance);
   EXPECT_NEAR(volume(s.plus, splitter.points()), 4.0, kTolerance);
   EXPECT_EQ(s.capPolygons, 2u);  // two rectangles either side of the hole
   // Across the top: the caps keep their holes on one side.
-  const PieceSplit t = splitter.split(toPiece(prism), SplitPlane::axisAligned(2, 0.5, 8),
-                                      FaceOrigin::Interior);
+  const PieceSplit t =
+      splitter.split(toPiece(prism), SplitPlane::axisAligned(2, 0.5, 8), FaceOrigin::Interior);
   EXPECT_EQ(t.capPolygons, 1u);
   std::size_t holed = 0;
   for (const PiecePolygon& q : t.minus) holed += q.numLoops() == 2;
   EXPECT_EQ(holed, 2u);  // the bottom face and the cap
   EXPECT_NEAR(volume(t.minus, splitter.points()), 4.0, kTolerance);
   // Along a side of the hole (x = 1): the plane contains the hole's wall.
-  const PieceSplit w = splitter.split(toPiece(prism), SplitPlane::axisAligned(0, 1.0, 9),
-                                      FaceOrigin::Interior);
+  const PieceSplit w =
+      splitter.split(toPiece(prism), SplitPlane::axisAligned(0, 1.0, 9), FaceOrigin::Interior);
   EXPECT_TRUE(closed(w.minus));
   EXPECT_TRUE(closed(w.plus));
   EXPECT_NEAR(volume(w.minus, splitter.points()), 3.0, kTolerance);

@@ -39,8 +39,8 @@ TEST(PolyMesh, HexGridSharesInteriorFaces) {
 TEST(PolyMesh, ReverseMatchingIgnoresRotationButNotDirection) {
   PolyMesh mesh;
   for (int i = 0; i < 4; ++i) mesh.addVertex(Vec3(i, i * i, 0));
-  const FaceId f = mesh.addFace({Loop{VertexId(0), VertexId(1), VertexId(2), VertexId(3)}},
-                                FaceOrigin::Surface);
+  const FaceId f =
+      mesh.addFace({Loop{VertexId(0), VertexId(1), VertexId(2), VertexId(3)}}, FaceOrigin::Surface);
   const Face& face = mesh.face(f);
   EXPECT_TRUE(isReverseOf(face, {Loop{VertexId(2), VertexId(1), VertexId(0), VertexId(3)}}));
   EXPECT_TRUE(isReverseOf(face, {Loop{VertexId(3), VertexId(2), VertexId(1), VertexId(0)}}));
@@ -51,8 +51,7 @@ TEST(PolyMesh, ReverseMatchingIgnoresRotationButNotDirection) {
 TEST(PolyMesh, RejectsFaceSideUsedTwice) {
   PolyMesh mesh;
   for (int i = 0; i < 3; ++i) mesh.addVertex(Vec3(i, i * i, 1));
-  const FaceId f =
-      mesh.addFace({Loop{VertexId(0), VertexId(1), VertexId(2)}}, FaceOrigin::Surface);
+  const FaceId f = mesh.addFace({Loop{VertexId(0), VertexId(1), VertexId(2)}}, FaceOrigin::Surface);
   mesh.addElementFromFaces(std::vector<FaceUse>{{f, false}});
   EXPECT_THROW(mesh.addElementFromFaces(std::vector<FaceUse>{{f, false}}), std::invalid_argument);
   EXPECT_THROW(mesh.addFace({Loop{VertexId(0), VertexId(7), VertexId(2)}}, FaceOrigin::Surface),

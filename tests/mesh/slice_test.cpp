@@ -85,8 +85,8 @@ TEST(Slice, PlateThinnerThanOneCell) {
 }
 
 TEST(Slice, TwoSpheresInOneCellAreTwoElements) {
-  const TriangleSurface two = combine(icosphere(Vec3(0.3, 0.5, 0.5), 0.15, 2),
-                                      icosphere(Vec3(0.7, 0.5, 0.5), 0.15, 2));
+  const TriangleSurface two =
+      combine(icosphere(Vec3(0.3, 0.5, 0.5), 0.15, 2), icosphere(Vec3(0.7, 0.5, 0.5), 0.15, 2));
   const Grid grid = Grid::covering(Box3(Vec3(0, 0, 0), Vec3(1, 1, 1)), 1.0);
   ASSERT_EQ(grid.cells, (std::array<int, 3>{1, 1, 1}));
   const Sliced s = slice(two, grid);
@@ -99,8 +99,8 @@ TEST(Slice, TwoSpheresInOneCellAreTwoElements) {
 }
 
 TEST(Slice, HollowSphereKeepsItsCavity) {
-  const TriangleSurface hollow = combine(icosphere(Vec3::Zero(), 1.0, 3),
-                                         reversedSurface(icosphere(Vec3::Zero(), 0.6, 2)));
+  const TriangleSurface hollow =
+      combine(icosphere(Vec3::Zero(), 1.0, 3), reversedSurface(icosphere(Vec3::Zero(), 0.6, 2)));
   const Sliced s = slice(hollow, Grid::withCellsAlongLongest(bounds(hollow), 7));
   expectGood(s, enclosedVolume(hollow), 1);
   EXPECT_LT(enclosedVolume(hollow), enclosedVolume(icosphere(Vec3::Zero(), 1.0, 3)));
@@ -111,10 +111,10 @@ TEST(Slice, FarFromTheOriginAndAtSmallScale) {
     double scale;
     Vec3 offset;
   };
-  const TriangleSurface base = combine(icosphere(Vec3::Zero(), 1.0, 3),
-                                       reversedSurface(icosphere(Vec3::Zero(), 0.5, 2)));
-  for (const Case& c : {Case{1.0, Vec3(1e6, -1e6, 1e6)}, Case{1e-6, Vec3::Zero()},
-                        Case{1e6, Vec3::Zero()}}) {
+  const TriangleSurface base =
+      combine(icosphere(Vec3::Zero(), 1.0, 3), reversedSurface(icosphere(Vec3::Zero(), 0.5, 2)));
+  for (const Case& c :
+       {Case{1.0, Vec3(1e6, -1e6, 1e6)}, Case{1e-6, Vec3::Zero()}, Case{1e6, Vec3::Zero()}}) {
     const TriangleSurface moved = transformed(base, c.scale, c.offset);
     const Sliced s = slice(moved, Grid::withCellsAlongLongest(bounds(moved), 6));
     SCOPED_TRACE("scale " + std::to_string(c.scale) + " offset " + std::to_string(c.offset.x()));

@@ -264,8 +264,8 @@ const std::array<std::array<int, 4>, 6> kBoxQuads = {
 std::string boxQuadLines() {
   std::string text;
   for (const auto& q : kBoxQuads)
-    text += "f " + std::to_string(q[0]) + " " + std::to_string(q[1]) + " " +
-            std::to_string(q[2]) + " " + std::to_string(q[3]) + "\n";
+    text += "f " + std::to_string(q[0]) + " " + std::to_string(q[1]) + " " + std::to_string(q[2]) +
+            " " + std::to_string(q[3]) + "\n";
   return text;
 }
 
@@ -454,8 +454,9 @@ TEST(ReadSurfaceDouble, ObjVariantsCgalReads) {
        "v\t0 0 0\nv 2\t0 0\r\nv 0 3 0\nv 0 0 4\nvt 0 0\nvn 0 0 1\n"
        "f\t1/1/1\t3/1/1\t2/1/1\nf 1//1 2//1 4//1\r\nf 1 4 3 # comment\nf 2/1 3/1 4/1#c\n"},
       {"forward.obj", "v 0 0 0\nf 1 3 2\nv 2 0 0\nv 0 3 0\nv 0 0 4\nf 1 2 4\nf 1 4 3\nf 2 3 4\n"},
-      {"weight_one.obj", "v 0 0 0 1\nv 2 0 0 1.0\nv 0 3 0 1\nv 0 0 4 1\n"
-                         "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n"},
+      {"weight_one.obj",
+       "v 0 0 0 1\nv 2 0 0 1.0\nv 0 3 0 1\nv 0 0 4 1\n"
+       "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n"},
       {"short_faces.obj", tetra + "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\nf 1 2\nf 3\n"},
   };
   for (const auto& [name, text] : files) {
@@ -476,29 +477,35 @@ TEST(ReadSurfaceDouble, ObjVariantsCgalReads) {
 TEST(ReadSurfaceDouble, FallsBackToAssimpForWhatCgalDoesNotRead) {
   const TempDir dir("fallback");
   const std::string faces = "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
-  const std::string plyFaces = "element face 4\nproperty list uchar int vertex_indices\n"
-                               "end_header\n";
+  const std::string plyFaces =
+      "element face 4\nproperty list uchar int vertex_indices\n"
+      "end_header\n";
   const std::vector<std::pair<std::string, std::string>> files = {
       // Homogeneous coordinates: CGAL would ignore w; assimp divides by it.
       {"homogeneous.obj", "v 0 0 0 2\nv 4 0 0 2\nv 0 6 0 2\nv 0 0 8 2\n" + faces},
       // A line continuation, which CGAL does not join.
-      {"continued.obj", "v 0 0 0\nv 2 0 0\nv 0 3 0\nv 0 0 4\nf 1 3 \\\n 2\nf 1 2 4\nf 1 4 3\n"
-                        "f 2 3 4\n"},
+      {"continued.obj",
+       "v 0 0 0\nv 2 0 0\nv 0 3 0\nv 0 0 4\nf 1 3 \\\n 2\nf 1 2 4\nf 1 4 3\n"
+       "f 2 3 4\n"},
       // Integer coordinates, on which CGAL's PLY reader asserts.
-      {"int_coordinates.ply", "ply\nformat ascii 1.0\nelement vertex 4\nproperty int x\n"
-                              "property int y\nproperty int z\n" + plyFaces +
-                                  "0 0 0\n2 0 0\n0 3 0\n0 0 4\n3 0 2 1\n3 0 1 3\n3 0 3 2\n"
-                                  "3 1 2 3\n"},
+      {"int_coordinates.ply",
+       "ply\nformat ascii 1.0\nelement vertex 4\nproperty int x\n"
+       "property int y\nproperty int z\n" +
+           plyFaces +
+           "0 0 0\n2 0 0\n0 3 0\n0 0 4\n3 0 2 1\n3 0 1 3\n3 0 3 2\n"
+           "3 1 2 3\n"},
       // 32-bit list counts, which CGAL allocates without a bound.
-      {"uint_counts.ply", "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\n"
-                          "property float y\nproperty float z\nelement face 4\n"
-                          "property list uint int vertex_indices\nend_header\n"
-                          "0 0 0\n2 0 0\n0 3 0\n0 0 4\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n"},
+      {"uint_counts.ply",
+       "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\n"
+       "property float y\nproperty float z\nelement face 4\n"
+       "property list uint int vertex_indices\nend_header\n"
+       "0 0 0\n2 0 0\n0 3 0\n0 0 4\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n"},
       // Indices of type ushort, which CGAL's PLY reader does not look for.
-      {"ushort_indices.ply", "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\n"
-                             "property float y\nproperty float z\nelement face 4\n"
-                             "property list uchar ushort vertex_indices\nend_header\n"
-                             "0 0 0\n2 0 0\n0 3 0\n0 0 4\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n"},
+      {"ushort_indices.ply",
+       "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\n"
+       "property float y\nproperty float z\nelement face 4\n"
+       "property list uchar ushort vertex_indices\nend_header\n"
+       "0 0 0\n2 0 0\n0 3 0\n0 0 4\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n"},
   };
   for (const auto& [name, text] : files) {
     SurfaceReadInfo info;
@@ -513,9 +520,10 @@ TEST(ReadSurfaceDouble, FallsBackToAssimpForWhatCgalDoesNotRead) {
   SurfaceReadInfo info;
   readSurface(dir.write("keyword.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nbogus 1\n"), &info);
   EXPECT_EQ(info.reader, "assimp");
-  readSurface(dir.write("quad.stl", "solid q\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\n"
-                                    "vertex 1 0 0\nvertex 1 1 0\nvertex 0 1 0\nendloop\n"
-                                    "endfacet\nendsolid q\n"),
+  readSurface(dir.write("quad.stl",
+                        "solid q\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\n"
+                        "vertex 1 0 0\nvertex 1 1 0\nvertex 0 1 0\nendloop\n"
+                        "endfacet\nendsolid q\n"),
               &info);
   EXPECT_EQ(info.reader, "assimp");
 }
@@ -545,8 +553,9 @@ TEST(ReadSurfaceErrors, HeaderCountsLargerThanTheFile) {
   const AddressSpaceCap cap(kReadAddressSpace);
   const TempDir dir("counts");
   const std::string off =
-      dir.write("faces.off", "OFF\n# corrupt face count\n3 4000000000 0\n0 0 0\n1 0 0\n0 1 0\n"
-                             "3 0 1 2\n");
+      dir.write("faces.off",
+                "OFF\n# corrupt face count\n3 4000000000 0\n0 0 0\n1 0 0\n0 1 0\n"
+                "3 0 1 2\n");
   EXPECT_EQ(readError(off), off + ": header declares 4000000000 faces but the file has only " +
                                 std::to_string(fs::file_size(off)) + " bytes; the file is corrupt");
   const std::string ply = dir.write(
@@ -554,15 +563,17 @@ TEST(ReadSurfaceErrors, HeaderCountsLargerThanTheFile) {
       "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
       "property float z\nelement face 1500000000\nproperty list uchar int vertex_indices\n"
       "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
-  EXPECT_EQ(readError(ply), ply + ": header declares 1500000000 'face' elements but the file "
-                                  "has only " + std::to_string(fs::file_size(ply)) +
-                                " bytes; the file is corrupt");
+  EXPECT_EQ(readError(ply), ply +
+                                ": header declares 1500000000 'face' elements but the file "
+                                "has only " +
+                                std::to_string(fs::file_size(ply)) + " bytes; the file is corrupt");
 }
 
 TEST(ReadSurfaceErrors, OnlyPointsOrLines) {
   const TempDir dir("points");
-  const std::string expected = ": contains only points/lines, no triangles; polydg needs a "
-                               "surface mesh";
+  const std::string expected =
+      ": contains only points/lines, no triangles; polydg needs a "
+      "surface mesh";
   const std::string points = dir.write("points.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\np 1 2\np 3\n");
   EXPECT_EQ(readError(points), points + expected);
   const std::string lines = dir.write("lines.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2 3\n");
@@ -581,16 +592,17 @@ TEST(ReadSurfaceErrors, SceneWithoutMeshes) {
 TEST(ReadSurfaceErrors, OnlyDegenerateTriangles) {
   const TempDir dir("degenerate");
   const std::string path = dir.write("flat.obj", "v 0 0 0\nv 0 0 0\nv 0 1 0\nf 1 2 3\n");
-  EXPECT_EQ(readError(path), path + ": no face has three distinct vertices (1 degenerate); "
-                                    "polydg needs a surface mesh");
+  EXPECT_EQ(readError(path), path +
+                                 ": no face has three distinct vertices (1 degenerate); "
+                                 "polydg needs a surface mesh");
 }
 
 TEST(ReadSurfaceErrors, NonFiniteCoordinate) {
   const TempDir dir("nonfinite");
   for (const char* value : {"inf", "nan"}) {
     const std::string path = dir.write(std::string(value) + ".obj", std::string("v ") + value +
-                                                                       " 0 0\nv 1 0 0\nv 0 1 0\n"
-                                                                       "f 1 2 3\n");
+                                                                        " 0 0\nv 1 0 0\nv 0 1 0\n"
+                                                                        "f 1 2 3\n");
     EXPECT_EQ(readError(path),
               path + ": a vertex has a non-finite coordinate (NaN or infinity); fix the file");
   }
@@ -680,8 +692,8 @@ TEST(ReadSurface, PrintsNothing) {
   // Readable models and each kind of error; assimp's corpus is checked the same way below.
   const TempDir dir("quiet");
   std::vector<std::string> paths;
-  for (const char* name : {"cube.obj", "octahedron.stl", "tetra.off", "Lprism.ply",
-                           "two_cubes.obj", "instanced_cubes.gltf", "no_such_model.obj"})
+  for (const char* name : {"cube.obj", "octahedron.stl", "tetra.off", "Lprism.ply", "two_cubes.obj",
+                           "instanced_cubes.gltf", "no_such_model.obj"})
     paths.push_back(testdata(name));
   paths.push_back(dir.write("points.obj", "v 0 0 0\nv 1 0 0\np 1 2\n"));
   paths.push_back(dir.write("broken.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n"));
@@ -690,14 +702,16 @@ TEST(ReadSurface, PrintsNothing) {
   // PLY faces without vertex indices, a truncated OFF file and a binary STL (whose header CGAL
   // echoes to std::cout).
   paths.push_back(dir.write("keyword.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nbogus\n"));
-  paths.push_back(dir.write("quad.stl", "solid q\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\n"
-                                        "vertex 1 0 0\nvertex 1 1 0\nvertex 0 1 0\nendloop\n"
-                                        "endfacet\nendsolid q\n"));
-  paths.push_back(dir.write("noindex.ply", "ply\nformat ascii 1.0\nelement vertex 3\n"
-                                           "property float x\nproperty float y\n"
-                                           "property float z\nelement face 1\n"
-                                           "property list uchar int corners\nend_header\n"
-                                           "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"));
+  paths.push_back(dir.write("quad.stl",
+                            "solid q\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\n"
+                            "vertex 1 0 0\nvertex 1 1 0\nvertex 0 1 0\nendloop\n"
+                            "endfacet\nendsolid q\n"));
+  paths.push_back(dir.write("noindex.ply",
+                            "ply\nformat ascii 1.0\nelement vertex 3\n"
+                            "property float x\nproperty float y\n"
+                            "property float z\nelement face 1\n"
+                            "property list uchar int corners\nend_header\n"
+                            "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"));
   paths.push_back(dir.write("short.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n"));
   paths.push_back(dir.write(
       "binary.stl", binaryStl("solid-looking header", {{{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}}})));
@@ -725,8 +739,8 @@ TEST(AssimpModels, EveryModelReadsOrFailsWithOneLine) {
     open += what == "open";
     errors += what.rfind("error", 0) == 0;
   }
-  std::cout << outcome.size() << " models: " << closed << " closed, " << open << " open, "
-            << errors << " errors\n";
+  std::cout << outcome.size() << " models: " << closed << " closed, " << open << " open, " << errors
+            << " errors\n";
   EXPECT_EQ(closed + open + errors, outcome.size());
   // Known outcomes, one per kind, so that a reader that fails everything cannot pass.
   const auto expect = [&](const char* model, const std::string& what) {

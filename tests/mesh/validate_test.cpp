@@ -77,9 +77,8 @@ TEST(Validate, CountsComponents) {
 TEST(Validate, RejectsLeakyElement) {
   const PolyMesh grid = hexGridMesh(2, 1, 1, Box3(Vec3(0, 0, 0), Vec3(2, 1, 1)));
   const FaceId dropped = grid.element(ElementId(1)).faces[3].face;
-  const PolyMesh leaky = rebuild(grid, [dropped](std::size_t e, FaceId f, auto&) {
-    return !(e == 1 && f == dropped);
-  });
+  const PolyMesh leaky = rebuild(
+      grid, [dropped](std::size_t e, FaceId f, auto&) { return !(e == 1 && f == dropped); });
   const ValidationReport r = validate(leaky);
   EXPECT_FALSE(r.passed);
   EXPECT_EQ(r.openElements, 1u);
@@ -115,8 +114,7 @@ TEST(Validate, RejectsNonPlanarFace) {
 TEST(Validate, RejectsDegenerateFaceAndEmptyMesh) {
   PolyMesh mesh;
   for (int i = 0; i < 3; ++i) mesh.addVertex(Vec3(i, 0, 0));  // collinear
-  const FaceId f =
-      mesh.addFace({Loop{VertexId(0), VertexId(1), VertexId(2)}}, FaceOrigin::Surface);
+  const FaceId f = mesh.addFace({Loop{VertexId(0), VertexId(1), VertexId(2)}}, FaceOrigin::Surface);
   mesh.addElementFromFaces(std::vector<FaceUse>{{f, false}});
   const ValidationReport r = validate(mesh);
   EXPECT_FALSE(r.passed);

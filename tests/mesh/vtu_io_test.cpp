@@ -397,8 +397,7 @@ INSTANTIATE_TEST_SUITE_P(
                       RoundTripCase{"MixedCellsAppended", mixedCells, VtuEncoding::Appended},
                       RoundTripCase{"CutBoxesAppended", cutBoxes, VtuEncoding::Appended},
                       RoundTripCase{"CutBoxesAscii", cutBoxes, VtuEncoding::Ascii},
-                      RoundTripCase{"FinitelyCutGridBinary", finitelyCutGrid,
-                                    VtuEncoding::Binary}),
+                      RoundTripCase{"FinitelyCutGridBinary", finitelyCutGrid, VtuEncoding::Binary}),
     [](const auto& info) { return info.param.name; });
 
 TEST(VtuRoundTrip, InteriorFaceWhoseFrontIsTheLaterElement) {
@@ -480,14 +479,17 @@ TEST(VtuCut, CornerDataIsAveragedPerSideOfACut) {
     const Vec3 x(points[3 * p], points[3 * p + 1], points[3 * p + 2]);
     if (x.x() == 1.0 && x.y() == 0.0) cutCorner.push_back(values[p]);
     if (x.x() == 1.0 && x.y() == 1.0) front.push_back(values[p]);
-    if (x.x() == 0.0 && x.y() == 0.0) EXPECT_EQ(values[p], 0.0);  // element 0's alone
+    if (x.x() == 0.0 && x.y() == 0.0) {
+      EXPECT_EQ(values[p], 0.0);  // element 0's alone
+    }
   }
   std::sort(cutCorner.begin(), cutCorner.end());
   EXPECT_EQ(cutCorner, (std::vector<double>{0.0, 0.0, 1.0, 1.0}));  // z = 0 and z = 1
   EXPECT_EQ(front, (std::vector<double>{1.5, 1.5}));
   // A corner array is checked like the others.
-  EXPECT_THROW(writeVtu(mesh, path.string(), {}, {}, {}, {CornerArray{"volume_like", 2, index.value}}),
-               std::invalid_argument);
+  EXPECT_THROW(
+      writeVtu(mesh, path.string(), {}, {}, {}, {CornerArray{"volume_like", 2, index.value}}),
+      std::invalid_argument);
   EXPECT_THROW(writeVtu(mesh, path.string(), {}, {}, {}, {CornerArray{"no_function", 1, {}}}),
                std::invalid_argument);
 }

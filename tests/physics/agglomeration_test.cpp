@@ -56,7 +56,8 @@ TEST(Agglomeration, GroupsAHexGridIntoCubesOfEight) {
     // The eight centres span one element width (0.1) along each axis: a 2 x 2 x 2 cube.
     Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
     for (int k = first; k < last; ++k) {
-      const Eigen::Vector3d& c = s.frames.centres[static_cast<std::size_t>(groups.children[static_cast<std::size_t>(k)])];
+      const Eigen::Vector3d& c =
+          s.frames.centres[static_cast<std::size_t>(groups.children[static_cast<std::size_t>(k)])];
       lo = lo.cwiseMin(c);
       hi = hi.cwiseMax(c);
     }
@@ -82,8 +83,8 @@ TEST(Agglomeration, CoarseFunctionsAreTheLinearDisplacementsOfEachGroup) {
   const DgBasis& basis = solver.basis();
   const ElementFrames frames = elementFrames(basis);
   const int n = basis.size();
-  const Agglomeration groups =
-      agglomerate(blockRows(solver.system().matrix, n), frames.centres, frames.scales, &frames.linear);
+  const Agglomeration groups = agglomerate(blockRows(solver.system().matrix, n), frames.centres,
+                                           frames.scales, &frames.linear);
   EXPECT_LT(groups.groups(), static_cast<int>(mesh.numElements()) / 3);
   // u(x) = a + B x, as each group's coefficients: u(C) and H grad u.
   const Eigen::Vector3d a(0.3, -1.2, 2.0);
@@ -105,13 +106,14 @@ TEST(Agglomeration, CoarseFunctionsAreTheLinearDisplacementsOfEachGroup) {
       coefficients.col(d) = w * coarse;
     }
     const ElementId id(e);
-    for (const Eigen::Vector3d& offset :
-         {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0.4, -0.3, 0.2), Eigen::Vector3d(-0.5, 0.5, -0.5)}) {
+    for (const Eigen::Vector3d& offset : {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0.4, -0.3, 0.2),
+                                          Eigen::Vector3d(-0.5, 0.5, -0.5)}) {
       const Eigen::Vector3d x = basis.centre(id) + basis.scale(id) * offset;
       basis.values(id, x, phi);
       Eigen::Vector3d value = Eigen::Vector3d::Zero();
       for (int d = 0; d < 3; ++d)
-        for (int i = 0; i < 4; ++i) value[d] += coefficients(i, d) * phi[static_cast<std::size_t>(i)];
+        for (int i = 0; i < 4; ++i)
+          value[d] += coefficients(i, d) * phi[static_cast<std::size_t>(i)];
       worst = std::max(worst, (value - u(x)).norm() / u(x).norm());
     }
   }

@@ -40,8 +40,8 @@ TEST_P(B1Convergence, InteriorPenaltyConvergesAtTheOptimalRates) {
   const BenchmarkRun coarse = runBenchmarkB1(n, options(Method::IP, p));
   const BenchmarkRun fine = runBenchmarkB1(2 * n, options(Method::IP, p));
   const double l2 = rate(coarse.l2Error, fine.l2Error), h1 = rate(coarse.h1Error, fine.h1Error);
-  std::printf("B1 IP p=%d n=%d->%d: L2 %.3e -> %.3e (rate %.2f), H1 %.3e -> %.3e (rate %.2f)\n",
-              p, n, 2 * n, coarse.l2Error, fine.l2Error, l2, coarse.h1Error, fine.h1Error, h1);
+  std::printf("B1 IP p=%d n=%d->%d: L2 %.3e -> %.3e (rate %.2f), H1 %.3e -> %.3e (rate %.2f)\n", p,
+              n, 2 * n, coarse.l2Error, fine.l2Error, l2, coarse.h1Error, fine.h1Error, h1);
   EXPECT_GE(l2, p + kL2RateMargin);
   EXPECT_GE(h1, p - kH1RateMargin);
   EXPECT_LT(fine.report.solver.residual, 1e-10);
@@ -57,19 +57,19 @@ TEST(B1Convergence, BabuskaZlamalIsInconsistent) {
   const BenchmarkRun bz4 = runBenchmarkB1(4, options(Method::BZ, 2));
   const BenchmarkRun bz8 = runBenchmarkB1(8, options(Method::BZ, 2));
   const BenchmarkRun ip8 = runBenchmarkB1(8, options(Method::IP, 2));
-  std::printf("B1 BZ p=2: L2 %.3e -> %.3e (rate %.2f); IP at n=8: %.3e\n", bz4.l2Error,
-              bz8.l2Error, rate(bz4.l2Error, bz8.l2Error), ip8.l2Error);
+  std::printf("B1 BZ p=2: L2 %.3e -> %.3e (rate %.2f); IP at n=8: %.3e\n", bz4.l2Error, bz8.l2Error,
+              rate(bz4.l2Error, bz8.l2Error), ip8.l2Error);
   EXPECT_LT(bz8.l2Error, bz4.l2Error);
   EXPECT_LT(rate(bz4.l2Error, bz8.l2Error), 1.0);
   EXPECT_GT(bz8.l2Error, 10.0 * ip8.l2Error);
 }
 
 TEST(B3Cantilever, DegreeTwoTipDeflectionWithinThreePercent) {
-  const CantileverResult r = runBenchmarkB3({.nx = 40, .ny = 4, .nz = 4, .poissonRatio = 0.3},
-                                            options(Method::IP, 2));
+  const CantileverResult r =
+      runBenchmarkB3({.nx = 40, .ny = 4, .nz = 4, .poissonRatio = 0.3}, options(Method::IP, 2));
   const double reference = cantileverReference(0.3);
-  std::printf("B3 IP p=2 40x4x4 nu=0.3: tip %.4f (reference %.4f, eta %.3g)\n",
-              r.tipDeflection, reference, r.report.eta);
+  std::printf("B3 IP p=2 40x4x4 nu=0.3: tip %.4f (reference %.4f, eta %.3g)\n", r.tipDeflection,
+              reference, r.report.eta);
   EXPECT_NEAR(reference, 4.031, 5e-4);
   EXPECT_NEAR(r.tipDeflection, reference, kCantileverTolerance * reference);
 }

@@ -52,8 +52,8 @@ TEST_P(PMultigridSolve, ConjugateGradientMatchesCholesky) {
   cg.tolerance = kCgTolerance;
   SolveReport report;
   LinearSolver solver(cg);
-  ASSERT_TRUE(solver.compute(system.matrix, system.blockSize,
-                             c.agglomerate ? &framed.frames : nullptr));
+  ASSERT_TRUE(
+      solver.compute(system.matrix, system.blockSize, c.agglomerate ? &framed.frames : nullptr));
   const Eigen::VectorXd u = solver.solve(system.rhs, report);
   std::printf("%s p=%d n=%d %s: %d iterations, residual %.2e\n",
               c.method == Method::IP ? "ip" : "bz", c.degree, c.n,
@@ -64,18 +64,17 @@ TEST_P(PMultigridSolve, ConjugateGradientMatchesCholesky) {
   EXPECT_LE((u - reference).norm(), kSolutionAgreement * reference.norm());
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    HexAndSliced, PMultigridSolve,
-    ::testing::Values(Case{BenchmarkMesh::Hex, 4, Method::IP, 1},
-                      Case{BenchmarkMesh::Hex, 4, Method::BZ, 2},
-                      Case{BenchmarkMesh::Hex, 3, Method::IP, 3},
-                      Case{BenchmarkMesh::Sliced, 3, Method::IP, 2},
-                      Case{BenchmarkMesh::Sliced, 3, Method::BZ, 1},
-                      Case{BenchmarkMesh::Hex, 4, Method::IP, 1, true},
-                      Case{BenchmarkMesh::Hex, 4, Method::BZ, 2, true},
-                      Case{BenchmarkMesh::Hex, 3, Method::IP, 3, true},
-                      Case{BenchmarkMesh::Sliced, 4, Method::IP, 2, true},
-                      Case{BenchmarkMesh::Sliced, 4, Method::BZ, 1, true}));
+INSTANTIATE_TEST_SUITE_P(HexAndSliced, PMultigridSolve,
+                         ::testing::Values(Case{BenchmarkMesh::Hex, 4, Method::IP, 1},
+                                           Case{BenchmarkMesh::Hex, 4, Method::BZ, 2},
+                                           Case{BenchmarkMesh::Hex, 3, Method::IP, 3},
+                                           Case{BenchmarkMesh::Sliced, 3, Method::IP, 2},
+                                           Case{BenchmarkMesh::Sliced, 3, Method::BZ, 1},
+                                           Case{BenchmarkMesh::Hex, 4, Method::IP, 1, true},
+                                           Case{BenchmarkMesh::Hex, 4, Method::BZ, 2, true},
+                                           Case{BenchmarkMesh::Hex, 3, Method::IP, 3, true},
+                                           Case{BenchmarkMesh::Sliced, 4, Method::IP, 2, true},
+                                           Case{BenchmarkMesh::Sliced, 4, Method::BZ, 1, true}));
 
 TEST(PMultigrid, AgglomeratesNeedFewerIterationsThanConstantsOnTheBentCube) {
   // B2: clamped on one side and bent by gravity. The error's smooth part is mostly rotation,
@@ -87,8 +86,8 @@ TEST(PMultigrid, AgglomeratesNeedFewerIterationsThanConstantsOnTheBentCube) {
     int iterations[2] = {0, 0};
     for (int agglomerate = 0; agglomerate < 2; ++agglomerate) {
       LinearSolver solver(cg);
-      ASSERT_TRUE(solver.compute(s.system.matrix, s.system.blockSize,
-                                 agglomerate ? &s.frames : nullptr));
+      ASSERT_TRUE(
+          solver.compute(s.system.matrix, s.system.blockSize, agglomerate ? &s.frames : nullptr));
       SolveReport report;
       solver.solve(s.system.rhs, report);
       EXPECT_TRUE(report.success);
@@ -108,8 +107,8 @@ TEST(PMultigrid, AgglomeratesOfTwoSeparateBodies) {
   SolverOptions direct;
   direct.kind = SolverKind::Cholesky;
   SolveReport directReport;
-  const Eigen::VectorXd reference = solveLinearSystem(s.system.matrix, s.system.rhs,
-                                                      s.system.blockSize, direct, directReport);
+  const Eigen::VectorXd reference =
+      solveLinearSystem(s.system.matrix, s.system.rhs, s.system.blockSize, direct, directReport);
   ASSERT_TRUE(directReport.success);
   PMultigrid mg;
   ASSERT_TRUE(mg.compute(s.system.matrix, 2, nullptr, &s.frames));
@@ -146,8 +145,8 @@ TEST_P(VCycle, IsSymmetricPositiveDefinite) {
   // groups of groups (factorized), the middle level smoothed by its own colouring.
   const bool agglomerate = GetParam();
   const int degree = agglomerate ? 1 : 2;
-  const FramedSystem framed =
-      b1FramedSystem(benchmarkB1Mesh(BenchmarkMesh::Sliced, agglomerate ? 8 : 3), Method::IP, degree);
+  const FramedSystem framed = b1FramedSystem(
+      benchmarkB1Mesh(BenchmarkMesh::Sliced, agglomerate ? 8 : 3), Method::IP, degree);
   const LinearSystem& system = framed.system;
   PMultigrid mg;
   ASSERT_TRUE(mg.compute(system.matrix, degree, nullptr, agglomerate ? &framed.frames : nullptr));

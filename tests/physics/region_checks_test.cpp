@@ -16,8 +16,8 @@
 #include "polydg/mesh/primitives.h"
 #include "polydg/mesh/slice.h"
 #include "polydg/mesh/surface_shapes.h"
-#include "tests/support/shapes.h"
 #include "polydg/mesh/validate.h"
+#include "tests/support/shapes.h"
 
 namespace polydg {
 namespace {
@@ -101,7 +101,9 @@ void expectPasses(const PolyMesh& mesh, const Region& region, const std::string&
 PolyMesh grid4() { return hexGridMesh(4, 4, 4, Box3(Vec3::Zero(), Vec3::Ones())); }
 
 /// Grid element (i, j, k) of an n^3 grid (hexGridMesh numbers x fastest).
-std::size_t cell(int n, int i, int j, int k) { return static_cast<std::size_t>(i + n * (j + n * k)); }
+std::size_t cell(int n, int i, int j, int k) {
+  return static_cast<std::size_t>(i + n * (j + n * k));
+}
 
 TEST(RegionChecks, HexGridRegionsOfOneFewAndManyElements) {
   const PolyMesh mesh = grid4();
@@ -128,7 +130,8 @@ TEST(RegionChecks, DisconnectedRegionsCountTheirComponents) {
   for (int i = 0; i < 4; ++i)
     for (int j = 0; j < 4; ++j) layers[cell(4, i, j, 0)] = layers[cell(4, i, j, 2)] = 1;
   // Elements touching only along an edge are not connected: a checkerboard of 4 in one layer.
-  const Region diagonal = only(mesh, {cell(4, 0, 0, 1), cell(4, 1, 1, 1), cell(4, 2, 2, 1), cell(4, 3, 3, 1)});
+  const Region diagonal =
+      only(mesh, {cell(4, 0, 0, 1), cell(4, 1, 1, 1), cell(4, 2, 2, 1), cell(4, 3, 3, 1)});
   ASSERT_EQ(regionComponents(mesh, two), 2u);
   ASSERT_EQ(regionComponents(mesh, layers), 2u);
   ASSERT_EQ(regionComponents(mesh, diagonal), 4u);

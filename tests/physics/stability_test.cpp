@@ -6,8 +6,8 @@
 
 #include <gtest/gtest.h>
 
-#include <cmath>
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <vector>
 
@@ -74,8 +74,7 @@ TEST(ConditionEstimate, NotPositiveDefiniteWithoutBoundaryConditions) {
   const PolyMesh mesh = sliverMesh(1.0);
   StaticSolver solver(mesh, Material{}, options);
   solver.assemble(LoadCase{});  // free body: six rigid modes
-  const ConditionEstimate c =
-      conditionEstimate(solver.system().matrix, solver.system().blockSize);
+  const ConditionEstimate c = conditionEstimate(solver.system().matrix, solver.system().blockSize);
   std::printf("free body: positive definite %d, cond %.3e\n", c.positiveDefinite, c.cond);
   EXPECT_FALSE(c.positiveDefinite);
   EXPECT_TRUE(std::isinf(c.cond));
@@ -113,9 +112,9 @@ TEST(StabilityMeshes, ThinNeckIsOneValidElement) {
 
 TEST(StabilityMeshes, PartlyCoveredSideIsRefused) {
   // A unit box beside a half-height box: the first box's side x = 1 is half covered.
-  EXPECT_THROW(boxCellsMesh({Box3(Vec3::Zero(), Vec3::Ones()),
-                             Box3(Vec3(1, 0, 0), Vec3(2, 1, 0.5))}),
-               std::invalid_argument);
+  EXPECT_THROW(
+      boxCellsMesh({Box3(Vec3::Zero(), Vec3::Ones()), Box3(Vec3(1, 0, 0), Vec3(2, 1, 0.5))}),
+      std::invalid_argument);
 }
 
 TEST(Stability, RegularGridConditionIsFiniteAndAboveOne) {
@@ -138,9 +137,10 @@ TEST(Stability, MergedSliverStaysNearTheRegularGrid) {
     for (double r : {1e-1, 1e-4, 1e-8, 1e-12}) {
       const StabilityConditionRun merged = runSliverCase(r, true, p);
       const StabilityConditionRun raw = runSliverCase(r, false, p);
-      std::printf("sliver p=%d r=%.0e: cond merged %.4e, unmerged %.4e (Jacobi-scaled %.4e), "
-                  "regular %.4e\n", p, r, merged.estimate.cond, raw.estimate.cond,
-                  raw.jacobiEstimate.cond, regular);
+      std::printf(
+          "sliver p=%d r=%.0e: cond merged %.4e, unmerged %.4e (Jacobi-scaled %.4e), "
+          "regular %.4e\n",
+          p, r, merged.estimate.cond, raw.estimate.cond, raw.jacobiEstimate.cond, regular);
       EXPECT_LE(merged.estimate.cond, kMergedSliverFactor * regular) << "p " << p << " r " << r;
     }
   }
@@ -151,8 +151,8 @@ TEST(Stability, ThinNeckConditionStaysBounded) {
     const double first = runThinNeckCase(1e-1, p).estimate.cond;
     for (double eps : {1e-3, 1e-6, 1e-9}) {
       const StabilityConditionRun r = runThinNeckCase(eps, p);
-      std::printf("thin neck p=%d eps=%.0e: cond %.4e (eps 0.1: %.4e)\n", p, eps,
-                  r.estimate.cond, first);
+      std::printf("thin neck p=%d eps=%.0e: cond %.4e (eps 0.1: %.4e)\n", p, eps, r.estimate.cond,
+                  first);
       EXPECT_TRUE(r.estimate.positiveDefinite);
       EXPECT_LE(r.estimate.cond, kThinNeckFactor * first) << "p " << p << " eps " << eps;
     }
@@ -165,9 +165,10 @@ TEST(Stability, ScaledAndTranslatedB1KeepsItsRelativeError) {
     for (const Vec3& o : {Vec3(0, 0, 0), Vec3(1e6, -1e6, 1e6)}) {
       const ScaleRun r = runScaleCase(ScaleProblem::B1, s, o, 2, true);
       const double change = std::abs(r.value / base.value - 1.0);
-      std::printf("B1 scale %.0e offset %.0e: rel error %.10e (unscaled %.10e), change %.2e, "
-                  "coordinate resolution %.2e\n",
-                  s, o.x(), r.value, base.value, change, r.coordinateResolution);
+      std::printf(
+          "B1 scale %.0e offset %.0e: rel error %.10e (unscaled %.10e), change %.2e, "
+          "coordinate resolution %.2e\n",
+          s, o.x(), r.value, base.value, change, r.coordinateResolution);
       // Round-off: a few hundred ulps of the coordinates' relative resolution.
       EXPECT_LE(change, 1e3 * r.coordinateResolution + 1e-12);
     }

@@ -16,8 +16,8 @@
 #include "polydg/mesh/primitives.h"
 #include "polydg/mesh/slice.h"
 #include "polydg/mesh/surface_shapes.h"
-#include "tests/support/shapes.h"
 #include "polydg/mesh/validate.h"
+#include "tests/support/shapes.h"
 
 namespace polydg {
 namespace {
@@ -225,7 +225,8 @@ TEST(PhysicsValidation, LocalChecksFailOnAReversedFace) {
 
 TEST(PhysicsValidation, LocalChecksFailOnAnInvertedElement) {
   // A lone box with every face reversed: negative volume, a negative definite stiffness.
-  const PolyMesh mesh = withReversedFaces(boxMesh(Box3(Vec3::Zero(), Vec3(1, 2, 3))), ElementId(0), -1);
+  const PolyMesh mesh =
+      withReversedFaces(boxMesh(Box3(Vec3::Zero(), Vec3(1, 2, 3))), ElementId(0), -1);
   EXPECT_FALSE(validate(mesh).passed);
   const LocalDgCheck c = localChecks(mesh, 1);
   EXPECT_FALSE(c.passed());

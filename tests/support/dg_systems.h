@@ -39,8 +39,7 @@ inline LinearSystem b1System(const PolyMesh& mesh, Method method, int degree) {
 /// K, F and frames of B2 (the clamped cube under gravity: it bends, so rotations dominate
 /// the smooth part of the error).
 inline FramedSystem b2FramedSystem(Method method, int degree) {
-  return framedSystem(benchmarkB2Mesh(), benchmarkB2Material(), benchmarkB2Loads(), method,
-                      degree);
+  return framedSystem(benchmarkB2Mesh(), benchmarkB2Material(), benchmarkB2Loads(), method, degree);
 }
 
 }  // namespace polydg

@@ -64,17 +64,17 @@ struct OperationValidation {
   std::size_t regionElements = 0;   ///< DG region (touched elements plus one ring)
   double patchTestError = 0.0;      ///< relative, over the region (or the mesh, Full)
   std::size_t regionComponents = 0;
-  std::size_t zeroModes = 0;        ///< expected: 6 * regionComponents
-  double volumeRelError = 0.0;      ///< |V_before - V_removed - V_after| / V_before
-  std::string failure;              ///< first failed check, one line; empty when passed
+  std::size_t zeroModes = 0;    ///< expected: 6 * regionComponents
+  double volumeRelError = 0.0;  ///< |V_before - V_removed - V_after| / V_before
+  std::string failure;          ///< first failed check, one line; empty when passed
 };
 
 /// What one operation did.
 struct OperationReport {
-  std::string op;  ///< "cut", "cut_polygon" or "merge"
-  std::size_t elementsSplit = 0;   ///< elements the blade divided
-  std::size_t piecesCreated = 0;   ///< elements made from them (before sliver merging)
-  std::size_t elementsRemoved = 0; ///< pieces deleted by removeSide
+  std::string op;                   ///< "cut", "cut_polygon" or "merge"
+  std::size_t elementsSplit = 0;    ///< elements the blade divided
+  std::size_t piecesCreated = 0;    ///< elements made from them (before sliver merging)
+  std::size_t elementsRemoved = 0;  ///< pieces deleted by removeSide
   double volumeRemoved = 0.0;
   std::size_t slivers = 0, sliversMerged = 0, isolatedSlivers = 0;
   std::size_t facesReintegrated = 0;  ///< faces whose moments this operation computed

@@ -48,8 +48,8 @@ class ElementGrid {
 
   double cellSize_ = 1.0;
   std::unordered_map<std::uint64_t, std::vector<ElementId>> cells_;
-  std::vector<Box3> boxes_;   ///< by element id
-  std::vector<char> inGrid_;  ///< by element id
+  std::vector<Box3> boxes_;            ///< by element id
+  std::vector<char> inGrid_;           ///< by element id
   Cell lo_{0, 0, 0}, hi_{-1, -1, -1};  ///< occupied cell range (grows only)
 };
 

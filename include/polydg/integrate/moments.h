@@ -10,10 +10,10 @@
 //     int_F (x-c_F)^alpha dA = sum_edges 2 A_ab alpha!/(k+2)! [c^alpha] h_k(a.c, b.c),
 // where A_ab = (a x b).n_F / 2 is the signed area of the triangle (c_F, a, b), h_k(s, t) =
 // sum_{i+j=k} s^i t^j, and [c^alpha] takes the coefficient of c^alpha in that polynomial of c
-// (the simplex moment formula; a polynomial in the edge's endpoints). Faces with holes and non-convex faces need no special
-// treatment: the signed terms cancel outside the face. Moments of a face are taken about its
-// reference point c_F (its first vertex) and shifted, per element, to the element's local
-// origin by the binomial theorem. All orderings follow integrate/monomials.h.
+// (the simplex moment formula; a polynomial in the edge's endpoints). Faces with holes and
+// non-convex faces need no special treatment: the signed terms cancel outside the face. Moments of
+// a face are taken about its reference point c_F (its first vertex) and shifted, per element, to
+// the element's local origin by the binomial theorem. All orderings follow integrate/monomials.h.
 #pragma once
 
 #include <span>
@@ -38,10 +38,9 @@ void shiftMoments(int degree, const Vec3& d, std::span<const double> in, std::sp
 ///   out[alpha] += sign * h / (|alpha| + 3) * int_F (x - origin)^alpha dA,
 /// with h = normal . (faceRef - origin) and sign = -1 if the element uses the face reversed.
 /// `faceMoments` are about `faceRef`. `scratch` must hold numMonomials(degree) values.
-void accumulateElementMoments(int degree, std::span<const double> faceMoments,
-                              const Vec3& faceRef, const Vec3& normal, bool reversed,
-                              const Vec3& origin, std::span<double> scratch,
-                              std::span<double> out);
+void accumulateElementMoments(int degree, std::span<const double> faceMoments, const Vec3& faceRef,
+                              const Vec3& normal, bool reversed, const Vec3& origin,
+                              std::span<double> scratch, std::span<double> out);
 
 /// One-shot: element moments int_K (x - origin)^alpha dV, computing each face's moments.
 std::vector<double> elementMoments(const PolyMesh& mesh, ElementId e, int degree,

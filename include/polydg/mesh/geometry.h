@@ -54,7 +54,6 @@ double planarityDeviation(const PolyMesh& mesh, FaceId f);
 /// planarityDeviation() with the face's areaVector() computed by the caller.
 double planarityDeviation(const PolyMesh& mesh, FaceId f, const Vec3& areaVector);
 
-
 /// Bounding box of all vertices.
 Box3 meshBounds(const PolyMesh& mesh);
 

@@ -23,17 +23,16 @@ struct SliverMergeSummary {
 };
 
 struct SliverMergeReport {
-  double threshold = 0.0;      ///< absolute volume below which an element is a sliver
-  std::size_t slivers = 0;     ///< elements below the threshold before merging
-  std::size_t merged = 0;      ///< slivers merged into a neighbour
-  std::size_t isolated = 0;    ///< slivers with no neighbour at all, left as they are
+  double threshold = 0.0;            ///< absolute volume below which an element is a sliver
+  std::size_t slivers = 0;           ///< elements below the threshold before merging
+  std::size_t merged = 0;            ///< slivers merged into a neighbour
+  std::size_t isolated = 0;          ///< slivers with no neighbour at all, left as they are
   std::vector<std::uint32_t> group;  ///< new element of each old element
 };
 
 /// Merges every element with volume below `volumeThreshold` into the neighbour across the
 /// largest total shared face area, smallest first, until no sliver with a neighbour is left
 /// (a merged pair that is still below the threshold keeps merging). Deterministic.
-PolyMesh mergeSlivers(PolyMesh mesh, double volumeThreshold,
-                      SliverMergeReport* report = nullptr);
+PolyMesh mergeSlivers(PolyMesh mesh, double volumeThreshold, SliverMergeReport* report = nullptr);
 
 }  // namespace polydg

@@ -7,9 +7,9 @@
 #include <cstdint>
 #include <unordered_map>
 
-#include <boost/container/small_vector.hpp>
 #include <tbb/concurrent_hash_map.h>
 #include <tbb/concurrent_vector.h>
+#include <boost/container/small_vector.hpp>
 #include <vector>
 
 #include "polydg/mesh/poly_mesh.h"

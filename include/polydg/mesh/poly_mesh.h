@@ -8,9 +8,9 @@
 #include <unordered_map>
 #include <vector>
 
-#include <boost/container/small_vector.hpp>
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <boost/container/small_vector.hpp>
 
 #include "polydg/mesh/ids.h"
 
@@ -181,7 +181,6 @@ class PolyMesh {
   bool splitEdge(FaceId f, VertexId a, VertexId b, VertexId p);
 
  private:
-
   VertexData<Vec3> positions_;
   FaceData<Face> faces_;
   ElementData<Element> elements_;

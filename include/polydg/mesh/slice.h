@@ -18,9 +18,7 @@ struct Grid {
 
   /// Coordinate of the plane with index i (0..cells[axis]) along `axis`: centre + (i - n/2) h,
   /// so planes sit symmetrically about the centre (the middle plane, for even n, exactly on it).
-  double plane(int axis, int i) const {
-    return centre[axis] + (i - 0.5 * cells[axis]) * cellSize;
-  }
+  double plane(int axis, int i) const { return centre[axis] + (i - 0.5 * cells[axis]) * cellSize; }
   /// The grid's lowest corner.
   Vec3 origin() const { return Vec3(plane(0, 0), plane(1, 0), plane(2, 0)); }
   double cellVolume() const { return cellSize * cellSize * cellSize; }
@@ -32,14 +30,14 @@ struct Grid {
 };
 
 struct SliceStats {
-  std::size_t splits = 0;          ///< plane splits of a piece
-  std::size_t polygonsSplit = 0;   ///< polygons cut in two or more
-  std::size_t leafCells = 0;       ///< cells that hold part of the solid
-  std::size_t multiPieceCells = 0; ///< cells holding two or more disconnected pieces
+  std::size_t splits = 0;             ///< plane splits of a piece
+  std::size_t polygonsSplit = 0;      ///< polygons cut in two or more
+  std::size_t leafCells = 0;          ///< cells that hold part of the solid
+  std::size_t multiPieceCells = 0;    ///< cells holding two or more disconnected pieces
   std::size_t collapsedPolygons = 0;  ///< polygons removed when rounding made points equal
   std::size_t weldedPoints = 0;       ///< points within coordinate resolution of another
-  double secondsSplitting = 0.0;   ///< wall time of the recursive plane splits
-  double secondsBuilding = 0.0;    ///< wall time of welding and assembling the PolyMesh
+  double secondsSplitting = 0.0;      ///< wall time of the recursive plane splits
+  double secondsBuilding = 0.0;       ///< wall time of welding and assembling the PolyMesh
 };
 
 /// Progress callback: fraction done in [0, 1].

@@ -19,11 +19,11 @@ struct TriangleSurface {
 /// Edge-based facts about a surface.
 struct SurfaceTopology {
   std::size_t edges = 0;
-  std::size_t boundaryEdges = 0;      ///< used by one triangle
-  std::size_t nonManifoldEdges = 0;   ///< used by three or more triangles
-  std::size_t misorientedEdges = 0;   ///< used twice in the same direction
+  std::size_t boundaryEdges = 0;        ///< used by one triangle
+  std::size_t nonManifoldEdges = 0;     ///< used by three or more triangles
+  std::size_t misorientedEdges = 0;     ///< used twice in the same direction
   std::size_t degenerateTriangles = 0;  ///< two equal vertex indices or zero area
-  std::size_t components = 0;         ///< connected through shared edges
+  std::size_t components = 0;           ///< connected through shared edges
   /// Closed: every edge used by exactly two triangles in opposite directions.
   bool closed() const {
     return boundaryEdges == 0 && nonManifoldEdges == 0 && misorientedEdges == 0;

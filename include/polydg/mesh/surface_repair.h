@@ -11,9 +11,9 @@ namespace polydg {
 /// What is wrong with a surface, as counts.
 struct SurfaceDiagnosis {
   SurfaceTopology topology;
-  std::size_t selfIntersections = 0;  ///< pairs of triangles that intersect improperly
+  std::size_t selfIntersections = 0;      ///< pairs of triangles that intersect improperly
   bool checkedSelfIntersections = false;  ///< only possible on a manifold (orientable) soup
-  std::size_t shells = 0;             ///< connected components (see orientToBoundVolume)
+  std::size_t shells = 0;                 ///< connected components (see orientToBoundVolume)
 
   bool closed() const { return topology.closed() || misorientedOnly(); }
   bool manifold() const { return topology.nonManifoldEdges == 0; }
@@ -34,8 +34,7 @@ SurfaceDiagnosis diagnose(const TriangleSurface& surface);
 /// `cavities` (optional) receive the number of closed components and of those nested at odd
 /// depth (holes in the solid).
 TriangleSurface orientToBoundVolume(const TriangleSurface& surface, bool& changed,
-                                    std::size_t* shells = nullptr,
-                                    std::size_t* cavities = nullptr);
+                                    std::size_t* shells = nullptr, std::size_t* cavities = nullptr);
 
 /// Removes triangles with repeated vertices or zero area, welding their edges away (CGAL's
 /// remove_degenerate_faces on the soup made into a mesh). Returns how many were removed.

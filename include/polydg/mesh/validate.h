@@ -36,13 +36,13 @@ struct ValidationReport {
   std::size_t openElements = 0;         ///< a directed edge not matched by its reverse
   std::size_t nonPositiveElements = 0;  ///< volume <= 0 (inverted or flat)
   std::size_t nonPlanarFaces = 0;
-  std::size_t degenerateFaces = 0;      ///< a loop with < 3 vertices, a repeated vertex, or zero area
+  std::size_t degenerateFaces = 0;  ///< a loop with < 3 vertices, a repeated vertex, or zero area
   /// The same polygon as another face, not shared (except the two sides of a cut: boundary
   /// faces tagged Cut, one the other reversed).
   std::size_t duplicateFaces = 0;
-  std::size_t inconsistentFaces = 0;    ///< face/element links disagree, or unused face
-  std::size_t emptyElements = 0;        ///< an element without faces
-  std::vector<std::string> messages;    ///< the first few problems, one line each
+  std::size_t inconsistentFaces = 0;  ///< face/element links disagree, or unused face
+  std::size_t emptyElements = 0;      ///< an element without faces
+  std::vector<std::string> messages;  ///< the first few problems, one line each
 };
 
 /// Runs every check over the whole mesh.

@@ -52,7 +52,8 @@ struct Agglomeration {
 /// `centres` and `scales` are the blocks' frames; `linear` their T (ElementFrames::linear), or
 /// nullptr when the blocks' functions are the scaled monomials themselves (groups of a finer
 /// agglomeration).
-Agglomeration agglomerate(const BlockRows<double>& rows, const std::vector<Eigen::Vector3d>& centres,
+Agglomeration agglomerate(const BlockRows<double>& rows,
+                          const std::vector<Eigen::Vector3d>& centres,
                           const std::vector<double>& scales,
                           const std::vector<Eigen::Matrix4d>* linear);
 

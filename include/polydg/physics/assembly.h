@@ -91,7 +91,7 @@ struct LinearSystem {
 ///     of f's rows against e's columns is its transpose, never computed.
 struct LocalMatrices {
   int blockSize = 0;
-  int functions = 0;  ///< n, functions per component
+  int functions = 0;                       ///< n, functions per component
   bool componentDiagonalCoupling = false;  ///< BZ: coupling blocks couple equal components only
   /// Neighbours of each element through interior faces, sorted, the element itself included.
   std::vector<std::vector<std::uint32_t>> neighbours;
@@ -103,9 +103,8 @@ struct LocalMatrices {
 };
 
 /// The element and face matrices of `form` (both IP and BZ), in parallel over elements.
-LocalMatrices localMatrices(const PolyMesh& mesh, const DgBasis& basis,
-                            const MomentCache& moments, const FaceRoles& roles,
-                            const FormCoefficients& form);
+LocalMatrices localMatrices(const PolyMesh& mesh, const DgBasis& basis, const MomentCache& moments,
+                            const FaceRoles& roles, const FormCoefficients& form);
 
 /// K from the local matrices: both triangles, each column written once, in parallel over
 /// elements. With BZ, blocks between neighbours couple equal components only and are stored
@@ -113,18 +112,19 @@ LocalMatrices localMatrices(const PolyMesh& mesh, const DgBasis& basis,
 Eigen::SparseMatrix<double, Eigen::ColMajor, int> assembleStiffness(const LocalMatrices& local);
 
 /// K of `form`: localMatrices() then assembleStiffness().
-Eigen::SparseMatrix<double, Eigen::ColMajor, int> assembleStiffness(
-    const PolyMesh& mesh, const DgBasis& basis, const MomentCache& moments,
-    const FaceRoles& roles, const FormCoefficients& form);
+Eigen::SparseMatrix<double, Eigen::ColMajor, int> assembleStiffness(const PolyMesh& mesh,
+                                                                    const DgBasis& basis,
+                                                                    const MomentCache& moments,
+                                                                    const FaceRoles& roles,
+                                                                    const FormCoefficients& form);
 
 /// F: body forces (density * gravity exactly, `bodyForce` by element quadrature of degree
 /// `quadratureDegree`), tractions, and the Dirichlet terms of `form`:
 ///   int_F mu eta_F g.v - (sigma(v) n).g + lambda c_K (R g.n, R v.n)      (IP)
 ///   int_F mu eta_F g.v                                                   (BZ)
 /// with g integrated by face quadrature of degree `quadratureDegree`.
-Eigen::VectorXd assembleLoad(const PolyMesh& mesh, const DgBasis& basis,
-                             const MomentCache& moments, const FaceRoles& roles,
-                             const FormCoefficients& form, const Material& material,
-                             const LoadCase& loads, int quadratureDegree);
+Eigen::VectorXd assembleLoad(const PolyMesh& mesh, const DgBasis& basis, const MomentCache& moments,
+                             const FaceRoles& roles, const FormCoefficients& form,
+                             const Material& material, const LoadCase& loads, int quadratureDegree);
 
 }  // namespace polydg

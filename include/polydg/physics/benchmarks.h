@@ -7,8 +7,8 @@
 
 #include "polydg/mesh/meshing_benchmark.h"
 #include "polydg/physics/post_process.h"
-#include "polydg/physics/validation.h"
 #include "polydg/physics/static_solver.h"
+#include "polydg/physics/validation.h"
 
 namespace polydg {
 
@@ -46,12 +46,12 @@ struct BenchmarkRun {
   Method method = Method::IP;
   int degree = 1;
   BenchmarkMesh mesh = BenchmarkMesh::Hex;
-  int n = 0;                 ///< grid cells per unit length
+  int n = 0;  ///< grid cells per unit length
   StaticReport report;
-  double l2Error = 0.0;  ///< B1 only
-  double h1Error = 0.0;  ///< B1 only (broken H1 seminorm)
-  double l2Norm = 0.0;   ///< B1 only: L2 norm of the exact solution
-  double sparsity = 0.0; ///< nonzeros / dofs^2
+  double l2Error = 0.0;   ///< B1 only
+  double h1Error = 0.0;   ///< B1 only (broken H1 seminorm)
+  double l2Norm = 0.0;    ///< B1 only: L2 norm of the exact solution
+  double sparsity = 0.0;  ///< nonzeros / dofs^2
 };
 
 /// Quadrature degree of the B1 error norms: max(p + 4, 2p + 2).

@@ -11,10 +11,10 @@
 #include <utility>
 #include <vector>
 
-#include <Eigen/Core>
-#include <Eigen/SparseCore>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
 
 namespace polydg {
 

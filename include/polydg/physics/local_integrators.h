@@ -52,10 +52,10 @@ struct FaceView {
   FaceId face;
   FaceKind kind = FaceKind::Interior;
   ElementId self;
-  ElementId other;               ///< Interior only
-  bool selfIsFront = true;       ///< the face's own normal points out of `self`
-  int selfCoupledFaces = 0;      ///< faces of `self` with face terms (Interior or Dirichlet)
-  int otherCoupledFaces = 0;     ///< the same for `other`
+  ElementId other;            ///< Interior only
+  bool selfIsFront = true;    ///< the face's own normal points out of `self`
+  int selfCoupledFaces = 0;   ///< faces of `self` with face terms (Interior or Dirichlet)
+  int otherCoupledFaces = 0;  ///< the same for `other`
 };
 
 /// Element stiffness K_K = int_K B^T C B = int_K sigma(u) : eps(v), paper eq. (10), with

@@ -71,8 +71,8 @@ decltype(auto) dispatchBasisDegree(int degree, F&& f) {
     case 2: return f(std::integral_constant<int, 2>{});
     case 3: return f(std::integral_constant<int, 3>{});
     default:
-      throw std::invalid_argument("basis degree " + std::to_string(degree) +
-                                  " is outside 1.." + std::to_string(kMaxBasisDegree));
+      throw std::invalid_argument("basis degree " + std::to_string(degree) + " is outside 1.." +
+                                  std::to_string(kMaxBasisDegree));
   }
 }
 static_assert(kMaxBasisDegree == 3, "dispatchBasisDegree lists every degree up to the maximum");

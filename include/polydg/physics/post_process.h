@@ -1,6 +1,6 @@
 // Quantities derived from a DG solution: point values and gradients, the corner values that
-// eq. (17) averages at the vertices, per-element mean displacement, von Mises stress and largest jump,
-// and error norms against a known solution.
+// eq. (17) averages at the vertices, per-element mean displacement, von Mises stress and largest
+// jump, and error norms against a known solution.
 #pragma once
 
 #include <functional>
@@ -52,18 +52,17 @@ struct ElementFields {
 };
 
 /// Per-element fields of a solution (moments up to degree p, e.g. the solve's cache).
-ElementFields elementFields(const PolyMesh& mesh, const DgBasis& basis,
-                            const MomentCache& moments, const Eigen::VectorXd& coefficients,
-                            const Material& material);
+ElementFields elementFields(const PolyMesh& mesh, const DgBasis& basis, const MomentCache& moments,
+                            const Eigen::VectorXd& coefficients, const Material& material);
 
 /// Gradient of a vector field: G(d, k) = d u_d / d x_k.
 using GradientField = std::function<Eigen::Matrix3d(const Vec3&)>;
 
 struct ErrorNorms {
-  double l2 = 0.0;         ///< |u - u_h|_L2
-  double h1 = 0.0;         ///< broken H1 seminorm: sqrt(sum_K |grad(u - u_h)|^2_L2(K))
-  double l2Exact = 0.0;    ///< |u|_L2
-  double h1Exact = 0.0;    ///< |grad u|_L2
+  double l2 = 0.0;       ///< |u - u_h|_L2
+  double h1 = 0.0;       ///< broken H1 seminorm: sqrt(sum_K |grad(u - u_h)|^2_L2(K))
+  double l2Exact = 0.0;  ///< |u|_L2
+  double h1Exact = 0.0;  ///< |grad u|_L2
 };
 
 /// Errors against (u, grad u) by element quadrature (integrate/quadrature.h) exact to
@@ -75,9 +74,7 @@ ErrorNorms errorNorms(const PolyMesh& mesh, const DgBasis& basis,
 
 /// Coefficients of the element-wise L2 projection of `field` onto the basis (quadrature of
 /// degree `quadratureDegree`; exact for polynomial fields of degree <= quadratureDegree - p).
-Eigen::VectorXd projectField(const PolyMesh& mesh, const DgBasis& basis,
-                             const MomentCache& moments,
-                             const std::function<Vec3(const Vec3&)>& field,
-                             int quadratureDegree);
+Eigen::VectorXd projectField(const PolyMesh& mesh, const DgBasis& basis, const MomentCache& moments,
+                             const std::function<Vec3(const Vec3&)>& field, int quadratureDegree);
 
 }  // namespace polydg

@@ -67,7 +67,6 @@ struct RegionDgCheck {
 /// inconsistently (a face side used twice).
 /// `moments` must be up to date and hold degree 2p moments.
 RegionDgCheck regionDgChecks(const PolyMesh& mesh, const MomentCache& moments,
-                             std::span<const char> region,
-                             const LocalDgCheckOptions& options = {});
+                             std::span<const char> region, const LocalDgCheckOptions& options = {});
 
 }  // namespace polydg

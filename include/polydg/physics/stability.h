@@ -64,7 +64,7 @@ inline constexpr double kStabilitySliverTau = 0.01;
 struct StabilityConditionRun {
   int degree = 1;
   std::size_t elements = 0, dofs = 0;
-  double eta = 0.0;  ///< the penalty used (PenaltyRule::TraceBound)
+  double eta = 0.0;                  ///< the penalty used (PenaltyRule::TraceBound)
   ConditionEstimate estimate;        ///< of K
   ConditionEstimate jacobiEstimate;  ///< of jacobiScaled(K)
 };

@@ -51,19 +51,20 @@ struct StaticOptions {
 struct StaticReport {
   std::size_t elements = 0;
   std::size_t dofs = 0;
-  std::size_t nonzeros = 0;    ///< stored entries of K (both triangles)
-  double eta = 0.0;            ///< the global penalty used (local: the largest eta_K)
-  double etaThreshold = 0.0;   ///< penaltyThreshold() (the IP coercivity bound)
-  int penaltyAttempts = 1;     ///< factorizations tried by PenaltyRule::Doubling
+  std::size_t nonzeros = 0;   ///< stored entries of K (both triangles)
+  double eta = 0.0;           ///< the global penalty used (local: the largest eta_K)
+  double etaThreshold = 0.0;  ///< penaltyThreshold() (the IP coercivity bound)
+  int penaltyAttempts = 1;    ///< factorizations tried by PenaltyRule::Doubling
   std::size_t dirichletFaces = 0, tractionFaces = 0;
   std::size_t basisFallbacks = 0;  ///< DgBasis::fallbackElements()
   /// The thesis's phases (Kaufmann 2013, Table 4.1). Integration: moments, bases, face roles,
   /// penalty bounds, and the element and face matrices (localMatrices()).
   double integrateSeconds = 0.0;
-  double assembleSeconds = 0.0;    ///< accumulating K from them, and the load vector F
-  double solveSeconds = 0.0;       ///< factorization (or preconditioner) and solve
+  double assembleSeconds = 0.0;  ///< accumulating K from them, and the load vector F
+  double solveSeconds = 0.0;     ///< factorization (or preconditioner) and solve
   SolveReport solver;
-  double energy = 0.0;  ///< U.F / 2: the strain energy U.K.U / 2 when prescribed displacements are 0
+  double energy =
+      0.0;  ///< U.F / 2: the strain energy U.K.U / 2 when prescribed displacements are 0
 };
 
 /// A solved problem: the bases and the DG coefficients (see LinearSystem for the layout).
@@ -123,7 +124,7 @@ class StaticSolver {
 };
 
 /// One-shot: integrate, assemble and solve.
-StaticSolution solveStatic(const PolyMesh& mesh, const Material& material,
-                           const LoadCase& loads, const StaticOptions& options = {});
+StaticSolution solveStatic(const PolyMesh& mesh, const Material& material, const LoadCase& loads,
+                           const StaticOptions& options = {});
 
 }  // namespace polydg

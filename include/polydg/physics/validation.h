@@ -29,7 +29,7 @@ struct PatchTestResult {
   double relativeError = 0.0;    ///< |u_h - u|_L2 / |u|_L2 over the mesh
   double maxElementError = 0.0;  ///< max over elements of |u_h - u|_L2(K) / |u|_L2(K)
   double eta = 0.0;
-  double residual = 0.0;         ///< of the linear solve
+  double residual = 0.0;  ///< of the linear solve
 };
 
 /// The patch test: u(x) = L b + A (x - x0) (a fixed general matrix A with |A| ~ 1, x0 and L
@@ -41,11 +41,11 @@ struct PatchTestResult {
 PatchTestResult patchTest(const PolyMesh& mesh, const PhysicsCheckOptions& options);
 
 struct ZeroModeReport {
-  std::size_t components = 0;                       ///< connected through shared faces
-  std::vector<std::size_t> zeroModesPerComponent;   ///< eigenvalues below kZeroModeThreshold
-  std::size_t zeroModes = 0;                        ///< their sum
-  double largestZeroEigenvalue = 0.0;     ///< largest of those (Jacobi-scaled)
-  double smallestNonzeroEigenvalue = 0.0; ///< smallest eigenvalue above the threshold found
+  std::size_t components = 0;                      ///< connected through shared faces
+  std::vector<std::size_t> zeroModesPerComponent;  ///< eigenvalues below kZeroModeThreshold
+  std::size_t zeroModes = 0;                       ///< their sum
+  double largestZeroEigenvalue = 0.0;              ///< largest of those (Jacobi-scaled)
+  double smallestNonzeroEigenvalue = 0.0;  ///< smallest eigenvalue above the threshold found
   /// max over the 6 rigid motions r of each component of |S r| / |r|, S the scaled matrix.
   double rigidMotionResidual = 0.0;
 };
@@ -63,9 +63,9 @@ ZeroModeReport zeroModes(const PolyMesh& mesh, const DgBasis& basis, const Momen
 ZeroModeReport rigidModes(const PolyMesh& mesh, const PhysicsCheckOptions& options);
 
 struct DefinitenessReport {
-  double asymmetry = 0.0;         ///< max |K_ij - K_ji| / max |K_ij|
-  bool choleskySucceeded = false; ///< CHOLMOD's LL^T factorization
-  ZeroModeReport modes;           ///< with the Dirichlet conditions: 0 zero modes expected
+  double asymmetry = 0.0;          ///< max |K_ij - K_ji| / max |K_ij|
+  bool choleskySucceeded = false;  ///< CHOLMOD's LL^T factorization
+  ZeroModeReport modes;            ///< with the Dirichlet conditions: 0 zero modes expected
 };
 
 /// The stiffness matrix with u = 0 weakly on every boundary face: symmetric positive definite.
@@ -111,10 +111,10 @@ struct LocalDgCheck {
   /// Max over elements of the local patch-test error (see localDgChecks()); +inf when a local
   /// solve produced a non-finite value.
   double maxPatchTestError = 0.0;
-  ElementId worstPatchTestElement;                ///< where the maximum is (invalid if none)
-  std::size_t patchTestFailures = 0;              ///< elements above kLocalPatchTestTolerance
-  std::size_t elementsWithWrongRigidModes = 0;    ///< stiffness without exactly 6 zero modes
-  ElementId firstWrongRigidModeElement;           ///< lowest such id (invalid if none)
+  ElementId worstPatchTestElement;              ///< where the maximum is (invalid if none)
+  std::size_t patchTestFailures = 0;            ///< elements above kLocalPatchTestTolerance
+  std::size_t elementsWithWrongRigidModes = 0;  ///< stiffness without exactly 6 zero modes
+  ElementId firstWrongRigidModeElement;         ///< lowest such id (invalid if none)
   /// Elements whose local IP matrix was not positive definite (a pivot of its LDL^T was not
   /// positive; the error is then computed with a full-pivoting LU solve). The local penalty
   /// makes it SPD on every valid element.
