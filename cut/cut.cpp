@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <array>
-#include <chrono>
 #include <cmath>
 #include <map>
 #include <numeric>
@@ -19,6 +18,8 @@
 #include "polydg/mesh/plane_split.h"
 #include "polydg/mesh/validate.h"
 #include "polydg/physics/region_checks.h"
+#include "polydg/util/stopwatch.h"
+#include "polydg/util/union_find.h"
 
 namespace polydg {
 
@@ -708,18 +709,14 @@ class Splitter {
 
   /// Connected components of a side's parts, joined across shared edges (mesh vertex ids).
   std::vector<std::vector<std::size_t>> components(const std::vector<Part>& parts) {
-    std::vector<std::size_t> parent(parts.size());
-    std::iota(parent.begin(), parent.end(), 0);
-    auto find = [&](std::size_t i) {
-      while (parent[i] != i) i = parent[i] = parent[parent[i]];
-      return i;
-    };
+    UnionFind sets(parts.size());
     std::unordered_map<std::uint64_t, std::size_t> firstUse;
     auto addEdge = [&](std::size_t p, VertexId a, VertexId b) {
       const std::uint64_t key =
           std::uint64_t(std::min(a.value, b.value)) << 32 | std::max(a.value, b.value);
       const auto [it, inserted] = firstUse.try_emplace(key, p);
-      if (!inserted) parent[find(p)] = find(it->second);
+      if (!inserted)
+        sets.unite(static_cast<std::uint32_t>(p), static_cast<std::uint32_t>(it->second));
     };
     for (std::size_t p = 0; p < parts.size(); ++p) {
       if (parts[p].kind == Part::Kind::Whole) {
@@ -743,7 +740,8 @@ class Splitter {
     std::vector<std::vector<std::size_t>> out;
     std::unordered_map<std::size_t, std::size_t> index;
     for (std::size_t p = 0; p < parts.size(); ++p) {
-      const auto [it, inserted] = index.try_emplace(find(p), out.size());
+      const auto [it, inserted] =
+          index.try_emplace(sets.find(static_cast<std::uint32_t>(p)), out.size());
       if (inserted) out.emplace_back();
       out[it->second].push_back(p);
     }
@@ -982,7 +980,7 @@ void checkOptions(const CutOptions& options) {
 OperationReport MeshEditor::cut(const Blade& blade, const CutOptions& options) {
   checkOptions(options);
   if (!state_) throw std::logic_error("MeshEditor: used after release()");
-  const auto start = std::chrono::steady_clock::now();
+  const Stopwatch start;
   try {
     return cutInPlace(blade, options);
   } catch (const std::exception& e) {
@@ -993,14 +991,13 @@ OperationReport MeshEditor::cut(const Blade& blade, const CutOptions& options) {
     report.validation.level = options.validation;
     report.validation.passed = false;
     report.validation.failure = std::string("split: ") + e.what();
-    report.seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    report.seconds = start.seconds();
     return report;
   }
 }
 
 OperationReport MeshEditor::cutInPlace(const Blade& blade, const CutOptions& options) {
-  const auto start = std::chrono::steady_clock::now();
+  const Stopwatch start;
   State& s = *state_;
   OperationReport report;
   report.op = blade.finite() ? "cut_polygon" : "cut";
@@ -1199,7 +1196,7 @@ OperationReport MeshEditor::cutInPlace(const Blade& blade, const CutOptions& opt
     if (v.passed) v.failure = msg.str();
     v.passed = false;
   }
-  report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  report.seconds = start.seconds();
   return report;
 }
 
@@ -1210,7 +1207,7 @@ OperationReport MeshEditor::mergeSlivers(double fraction, ValidationLevel valida
   options.validationDegree = validationDegree;
   checkOptions(options);
   if (!state_) throw std::logic_error("MeshEditor: used after release()");
-  const auto start = std::chrono::steady_clock::now();
+  const Stopwatch start;
   State& s = *state_;
   OperationReport report;
   report.op = "merge";
@@ -1243,7 +1240,7 @@ OperationReport MeshEditor::mergeSlivers(double fraction, ValidationLevel valida
           "volume balance: relative error " + std::to_string(report.validation.volumeRelError);
     report.validation.passed = false;
   }
-  report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  report.seconds = start.seconds();
   return report;
 }
 

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "polydg/mesh/geometry.h"
+#include "polydg/util/union_find.h"
 
 #include <tbb/parallel_for.h>
 
@@ -80,12 +81,7 @@ PolyMesh mergeSlivers(PolyMesh mesh, double volumeThreshold, SliverMergeReport* 
       });
   auto faceArea = [&](std::size_t f) { return area[f].norm(); };
 
-  std::vector<std::size_t> parent(n);
-  std::iota(parent.begin(), parent.end(), 0);
-  auto find = [&](std::size_t i) {
-    while (parent[i] != i) i = parent[i] = parent[parent[i]];
-    return i;
-  };
+  UnionFind groups(n);
   // Members of each group that took in another (a group never merged is its element alone).
   std::vector<std::vector<std::size_t>> members(n);
 
@@ -105,7 +101,7 @@ PolyMesh mergeSlivers(PolyMesh mesh, double volumeThreshold, SliverMergeReport* 
   };
 
   for (std::size_t e : order) {
-    std::size_t g = find(e);
+    std::size_t g = groups.find(static_cast<std::uint32_t>(e));
     while (volume[g] < volumeThreshold) {
       // Shared area with each neighbouring group.
       std::map<std::size_t, double> shared;
@@ -113,7 +109,7 @@ PolyMesh mergeSlivers(PolyMesh mesh, double volumeThreshold, SliverMergeReport* 
         for (const FaceUse& use : mesh.element(ElementId(m)).faces) {
           const Face& face = mesh.face(use.face);
           if (!face.front.valid() || !face.back.valid()) continue;
-          const std::size_t other = find((use.reversed ? face.front : face.back).index());
+          const std::size_t other = groups.find((use.reversed ? face.front : face.back).value);
           if (other != g) shared[other] += faceArea(use.face.index());
         }
       if (shared.empty()) {
@@ -123,7 +119,7 @@ PolyMesh mergeSlivers(PolyMesh mesh, double volumeThreshold, SliverMergeReport* 
       const auto best = std::max_element(shared.begin(), shared.end(),
                                          [](auto& a, auto& b) { return a.second < b.second; });
       const std::size_t target = best->first;
-      parent[g] = target;
+      groups.unite(static_cast<std::uint32_t>(g), static_cast<std::uint32_t>(target));
       volume[target] += volume[g];
       std::vector<std::size_t>& into = membersOf(target);
       const std::vector<std::size_t>& from = membersOf(g);
@@ -134,15 +130,8 @@ PolyMesh mergeSlivers(PolyMesh mesh, double volumeThreshold, SliverMergeReport* 
     }
   }
   // Number the groups in order of their first element.
-  std::vector<std::uint32_t> label(n, 0xffffffffu);
-  r.group.assign(n, 0);
-  std::uint32_t groups = 0;
-  for (std::size_t e = 0; e < n; ++e) {
-    const std::size_t root = find(e);
-    if (label[root] == 0xffffffffu) label[root] = groups++;
-    r.group[e] = label[root];
-  }
-  PolyMesh out = groups == n ? std::move(mesh) : mergeElements(mesh, r.group, groups);
+  const std::size_t count = groups.labels(r.group);
+  PolyMesh out = count == n ? std::move(mesh) : mergeElements(mesh, r.group, count);
   if (report) *report = std::move(r);
   return out;
 }

@@ -4,12 +4,12 @@
 #include <tbb/parallel_reduce.h>
 #include <tbb/task_group.h>
 
-#include <chrono>
 #include <cmath>
 #include <exception>
 #include <sstream>
 
 #include "polydg/mesh/surface_repair.h"
+#include "polydg/util/stopwatch.h"
 
 namespace polydg {
 
@@ -19,14 +19,13 @@ class PhaseTimer {
  public:
   explicit PhaseTimer(std::vector<std::pair<std::string, double>>& timings) : timings_(timings) {}
   void done(const std::string& phase) {
-    const auto now = std::chrono::steady_clock::now();
-    timings_.emplace_back(phase, std::chrono::duration<double>(now - start_).count());
-    start_ = now;
+    timings_.emplace_back(phase, phase_.seconds());
+    phase_.restart();
   }
 
  private:
   std::vector<std::pair<std::string, double>>& timings_;
-  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+  Stopwatch phase_;
 };
 
 /// "open (12 boundary edges), self-intersecting (40 triangle pairs)".
@@ -142,9 +141,9 @@ std::optional<MeshingResult> meshWhileDiagnosing(const TriangleSurface& input,
   double checkSeconds = 0.0;
   tbb::task_group diagnosis;
   diagnosis.run([&] {
-    const auto start = std::chrono::steady_clock::now();
+    const Stopwatch start;
     d = diagnose(input);
-    checkSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    checkSeconds = start.seconds();
   });
   std::exception_ptr failure;  // of the slicing; it matters only if the surface is sound
   try {
@@ -164,10 +163,9 @@ std::optional<MeshingResult> meshWhileDiagnosing(const TriangleSurface& input,
 }  // namespace
 
 MeshingResult meshSurface(const TriangleSurface& input, const MeshingOptions& options) {
-  const auto start = std::chrono::steady_clock::now();
+  const Stopwatch start;
   auto finish = [&](MeshingResult& result) {
-    result.report.seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    result.report.seconds = start.seconds();
     if (options.validate) validateMeshing(result);
   };
   if (input.triangles.empty()) throw InputError("the surface has no triangles");
@@ -247,7 +245,7 @@ MeshingResult meshSurface(const TriangleSurface& input, const MeshingOptions& op
 }
 
 void validateMeshing(MeshingResult& result) {
-  const auto start = std::chrono::steady_clock::now();
+  const Stopwatch start;
   MeshingReport& r = result.report;
   const PolyMesh& mesh = result.mesh;
   r.validation = validate(mesh);
@@ -275,8 +273,7 @@ void validateMeshing(MeshingResult& result) {
   r.hexahedra = counts.first;
   r.nonconvex = counts.second;
   r.polyhedra = r.elements - r.hexahedra;
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double seconds = start.seconds();
   r.timings.emplace_back("validate", seconds);
   r.seconds += seconds;
 }

@@ -9,6 +9,8 @@
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Exact_rational.h>
 
+#include "polydg/util/union_find.h"
+
 namespace polydg {
 
 namespace {
@@ -528,12 +530,7 @@ PieceSplit PlaneSplitter::split(Piece piece, const SplitPlane& plane, FaceOrigin
 
 std::vector<Piece> PlaneSplitter::components(Piece piece) {
   const std::size_t n = piece.size();
-  std::vector<std::uint32_t> parent(n);
-  std::iota(parent.begin(), parent.end(), 0u);
-  auto find = [&](std::uint32_t i) {
-    while (parent[i] != i) i = parent[i] = parent[parent[i]];
-    return i;
-  };
+  UnionFind sets(n);
   // Every edge with the polygon that uses it, sorted by edge: polygons on a run of equal edges
   // are joined. Most pieces are a few dozen polygons, so the list lives on the stack.
   boost::container::small_vector<std::pair<std::uint64_t, std::uint32_t>, 64> uses;
@@ -551,11 +548,11 @@ std::vector<Piece> PlaneSplitter::components(Piece piece) {
   }
   std::sort(uses.begin(), uses.end());
   for (std::size_t i = 1; i < uses.size(); ++i)
-    if (uses[i].first == uses[i - 1].first) parent[find(uses[i].second)] = find(uses[i - 1].second);
+    if (uses[i].first == uses[i - 1].first) sets.unite(uses[i].second, uses[i - 1].second);
   // Components in order of their first polygon, polygons in their order within the piece.
-  const std::uint32_t firstRoot = n ? find(0) : 0;
+  const std::uint32_t firstRoot = n ? sets.find(0) : 0;
   bool connected = true;
-  for (std::uint32_t p = 1; p < n && connected; ++p) connected = find(p) == firstRoot;
+  for (std::uint32_t p = 1; p < n && connected; ++p) connected = sets.find(p) == firstRoot;
   if (connected) {
     std::vector<Piece> one;
     if (n) one.push_back(std::move(piece));
@@ -567,7 +564,7 @@ std::vector<Piece> PlaneSplitter::components(Piece piece) {
   std::vector<std::uint32_t> index(n, kUnset);
   std::vector<Piece> out;
   for (std::size_t p = 0; p < n; ++p) {
-    std::uint32_t& slot = index[find(static_cast<std::uint32_t>(p))];
+    std::uint32_t& slot = index[sets.find(static_cast<std::uint32_t>(p))];
     if (slot == kUnset) {
       slot = static_cast<std::uint32_t>(out.size());
       out.emplace_back();

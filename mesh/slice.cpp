@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <chrono>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -13,6 +12,7 @@
 #include <tuple>
 
 #include "polydg/mesh/plane_split.h"
+#include "polydg/util/stopwatch.h"
 
 #include <tbb/concurrent_vector.h>
 #include <tbb/enumerable_thread_specific.h>
@@ -564,16 +564,15 @@ PolyMesh sliceSurface(const TriangleSurface& surface, const Grid& grid, SliceSta
     p.origin = FaceOrigin::Surface;
     solid.push_back(std::move(p));
   }
-  const auto start = std::chrono::steady_clock::now();
+  Stopwatch phase;
   Slicer slicer(grid, surface.vertices, progress);
   slicer.reserve(expectedPoints(surface, grid));
   slicer.run(std::move(solid));
-  const auto split = std::chrono::steady_clock::now();
+  slicer.stats.secondsSplitting = phase.seconds();
+  phase.restart();
   if (elementCell) elementCell->clear();
   PolyMesh mesh = slicer.build(elementCell);
-  slicer.stats.secondsSplitting = std::chrono::duration<double>(split - start).count();
-  slicer.stats.secondsBuilding =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - split).count();
+  slicer.stats.secondsBuilding = phase.seconds();
   if (stats) *stats = slicer.stats;
   return mesh;
 }

@@ -1,24 +1,12 @@
 #include "polydg/mesh/surface.h"
 
+#include "polydg/util/union_find.h"
+
 #include <algorithm>
 #include <map>
 #include <numeric>
 
 namespace polydg {
-
-namespace {
-
-struct UnionFind {
-  explicit UnionFind(std::size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
-  std::size_t find(std::size_t i) {
-    while (parent[i] != i) i = parent[i] = parent[parent[i]];
-    return i;
-  }
-  void unite(std::size_t a, std::size_t b) { parent[find(a)] = find(b); }
-  std::vector<std::size_t> parent;
-};
-
-}  // namespace
 
 SurfaceTopology analyzeTopology(const TriangleSurface& surface) {
   SurfaceTopology topo;

@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "polydg/mesh/geometry.h"
+#include "polydg/util/union_find.h"
 
 namespace polydg {
 
@@ -188,26 +189,11 @@ ValidationReport validateElements(const PolyMesh& mesh, std::span<const ElementI
 }
 
 ElementData<std::uint32_t> connectedComponents(const PolyMesh& mesh, std::size_t& count) {
-  const std::size_t n = mesh.numElements();
-  std::vector<std::size_t> parent(n);
-  std::iota(parent.begin(), parent.end(), 0);
-  auto find = [&](std::size_t i) {
-    while (parent[i] != i) i = parent[i] = parent[parent[i]];
-    return i;
-  };
-  for (const Face& face : mesh.faces()) {
-    if (face.front.valid() && face.back.valid())
-      parent[find(face.front.index())] = find(face.back.index());
-  }
-  ElementData<std::uint32_t> component(n, 0);
-  std::vector<std::uint32_t> label(n, std::numeric_limits<std::uint32_t>::max());
-  count = 0;
-  for (std::size_t e = 0; e < n; ++e) {
-    const std::size_t root = find(e);
-    if (label[root] == std::numeric_limits<std::uint32_t>::max())
-      label[root] = static_cast<std::uint32_t>(count++);
-    component[ElementId(e)] = label[root];
-  }
+  UnionFind sets(mesh.numElements());
+  for (const Face& face : mesh.faces())
+    if (face.front.valid() && face.back.valid()) sets.unite(face.front.value, face.back.value);
+  ElementData<std::uint32_t> component;
+  count = sets.labels(component.raw());
   return component;
 }
 

@@ -1,6 +1,5 @@
 #include "polydg/physics/benchmarks.h"
 
-#include <chrono>
 #include <cmath>
 #include <numbers>
 
@@ -10,6 +9,7 @@
 #include "polydg/mesh/slice.h"
 #include "polydg/mesh/surface_shapes.h"
 #include "polydg/physics/face_quadrature.h"
+#include "polydg/util/stopwatch.h"
 
 namespace polydg {
 
@@ -200,12 +200,12 @@ MeshingCostRun runMeshingCostCase(const std::string& model, const TriangleSurfac
   run.meshing = meshingBenchmarkRun(model, surface, cells, result.report);
   for (const auto& [phase, seconds] : result.report.timings)
     if (phase == "validate") run.geometricValidationSeconds += seconds;
-  const auto t0 = std::chrono::steady_clock::now();
+  const Stopwatch t0;
   LocalDgCheckOptions checks;
   MomentCache moments(result.mesh, 2 * checks.basis.degree);
   moments.update();
   const LocalDgCheck check = localDgChecks(result.mesh, moments, checks);
-  run.dgCheckSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  run.dgCheckSeconds = t0.seconds();
   run.dgElements = check.elements;
   run.dgPassed = check.passed();
   return run;

@@ -1,6 +1,5 @@
 #include "polydg/physics/linear_solver.h"
 
-#include <chrono>
 #include <cmath>
 
 #include <tbb/parallel_for.h>
@@ -11,17 +10,13 @@
 #include "polydg/integrate/monomials.h"
 #include "polydg/physics/block_rows.h"
 #include "polydg/physics/p_multigrid.h"
+#include "polydg/util/stopwatch.h"
 
 namespace polydg {
 
 namespace {
 
 using SpMat = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
-using Clock = std::chrono::steady_clock;
-
-double secondsSince(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
 
 /// Quiet CHOLMOD: "not positive definite" is an expected outcome of a penalty search.
 template <class Solver>
@@ -223,7 +218,7 @@ bool LinearSolver::compute(const SpMat& matrix, int blockSize, const ElementFram
   m.matrix = &matrix;
   m.blockSize = blockSize;
   m.kind = chooseSolver(matrix, m.options);
-  const auto t0 = Clock::now();
+  const Stopwatch t0;
   bool ok = true;
   if (m.kind == SolverKind::Cholesky) {
     m.cholesky = std::make_unique<Eigen::CholmodSupernodalLLT<SpMat, Eigen::Lower>>();
@@ -234,7 +229,7 @@ bool LinearSolver::compute(const SpMat& matrix, int blockSize, const ElementFram
   } else {
     ok = m.buildPreconditioner(frames);
   }
-  m.factorSeconds = secondsSince(t0);
+  m.factorSeconds = t0.seconds();
   return ok;
 }
 
@@ -244,7 +239,7 @@ Eigen::VectorXd LinearSolver::solve(const Eigen::VectorXd& rhs, SolveReport& rep
   report.used = m.kind;
   report.preconditioner = m.preconditioner;
   report.factorSeconds = m.factorSeconds;
-  const auto t0 = Clock::now();
+  const Stopwatch t0;
   Eigen::VectorXd u;
   if (m.kind == SolverKind::Cholesky) {
     report.success = m.cholesky && m.cholesky->info() == Eigen::Success;
@@ -253,7 +248,7 @@ Eigen::VectorXd LinearSolver::solve(const Eigen::VectorXd& rhs, SolveReport& rep
   } else {
     u = m.conjugateGradient(rhs, report);
   }
-  report.solveSeconds = secondsSince(t0);
+  report.solveSeconds = t0.seconds();
   Eigen::VectorXd ku;
   symmetricProduct(*m.matrix, u, ku);
   const double fNorm = rhs.norm();

@@ -1,7 +1,6 @@
 #include "polydg/physics/region_checks.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -15,6 +14,7 @@
 #include "polydg/physics/face_quadrature.h"
 #include "polydg/physics/linear_solver.h"
 #include "polydg/physics/post_process.h"
+#include "polydg/util/stopwatch.h"
 
 namespace polydg {
 
@@ -276,7 +276,7 @@ double regionPatchTest(const SubMesh& sub, std::size_t regionSize, const DgBasis
 
 RegionDgCheck regionDgChecks(const PolyMesh& mesh, const MomentCache& moments,
                              std::span<const char> region, const LocalDgCheckOptions& options) {
-  const auto start = std::chrono::steady_clock::now();
+  const Stopwatch start;
   options.material.check();
   if (region.size() != mesh.numElements())
     throw std::invalid_argument("regionDgChecks: `region` needs one entry per element");
@@ -332,7 +332,7 @@ RegionDgCheck regionDgChecks(const PolyMesh& mesh, const MomentCache& moments,
   const auto u = [&](const Vec3& x) -> Vec3 { return b + gradient * (x - x0); };
   const Eigen::VectorXd exact = projectField(sub.mesh(), basis, fresh, u, degree + 1);
   c.patchTestError = regionPatchTest(sub, regionSize, basis, fresh, form, gradient, exact);
-  c.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  c.seconds = start.seconds();
   return c;
 }
 

@@ -1,18 +1,14 @@
 #include "polydg/physics/static_solver.h"
 
 #include <algorithm>
-#include <chrono>
 #include <stdexcept>
 
 #include "polydg/physics/agglomeration.h"
+#include "polydg/util/stopwatch.h"
 
 namespace polydg {
 
 namespace {
-using Clock = std::chrono::steady_clock;
-double secondsSince(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
 /// Doubling gives up after this many factorizations (eta grows by 2^kMaxDoublings).
 constexpr int kMaxDoublings = 40;
 }  // namespace
@@ -24,12 +20,12 @@ StaticSolver::StaticSolver(const PolyMesh& mesh, const Material& material,
 }
 
 void StaticSolver::integrate() {
-  const auto t0 = Clock::now();
+  const Stopwatch t0;
   const int p = options_.discretization.basis.degree;
   moments_ = std::make_unique<MomentCache>(*mesh_, 2 * p);
   moments_->update();
   basis_ = std::make_unique<DgBasis>(*mesh_, *moments_, options_.discretization.basis);
-  momentsSeconds_ = secondsSince(t0);
+  momentsSeconds_ = t0.seconds();
   report_.integrateSeconds = momentsSeconds_;
   report_.elements = mesh_->numElements();
   report_.basisFallbacks = basis_->fallbackElements();
@@ -37,7 +33,7 @@ void StaticSolver::integrate() {
 
 void StaticSolver::assemble(const LoadCase& loads) {
   if (!basis_) integrate();
-  const auto t0 = Clock::now();
+  const Stopwatch t0;
   const DiscretizationOptions& disc = options_.discretization;
   roles_ = classifyFaces(*mesh_, loads);
   report_.dirichletFaces = roles_.dirichletFaces;
@@ -73,8 +69,8 @@ void StaticSolver::assemble(const LoadCase& loads) {
   // The thesis's phases (Table 4.1): "integration" computes the element and face matrices,
   // "assembly" accumulates them into K and F.
   LocalMatrices local = localMatrices(*mesh_, *basis_, *moments_, roles_, form_);
-  const auto tAssemble = Clock::now();
-  const double localSeconds = secondsSince(t0);
+  const Stopwatch tAssemble;
+  const double localSeconds = t0.seconds();
   assembleInto(local, system_.matrix);
 
   double searchSeconds = 0.0;
@@ -82,10 +78,10 @@ void StaticSolver::assemble(const LoadCase& loads) {
     SolverOptions direct = options_.solver;
     direct.kind = SolverKind::Cholesky;
     for (int attempt = 1;; ++attempt) {
-      const auto ts = Clock::now();
+      const Stopwatch ts;
       solver_ = LinearSolver(direct);
       const bool ok = solver_.compute(system_.matrix, system_.blockSize);
-      searchSeconds += secondsSince(ts);
+      searchSeconds += ts.seconds();
       report_.penaltyAttempts = attempt;
       if (ok) {
         factorized_ = true;
@@ -107,7 +103,7 @@ void StaticSolver::assemble(const LoadCase& loads) {
   report_.nonzeros = static_cast<std::size_t>(system_.matrix.nonZeros());
   // Trial factorizations belong to the solve phase; the one that succeeded is reused.
   report_.integrateSeconds = momentsSeconds_ + localSeconds;
-  report_.assembleSeconds = secondsSince(tAssemble) - searchSeconds;
+  report_.assembleSeconds = tAssemble.seconds() - searchSeconds;
   report_.solveSeconds = searchSeconds;
 }
 
@@ -122,7 +118,7 @@ void StaticSolver::assembleInto(const LocalMatrices& local,
 const Eigen::VectorXd& StaticSolver::solve() {
   if (system_.matrix.rows() == 0 && mesh_->numElements() > 0)
     throw std::logic_error("StaticSolver::solve: call assemble() first");
-  const auto t0 = Clock::now();
+  const Stopwatch t0;
   if (!factorized_) {
     solver_ = LinearSolver(options_.solver);
     const bool direct = chooseSolver(system_.matrix, options_.solver) == SolverKind::Cholesky;
@@ -141,7 +137,7 @@ const Eigen::VectorXd& StaticSolver::solve() {
     factorized_ = true;
   }
   coefficients_ = solver_.solve(system_.rhs, report_.solver);
-  report_.solveSeconds += secondsSince(t0);
+  report_.solveSeconds += t0.seconds();
   report_.energy = 0.5 * coefficients_.dot(system_.rhs);
   return coefficients_;
 }

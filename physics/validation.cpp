@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <array>
-#include <chrono>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -18,6 +17,7 @@
 #include "polydg/mesh/validate.h"
 #include "polydg/physics/polynomial_tables.h"
 #include "polydg/physics/post_process.h"
+#include "polydg/util/stopwatch.h"
 
 namespace polydg {
 
@@ -510,7 +510,7 @@ struct CheckTotals {
 
 LocalDgCheck localDgChecks(const PolyMesh& mesh, const MomentCache& moments,
                            const LocalDgCheckOptions& options) {
-  const auto start = std::chrono::steady_clock::now();
+  const Stopwatch start;
   options.material.check();
   if (!options.only.empty() && options.only.size() != mesh.numElements())
     throw std::invalid_argument("localDgChecks: `only` needs one entry per element");
@@ -562,7 +562,7 @@ LocalDgCheck localDgChecks(const PolyMesh& mesh, const MomentCache& moments,
   c.elementsWithWrongRigidModes = totals.wrongRigid;
   c.firstWrongRigidModeElement = totals.firstWrongRigid;
   c.nonDefiniteElements = totals.nonDefinite;
-  c.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  c.seconds = start.seconds();
   return c;
 }
 
@@ -648,7 +648,7 @@ PolyMesh selectionWithNeighbours(const PolyMesh& mesh, const std::vector<char>& 
 }  // namespace
 
 LocalDgCheck localDgChecksOfSelection(const PolyMesh& mesh, const LocalDgCheckOptions& options) {
-  const auto start = std::chrono::steady_clock::now();
+  const Stopwatch start;
   if (options.only.size() != mesh.numElements())
     throw std::invalid_argument("localDgChecksOfSelection: `only` needs one entry per element");
   std::vector<ElementId> original;
@@ -663,7 +663,7 @@ LocalDgCheck localDgChecksOfSelection(const PolyMesh& mesh, const LocalDgCheckOp
   auto back = [&](ElementId e) { return e.valid() ? original[e.index()] : ElementId(); };
   c.worstPatchTestElement = back(c.worstPatchTestElement);
   c.firstWrongRigidModeElement = back(c.firstWrongRigidModeElement);
-  c.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  c.seconds = start.seconds();
   return c;
 }
 

@@ -15,6 +15,7 @@
 #include "polydg/mesh/meshing.h"
 #include "polydg/mesh/surface_shapes.h"
 #include "polydg/mesh/validate.h"
+#include "polydg/util/union_find.h"
 
 namespace polydg {
 namespace {
@@ -30,20 +31,16 @@ constexpr double kVolumeTolerance = 1e-10;
 /// Components as unions of elements that list the same face (element face lists only, not the
 /// faces' front/back links that validate() and the editor use).
 std::size_t componentsFromFaceLists(const PolyMesh& mesh) {
-  std::vector<std::size_t> parent(mesh.numElements());
-  std::iota(parent.begin(), parent.end(), 0);
-  auto find = [&](std::size_t i) {
-    while (parent[i] != i) i = parent[i] = parent[parent[i]];
-    return i;
-  };
+  UnionFind sets(mesh.numElements());
   std::unordered_map<std::uint32_t, std::size_t> firstUser;
   for (std::size_t e = 0; e < mesh.numElements(); ++e)
     for (const FaceUse& use : mesh.element(ElementId(e)).faces) {
       const auto [it, inserted] = firstUser.try_emplace(use.face.value, e);
-      if (!inserted) parent[find(e)] = find(it->second);
+      if (!inserted)
+        sets.unite(static_cast<std::uint32_t>(e), static_cast<std::uint32_t>(it->second));
     }
   std::size_t count = 0;
-  for (std::size_t e = 0; e < parent.size(); ++e) count += find(e) == e;
+  for (std::uint32_t e = 0; e < sets.size(); ++e) count += sets.find(e) == e;
   return count;
 }
 
