@@ -37,15 +37,16 @@
 
 #include "cli/commands.h"
 #include "cli/csv.h"
-#include "cli/json_reports.h"
 #include "cli/plot.h"
-#include "cli/report.h"
 #include "polydg/cut/cut.h"
 #include "polydg/mesh/meshing.h"
 #include "polydg/mesh/primitives.h"
 #include "polydg/mesh/surface_io.h"
+#include "polydg/model/files.h"
+#include "polydg/model/names.h"
 #include "polydg/physics/benchmarks.h"
 #include "polydg/physics/stability.h"
+#include "polydg/util/error.h"
 
 #ifndef POLYDG_TESTDATA_DIR
 #define POLYDG_TESTDATA_DIR "testdata"
@@ -95,7 +96,7 @@ struct SuiteOutput {
 };
 
 void writeSuite(const fs::path& dir, const SuiteOutput& s, bool quiet) {
-  writeReport(dir / (s.name + ".json"), s.json);
+  writeJsonFile(dir / (s.name + ".json"), s.json);
   const std::string csv = toCsv(s.rows);
   writeFileAtomically(dir / (s.name + ".csv"), [&](std::ostream& os) { os << csv; });
   for (const NamedPlot& p : s.plots) {
@@ -499,7 +500,7 @@ SuiteOutput meshingSuite(const BenchOptions& o, bool quiet) {
   SuiteOutput s{"meshing", nlohmann::json::array(), nlohmann::json::array(), {}};
   const std::string torusPath = (fs::path(o.dataDir) / "torus.obj").string();
   if (!fs::exists(torusPath))
-    throw UserError(torusPath + " not found; pass the folder of the bundled models with --data");
+    throw InputError(torusPath + " not found; pass the folder of the bundled models with --data");
   std::vector<std::pair<std::string, TriangleSurface>> models;
   models.emplace_back("torus.obj", readSurface(torusPath));
   if (!o.quick) {
@@ -661,7 +662,7 @@ SuiteOutput cuttingSuite(const BenchOptions& o, bool quiet) {
 void runBench(const BenchOptions& o, const CommonOptions& common) {
   std::error_code ec;
   fs::create_directories(o.out, ec);
-  if (ec) throw UserError("cannot create " + o.out + ": " + ec.message());
+  if (ec) throw InputError("cannot create " + o.out + ": " + ec.message());
   const bool all = o.suite == "all";
   const auto t0 = Clock::now();
   auto timed = [&](const std::string& name, auto&& run) {

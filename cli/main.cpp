@@ -19,7 +19,7 @@
 #include <unistd.h>
 
 #include "cli/commands.h"
-#include "cli/report.h"
+#include "polydg/util/error.h"
 
 namespace {
 
@@ -66,6 +66,13 @@ void keepFreedMemory() {
 #endif
 }
 
+/// The first argument that is not an option: the subcommand a user asked for.
+const char* requestedCommand(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i)
+    if (argv[i][0] != '-') return argv[i];
+  return nullptr;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -82,9 +89,25 @@ int main(int argc, char** argv) {
   polydg::cli::addMeshCommand(app, common, exitCode);
   polydg::cli::addCheckCommand(app, common, exitCode);
   polydg::cli::addSolveCommand(app, common, exitCode);
-  polydg::cli::addBenchCommand(app, common, exitCode);
-  polydg::cli::addRunCommand(app, common, exitCode);
   polydg::cli::addCutCommand(app, common, exitCode);
+  polydg::cli::addRunCommand(app, common, exitCode);
+  polydg::cli::addBenchCommand(app, common, exitCode);
+  // CLI11 would answer an unknown command with "A subcommand is required".
+  if (const char* command = requestedCommand(argc, argv)) {
+    std::string known;
+    for (const CLI::App* sub : app.get_subcommands({})) {
+      if (sub->get_name() == command) {
+        known.clear();
+        break;
+      }
+      known += (known.empty() ? "" : ", ") + sub->get_name();
+    }
+    if (!known.empty()) {
+      std::cerr << "polydg: error: unknown command '" << command << "'; the commands are " << known
+                << " (see polydg --help)\n";
+      return 2;
+    }
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -97,6 +120,9 @@ int main(int argc, char** argv) {
     // One line, like every other error; CLI11's own would add a second.
     std::cerr << "polydg: error: " << e.what() << " (see polydg --help)\n";
     return 2;
+  } catch (const polydg::CheckFailure& e) {
+    std::cerr << "polydg: error: " << e.what() << '\n';
+    return 1;
   } catch (const std::exception& e) {
     std::cerr << "polydg: error: " << e.what() << '\n';
     return 2;

@@ -12,7 +12,6 @@
 #include <unordered_set>
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/Exact_rational.h>
 
 #include "polydg/cut/element_grid.h"
 #include "polydg/mesh/plane_split.h"
@@ -26,16 +25,6 @@ namespace polydg {
 namespace {
 
 using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
-
-/// Exact side of p with respect to {normal . x = offset}: -1, 0, +1 (the predicate
-/// PlaneSplitter::side uses for general planes).
-int exactSide(const Kernel::Plane_3& plane, const Vec3& p) {
-  switch (plane.oriented_side(Kernel::Point_3(p.x(), p.y(), p.z()))) {
-    case CGAL::ON_NEGATIVE_SIDE: return -1;
-    case CGAL::ON_POSITIVE_SIDE: return 1;
-    default: return 0;
-  }
-}
 
 /// The blade's polygon seen in 2D: the coordinate plane that drops the normal's largest
 /// component, with orientations corrected so that the corners run counter-clockwise.
@@ -130,12 +119,8 @@ PiecePolygon reversedPolygon(const PiecePolygon& p) {
 // --- Blade -------------------------------------------------------------------------------
 
 Blade Blade::plane(const Vec3& normal, double offset) {
-  if (!normal.allFinite() || normal == Vec3::Zero())
-    throw std::invalid_argument("the blade's normal must be finite and not zero");
-  if (!std::isfinite(offset)) throw std::invalid_argument("the blade's offset must be finite");
   Blade b;
-  b.normal = normal;
-  b.offset = offset;
+  static_cast<Plane&>(b) = Plane::make(normal, offset);
   return b;
 }
 
@@ -159,8 +144,7 @@ Blade Blade::fromPolygon(std::vector<Vec3> corners) {
     if (std::abs(n.dot(c) - offset) > 1e-9 * n.norm() * diameter)
       throw std::invalid_argument("the polygon blade's corners are not coplanar");
   Blade b;
-  b.normal = n;
-  b.offset = offset;
+  static_cast<Plane&>(b) = Plane::make(n, offset);
   b.polygon = std::move(corners);
   const PolygonTest test(b);
   const std::size_t m = test.corners.size();
@@ -192,22 +176,22 @@ struct MeshEditor::State {
   /// sees it on the plane (its rounded position may not be).
   /// later cut by the same plane sees it on the plane (its rounded position may not be).
   std::vector<PlaneTags> vertexPlane;
-  std::vector<std::pair<Vec3, double>> planes;  ///< (normal, offset) of every cut so far
+  std::vector<Plane> planes;  ///< the plane of every cut so far
+  /// Faces integrated by caches this editor has replaced with ones of higher degree.
+  std::size_t retiredIntegrations = 0;
 };
 
-namespace {
-
-/// True if {a.x = da} and {b.x = db} are the same plane: (a, da) and (b, db) proportional,
-/// decided exactly (every 2x2 minor zero, in rational arithmetic).
-bool samePlane(const Vec3& a, double da, const Vec3& b, double db) {
-  if (a.cross(b).norm() > 1e-8 * a.norm() * b.norm()) return false;  // clearly not parallel
-  using Q = CGAL::Exact_rational;
-  const double x[4] = {a.x(), a.y(), a.z(), da}, y[4] = {b.x(), b.y(), b.z(), db};
-  for (int i = 0; i < 4; ++i)
-    for (int j = i + 1; j < 4; ++j)
-      if (Q(x[i]) * Q(y[j]) != Q(x[j]) * Q(y[i])) return false;
-  return true;  // opposite normals describe the same set of points
+std::size_t MeshEditor::raiseMomentDegree(int degree) {
+  State& s = *state_;
+  if (degree <= s.moments->degree()) return 0;
+  s.retiredIntegrations += s.moments->facesIntegrated();
+  s.moments = std::make_unique<MomentCache>(s.mesh, degree);
+  s.moments->reserve(s.mesh.numFaces() + s.mesh.numFaces() / 4,
+                     s.mesh.numElements() + s.mesh.numElements() / 4);
+  return s.moments->update();
 }
+
+namespace {
 
 /// One editing operation on an editor's state: topology changes with ids kept stable (dead
 /// faces and elements are only marked), then compaction by swap-with-last, with the moments,
@@ -374,17 +358,14 @@ class VertexSides {
  public:
   VertexSides(const PolyMesh& mesh, const Blade& blade, const std::vector<PlaneTags>& tags,
               std::uint32_t planeId)
-      : mesh_(mesh),
-        plane_(blade.normal.x(), blade.normal.y(), blade.normal.z(), -blade.offset),
-        tags_(tags),
-        planeId_(planeId) {}
+      : mesh_(mesh), plane_(blade), tags_(tags), planeId_(planeId) {}
   int operator()(VertexId v) {
     const auto [it, inserted] = sides_.try_emplace(v.value, 0);
     if (inserted) {
       const bool onThisPlane =
           v.index() < tags_.size() && std::find(tags_[v.index()].begin(), tags_[v.index()].end(),
                                                 planeId_) != tags_[v.index()].end();
-      it->second = onThisPlane ? 0 : exactSide(plane_, mesh_.position(v));
+      it->second = onThisPlane ? 0 : plane_.side(mesh_.position(v));
     }
     return it->second;
   }
@@ -410,7 +391,7 @@ class VertexSides {
 
  private:
   const PolyMesh& mesh_;
-  Kernel::Plane_3 plane_;
+  const Plane& plane_;
   const std::vector<PlaneTags>& tags_;
   std::uint32_t planeId_;
   std::unordered_map<std::uint32_t, int> sides_;
@@ -438,11 +419,7 @@ class Splitter {
         blade_(blade),
         tags_(tags),
         planeId_(planeId) {
-    plane_.normal = blade.normal;
-    plane_.offset = blade.offset;
-    for (int a = 0; a < 3; ++a)
-      if (blade.normal == Vec3::Unit(a)) plane_.axis = a;
-    plane_.id = 0;
+    plane_ = SplitPlane(blade, 0);
   }
 
   /// The local points of `elements` (mesh vertex ids <-> local indices).
@@ -792,6 +769,7 @@ void decouple(Edit& edit, FaceId f) {
 /// neighbour. Counts go to `report`.
 void mergeSliverPieces(Edit& edit, std::vector<ElementId> candidates, double threshold,
                        OperationReport& report) {
+  report.sliverThreshold = threshold;
   PolyMesh& mesh = edit.mesh();
   MomentCache& cache = edit.cache();
   std::unordered_set<std::uint32_t> dead;
@@ -832,7 +810,11 @@ void mergeSliverPieces(Edit& edit, std::vector<ElementId> candidates, double thr
 
 // --- MeshEditor --------------------------------------------------------------------------
 
-MeshEditor::MeshEditor(PolyMesh mesh, double referenceVolume) : state_(std::make_unique<State>()) {
+MeshEditor::MeshEditor(PolyMesh mesh, double referenceVolume)
+    : MeshEditor(std::move(mesh), referenceVolume, nullptr) {}
+
+MeshEditor::MeshEditor(PolyMesh mesh, double referenceVolume, std::unique_ptr<MomentCache> moments)
+    : state_(std::make_unique<State>()) {
   State& s = *state_;
   s.mesh = std::move(mesh);
   if (s.mesh.numElements() == 0) throw std::invalid_argument("MeshEditor: the mesh is empty");
@@ -841,7 +823,12 @@ MeshEditor::MeshEditor(PolyMesh mesh, double referenceVolume) : state_(std::make
   const auto headroom = [](std::size_t n) { return n + n / 4 + 64; };
   s.mesh.reserve(headroom(s.mesh.numVertices()), headroom(s.mesh.numFaces()),
                  headroom(s.mesh.numElements()));
-  s.moments = std::make_unique<MomentCache>(s.mesh, 2);
+  if (moments && moments->degree() >= 2) {
+    s.moments = std::move(moments);
+    s.moments->rebind(s.mesh);
+  } else {
+    s.moments = std::make_unique<MomentCache>(s.mesh, 2);
+  }
   s.moments->reserve(headroom(s.mesh.numFaces()), headroom(s.mesh.numElements()));
   s.moments->update();
   std::vector<double> volumes(s.mesh.numElements());
@@ -867,6 +854,16 @@ MeshEditor& MeshEditor::operator=(MeshEditor&&) noexcept = default;
 
 const PolyMesh& MeshEditor::mesh() const { return state_->mesh; }
 const MomentCache& MeshEditor::moments() const { return *state_->moments; }
+
+const MomentCache& MeshEditor::requireMoments(int degree) {
+  if (!state_) throw std::logic_error("MeshEditor: used after release()");
+  raiseMomentDegree(degree);
+  return *state_->moments;
+}
+
+std::size_t MeshEditor::facesIntegrated() const {
+  return state_->retiredIntegrations + state_->moments->facesIntegrated();
+}
 double MeshEditor::referenceVolume() const { return state_->referenceVolume; }
 double MeshEditor::volume() const { return state_->volume; }
 
@@ -1001,19 +998,12 @@ OperationReport MeshEditor::cutInPlace(const Blade& blade, const CutOptions& opt
   State& s = *state_;
   OperationReport report;
   report.op = blade.finite() ? "cut_polygon" : "cut";
-  if (2 * options.validationDegree > s.moments->degree()) {
-    s.moments = std::make_unique<MomentCache>(s.mesh, 2 * options.validationDegree);
-    s.moments->reserve(s.mesh.numFaces() + s.mesh.numFaces() / 4,
-                       s.mesh.numElements() + s.mesh.numElements() / 4);
-    report.facesReintegrated += s.moments->update();
-  }
+  report.facesReintegrated += raiseMomentDegree(2 * options.validationDegree);
   const double volumeBefore = s.volume;
   Edit edit(s.mesh, *s.moments, s.grid);
   std::uint32_t planeId = 0;
-  while (planeId < s.planes.size() &&
-         !samePlane(s.planes[planeId].first, s.planes[planeId].second, blade.normal, blade.offset))
-    ++planeId;
-  if (planeId == s.planes.size()) s.planes.emplace_back(blade.normal, blade.offset);
+  while (planeId < s.planes.size() && !s.planes[planeId].sameAs(blade)) ++planeId;
+  if (planeId == s.planes.size()) s.planes.push_back(blade);
   s.vertexPlane.resize(s.mesh.numVertices());
   const std::size_t oldVertices = s.mesh.numVertices();
   VertexSides sides(s.mesh, blade, s.vertexPlane, planeId);
@@ -1112,8 +1102,7 @@ OperationReport MeshEditor::cutInPlace(const Blade& blade, const CutOptions& opt
   auto onPlane = [&](std::uint32_t v, std::uint32_t t) {
     const PlaneTags& tags = s.vertexPlane[v];
     if (std::find(tags.begin(), tags.end(), t) != tags.end()) return true;
-    const auto& [n, d] = s.planes[t];
-    return exactSide(Kernel::Plane_3(n.x(), n.y(), n.z(), -d), s.mesh.position(VertexId(v))) == 0;
+    return s.planes[t].side(s.mesh.position(VertexId(v))) == 0;
   };
   for (const auto& [edge, p] : points) {
     if (p.index() < oldVertices) continue;
@@ -1211,10 +1200,7 @@ OperationReport MeshEditor::mergeSlivers(double fraction, ValidationLevel valida
   State& s = *state_;
   OperationReport report;
   report.op = "merge";
-  if (2 * validationDegree > s.moments->degree()) {
-    s.moments = std::make_unique<MomentCache>(s.mesh, 2 * validationDegree);
-    report.facesReintegrated += s.moments->update();
-  }
+  report.facesReintegrated += raiseMomentDegree(2 * validationDegree);
   const double volumeBefore = s.volume;
   Edit edit(s.mesh, *s.moments, s.grid);
   std::vector<ElementId> all(s.mesh.numElements());

@@ -114,4 +114,34 @@ void transform(PolyMesh& mesh, double scale, const Vec3& offset) {
   for (Vec3& p : mesh.positions()) p = scale * p + offset;
 }
 
+bool isGridHexahedron(const PolyMesh& mesh, ElementId e) {
+  const Element& element = mesh.element(e);
+  if (element.faces.size() != 6) return false;
+  for (const FaceUse& use : element.faces) {
+    const Face& face = mesh.face(use.face);
+    if (face.numLoops() != 1 || face.vertices.size() != 4) return false;
+    const Vec3 n = unitNormal(mesh, use.face);
+    if (std::abs(n.x()) != 1.0 && std::abs(n.y()) != 1.0 && std::abs(n.z()) != 1.0) return false;
+  }
+  return true;
+}
+
+bool isConvex(const PolyMesh& mesh, ElementId e, double relativeTolerance) {
+  const Box3 box = elementBounds(mesh, e);
+  const double tolerance = relativeTolerance * box.diagonal().norm();
+  const std::vector<VertexId> vertices = elementVertices(mesh, e);
+  for (const FaceUse& use : mesh.element(e).faces) {
+    // A face narrower than the tolerance (area / diameter) cannot show non-convexity at that
+    // tolerance, and the normal of a face of round-off width means nothing.
+    const Vec3 a = areaVector(mesh, use.face);
+    if (a.norm() <= tolerance * faceBounds(mesh, use.face).diagonal().norm()) continue;
+    Vec3 n = a.normalized();
+    if (use.reversed) n = -n;
+    const Vec3& c = faceReferencePoint(mesh, use.face);
+    for (VertexId v : vertices)
+      if (n.dot(mesh.position(v) - c) > tolerance) return false;
+  }
+  return true;
+}
+
 }  // namespace polydg

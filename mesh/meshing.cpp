@@ -61,36 +61,6 @@ double cellSizeFor(const Box3& box, const MeshingOptions& o) {
 
 }  // namespace
 
-bool isGridHexahedron(const PolyMesh& mesh, ElementId e) {
-  const Element& element = mesh.element(e);
-  if (element.faces.size() != 6) return false;
-  for (const FaceUse& use : element.faces) {
-    const Face& face = mesh.face(use.face);
-    if (face.numLoops() != 1 || face.vertices.size() != 4) return false;
-    const Vec3 n = unitNormal(mesh, use.face);
-    if (std::abs(n.x()) != 1.0 && std::abs(n.y()) != 1.0 && std::abs(n.z()) != 1.0) return false;
-  }
-  return true;
-}
-
-bool isConvex(const PolyMesh& mesh, ElementId e, double relativeTolerance) {
-  const Box3 box = elementBounds(mesh, e);
-  const double tolerance = relativeTolerance * box.diagonal().norm();
-  const std::vector<VertexId> vertices = elementVertices(mesh, e);
-  for (const FaceUse& use : mesh.element(e).faces) {
-    // A face narrower than the tolerance (area / diameter) cannot show non-convexity at that
-    // tolerance, and the normal of a face of round-off width means nothing.
-    const Vec3 a = areaVector(mesh, use.face);
-    if (a.norm() <= tolerance * faceBounds(mesh, use.face).diagonal().norm()) continue;
-    Vec3 n = a.normalized();
-    if (use.reversed) n = -n;
-    const Vec3& c = faceReferencePoint(mesh, use.face);
-    for (VertexId v : vertices)
-      if (n.dot(mesh.position(v) - c) > tolerance) return false;
-  }
-  return true;
-}
-
 namespace {
 
 /// The input part of the report from the diagnosis of the surface as read.
@@ -244,10 +214,10 @@ MeshingResult meshSurface(const TriangleSurface& input, const MeshingOptions& op
   return result;
 }
 
-void validateMeshing(MeshingResult& result) {
+void validateMeshing(MeshingResult& result) { validateMeshing(result.mesh, result.report); }
+
+void validateMeshing(const PolyMesh& mesh, MeshingReport& r) {
   const Stopwatch start;
-  MeshingReport& r = result.report;
-  const PolyMesh& mesh = result.mesh;
   r.validation = validate(mesh);
   r.elements = mesh.numElements();
   r.faces = r.validation.faces;

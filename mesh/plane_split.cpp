@@ -108,17 +108,7 @@ int PlaneSplitter::compareExactly(std::uint32_t v, std::uint32_t w, int k) const
 int PlaneSplitter::side(std::uint32_t v, const SplitPlane& plane) const {
   const PointRecord& r = records_[v];
   if (r.onPlane == plane.id) return 0;
-  const Vec3& p = r.position;
-  if (plane.axis >= 0) {
-    const double x = p[plane.axis];
-    return x < plane.offset ? -1 : (x > plane.offset ? 1 : 0);
-  }
-  const Kernel::Plane_3 h(plane.normal.x(), plane.normal.y(), plane.normal.z(), -plane.offset);
-  switch (h.oriented_side(Kernel::Point_3(p.x(), p.y(), p.z()))) {
-    case CGAL::ON_NEGATIVE_SIDE: return -1;
-    case CGAL::ON_POSITIVE_SIDE: return 1;
-    default: return 0;
-  }
+  return plane.side(r.position);
 }
 
 std::uint32_t PlaneSplitter::edgePoint(std::uint32_t u, std::uint32_t v, const SplitPlane& plane) {

@@ -135,7 +135,7 @@ Material benchmarkB2Material() {
 
 LoadCase benchmarkB2Loads() {
   LoadCase loads;
-  loads.dirichlet.push_back({FaceSelector::plane(0, 0.0), {}});
+  loads.dirichlet.push_back({FaceSelector::inPlane(0, 0.0), {}});
   loads.gravity = Vec3(0, 0, -1);
   return loads;
 }
@@ -181,12 +181,12 @@ CantileverResult runBenchmarkB3(const CantileverSetup& setup, const StaticOption
   material.youngsModulus = 1000.0;
   material.poissonRatio = setup.poissonRatio;
   LoadCase loads;
-  loads.dirichlet.push_back({FaceSelector::plane(0, beam.min().x()), {}});
-  loads.tractions.push_back({FaceSelector::plane(0, beam.max().x()), Vec3(0, 0, -1)});
+  loads.dirichlet.push_back({FaceSelector::inPlane(0, beam.min().x()), {}});
+  loads.tractions.push_back({FaceSelector::inPlane(0, beam.max().x()), Vec3(0, 0, -1)});
   const StaticSolution s = solveStatic(mesh, material, loads, options);
   CantileverResult r;
   r.tipDeflection = -meanBoundaryDisplacement(mesh, *s.basis, s.coefficients,
-                                              FaceSelector::plane(0, beam.max().x()), 2);
+                                              FaceSelector::inPlane(0, beam.max().x()), 2);
   r.report = s.report;
   return r;
 }

@@ -165,7 +165,7 @@ struct LinearSolver::Impl {
     });
   }
 
-  Eigen::VectorXd conjugateGradient(const Eigen::VectorXd& f, SolveReport& report) const {
+  Eigen::VectorXd conjugateGradient(const Eigen::VectorXd& f, LinearSolveReport& report) const {
     const double fNorm = std::sqrt(parallelDot(f, f));
     Eigen::VectorXd u = Eigen::VectorXd::Zero(f.size());
     if (fNorm == 0.0) {
@@ -233,9 +233,9 @@ bool LinearSolver::compute(const SpMat& matrix, int blockSize, const ElementFram
   return ok;
 }
 
-Eigen::VectorXd LinearSolver::solve(const Eigen::VectorXd& rhs, SolveReport& report) {
+Eigen::VectorXd LinearSolver::solve(const Eigen::VectorXd& rhs, LinearSolveReport& report) {
   Impl& m = *impl_;
-  report = SolveReport{};
+  report = LinearSolveReport{};
   report.used = m.kind;
   report.preconditioner = m.preconditioner;
   report.factorSeconds = m.factorSeconds;
@@ -257,7 +257,7 @@ Eigen::VectorXd LinearSolver::solve(const Eigen::VectorXd& rhs, SolveReport& rep
 }
 
 Eigen::VectorXd solveLinearSystem(const SpMat& matrix, const Eigen::VectorXd& rhs, int blockSize,
-                                  const SolverOptions& options, SolveReport& report) {
+                                  const SolverOptions& options, LinearSolveReport& report) {
   LinearSolver solver(options);
   solver.compute(matrix, blockSize);
   return solver.solve(rhs, report);

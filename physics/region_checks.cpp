@@ -255,7 +255,7 @@ double regionPatchTest(const SubMesh& sub, std::size_t regionSize, const DgBasis
   // The error delta = U_h - U solves A_RR delta = -r.
   LinearSolver solver(SolverOptions{.kind = SolverKind::Cholesky});
   if (!solver.compute(a, bs)) return std::numeric_limits<double>::infinity();
-  SolveReport report;
+  LinearSolveReport report;
   const Eigen::VectorXd delta = solver.solve(-residual, report);
   double errorSq = 0.0, normSq = 0.0;
   Eigen::MatrixXd mass;

@@ -31,7 +31,7 @@ class InverseOperator {
   Eigen::Index rows() const { return n_; }
   Eigen::Index cols() const { return n_; }
   void perform_op(const double* x, double* y) const {
-    SolveReport report;
+    LinearSolveReport report;
     Eigen::Map<Eigen::VectorXd>(y, n_) =
         solver_->solve(Eigen::Map<const Eigen::VectorXd>(x, n_), report);
     ++products;
@@ -262,7 +262,7 @@ StabilityConditionRun runSliverCase(double volumeRatio, bool merge, int degree) 
 }
 
 StabilityConditionRun runThinNeckCase(double eps, int degree) {
-  return stiffnessCondition(thinNeckMesh(eps), degree, FaceSelector::plane(0, 0.0));
+  return stiffnessCondition(thinNeckMesh(eps), degree, FaceSelector::inPlane(0, 0.0));
 }
 
 LockingSetup lockingSetup(int degree, bool quick) {
@@ -325,7 +325,7 @@ double scaleProblemCondition(ScaleProblem problem, int degree, bool quick) {
   const CantileverSetup beam = lockingSetup(degree, quick).mesh;
   return stiffnessCondition(
              hexGridMesh(beam.nx, beam.ny, beam.nz, Box3(Vec3::Zero(), Vec3(10.0, 1.0, 1.0))),
-             degree, FaceSelector::plane(0, 0.0))
+             degree, FaceSelector::inPlane(0, 0.0))
       .estimate.cond;
 }
 

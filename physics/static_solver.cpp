@@ -14,16 +14,28 @@ constexpr int kMaxDoublings = 40;
 }  // namespace
 
 StaticSolver::StaticSolver(const PolyMesh& mesh, const Material& material,
-                           const StaticOptions& options)
-    : mesh_(&mesh), material_(material), options_(options), solver_(options.solver) {
+                           const StaticOptions& options, const MomentCache* moments)
+    : mesh_(&mesh),
+      material_(material),
+      options_(options),
+      moments_(moments),
+      solver_(options.solver) {
   material_.check();
+  const int needed = 2 * options.discretization.basis.degree;
+  if (moments_ && moments_->degree() < needed)
+    throw std::invalid_argument("StaticSolver: the moments are of degree " +
+                                std::to_string(moments_->degree()) + ", the basis needs " +
+                                std::to_string(needed));
 }
 
 void StaticSolver::integrate() {
   const Stopwatch t0;
   const int p = options_.discretization.basis.degree;
-  moments_ = std::make_unique<MomentCache>(*mesh_, 2 * p);
-  moments_->update();
+  if (moments_ == nullptr || ownMoments_) {
+    ownMoments_ = std::make_unique<MomentCache>(*mesh_, 2 * p);
+    report_.facesIntegrated = ownMoments_->update();
+    moments_ = ownMoments_.get();
+  }
   basis_ = std::make_unique<DgBasis>(*mesh_, *moments_, options_.discretization.basis);
   momentsSeconds_ = t0.seconds();
   report_.integrateSeconds = momentsSeconds_;
@@ -144,7 +156,8 @@ const Eigen::VectorXd& StaticSolver::solve() {
 
 StaticSolution StaticSolver::release() {
   StaticSolution s;
-  s.moments = std::move(moments_);
+  s.moments = std::move(ownMoments_);
+  moments_ = nullptr;
   s.basis = std::move(basis_);
   s.coefficients = std::move(coefficients_);
   s.report = report_;
@@ -152,8 +165,8 @@ StaticSolution StaticSolver::release() {
 }
 
 StaticSolution solveStatic(const PolyMesh& mesh, const Material& material, const LoadCase& loads,
-                           const StaticOptions& options) {
-  StaticSolver solver(mesh, material, options);
+                           const StaticOptions& options, const MomentCache* moments) {
+  StaticSolver solver(mesh, material, options, moments);
   solver.integrate();
   solver.assemble(loads);
   solver.solve();

@@ -101,7 +101,8 @@ Eigen::VectorXd smallestEigenvalues(const SpMat& s) {
 
 }  // namespace
 
-PatchTestResult patchTest(const PolyMesh& mesh, const PhysicsCheckOptions& options) {
+PatchTestResult patchTest(const PolyMesh& mesh, const PhysicsCheckOptions& options,
+                          const MomentCache* moments) {
   const Box3 box = meshBounds(mesh);
   const Vec3 x0 = box.center();
   const double length = box.diagonal().norm();
@@ -111,16 +112,17 @@ PatchTestResult patchTest(const PolyMesh& mesh, const PhysicsCheckOptions& optio
   const auto exact = [=](const Vec3& x) -> Vec3 { return b + a * (x - x0); };
   LoadCase loads;
   loads.dirichlet.push_back({FaceSelector::allBoundary(), exact});
-  StaticSolution s = solveStatic(mesh, options.material, loads, staticOptions(options));
+  StaticSolution s = solveStatic(mesh, options.material, loads, staticOptions(options), moments);
+  const MomentCache& cache = moments ? *moments : *s.moments;
   const DgBasis& basis = *s.basis;
   const int degree = basis.degree();
-  const Eigen::VectorXd projected = projectField(mesh, basis, *s.moments, exact, degree + 1);
+  const Eigen::VectorXd projected = projectField(mesh, basis, cache, exact, degree + 1);
   const int bs = 3 * basis.size(), n = basis.size();
   double errorSq = 0.0, normSq = 0.0, worst = 0.0;
   Eigen::MatrixXd mass;
   for (std::size_t i = 0; i < mesh.numElements(); ++i) {
     const ElementId e(i);
-    elementMass(basis, *s.moments, e, mass);
+    elementMass(basis, cache, e, mass);
     double ei = 0.0, ni = 0.0;
     for (int d = 0; d < 3; ++d) {
       const Eigen::VectorXd u = projected.segment(i * bs + d * n, n);
@@ -221,16 +223,18 @@ ZeroModeReport zeroModes(const PolyMesh& mesh, const DgBasis& basis, const Momen
   return report;
 }
 
-ZeroModeReport rigidModes(const PolyMesh& mesh, const PhysicsCheckOptions& options) {
-  StaticSolver solver(mesh, options.material, staticOptions(options));
+ZeroModeReport rigidModes(const PolyMesh& mesh, const PhysicsCheckOptions& options,
+                          const MomentCache* moments) {
+  StaticSolver solver(mesh, options.material, staticOptions(options), moments);
   solver.integrate();
   LoadCase none;
   solver.assemble(none);
   return zeroModes(mesh, solver.basis(), solver.moments(), solver.system().matrix);
 }
 
-DefinitenessReport definiteness(const PolyMesh& mesh, const PhysicsCheckOptions& options) {
-  StaticSolver solver(mesh, options.material, staticOptions(options));
+DefinitenessReport definiteness(const PolyMesh& mesh, const PhysicsCheckOptions& options,
+                                const MomentCache* moments) {
+  StaticSolver solver(mesh, options.material, staticOptions(options), moments);
   LoadCase clamped;
   clamped.dirichlet.push_back({FaceSelector::allBoundary(), {}});
   solver.assemble(clamped);
@@ -654,7 +658,7 @@ LocalDgCheck localDgChecksOfSelection(const PolyMesh& mesh, const LocalDgCheckOp
   std::vector<ElementId> original;
   const PolyMesh sub = selectionWithNeighbours(mesh, options.only, original);
   MomentCache moments(sub, 2 * options.basis.degree);
-  moments.update();
+  const std::size_t integrated = moments.update();
   LocalDgCheckOptions subOptions = options;
   subOptions.only.resize(original.size());
   for (std::size_t i = 0; i < original.size(); ++i)
@@ -664,6 +668,7 @@ LocalDgCheck localDgChecksOfSelection(const PolyMesh& mesh, const LocalDgCheckOp
   c.worstPatchTestElement = back(c.worstPatchTestElement);
   c.firstWrongRigidModeElement = back(c.firstWrongRigidModeElement);
   c.seconds = start.seconds();
+  c.facesIntegrated = integrated;
   return c;
 }
 

@@ -41,7 +41,7 @@ TEST_P(PMultigridSolve, ConjugateGradientMatchesCholesky) {
   const LinearSystem& system = framed.system;
   SolverOptions direct;
   direct.kind = SolverKind::Cholesky;
-  SolveReport directReport;
+  LinearSolveReport directReport;
   const Eigen::VectorXd reference =
       solveLinearSystem(system.matrix, system.rhs, system.blockSize, direct, directReport);
   ASSERT_TRUE(directReport.success);
@@ -50,7 +50,7 @@ TEST_P(PMultigridSolve, ConjugateGradientMatchesCholesky) {
   cg.kind = SolverKind::ConjugateGradient;
   cg.preconditioner = CgPreconditioner::PMultigrid;
   cg.tolerance = kCgTolerance;
-  SolveReport report;
+  LinearSolveReport report;
   LinearSolver solver(cg);
   ASSERT_TRUE(
       solver.compute(system.matrix, system.blockSize, c.agglomerate ? &framed.frames : nullptr));
@@ -88,7 +88,7 @@ TEST(PMultigrid, AgglomeratesNeedFewerIterationsThanConstantsOnTheBentCube) {
       LinearSolver solver(cg);
       ASSERT_TRUE(
           solver.compute(s.system.matrix, s.system.blockSize, agglomerate ? &s.frames : nullptr));
-      SolveReport report;
+      LinearSolveReport report;
       solver.solve(s.system.rhs, report);
       EXPECT_TRUE(report.success);
       iterations[agglomerate] = report.iterations;
@@ -106,7 +106,7 @@ TEST(PMultigrid, AgglomeratesOfTwoSeparateBodies) {
   const FramedSystem s = b1FramedSystem(testing::twoSeparateBlocks(), Method::IP, 2);
   SolverOptions direct;
   direct.kind = SolverKind::Cholesky;
-  SolveReport directReport;
+  LinearSolveReport directReport;
   const Eigen::VectorXd reference =
       solveLinearSystem(s.system.matrix, s.system.rhs, s.system.blockSize, direct, directReport);
   ASSERT_TRUE(directReport.success);
@@ -117,7 +117,7 @@ TEST(PMultigrid, AgglomeratesOfTwoSeparateBodies) {
   cg.kind = SolverKind::ConjugateGradient;
   LinearSolver solver(cg);
   ASSERT_TRUE(solver.compute(s.system.matrix, s.system.blockSize, &s.frames));
-  SolveReport report;
+  LinearSolveReport report;
   const Eigen::VectorXd u = solver.solve(s.system.rhs, report);
   EXPECT_TRUE(report.success);
   EXPECT_LE((u - reference).norm(), kSolutionAgreement * reference.norm());

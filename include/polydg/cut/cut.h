@@ -13,16 +13,15 @@
 #include <vector>
 
 #include "polydg/integrate/moment_cache.h"
+#include "polydg/mesh/plane.h"
 #include "polydg/mesh/poly_mesh.h"
 
 namespace polydg {
 
-/// The blade of a cut: the plane {x : normal . x = offset} (normal need not be unit length;
+/// The blade of a cut: its plane {x : normal . x = offset} (normal need not be unit length;
 /// its minus side is normal . x < offset), or, when `polygon` is not empty, the convex planar
 /// polygon with those corners, which lies in that plane.
-struct Blade {
-  Vec3 normal = Vec3::UnitX();
-  double offset = 0.0;
+struct Blade : Plane {
   std::vector<Vec3> polygon;  ///< empty: the whole plane
 
   /// Throws std::invalid_argument for a zero or non-finite normal or a non-finite offset.
@@ -76,6 +75,9 @@ struct OperationReport {
   std::size_t piecesCreated = 0;    ///< elements made from them (before sliver merging)
   std::size_t elementsRemoved = 0;  ///< pieces deleted by removeSide
   double volumeRemoved = 0.0;
+  /// Pieces below this volume (the sliver fraction times the editor's reference volume) are
+  /// slivers; 0 when merging was off.
+  double sliverThreshold = 0.0;
   std::size_t slivers = 0, sliversMerged = 0, isolatedSlivers = 0;
   std::size_t facesReintegrated = 0;  ///< faces whose moments this operation computed
   std::size_t facesTotal = 0;         ///< faces of the mesh after it
@@ -94,13 +96,24 @@ class MeshEditor {
   /// sliver fractions multiply (the grid cell volume of a sliced mesh); 0: the median element
   /// volume of `mesh`.
   explicit MeshEditor(PolyMesh mesh, double referenceVolume = 0.0);
+  /// The same with the mesh's moments already integrated (up to date for `mesh`, degree >= 2;
+  /// they are taken over, nothing is integrated again); a null or lower-degree cache is
+  /// replaced as above.
+  MeshEditor(PolyMesh mesh, double referenceVolume, std::unique_ptr<MomentCache> moments);
   ~MeshEditor();
   MeshEditor(MeshEditor&&) noexcept;
   MeshEditor& operator=(MeshEditor&&) noexcept;
 
   const PolyMesh& mesh() const;
-  /// Moments up to degree 2 * the largest validation degree used so far (at least 2).
+  /// Moments up to degree 2 * the largest validation degree used so far (at least 2), or the
+  /// degree last asked of requireMoments().
   const MomentCache& moments() const;
+  /// The moments up to at least `degree`: if the cache holds less, every face is integrated
+  /// again, once, to that degree (and kept up to date from then on).
+  const MomentCache& requireMoments(int degree);
+  /// Faces integrated since the editor was made (with the integrations of a cache it was given):
+  /// the work the cache saved shows as a count that grows only with what edits changed.
+  std::size_t facesIntegrated() const;
   double referenceVolume() const;
   /// Total volume, kept up to date incrementally.
   double volume() const;
@@ -120,6 +133,9 @@ class MeshEditor {
 
  private:
   OperationReport cutInPlace(const Blade& blade, const CutOptions& options);
+  /// Replaces the moment cache with one of at least `degree` (every face integrated again,
+  /// once) if it holds less; returns the number of faces integrated.
+  std::size_t raiseMomentDegree(int degree);
 
   struct State;
   std::unique_ptr<State> state_;

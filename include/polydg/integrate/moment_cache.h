@@ -36,6 +36,9 @@ class MomentCache {
   /// Follows the mesh's size: picks up faces and elements appended since the last call (marks
   /// them dirty) and drops those removed from the end.
   void sync();
+  /// The mesh the cache reads was moved to `mesh` (same vertices, faces and elements): the
+  /// moments stay valid and the cache follows it from now on.
+  void rebind(const PolyMesh& mesh) { mesh_ = &mesh; }
 
   // In-place edits (PolyMesh::removeFace / removeElement / reverseFace): call these right after
   // the mesh's operation, so the moments move with their face or element and only new or

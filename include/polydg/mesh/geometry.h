@@ -60,4 +60,12 @@ Box3 meshBounds(const PolyMesh& mesh);
 /// Applies x -> scale * x + offset to every vertex.
 void transform(PolyMesh& mesh, double scale, const Vec3& offset);
 
+/// True for an element that is a whole grid cell: six faces, each a single quadrilateral with
+/// an exactly axis-aligned normal. All such elements of one grid are congruent boxes.
+bool isGridHexahedron(const PolyMesh& mesh, ElementId e);
+
+/// True if the element is convex: every vertex on the inner side of every face plane, within
+/// `relativeTolerance` times the element's size (a reporting statistic, not a decision).
+bool isConvex(const PolyMesh& mesh, ElementId e, double relativeTolerance = 1e-9);
+
 }  // namespace polydg

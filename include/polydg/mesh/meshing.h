@@ -10,16 +10,11 @@
 #include "polydg/mesh/merge_elements.h"
 #include "polydg/mesh/slice.h"
 #include "polydg/mesh/validate.h"
+#include "polydg/util/error.h"
 
 namespace polydg {
 
 enum class RepairMode { None, Fill, Wrap };
-
-/// Raised for input the pipeline refuses; the message is one line naming the defect, its count
-/// and what to do.
-struct InputError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
 
 struct MeshingOptions {
   /// Cell edge length; if unset, `cellsAlongLongest` cells along the bounding box's longest side.
@@ -80,13 +75,7 @@ MeshingResult meshSurface(const TriangleSurface& surface, const MeshingOptions& 
 /// faces, volume and its error, hexahedra, polyhedra, non-convex), timed as phase "validate".
 /// meshSurface() ends with it unless MeshingOptions::validate is false.
 void validateMeshing(MeshingResult& result);
-
-/// True for an element that is a whole grid cell: six faces, each a single quadrilateral with
-/// an exactly axis-aligned normal. All such elements of one grid are congruent boxes.
-bool isGridHexahedron(const PolyMesh& mesh, ElementId e);
-
-/// True if the element is convex: every vertex on the inner side of every face plane, within
-/// `relativeTolerance` times the element's size (a reporting statistic, not a decision).
-bool isConvex(const PolyMesh& mesh, ElementId e, double relativeTolerance = 1e-9);
+/// The same for a mesh kept apart from its report (moved into a model before validation).
+void validateMeshing(const PolyMesh& mesh, MeshingReport& report);
 
 }  // namespace polydg

@@ -12,6 +12,7 @@
 #include <boost/container/small_vector.hpp>
 #include <vector>
 
+#include "polydg/mesh/plane.h"
 #include "polydg/mesh/poly_mesh.h"
 
 namespace polydg {
@@ -31,22 +32,15 @@ struct PiecePolygon {
 /// A closed, outward-oriented set of polygons (one or more connected components).
 using Piece = std::vector<PiecePolygon>;
 
-/// The plane {x : normal . x = offset}. Its minus side is normal . x < offset. When `axis` is
-/// 0, 1 or 2 the plane is axis-aligned (normal = e_axis) and side tests are plain comparisons.
-/// `id` identifies the plane in the shared-vertex map: one id per distinct plane.
-struct SplitPlane {
-  Vec3 normal = Vec3::UnitX();
-  double offset = 0.0;
-  int axis = -1;
+/// A plane to split by, with the `id` that identifies it in the shared-vertex map: one id per
+/// distinct plane.
+struct SplitPlane : Plane {
   std::uint32_t id = 0;
 
+  SplitPlane() = default;
+  SplitPlane(const Plane& plane, std::uint32_t id) : Plane(plane), id(id) {}
   static SplitPlane axisAligned(int axis, double value, std::uint32_t id) {
-    SplitPlane p;
-    p.normal = Vec3::Unit(axis);
-    p.offset = value;
-    p.axis = axis;
-    p.id = id;
-    return p;
+    return {Plane::axisAligned(axis, value), id};
   }
 };
 

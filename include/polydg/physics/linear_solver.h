@@ -57,7 +57,7 @@ struct SolverOptions {
 };
 
 /// What a solve did. Times are wall seconds.
-struct SolveReport {
+struct LinearSolveReport {
   SolverKind used = SolverKind::Auto;
   CgPreconditioner preconditioner = CgPreconditioner::PMultigrid;  ///< CG only
   bool success = false;        ///< factorization succeeded (SPD) / CG converged
@@ -87,7 +87,7 @@ class LinearSolver {
   bool compute(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix, int blockSize,
                const ElementFrames* frames = nullptr);
   /// Solves K U = F; fills `report` (times of this solve; factorSeconds from compute()).
-  Eigen::VectorXd solve(const Eigen::VectorXd& rhs, SolveReport& report);
+  Eigen::VectorXd solve(const Eigen::VectorXd& rhs, LinearSolveReport& report);
 
   SolverKind kind() const;
 
@@ -99,7 +99,7 @@ class LinearSolver {
 /// One-shot: compute() then solve().
 Eigen::VectorXd solveLinearSystem(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix,
                                   const Eigen::VectorXd& rhs, int blockSize,
-                                  const SolverOptions& options, SolveReport& report);
+                                  const SolverOptions& options, LinearSolveReport& report);
 
 /// y = K x for a symmetric matrix stored in both triangles, in parallel over rows.
 void symmetricProduct(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix,

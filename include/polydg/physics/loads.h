@@ -6,25 +6,48 @@
 #include <optional>
 #include <vector>
 
+#include <string>
+
 #include "polydg/mesh/geometry.h"
+#include "polydg/mesh/plane.h"
 
 namespace polydg {
 
 /// A vector field of position, e.g. a prescribed displacement or a force density.
 using VectorField = std::function<Vec3(const Vec3&)>;
 
-/// Chooses boundary faces (faces used by one element only; interior faces are never chosen).
+/// Chooses boundary faces (faces used by one element only; interior faces are never chosen) by
+/// where they lie: the one region selection of clamps and tractions, in `polydg solve`, pipeline
+/// solve steps and simulation scenes. A face is chosen when all its vertices are in the region.
 struct FaceSelector {
   enum class Kind {
     AllBoundary,  ///< every boundary face
-    Plane,        ///< boundary faces whose vertices all lie in the plane x_axis = value
+    /// Faces lying in `plane`: every vertex within kPlaneSelectorTolerance times the mesh's
+    /// bounding-box diagonal of it (a face of a scanned model is never exactly in a plane that
+    /// was typed in; use Below or Box for those).
+    Plane,
+    /// Faces in the closed half-space normal . x <= offset of `plane`, decided exactly.
+    Below,
+    /// Faces in the closed axis-aligned `box`, decided exactly.
+    Box,
   };
   Kind kind = Kind::AllBoundary;
-  int axis = 0;        ///< 0, 1, 2 for x, y, z (Plane only)
-  double value = 0.0;  ///< the plane's coordinate (Plane only)
+  Plane plane;  ///< Plane, Below
+  Box3 box;     ///< Box
 
   static FaceSelector allBoundary() { return {}; }
-  static FaceSelector plane(int axis, double value) { return {Kind::Plane, axis, value}; }
+  /// The faces in the plane x_axis = value (axis 0, 1, 2 for x, y, z).
+  static FaceSelector inPlane(int axis, double value) {
+    return inPlane(Plane::axisAligned(axis, value));
+  }
+  static FaceSelector inPlane(const Plane& p) { return {Kind::Plane, p, Box3()}; }
+  static FaceSelector below(const Plane& p) { return {Kind::Below, p, Box3()}; }
+  /// Throws std::invalid_argument for a box with non-finite corners or min > max.
+  static FaceSelector inBox(const Box3& b);
+
+  /// The region in words and numbers, as users write it: "the plane z = 0", "the plane
+  /// 1,0,1,0.5", "below 0,0,1,0.1", "the box [0,0,0]-[1,1,0.2]", "the whole boundary".
+  std::string describe() const;
 };
 
 /// Relative tolerance of FaceSelector::Plane: a vertex lies in the plane when its distance

@@ -54,7 +54,7 @@ class PMultigrid {
   /// LinearSystem). `matrix` must stay alive while the preconditioner is used. Returns false
   /// if a diagonal block or the level-0 matrix is found not positive definite. A body held by
   /// no Dirichlet condition makes level 0 exactly singular, which the factorization may miss
-  /// on rounding: CG then fails to converge and reports it (SolveReport::success).
+  /// on rounding: CG then fails to converge and reports it (LinearSolveReport::success).
   /// `matrixBlocks`, if given with values, is `matrix` by block rows (BlockRows): the top
   /// level's smoother copy is then converted from it instead of built from the CSR matrix.
   /// `frames`, if given (one per element), replace the degree-0 level by agglomeration levels.

@@ -62,14 +62,17 @@ struct StaticReport {
   double integrateSeconds = 0.0;
   double assembleSeconds = 0.0;  ///< accumulating K from them, and the load vector F
   double solveSeconds = 0.0;     ///< factorization (or preconditioner) and solve
-  SolveReport solver;
+  /// Faces integrated by this solve: every face of the mesh when the solver made its own
+  /// moments, 0 when it used the caller's (StaticSolver's `moments` argument).
+  std::size_t facesIntegrated = 0;
+  LinearSolveReport solver;
   double energy =
       0.0;  ///< U.F / 2: the strain energy U.K.U / 2 when prescribed displacements are 0
 };
 
 /// A solved problem: the bases and the DG coefficients (see LinearSystem for the layout).
 struct StaticSolution {
-  std::unique_ptr<MomentCache> moments;
+  std::unique_ptr<MomentCache> moments;  ///< the solver's own; null if it used the caller's
   std::unique_ptr<DgBasis> basis;
   Eigen::VectorXd coefficients;
   StaticReport report;
@@ -80,9 +83,13 @@ struct StaticSolution {
 class StaticSolver {
  public:
   /// `mesh` must outlive the solver.
-  StaticSolver(const PolyMesh& mesh, const Material& material, const StaticOptions& options);
+  /// `moments`, if given, is the mesh's moment cache, up to date and of degree >= 2p (a model's,
+  /// kept through a pipeline): the solver uses it instead of integrating the mesh again, and it
+  /// must outlive the solver. Throws std::invalid_argument if its degree is too low.
+  StaticSolver(const PolyMesh& mesh, const Material& material, const StaticOptions& options,
+               const MomentCache* moments = nullptr);
 
-  /// Moments up to degree 2p and the bases.
+  /// The bases, with moments up to degree 2p integrated here unless the caller gave them.
   void integrate();
   /// Face roles, penalty, element and face matrices (timed as integration), K and F for
   /// `loads` (calls integrate() first if needed). With
@@ -109,7 +116,8 @@ class StaticSolver {
   const PolyMesh* mesh_;
   Material material_;
   StaticOptions options_;
-  std::unique_ptr<MomentCache> moments_;
+  const MomentCache* moments_ = nullptr;  ///< the caller's, or ownMoments_
+  std::unique_ptr<MomentCache> ownMoments_;
   std::unique_ptr<DgBasis> basis_;
   FaceRoles roles_;
   /// Per-element penalties that form_.elementEta points to (on the heap: stable under moves).
@@ -123,8 +131,8 @@ class StaticSolver {
   StaticReport report_;
 };
 
-/// One-shot: integrate, assemble and solve.
+/// One-shot: integrate (unless `moments` is given, as for StaticSolver), assemble and solve.
 StaticSolution solveStatic(const PolyMesh& mesh, const Material& material, const LoadCase& loads,
-                           const StaticOptions& options = {});
+                           const StaticOptions& options = {}, const MomentCache* moments = nullptr);
 
 }  // namespace polydg

@@ -38,7 +38,9 @@ struct PatchTestResult {
 /// meshes, ~1e-10 with slivers of relative thickness 1e-6, and ~3e-10 for a unit mesh
 /// translated by 1e6 (quadrature points and g are evaluated in absolute coordinates, whose
 /// spacing there is 1e6 * 2^-52 ~ 1e-10). Errors are exact (element mass matrices).
-PatchTestResult patchTest(const PolyMesh& mesh, const PhysicsCheckOptions& options);
+/// `moments`, if given, is the mesh's cache of degree >= 2p (else the mesh is integrated here).
+PatchTestResult patchTest(const PolyMesh& mesh, const PhysicsCheckOptions& options,
+                          const MomentCache* moments = nullptr);
 
 struct ZeroModeReport {
   std::size_t components = 0;                      ///< connected through shared faces
@@ -59,8 +61,9 @@ ZeroModeReport zeroModes(const PolyMesh& mesh, const DgBasis& basis, const Momen
                          const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix);
 
 /// The stiffness matrix without boundary conditions (every boundary face free): expected
-/// exactly 6 zero modes per component.
-ZeroModeReport rigidModes(const PolyMesh& mesh, const PhysicsCheckOptions& options);
+/// exactly 6 zero modes per component. `moments` as for patchTest().
+ZeroModeReport rigidModes(const PolyMesh& mesh, const PhysicsCheckOptions& options,
+                          const MomentCache* moments = nullptr);
 
 struct DefinitenessReport {
   double asymmetry = 0.0;          ///< max |K_ij - K_ji| / max |K_ij|
@@ -69,7 +72,9 @@ struct DefinitenessReport {
 };
 
 /// The stiffness matrix with u = 0 weakly on every boundary face: symmetric positive definite.
-DefinitenessReport definiteness(const PolyMesh& mesh, const PhysicsCheckOptions& options);
+/// `moments` as for patchTest().
+DefinitenessReport definiteness(const PolyMesh& mesh, const PhysicsCheckOptions& options,
+                                const MomentCache* moments = nullptr);
 
 /// A mode of one element's stiffness is zero when its eigenvalue, for the Jacobi-scaled matrix
 /// D^(-1/2) K_K D^(-1/2) (unit diagonal where the diagonal is positive; the constant functions
@@ -120,6 +125,9 @@ struct LocalDgCheck {
   /// makes it SPD on every valid element.
   std::size_t nonDefiniteElements = 0;
   double seconds = 0.0;  ///< wall time, face roles and bases included (moments excluded)
+  /// Faces whose moments the checks integrated (localDgChecksOfSelection(); 0 when the caller
+  /// gave the moments).
+  std::size_t facesIntegrated = 0;
 
   bool passed() const {
     return maxPatchTestError < kLocalPatchTestTolerance && elementsWithWrongRigidModes == 0 &&

@@ -1,0 +1,70 @@
+// Reading polydg's JSON documents (pipelines today, simulation scenes next) strictly: every key
+// is checked, values must have the expected type and range, and every error is one line naming
+// the file and the place ("pipeline.json: steps[1].plnae: unknown key; see ...").
+#pragma once
+
+#include <set>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "polydg/mesh/poly_mesh.h"
+#include "polydg/model/names.h"
+#include "polydg/physics/loads.h"
+#include "polydg/util/error.h"
+
+namespace polydg {
+
+/// Reads one JSON object of a document. Each accessor records the key as known; finish()
+/// refuses any key nobody asked about. Errors throw InputError("FILE: PLACE: WHAT; HINT").
+class JsonObjectReader {
+ public:
+  /// `place` names the object in messages ("pipeline", "steps[2]"); `hint` ends every message.
+  JsonObjectReader(const nlohmann::json& object, std::string place, std::string file,
+                   std::string hint);
+
+  [[noreturn]] void fail(const std::string& place, const std::string& what) const;
+  /// "PLACE.key".
+  std::string at(const std::string& key) const { return place_ + "." + key; }
+  const std::string& place() const { return place_; }
+
+  bool has(const std::string& key);
+  /// The value of a required key (fails if missing).
+  const nlohmann::json& get(const std::string& key);
+  /// A finite number in [lo, hi].
+  double number(const std::string& key, double lo, double hi);
+  /// An integer in [lo, hi].
+  int integer(const std::string& key, int lo, int hi);
+  bool boolean(const std::string& key);
+  std::string string(const std::string& key);
+  /// One of `names` (model/names.h), the choices listed in the error.
+  template <class E>
+  E choice(const std::string& key, const Names<E>& names) {
+    const std::string s = string(key);
+    if (const auto v = parseName(names, s)) return *v;
+    fail(at(key), "'" + s + "' is not one of " + listNames(names));
+  }
+  /// `value` as exactly n finite numbers (`place` names it in errors).
+  std::vector<double> numbers(const nlohmann::json& value, const std::string& place,
+                              std::size_t n) const;
+  Vec3 vec3(const nlohmann::json& value, const std::string& place) const;
+  /// A region of the boundary, from the keys of this object: "below" [a, b, c, d] (the
+  /// half-space a x + b y + c z <= d), "plane" [a, b, c, d] (faces lying in the plane),
+  /// "box" [[x0, y0, z0], [x1, y1, z1]], or "axis" ("x", "y", "z") with "value" (the plane
+  /// axis = value). Exactly one form.
+  FaceSelector selection();
+  /// A reader of the object under `key` (fails unless it is an object).
+  JsonObjectReader object(const std::string& key);
+  /// A reader of element i of the list `list` (named `place` in errors).
+  JsonObjectReader element(const nlohmann::json& list, const std::string& place, std::size_t i) const;
+  /// Call after reading: any key not asked about is an error.
+  void finish() const;
+
+ private:
+  const nlohmann::json& object_;
+  std::string place_, file_, hint_;
+  std::set<std::string> known_;
+};
+
+}  // namespace polydg

@@ -1,0 +1,228 @@
+// The model: one object that owns a polyhedral mesh with its moment cache, its editor and its
+// provenance, and the typed operations every front end applies to it (the polydg commands,
+// pipeline steps, the Python module): create from a surface, read, cut, merge slivers, check,
+// solve, write. Each operation returns a typed report (model/report_json.h gives their JSON).
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "polydg/cut/cut.h"
+#include "polydg/mesh/meshing.h"
+#include "polydg/mesh/vtu_io.h"
+#include "polydg/physics/loads.h"
+#include "polydg/physics/mesh_checks.h"
+#include "polydg/physics/post_process.h"
+#include "polydg/physics/static_solver.h"
+
+namespace polydg {
+
+/// What sliver fractions multiply.
+enum class ReferenceKind {
+  GridCell,       ///< the volume of the slicing grid's cell
+  MedianElement,  ///< the median element volume of the mesh when it was first read
+};
+
+/// Where a mesh came from and the scale its rules refer to. It travels with the mesh (VTU field
+/// data, model/provenance.h), so `polydg mesh` then `polydg cut` applies the same sliver
+/// threshold as one `polydg run` of the same steps.
+struct Provenance {
+  std::string source;      ///< the file the mesh was made from; "" if built in memory
+  double cellSize = 0.0;   ///< edge of the slicing grid's cells; 0 if not sliced by polydg
+  /// The volume sliver fractions multiply: cellSize^3 for a sliced mesh, else the median
+  /// element volume when the mesh was first read. Positive.
+  double referenceVolume = 0.0;
+  ReferenceKind referenceKind = ReferenceKind::MedianElement;
+  /// The sliver rule: pieces below this fraction of the reference volume are slivers. Meshing
+  /// sets it (MeshOptions::sliverFraction); later cuts and merges use it unless told otherwise.
+  double sliverFraction = kDefaultSliverFraction;
+};
+
+// --- creation ------------------------------------------------------------------------------
+
+/// Options of Model::fromSurface() (`polydg mesh`, pipeline mesh steps, polydg.mesh()).
+struct MeshOptions {
+  /// Cell edge length; if unset, `cells` cells along the bounding box's longest side.
+  std::optional<double> cellSize;
+  int cells = 0;
+  RepairMode repair = RepairMode::None;
+  /// Elements below this fraction of a cell's volume are merged into a neighbour (0: off).
+  double sliverFraction = kDefaultSliverFraction;
+  /// The element-local DG checks (degree 1) of the new mesh, besides the geometric validation.
+  bool dgChecks = true;
+  /// Moments to keep on the model: 0 integrates only what the DG checks read (for a mesh that is
+  /// written and dropped); d >= 2 integrates every face once to degree d, the DG checks read
+  /// them, and later operations of up to degree d integrate nothing again.
+  int momentDegree = 0;
+  /// If not empty, the mesh is written to this VTU while it is validated and checked (the three
+  /// overlap); the file appears only if every check passed.
+  std::string output;
+  ProgressFn progress;  ///< slicing progress in [0, 1]
+};
+
+struct MeshReport {
+  MeshingReport meshing;  ///< input checks, grid, slicing, slivers, geometric validation
+  /// The DG checks of the new mesh (no geometry: that is meshing.validation); empty local
+  /// check when skipped (MeshOptions::dgChecks false, or the geometry failed).
+  MeshCheck dg;
+  std::string output;    ///< the file written, "" if none
+  double readSeconds = 0.0;   ///< set by callers that read the surface (fromFile)
+  double writeSeconds = 0.0;  ///< overlapped with the checks
+  double wallSeconds = 0.0;   ///< the whole operation, read to write
+
+  bool passed() const { return meshing.validation.passed && dg.passed(); }
+  /// One line per failed check (empty when passed).
+  std::vector<std::string> failures() const;
+};
+
+/// What Model::read() found.
+struct ReadReport {
+  std::string file;
+  std::size_t elements = 0, faces = 0, vertices = 0;
+  bool provenanceRestored = false;  ///< the file carried polydg's provenance field data
+  double seconds = 0.0;
+};
+
+// --- operations ----------------------------------------------------------------------------
+
+/// A cut of the model (`polydg cut`, pipeline cut steps, Model.cut in Python).
+struct CutRequest {
+  Blade blade;
+  /// +1: delete the plus side (normal . x > offset), -1 the minus side, 0 keep both.
+  int removeSide = 0;
+  /// Pieces below this fraction of the reference volume are merged (0: never); unset: the
+  /// mesh's sliver rule (Provenance::sliverFraction).
+  std::optional<double> sliverFraction;
+  ValidationLevel validation = ValidationLevel::Local;
+  int validationDegree = 1;
+};
+
+/// A sliver merge (`merge` pipeline steps).
+struct MergeRequest {
+  std::optional<double> fraction;  ///< unset: the mesh's sliver rule
+  ValidationLevel validation = ValidationLevel::Local;
+  int validationDegree = 1;
+};
+
+/// A traction (force per area) on a region of the boundary.
+struct TractionLoad {
+  FaceSelector where;
+  Vec3 traction = Vec3::Zero();
+};
+
+/// A static solve (`polydg solve`, pipeline solve steps, Model.solve in Python).
+struct SolveOptions {
+  Method method = Method::IP;
+  int degree = 1;
+  Material material;
+  Vec3 gravity = Vec3::Zero();
+  std::vector<FaceSelector> clamps;  ///< u = 0 (weakly) on each; at least one
+  std::vector<TractionLoad> tractions;
+  SolverKind solver = SolverKind::Auto;
+  PenaltyRule penalty = PenaltyRule::TraceBound;
+  double eta = 0.0;  ///< PenaltyRule::Fixed: the penalty; Doubling: the first value (0: 1)
+};
+
+/// What a solve did, with the figures of its solution.
+struct SolveReport {
+  SolveOptions options;
+  StaticReport solve;
+  std::vector<std::size_t> clampFaces;    ///< boundary faces each clamp selected
+  std::vector<std::size_t> tractionFaces;  ///< boundary faces each traction selected
+  double maxDisplacement = 0.0;  ///< largest |u_K(v)| over element corners
+  double maxVonMises = 0.0;      ///< largest element von Mises stress
+  double maxJump = 0.0;          ///< largest displacement jump across interior faces
+  std::size_t facesIntegrated = 0;  ///< by this solve (0 when the model's moments sufficed)
+};
+
+/// The solution of the model's last solve, until the mesh changes.
+struct Solution {
+  std::unique_ptr<DgBasis> basis;
+  Eigen::VectorXd coefficients;  ///< LinearSystem's layout
+  Material material;
+  CornerValues corners;  ///< u_K at every corner (eq. 17 averages them per side of a cut)
+  ElementFields fields;  ///< mean displacement, von Mises, largest jump per element
+};
+
+struct WriteOptions {
+  VtuEncoding encoding = VtuEncoding::Appended;
+  /// Add the last solution's fields (point displacement, per element mean displacement, von
+  /// Mises stress, largest jump) if there is one.
+  bool solution = true;
+};
+
+struct WriteReport {
+  std::string file;
+  bool withSolution = false;
+  double seconds = 0.0;
+};
+
+/// A polyhedral mesh with its cached integrals, editor and provenance. Operations keep the
+/// moment cache up to date: every face is integrated once (to the highest degree asked for so
+/// far) and again only when an edit changes it; facesIntegrated() counts every integration.
+/// Not thread-safe: one thread at a time (const members may be called concurrently).
+class Model {
+ public:
+  /// A model of `mesh` (which must be valid for the operations to mean anything). An unset or
+  /// non-positive reference volume in `provenance` becomes the median element volume.
+  explicit Model(PolyMesh mesh, Provenance provenance = {});
+  ~Model();
+  Model(Model&&) noexcept;
+  Model& operator=(Model&&) noexcept;
+
+  /// Meshes a surface: checks it, orients or repairs it, slices it, merges slivers, validates
+  /// the mesh and runs the DG checks of `options`. Throws InputError (one line naming the
+  /// defect) for a surface it refuses. A mesh that fails a check is returned with
+  /// `report.passed()` false (and no file written); `source` becomes the provenance's.
+  static Model fromSurface(const TriangleSurface& surface, const MeshOptions& options,
+                           MeshReport& report, const std::string& source = "");
+
+  /// Reads a VTU file (mesh/vtu_io.h) with its provenance if polydg wrote it. Throws InputError
+  /// for a file it cannot read.
+  static Model read(const std::string& path, ReadReport* report = nullptr);
+
+  const PolyMesh& mesh() const;
+  const Provenance& provenance() const;
+  /// Sum of the element volumes (from the moments if integrated, else signedVolume()).
+  double volume() const;
+
+  /// The moments up to at least `degree` (integrated now if the cache holds less).
+  const MomentCache& moments(int degree = 2);
+  /// Faces integrated over the model's life (every integration of every face counts).
+  std::size_t facesIntegrated() const;
+
+  /// Cuts the model in place and validates the operation. Throws InputError for bad options.
+  /// A failed validation (or a cut that would leave nothing) throws CheckFailure naming the
+  /// operation and the check; the model must then not be used further.
+  OperationReport cut(const CutRequest& request);
+  /// Merges slivers (see MergeRequest), validated like a cut.
+  OperationReport mergeSlivers(const MergeRequest& request);
+
+  /// The checks of `options` (physics/mesh_checks.h) with the model's moments.
+  MeshCheck check(const MeshCheckOptions& options);
+
+  /// Static linear elasticity: validates the mesh, selects the clamped and loaded faces
+  /// (InputError naming a selection that picks no face), assembles with the model's moments,
+  /// solves, and keeps the solution (solution()). Throws CheckFailure if the mesh is invalid or
+  /// the stiffness is singular (a piece left free).
+  SolveReport solve(const SolveOptions& options);
+  /// The last solve's solution; null after an edit or before any solve.
+  const Solution* solution() const;
+
+  /// Writes the model as a VTU file with its provenance (and the solution's fields, see
+  /// WriteOptions), atomically: `path` is never left half-written.
+  WriteReport write(const std::string& path, const WriteOptions& options = {}) const;
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
+
+/// The default reference volume of a mesh read from a file: its median element volume.
+double medianElementVolume(const PolyMesh& mesh);
+
+}  // namespace polydg

@@ -1,0 +1,26 @@
+// The errors polydg reports to its users: each carries one line saying what is wrong and what
+// to do about it. Front ends map them to exit codes (the CLI) or to polydg.Error (Python).
+#pragma once
+
+#include <stdexcept>
+
+namespace polydg {
+
+/// An error meant for the user: one line naming the problem and what to do about it.
+struct Error : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+/// Input polydg refuses: a file, an option value or a request that cannot be carried out as
+/// given (the CLI exits with 2). Nothing was changed or written.
+struct InputError : Error {
+  using Error::Error;
+};
+
+/// An operation that ran but whose result failed a check, or left nothing (the CLI exits
+/// with 1). Its outputs were not written.
+struct CheckFailure : Error {
+  using Error::Error;
+};
+
+}  // namespace polydg

@@ -1,0 +1,497 @@
+#include "polydg/model/model.h"
+
+#include <algorithm>
+#include <cmath>
+#include <exception>
+#include <filesystem>
+#include <sstream>
+
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
+#include <unistd.h>
+
+#include "polydg/mesh/geometry.h"
+#include "polydg/model/provenance.h"
+#include "polydg/util/error.h"
+#include "polydg/util/stopwatch.h"
+
+namespace polydg {
+
+namespace fs = std::filesystem;
+
+/// The model's parts. Until the first edit the model holds the mesh and its moment cache
+/// itself; the first cut or merge hands both to a MeshEditor, which owns them from then on.
+struct Model::State {
+  Provenance provenance;
+  PolyMesh mesh;                          ///< until the first edit
+  std::unique_ptr<MomentCache> moments;   ///< until the first edit (null until needed)
+  std::unique_ptr<MeshEditor> editor;     ///< from the first edit
+  std::size_t retiredIntegrations = 0;    ///< faces integrated by caches replaced before it
+  /// Whether the mesh is known to pass validate(): set by a passed validation, kept by edits
+  /// whose own validation passed, unknown (nullopt) after an unvalidated edit.
+  std::optional<bool> valid;
+  /// Set by an operation that failed part-way: the mesh must not be used further.
+  std::string broken;
+  std::optional<Solution> solution;
+
+  const PolyMesh& currentMesh() const { return editor ? editor->mesh() : mesh; }
+  const MomentCache* currentMoments() const {
+    return editor ? &editor->moments() : moments.get();
+  }
+  MeshEditor& edit() {
+    if (!editor) {
+      editor = std::make_unique<MeshEditor>(std::move(mesh), provenance.referenceVolume,
+                                            std::move(moments));
+      mesh = PolyMesh();
+    }
+    return *editor;
+  }
+  void requireUsable() const {
+    if (!broken.empty())
+      throw CheckFailure("the model cannot be used after a failed operation (" + broken +
+                         "); start again from its input");
+  }
+};
+
+double medianElementVolume(const PolyMesh& mesh) {
+  if (mesh.numElements() == 0) return 0.0;
+  std::vector<double> volumes(mesh.numElements());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, volumes.size(), 4096),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t e = r.begin(); e != r.end(); ++e)
+                        volumes[e] = signedVolume(mesh, ElementId(e));
+                    });
+  std::nth_element(volumes.begin(), volumes.begin() + volumes.size() / 2, volumes.end());
+  return volumes[volumes.size() / 2];
+}
+
+Model::Model(PolyMesh mesh, Provenance provenance) : state_(std::make_unique<State>()) {
+  if (mesh.numElements() == 0)
+    throw InputError("the mesh has no elements; there is nothing to model");
+  if (!(provenance.referenceVolume > 0.0) || !std::isfinite(provenance.referenceVolume)) {
+    provenance.referenceVolume = medianElementVolume(mesh);
+    provenance.referenceKind = ReferenceKind::MedianElement;
+    if (!(provenance.referenceVolume > 0.0))
+      throw InputError("the median element volume is not positive: the mesh is inverted or "
+                       "flat; run 'polydg check' on it");
+  }
+  state_->provenance = std::move(provenance);
+  state_->mesh = std::move(mesh);
+}
+
+Model::~Model() = default;
+Model::Model(Model&&) noexcept = default;
+Model& Model::operator=(Model&&) noexcept = default;
+
+const PolyMesh& Model::mesh() const { return state_->currentMesh(); }
+const Provenance& Model::provenance() const { return state_->provenance; }
+
+double Model::volume() const {
+  if (state_->editor) return state_->editor->volume();
+  const PolyMesh& mesh = state_->mesh;
+  double v = 0.0;
+  if (const MomentCache* m = state_->moments.get())
+    for (std::size_t e = 0; e < mesh.numElements(); ++e) v += m->volume(ElementId(e));
+  else
+    for (std::size_t e = 0; e < mesh.numElements(); ++e) v += signedVolume(mesh, ElementId(e));
+  return v;
+}
+
+const MomentCache& Model::moments(int degree) {
+  State& s = *state_;
+  s.requireUsable();
+  // Degree 2 at least: every DG operation of degree 1 reads those, so a first request for
+  // volumes alone does not cost a second integration later.
+  degree = std::max(degree, 2);
+  if (s.editor) return s.editor->requireMoments(degree);
+  if (!s.moments || s.moments->degree() < degree) {
+    if (s.moments) s.retiredIntegrations += s.moments->facesIntegrated();
+    s.moments = std::make_unique<MomentCache>(s.mesh, degree);
+    s.moments->update();
+  }
+  return *s.moments;
+}
+
+std::size_t Model::facesIntegrated() const {
+  const State& s = *state_;
+  if (s.editor) return s.retiredIntegrations + s.editor->facesIntegrated();
+  return s.retiredIntegrations + (s.moments ? s.moments->facesIntegrated() : 0);
+}
+
+// --- creation ------------------------------------------------------------------------------
+
+std::vector<std::string> MeshReport::failures() const {
+  std::vector<std::string> out;
+  if (!meshing.validation.passed) {
+    if (meshing.validation.messages.empty()) out.push_back("geometry: the new mesh is invalid");
+    for (const std::string& m : meshing.validation.messages) out.push_back("geometry: " + m);
+  }
+  for (std::string& m : dg.failures()) out.push_back(std::move(m));
+  return out;
+}
+
+namespace {
+
+/// A file written under a temporary name beside `path` and renamed into place by commit();
+/// removed if never committed.
+class PendingFile {
+ public:
+  explicit PendingFile(std::string path)
+      : path_(std::move(path)), temporary_(path_ + ".pending-" + std::to_string(::getpid())) {}
+  ~PendingFile() {
+    std::error_code ignored;
+    if (!committed_) fs::remove(temporary_, ignored);
+  }
+  const std::string& temporary() const { return temporary_; }
+  void commit() {
+    std::error_code ec;
+    fs::rename(temporary_, path_, ec);
+    if (ec) throw InputError("cannot write " + path_ + ": " + ec.message());
+    committed_ = true;
+  }
+
+ private:
+  std::string path_, temporary_;
+  bool committed_ = false;
+};
+
+}  // namespace
+
+Model Model::fromSurface(const TriangleSurface& surface, const MeshOptions& options,
+                         MeshReport& report, const std::string& source) {
+  const Stopwatch wall;
+  if (options.momentDegree != 0 && (options.momentDegree < 2 || options.momentDegree > 6))
+    throw InputError("the moment degree to keep must be 0 or 2..6");
+  MeshingOptions meshing;
+  meshing.cellSize = options.cellSize;
+  meshing.cellsAlongLongest = options.cells;
+  meshing.repair = options.repair;
+  meshing.sliverTau = options.sliverFraction;
+  meshing.progress = options.progress;
+  meshing.validate = false;  // below, beside the checks and the writing
+  MeshingResult meshed = meshSurface(surface, meshing);
+  report.meshing = std::move(meshed.report);
+  const Grid& grid = report.meshing.grid;
+
+  Provenance provenance;
+  provenance.source = source;
+  provenance.cellSize = grid.cellSize;
+  provenance.referenceVolume = grid.cellSize * grid.cellSize * grid.cellSize;
+  provenance.referenceKind = ReferenceKind::GridCell;
+  provenance.sliverFraction = options.sliverFraction;
+  Model model(std::move(meshed.mesh), provenance);
+  const PolyMesh& mesh = model.mesh();
+
+  // The mesh is validated, DG-checked and written side by side: all three only read it, and
+  // the writer's serial part (formatting and I/O) fills the gaps of the checks' parallel
+  // loops. The DG checks presume a geometrically valid mesh (faces shared properly), so their
+  // outcome counts only if the validation passed; the file is kept only if everything passed.
+  std::optional<PendingFile> file;
+  if (!options.output.empty()) file.emplace(options.output);
+  std::exception_ptr writeFailure, dgFailure;
+  MeshCheck dg;
+  tbb::parallel_invoke(
+      [&] { validateMeshing(mesh, report.meshing); },
+      [&] {
+        if (!options.dgChecks) return;
+        try {
+          MeshCheckOptions checks;
+          checks.degree = 1;
+          checks.geometry = false;
+          checks.oneGridCellForAll = true;
+          checks.rigidModes = GlobalCheck::Never;
+          const MomentCache* moments =
+              options.momentDegree > 0 ? &model.moments(options.momentDegree) : nullptr;
+          dg = checkMesh(mesh, checks, moments);
+        } catch (...) {
+          dgFailure = std::current_exception();
+        }
+      },
+      [&] {
+        if (!file) return;
+        try {
+          const Stopwatch write;
+          writeVtu(mesh, file->temporary(), {}, {}, {}, {}, provenanceFieldData(provenance));
+          report.writeSeconds = write.seconds();
+        } catch (...) {
+          writeFailure = std::current_exception();
+        }
+      });
+  if (options.momentDegree > 0 && !options.dgChecks) model.moments(options.momentDegree);
+  if (!report.meshing.validation.passed) {
+    dg = MeshCheck();
+    dg.notes.push_back("DG checks skipped: the mesh failed the geometric validation");
+  } else if (dgFailure) {
+    std::rethrow_exception(dgFailure);
+  }
+  if (!options.dgChecks) dg.notes.push_back("DG checks skipped (not asked for)");
+  report.dg = std::move(dg);
+  if (writeFailure) std::rethrow_exception(writeFailure);
+  model.state_->valid = report.meshing.validation.passed;
+  if (file && report.passed()) {
+    file->commit();
+    report.output = options.output;
+  }
+  report.wallSeconds = wall.seconds();
+  return model;
+}
+
+Model Model::read(const std::string& path, ReadReport* report) {
+  const Stopwatch watch;
+  VtuFieldData fields;
+  PolyMesh mesh;
+  try {
+    mesh = readVtu(path, &fields);
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw InputError(e.what());
+  }
+  if (mesh.numElements() == 0)
+    throw InputError(path + ": the file holds no cells; there is nothing to model");
+  const std::optional<Provenance> stored = provenanceFromFieldData(fields);
+  Provenance provenance;
+  if (stored) {
+    provenance = *stored;
+  } else {
+    provenance.source = path;
+  }
+  Model model(std::move(mesh), provenance);
+  if (report) {
+    report->file = path;
+    report->elements = model.mesh().numElements();
+    report->faces = model.mesh().numFaces();
+    report->vertices = model.mesh().numVertices();
+    report->provenanceRestored = stored.has_value();
+    report->seconds = watch.seconds();
+  }
+  return model;
+}
+
+// --- editing -------------------------------------------------------------------------------
+
+namespace {
+
+/// The checks an edit's report asks of the model: a validation that failed or an edit that
+/// left no element makes the operation fail.
+void judgeEdit(OperationReport& report, const PolyMesh& mesh) {
+  if (mesh.numElements() == 0 && report.validation.passed) {
+    report.validation.passed = false;
+    report.validation.failure =
+        "the " + report.op + " left no element (everything was removed); nothing to write";
+  }
+}
+
+}  // namespace
+
+OperationReport Model::cut(const CutRequest& request) {
+  State& s = *state_;
+  s.requireUsable();
+  CutOptions options;
+  options.removeSide = request.removeSide;
+  options.sliverFraction = request.sliverFraction.value_or(s.provenance.sliverFraction);
+  options.validation = request.validation;
+  options.validationDegree = request.validationDegree;
+  if (request.removeSide < -1 || request.removeSide > 1)
+    throw InputError("the side to remove must be +, - or none");
+  if (!(options.sliverFraction >= 0.0 && options.sliverFraction <= 1.0))
+    throw InputError("the sliver fraction must be a number in [0, 1]");
+  if (options.validationDegree < 1 || options.validationDegree > 3)
+    throw InputError("the validation degree must be 1, 2 or 3");
+  OperationReport report = s.edit().cut(request.blade, options);
+  s.solution.reset();
+  judgeEdit(report, mesh());
+  if (!report.validation.passed) s.broken = report.op + " failed: " + report.validation.failure;
+  else if (request.validation == ValidationLevel::None) s.valid.reset();
+  return report;
+}
+
+OperationReport Model::mergeSlivers(const MergeRequest& request) {
+  State& s = *state_;
+  s.requireUsable();
+  const double fraction = request.fraction.value_or(s.provenance.sliverFraction);
+  if (!(fraction >= 0.0 && fraction <= 1.0))
+    throw InputError("the sliver fraction must be a number in [0, 1]");
+  if (request.validationDegree < 1 || request.validationDegree > 3)
+    throw InputError("the validation degree must be 1, 2 or 3");
+  OperationReport report =
+      s.edit().mergeSlivers(fraction, request.validation, request.validationDegree);
+  s.solution.reset();
+  judgeEdit(report, mesh());
+  if (!report.validation.passed) s.broken = "merge failed: " + report.validation.failure;
+  else if (request.validation == ValidationLevel::None) s.valid.reset();
+  return report;
+}
+
+// --- checks and solves ---------------------------------------------------------------------
+
+MeshCheck Model::check(const MeshCheckOptions& options) {
+  State& s = *state_;
+  s.requireUsable();
+  if (options.degree < 1 || options.degree > 3)
+    throw InputError("the degree of the DG checks must be 1, 2 or 3");
+  const bool dg = options.local || options.patchTest != GlobalCheck::Never ||
+                  options.rigidModes != GlobalCheck::Never;
+  // Integrate (once, for this and every later operation) only what the DG checks read.
+  const MomentCache* moments = dg ? &this->moments(2 * options.degree) : nullptr;
+  MeshCheck c = checkMesh(mesh(), options, moments);
+  if (c.geometry) s.valid = c.geometry->passed;
+  return c;
+}
+
+namespace {
+
+/// Boundary faces each selection picks (a selection of zero faces is an error for the caller).
+std::vector<std::size_t> countSelected(const PolyMesh& mesh,
+                                       const std::vector<const FaceSelector*>& selections) {
+  std::vector<std::size_t> counts(selections.size(), 0);
+  const double diagonal = meshBounds(mesh).diagonal().norm();
+  for (std::size_t f = 0; f < mesh.numFaces(); ++f) {
+    if (!mesh.face(FaceId(f)).isBoundary()) continue;
+    for (std::size_t i = 0; i < selections.size(); ++i)
+      counts[i] += selects(*selections[i], mesh, FaceId(f), diagonal);
+  }
+  return counts;
+}
+
+std::string boxText(const Box3& box) {
+  std::ostringstream s;
+  s << "[" << box.min().x() << "," << box.min().y() << "," << box.min().z() << "]-["
+    << box.max().x() << "," << box.max().y() << "," << box.max().z() << "]";
+  return s.str();
+}
+
+}  // namespace
+
+SolveReport Model::solve(const SolveOptions& options) {
+  State& s = *state_;
+  s.requireUsable();
+  try {
+    options.material.check();
+  } catch (const std::invalid_argument& e) {
+    throw InputError(std::string(e.what()) + "; check E, nu and density");
+  }
+  if (options.degree < 1 || options.degree > 3)
+    throw InputError("the degree must be 1, 2 or 3");
+  if (!options.gravity.allFinite()) throw InputError("gravity must be three finite numbers");
+  for (const TractionLoad& t : options.tractions)
+    if (!t.traction.allFinite()) throw InputError("a traction must be three finite numbers");
+  if (options.clamps.empty())
+    throw InputError("nothing holds the body: give at least one clamp (a plane, below or box)");
+  const PolyMesh& m = mesh();
+  if (!s.valid.has_value()) s.valid = validate(m).passed;
+  if (!*s.valid) {
+    const ValidationReport v = validate(m);
+    throw CheckFailure("the mesh is invalid (" +
+                       (v.messages.empty() ? std::string("see 'polydg check'") : v.messages.front()) +
+                       "); run 'polydg check' for details");
+  }
+
+  // Every selection must pick something.
+  std::vector<const FaceSelector*> selections;
+  for (const FaceSelector& c : options.clamps) selections.push_back(&c);
+  for (const TractionLoad& t : options.tractions) selections.push_back(&t.where);
+  const std::vector<std::size_t> counts = countSelected(m, selections);
+  SolveReport report;
+  report.options = options;
+  for (std::size_t i = 0; i < counts.size(); ++i) {
+    const bool clamp = i < options.clamps.size();
+    (clamp ? report.clampFaces : report.tractionFaces).push_back(counts[i]);
+    if (counts[i] == 0)
+      throw InputError(std::string(clamp ? "the clamp " : "the traction on ") +
+                       selections[i]->describe() + " selects no boundary face (the mesh spans " +
+                       boxText(meshBounds(m)) + "); use a region that meets the boundary");
+  }
+
+  LoadCase loads;
+  for (const FaceSelector& c : options.clamps) loads.dirichlet.push_back({c, {}});
+  for (const TractionLoad& t : options.tractions) loads.tractions.push_back({t.where, t.traction});
+  loads.gravity = options.gravity;
+  StaticOptions so;
+  so.discretization.method = options.method;
+  so.discretization.basis.degree = options.degree;
+  so.discretization.penalty.rule = options.penalty;
+  if (options.penalty != PenaltyRule::TraceBound) {
+    if (options.penalty == PenaltyRule::Fixed && !(options.eta > 0.0 && std::isfinite(options.eta)))
+      throw InputError("a fixed penalty needs a positive, finite eta");
+    if (options.eta > 0.0) so.discretization.penalty.eta = options.eta;
+  }
+  so.solver.kind = options.solver;
+
+  const std::size_t before = facesIntegrated();
+  const MomentCache& moments = this->moments(2 * options.degree);
+  StaticSolver solver(m, options.material, so, &moments);
+  solver.integrate();
+  solver.assemble(loads);
+  try {
+    solver.solve();
+  } catch (const std::runtime_error& e) {
+    throw CheckFailure(std::string(e.what()) + "; hold every piece of the body with a clamp");
+  }
+  report.solve = solver.report();
+  if (!report.solve.solver.success)
+    throw CheckFailure("the linear solver did not converge (residual " +
+                       std::to_string(report.solve.solver.residual) +
+                       "); is every piece of the body clamped?");
+  report.facesIntegrated = facesIntegrated() - before;
+
+  StaticSolution solved = solver.release();
+  Solution solution;
+  solution.material = options.material;
+  solution.basis = std::move(solved.basis);
+  solution.coefficients = std::move(solved.coefficients);
+  solution.corners = cornerDisplacements(m, *solution.basis, solution.coefficients);
+  solution.fields =
+      elementFields(m, *solution.basis, moments, solution.coefficients, options.material);
+  report.maxDisplacement = solution.corners.largestNorm();
+  for (double j : solution.fields.largestJump) report.maxJump = std::max(report.maxJump, j);
+  for (double v : solution.fields.vonMises) report.maxVonMises = std::max(report.maxVonMises, v);
+  s.solution = std::move(solution);
+  return report;
+}
+
+const Solution* Model::solution() const {
+  return state_->solution ? &*state_->solution : nullptr;
+}
+
+// --- writing -------------------------------------------------------------------------------
+
+namespace {
+
+template <class Tag>
+VtuArray<Tag> vectorArray(const std::string& name, const IndexedData<Tag, Vec3>& data) {
+  VtuArray<Tag> a{name, 3, {}};
+  a.values.reserve(3 * data.size());
+  for (const Vec3& v : data) a.values.insert(a.values.end(), {v.x(), v.y(), v.z()});
+  return a;
+}
+
+}  // namespace
+
+WriteReport Model::write(const std::string& path, const WriteOptions& options) const {
+  const State& s = *state_;
+  s.requireUsable();
+  const Stopwatch watch;
+  VtuWriteOptions vtu;
+  vtu.encoding = options.encoding;
+  std::vector<CellArray> cells;
+  std::vector<CornerArray> corners;
+  const bool withSolution = options.solution && s.solution.has_value();
+  if (withSolution) {
+    const Solution& u = *s.solution;
+    cells = {vectorArray("mean_displacement", u.fields.meanDisplacement),
+             CellArray{"von_mises", 1, u.fields.vonMises.raw()},
+             CellArray{"largest_jump", 1, u.fields.largestJump.raw()}};
+    corners.push_back(displacementPointData(u.corners));
+  }
+  try {
+    writeVtu(mesh(), path, vtu, cells, {}, corners, provenanceFieldData(s.provenance));
+  } catch (const std::invalid_argument&) {
+    throw;
+  } catch (const std::runtime_error& e) {
+    throw InputError(e.what());
+  }
+  return {path, withSolution, watch.seconds()};
+}
+
+}  // namespace polydg

@@ -1,0 +1,48 @@
+#include "polydg/model/names.h"
+
+namespace polydg {
+
+const Names<Method>& methodNames() {
+  static const Names<Method> names{{"ip", Method::IP}, {"bz", Method::BZ}};
+  return names;
+}
+
+const Names<SolverKind>& solverNames() {
+  static const Names<SolverKind> names{{"auto", SolverKind::Auto},
+                                       {"cholesky", SolverKind::Cholesky},
+                                       {"cg", SolverKind::ConjugateGradient}};
+  return names;
+}
+
+const Names<PenaltyRule>& penaltyNames() {
+  static const Names<PenaltyRule> names{{"bound", PenaltyRule::TraceBound},
+                                        {"doubling", PenaltyRule::Doubling},
+                                        {"fixed", PenaltyRule::Fixed}};
+  return names;
+}
+
+const Names<RepairMode>& repairNames() {
+  static const Names<RepairMode> names{
+      {"none", RepairMode::None}, {"fill", RepairMode::Fill}, {"wrap", RepairMode::Wrap}};
+  return names;
+}
+
+const Names<ValidationLevel>& validationNames() {
+  static const Names<ValidationLevel> names{{"none", ValidationLevel::None},
+                                            {"local", ValidationLevel::Local},
+                                            {"full", ValidationLevel::Full}};
+  return names;
+}
+
+const Names<CgPreconditioner>& preconditionerNames() {
+  static const Names<CgPreconditioner> names{{"p-multigrid", CgPreconditioner::PMultigrid},
+                                             {"block-jacobi", CgPreconditioner::BlockJacobi}};
+  return names;
+}
+
+const Names<int>& removeSideNames() {
+  static const Names<int> names{{"+", 1}, {"-", -1}, {"none", 0}};
+  return names;
+}
+
+}  // namespace polydg

@@ -1,0 +1,305 @@
+#include "polydg/model/report_json.h"
+
+#include "polydg/model/names.h"
+
+namespace polydg {
+
+using nlohmann::json;
+
+namespace {
+
+json idOrNull(ElementId e) { return e.valid() ? json(e.value) : json(nullptr); }
+
+json vectorJson(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
+
+/// The region of a selection as pipelines write it.
+json selectionJson(const FaceSelector& s) {
+  const auto plane = [](const Plane& p) {
+    return json{p.normal.x(), p.normal.y(), p.normal.z(), p.offset};
+  };
+  switch (s.kind) {
+    case FaceSelector::Kind::AllBoundary: return {{"all", true}};
+    case FaceSelector::Kind::Plane: return {{"plane", plane(s.plane)}};
+    case FaceSelector::Kind::Below: return {{"below", plane(s.plane)}};
+    case FaceSelector::Kind::Box:
+      return {{"box", {vectorJson(s.box.min()), vectorJson(s.box.max())}}};
+  }
+  return nullptr;
+}
+
+/// The keys of the local DG checks when they did not run.
+void nullLocalKeys(json& v) {
+  v["patch_test_error"] = nullptr;
+  v["rigid_mode_failures"] = nullptr;
+  v["dg_passed"] = nullptr;
+  v["dg_seconds"] = nullptr;
+}
+
+json timingsJson(const std::vector<std::pair<std::string, double>>& timings) {
+  json out = json::object();
+  double total = 0.0;
+  for (const auto& [phase, seconds] : timings) {
+    out[phase] = seconds;
+    total += seconds;
+  }
+  out["total"] = total;
+  return out;
+}
+
+}  // namespace
+
+json toJson(const Box3& box) {
+  if (box.isEmpty()) return nullptr;
+  return {{"min", vectorJson(box.min())}, {"max", vectorJson(box.max())}};
+}
+
+json toJson(const Provenance& p) {
+  return {{"source", p.source},
+          {"cell_size", p.cellSize > 0.0 ? json(p.cellSize) : json(nullptr)},
+          {"reference_volume", p.referenceVolume},
+          {"reference", p.referenceKind == ReferenceKind::GridCell ? "grid_cell" : "median_element"},
+          {"sliver_fraction", p.sliverFraction},
+          {"sliver_threshold", p.sliverFraction * p.referenceVolume}};
+}
+
+json toJson(const ValidationReport& r) {
+  return {{"passed", r.passed},
+          {"elements", r.elements},
+          {"faces", r.faces},
+          {"interior_faces", r.interiorFaces},
+          {"boundary_faces", r.boundaryFaces},
+          {"components", r.components},
+          {"volume", r.volume},
+          {"min_element_volume", r.minElementVolume},
+          {"max_element_volume", r.maxElementVolume},
+          {"problems",
+           {{"open_elements", r.openElements},
+            {"non_positive_elements", r.nonPositiveElements},
+            {"non_planar_faces", r.nonPlanarFaces},
+            {"degenerate_faces", r.degenerateFaces},
+            {"duplicate_faces", r.duplicateFaces},
+            {"inconsistent_faces", r.inconsistentFaces},
+            {"empty_elements", r.emptyElements}}},
+          {"messages", r.messages}};
+}
+
+json toJson(const LocalDgCheck& c, double seconds) {
+  return {{"dg_degree", c.degree},
+          {"patch_test_error", c.maxPatchTestError},
+          {"patch_test_tolerance", kLocalPatchTestTolerance},
+          {"patch_test_failures", c.patchTestFailures},
+          {"worst_patch_test_element", idOrNull(c.worstPatchTestElement)},
+          {"rigid_mode_failures", c.elementsWithWrongRigidModes},
+          {"first_rigid_mode_failure", idOrNull(c.firstWrongRigidModeElement)},
+          {"non_definite_elements", c.nonDefiniteElements},
+          {"dg_elements_checked", c.elements},
+          {"dg_passed", c.passed()},
+          {"dg_seconds", seconds}};
+}
+
+json toJson(const MeshCheck& c) {
+  json v = c.geometry ? toJson(*c.geometry) : json::object();
+  v["passed"] = c.passed();
+  v["geometry_passed"] = c.geometryPassed();
+  v["dg_checked"] = c.local.has_value();
+  v["messages"] = json::array();
+  if (c.geometry)
+    for (const std::string& m : c.geometry->messages) v["messages"].push_back(m);
+  if (c.local) {
+    v.update(toJson(*c.local, c.localSeconds));
+    for (const std::string& m : failureMessages(*c.local)) v["messages"].push_back(m);
+  } else {
+    nullLocalKeys(v);
+  }
+  // Zero modes of the global stiffness without boundary conditions (6 per component).
+  if (c.rigid) {
+    v["rigid_modes"] = c.rigid->zeroModes;
+    v["rigid_modes_global"] = c.rigid->zeroModes;
+    v["rigid_modes_per_component"] = c.rigid->zeroModesPerComponent;
+    v["rigid_modes_expected"] = 6 * c.rigid->components;
+    v["rigid_modes_seconds"] = c.rigidSeconds;
+    if (!c.rigidPassed()) v["messages"].push_back(c.failures().back());
+  } else {
+    v["rigid_modes"] = nullptr;
+    v["rigid_modes_global"] = nullptr;
+    v["rigid_modes_expected"] =
+        c.geometry ? json(6 * c.geometry->components) : json(nullptr);
+  }
+  if (c.patch) {
+    v["global_patch_test_error"] = c.patch->relativeError;
+    v["global_patch_test_seconds"] = c.patchSeconds;
+  }
+  v["dofs"] = c.dofs;
+  v["faces_integrated"] = c.facesIntegrated;
+  if (!c.notes.empty()) {
+    std::string note;
+    for (const std::string& n : c.notes) note += (note.empty() ? "" : "; ") + n;
+    v["dg_note"] = note;
+  }
+  return v;
+}
+
+json toJson(const MeshReport& report) {
+  const MeshingReport& r = report.meshing;
+  json timings = timingsJson(r.timings);
+  timings["read"] = report.readSeconds;
+  if (report.dg.local) timings["dg_checks"] = report.dg.localSeconds;
+  else timings["dg_checks"] = nullptr;
+  if (!report.output.empty()) timings["write"] = report.writeSeconds;
+  // The whole operation, read to write; less than "total" where phases overlap.
+  timings["wall"] = report.wallSeconds;
+  // The two parts of "slice" (not added to "total"): plane splits, then the mesh build.
+  timings["slice_split"] = r.slice.secondsSplitting;
+  timings["slice_build"] = r.slice.secondsBuilding;
+
+  json validation = toJson(r.validation);
+  validation["geometry_passed"] = r.validation.passed;
+  validation["passed"] = report.passed();
+  validation["dg_checked"] = report.dg.local.has_value();
+  if (report.dg.local) {
+    validation.update(toJson(*report.dg.local, report.dg.localSeconds));
+    for (const std::string& m : failureMessages(*report.dg.local))
+      validation["messages"].push_back(m);
+  } else {
+    nullLocalKeys(validation);
+  }
+  return {
+      {"input",
+       {{"vertices", r.inputVertices},
+        {"triangles", r.inputTriangles},
+        {"closed", r.inputClosed},
+        {"manifold", r.inputManifold},
+        {"self_intersecting",
+         r.selfIntersectionsChecked ? json(r.selfIntersections > 0) : json(nullptr)},
+        {"self_intersections", r.selfIntersections},
+        {"shells", r.shells},
+        {"cavities", r.cavities},
+        {"volume", r.inputVolume},
+        {"volume_before_repair", r.repairs.empty() ? json(nullptr) : json(r.volumeBeforeRepair)},
+        {"repairs", r.repairs}}},
+      {"grid",
+       {{"origin", vectorJson(r.grid.origin())},
+        {"cell_size", r.grid.cellSize},
+        {"cells", r.grid.cells}}},
+      {"output",
+       {{"file", report.output.empty() ? json(nullptr) : json(report.output)},
+        {"elements", r.elements},
+        {"hexahedra", r.hexahedra},
+        {"polyhedra", r.polyhedra},
+        {"nonconvex", r.nonconvex},
+        {"faces", r.faces},
+        {"interior_faces", r.interiorFaces},
+        {"boundary_faces", r.boundaryFaces},
+        {"volume", r.outputVolume},
+        {"slivers", r.slivers.slivers},
+        {"slivers_merged", r.slivers.merged},
+        {"isolated_slivers", r.slivers.isolated},
+        {"sliver_threshold", r.slivers.threshold},
+        {"cells_with_several_pieces", r.slice.multiPieceCells}}},
+      {"volume_rel_error", r.volumeRelError},
+      {"validation", validation},
+      {"faces_integrated", report.dg.facesIntegrated},
+      {"timings_s", timings}};
+}
+
+json toJson(const OperationReport& r) {
+  const OperationValidation& v = r.validation;
+  constexpr std::size_t kListedIds = 20;
+  std::vector<std::uint32_t> firstIds;
+  for (std::size_t i = 0; i < r.leftWhole.size() && i < kListedIds; ++i)
+    firstIds.push_back(r.leftWhole[i].value);
+  return {{"op", r.op},
+          {"elements_split", r.elementsSplit},
+          {"pieces_created", r.piecesCreated},
+          {"elements_removed", r.elementsRemoved},
+          {"volume_removed", r.volumeRemoved},
+          {"sliver_threshold", r.sliverThreshold},
+          {"slivers", r.slivers},
+          {"slivers_merged", r.sliversMerged},
+          {"isolated_slivers", r.isolatedSlivers},
+          {"faces_reintegrated", r.facesReintegrated},
+          {"faces_total", r.facesTotal},
+          {"left_whole", {{"count", r.leftWhole.size()}, {"first_ids", firstIds}}},
+          {"validation",
+           {{"passed", v.passed},
+            {"level", toString(v.level)},
+            {"elements_checked", v.elementsChecked},
+            {"region_elements", v.regionElements},
+            {"patch_test_error", v.patchTestError},
+            {"region_components", v.regionComponents},
+            {"zero_modes", v.zeroModes},
+            {"volume_rel_error", v.volumeRelError},
+            {"failure", v.failure}}},
+          {"time_s", r.seconds}};
+}
+
+json toJson(const SolveReport& report) {
+  const StaticReport& r = report.solve;
+  const SolveOptions& o = report.options;
+  const double dofs = static_cast<double>(r.dofs);
+  json clamps = json::array(), tractions = json::array();
+  for (std::size_t i = 0; i < o.clamps.size(); ++i) {
+    json c = selectionJson(o.clamps[i]);
+    c["faces"] = i < report.clampFaces.size() ? report.clampFaces[i] : 0;
+    clamps.push_back(c);
+  }
+  for (std::size_t i = 0; i < o.tractions.size(); ++i) {
+    json t = selectionJson(o.tractions[i].where);
+    t["traction"] = vectorJson(o.tractions[i].traction);
+    t["faces"] = i < report.tractionFaces.size() ? report.tractionFaces[i] : 0;
+    tractions.push_back(t);
+  }
+  return {{"method", toString(o.method)},
+          {"degree", o.degree},
+          {"material",
+           {{"E", o.material.youngsModulus},
+            {"nu", o.material.poissonRatio},
+            {"density", o.material.density}}},
+          {"gravity", vectorJson(o.gravity)},
+          {"penalty_rule", toString(o.penalty)},
+          {"clamps", clamps},
+          {"tractions", tractions},
+          {"elements", r.elements},
+          {"dofs", r.dofs},
+          {"nonzeros", r.nonzeros},
+          {"sparsity", dofs > 0 ? static_cast<double>(r.nonzeros) / (dofs * dofs) : 0.0},
+          {"eta", r.eta},
+          {"eta_threshold", r.etaThreshold},
+          {"penalty_attempts", r.penaltyAttempts},
+          {"dirichlet_faces", r.dirichletFaces},
+          {"traction_faces", r.tractionFaces},
+          {"basis_fallbacks", r.basisFallbacks},
+          {"solver",
+           {{"kind", toString(r.solver.used)},
+            {"preconditioner", r.solver.used == SolverKind::ConjugateGradient
+                                   ? json(toString(r.solver.preconditioner))
+                                   : json("none")},
+            {"success", r.solver.success},
+            {"iterations", r.solver.iterations},
+            {"residual", r.solver.residual}}},
+          {"energy", r.energy},
+          {"max_displacement", report.maxDisplacement},
+          {"max_von_mises", report.maxVonMises},
+          {"max_jump", report.maxJump},
+          {"faces_integrated", report.facesIntegrated},
+          {"timings_s",
+           {{"integrate", r.integrateSeconds},
+            {"assemble", r.assembleSeconds},
+            {"solve", r.solveSeconds},
+            {"factorize", r.solver.factorSeconds}}}};
+}
+
+json toJson(const ReadReport& r) {
+  return {{"file", r.file},
+          {"elements", r.elements},
+          {"faces", r.faces},
+          {"vertices", r.vertices},
+          {"provenance_restored", r.provenanceRestored},
+          {"time_s", r.seconds}};
+}
+
+json toJson(const WriteReport& r) {
+  return {{"file", r.file}, {"with_solution", r.withSolution}, {"time_s", r.seconds}};
+}
+
+}  // namespace polydg

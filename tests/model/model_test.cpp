@@ -1,0 +1,213 @@
+// The model: provenance that travels with the mesh, a moment cache that every operation shares
+// (each face integrated once), region selections, and operations that refuse to leave nothing.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "polydg/mesh/surface_shapes.h"
+#include "polydg/model/model.h"
+#include "polydg/model/report_json.h"
+
+namespace polydg {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// A scratch folder per test, removed at the end.
+class ModelTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("polydg_model_test_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  fs::path dir_;
+};
+
+/// The unit box [0,1]^3 meshed with 4 cells along each side (plus the slicer's boundary layer).
+Model unitBox(MeshReport& report, int momentDegree = 0) {
+  MeshOptions options;
+  options.cells = 4;
+  options.momentDegree = momentDegree;
+  return Model::fromSurface(boxSurface(Box3(Vec3::Zero(), Vec3::Ones())), options, report,
+                            "box.obj");
+}
+
+TEST_F(ModelTest, ProvenanceTravelsWithTheMeshThroughAFile) {
+  MeshReport report;
+  MeshOptions options;
+  options.cells = 5;
+  options.sliverFraction = 0.03;
+  const TriangleSurface torusSurface = torus(Vec3::Zero(), 1.0, 0.4, 48, 24);
+  Model meshed = Model::fromSurface(torusSurface, options, report, "torus.obj");
+  ASSERT_TRUE(report.passed());
+  const Provenance& p = meshed.provenance();
+  EXPECT_EQ(p.referenceKind, ReferenceKind::GridCell);
+  EXPECT_EQ(p.cellSize, report.meshing.grid.cellSize);
+  EXPECT_EQ(p.referenceVolume, p.cellSize * p.cellSize * p.cellSize);
+  EXPECT_EQ(p.sliverFraction, 0.03);
+  EXPECT_EQ(p.source, "torus.obj");
+
+  const std::string file = (dir_ / "torus.vtu").string();
+  meshed.write(file);
+  ReadReport read;
+  const Model back = Model::read(file, &read);
+  EXPECT_TRUE(read.provenanceRestored);
+  EXPECT_EQ(back.provenance().referenceKind, ReferenceKind::GridCell);
+  EXPECT_EQ(back.provenance().cellSize, p.cellSize);  // bit for bit
+  EXPECT_EQ(back.provenance().referenceVolume, p.referenceVolume);
+  EXPECT_EQ(back.provenance().sliverFraction, 0.03);
+  EXPECT_EQ(back.provenance().source, "torus.obj");
+  EXPECT_EQ(back.mesh().numElements(), meshed.mesh().numElements());
+}
+
+TEST_F(ModelTest, AMeshWithoutProvenanceUsesItsMedianElementVolume) {
+  PolyMesh grid = hexGridMesh(3, 2, 1, Box3(Vec3::Zero(), Vec3(3.0, 2.0, 0.5)));
+  const Model model(std::move(grid));
+  EXPECT_EQ(model.provenance().referenceKind, ReferenceKind::MedianElement);
+  EXPECT_DOUBLE_EQ(model.provenance().referenceVolume, 0.5);  // every cell 1 x 1 x 0.5
+  EXPECT_EQ(model.provenance().sliverFraction, kDefaultSliverFraction);
+}
+
+TEST_F(ModelTest, EveryFaceIsIntegratedOnceAcrossCutCheckAndSolve) {
+  MeshReport report;
+  Model model = unitBox(report, 4);  // degree 4: enough for checks and solves of degree 2
+  ASSERT_TRUE(report.passed());
+  const std::size_t meshed = model.facesIntegrated();
+  EXPECT_EQ(meshed, model.mesh().numFaces());  // the DG checks read the model's moments
+
+  CutRequest cut;
+  cut.blade = Blade::plane(Vec3(1.0, 0.3, 0.2), 0.55);
+  const OperationReport op = model.cut(cut);
+  ASSERT_TRUE(op.validation.passed) << op.validation.failure;
+  EXPECT_GT(op.facesReintegrated, 0u);
+  EXPECT_EQ(model.facesIntegrated(), meshed + op.facesReintegrated);
+
+  MeshCheckOptions check;
+  check.degree = 2;
+  const MeshCheck c = model.check(check);
+  ASSERT_TRUE(c.passed());
+  EXPECT_EQ(c.facesIntegrated, 0u);
+
+  SolveOptions solve;
+  solve.degree = 2;
+  solve.clamps.push_back(FaceSelector::below(Plane::make(Vec3::UnitZ(), 0.0)));
+  solve.gravity = Vec3(0.0, 0.0, -1.0);
+  const SolveReport s = model.solve(solve);
+  EXPECT_EQ(s.facesIntegrated, 0u);
+  EXPECT_EQ(s.solve.facesIntegrated, 0u);
+  EXPECT_EQ(model.facesIntegrated(), meshed + op.facesReintegrated);
+
+  // A degree the cache does not hold integrates every face once more, and only once.
+  check.degree = 3;
+  const std::size_t faces = model.mesh().numFaces();
+  model.check(check);
+  model.check(check);
+  EXPECT_EQ(model.facesIntegrated(), meshed + op.facesReintegrated + faces);
+}
+
+TEST_F(ModelTest, SelectionsPickTheFacesInTheirRegion) {
+  MeshReport report;
+  Model model = unitBox(report);
+  ASSERT_TRUE(report.passed());
+  SolveOptions solve;
+  solve.degree = 1;
+  solve.gravity = Vec3(0.0, 0.0, -1.0);
+  // The bottom z = 0: as a plane, as a half-space and as a thin box, the same 16 faces (the
+  // unit box sliced by a 4 x 4 x 4 grid of cell 0.25 plus a layer of boundary cells).
+  const std::vector<FaceSelector> bottoms{
+      FaceSelector::inPlane(2, 0.0), FaceSelector::inPlane(Plane::make(Vec3(0, 0, 2), 0.0)),
+      FaceSelector::below(Plane::make(Vec3::UnitZ(), 0.0)),
+      FaceSelector::inBox(Box3(Vec3(-1, -1, -1), Vec3(2, 2, 0)))};
+  std::vector<std::size_t> counts;
+  for (const FaceSelector& bottom : bottoms) {
+    solve.clamps = {bottom};
+    counts.push_back(model.solve(solve).clampFaces.front());
+  }
+  EXPECT_GT(counts.front(), 0u);
+  for (std::size_t c : counts) EXPECT_EQ(c, counts.front());
+  // Below z = 0.5 also takes the lower half of the sides.
+  solve.clamps = {FaceSelector::below(Plane::make(Vec3::UnitZ(), 0.5))};
+  EXPECT_GT(model.solve(solve).clampFaces.front(), counts.front());
+}
+
+TEST_F(ModelTest, ASelectionOfNoFaceIsAnErrorNamingIt) {
+  MeshReport report;
+  Model model = unitBox(report);
+  SolveOptions solve;
+  solve.clamps = {FaceSelector::below(Plane::make(Vec3::UnitZ(), -0.5))};
+  try {
+    model.solve(solve);
+    FAIL() << "a clamp below the body was accepted";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("below 0,0,1,-0.5"), std::string::npos) << what;
+    EXPECT_NE(what.find("selects no boundary face"), std::string::npos) << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos);
+  }
+  solve.clamps = {FaceSelector::inPlane(0, 0.0)};
+  solve.tractions = {{FaceSelector::inBox(Box3(Vec3(5, 5, 5), Vec3(6, 6, 6))), Vec3(1, 0, 0)}};
+  EXPECT_THROW(model.solve(solve), InputError);
+}
+
+TEST_F(ModelTest, ACutThatRemovesEverythingFails) {
+  MeshReport report;
+  Model model = unitBox(report);
+  CutRequest cut;
+  cut.blade = Blade::plane(Vec3::UnitZ(), 2.0);  // everything is below z = 2
+  cut.removeSide = -1;
+  const OperationReport r = model.cut(cut);
+  EXPECT_FALSE(r.validation.passed);
+  EXPECT_NE(r.validation.failure.find("left no element"), std::string::npos)
+      << r.validation.failure;
+  EXPECT_EQ(model.mesh().numElements(), 0u);
+  // The model refuses further use rather than writing an empty mesh.
+  EXPECT_THROW(model.write((dir_ / "empty.vtu").string()), CheckFailure);
+  EXPECT_FALSE(fs::exists(dir_ / "empty.vtu"));
+}
+
+TEST_F(ModelTest, CutsUseTheMeshesSliverRule) {
+  MeshReport report;
+  MeshOptions options;
+  options.cells = 4;
+  options.sliverFraction = 0.05;
+  Model model = Model::fromSurface(boxSurface(Box3(Vec3::Zero(), Vec3::Ones())), options, report);
+  CutRequest cut;
+  cut.blade = Blade::plane(Vec3::UnitX(), 0.3);
+  const OperationReport r = model.cut(cut);
+  const double cell = report.meshing.grid.cellSize;
+  EXPECT_DOUBLE_EQ(r.sliverThreshold, 0.05 * cell * cell * cell);
+  cut.blade = Blade::plane(Vec3::UnitY(), 0.3);
+  cut.sliverFraction = 0.0;
+  EXPECT_EQ(model.cut(cut).sliverThreshold, 0.0);
+}
+
+TEST_F(ModelTest, SolveReportsAndWritesTheSolution) {
+  MeshReport report;
+  Model model = unitBox(report);
+  SolveOptions solve;
+  solve.degree = 1;
+  solve.clamps = {FaceSelector::inPlane(2, 0.0)};
+  solve.gravity = Vec3(0.0, 0.0, -1.0);
+  const SolveReport r = model.solve(solve);
+  ASSERT_NE(model.solution(), nullptr);
+  EXPECT_GT(r.maxDisplacement, 0.0);
+  EXPECT_GT(r.maxVonMises, 0.0);
+  const nlohmann::json j = toJson(r);
+  EXPECT_EQ(j["clamps"][0]["faces"], r.clampFaces[0]);
+  EXPECT_EQ(j["method"], "ip");
+  const WriteReport w = model.write((dir_ / "solved.vtu").string());
+  EXPECT_TRUE(w.withSolution);
+  // An edit drops the solution: it no longer belongs to the mesh.
+  CutRequest cut;
+  cut.blade = Blade::plane(Vec3::UnitX(), 0.55);
+  model.cut(cut);
+  EXPECT_EQ(model.solution(), nullptr);
+}
+
+}  // namespace
+}  // namespace polydg
