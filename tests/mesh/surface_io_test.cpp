@@ -5,11 +5,11 @@
 // (tests/mesh/surface_volume.py).
 #include "polydg/mesh/surface_io.h"
 #include "tests/support/assimp_models.h"
+#include "tests/support/temp_dir.h"
 
 #include <gtest/gtest.h>
 
 #include <sys/resource.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <array>
@@ -44,6 +44,7 @@ constexpr double kVtkRelTol = 1e-9;
 constexpr rlim_t kReadAddressSpace = rlim_t{4} << 30;
 
 using polydg::corpus::kAssimpModels;
+using polydg::testing::TempDir;
 const fs::path kSystemPython = "/usr/bin/python3";
 
 std::string testdata(const std::string& name) {
@@ -57,29 +58,6 @@ fs::path volumeScript() {
 double relativeError(double value, double exact) {
   return std::abs(value - exact) / std::abs(exact);
 }
-
-/// A fresh directory under the system temp dir, removed when the test ends.
-class TempDir {
- public:
-  explicit TempDir(const std::string& name)
-      : path_(fs::temp_directory_path() /
-              ("polydg_surface_io_" + name + "_" + std::to_string(getpid()))) {
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  std::string write(const std::string& name, const std::string& text) const {
-    const fs::path file = path_ / name;
-    std::ofstream(file) << text;
-    return file.string();
-  }
-
- private:
-  fs::path path_;
-};
 
 /// Caps this process's address space for its lifetime, so that a reader allocating what a
 /// corrupt header declares fails with std::bad_alloc instead of exhausting the machine's memory
@@ -121,7 +99,7 @@ struct ModelCase {
 
 void PrintTo(const ModelCase& c, std::ostream* os) { *os << c.file; }
 
-class TestModel : public testing::TestWithParam<ModelCase> {};
+class TestModel : public ::testing::TestWithParam<ModelCase> {};
 
 TEST_P(TestModel, ReadsClosedWithExactCountsVolumeAndArea) {
   const ModelCase& c = GetParam();
@@ -154,7 +132,7 @@ TEST_P(TestModel, ReadsClosedWithExactCountsVolumeAndArea) {
 
 INSTANTIATE_TEST_SUITE_P(
     Testdata, TestModel,
-    testing::Values(
+    ::testing::Values(
         // Unit cube of six quads: 24 OBJ corners weld to 8 vertices, quads become 12 triangles.
         ModelCase{"cube.obj", 1, 6, 8, 12, 1, 1.0, 6.0, "cgal"},
         // Octahedron (+-1, 0, 0), (0, +-2, 0), (0, 0, +-3): volume 4/3 * 1 * 2 * 3, eight faces
@@ -173,7 +151,7 @@ INSTANTIATE_TEST_SUITE_P(
         // One unit-cube mesh used by two glTF nodes (one scaled by 2) under a translated root:
         // closed with two components only if node transforms are baked per instance.
         ModelCase{"instanced_cubes.gltf", 1, 0, 16, 24, 2, 9.0, 30.0, "assimp"}),
-    [](const testing::TestParamInfo<ModelCase>& info) {
+    [](const ::testing::TestParamInfo<ModelCase>& info) {
       std::string name = info.param.file;
       for (char& ch : name)
         if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
@@ -648,8 +626,8 @@ std::map<std::string, std::string> readAll(const fs::path& root, bool (*wanted)(
     if (entry.is_regular_file() && wanted(entry.path())) paths.push_back(entry.path().string());
   std::map<std::string, std::string> outcome;
   const AddressSpaceCap cap(kReadAddressSpace);
-  testing::internal::CaptureStdout();
-  testing::internal::CaptureStderr();
+  ::testing::internal::CaptureStdout();
+  ::testing::internal::CaptureStderr();
   for (const std::string& path : paths) {
     try {
       outcome[path] = analyzeTopology(readSurface(path)).closed() ? "closed" : "open";
@@ -660,7 +638,7 @@ std::map<std::string, std::string> readAll(const fs::path& root, bool (*wanted)(
     }
   }
   const std::string printed =
-      testing::internal::GetCapturedStdout() + testing::internal::GetCapturedStderr();
+      ::testing::internal::GetCapturedStdout() + ::testing::internal::GetCapturedStderr();
   EXPECT_EQ(printed, "") << "reading files under " << root << " printed output";
   for (auto& [path, what] : outcome) {
     EXPECT_EQ(what.rfind("unexpected", 0), std::string::npos) << path << ": " << what;
@@ -715,11 +693,11 @@ TEST(ReadSurface, PrintsNothing) {
   paths.push_back(dir.write("short.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n"));
   paths.push_back(dir.write(
       "binary.stl", binaryStl("solid-looking header", {{{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}}})));
-  testing::internal::CaptureStdout();
-  testing::internal::CaptureStderr();
+  ::testing::internal::CaptureStdout();
+  ::testing::internal::CaptureStderr();
   for (const std::string& path : paths) readError(path);
-  const std::string out = testing::internal::GetCapturedStdout();
-  const std::string err = testing::internal::GetCapturedStderr();
+  const std::string out = ::testing::internal::GetCapturedStdout();
+  const std::string err = ::testing::internal::GetCapturedStderr();
   EXPECT_EQ(out, "");
   EXPECT_EQ(err, "");
 }
