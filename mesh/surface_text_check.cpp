@@ -239,6 +239,8 @@ ObjText checkObjText(const std::string& path, std::string_view text, ReadWarning
     out.assimpReason = "the file is not text (NUL bytes)";
     return out;
   }
+  // A UTF-8 byte order mark is no part of the first line (it would make "v" a word of its own).
+  if (text.starts_with("\xEF\xBB\xBF")) text.remove_prefix(3);
   out.cgalText.reserve(text.size());
   std::string material;          // the default material until the first usemtl
   bool materialCounted = false;  // `material` is in out.materials already
@@ -696,6 +698,10 @@ void checkAsciiStlText(const std::string& path, std::string_view text, ReadWarni
   while (words.next(word)) {
     const std::size_t number = words.line();
     if (word == "solid" || word == "endsolid") {
+      if (inFacet)
+        failAtLine(path, facetLine,
+                   "facet without endfacet (the solid ends at line " + std::to_string(number) +
+                       "); complete it");
       words.restOfLine();  // the name
     } else if (word == "facet") {
       if (inFacet)

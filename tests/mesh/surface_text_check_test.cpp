@@ -174,6 +174,8 @@ TEST(ObjLines, NeitherWarningNorErrorForWellFormedVariants) {
   std::string path;
   const std::vector<std::string> warnings = tetraWarnings(dir, "clean.obj", text, path);
   EXPECT_TRUE(warnings.empty()) << warnings.front();
+  // A UTF-8 byte order mark before the first vertex.
+  EXPECT_TRUE(tetraWarnings(dir, "bom.obj", "\xEF\xBB\xBF" + joined(kObj), path).empty());
 }
 
 TEST(ObjLines, SkippableLinesWarnAndNameTheirLine) {
@@ -410,6 +412,8 @@ TEST(StlLines, LinesThatChangeTheGeometryAreErrors) {
           {"outside.stl", joined(inserted(kStl, 9, "vertex 1 1 1")), 9, "vertex outside a facet"},
           {"no_endfacet.stl", joined(replaced(kStl, 8, "")), 2,
            "facet without endfacet (the next facet starts at line 9)"},
+          {"no_last_endfacet.stl", joined(replaced(kStl, 29, "")), 23,
+           "facet without endfacet (the solid ends at line 30)"},
           {"truncated.stl", joined(Lines(kStl.begin(), kStl.begin() + 27)), 27,
            "the file ends inside the facet of line 23"},
       });
