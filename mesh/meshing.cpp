@@ -4,9 +4,11 @@
 #include <tbb/parallel_reduce.h>
 #include <tbb/task_group.h>
 
+#include <algorithm>
 #include <cmath>
 #include <exception>
 #include <sstream>
+#include <string>
 
 #include "polydg/mesh/surface_repair.h"
 #include "polydg/util/stopwatch.h"
@@ -59,6 +61,50 @@ double cellSizeFor(const Box3& box, const MeshingOptions& o) {
   return box.diagonal().maxCoeff() / o.cellsAlongLongest;
 }
 
+/// "1.27e+30": a length for a message.
+std::string shortNumber(double x) {
+  std::ostringstream out;
+  out.precision(3);
+  out << x;
+  return out.str();
+}
+
+/// Refuses a surface whose lengths would overflow or underflow downstream (kLargestLength and
+/// kSmallestLength) and returns the cell size.
+double checkedCellSize(const TriangleSurface& input, const MeshingOptions& options) {
+  const Box3 box = bounds(input);
+  for (const Vec3& p : input.vertices)
+    if (!p.allFinite())
+      throw InputError("a vertex has a non-finite coordinate (NaN or infinity); fix the surface");
+  const double extent = box.diagonal().maxCoeff();
+  const double largest = std::max(box.min().cwiseAbs().maxCoeff(), box.max().cwiseAbs().maxCoeff());
+  const std::string spans = "its bounding box spans " + shortNumber(extent) +
+                            " (largest |coordinate| " + shortNumber(largest) + ")";
+  if (!(extent <= kLargestLength))
+    throw InputError("the surface is too large for double precision: " + spans + ", more than " +
+                     shortNumber(kLargestLength) +
+                     " (2^100), so volumes and element moments (up to length^9) would overflow; "
+                     "scale the model down (change its units) to span at most " +
+                     shortNumber(kLargestLength));
+  if (!(extent >= kSmallestLength))
+    throw InputError("the surface is too small for double precision: " + spans + ", less than " +
+                     shortNumber(kSmallestLength) +
+                     " (2^-100), so volumes and element moments (up to length^9) would underflow "
+                     "to zero; scale the model up (change its units) to span at least " +
+                     shortNumber(kSmallestLength));
+  const double h = cellSizeFor(box, options);
+  if (!(h <= kLargestLength))
+    throw InputError("the cell size " + shortNumber(h) + " is more than " +
+                     shortNumber(kLargestLength) +
+                     " (2^100), so cell volumes would overflow; use a smaller cell");
+  if (!(h >= kSmallestLength))
+    throw InputError("the cell size " + shortNumber(h) + " is less than " +
+                     shortNumber(kSmallestLength) +
+                     " (2^-100), so element volumes and moments (up to length^9) would "
+                     "underflow; use fewer cells, or scale the model up");
+  return h;
+}
+
 }  // namespace
 
 namespace {
@@ -103,7 +149,7 @@ void orientAndSlice(const TriangleSurface& closed, double cellSize, const Meshin
 /// input: the self-intersection test (the costly, serial part of the diagnosis) runs while the
 /// surface is oriented and sliced. The result, if the test finds no defect; otherwise nothing
 /// (the slicing is dropped, and the caller repairs or refuses the surface from `d`).
-std::optional<MeshingResult> meshWhileDiagnosing(const TriangleSurface& input,
+std::optional<MeshingResult> meshWhileDiagnosing(const TriangleSurface& input, double cellSize,
                                                  const MeshingOptions& options,
                                                  SurfaceDiagnosis& d) {
   MeshingResult result;
@@ -117,7 +163,7 @@ std::optional<MeshingResult> meshWhileDiagnosing(const TriangleSurface& input,
   });
   std::exception_ptr failure;  // of the slicing; it matters only if the surface is sound
   try {
-    orientAndSlice(input, cellSizeFor(bounds(input), options), options, result, timer);
+    orientAndSlice(input, cellSize, options, result, timer);
   } catch (...) {
     failure = std::current_exception();
   }
@@ -139,12 +185,13 @@ MeshingResult meshSurface(const TriangleSurface& input, const MeshingOptions& op
     if (options.validate) validateMeshing(result);
   };
   if (input.triangles.empty()) throw InputError("the surface has no triangles");
+  const double cellSize = checkedCellSize(input, options);
   SurfaceDiagnosis d;
   bool diagnosed = false;
   const SurfaceTopology topology = analyzeTopology(input);
   if (topology.boundaryEdges == 0 && topology.nonManifoldEdges == 0 &&
       topology.degenerateTriangles == 0) {
-    if (std::optional<MeshingResult> done = meshWhileDiagnosing(input, options, d)) {
+    if (std::optional<MeshingResult> done = meshWhileDiagnosing(input, cellSize, options, d)) {
       finish(*done);
       return std::move(*done);
     }
@@ -167,7 +214,6 @@ MeshingResult meshSurface(const TriangleSurface& input, const MeshingOptions& op
   }
   timer.done("check");
 
-  const double cellSize = cellSizeFor(bounds(input), options);
   if (broken(d)) {
     const std::string defects = describeDefects(d);
     switch (options.repair) {

@@ -40,6 +40,7 @@
 #include <vector>
 
 #include "polydg/mesh/face_triangulation.h"
+#include "polydg/mesh/surface_text_check.h"
 
 namespace polydg {
 
@@ -213,9 +214,12 @@ struct PolygonSoup {
   std::vector<SoupPolygon> polygons;
   std::size_t meshes = 1;
   std::size_t inputVertices = 0;
-  std::size_t ignoredPoints = 0;   ///< OBJ `p` indices, removed before CGAL parsed the file
-  std::size_t ignoredLines = 0;    ///< OBJ `l` segments, removed likewise
-  bool onlyPointsOrLines = false;  ///< an OBJ file with vertices and no `f` line
+  std::size_t ignoredPoints = 0;  ///< OBJ `p` indices and faces of one corner, removed before
+                                  ///< CGAL parsed the file
+  std::size_t ignoredLines = 0;   ///< OBJ `l` segments and faces of two corners, likewise
+  /// An OBJ file with vertices and no `f` line of three or more corners.
+  bool onlyPointsOrLines = false;
+  std::vector<std::string> warnings;  ///< see SurfaceReadInfo::warnings
 };
 
 /// The point type for CGAL's STL reader, which merges equal points through a std::map: ordered
@@ -311,118 +315,24 @@ std::vector<Vec3> toVec3(const std::vector<Point>& points) {
   return out;
 }
 
-/// The space-separated words of `line`, into `out` (cleared first, so that one buffer serves
-/// every line of a file).
-void splitWords(std::string_view line, std::vector<std::string_view>& out) {
-  out.clear();
-  std::size_t i = 0;
-  while (true) {
-    while (i < line.size() && line[i] == ' ') ++i;
-    if (i == line.size()) return;
-    const std::size_t start = i;
-    while (i < line.size() && line[i] != ' ') ++i;
-    out.push_back(line.substr(start, i - start));
-  }
-}
-
-/// The OBJ text that CGAL's reader parses safely, with the facts CGAL does not report.
-struct ObjScan {
-  std::string text;  ///< tabs and CRs as spaces, comments cut, `p`/`l` lines removed,
-                     ///< `f` lines reduced to their vertex indices
-  std::size_t vertices = 0, faces = 0, points = 0, lines = 0;
-  std::set<std::string> materials;  ///< used by faces, points and lines ("" before any usemtl)
-};
-
-/// Prepares an OBJ file for CGAL's reader, or returns why CGAL must not read it: CGAL would
-/// silently misread face indices that are zero (taken as relative), overflow an int or are not
-/// integers (the face ends there), homogeneous coordinates (w ignored) and line continuations;
-/// it rejects `l` lines, which are counted and removed here like `p` lines; it keeps an `f` line
-/// without indices as an empty face, which is removed here (assimp skips it).
-std::variant<ObjScan, Reason> scanObj(const std::string& path) {
+/// The whole file, or nothing if it cannot be read.
+std::optional<std::string> readText(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (!in.good() && !in.eof()) return Reason("cannot read the file");
-  if (text.find('\0') != std::string::npos) return Reason("the file is not text (NUL bytes)");
-  ObjScan scan;
-  scan.text.reserve(text.size());
-  std::string material;          // the default material until the first usemtl
-  bool materialCounted = false;  // `material` is in scan.materials already
-  std::size_t lineNumber = 0;
-  std::string line;                 // one buffer for every line
-  std::vector<std::string_view> w;  // and one for its words
-  for (std::size_t begin = 0; begin < text.size();) {
-    std::size_t end = text.find('\n', begin);
-    if (end == std::string::npos) end = text.size();
-    line.assign(text, begin, end - begin);
-    begin = end + 1;
-    ++lineNumber;
-    const auto where = [&] { return "line " + std::to_string(lineNumber) + ": "; };
-    for (char& c : line)
-      if (c == '\t' || c == '\r' || c == '\v' || c == '\f') c = ' ';
-    if (const std::size_t hash = line.find('#'); hash != std::string::npos) line.resize(hash);
-    while (!line.empty() && line.back() == ' ') line.pop_back();
-    if (!line.empty() && line.back() == '\\') return where() + "line continuation";
-    splitWords(line, w);
-    if (w.empty()) {
-      scan.text += '\n';
-      continue;
-    }
-    const std::string_view keyword = w[0];
-    if (keyword == "v") {
-      ++scan.vertices;
-      if (w.size() == 5) {  // x y z w
-        const std::string weight(w[4]);
-        char* stop = nullptr;
-        const double value = std::strtod(weight.c_str(), &stop);
-        if (*stop != '\0' || value != 1.0) return where() + "homogeneous vertex (w != 1)";
-      }
-      scan.text += line;
-    } else if (keyword == "f" && w.size() == 1) {
-      // An empty face, which assimp skips too; CGAL would keep it as a face of no corners.
-    } else if (keyword == "f") {
-      ++scan.faces;
-      if (!materialCounted) scan.materials.insert(material);
-      materialCounted = true;
-      std::string face = "f";
-      for (std::size_t k = 1; k < w.size(); ++k) {
-        // An index: [+-]digits, optionally followed by /texture/normal.
-        const std::string_view token = w[k];
-        std::size_t digits = token.starts_with('-') || token.starts_with('+') ? 1 : 0;
-        const std::size_t first = digits;
-        while (digits < token.size() && std::isdigit(static_cast<unsigned char>(token[digits])))
-          ++digits;
-        const std::string_view number = token.substr(0, digits);
-        if (digits == first || digits - first > 9 ||
-            (digits < token.size() && token[digits] != '/') ||
-            number.find_first_not_of("+-0") == std::string_view::npos)
-          return where() + "face index '" + std::string(token) + "' is not a nonzero integer";
-        face += ' ';
-        face += number;
-      }
-      scan.text += face;
-    } else if (keyword == "p") {
-      scan.points += w.size() - 1;
-      scan.materials.insert(material);
-    } else if (keyword == "l") {
-      scan.lines += w.size() > 2 ? w.size() - 2 : 0;
-      scan.materials.insert(material);
-    } else {
-      if (keyword == "usemtl") {
-        const std::size_t start = line.find("usemtl") + 6;
-        material = line.substr(std::min(line.size(), line.find_first_not_of(' ', start)));
-        materialCounted = false;
-      }
-      scan.text += line;
-    }
-    scan.text += '\n';
-  }
-  return scan;
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (!in.good() && !in.eof()) return std::nullopt;
+  return text;
 }
 
-std::variant<PolygonSoup, Reason> readObjWithCgal(const std::string& path) {
-  auto scanned = scanObj(path);
-  if (auto* reason = std::get_if<Reason>(&scanned)) return *reason;
-  const ObjScan& scan = std::get<ObjScan>(scanned);
+/// Reads an OBJ file with CGAL after checkObjText, or returns why CGAL must not read it. CGAL
+/// parses only the `v` and `f` lines (checkObjText counts and checks the rest): it would
+/// silently misread face indices that are zero (taken as relative), overflow an int or are not
+/// integers (the face ends there), homogeneous coordinates (w ignored) and line continuations,
+/// and it rejects `l` lines and keywords it does not know.
+std::variant<PolygonSoup, Reason> readObjWithCgal(const std::string& path, ReadWarnings& warnings) {
+  const std::optional<std::string> text = readText(path);
+  if (!text) return Reason("cannot read the file");
+  const ObjText scan = checkObjText(path, *text, warnings);
+  if (!scan.assimpReason.empty()) return scan.assimpReason;
   PolygonSoup soup;
   soup.meshes = std::max<std::size_t>(1, scan.materials.size());
   soup.inputVertices = scan.vertices;
@@ -433,7 +343,7 @@ std::variant<PolygonSoup, Reason> readObjWithCgal(const std::string& path) {
     return soup;
   }
   std::vector<CgalPoint> points;
-  std::istringstream in(scan.text);
+  std::istringstream in(scan.cgalText);
   Reason reason = runCgal([&] {
     return CGAL::IO::read_OBJ(in, points, soup.polygons, CGAL::parameters::verbose(true));
   });
@@ -446,22 +356,12 @@ std::variant<PolygonSoup, Reason> readObjWithCgal(const std::string& path) {
   return soup;
 }
 
-/// One property of a PLY element as its header declares it.
-struct PlyProperty {
-  std::string name, type, sizeType;  // sizeType: the count type of a list, else ""
-};
-
-struct PlyElement {
-  std::string name;
-  std::vector<PlyProperty> properties;
-};
-
 /// Why CGAL's PLY reader must not read a file with this header, or "": it asserts (crashes when
 /// assertions are off) on x/y/z of integer type, silently misaligns on a property type it does
 /// not know, fills a list from its declared count (a corrupt 32-bit count allocates gigabytes),
 /// reads "vertices"/"faces"/"halfedge" elements its own way, and ignores the triangle strips and
-/// range grids that assimp reads.
-Reason plyHeaderProblem(const std::string& head) {
+/// range grids that assimp reads. `header` is parsed from the file's first 64 KiB.
+Reason plyHeaderProblem(const PlyHeader& header) {
   static const std::set<std::string> kScalar = {
       "char", "int8",  "uchar", "uint8",  "short", "int16",   "ushort", "uint16",
       "int",  "int32", "uint",  "uint32", "float", "float32", "double", "float64"};
@@ -470,46 +370,20 @@ Reason plyHeaderProblem(const std::string& head) {
   static const std::set<std::string> kReal = {"float", "float32", "double", "float64"};
   static const std::set<std::string> kForeign = {"vertices", "faces", "halfedge", "tristrips",
                                                  "range_grid"};
-  std::istringstream lines(head);
-  std::string line;
-  std::vector<PlyElement> elements;
-  bool ended = false;
-  for (std::size_t number = 1; std::getline(lines, line); ++number) {
-    std::istringstream in(line);
-    std::string keyword;
-    in >> keyword;
-    if (number == 2 && keyword != "format") return "the header's second line is not its format";
-    if (number == 2) {
-      std::string format;
-      in >> format;
-      if (format != "ascii" && format != "binary_little_endian" && format != "binary_big_endian")
-        return "unknown PLY format '" + format + "'";
-    } else if (keyword == "element") {
-      PlyElement element;
-      in >> element.name;
-      if (kForeign.contains(element.name))
-        return "element '" + element.name + "' is not read the same way by CGAL";
-      elements.push_back(element);
-    } else if (keyword == "property") {
-      if (elements.empty()) return "a property before any element";
-      PlyProperty property;
-      in >> property.type;
-      if (property.type == "list") {
-        in >> property.sizeType >> property.type;
-        if (!kListCount.contains(property.sizeType))
-          return "list count type '" + property.sizeType + "' (CGAL reads 8 and 16 bits only)";
-      }
-      if (!kScalar.contains(property.type)) return "property type '" + property.type + "'";
-      in >> property.name;
-      elements.back().properties.push_back(property);
-    } else if (keyword == "end_header") {
-      ended = true;
-      break;
-    }
-  }
-  if (!ended) return "no end_header in the first 64 KiB";
+  if (header.problem == "no end_header") return "no end_header in the first 64 KiB";
+  if (!header.problem.empty()) return header.problem;
+  if (header.format != "ascii" && header.format != "binary_little_endian" &&
+      header.format != "binary_big_endian")
+    return "unknown PLY format '" + header.format + "'";
   bool haveVertex = false;
-  for (const PlyElement& element : elements) {
+  for (const PlyElement& element : header.elements) {
+    if (kForeign.contains(element.name))
+      return "element '" + element.name + "' is not read the same way by CGAL";
+    for (const PlyProperty& property : element.properties) {
+      if (!property.sizeType.empty() && !kListCount.contains(property.sizeType))
+        return "list count type '" + property.sizeType + "' (CGAL reads 8 and 16 bits only)";
+      if (!kScalar.contains(property.type)) return "property type '" + property.type + "'";
+    }
     if (element.name != "vertex") continue;
     haveVertex = true;
     for (const char* axis : {"x", "y", "z"}) {
@@ -527,24 +401,16 @@ Reason plyHeaderProblem(const std::string& head) {
 /// Why CGAL's OFF reader must not read a file with this header, or "": it allocates the vertex
 /// and face counts before reading, so only the ASCII forms whose counts checkDeclaredCounts has
 /// bounded are given to it ([ST][C][N][4]OFF, then the counts): not nOFF (a dimension first),
-/// binary OFF (binary counts) or SKEL.
-Reason offHeaderProblem(const std::string& head) {
-  std::istringstream lines(head);
-  std::vector<std::string> tokens;
-  for (std::string line; tokens.size() < 3 && std::getline(lines, line);) {
-    std::istringstream words(line.substr(0, line.find('#')));
-    for (std::string word; tokens.size() < 3 && words >> word;) tokens.push_back(word);
-  }
-  if (tokens.empty()) return "no OFF header";
-  std::string keyword = tokens[0];
+/// binary OFF (binary counts) or SKEL. Counts that are missing or malformed are an error of
+/// checkOffText (CGAL and assimp would both take a missing edge count from the first vertex
+/// line: "OFF\n4 4\n1.5 0 0" has 1 edge and a first vertex at x = 0.5 for both).
+Reason offHeaderProblem(const OffHeader& header) {
+  if (header.keyword.empty()) return "no OFF header";
+  std::string keyword = header.keyword;
   for (const char* prefix : {"ST", "C", "N", "4"})
     if (keyword.starts_with(prefix)) keyword.erase(0, std::strlen(prefix));
-  if (keyword != "OFF") return "header keyword '" + tokens[0] + "' is not one CGAL reads here";
-  for (std::size_t k = 1; k < 3; ++k) {
-    bool ok = k < tokens.size();
-    if (ok) parseCount(tokens[k], ok);
-    if (!ok) return "no vertex and face counts after '" + tokens[0] + "'";
-  }
+  if (keyword != "OFF") return "header keyword '" + header.keyword + "' is not one CGAL reads here";
+  if (!header.counts.empty() && header.counts[0] == "BINARY") return "binary OFF";
   return "";
 }
 
@@ -552,9 +418,11 @@ Reason offHeaderProblem(const std::string& head) {
 /// chosen as assimp chooses: binary if the file has exactly 84 + 50 n bytes, n being the facet
 /// count at byte 80; else ASCII if its first word is "solid". CGAL's read_STL is not used: it
 /// takes "solid" followed by a tab for binary, and when one parser fails it runs the other on
-/// the same output, appending the second parse to what the first left.
+/// the same output, appending the second parse to what the first left. An ASCII file's text is
+/// checked first (checkAsciiStlText), unless it holds NUL bytes (binary content, which CGAL then
+/// fails on).
 Reason readStl(const std::string& path, const std::string& head, std::vector<StlPoint>& points,
-               std::vector<SoupPolygon>& triangles) {
+               std::vector<SoupPolygon>& triangles, ReadWarnings& warnings) {
   std::error_code ec;
   const std::uintmax_t size = std::filesystem::file_size(path, ec);
   if (ec) return "cannot find its size";
@@ -566,6 +434,11 @@ Reason readStl(const std::string& path, const std::string& head, std::vector<Stl
     return "neither binary (" + std::to_string(size) +
            " bytes, not 84 + 50 x its facet count) "
            "nor ASCII (no 'solid' first)";
+  if (!binary) {
+    const std::optional<std::string> text = readText(path);
+    if (!text) return "cannot read the file";
+    if (text->find('\0') == std::string::npos) checkAsciiStlText(path, *text, warnings);
+  }
   std::ifstream in(path, std::ios::binary);
   return runCgal([&] {
     return binary ? CGAL::IO::internal::parse_binary_STL(in, points, triangles, true)
@@ -574,38 +447,60 @@ Reason readStl(const std::string& path, const std::string& head, std::vector<Stl
 }
 
 /// Reads an OBJ, OFF, PLY or STL file (`extension` in lower case) with CGAL, or returns why not.
+/// Malformed lines throw; warnings go into the soup.
 std::variant<PolygonSoup, Reason> readWithCgal(const std::string& path,
                                                const std::string& extension,
                                                const std::string& head) {
   if (head.empty()) return Reason("the file is empty");
+  ReadWarnings warnings(path);
   PolygonSoup soup;
   Reason reason;
+  bool linesChecked = false;  // faces without corners were warned about and are dropped
   if (extension == "obj") {
-    auto read = readObjWithCgal(path);
+    auto read = readObjWithCgal(path, warnings);
     if (auto* r = std::get_if<Reason>(&read)) return *r;
     soup = std::move(std::get<PolygonSoup>(read));
     if (soup.onlyPointsOrLines) return soup;
   } else if (extension == "stl") {
     std::vector<StlPoint> points;
-    reason = readStl(path, head, points, soup.polygons);
+    reason = readStl(path, head, points, soup.polygons, warnings);
     soup.points = toVec3(points);
     soup.inputVertices = 3 * soup.polygons.size();
   } else {
-    reason = extension == "ply" ? plyHeaderProblem(head) : offHeaderProblem(head);
+    const bool ply = extension == "ply";
+    std::optional<PlyHeader> plyHeader;
+    if (ply) {
+      plyHeader = parsePlyHeader(head);
+      reason = plyHeaderProblem(*plyHeader);
+    } else {
+      reason = offHeaderProblem(parseOffHeader(head));
+    }
     if (!reason.empty()) return reason;
+    linesChecked = !ply || plyHeader->format == "ascii";
+    if (linesChecked) {
+      const std::optional<std::string> text = readText(path);
+      if (!text) return Reason("cannot read the file");
+      if (ply)
+        checkAsciiPlyText(path, *text, parsePlyHeader(*text), warnings);
+      else
+        checkOffText(path, *text, parseOffHeader(*text), warnings);
+    }
     std::vector<CgalPoint> points;
     reason = runCgal([&] {
       const auto verbose = CGAL::parameters::verbose(true);
-      return extension == "ply" ? CGAL::IO::read_PLY(path, points, soup.polygons, verbose)
-                                : CGAL::IO::read_OFF(path, points, soup.polygons, verbose);
+      return ply ? CGAL::IO::read_PLY(path, points, soup.polygons, verbose)
+                 : CGAL::IO::read_OFF(path, points, soup.polygons, verbose);
     });
     soup.points = toVec3(points);
     soup.inputVertices = soup.points.size();
   }
   if (!reason.empty()) return reason;
   if (soup.points.empty()) return Reason("no vertices");
+  if (linesChecked)
+    std::erase_if(soup.polygons, [](const SoupPolygon& polygon) { return polygon.empty(); });
   reason = checkIndices(soup.polygons, soup.points.size());
   if (!reason.empty()) return reason;
+  soup.warnings = warnings.lines();
   return soup;
 }
 
@@ -769,6 +664,7 @@ TriangleSurface readSurface(const std::string& path, SurfaceReadInfo* info) {
     }
     counts.ignoredPoints += soup->ignoredPoints;
     counts.ignoredLines += soup->ignoredLines;
+    counts.warnings = std::move(soup->warnings);
   } else {
     const aiScene* scene = importScene(importer, path, cgalReason);
     counts.reader = "assimp";

@@ -1,15 +1,18 @@
 // The meshing pipeline (meshSurface): a closed surface is sliced while its self-intersection
 // test runs, and the result is kept only if the test finds nothing; a self-intersecting closed
 // surface is refused (or wrapped with RepairMode::Wrap), an inward one re-oriented, and the
-// report holds the diagnosis and every phase either way.
+// report holds the diagnosis and every phase either way. Surfaces whose lengths would overflow
+// or underflow double precision downstream are refused as such, on both sides of the limits.
 #include "polydg/mesh/meshing.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
+#include "polydg/integrate/moment_cache.h"
 #include "polydg/mesh/surface_shapes.h"
 
 namespace polydg {
@@ -96,6 +99,118 @@ TEST(Meshing, ValidationCanBeLeftToTheCaller) {
   EXPECT_EQ(m.report.elements, m.mesh.numElements());
   EXPECT_EQ(m.report.hexahedra + m.report.polyhedra, m.report.elements);
   EXPECT_LT(m.report.volumeRelError, kVolumeTolerance);
+}
+
+// --- scale: overflow and underflow ------------------------------------------------------------
+
+/// The cube [0, side]^3; with `side` a power of two every coordinate and volume is exact.
+TriangleSurface cube(double side) { return boxSurface(Box3(Vec3::Zero(), Vec3::Constant(side))); }
+
+/// The one-line message of the InputError meshSurface throws, or "" if it meshes.
+std::string refusal(const TriangleSurface& surface, const MeshingOptions& options) {
+  try {
+    meshSurface(surface, options);
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << e.what();
+    return e.what();
+  }
+  return "";
+}
+
+/// Meshes `surface` and checks the result: valid, with the volume `volume`, and element moments
+/// up to degree 6 (what a degree-3 DG basis needs) finite, the largest of them normal.
+void expectMeshesExactly(const TriangleSurface& surface, const MeshingOptions& options,
+                         double volume, std::size_t elements) {
+  const MeshingResult m = meshSurface(surface, options);
+  EXPECT_TRUE(m.report.validation.passed);
+  EXPECT_EQ(m.report.elements, elements);
+  EXPECT_LT(std::abs(m.report.outputVolume - volume) / volume, kVolumeTolerance)
+      << m.report.outputVolume << " vs " << volume;
+  MomentCache moments(m.mesh, 6);
+  moments.update();
+  for (std::size_t e = 0; e < m.mesh.numElements(); ++e) {
+    double largest = 0.0;
+    for (double value : moments.element(ElementId(e))) {
+      ASSERT_TRUE(std::isfinite(value)) << "element " << e;
+      largest = std::max(largest, std::abs(value));
+    }
+    EXPECT_GE(largest, std::numeric_limits<double>::min()) << "element " << e;
+  }
+}
+
+TEST(MeshingScale, CubesJustInsideTheLimitsMeshWithTheirExactVolume) {
+  // The largest extent, sliced into 8^3 cells of 2^97.
+  expectMeshesExactly(cube(kLargestLength), cells(8), std::pow(kLargestLength, 3), 512);
+  // The smallest cell, 2^-100, in a cube of 2^-97.
+  const double small = 8 * kSmallestLength;
+  expectMeshesExactly(cube(small), cells(8), std::pow(small, 3), 512);
+  // The smallest extent: one cell.
+  MeshingOptions one;
+  one.cellSize = kSmallestLength;
+  expectMeshesExactly(cube(kSmallestLength), one, std::pow(kSmallestLength, 3), 1);
+  // And the scales the README promises work as at 1: 1e-6 and 1e6.
+  for (double scale : {1e-6, 1e6}) {
+    SCOPED_TRACE(scale);
+    const TriangleSurface sphere =
+        transformed(icosphere(Vec3::Zero(), 1.0, 3), scale, Vec3::Zero());
+    expectMeshesExactly(sphere, cells(6), enclosedVolume(sphere),
+                        meshSurface(icosphere(Vec3::Zero(), 1.0, 3), cells(6)).report.elements);
+  }
+}
+
+TEST(MeshingScale, LargerSurfacesAreRefusedAsOverflowNamingTheLargestCoordinate) {
+  // Just beyond 2^100, and near the largest double, which was refused as "encloses no volume"
+  // (its volume, 1e924, is infinite in double).
+  for (double side : {std::nextafter(kLargestLength, 2 * kLargestLength), 1e308}) {
+    SCOPED_TRACE(side);
+    const std::string why = refusal(cube(side), cells(8));
+    EXPECT_EQ(
+        why.rfind("the surface is too large for double precision: its bounding box spans ", 0), 0u)
+        << why;
+    EXPECT_NE(why.find("would overflow"), std::string::npos) << why;
+    EXPECT_NE(why.find(side == 1e308 ? "(largest |coordinate| 1e+308)"
+                                     : "(largest |coordinate| 1.27e+30)"),
+              std::string::npos)
+        << why;
+    EXPECT_NE(why.find("; scale the model down"), std::string::npos) << why;
+  }
+}
+
+TEST(MeshingScale, SmallerSurfacesAreRefusedAsUnderflow) {
+  MeshingOptions one;
+  one.cellSize = kSmallestLength;
+  for (double side : {std::nextafter(kSmallestLength, 0.0), 1e-300}) {
+    SCOPED_TRACE(side);
+    const std::string why = refusal(cube(side), cells(8));
+    EXPECT_EQ(
+        why.rfind("the surface is too small for double precision: its bounding box spans ", 0), 0u)
+        << why;
+    EXPECT_NE(why.find("would underflow to zero"), std::string::npos) << why;
+    EXPECT_NE(why.find(side == 1e-300 ? "(largest |coordinate| 1e-300)"
+                                      : "(largest |coordinate| 7.89e-31)"),
+              std::string::npos)
+        << why;
+    EXPECT_NE(why.find("; scale the model up"), std::string::npos) << why;
+    EXPECT_EQ(refusal(cube(side), one), why);  // whatever the cell size
+  }
+}
+
+TEST(MeshingScale, CellSizesOutsideTheLimitsAreRefused) {
+  // 16 cells along 2^-97: cells of 2^-101.
+  const std::string small = refusal(cube(8 * kSmallestLength), cells(16));
+  EXPECT_EQ(small.rfind("the cell size 3.94e-31 is less than 7.89e-31 (2^-100)", 0), 0u) << small;
+  EXPECT_NE(small.find("; use fewer cells, or scale the model up"), std::string::npos) << small;
+  MeshingOptions huge;
+  huge.cellSize = 2 * kLargestLength;
+  const std::string large = refusal(cube(1.0), huge);
+  EXPECT_EQ(large.rfind("the cell size 2.54e+30 is more than 1.27e+30 (2^100)", 0), 0u) << large;
+}
+
+TEST(MeshingScale, NonFiniteCoordinatesAreRefused) {
+  TriangleSurface s = cube(1.0);
+  s.vertices[3].x() = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(refusal(s, cells(4)),
+            "a vertex has a non-finite coordinate (NaN or infinity); fix the surface");
 }
 
 }  // namespace

@@ -16,6 +16,35 @@ namespace polydg {
 
 enum class RepairMode { None, Fill, Wrap };
 
+/// The range of lengths meshSurface() accepts: the largest side E of the surface's bounding box
+/// and the cell size h must both lie in [kSmallestLength, kLargestLength] = [2^-100, 2^100]
+/// (about 7.9e-31 to 1.27e30). Outside it meshSurface() refuses the surface (InputError) instead
+/// of returning a mesh whose volumes and moments overflow or underflow in double precision.
+///
+/// Derivation. Downstream of meshing, lengths enter products only as differences from a local
+/// origin (the bounding-box centre for the enclosed volume, an edge's endpoint for its crossing
+/// with a grid plane, a face's first vertex and an element's reference point for moments);
+/// absolute coordinates are only added to and compared (grid planes, exact rational
+/// comparisons). The highest power of a length is in the element moments a degree-p DG basis
+/// needs (p <= 3, physics/dg_basis.h): int_K (x - o)^alpha dV with |alpha| = 2p = 6, at most
+/// vol(K) diam(K)^6 <= diam(K)^9; below come face moments (diam^8), squared norms of area vectors
+/// (diam^4) and volumes (diam^3). (The bases divide moments by diam^|alpha| before any other
+/// product, so nothing of higher degree follows.) An element lies in the bounding box and in one
+/// cell, so diam(K) <= sqrt(3) min(E, h).
+/// - Overflow: at E = 2^100, (sqrt(3) E)^9 = 3^4.5 2^900 ~ 1.2e273, a factor ~2^116 (1e35) below
+///   the largest double (1.8e308), left for sums over faces and elements and for shifting moments
+///   between origins (binomial coefficients up to 20). Cell volumes h^3 (the sliver threshold)
+///   bound h likewise.
+/// - Underflow: a cell-sized element has degree-6 moments about its centre of about h^9 / 2^6; at
+///   h = 2^-100 that is 2^-906, a factor 2^116 above the smallest normal double (2^-1022), which
+///   keeps at full precision the moments of pieces down to 1e-35 of a cell (slivers), where
+///   E = h = 1e-300 would give volumes of 1e-900, zero in double.
+/// |coordinates| need no bound of their own: a surface that encloses volume has two distinct
+/// values on each axis, so E >= ulp(C) ~ C 2^-52 for its largest |coordinate| C, and E <= 2^100
+/// keeps C below 2^153 (~1e46), where sums like C + E are far from overflowing.
+inline constexpr double kLargestLength = 0x1p100;
+inline constexpr double kSmallestLength = 0x1p-100;
+
 struct MeshingOptions {
   /// Cell edge length; if unset, `cellsAlongLongest` cells along the bounding box's longest side.
   std::optional<double> cellSize;
@@ -68,7 +97,9 @@ struct MeshingResult {
 };
 
 /// Runs the pipeline on a surface as read from a file. Throws InputError for input it refuses
-/// (open, non-manifold or self-intersecting without a repair mode; empty; a repair that failed).
+/// (open, non-manifold or self-intersecting without a repair mode; empty; a non-finite
+/// coordinate; a bounding box or cell size outside [kSmallestLength, kLargestLength], named as
+/// overflow or underflow with the largest coordinate; a repair that failed).
 MeshingResult meshSurface(const TriangleSurface& surface, const MeshingOptions& options);
 
 /// The geometric validation of `result.mesh` and the output part of its report (elements,

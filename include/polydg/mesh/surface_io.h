@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <string>
+#include <vector>
 
 #include "polydg/mesh/surface.h"
 
@@ -29,7 +30,14 @@ struct SurfaceReadInfo {
   std::size_t ignoredLines = 0;       ///< line primitives skipped
   /// The library that parsed the file: "cgal" (double precision) or "assimp" (single precision).
   std::string reader;
+  /// Lines of the file that were skipped (see "Malformed lines" at readSurface), one line each,
+  /// "FILE:LINE: what; what was done", in file order: at most kMaxReadWarnings, then one line
+  /// "... and N more" if there were more. Empty for files assimp read.
+  std::vector<std::string> warnings;
 };
+
+/// The most warnings SurfaceReadInfo::warnings lists before its final "... and N more" line.
+inline constexpr std::size_t kMaxReadWarnings = 20;
 
 /// Reads the triangles of the surface in the file at `path`.
 ///
@@ -37,17 +45,59 @@ struct SurfaceReadInfo {
 /// CGAL's polygon-soup readers (CGAL/IO/OBJ.h, OFF.h, PLY.h, STL.h), which parse coordinates
 /// into doubles, correctly rounded from the text (binary STL and PLY float32 values are widened
 /// exactly). Before CGAL sees a file it is checked for what CGAL would misread or crash on
-/// (OBJ: face indices that are zero or not integers, homogeneous `v` coordinates with w != 1,
-/// line continuations, binary content; PLY: property types CGAL does not know, 32-bit list
-/// counts, x/y/z that are not float or double, elements CGAL or assimp give another meaning;
-/// OFF: headers other than [ST][C][N][4]OFF with ASCII counts; STL: neither 84 + 50 n bytes
-/// (binary) nor starting with "solid" (ASCII)), and after CGAL it is checked that every face
-/// index names a vertex. OBJ `p` and `l` lines are counted here and removed before CGAL parses
-/// the rest. If CGAL cannot read such a file (an OBJ keyword it does not know, an STL facet of
-/// four corners, PLY indices of 8 or 16 bits, ...), or the file fails one of the checks, or CGAL
-/// finds no vertex, assimp reads it instead, in single precision as for every other format:
-/// `info->reader` says which did. An OBJ file with `v` lines but no `f` line is reported as
-/// holding only points/lines without asking assimp.
+/// (OBJ: homogeneous `v` coordinates with w != 1, line continuations, binary content; PLY:
+/// property types CGAL does not know, 32-bit list counts, x/y/z that are not float or double,
+/// elements CGAL or assimp give another meaning; OFF: headers other than [ST][C][N][4]OFF with
+/// the three ASCII counts on one line; STL: neither 84 + 50 n bytes (binary) nor starting with
+/// "solid" (ASCII)), its text is checked line by line (below), and after CGAL it is checked that
+/// every face index names a vertex. CGAL parses an OBJ file's `v` lines (x y z as written) and
+/// `f` lines of three or more corners (vertex indices only); every other line is counted or
+/// checked here and removed before CGAL parses the rest. If CGAL cannot read such a file (PLY
+/// indices of 8 or 16 bits, an STL file without endsolid, ...), or the file fails one of the
+/// checks, or CGAL finds no vertex, assimp reads it instead, in single precision as for every
+/// other format: `info->reader` says which did. An OBJ file with `v` lines but no `f` line of
+/// three or more corners is reported as holding only points/lines without asking assimp.
+///
+/// Malformed lines. The text of an OBJ, OFF, ASCII PLY or ASCII STL file is checked before CGAL
+/// parses it (polydg/mesh/surface_text_check.h). The rule: a line that can be skipped without
+/// changing the geometry is skipped with a warning (`info->warnings`); a line that would change
+/// the geometry if it were skipped or misread (a vertex, a vertex index of a face, the corners
+/// of a facet) is an error, thrown as std::runtime_error "FILE:LINE: what is wrong; what to do"
+/// whichever reader would have read the file. Blank lines, comments, CR LF line ends and
+/// well-formed attributes (normals of any length, texture coordinates, colours, groups,
+/// materials) are neither. A number is a whole decimal number as C++ streams read it: not
+/// "abc", "nan", "inf", "0x1p3", or a number with anything after it ("3.1+e2", "2x").
+///
+///   format  warning (line or word skipped)           error
+///   OBJ     `f` without indices; `f` of 1 or 2      `v` with fewer than 3 numbers or an x/y/z
+///           corners (counted as a point or line);   that is not a number or beyond double's
+///           unknown keyword; free-form statement    range; `f` vertex index that is not an
+///           (curv, surf, ...); after x y z a word   integer ("x", "1.5", "/2"), is 0, is beyond
+///           that is not a number, or numbers that   the file's vertices, or counts back past
+///           are neither w nor r g b; a texture or   the first (-k with fewer than k vertices
+///           normal reference that is not an         before it)
+///           integer ("1/2/x"); malformed vt/vn/vp
+///   OFF     face of 0-2 vertices; a word after a    vertex with fewer than 3 (4OFF: 4) numbers
+///           vertex's coordinates or a face's        or a coordinate that is not a number; face
+///           indices that is not a number; lines     size or index that is not an integer, index
+///           after the last face                     out of range, fewer indices than the size;
+///                                                   fewer records than the header declares
+///   PLY     face of 0-2 vertices; lines after the   a value that is not a number of its
+///   ASCII   last element                            property's type or is beyond its range; a
+///                                                   line with a value too many or too few for
+///                                                   its element (CGAL reads a stream of values);
+///                                                   face index out of range; fewer lines than
+///                                                   the header declares
+///   STL     `facet` line that is not "facet normal  vertex with fewer than 3 numbers or a
+///   ASCII   nx ny nz" (normals are not used: zero,  coordinate that is not a number; vertex
+///           non-unit and NaN normals are fine);     outside a facet; facet of other than 3
+///           `outer` line that is not "outer loop";  vertices; facet without endfacet; the file
+///           any other word (rest of its line)       ending inside a facet
+///
+/// Warnings are kept only when CGAL reads the file: for one that goes to assimp (homogeneous
+/// coordinates, a line continuation, a header form CGAL does not read, ...) they would describe
+/// another reader, and `info->warnings` is empty. Binary PLY, OFF and STL files have no lines
+/// to check.
 ///
 /// For assimp, every node's transform is applied to the meshes it references (instanced meshes
 /// appear once per instance). For CGAL, faces are taken in file order.
@@ -73,9 +123,10 @@ struct SurfaceReadInfo {
 /// those of the file as parsed (double precision by CGAL; single precision by assimp, widened
 /// exactly to double), with -0.0 stored as 0.0.
 ///
-/// If `info` is not null it receives the counts above. Throws std::runtime_error with a
-/// one-line message naming the file when the file is missing, its header declares more items
-/// than it can hold, neither reader can read it (quoting assimp's reason and, for the CGAL
+/// If `info` is not null it receives the counts above and the warnings. Throws
+/// std::runtime_error with a one-line message naming the file (and the line, for a malformed
+/// line) when the file is missing, its header declares more items than it can hold, a line is
+/// malformed as above, neither reader can read it (quoting assimp's reason and, for the CGAL
 /// formats, CGAL's), it holds no meshes or only points and lines, no triangle survives welding,
 /// or a used vertex has a non-finite coordinate. Nothing is printed: polydg never creates
 /// assimp's DefaultLogger, so assimp logs to its null logger unless the application installs

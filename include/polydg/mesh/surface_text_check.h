@@ -1,0 +1,117 @@
+// Line-by-line checks of the text of OBJ, OFF, ASCII PLY and ASCII STL surface files, run before
+// CGAL parses them (readSurface, polydg/mesh/surface_io.h): a line that can be skipped without
+// changing the geometry becomes a warning, a line that would change the geometry if skipped or
+// misread is an error (std::runtime_error "FILE:LINE: what is wrong; what to do"). The rule, per
+// format, is documented with readSurface.
+#pragma once
+
+#include <cstddef>
+#include <set>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "polydg/mesh/surface_io.h"
+
+namespace polydg {
+
+/// Warnings about the lines of one file, each "FILE:LINE: what; what was done": the first
+/// kMaxReadWarnings are kept, the rest only counted.
+class ReadWarnings {
+ public:
+  explicit ReadWarnings(std::string path) : path_(std::move(path)) {}
+  /// Adds the warning `what` about line `line` (1-based).
+  void add(std::size_t line, const std::string& what);
+  /// The kept warnings in the order added, then "... and N more" if N were left out.
+  std::vector<std::string> lines() const;
+  /// Warnings added, kept or not.
+  std::size_t count() const { return count_; }
+
+ private:
+  std::string path_;
+  std::vector<std::string> kept_;
+  std::size_t count_ = 0;
+};
+
+/// Throws std::runtime_error(path + ":" + line + ": " + what); `what` says what is wrong and,
+/// after a semicolon, what to do.
+[[noreturn]] void failAtLine(const std::string& path, std::size_t line, const std::string& what);
+
+/// True if `token` is a whole decimal number as C++ streams (CGAL's readers) and strtod read it:
+/// [+-] digits [. [digits]] or [+-] . digits, then optionally [eE] [+-] digits. Not "inf", "nan",
+/// hexadecimal, or a number followed by anything ("3.1+e2", "1,5", "2x").
+bool isDecimalNumber(std::string_view token);
+
+/// True if `token` is [+-] digits.
+bool isIntegerNumber(std::string_view token);
+
+/// What checkObjText found in an OBJ file, and the text CGAL is to parse.
+struct ObjText {
+  /// One line per line of the file: `v` lines reduced to "v x y z" (the coordinates' own text),
+  /// `f` lines of three or more corners reduced to "f" and their vertex indices, every other
+  /// line empty. CGAL's reader parses it; line numbers are kept.
+  std::string cgalText;
+  std::size_t vertices = 0;         ///< `v` lines
+  std::size_t faces = 0;            ///< `f` lines of three or more corners, in cgalText
+  std::size_t points = 0;           ///< `p` indices and faces of one corner
+  std::size_t lines = 0;            ///< `l` segments and faces of two corners
+  std::set<std::string> materials;  ///< used by faces, points and lines ("" before any usemtl)
+  /// Not empty: CGAL must not read this file (homogeneous coordinates, which CGAL ignores; a line
+  /// continuation, which it does not join; NUL bytes), and the warnings do not apply.
+  std::string assimpReason;
+};
+
+/// Checks the OBJ `text` of the file at `path` line by line (comments cut at '#'; tabs, CRs and
+/// other control white space are spaces) and returns what CGAL is to read. Warnings go to
+/// `warnings`; errors throw (failAtLine). The rule is the OBJ part of readSurface's table.
+ObjText checkObjText(const std::string& path, std::string_view text, ReadWarnings& warnings);
+
+/// The header of an ASCII OFF file: "[ST][C][N][4][n]OFF" (or anything else, for the caller to
+/// refuse), then the vertex, face and edge counts on one line; '#' starts a comment.
+struct OffHeader {
+  std::string keyword;              ///< "" if the file has no token at all
+  std::vector<std::string> counts;  ///< up to three tokens of the line that follows the keyword
+  std::size_t dataOffset = 0;       ///< where the vertex records start: just after the counts
+  std::size_t dataLine = 0;         ///< the line (1-based) holding dataOffset
+};
+OffHeader parseOffHeader(std::string_view text);
+
+/// Checks the counts and records of an ASCII OFF file whose header keyword is one of CGAL's
+/// forms: three counts on one line (a missing edge count is an error: CGAL and assimp would both
+/// read it from the first vertex line), then vertex records, the comment-free, non-blank lines
+/// after the counts (the rest of the counts line is one, if not blank, as CGAL reads it).
+void checkOffText(const std::string& path, std::string_view text, const OffHeader& header,
+                  ReadWarnings& warnings);
+
+/// One property of a PLY element as its header declares it.
+struct PlyProperty {
+  std::string name, type, sizeType;  ///< sizeType: the count type of a list, else ""
+};
+
+struct PlyElement {
+  std::string name, count;  ///< count as written
+  std::vector<PlyProperty> properties;
+};
+
+/// A PLY header, up to and including its end_header line.
+struct PlyHeader {
+  std::string format;  ///< "ascii", "binary_little_endian", "binary_big_endian" or other
+  std::vector<PlyElement> elements;
+  /// Not empty if the header is malformed (no format line second, a property before any
+  /// element, no end_header); the other fields are then incomplete.
+  std::string problem;
+  std::size_t dataOffset = 0;  ///< the first byte after the end_header line
+  std::size_t dataLine = 0;    ///< the line number (1-based) of dataOffset
+};
+PlyHeader parsePlyHeader(std::string_view text);
+
+/// Checks the data lines of an ASCII PLY file, one element per line as the format requires
+/// (CGAL reads values as a stream, so a line with a value too many or too few shifts every later
+/// element). `header` must be free of problems.
+void checkAsciiPlyText(const std::string& path, std::string_view text, const PlyHeader& header,
+                       ReadWarnings& warnings);
+
+/// Checks an ASCII STL file ("solid" ... "endsolid"), token by token as CGAL reads it.
+void checkAsciiStlText(const std::string& path, std::string_view text, ReadWarnings& warnings);
+
+}  // namespace polydg
