@@ -36,17 +36,18 @@ CLI::Validator numberCheck(const std::string& name, const std::function<bool(dou
 
 }  // namespace
 
-const CLI::Validator kFinite =
-    numberCheck("FINITE", [](double) { return true; }, "a finite number");
-const CLI::Validator kPositive =
-    numberCheck("POSITIVE", [](double x) { return x > 0.0; }, "a finite number > 0");
-const CLI::Validator kNonNegative =
-    numberCheck("NONNEGATIVE", [](double x) { return x >= 0.0; }, "a finite number >= 0");
+const CLI::Validator kFinite = numberCheck(
+    "FINITE", [](double) { return true; }, "a finite number");
+const CLI::Validator kPositive = numberCheck(
+    "POSITIVE", [](double x) { return x > 0.0; }, "a finite number > 0");
+const CLI::Validator kNonNegative = numberCheck(
+    "NONNEGATIVE", [](double x) { return x >= 0.0; }, "a finite number >= 0");
 
 CLI::Validator finiteRange(double lo, double hi) {
   std::ostringstream s;
   s << "a finite number in [" << lo << ", " << hi << "]";
-  return numberCheck("RANGE", [lo, hi](double x) { return x >= lo && x <= hi; }, s.str());
+  return numberCheck(
+      "RANGE", [lo, hi](double x) { return x >= lo && x <= hi; }, s.str());
 }
 
 std::vector<double> parseNumbers(const std::string& text, std::size_t count,

@@ -28,7 +28,7 @@ std::vector<double> parseNumbers(const std::string& text, std::size_t count,
                                  const std::string& option);
 Vec3 parseVector(const std::string& text, const std::string& option);  ///< "x,y,z"
 Plane parsePlane(const std::string& text, const std::string& option);  ///< "nx,ny,nz,d"
-Box3 parseBox(const std::string& text, const std::string& option);  ///< "x0,y0,z0,x1,y1,z1"
+Box3 parseBox(const std::string& text, const std::string& option);     ///< "x0,y0,z0,x1,y1,z1"
 /// "x=0.5": the plane x = 0.5 (axis x, y or z).
 Plane parseAxisPlane(const std::string& text, const std::string& option);
 /// "x1,y1,z1;x2,y2,z2;...": a convex planar polygon blade.
@@ -45,7 +45,8 @@ CLI::Option* addChoice(CLI::App& cmd, const std::string& flag, E& target, const 
           flag,
           [&target, &names, flag](const std::string& s) {
             const auto v = parseName(names, s);
-            if (!v) throw CLI::ValidationError(flag, "'" + s + "' is not one of " + listNames(names));
+            if (!v)
+              throw CLI::ValidationError(flag, "'" + s + "' is not one of " + listNames(names));
             target = *v;
           },
           help + " (" + listNames(names) + "; default " + nameOf(names, target) + ")")

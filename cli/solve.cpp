@@ -18,7 +18,11 @@ namespace {
 
 struct SolveCommandOptions {
   std::string input, output, report;
-  SolveOptions solve{.degree = 2};
+  SolveOptions solve = [] {
+    SolveOptions s;
+    s.degree = 2;  // the command's default (pipelines and the library default to 1)
+    return s;
+  }();
 };
 
 void run(const SolveCommandOptions& o, const CommonOptions& common) {

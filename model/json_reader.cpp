@@ -84,8 +84,9 @@ Vec3 JsonObjectReader::vec3(const json& value, const std::string& place) const {
 FaceSelector JsonObjectReader::selection() {
   const bool below = has("below"), plane = has("plane"), box = has("box"), axis = has("axis");
   if (below + plane + box + axis != 1)
-    fail(place_, "give exactly one region: \"below\" [a, b, c, d], \"plane\" [a, b, c, d], "
-                 "\"box\" [[x0, y0, z0], [x1, y1, z1]] or \"axis\" with \"value\"");
+    fail(place_,
+         "give exactly one region: \"below\" [a, b, c, d], \"plane\" [a, b, c, d], "
+         "\"box\" [[x0, y0, z0], [x1, y1, z1]] or \"axis\" with \"value\"");
   try {
     if (below || plane) {
       const std::string key = below ? "below" : "plane";

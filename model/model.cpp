@@ -23,10 +23,10 @@ namespace fs = std::filesystem;
 /// itself; the first cut or merge hands both to a MeshEditor, which owns them from then on.
 struct Model::State {
   Provenance provenance;
-  PolyMesh mesh;                          ///< until the first edit
-  std::unique_ptr<MomentCache> moments;   ///< until the first edit (null until needed)
-  std::unique_ptr<MeshEditor> editor;     ///< from the first edit
-  std::size_t retiredIntegrations = 0;    ///< faces integrated by caches replaced before it
+  PolyMesh mesh;                         ///< until the first edit
+  std::unique_ptr<MomentCache> moments;  ///< until the first edit (null until needed)
+  std::unique_ptr<MeshEditor> editor;    ///< from the first edit
+  std::size_t retiredIntegrations = 0;   ///< faces integrated by caches replaced before it
   /// Whether the mesh is known to pass validate(): set by a passed validation, kept by edits
   /// whose own validation passed, unknown (nullopt) after an unvalidated edit.
   std::optional<bool> valid;
@@ -35,9 +35,7 @@ struct Model::State {
   std::optional<Solution> solution;
 
   const PolyMesh& currentMesh() const { return editor ? editor->mesh() : mesh; }
-  const MomentCache* currentMoments() const {
-    return editor ? &editor->moments() : moments.get();
-  }
+  const MomentCache* currentMoments() const { return editor ? &editor->moments() : moments.get(); }
   MeshEditor& edit() {
     if (!editor) {
       editor = std::make_unique<MeshEditor>(std::move(mesh), provenance.referenceVolume,
@@ -72,8 +70,9 @@ Model::Model(PolyMesh mesh, Provenance provenance) : state_(std::make_unique<Sta
     provenance.referenceVolume = medianElementVolume(mesh);
     provenance.referenceKind = ReferenceKind::MedianElement;
     if (!(provenance.referenceVolume > 0.0))
-      throw InputError("the median element volume is not positive: the mesh is inverted or "
-                       "flat; run 'polydg check' on it");
+      throw InputError(
+          "the median element volume is not positive: the mesh is inverted or "
+          "flat; run 'polydg check' on it");
   }
   state_->provenance = std::move(provenance);
   state_->mesh = std::move(mesh);
@@ -301,8 +300,10 @@ OperationReport Model::cut(const CutRequest& request) {
   OperationReport report = s.edit().cut(request.blade, options);
   s.solution.reset();
   judgeEdit(report, mesh());
-  if (!report.validation.passed) s.broken = report.op + " failed: " + report.validation.failure;
-  else if (request.validation == ValidationLevel::None) s.valid.reset();
+  if (!report.validation.passed)
+    s.broken = report.op + " failed: " + report.validation.failure;
+  else if (request.validation == ValidationLevel::None)
+    s.valid.reset();
   return report;
 }
 
@@ -318,8 +319,10 @@ OperationReport Model::mergeSlivers(const MergeRequest& request) {
       s.edit().mergeSlivers(fraction, request.validation, request.validationDegree);
   s.solution.reset();
   judgeEdit(report, mesh());
-  if (!report.validation.passed) s.broken = "merge failed: " + report.validation.failure;
-  else if (request.validation == ValidationLevel::None) s.valid.reset();
+  if (!report.validation.passed)
+    s.broken = "merge failed: " + report.validation.failure;
+  else if (request.validation == ValidationLevel::None)
+    s.valid.reset();
   return report;
 }
 
@@ -371,8 +374,7 @@ SolveReport Model::solve(const SolveOptions& options) {
   } catch (const std::invalid_argument& e) {
     throw InputError(std::string(e.what()) + "; check E, nu and density");
   }
-  if (options.degree < 1 || options.degree > 3)
-    throw InputError("the degree must be 1, 2 or 3");
+  if (options.degree < 1 || options.degree > 3) throw InputError("the degree must be 1, 2 or 3");
   if (!options.gravity.allFinite()) throw InputError("gravity must be three finite numbers");
   for (const TractionLoad& t : options.tractions)
     if (!t.traction.allFinite()) throw InputError("a traction must be three finite numbers");
@@ -382,9 +384,10 @@ SolveReport Model::solve(const SolveOptions& options) {
   if (!s.valid.has_value()) s.valid = validate(m).passed;
   if (!*s.valid) {
     const ValidationReport v = validate(m);
-    throw CheckFailure("the mesh is invalid (" +
-                       (v.messages.empty() ? std::string("see 'polydg check'") : v.messages.front()) +
-                       "); run 'polydg check' for details");
+    throw CheckFailure(
+        "the mesh is invalid (" +
+        (v.messages.empty() ? std::string("see 'polydg check'") : v.messages.front()) +
+        "); run 'polydg check' for details");
   }
 
   // Every selection must pick something.
@@ -450,9 +453,7 @@ SolveReport Model::solve(const SolveOptions& options) {
   return report;
 }
 
-const Solution* Model::solution() const {
-  return state_->solution ? &*state_->solution : nullptr;
-}
+const Solution* Model::solution() const { return state_->solution ? &*state_->solution : nullptr; }
 
 // --- writing -------------------------------------------------------------------------------
 

@@ -152,7 +152,7 @@ SolveStep solveStep(JsonObjectReader& r) {
 }
 
 PipelineStep parseStep(JsonObjectReader& r) {
-  static const Names<int> kinds{{"mesh", 0}, {"cut", 1},   {"merge", 2},
+  static const Names<int> kinds{{"mesh", 0},  {"cut", 1},   {"merge", 2},
                                 {"check", 3}, {"solve", 4}, {"write", 5}};
   switch (r.choice("step", kinds)) {
     case 0: return meshStep(r);
@@ -310,11 +310,14 @@ class InputRun {
       throw StepFailure(input_ + ": " + e.what());
     }
     result.update(toJson(report));
+    result["input"]["warnings"] = info.warnings;
+    for (const std::string& w : info.warnings) log("warning: " + w);
     result["faces_integrated"] = model_->facesIntegrated();
     if (!report.passed()) {
       const auto failures = report.failures();
       throw StepFailure("the new mesh failed its checks (" +
-                        (failures.empty() ? std::string("see the report") : failures.front()) + ")");
+                        (failures.empty() ? std::string("see the report") : failures.front()) +
+                        ")");
     }
     log("meshed: " + std::to_string(report.meshing.elements) + " elements, volume " +
         formatNumber(report.meshing.outputVolume));
@@ -328,14 +331,14 @@ class InputRun {
 
   void edit(const OperationReport& r, const char* what, json& result) {
     result["operations"] = json::array({toJson(r)});
-    result["output"] = {{"elements", current().mesh().numElements()}, {"volume", current().volume()}};
+    result["output"] = {{"elements", current().mesh().numElements()},
+                        {"volume", current().volume()}};
     if (!r.validation.passed)
-      throw StepFailure(std::string("the ") + what + " failed its validation: " +
-                        r.validation.failure);
+      throw StepFailure(std::string("the ") + what +
+                        " failed its validation: " + r.validation.failure);
     log(std::string(what) + ": " + std::to_string(r.elementsSplit) + " elements split, " +
-        std::to_string(r.elementsRemoved) + " removed, " +
-        std::to_string(r.sliversMerged) + " slivers merged, " +
-        std::to_string(current().mesh().numElements()) + " elements");
+        std::to_string(r.elementsRemoved) + " removed, " + std::to_string(r.sliversMerged) +
+        " slivers merged, " + std::to_string(current().mesh().numElements()) + " elements");
   }
 
   void apply(const CheckStep& s, json& result) {
@@ -368,7 +371,9 @@ class InputRun {
     const std::string relative = substituteStem(s.path, stem_);
     const fs::path file = folder_ / relative;
     fs::create_directories(file.parent_path());
-    current().write(file.string(), {.solution = false});
+    WriteOptions options;
+    options.solution = false;  // the mesh only: a solution goes with a solve step's output
+    current().write(file.string(), options);
     result["path"] = relative;
     result["elements"] = current().mesh().numElements();
     log("wrote " + relative);
@@ -518,8 +523,8 @@ json batchReport(const Pipeline& pipeline, const fs::path& out,
     failed += !o.passed;
     inputs.push_back(o.report);
   }
-  return {{"command", "run"},     {"pipeline", pipeline.file}, {"out", out.string()},
-          {"inputs", inputs},     {"failed", failed},          {"passed", failed == 0}};
+  return {{"command", "run"}, {"pipeline", pipeline.file}, {"out", out.string()},
+          {"inputs", inputs}, {"failed", failed},          {"passed", failed == 0}};
 }
 
 }  // namespace polydg

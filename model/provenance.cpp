@@ -40,9 +40,12 @@ std::optional<Provenance> provenanceFromFieldData(const VtuFieldData& data) {
       !(*fraction >= 0.0 && *fraction <= 1.0))
     return std::nullopt;
   Provenance p;
-  if (kind->second == "grid_cell") p.referenceKind = ReferenceKind::GridCell;
-  else if (kind->second == "median_element") p.referenceKind = ReferenceKind::MedianElement;
-  else return std::nullopt;
+  if (kind->second == "grid_cell")
+    p.referenceKind = ReferenceKind::GridCell;
+  else if (kind->second == "median_element")
+    p.referenceKind = ReferenceKind::MedianElement;
+  else
+    return std::nullopt;
   p.cellSize = *cell;
   p.referenceVolume = *volume;
   p.sliverFraction = *fraction;

@@ -54,12 +54,13 @@ json toJson(const Box3& box) {
 }
 
 json toJson(const Provenance& p) {
-  return {{"source", p.source},
-          {"cell_size", p.cellSize > 0.0 ? json(p.cellSize) : json(nullptr)},
-          {"reference_volume", p.referenceVolume},
-          {"reference", p.referenceKind == ReferenceKind::GridCell ? "grid_cell" : "median_element"},
-          {"sliver_fraction", p.sliverFraction},
-          {"sliver_threshold", p.sliverFraction * p.referenceVolume}};
+  return {
+      {"source", p.source},
+      {"cell_size", p.cellSize > 0.0 ? json(p.cellSize) : json(nullptr)},
+      {"reference_volume", p.referenceVolume},
+      {"reference", p.referenceKind == ReferenceKind::GridCell ? "grid_cell" : "median_element"},
+      {"sliver_fraction", p.sliverFraction},
+      {"sliver_threshold", p.sliverFraction * p.referenceVolume}};
 }
 
 json toJson(const ValidationReport& r) {
@@ -122,8 +123,7 @@ json toJson(const MeshCheck& c) {
   } else {
     v["rigid_modes"] = nullptr;
     v["rigid_modes_global"] = nullptr;
-    v["rigid_modes_expected"] =
-        c.geometry ? json(6 * c.geometry->components) : json(nullptr);
+    v["rigid_modes_expected"] = c.geometry ? json(6 * c.geometry->components) : json(nullptr);
   }
   if (c.patch) {
     v["global_patch_test_error"] = c.patch->relativeError;
@@ -143,8 +143,10 @@ json toJson(const MeshReport& report) {
   const MeshingReport& r = report.meshing;
   json timings = timingsJson(r.timings);
   timings["read"] = report.readSeconds;
-  if (report.dg.local) timings["dg_checks"] = report.dg.localSeconds;
-  else timings["dg_checks"] = nullptr;
+  if (report.dg.local)
+    timings["dg_checks"] = report.dg.localSeconds;
+  else
+    timings["dg_checks"] = nullptr;
   if (!report.output.empty()) timings["write"] = report.writeSeconds;
   // The whole operation, read to write; less than "total" where phases overlap.
   timings["wall"] = report.wallSeconds;

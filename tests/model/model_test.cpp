@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "polydg/mesh/primitives.h"
 #include "polydg/mesh/surface_shapes.h"
 #include "polydg/model/model.h"
 #include "polydg/model/report_json.h"

@@ -32,7 +32,8 @@ class PipelineTest : public ::testing::Test {
     std::ofstream out(path);
     out.precision(17);
     for (const Vec3& v : t.vertices) out << "v " << v.x() << ' ' << v.y() << ' ' << v.z() << '\n';
-    for (const auto& f : t.triangles) out << "f " << f[0] + 1 << ' ' << f[1] + 1 << ' ' << f[2] + 1 << '\n';
+    for (const auto& f : t.triangles)
+      out << "f " << f[0] + 1 << ' ' << f[1] + 1 << ' ' << f[2] + 1 << '\n';
     return path.string();
   }
   fs::path dir_;
@@ -63,7 +64,9 @@ TEST_F(PipelineTest, EachFaceIsIntegratedOnceThroughAllSteps) {
   EXPECT_EQ(expected, steps[0]["output"]["faces"].get<std::size_t>());
   for (std::size_t k : {1, 2, 3}) {
     const std::size_t edited = steps[k]["operations"][0]["faces_reintegrated"].get<std::size_t>();
-    if (k < 3) EXPECT_GT(edited, 0u) << steps[k].dump();
+    if (k < 3) {
+      EXPECT_GT(edited, 0u) << steps[k].dump();
+    }
     expected += edited;
   }
   EXPECT_EQ(steps[4]["validation"]["faces_integrated"], 0);
@@ -78,7 +81,8 @@ TEST_F(PipelineTest, EachFaceIsIntegratedOnceThroughAllSteps) {
 TEST_F(PipelineTest, AVtuInputIsIntegratedOnceToTheDegreeItsStepsNeed) {
   const std::string torus = torusFile();
   const Pipeline meshOnly = parsePipeline(
-      json::parse(R"({"steps": [{"step": "mesh", "cells": 6}, {"step": "write", "path": "m.vtu"}]})"),
+      json::parse(
+          R"({"steps": [{"step": "mesh", "cells": 6}, {"step": "write", "path": "m.vtu"}]})"),
       "a.json", dir_);
   ASSERT_TRUE(runPipelineInput(meshOnly, torus, "torus", dir_ / "a").passed);
   const Pipeline steps = parsePipeline(json::parse(R"({"steps": [
@@ -92,9 +96,9 @@ TEST_F(PipelineTest, AVtuInputIsIntegratedOnceToTheDegreeItsStepsNeed) {
   EXPECT_EQ(read["step"], "read");
   EXPECT_EQ(read["provenance_restored"], true);
   EXPECT_EQ(read["faces_integrated"], read["faces"]);  // once, to degree 6
-  EXPECT_EQ(o.facesIntegrated, read["faces_integrated"].get<std::size_t>() +
-                                   o.report["steps"][1]["operations"][0]["faces_reintegrated"]
-                                       .get<std::size_t>());
+  EXPECT_EQ(o.facesIntegrated,
+            read["faces_integrated"].get<std::size_t>() +
+                o.report["steps"][1]["operations"][0]["faces_reintegrated"].get<std::size_t>());
 }
 
 TEST_F(PipelineTest, ErrorsNameTheFileAndThePlace) {
@@ -108,14 +112,17 @@ TEST_F(PipelineTest, ErrorsNameTheFileAndThePlace) {
   };
   EXPECT_EQ(refused(R"({"steps": [{"step": "cut", "plnae": [0, 0, 1, 0]}]})").substr(0, 32),
             "p.json: steps[0]: a cut step nee");
-  EXPECT_NE(refused(R"({"steps": [{"step": "check", "degre": 2}]})").find("steps[0].degre: unknown key"),
-            std::string::npos);
+  EXPECT_NE(
+      refused(R"({"steps": [{"step": "check", "degre": 2}]})").find("steps[0].degre: unknown key"),
+      std::string::npos);
   EXPECT_NE(refused(R"({"steps": [{"step": "solve", "clamp": [{"below": [0, 0, 1]}]}]})")
                 .find("steps[0].clamp[0].below: expected 4 finite numbers"),
             std::string::npos);
-  EXPECT_NE(refused(R"({"steps": [{"step": "solve", "clamp": [{"below": [0, 0, 1, 0], "box": [[0,0,0],[1,1,1]]}]}]})")
-                .find("give exactly one region"),
-            std::string::npos);
+  EXPECT_NE(
+      refused(
+          R"({"steps": [{"step": "solve", "clamp": [{"below": [0, 0, 1, 0], "box": [[0,0,0],[1,1,1]]}]}]})")
+          .find("give exactly one region"),
+      std::string::npos);
   EXPECT_NE(refused(R"({"steps": [{"step": "solve", "clamp": [{"box": [[1,0,0],[0,1,1]]}]}]})")
                 .find("steps[0].clamp[0]: the box's first corner"),
             std::string::npos);

@@ -20,8 +20,8 @@ struct SurfaceInfo {
   bool closed = false;
   Box3 bounds;
   double area = 0.0;
-  std::optional<double> volume;  ///< enclosed volume, for a closed surface only
-  std::string reader;            ///< "cgal" or "assimp"
+  std::optional<double> volume;       ///< enclosed volume, for a closed surface only
+  std::string reader;                 ///< "cgal" or "assimp"
   std::vector<std::string> warnings;  ///< lines of the file that were skipped
 };
 

@@ -57,7 +57,8 @@ class JsonObjectReader {
   /// A reader of the object under `key` (fails unless it is an object).
   JsonObjectReader object(const std::string& key);
   /// A reader of element i of the list `list` (named `place` in errors).
-  JsonObjectReader element(const nlohmann::json& list, const std::string& place, std::size_t i) const;
+  JsonObjectReader element(const nlohmann::json& list, const std::string& place,
+                           std::size_t i) const;
   /// Call after reading: any key not asked about is an error.
   void finish() const;
 

@@ -31,8 +31,8 @@ enum class ReferenceKind {
 /// data, model/provenance.h), so `polydg mesh` then `polydg cut` applies the same sliver
 /// threshold as one `polydg run` of the same steps.
 struct Provenance {
-  std::string source;      ///< the file the mesh was made from; "" if built in memory
-  double cellSize = 0.0;   ///< edge of the slicing grid's cells; 0 if not sliced by polydg
+  std::string source;     ///< the file the mesh was made from; "" if built in memory
+  double cellSize = 0.0;  ///< edge of the slicing grid's cells; 0 if not sliced by polydg
   /// The volume sliver fractions multiply: cellSize^3 for a sliced mesh, else the median
   /// element volume when the mesh was first read. Positive.
   double referenceVolume = 0.0;
@@ -69,7 +69,7 @@ struct MeshReport {
   /// The DG checks of the new mesh (no geometry: that is meshing.validation); empty local
   /// check when skipped (MeshOptions::dgChecks false, or the geometry failed).
   MeshCheck dg;
-  std::string output;    ///< the file written, "" if none
+  std::string output;         ///< the file written, "" if none
   double readSeconds = 0.0;   ///< set by callers that read the surface (fromFile)
   double writeSeconds = 0.0;  ///< overlapped with the checks
   double wallSeconds = 0.0;   ///< the whole operation, read to write
@@ -131,12 +131,12 @@ struct SolveOptions {
 struct SolveReport {
   SolveOptions options;
   StaticReport solve;
-  std::vector<std::size_t> clampFaces;    ///< boundary faces each clamp selected
+  std::vector<std::size_t> clampFaces;     ///< boundary faces each clamp selected
   std::vector<std::size_t> tractionFaces;  ///< boundary faces each traction selected
-  double maxDisplacement = 0.0;  ///< largest |u_K(v)| over element corners
-  double maxVonMises = 0.0;      ///< largest element von Mises stress
-  double maxJump = 0.0;          ///< largest displacement jump across interior faces
-  std::size_t facesIntegrated = 0;  ///< by this solve (0 when the model's moments sufficed)
+  double maxDisplacement = 0.0;            ///< largest |u_K(v)| over element corners
+  double maxVonMises = 0.0;                ///< largest element von Mises stress
+  double maxJump = 0.0;                    ///< largest displacement jump across interior faces
+  std::size_t facesIntegrated = 0;         ///< by this solve (0 when the model's moments sufficed)
 };
 
 /// The solution of the model's last solve, until the mesh changes.

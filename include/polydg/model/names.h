@@ -18,11 +18,11 @@ namespace polydg {
 template <class E>
 using Names = std::vector<std::pair<std::string, E>>;
 
-const Names<Method>& methodNames();                   ///< ip, bz
-const Names<SolverKind>& solverNames();               ///< auto, cholesky, cg
-const Names<PenaltyRule>& penaltyNames();             ///< bound, doubling, fixed
-const Names<RepairMode>& repairNames();               ///< none, fill, wrap
-const Names<ValidationLevel>& validationNames();      ///< none, local, full
+const Names<Method>& methodNames();                    ///< ip, bz
+const Names<SolverKind>& solverNames();                ///< auto, cholesky, cg
+const Names<PenaltyRule>& penaltyNames();              ///< bound, doubling, fixed
+const Names<RepairMode>& repairNames();                ///< none, fill, wrap
+const Names<ValidationLevel>& validationNames();       ///< none, local, full
 const Names<CgPreconditioner>& preconditionerNames();  ///< p-multigrid, block-jacobi
 /// Which side of a cut to delete: "+" (normal . x > d) is +1, "-" is -1, "none" is 0.
 const Names<int>& removeSideNames();

@@ -69,7 +69,7 @@ struct InputOutcome {
   std::optional<double> volume;
   std::size_t facesIntegrated = 0;
   double seconds = 0.0;
-  std::string error;    ///< the failed step and why, one line
+  std::string error;      ///< the failed step and why, one line
   nlohmann::json report;  ///< what DIR/<stem>/report.json holds
   std::string log;        ///< a line per step, for the terminal
 };
@@ -87,8 +87,7 @@ std::vector<std::string> uniqueStems(const std::vector<std::string>& inputs);
 
 /// Throws InputError if an input lies in a folder the run would replace (out/<stem>).
 void refuseInputsInOutputs(const std::vector<std::string>& inputs,
-                           const std::vector<std::string>& stems,
-                           const std::filesystem::path& out);
+                           const std::vector<std::string>& stems, const std::filesystem::path& out);
 
 struct BatchOptions {
   int jobs = 1;  ///< inputs at a time (threads)

@@ -39,10 +39,11 @@ struct MeshCheckOptions {
   /// one, which stands for all: their local equations are the same up to translation (the
   /// geometric validation still covers each). For meshes fresh from the slicer.
   bool oneGridCellForAll = false;
-  GlobalCheck patchTest = GlobalCheck::Never;    ///< patchTest() of the whole mesh
+  GlobalCheck patchTest = GlobalCheck::Never;       ///< patchTest() of the whole mesh
   GlobalCheck rigidModes = GlobalCheck::UpToLimit;  ///< rigidModes(): 6 per component
   std::size_t globalDofLimit = kGlobalRigidModesDofLimit;
-  PhysicsCheckOptions physics;  ///< method, material, penalty of the DG checks (basis degree is `degree`)
+  PhysicsCheckOptions
+      physics;  ///< method, material, penalty of the DG checks (basis degree is `degree`)
 };
 
 /// What checkMesh() found; a check that did not run is empty and `notes` says why.
