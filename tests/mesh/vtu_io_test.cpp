@@ -669,31 +669,6 @@ TEST(VtuRead, PointIdOutOfRangeThrows) {
   EXPECT_EQ(message.rfind(path.string() + ": cell 0 refers to point 12", 0), 0u) << message;
 }
 
-// --- base64 --------------------------------------------------------------------------------
-
-TEST(Base64, MatchesRfc4648Vectors) {
-  const std::pair<std::string, std::string> vectors[] = {{"", ""},
-                                                         {"f", "Zg=="},
-                                                         {"fo", "Zm8="},
-                                                         {"foo", "Zm9v"},
-                                                         {"foob", "Zm9vYg=="},
-                                                         {"fooba", "Zm9vYmE="},
-                                                         {"foobar", "Zm9vYmFy"}};
-  for (const auto& [plain, encoded] : vectors) {
-    EXPECT_EQ(vtu_detail::base64Encode(plain), encoded);
-    EXPECT_EQ(vtu_detail::base64Decode(encoded), plain);
-  }
-  const std::string binary("\x00\xff\x10\x80\x7f", 5);
-  EXPECT_EQ(vtu_detail::base64Decode(vtu_detail::base64Encode(binary)), binary);
-}
-
-TEST(Base64, DecodesConcatenatedPaddedPiecesAndSkipsWhitespace) {
-  EXPECT_EQ(vtu_detail::base64Decode("Zg==Zm8=\n  Zm9v"), "ffofoo");
-  EXPECT_THROW(vtu_detail::base64Decode("Zm9v!"), std::runtime_error);
-  EXPECT_THROW(vtu_detail::base64Decode("Zm9vY"), std::runtime_error);
-  EXPECT_THROW(vtu_detail::base64Decode("Z==="), std::runtime_error);
-}
-
 // --- files written by VTK (ctest fixture: vtk_check.py --write-vtk) -------------------------
 
 /// The path of a file made by vtk_check.py --write-vtk: `suffix` "" for the main file.

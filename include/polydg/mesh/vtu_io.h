@@ -4,7 +4,6 @@
 
 #include <functional>
 #include <string>
-#include <string_view>
 #include <vector>
 
 #include "polydg/mesh/poly_mesh.h"
@@ -49,12 +48,12 @@ struct CornerArray {
 /// Layout: points (Float64) are the mesh's vertices in id order, followed by extra copies of
 /// vertices: per vertex, its elements are grouped by connectivity through the interior faces
 /// that contain the vertex, and each group has its own point (the first group, in element
-/// order, the vertex itself). So elements coupled across interior faces share points, while the
-/// two sides of a FaceOrigin::Cut face (boundary faces of both, on the same vertex ids) do not:
-/// VTK and meshio see them as separate regions, and a finite cut shares points only along its
-/// front. Each element is one VTK_POLYHEDRON (type 42) cell, cells ordered by point count (see
-/// polydg_element). Cells/connectivity holds a cell's distinct point ids, Cells/faces per cell
-/// the number of face records and then, per record, its number of points and point ids;
+/// order, the vertex itself; polydg/mesh/point_groups.h). So elements coupled across interior faces
+/// share points, while the two sides of a FaceOrigin::Cut face (boundary faces of both, on the same
+/// vertex ids) do not: VTK and meshio see them as separate regions, and a finite cut shares points
+/// only along its front. Each element is one VTK_POLYHEDRON (type 42) cell, cells ordered by point
+/// count (see polydg_element). Cells/connectivity holds a cell's distinct point ids, Cells/faces
+/// per cell the number of face records and then, per record, its number of points and point ids;
 /// Cells/faceoffsets the end of each cell's run in `faces`. Integer arrays are stored as UInt8,
 /// Int32 or Int64, the smallest that holds their values. Every record is oriented so that its
 /// normal points out of the cell (the face's loop if the element uses it unreversed, the loop
@@ -109,16 +108,5 @@ void writeVtu(const PolyMesh& mesh, const std::string& path, const VtuWriteOptio
 /// "FILE: not a VTK UnstructuredGrid file" or "FILE: cell 3 has VTK type 5, which polydg does not
 /// read; only 3D linear cells and polyhedra are supported".
 PolyMesh readVtu(const std::string& path);
-
-/// Base64 (RFC 4648, with '=' padding), as used for binary data in VTK XML files. Exposed for
-/// tests.
-namespace vtu_detail {
-std::string base64Encode(std::string_view bytes);
-/// Decodes groups of four characters, ignoring whitespace; a group may end in padding
-/// anywhere, so separately encoded pieces that were concatenated (as VTK writes headers and
-/// data) decode to the concatenated bytes. Throws std::runtime_error on any other character or
-/// an incomplete final group.
-std::string base64Decode(std::string_view text);
-}  // namespace vtu_detail
 
 }  // namespace polydg
