@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <optional>
 #include <sstream>
 #include <type_traits>
 
@@ -257,7 +258,8 @@ namespace {
 
 enum class Scalar { Int8, UInt8, Int16, UInt16, Int32, UInt32, Int64, UInt64, Float32, Float64 };
 
-Scalar parseScalar(std::string_view type, std::string_view array) {
+/// The scalar of a DataArray `type` (VTK's names and their legacy aliases), if numeric.
+std::optional<Scalar> scalarOf(std::string_view type) {
   static const std::pair<std::string_view, Scalar> kTypes[] = {
       {"Int8", Scalar::Int8},       {"UInt8", Scalar::UInt8},   {"Int16", Scalar::Int16},
       {"UInt16", Scalar::UInt16},   {"Int32", Scalar::Int32},   {"UInt32", Scalar::UInt32},
@@ -268,6 +270,11 @@ Scalar parseScalar(std::string_view type, std::string_view array) {
       {"Float", Scalar::Float32},   {"Double", Scalar::Float64}};
   for (const auto& [name, scalar] : kTypes)
     if (name == type) return scalar;
+  return std::nullopt;
+}
+
+Scalar parseScalar(std::string_view type, std::string_view array) {
+  if (const std::optional<Scalar> scalar = scalarOf(type)) return *scalar;
   throw FormatError("array '" + std::string(array) + "' has unknown type '" + std::string(type) +
                     "'");
 }
@@ -398,22 +405,59 @@ std::string arrayName(pugi::xml_node array) {
   return *name ? name : array.parent().name();
 }
 
+namespace {
+
+/// Calls f(first, last) for each whitespace-separated token of `text`.
+template <class F>
+void forEachToken(std::string_view text, F&& f) {
+  std::size_t pos = 0;
+  while (true) {
+    while (pos < text.size() && isXmlSpace(text[pos])) ++pos;
+    if (pos == text.size()) return;
+    std::size_t end = pos;
+    while (end < text.size() && !isXmlSpace(text[end])) ++end;
+    f(text.data() + pos, text.data() + end);
+    pos = end;
+  }
+}
+
+FormatError invalidNumber(const std::string& name, const char* first, const char* last) {
+  return FormatError("array '" + name + "' has an invalid number '" +
+                     std::string(first, std::min<std::ptrdiff_t>(last - first, 32)) + "'");
+}
+
+bool isAscii(std::string_view format) { return format == "ascii" || format.empty(); }
+
+/// The bytes of a binary or appended array, after its header (decompressed).
+std::string binaryPayload(pugi::xml_node array, const FileLayout& layout, const std::string& name,
+                          std::string_view format) {
+  if (format == "binary") {
+    ByteReader in(array.child_value(), /*base64=*/true);
+    return readBinaryBytes(in, layout, "data in array '" + name + "'");
+  }
+  if (format == "appended") {
+    const pugi::xml_attribute offsetAttr = array.attribute("offset");
+    const unsigned long long offset = offsetAttr.as_ullong(~0ull);
+    if (!offsetAttr || offset == ~0ull)
+      throw FormatError("array '" + name + "' has no valid offset into the appended data");
+    if (offset > layout.appended.size())
+      throw FormatError("truncated appended data (array '" + name + "')");
+    ByteReader in(layout.appended.substr(offset), layout.appendedBase64);
+    return readBinaryBytes(in, layout, "appended data (array '" + name + "')");
+  }
+  throw FormatError("array '" + name + "' has unknown format '" + std::string(format) + "'");
+}
+
+}  // namespace
+
 template <class Out>
 std::vector<Out> readArray(pugi::xml_node array, const FileLayout& layout) {
   const std::string name = arrayName(array);
   const Scalar scalar = parseScalar(array.attribute("type").value(), name);
   const std::string_view format = array.attribute("format").value();
   std::vector<Out> out;
-  if (format == "ascii" || format.empty()) {
-    const std::string_view text = array.child_value();
-    std::size_t pos = 0;
-    while (true) {
-      while (pos < text.size() && isXmlSpace(text[pos])) ++pos;
-      if (pos == text.size()) break;
-      std::size_t end = pos;
-      while (end < text.size() && !isXmlSpace(text[end])) ++end;
-      const char* first = text.data() + pos;
-      const char* last = text.data() + end;
+  if (isAscii(format)) {
+    forEachToken(array.child_value(), [&](const char* first, const char* last) {
       std::from_chars_result result{};
       if (isFloat(scalar)) {
         double v = 0.0;
@@ -428,29 +472,11 @@ std::vector<Out> readArray(pugi::xml_node array, const FileLayout& layout) {
         result = std::from_chars(first, last, v);
         if (result.ec == std::errc()) out.push_back(convertValue<Out>(v, name));
       }
-      if (result.ec != std::errc() || result.ptr != last)
-        throw FormatError("array '" + name + "' has an invalid number '" +
-                          std::string(first, std::min<std::size_t>(last - first, 32)) + "'");
-      pos = end;
-    }
+      if (result.ec != std::errc() || result.ptr != last) throw invalidNumber(name, first, last);
+    });
     return out;
   }
-  std::string bytes;
-  if (format == "binary") {
-    ByteReader in(array.child_value(), /*base64=*/true);
-    bytes = readBinaryBytes(in, layout, "data in array '" + name + "'");
-  } else if (format == "appended") {
-    const pugi::xml_attribute offsetAttr = array.attribute("offset");
-    const unsigned long long offset = offsetAttr.as_ullong(~0ull);
-    if (!offsetAttr || offset == ~0ull)
-      throw FormatError("array '" + name + "' has no valid offset into the appended data");
-    if (offset > layout.appended.size())
-      throw FormatError("truncated appended data (array '" + name + "')");
-    ByteReader in(layout.appended.substr(offset), layout.appendedBase64);
-    bytes = readBinaryBytes(in, layout, "appended data (array '" + name + "')");
-  } else {
-    throw FormatError("array '" + name + "' has unknown format '" + std::string(format) + "'");
-  }
+  const std::string bytes = binaryPayload(array, layout, name, format);
   if (bytes.size() % scalarSize(scalar) != 0)
     throw FormatError("array '" + name +
                       "' has a byte count that is not a multiple of its type size");
@@ -460,6 +486,29 @@ std::vector<Out> readArray(pugi::xml_node array, const FileLayout& layout) {
 
 template std::vector<double> readArray<double>(pugi::xml_node, const FileLayout&);
 template std::vector<std::int64_t> readArray<std::int64_t>(pugi::xml_node, const FileLayout&);
+
+bool isNumericType(std::string_view type) { return scalarOf(type).has_value(); }
+
+std::string readBytes(pugi::xml_node array, const FileLayout& layout) {
+  const std::string name = arrayName(array);
+  const std::string_view type = array.attribute("type").value();
+  if (type != "String" && type != "Int8" && type != "UInt8" && type != "Char" && type != "UChar")
+    throw FormatError("array '" + name + "' has type '" + std::string(type) +
+                      "', which does not hold bytes");
+  const std::string_view format = array.attribute("format").value();
+  if (!isAscii(format)) return binaryPayload(array, layout, name, format);
+  std::string out;
+  forEachToken(array.child_value(), [&](const char* first, const char* last) {
+    int v = 0;
+    const auto result = std::from_chars(first, last, v);
+    if (result.ec != std::errc() || result.ptr != last) throw invalidNumber(name, first, last);
+    if (v < -128 || v > 255)
+      throw FormatError("array '" + name + "' holds " + std::to_string(v) +
+                        ", which is not a byte");
+    out.push_back(static_cast<char>(v));
+  });
+  return out;
+}
 
 pugi::xml_node findArray(pugi::xml_node parent, std::string_view name) {
   for (pugi::xml_node a : parent.children("DataArray"))

@@ -364,6 +364,31 @@ std::optional<PolydgFields> readPolydgFields(pugi::xml_node grid, const FileLayo
   return fields;
 }
 
+/// The file's FieldData arrays for the caller, as readVtu documents: text, numbers, no restore
+/// arrays.
+VtuFieldData readFieldData(pugi::xml_node grid, const FileLayout& layout) {
+  VtuFieldData out;
+  for (pugi::xml_node array : grid.child("FieldData").children()) {
+    const std::string_view tag = array.name();
+    if (tag != "DataArray" && tag != "Array") continue;
+    const std::string name = array.attribute("Name").value();
+    if (name.empty() || isReservedArrayName(name)) continue;
+    const std::string_view type = array.attribute("type").value();
+    if (type == "String") {
+      std::string text = vtk_format::readBytes(array, layout);
+      if (!text.empty() && text.back() == '\0') text.pop_back();
+      out.strings.insert_or_assign(name, std::move(text));
+    } else if ((type == "UInt8" || type == "UChar") && name.size() > kVtuTextSuffix.size() &&
+               name.ends_with(kVtuTextSuffix)) {
+      out.strings.insert_or_assign(name.substr(0, name.size() - kVtuTextSuffix.size()),
+                                   vtk_format::readBytes(array, layout));
+    } else if (vtk_format::isNumericType(type)) {
+      out.numbers.insert_or_assign(name, readArray<double>(array, layout));
+    }
+  }
+  return out;
+}
+
 std::string readWholeFile(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw FormatError("cannot open: " + errnoText(errno));
@@ -376,7 +401,9 @@ std::string readWholeFile(const std::string& path) {
   return std::move(bytes).str();
 }
 
-PolyMesh readVtuContents(const std::string& path) {
+/// readVtu without the file name in its errors; `fieldData` as readVtu's, filled as soon as the
+/// layout is known.
+PolyMesh readVtuContents(const std::string& path, VtuFieldData* fieldData) {
   const std::string bytes = readWholeFile(path);
   const vtk_format::FileParts parts = vtk_format::splitAppendedData(bytes);
 
@@ -394,6 +421,7 @@ PolyMesh readVtuContents(const std::string& path) {
   if (std::string_view(root.attribute("type").value()) != "UnstructuredGrid" || !grid)
     throw FormatError("not a VTK UnstructuredGrid file");
   const vtk_format::FileLayout layout = vtk_format::readLayout(root, parts.appended);
+  if (fieldData) *fieldData = readFieldData(grid, layout);
 
   std::vector<Vec3> points;
   CellFaces cells;
@@ -448,9 +476,12 @@ PolyMesh readVtuContents(const std::string& path) {
 
 }  // namespace
 
-PolyMesh readVtu(const std::string& path) {
+PolyMesh readVtu(const std::string& path, VtuFieldData* fieldData) {
   try {
-    return readVtuContents(path);
+    VtuFieldData read;
+    PolyMesh mesh = readVtuContents(path, fieldData ? &read : nullptr);
+    if (fieldData) *fieldData = std::move(read);
+    return mesh;
   } catch (const FormatError& e) {
     throw std::runtime_error(path + ": " + e.what());
   } catch (const std::bad_alloc&) {

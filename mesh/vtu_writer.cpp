@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <array>
 #include <cerrno>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
@@ -10,6 +11,9 @@
 #include <ostream>
 #include <span>
 #include <stdexcept>
+#include <string>
+#include <string_view>
+#include <unordered_map>
 #include <unordered_set>
 
 #include <tbb/parallel_for.h>
@@ -192,6 +196,48 @@ void checkArrays(const std::vector<VtuArray<Tag>>& arrays, std::size_t count, co
   }
 }
 
+/// `name` with control characters shown as '?', for messages.
+std::string printable(std::string_view name) {
+  std::string out(name);
+  for (char& c : out)
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
+  return out;
+}
+
+/// The rules of VtuFieldData (names, finite numbers) and distinct array names in the file.
+void checkFieldData(const VtuFieldData& fieldData) {
+  std::unordered_set<std::string> fileNames;
+  auto checkName = [&](const std::string& name, const std::string& fileName, const char* kind) {
+    if (name.empty())
+      throw std::invalid_argument(std::string("writeVtu: a field data ") + kind + " has no name");
+    for (char c : name)
+      if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
+        char code[8];
+        std::snprintf(code, sizeof code, "0x%02x", static_cast<unsigned>(c));
+        throw std::invalid_argument("writeVtu: field data name '" + printable(name) +
+                                    "' holds the control character " + code +
+                                    ", which an XML attribute cannot keep");
+      }
+    if (isReservedArrayName(name))
+      throw std::invalid_argument("writeVtu: field data name '" + name +
+                                  "' is reserved for polydg's restore arrays (names starting "
+                                  "with polydg_face_, polydg_element or polydg_point_)");
+    if (!fileNames.insert(fileName).second)
+      throw std::invalid_argument("writeVtu: field data text '" + name + "' is stored as '" +
+                                  fileName + "', the name of a number array");
+  };
+  for (const auto& [name, values] : fieldData.numbers) {
+    checkName(name, name, "number array");
+    for (std::size_t i = 0; i < values.size(); ++i)
+      if (!std::isfinite(values[i]))
+        throw std::invalid_argument("writeVtu: field data array '" + printable(name) + "' holds " +
+                                    (std::isnan(values[i]) ? "NaN" : "an infinity") + " at index " +
+                                    std::to_string(i) + "; only finite numbers can be written");
+  }
+  for (const auto& [name, text] : fieldData.strings)
+    checkName(name, name + std::string(kVtuTextSuffix), "text");
+}
+
 /// The point and cell values the file holds, in file order.
 struct FileValues {
   std::vector<double> points;                     ///< 3 per VTU point
@@ -266,14 +312,29 @@ FileValues fileValues(const PolyMesh& mesh, const CellStreams& s,
 void writeContents(std::ostream& os, const PolyMesh& mesh, const CellStreams& s,
                    const FileValues& values, const std::vector<CellArray>& cellData,
                    const std::vector<PointArray>& pointData,
-                   const std::vector<CornerArray>& cornerData, VtuEncoding enc) {
+                   const std::vector<CornerArray>& cornerData, const VtuFieldData& fieldData,
+                   VtuEncoding enc) {
   const std::string_view field = "      ", inner = "        ";
-  std::vector<ArrayOut> fieldArrays{intArray(field, kFaceGroupArray, s.faceGroup, true),
-                                    intArray(field, kFaceReversedArray, s.faceReversed, true),
-                                    intArray(field, kFaceOriginArray, s.faceOrigin, true),
-                                    intArray(field, kElementArray, s.element, true)};
+  std::vector<ArrayOut> restoreArrays{intArray(field, kFaceGroupArray, s.faceGroup, true),
+                                      intArray(field, kFaceReversedArray, s.faceReversed, true),
+                                      intArray(field, kFaceOriginArray, s.faceOrigin, true),
+                                      intArray(field, kElementArray, s.element, true)};
   if (s.pointVertex.size() != mesh.numVertices())
-    fieldArrays.push_back(intArray(field, kPointVertexArray, s.pointVertex, true));
+    restoreArrays.push_back(intArray(field, kPointVertexArray, s.pointVertex, true));
+  // The caller's field data: numbers, then text as its bytes (0 .. 255, which intArray stores as
+  // UInt8).
+  std::vector<std::string> textNames;
+  std::vector<std::vector<std::int64_t>> textBytes;
+  for (const auto& [name, text] : fieldData.strings) {
+    textNames.push_back(name + std::string(kVtuTextSuffix));
+    textBytes.emplace_back(reinterpret_cast<const unsigned char*>(text.data()),
+                           reinterpret_cast<const unsigned char*>(text.data()) + text.size());
+  }
+  std::vector<ArrayOut> callerArrays;
+  for (const auto& [name, values] : fieldData.numbers)
+    callerArrays.push_back(floatArray(field, name, 1, values, true));
+  for (std::size_t i = 0; i < textNames.size(); ++i)
+    callerArrays.push_back(intArray(field, textNames[i], textBytes[i], true));
   std::vector<ArrayOut> pointArrays, cellArrays;
   for (std::size_t i = 0; i < pointData.size(); ++i)
     pointArrays.push_back(
@@ -291,19 +352,39 @@ void writeContents(std::ostream& os, const PolyMesh& mesh, const CellStreams& s,
       intArray(inner, "types", s.types), intArray(inner, "faces", s.faces),
       intArray(inner, "faceoffsets", s.faceOffsets)};
 
-  std::size_t offset = 0;
+  // The appended data: polydg's arrays in document order, then the caller's field data in
+  // reverse order. meshio 7 reads raw appended data array by array, finding each <DataArray> by
+  // its offset attribute while it rewrites the attributes of the arrays already read to
+  // positions in a base64 text; where a rewritten offset equals the one it looks for and
+  // belongs to an array earlier in the document, it reads the wrong array (hostile field data
+  // placed in document order did so: tests/mesh/vtk_check.py --field-data). Read last to first
+  // after all of polydg's arrays, a caller's array is preceded in the document only by arrays
+  // not read yet (their offsets are all different) and by the restore arrays, whose rewritten
+  // offsets (4/3 of their raw bytes and a few characters) stay below the raw size of the whole
+  // mesh, where the caller's arrays begin. polydg's own arrays keep the offsets they have in a
+  // file without field data.
   std::vector<const ArrayOut*> appended;
-  auto put = [&](const ArrayOut& a) {
-    vtk_format::writeDataArray(os, a, enc, offset);
-    offset += a.binaryBytes();
-    appended.push_back(&a);
-  };
+  for (const ArrayOut& a : restoreArrays) appended.push_back(&a);
+  for (const ArrayOut& a : pointArrays) appended.push_back(&a);
+  for (const ArrayOut& a : cellArrays) appended.push_back(&a);
+  appended.push_back(&points);
+  for (const ArrayOut& a : cells) appended.push_back(&a);
+  for (auto a = callerArrays.rbegin(); a != callerArrays.rend(); ++a) appended.push_back(&*a);
+  std::unordered_map<const ArrayOut*, std::size_t> offsets;
+  std::size_t offset = 0;
+  for (const ArrayOut* a : appended) {
+    offsets.emplace(a, offset);
+    offset += a->binaryBytes();
+  }
+  auto put = [&](const ArrayOut& a) { vtk_format::writeDataArray(os, a, enc, offsets.at(&a)); };
+
   os << "<?xml version=\"1.0\"?>\n"
      << "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\""
         " header_type=\"UInt64\">\n"
      << "  <UnstructuredGrid>\n"
      << "    <FieldData>\n";
-  for (const ArrayOut& a : fieldArrays) put(a);
+  for (const ArrayOut& a : restoreArrays) put(a);
+  for (const ArrayOut& a : callerArrays) put(a);
   os << "    </FieldData>\n"
      << "    <Piece NumberOfPoints=\"" << s.points.numPoints() << "\" NumberOfCells=\""
      << mesh.numElements() << "\">\n";
@@ -331,7 +412,7 @@ std::string errnoText(int error) { return error != 0 ? std::strerror(error) : "I
 
 void writeVtu(const PolyMesh& mesh, const std::string& path, const VtuWriteOptions& options,
               const std::vector<CellArray>& cellData, const std::vector<PointArray>& pointData,
-              const std::vector<CornerArray>& cornerData) {
+              const std::vector<CornerArray>& cornerData, const VtuFieldData& fieldData) {
   std::unordered_set<std::string> cellNames{"volume"}, pointNames;
   checkArrays(cellData, mesh.numElements(), "cell", cellNames);
   checkArrays(pointData, mesh.numVertices(), "point", pointNames);
@@ -340,6 +421,7 @@ void writeVtu(const PolyMesh& mesh, const std::string& path, const VtuWriteOptio
     if (!a.value)
       throw std::invalid_argument("writeVtu: corner array '" + a.name + "' has no value function");
   }
+  checkFieldData(fieldData);
   // Everything that can fail for reasons other than I/O happens before the file is opened.
   const CellStreams streams = buildCellStreams(mesh);
   const FileValues values = fileValues(mesh, streams, cellData, pointData, cornerData);
@@ -354,7 +436,8 @@ void writeVtu(const PolyMesh& mesh, const std::string& path, const VtuWriteOptio
     if (!os) fail(errno);
     errno = 0;
     try {
-      writeContents(os, mesh, streams, values, cellData, pointData, cornerData, options.encoding);
+      writeContents(os, mesh, streams, values, cellData, pointData, cornerData, fieldData,
+                    options.encoding);
     } catch (...) {
       os.close();
       std::remove(tmp.c_str());

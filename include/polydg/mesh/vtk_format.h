@@ -159,6 +159,15 @@ std::string arrayName(pugi::xml_node array);
 template <class Out>
 std::vector<Out> readArray(pugi::xml_node array, const FileLayout& layout);
 
+/// True for the numeric types readArray reads: Int8 .. UInt64, Float32, Float64 and their legacy
+/// names (Char, UChar, Short, UShort, Int, UInt, Long, ULong, Float, Double).
+bool isNumericType(std::string_view type);
+
+/// The bytes of a one-byte array (type String, Int8, UInt8, Char or UChar) in any format; in
+/// ascii each number, from -128 to 255, is one byte. (VTK writes a String array, in an <Array>
+/// element, as its values each followed by a NUL byte.) Throws FormatError.
+std::string readBytes(pugi::xml_node array, const FileLayout& layout);
+
 /// The first <DataArray> child of `parent` with Name `name`, or a null node.
 pugi::xml_node findArray(pugi::xml_node parent, std::string_view name);
 

@@ -2,6 +2,7 @@
 // contents are documented at writeVtu in polydg/mesh/vtu_io.h), shared by the writer and reader.
 #pragma once
 
+#include <array>
 #include <string_view>
 
 namespace polydg {
@@ -20,5 +21,17 @@ constexpr std::string_view kElementArray = "polydg_element";
 /// For each VTU point, the mesh vertex it is a copy of; written only when some vertex has
 /// several points (see polydg/mesh/point_groups.h).
 constexpr std::string_view kPointVertexArray = "polydg_point_vertex";
+
+/// The name prefixes reserved for the restore arrays: no VtuFieldData name may start with one,
+/// and readVtu returns no field data array whose name does.
+constexpr std::array<std::string_view, 3> kReservedPrefixes{"polydg_face_", "polydg_element",
+                                                            "polydg_point_"};
+
+/// True if `name` starts with one of kReservedPrefixes.
+constexpr bool isReservedArrayName(std::string_view name) {
+  for (std::string_view prefix : kReservedPrefixes)
+    if (name.starts_with(prefix)) return true;
+  return false;
+}
 
 }  // namespace polydg
