@@ -75,6 +75,8 @@ class ByteReader {
   std::size_t pendingPos_ = 0;
 };
 
+/// True for the four characters XML counts as white space (space, tab, CR, LF), which separate
+/// ascii values and may appear anywhere in base64 text.
 bool isXmlSpace(char c);
 
 // --- writing --------------------------------------------------------------------------------
