@@ -2,14 +2,14 @@
 // (L2 ~ h^(p+1), broken H1 ~ h^p) on small hex grids, BZ's inconsistency, B3's cantilever tip
 // deflection and its locking-free behaviour as nu -> 1/2. Figures only; timings are in
 // `polydg bench`.
-#include "polydg/physics/benchmarks.h"
+#include "cli/bench/problems.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
 
-namespace polydg {
+namespace polydg::bench {
 namespace {
 
 /// Rates required by issue #4: L2 at least p + 0.8, broken H1 at least p - 0.2.
@@ -108,4 +108,4 @@ INSTANTIATE_TEST_SUITE_P(
     [](const auto& info) { return "p" + std::to_string(info.param.degree); });
 
 }  // namespace
-}  // namespace polydg
+}  // namespace polydg::bench

@@ -4,11 +4,10 @@
 // cantilever (B3 as nu -> 1/2); and B1 and B3 scaled and translated.
 #pragma once
 
-#include "polydg/mesh/geometry.h"
-#include "polydg/physics/benchmarks.h"
+#include "cli/bench/problems.h"
 #include "polydg/physics/condition_estimate.h"
 
-namespace polydg {
+namespace polydg::bench {
 
 /// The sliver mesh of B4: the 3 x 3 x 3 grid of unit cubes on [0,3]^3 whose centre cell is split
 /// by the plane x = 1 + volumeRatio into a sliver of volume `volumeRatio` (relative to its
@@ -44,7 +43,7 @@ StabilityConditionRun runSliverCase(double volumeRatio, bool merge, int degree);
 /// B4 thin neck: thinNeckMesh(eps) clamped on x = 0.
 StabilityConditionRun runThinNeckCase(double eps, int degree);
 
-/// The cantilever meshes of the locking test (tests/physics/benchmarks_test.cpp, issue 4):
+/// The cantilever meshes of the locking test (tests/cli/bench/problems_test.cpp, issue 4):
 /// 40 x 4 x 4 with the trace-bound penalty for p = 2; 160 x 4 x 8 with penalty doubling for
 /// p = 1 (linear elements need the smaller penalty in bending). `quick` divides nx by 4 (a
 /// coarser, faster smoke test; the 5% locking criterion is not meant for it).
@@ -89,4 +88,4 @@ ScaleRun runScaleCase(ScaleProblem problem, double scale, const Vec3& offset, in
 /// solution then changes by up to about that times this condition number.
 double scaleProblemCondition(ScaleProblem problem, int degree, bool quick = false);
 
-}  // namespace polydg
+}  // namespace polydg::bench

@@ -1,7 +1,7 @@
-// The B4 stability functions on small cases: the sliver and thin-neck meshes (valid, exact
-// volumes), the regular grid's condition (finite, > 1), the sliver grid with merging within
-// 100x of it, the thin neck bounded as eps -> 0, and scale invariance of B1.
-#include "polydg/physics/stability.h"
+// The B4 stability drivers (cli/bench/stability.h) on small cases: the sliver and thin-neck
+// meshes (valid, exact volumes), the regular grid's condition (finite, > 1), the sliver grid
+// with merging within 100x of it, the thin neck bounded as eps -> 0, and scale invariance of B1.
+#include "cli/bench/stability.h"
 
 #include <gtest/gtest.h>
 
@@ -13,7 +13,7 @@
 #include "polydg/integrate/moment_cache.h"
 #include "polydg/mesh/validate.h"
 
-namespace polydg {
+namespace polydg::bench {
 namespace {
 
 /// The B4 criteria (issue 6): with merging the sliver's condition estimate within 100x of the
@@ -114,4 +114,4 @@ TEST(Stability, ScaledAndTranslatedB1KeepsItsRelativeError) {
 }
 
 }  // namespace
-}  // namespace polydg
+}  // namespace polydg::bench

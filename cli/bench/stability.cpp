@@ -1,4 +1,4 @@
-#include "polydg/physics/stability.h"
+#include "cli/bench/stability.h"
 
 #include <limits>
 #include <stdexcept>
@@ -7,7 +7,7 @@
 #include "polydg/mesh/merge_elements.h"
 #include "polydg/mesh/primitives.h"
 
-namespace polydg {
+namespace polydg::bench {
 
 // --- meshes ---------------------------------------------------------------------------------
 
@@ -134,4 +134,4 @@ double scaleProblemCondition(ScaleProblem problem, int degree, bool quick) {
       .estimate.cond;
 }
 
-}  // namespace polydg
+}  // namespace polydg::bench

@@ -1,0 +1,98 @@
+// `polydg bench` end to end through the binary, as a user runs it: the stability and cutting
+// suites with --quick (every file written, the B4 JSON keys and findings, incremental cuts),
+// and an unknown suite refused with one line.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "tests/support/run_polydg.h"
+
+namespace polydg::bench {
+namespace {
+
+namespace fs = std::filesystem;
+
+using Result = polydg::testing::CommandResult;
+
+Result run(const std::string& arguments) { return polydg::testing::runPolydg(arguments); }
+
+TEST(BenchCommand, StabilitySuiteWritesJsonCsvAndPlots) {
+  // Unique per process: two test runs at once must not share (and delete) the folder.
+  const fs::path dir =
+      fs::temp_directory_path() / ("polydg_bench_stability_" + std::to_string(getpid()));
+  fs::remove_all(dir);
+  const Result r = run("bench --suite stability --quick --quiet --out " + dir.string());
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  EXPECT_TRUE(r.out.empty()) << r.out;  // --quiet
+  for (const char* file :
+       {"stability.json", "stability.csv", "stability_sliver.svg", "stability_thin_neck.svg",
+        "stability_incompressible.svg", "stability_scale.svg"})
+    EXPECT_TRUE(fs::exists(dir / file)) << file;
+  std::ifstream in(dir / "stability.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_TRUE(j["cond_method"].get<std::string>().find("Lanczos") != std::string::npos);
+  ASSERT_FALSE(j["sliver"].empty());
+  for (const nlohmann::json& s : j["sliver"]) {
+    ASSERT_TRUE(s.contains("volume_ratio") && s.contains("merged") && s.contains("cond"));
+    if (s["merged"].get<bool>()) {
+      EXPECT_LE(s["cond_over_regular"].get<double>(), 100.0);
+    }
+  }
+  for (const nlohmann::json& s : j["thin_neck"]) EXPECT_TRUE(s["positive_definite"].get<bool>());
+  EXPECT_EQ(j["incompressible"].size(), 8u);  // 4 values of nu, p = 1 and 2
+  for (const nlohmann::json& s : j["incompressible"])
+    EXPECT_TRUE(s.contains("tip") && s.contains("reference") && s.contains("nu"));
+  EXPECT_EQ(j["scale"].size(), 12u);  // B1 and B3, 3 scales, 2 offsets
+  // Round-off: the coordinates' relative resolution amplified by the stiffness's condition
+  // number, an order-of-magnitude bound (its constant is not known; the full suite reaches 2.6).
+  constexpr double kRoundoffBoundFactor = 10.0;
+  for (const nlohmann::json& s : j["scale"])
+    EXPECT_LE(s["change"].get<double>(), kRoundoffBoundFactor * s["roundoff_bound"].get<double>())
+        << s.dump();
+  std::ifstream csv(dir / "stability.csv");
+  std::string header;
+  std::getline(csv, header);
+  EXPECT_NE(header.find("case"), std::string::npos);
+  EXPECT_NE(header.find("volume_ratio"), std::string::npos);
+  fs::remove_all(dir);
+}
+
+TEST(BenchCommand, CuttingSuiteReintegratesOnlyWhatEachCutTouched) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("polydg_bench_cutting_" + std::to_string(getpid()));
+  fs::remove_all(dir);
+  const Result r = run("bench --suite cutting --quick --quiet --out " + dir.string());
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  for (const char* file : {"cutting.json", "cutting.csv", "cutting.svg"})
+    EXPECT_TRUE(fs::exists(dir / file)) << file;
+  std::ifstream in(dir / "cutting.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  ASSERT_GE(j["runs"].size(), 4u);  // 3 cuts with validation none, at least 1 with local
+  for (const nlohmann::json& run : j["runs"]) {
+    EXPECT_TRUE(run["validation_passed"].get<bool>()) << run.dump();
+    EXPECT_GT(run["elements_split"].get<std::size_t>(), 0u) << run.dump();
+    // Each split element re-integrates its own faces only: far fewer than the mesh's faces.
+    EXPECT_LT(run["faces_reintegrated"].get<std::size_t>(),
+              run["faces_total"].get<std::size_t>() / 4)
+        << run.dump();
+  }
+  fs::remove_all(dir);
+}
+
+TEST(BenchCommand, UnknownSuiteIsRefusedWithOneLine) {
+  const Result r = run("bench --suite nonsense --out " +
+                       (fs::temp_directory_path() / "polydg_bench_unknown").string());
+  EXPECT_EQ(r.exitCode, 2);
+  EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << r.out;
+  EXPECT_FALSE(fs::exists(fs::temp_directory_path() / "polydg_bench_unknown"));
+}
+
+}  // namespace
+}  // namespace polydg::bench
