@@ -5,13 +5,15 @@
 //   polydg bench --suite all --out bench/          (every suite; about a minute on 2 cores)
 //   polydg bench --suite stability --out bench/    (B4: conditioning, locking, scale)
 //   polydg bench --suite stability --out b/ --quick   (reduced sizes, as the tests run it)
-//   polydg bench --suite meshing --out b/ --data DIR  (torus.obj from DIR)
+//   polydg bench --suite meshing --out b/ --data DIR  (torus.obj from DIR instead of the
+//                                                      share/polydg folder beside the binary)
 #include <filesystem>
 #include <iostream>
 #include <memory>
 #include <string>
 #include <system_error>
 
+#include "cli/bench/data_files.h"
 #include "cli/bench/suites.h"
 #include "cli/commands.h"
 #include "cli/report.h"
@@ -23,10 +25,11 @@ namespace {
 
 using bench::BenchOptions;
 
-void runBench(const BenchOptions& o, const CommonOptions& common) {
+void runBench(BenchOptions o, const CommonOptions& common) {
   std::error_code ec;
   std::filesystem::create_directories(o.out, ec);
   if (ec) throw UserError("cannot create " + o.out + ": " + ec.message());
+  if (o.dataDir.empty()) o.dataDir = bench::dataDirectory().string();
   const bool all = o.suite == "all";
   const Stopwatch total;
   auto timed = [&](const std::string& name, auto&& run) {
@@ -52,7 +55,6 @@ void runBench(const BenchOptions& o, const CommonOptions& common) {
 
 void addBenchCommand(CLI::App& app, const CommonOptions& common, int& exitCode) {
   auto o = std::make_shared<BenchOptions>();
-  o->dataDir = POLYDG_TESTDATA_DIR;
   CLI::App* cmd = app.add_subcommand(
       "bench",
       "Benchmark suites as JSON, CSV and SVG plots: accuracy (B1), table41 (B2), "
@@ -65,9 +67,10 @@ void addBenchCommand(CLI::App& app, const CommonOptions& common, int& exitCode) 
   cmd->add_flag("--quick", o->quick,
                 "reduced sizes (a smoke test of every output; the figures are not the "
                 "benchmark's)");
-  cmd->add_option("--data", o->dataDir, "folder of the bundled models (testdata/torus.obj)")
-      ->check(CLI::ExistingDirectory)
-      ->capture_default_str();
+  cmd->add_option("--data", o->dataDir,
+                  "folder of the bundled models (torus.obj); default: share/polydg beside the "
+                  "folder of the polydg binary")
+      ->check(CLI::ExistingDirectory);
   cmd->callback([o, &common, &exitCode] {
     runBench(*o, common);
     exitCode = 0;

@@ -25,11 +25,13 @@
 namespace polydg::bench {
 
 struct BenchOptions {
-  std::string suite;  ///< accuracy, table41, stability, meshing, cutting or all
-  std::string out;    ///< the folder the files go to
+  std::string suite;        ///< accuracy, table41, stability, meshing, cutting or all
+  std::string out;          ///< the folder the files go to
   bool skipSliced = false;  ///< accuracy: hex grids only
   bool quick = false;
-  std::string dataDir;  ///< the folder of the bundled models the meshing suite reads (torus.obj)
+  /// The folder of the bundled models the meshing suite reads (torus.obj); `polydg bench` uses
+  /// dataDirectory() (cli/bench/data_files.h) unless --data names another.
+  std::string dataDir;
 };
 
 SuiteOutput accuracySuite(const BenchOptions& options, bool quiet);

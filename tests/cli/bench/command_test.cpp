@@ -1,6 +1,7 @@
 // `polydg bench` end to end through the binary, as a user runs it: the stability and cutting
 // suites with --quick (every file written, the B4 JSON keys and findings, incremental cuts),
-// and an unknown suite refused with one line.
+// the meshing suite finding its model in share/polydg beside the binary (build tree and an
+// installation's layout) or in --data, and an unknown suite refused with one line.
 #include <gtest/gtest.h>
 
 #include <unistd.h>
@@ -92,6 +93,46 @@ TEST(BenchCommand, UnknownSuiteIsRefusedWithOneLine) {
   EXPECT_EQ(r.exitCode, 2);
   EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << r.out;
   EXPECT_FALSE(fs::exists(fs::temp_directory_path() / "polydg_bench_unknown"));
+}
+
+/// A scratch folder per test (polydg::testing::CommandTest).
+class BenchData : public polydg::testing::CommandTest {};
+
+TEST_F(BenchData, MeshingSuiteFindsItsModelBesideTheBinaryFromAnyFolder) {
+  // Run from the scratch folder: no path relative to the working directory can help.
+  const Result r = polydg::testing::runShell("cd '" + dir_.string() + "' && " + POLYDG_BINARY +
+                                             " bench --suite meshing --quick --quiet --out out");
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  const nlohmann::json j = readJson("out/meshing.json");
+  ASSERT_EQ(j.size(), 2u);  // torus.obj at 8 and 16 cells
+  for (const nlohmann::json& row : j) {
+    EXPECT_EQ(row["model"], "torus.obj");
+    EXPECT_TRUE(row["valid"].get<bool>()) << row.dump();
+    EXPECT_TRUE(row["dg_passed"].get<bool>()) << row.dump();
+  }
+}
+
+TEST_F(BenchData, CopiedBinaryLooksInItsOwnShareFolderOrInData) {
+  // An installation's layout, PREFIX/bin/polydg beside PREFIX/share/polydg/.
+  fs::create_directories(dir_ / "bin");
+  fs::copy_file(POLYDG_BINARY, dir_ / "bin" / "polydg");
+  const std::string polydg = (dir_ / "bin" / "polydg").string() + " bench --suite meshing --quick";
+  const std::string expected = (dir_ / "share" / "polydg" / "torus.obj").string();
+  const Result missing = polydg::testing::runShell(polydg + " --out " + path("a"));
+  EXPECT_EQ(missing.exitCode, 2) << missing.out;
+  EXPECT_NE(missing.out.find(expected + " not found"), std::string::npos) << missing.out;
+  EXPECT_EQ(std::count(missing.out.begin(), missing.out.end(), '\n'), 1) << missing.out;
+
+  const Result data = polydg::testing::runShell(polydg + " --quiet --data " + POLYDG_TESTDATA_DIR +
+                                                " --out " + path("b"));
+  EXPECT_EQ(data.exitCode, 0) << data.out;
+  EXPECT_TRUE(fs::exists(dir_ / "b" / "meshing.json"));
+
+  fs::create_directories(dir_ / "share" / "polydg");
+  fs::copy_file(polydg::testing::testData("torus.obj"), expected);
+  const Result installed = polydg::testing::runShell(polydg + " --quiet --out " + path("c"));
+  EXPECT_EQ(installed.exitCode, 0) << installed.out;
+  EXPECT_TRUE(fs::exists(dir_ / "c" / "meshing.json"));
 }
 
 }  // namespace
