@@ -13,6 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "tests/cli/bench/b4_measurements.h"
 #include "tests/support/run_polydg.h"
 
 namespace polydg::bench {
@@ -40,23 +41,48 @@ TEST(BenchCommand, StabilitySuiteWritesJsonCsvAndPlots) {
   const nlohmann::json j = nlohmann::json::parse(in);
   EXPECT_TRUE(j["cond_method"].get<std::string>().find("Lanczos") != std::string::npos);
   ASSERT_FALSE(j["sliver"].empty());
+  // The figures of the quick cases against those measured (tests/cli/bench/b4_measurements.h):
+  // merged slivers (ratios 1e-4 and 1e-12) near the regular grid, the thin neck bounded.
   for (const nlohmann::json& s : j["sliver"]) {
     ASSERT_TRUE(s.contains("volume_ratio") && s.contains("merged") && s.contains("cond"));
-    if (s["merged"].get<bool>()) {
-      EXPECT_LE(s["cond_over_regular"].get<double>(), 100.0);
+    const double ratio = s["volume_ratio"].get<double>();
+    const int p = s["degree"].get<int>();
+    if (ratio == 1.0) {
+      EXPECT_EQ(s["cond_over_regular"].get<double>(), 1.0) << s.dump();
+    } else if (s["merged"].get<bool>()) {
+      EXPECT_TRUE(measured::within(s["cond_over_regular"].get<double>(),
+                                   measured::kMergedSliverOverRegular[p - 1],
+                                   measured::kConditionMargin))
+          << s.dump();
     }
   }
-  for (const nlohmann::json& s : j["thin_neck"]) EXPECT_TRUE(s["positive_definite"].get<bool>());
+  for (const nlohmann::json& s : j["thin_neck"]) {
+    ASSERT_TRUE(s["positive_definite"].get<bool>()) << s.dump();
+    const int p = s["degree"].get<int>();
+    EXPECT_LE(s["cond"].get<double>(),
+              measured::kThinNeckCondMax[p - 1] * measured::kConditionMargin)
+        << s.dump();
+    EXPECT_GE(s["cond"].get<double>(),
+              measured::kThinNeckCondMin[p - 1] / measured::kConditionMargin)
+        << s.dump();
+  }
   EXPECT_EQ(j["incompressible"].size(), 8u);  // 4 values of nu, p = 1 and 2
   for (const nlohmann::json& s : j["incompressible"])
     EXPECT_TRUE(s.contains("tip") && s.contains("reference") && s.contains("nu"));
   EXPECT_EQ(j["scale"].size(), 12u);  // B1 and B3, 3 scales, 2 offsets
-  // Round-off: the coordinates' relative resolution amplified by the stiffness's condition
-  // number, an order-of-magnitude bound (its constant is not known; the full suite reaches 2.6).
-  constexpr double kRoundoffBoundFactor = 10.0;
-  for (const nlohmann::json& s : j["scale"])
-    EXPECT_LE(s["change"].get<double>(), kRoundoffBoundFactor * s["roundoff_bound"].get<double>())
-        << s.dump();
+  // Each scaled or translated run changes its figure by no more than measured (with the margin):
+  // the unscaled, untranslated run by nothing.
+  for (const nlohmann::json& s : j["scale"]) {
+    const double scale = s["scale"].get<double>();
+    const bool translated = s["offset"][0].get<double>() != 0.0;
+    const ScaleProblem problem =
+        s["problem"].get<std::string>() == "B1" ? ScaleProblem::B1 : ScaleProblem::B3;
+    double bound = 0.0;
+    for (const measured::ScaleCase& c : measured::kScaleCases)
+      if (c.problem == problem && c.scale == scale && c.translated == translated)
+        bound = measured::kScaleChangeMargin * c.measuredChange;
+    EXPECT_LE(s["change"].get<double>(), bound) << s.dump();
+  }
   std::ifstream csv(dir / "stability.csv");
   std::string header;
   std::getline(csv, header);
