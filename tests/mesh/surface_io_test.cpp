@@ -190,6 +190,42 @@ TEST(ReadSurface, WeldsStlCornersIncludingNegativeZero) {
     for (int i = 0; i < 3; ++i) EXPECT_FALSE(p[i] == 0.0 && std::signbit(p[i])) << p.transpose();
 }
 
+// The welding rule (mesh/surface_io.h): corners become one vertex exactly when their
+// coordinates are bitwise equal, -0.0 counting as 0.0. Two triangles share the corners (0, 0, 0)
+// and (1, 0, 0); the second writes the first as (-0, -0.0, -0) and has the corner
+// (0, 1.0000000000000002, 0), one ulp from the first triangle's (0, 1, 0). Without welding the
+// file has 6 vertices, without the -0.0 rule 5, with any tolerance 3; exact welding gives 4.
+TEST(ReadSurface, WeldsBitwiseEqualCornersWithNegativeZeroAsZeroAndNothingCloser) {
+  const TempDir dir("weld_rule");
+  const std::string corners =
+      "v 0 0 0\nv 1 0 0\nv 0 1 0\nv -0 -0.0 -0\nv 1 0 0\nv 0 1.0000000000000002 0\n"
+      "f 1 2 3\nf 4 5 6\n";
+  SurfaceReadInfo info;
+  const TriangleSurface s = readSurface(dir.write("weld_rule.obj", corners), &info);
+  EXPECT_EQ(info.reader, "cgal");
+  EXPECT_EQ(info.inputVertices, 6u);
+  ASSERT_EQ(s.vertices.size(), 4u);
+  EXPECT_EQ(info.weldedVertices, 4u);
+  ASSERT_EQ(s.triangles.size(), 2u);
+  EXPECT_EQ(s.triangles[1][0], s.triangles[0][0]);  // -0 welded to 0
+  EXPECT_EQ(s.triangles[1][1], s.triangles[0][1]);  // (1, 0, 0) twice
+  EXPECT_NE(s.triangles[1][2], s.triangles[0][2]);  // one ulp apart: two vertices
+  EXPECT_EQ(s.vertices[s.triangles[1][2]].y(), std::nextafter(1.0, 2.0));
+  EXPECT_EQ(s.vertices[s.triangles[0][2]].y(), 1.0);
+  for (const Vec3& p : s.vertices)
+    for (int i = 0; i < 3; ++i) EXPECT_FALSE(std::signbit(p[i])) << p.transpose();
+
+  // The same corners through assimp (an OBJ keyword CGAL does not know makes it the reader), in
+  // single precision: 1.0000000000000002 is 1.0f, so that corner welds too; -0 still welds to 0.
+  SurfaceReadInfo single;
+  const TriangleSurface t =
+      readSurface(dir.write("weld_rule_assimp.obj", corners + "bogus\n"), &single);
+  EXPECT_EQ(single.reader, "assimp");
+  ASSERT_EQ(t.vertices.size(), 3u);
+  for (const Vec3& p : t.vertices)
+    for (int i = 0; i < 3; ++i) EXPECT_FALSE(std::signbit(p[i])) << p.transpose();
+}
+
 TEST(ReadSurface, BakesNodeTransformsOfInstancedMeshes) {
   SurfaceReadInfo info;
   const TriangleSurface s = readSurface(testdata("instanced_cubes.gltf"), &info);
