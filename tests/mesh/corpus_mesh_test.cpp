@@ -10,6 +10,7 @@
 #include "polydg/mesh/meshing.h"
 #include "polydg/mesh/surface_io.h"
 #include "tests/support/assimp_models.h"
+#include "tests/support/packages.h"
 
 namespace polydg {
 namespace {
@@ -63,8 +64,7 @@ Result meshModel(const std::string& path) {
 }
 
 TEST(CorpusMeshing, EveryModelMeshesOrIsRefusedWithOneLine) {
-  if (!fs::is_directory(corpus::kAssimpModels))
-    GTEST_SKIP() << corpus::kAssimpModels << " is missing (install assimp-testmodels)";
+  ASSERT_TRUE(packages::assimpTestModels());
   std::vector<fs::path> models;
   for (const auto& entry : fs::recursive_directory_iterator(corpus::kAssimpModels))
     if (entry.is_regular_file() && corpus::isSupportedModel(entry.path()))

@@ -5,6 +5,7 @@
 // (tests/mesh/surface_volume.py).
 #include "polydg/mesh/surface_io.h"
 #include "tests/support/assimp_models.h"
+#include "tests/support/packages.h"
 
 #include <gtest/gtest.h>
 
@@ -44,7 +45,7 @@ constexpr double kVtkRelTol = 1e-9;
 constexpr rlim_t kReadAddressSpace = rlim_t{4} << 30;
 
 using polydg::corpus::kAssimpModels;
-const fs::path kSystemPython = "/usr/bin/python3";
+using polydg::packages::kSystemPython;
 
 std::string testdata(const std::string& name) {
   return (fs::path(POLYDG_TESTDATA_DIR) / name).string();
@@ -711,7 +712,7 @@ std::map<std::string, std::string> readAll(const fs::path& root, bool (*wanted)(
 
 TEST(ReadSurfaceErrors, AssimpInvalidModelsFailCleanly) {
   const fs::path dir = kAssimpModels / "invalid";
-  if (!fs::is_directory(dir)) GTEST_SKIP() << dir << " is missing (install assimp-testmodels)";
+  ASSERT_TRUE(packages::assimpTestModels());
   const auto outcome = readAll(dir, [](const fs::path&) { return true; });
   ASSERT_FALSE(outcome.empty());
   for (const auto& [path, what] : outcome) {
@@ -765,8 +766,7 @@ TEST(ReadSurface, PrintsNothing) {
 using polydg::corpus::isSupportedModel;
 
 TEST(AssimpModels, EveryModelReadsOrFailsWithOneLine) {
-  if (!fs::is_directory(kAssimpModels))
-    GTEST_SKIP() << kAssimpModels << " is missing (install assimp-testmodels)";
+  ASSERT_TRUE(packages::assimpTestModels());
   const auto outcome = readAll(kAssimpModels, isSupportedModel);
   std::size_t closed = 0, open = 0, errors = 0;
   for (const auto& [path, what] : outcome) {
@@ -818,17 +818,10 @@ ScriptResult scriptVolume(const std::string& path) {
   return result;
 }
 
-bool canImport(const std::string& module) {
-  const std::string command =
-      kSystemPython.string() + " -c 'import " + module + "' >/dev/null 2>&1";
-  return fs::exists(kSystemPython) && std::system(command.c_str()) == 0;
-}
-
 TEST(VolumeScript, AgreesWithExactAndReadVolumes) {
-  if (!canImport("vtkmodules.vtkFiltersCore"))
-    GTEST_SKIP() << kSystemPython << " cannot import VTK (install python3-vtk9)";
-  if (!canImport("meshio"))
-    GTEST_SKIP() << kSystemPython << " cannot import meshio (install python3-meshio)";
+  ASSERT_TRUE(packages::pythonModule("vtkmodules.vtkFiltersCore", "python3-vtk9"));
+  ASSERT_TRUE(packages::pythonModule("meshio", "python3-meshio"));
+  ASSERT_TRUE(packages::assimpTestModels());
   // Testdata models, read by meshio in double precision, against their exact volumes (the
   // torus: that of its double-precision geometry) and readSurface's.
   const std::vector<std::pair<std::string, double>> exact = {
@@ -847,21 +840,18 @@ TEST(VolumeScript, AgreesWithExactAndReadVolumes) {
   // triangulation and readSurface's give the same volume. meshio 5.0 cannot read some of them
   // (cube_usemtl.obj: fewer normals than vertices; cube.ply: "list uint8 int32"), which VTK
   // then reads in single precision: exact here, as their coordinates are small dyadics.
-  if (fs::is_directory(kAssimpModels)) {
-    for (const char* model : {"OBJ/box.obj", "OBJ/cube_usemtl.obj", "OBJ/testmixed.obj",
-                              "PLY/cube.ply", "PLY/cube_binary.ply", "STL/Spider_binary.stl"}) {
-      const std::string path = (kAssimpModels / model).string();
-      const TriangleSurface s = readSurface(path);
-      const ScriptResult r = scriptVolume(path);
-      ASSERT_EQ(r.status, 0) << model;
-      EXPECT_TRUE(r.reader == "meshio" || r.reader == "vtk") << model << ": " << r.reader;
-      if (!analyzeTopology(s).closed()) continue;  // the volume of an open surface is arbitrary
-      EXPECT_LT(relativeError(std::stod(r.volume), std::abs(enclosedVolume(s))), kVtkRelTol)
-          << model;
-    }
-    // An OFF file of quads: meshio reads only triangles, and VTK has no OFF reader.
-    EXPECT_NE(scriptVolume((kAssimpModels / "OFF/Cube.off").string()).status, 0);
+  for (const char* model : {"OBJ/box.obj", "OBJ/cube_usemtl.obj", "OBJ/testmixed.obj",
+                            "PLY/cube.ply", "PLY/cube_binary.ply", "STL/Spider_binary.stl"}) {
+    const std::string path = (kAssimpModels / model).string();
+    const TriangleSurface s = readSurface(path);
+    const ScriptResult r = scriptVolume(path);
+    ASSERT_EQ(r.status, 0) << model;
+    EXPECT_TRUE(r.reader == "meshio" || r.reader == "vtk") << model << ": " << r.reader;
+    if (!analyzeTopology(s).closed()) continue;  // the volume of an open surface is arbitrary
+    EXPECT_LT(relativeError(std::stod(r.volume), std::abs(enclosedVolume(s))), kVtkRelTol) << model;
   }
+  // An OFF file of quads: meshio reads only triangles, and VTK has no OFF reader.
+  EXPECT_NE(scriptVolume((kAssimpModels / "OFF/Cube.off").string()).status, 0);
   // Failures: a format the script does not handle, and a file with no polygons.
   EXPECT_NE(scriptVolume(testdata("instanced_cubes.gltf")).status, 0);
   const TempDir dir("vtk");
