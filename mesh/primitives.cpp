@@ -1,6 +1,11 @@
 #include "polydg/mesh/primitives.h"
 
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
 #include <stdexcept>
+#include <utility>
 
 namespace polydg {
 
@@ -41,6 +46,107 @@ PolyMesh hexGridMesh(int nx, int ny, int nz, const Box3& box) {
 }
 
 PolyMesh boxMesh(const Box3& box) { return hexGridMesh(1, 1, 1, box); }
+
+namespace {
+
+using Key = std::array<double, 3>;
+Key keyOf(const Vec3& p) { return {p.x(), p.y(), p.z()}; }
+
+/// An axis-aligned rectangle in the plane x_axis = value, spanning [lo, hi] in the coordinates
+/// u = (axis + 1) % 3 and w = (axis + 2) % 3 (so e_u x e_w = e_axis).
+struct Tile {
+  int axis = 0;
+  double value = 0.0;
+  std::array<double, 2> lo{}, hi{};
+};
+
+/// The tile's boundary loop through every vertex lying on it, counter-clockwise about e_axis
+/// (or about -e_axis if `flip`).
+Loop tileLoop(const Tile& t, const std::map<Key, VertexId>& vertices, bool flip) {
+  const int u = (t.axis + 1) % 3, w = (t.axis + 2) % 3;
+  const double lu = t.hi[0] - t.lo[0], lw = t.hi[1] - t.lo[1];
+  std::vector<std::pair<double, VertexId>> onBoundary;
+  for (const auto& [p, id] : vertices) {
+    if (p[t.axis] != t.value) continue;
+    const double a = p[u], b = p[w];
+    if (a < t.lo[0] || a > t.hi[0] || b < t.lo[1] || b > t.hi[1]) continue;
+    // Perimeter parameter, starting at (lo, lo): bottom, right, top, left.
+    double s;
+    if (b == t.lo[1])
+      s = a - t.lo[0];
+    else if (a == t.hi[0])
+      s = lu + (b - t.lo[1]);
+    else if (b == t.hi[1])
+      s = lu + lw + (t.hi[0] - a);
+    else if (a == t.lo[0])
+      s = 2 * lu + lw + (t.hi[1] - b);
+    else
+      continue;  // inside the tile: not on its boundary
+    onBoundary.emplace_back(s, id);
+  }
+  std::sort(onBoundary.begin(), onBoundary.end());
+  Loop loop;
+  for (const auto& [s, id] : onBoundary) loop.push_back(id);
+  if (flip) std::reverse(loop.begin(), loop.end());
+  return loop;
+}
+
+/// The overlap of two rectangles given as [lo, hi] pairs; empty (false) if its area is zero.
+bool overlap(const Tile& a, const std::array<double, 2>& lo, const std::array<double, 2>& hi,
+             Tile& out) {
+  out = a;
+  for (int k = 0; k < 2; ++k) {
+    out.lo[k] = std::max(a.lo[k], lo[k]);
+    out.hi[k] = std::min(a.hi[k], hi[k]);
+    if (!(out.lo[k] < out.hi[k])) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+PolyMesh boxCellsMesh(const std::vector<Box3>& boxes) {
+  PolyMesh mesh;
+  std::map<Key, VertexId> vertices;
+  for (const Box3& b : boxes)
+    for (int c = 0; c < 8; ++c) {
+      const Vec3 p = b.corner(static_cast<Box3::CornerType>(c));
+      if (!vertices.count(keyOf(p))) vertices.emplace(keyOf(p), mesh.addVertex(p));
+    }
+  for (std::size_t i = 0; i < boxes.size(); ++i) {
+    std::vector<std::vector<Loop>> boundary;
+    for (int axis = 0; axis < 3; ++axis) {
+      const int u = (axis + 1) % 3, w = (axis + 2) % 3;
+      for (int side = 0; side < 2; ++side) {  // 0: the min side (outward -e_axis), 1: max
+        Tile whole;
+        whole.axis = axis;
+        whole.value = side ? boxes[i].max()[axis] : boxes[i].min()[axis];
+        whole.lo = {boxes[i].min()[u], boxes[i].min()[w]};
+        whole.hi = {boxes[i].max()[u], boxes[i].max()[w]};
+        double covered = 0.0;
+        std::vector<Tile> tiles;
+        for (std::size_t j = 0; j < boxes.size(); ++j) {
+          const double across = side ? boxes[j].min()[axis] : boxes[j].max()[axis];
+          Tile t;
+          if (j == i || across != whole.value ||
+              !overlap(whole, {boxes[j].min()[u], boxes[j].min()[w]},
+                       {boxes[j].max()[u], boxes[j].max()[w]}, t))
+            continue;
+          covered += (t.hi[0] - t.lo[0]) * (t.hi[1] - t.lo[1]);
+          tiles.push_back(t);
+        }
+        const double area = (whole.hi[0] - whole.lo[0]) * (whole.hi[1] - whole.lo[1]);
+        if (tiles.empty())
+          tiles.push_back(whole);
+        else if (std::abs(covered - area) > 1e-12 * area)
+          throw std::invalid_argument("boxCellsMesh: a box side is only partly covered");
+        for (const Tile& t : tiles) boundary.push_back({tileLoop(t, vertices, side == 0)});
+      }
+    }
+    mesh.addElement(boundary, FaceOrigin::Box);
+  }
+  return mesh;
+}
 
 double signedArea(const std::vector<Vec2>& loop) {
   double twice = 0.0;

@@ -12,6 +12,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "tests/support/packages.h"
 #include "tests/support/run_polydg.h"
 
 namespace {
@@ -53,12 +54,13 @@ TEST_F(Cli, InfoReportsClosedSurfaceAndVolume) {
 }
 
 TEST_F(Cli, InfoVolumesAgreeWithVtk) {
-  if (!fs::exists("/usr/bin/python3")) GTEST_SKIP() << "no /usr/bin/python3 for VTK";
+  ASSERT_TRUE(polydg::packages::pythonModule("vtkmodules.vtkFiltersCore", "python3-vtk9"));
+  ASSERT_TRUE(polydg::packages::pythonModule("meshio", "python3-meshio"));
+  ASSERT_TRUE(polydg::packages::assimpTestModels());
   const std::string script = std::string(POLYDG_SOURCE_DIR) + "/tests/mesh/surface_volume.py";
   for (const std::string& model :
        {data("torus.obj"), data("octahedron.stl"), data("Lprism.ply"), data("two_cubes.obj"),
-        std::string("/usr/share/assimp/models/PLY/cube_binary.ply")}) {
-    if (!fs::exists(model)) continue;
+        (polydg::corpus::kAssimpModels / "PLY" / "cube_binary.ply").string()}) {
     SCOPED_TRACE(model);
     const Result r = run("info " + model + " --quiet --report " + path("v.json"));
     ASSERT_EQ(r.exitCode, 0) << r.out;

@@ -5,6 +5,8 @@ files with VTK itself for polydg's reader.
 Sample runs (Debian's interpreter, which has python3-vtk9 and python3-meshio):
   /usr/bin/python3 tests/mesh/vtk_check.py out/grid.vtu 6.12 --cells 12
   /usr/bin/python3 tests/mesh/vtk_check.py out/cut_boxes.vtu 2 --cells 2 --regions 2
+  /usr/bin/python3 tests/mesh/vtk_check.py out/field_data_ascii.vtu 6.12 --field-data \
+      out/field_data.json
   /usr/bin/python3 tests/mesh/vtk_check.py --write-vtk build/vtk_cells.vtu
 
 Check mode: opens FILE with VTK 9.1 (vtkXMLUnstructuredGridReader) and with meshio 5. Every cell
@@ -14,8 +16,14 @@ projected volume). With meshio, each cell's volume is the divergence theorem ove
 lists (numpy). Each volume must match the file's `volume` cell data to 1e-9 relative, and the
 totals must match EXPECTED_TOTAL_VOLUME to 1e-9 relative. With --regions N, the cells must form
 N connected regions through shared points (VTK: vtkConnectivityFilter; meshio: cells joined by
-common point ids), which is how the two sides of a cut are told apart. Exits 1 with a message
-otherwise.
+common point ids), which is how the two sides of a cut are told apart. With --field-data
+EXPECTED.json, the file's field data must be, for both VTK and meshio, polydg's restore arrays
+(polydg_face_*, polydg_element*, polydg_point_*) plus exactly the expected arrays: each number
+array a Float64 array with the same values bit for bit, each text NAME a UInt8 array
+NAME.utf8 holding the text's bytes. EXPECTED.json, written by vtu_io_test's WriteForVtkCheck, is
+{"numbers": {NAME_HEX: [HEX_FLOAT, ...]}, "strings": {NAME_HEX: BYTES_HEX}}: names and text as
+hex of their UTF-8 bytes, numbers as C99 hex floats (printf "%a"), so that no JSON escaping
+stands between the test and this check. Exits 1 with a message otherwise.
 
 --write-vtk OUT.vtu: writes, with vtkXMLUnstructuredGridWriter, a mesh of three polyhedra:
 cell 0 the unit cube, cell 1 an L-shaped (non-convex) prism of volume 3 sharing the cube's
@@ -34,11 +42,15 @@ variants STEM_SUFFIX.vtu:
                        polyhedral unit cube, defaults
 and checks with VTK that the cells have these volumes (polyhedra as in check mode, linear cells
 with vtkCellSizeFilter) and that vtkCellValidator accepts the linear cells (but the voxel, which
-it always rejects).
+it always rejects). OUT.vtu and its first five variants (not _inverted, _leaky, _linear) carry
+the field data of add_field_data(), which vtu_io_test's VtkWrittenFile.ReturnsItsFieldData
+expects.
 """
 
 import argparse
+import json
 import os
+import struct
 import sys
 
 import numpy as np
@@ -206,6 +218,94 @@ def meshio_regions(path):
     return len({find(("cell", c)) for c in range(cell)})
 
 
+RESTORE_PREFIXES = ("polydg_face_", "polydg_element", "polydg_point_")
+TEXT_SUFFIX = ".utf8"
+
+
+def expected_field_data(json_path):
+    """{file array name: ("numbers", [float]) or ("text", bytes)} from EXPECTED.json."""
+    with open(json_path, encoding="ascii") as f:
+        spec = json.load(f)
+    expected = {}
+    for name_hex, values in spec["numbers"].items():
+        expected[bytes.fromhex(name_hex).decode("utf-8")] = (
+            "numbers", [float.fromhex(v) for v in values])
+    for name_hex, text_hex in spec["strings"].items():
+        expected[bytes.fromhex(name_hex).decode("utf-8") + TEXT_SUFFIX] = (
+            "text", bytes.fromhex(text_hex))
+    return expected
+
+
+def bits(values):
+    return struct.pack(f"<{len(values)}d", *values)
+
+
+def compare_field_data(reader, found, expected):
+    """`found`: {name: ("numbers" | "text" | type name, values or bytes)} as a reader saw it."""
+    names = {n for n in found if not n.startswith(RESTORE_PREFIXES)}
+    if names != set(expected):
+        raise CheckFailed(f"{reader}: field data {sorted(names)}, expected {sorted(expected)}")
+    for name, (kind, value) in expected.items():
+        found_kind, found_value = found[name]
+        if found_kind != kind:
+            raise CheckFailed(f"{reader}: field data {name!r} is {found_kind}, expected {kind}")
+        if kind == "numbers" and bits(found_value) != bits(value):
+            raise CheckFailed(f"{reader}: field data {name!r} is {found_value!r}, expected "
+                              f"{value!r}")
+        if kind == "text" and found_value != value:
+            raise CheckFailed(f"{reader}: field data {name!r} holds {found_value!r}, expected "
+                              f"{value!r}")
+
+
+def vtk_field_data(path):
+    reader = vtk.vtkXMLUnstructuredGridReader()
+    observer = ErrorObserver()
+    reader.AddObserver("ErrorEvent", observer)
+    reader.AddObserver("WarningEvent", observer)
+    reader.SetFileName(path)
+    reader.Update()
+    if observer.messages or reader.GetErrorCode() != 0:
+        raise CheckFailed(f"VTK could not read {path}: {observer.messages}")
+    field = reader.GetOutput().GetFieldData()
+    found = {}
+    for i in range(field.GetNumberOfArrays()):
+        array = field.GetAbstractArray(i)
+        values = [array.GetValue(k) for k in range(array.GetNumberOfValues())]
+        if isinstance(array, vtk.vtkDoubleArray):
+            found[array.GetName()] = ("numbers", values)
+        elif isinstance(array, vtk.vtkUnsignedCharArray):
+            found[array.GetName()] = ("text", bytes(values))
+        else:
+            found[array.GetName()] = (array.GetClassName(), values)
+    return found
+
+
+def meshio_field_data(path):
+    import meshio
+
+    try:
+        mesh = meshio.read(path, file_format="vtu")
+    except BaseException as error:  # meshio raises many kinds, and SystemExit for some files
+        raise CheckFailed(f"meshio could not read {path}: {type(error).__name__}: {error}")
+    found = {}
+    for name, data in mesh.field_data.items():
+        data = np.asarray(data)
+        if data.dtype == np.float64:
+            found[name] = ("numbers", [float(v) for v in data.ravel()])
+        elif data.dtype == np.uint8:
+            found[name] = ("text", data.tobytes())
+        else:
+            found[name] = (str(data.dtype), data.tolist())
+    return found
+
+
+def check_field_data(path, json_path):
+    expected = expected_field_data(json_path)
+    for reader, read in (("VTK", vtk_field_data), ("meshio", meshio_field_data)):
+        compare_field_data(reader, read(path), expected)
+        print(f"vtk_check: {reader}: {len(expected)} field data arrays as written: ok")
+
+
 def check(path, expected_total, expected_cells, expected_regions=None):
     for reader, volumes in (("VTK", vtk_cell_volumes), ("meshio", meshio_cell_volumes)):
         results = volumes(path)
@@ -329,6 +429,32 @@ def linear_cells(builder):
     return [1.0 / 6.0, 1.0, 2.0, 0.5, 1.0 / 3.0, 3.0, 6.0, 1.0]
 
 
+def add_field_data(grid):
+    """Field data of the kinds VTK writes, which polydg's reader must return (see
+    VtkWrittenFile.ReturnsItsFieldData): doubles, floats, two-component ints, unsigned chars
+    that are not text, 64-bit ids, a string with XML's special characters, non-ASCII letters, a
+    newline and a tab, two strings in one array, text by polydg's convention (UInt8 NAME.utf8),
+    and a bit array, which polydg skips."""
+    field = grid.GetFieldData()
+
+    def add(array, name, values, components=1):
+        array.SetName(name)
+        array.SetNumberOfComponents(components)
+        for v in values:
+            array.InsertNextValue(v)
+        field.AddArray(array)
+
+    add(vtk.vtkDoubleArray(), "cell_size", [0.125])
+    add(vtk.vtkFloatArray(), "scale", [0.25])
+    add(vtk.vtkIntArray(), "counts", [1, 2, 3, -4], components=2)
+    add(vtk.vtkUnsignedCharArray(), "mask", [0, 1, 255])
+    add(vtk.vtkIdTypeArray(), "ids", [-7, 2**31 - 1])  # the _uncompressed copy has Int32 ids
+    add(vtk.vtkStringArray(), "note", ['a "q" <b> & \u00e9\nx\ttab'])
+    add(vtk.vtkStringArray(), "tags", ["first", "second"])
+    add(vtk.vtkUnsignedCharArray(), "input_file" + TEXT_SUFFIX, list("torus \u00fc.obj".encode()))
+    add(vtk.vtkBitArray(), "flags", [1, 0, 1])
+
+
 def vtk_validity(grid, c):
     """vtkCellValidator's state of linear cell c (0: valid), checked on its own."""
     single = vtk.vtkUnstructuredGrid()
@@ -386,6 +512,7 @@ def write_vtk(out):
     cells = polyhedra_faces()
     builder = build(cells)
     grid = builder.grid()
+    add_field_data(grid)
     if len(builder.points) != 19:
         raise CheckFailed(f"expected 19 points, built {len(builder.points)}")
     check_with_vtk(grid, POLYHEDRA_VOLUMES, out, expect_valid=False)
@@ -405,7 +532,9 @@ def write_vtk(out):
         writer.SetHeaderTypeToUInt32()
         writer.SetIdTypeToInt32()
 
-    write_grid(builder.grid(vtk.VTK_FLOAT), f"{stem}_uncompressed.vtu", small_types)
+    float_grid = builder.grid(vtk.VTK_FLOAT)
+    add_field_data(float_grid)
+    write_grid(float_grid, f"{stem}_uncompressed.vtu", small_types)
 
     def inline_uncompressed(writer):
         writer.SetDataModeToBinary()
@@ -436,6 +565,8 @@ def main():
     parser.add_argument("--cells", type=int, help="expected number of cells")
     parser.add_argument("--regions", type=int,
                         help="expected number of regions connected through shared points")
+    parser.add_argument("--field-data", metavar="EXPECTED.json",
+                        help="the field data polydg wrote into FILE")
     parser.add_argument("--write-vtk", metavar="OUT.vtu", help="write test files with VTK")
     args = parser.parse_args()
     try:
@@ -443,6 +574,8 @@ def main():
             write_vtk(args.write_vtk)
         elif args.file is not None and args.expected_total_volume is not None:
             check(args.file, args.expected_total_volume, args.cells, args.regions)
+            if args.field_data:
+                check_field_data(args.file, args.field_data)
         else:
             parser.error("give FILE and EXPECTED_TOTAL_VOLUME, or --write-vtk OUT.vtu")
     except CheckFailed as failure:

@@ -1,22 +1,28 @@
-// Tests of mesh/vtu_io.h (VTU writing and reading) and mesh/face_triangulation.h.
+// Tests of mesh/vtu_io.h (VTU writing and reading, field data) and mesh/face_triangulation.h.
 //
 // Two groups only run when ctest sets an environment variable (they skip otherwise):
 //   POLYDG_VTK_FILES=DIR/vtk_cells.vtu: files written by VTK itself (tests/mesh/vtk_check.py
-//     --write-vtk), read back with known exact volumes;
+//     --write-vtk), read back with known exact volumes and field data;
 //   POLYDG_VTU_OUT_DIR=DIR: writes polydg files into DIR for vtk_check.py to open with VTK and
-//     meshio.
+//     meshio (volumes, regions, field data).
 #include "polydg/mesh/vtu_io.h"
 
 #include <algorithm>
+#include <bit>
+#include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <optional>
 #include <span>
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <string_view>
+#include <utility>
 
 #include <gtest/gtest.h>
 
@@ -600,8 +606,9 @@ TEST(VtuRead, TruncatedFilesThrowNamingTheFile) {
 }
 
 /// Twelve points p(i, j, k) = i + 3 j + 6 k at (i, j, k), i < 3, j, k < 2; `cells` is the
-/// inside of <Cells>.
-std::string handWrittenVtu(int numCells, const std::string& cells) {
+/// inside of <Cells>, `fieldData` (if not empty) the inside of <FieldData>.
+std::string handWrittenVtu(int numCells, const std::string& cells,
+                           const std::string& fieldData = "") {
   std::string points;
   for (int k = 0; k < 2; ++k)
     for (int j = 0; j < 2; ++j)
@@ -609,8 +616,9 @@ std::string handWrittenVtu(int numCells, const std::string& cells) {
         points += std::to_string(i) + " " + std::to_string(j) + " " + std::to_string(k) + " ";
   return "<?xml version=\"1.0\"?>\n"
          "<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
-         "<UnstructuredGrid><Piece NumberOfPoints=\"12\" NumberOfCells=\"" +
-         std::to_string(numCells) +
+         "<UnstructuredGrid>" +
+         (fieldData.empty() ? "" : "<FieldData>\n" + fieldData + "</FieldData>\n") +
+         "<Piece NumberOfPoints=\"12\" NumberOfCells=\"" + std::to_string(numCells) +
          "\">\n<Points><DataArray type=\"Float32\" NumberOfComponents=\"3\" format=\"ascii\">" +
          points + "</DataArray></Points>\n<Cells>" + cells +
          "</Cells></Piece></UnstructuredGrid></VTKFile>\n";
@@ -669,29 +677,249 @@ TEST(VtuRead, PointIdOutOfRangeThrows) {
   EXPECT_EQ(message.rfind(path.string() + ": cell 0 refers to point 12", 0), 0u) << message;
 }
 
-// --- base64 --------------------------------------------------------------------------------
+// --- field data ----------------------------------------------------------------------------
 
-TEST(Base64, MatchesRfc4648Vectors) {
-  const std::pair<std::string, std::string> vectors[] = {{"", ""},
-                                                         {"f", "Zg=="},
-                                                         {"fo", "Zm8="},
-                                                         {"foo", "Zm9v"},
-                                                         {"foob", "Zm9vYg=="},
-                                                         {"fooba", "Zm9vYmE="},
-                                                         {"foobar", "Zm9vYmFy"}};
-  for (const auto& [plain, encoded] : vectors) {
-    EXPECT_EQ(vtu_detail::base64Encode(plain), encoded);
-    EXPECT_EQ(vtu_detail::base64Decode(encoded), plain);
-  }
-  const std::string binary("\x00\xff\x10\x80\x7f", 5);
-  EXPECT_EQ(vtu_detail::base64Decode(vtu_detail::base64Encode(binary)), binary);
+/// Field data that tries the format: -0.0, a subnormal, the ends of the double range, an empty
+/// array; text with XML's special characters, quotes, non-ASCII UTF-8 (two, three and four bytes),
+/// CR, LF, a tab, a control character, a NUL, and an empty text; names with XML's special
+/// characters and a non-ASCII letter, one key used for a number array and a text, and a name
+/// that starts with "polydg_" without a reserved prefix.
+VtuFieldData hostileFieldData() {
+  using namespace std::string_literals;
+  VtuFieldData d;
+  d.numbers["grid_cell_size"] = {0.125};
+  d.numbers["extremes"] = {-0.0, 1e-300, 1e300,     4.9e-324,
+                           -2.5, 0.1,    1.0 / 3.0, -1.7976931348623157e308};
+  d.numbers["empty"] = {};
+  d.numbers["name with \"quotes\" & <brackets> \u00e9"] = {42.0};
+  d.numbers["polydg_sliver_tau"] = {0.01};
+  d.strings["input_file"] = "/data/my models/torus \"v2\".obj";
+  d.strings["hostile"] =
+      "a \"q\" 'x' <b>&amp; ]]> \u00e9 \u4e2d\u6587 \U0001F600\nline\r\n\ttab \x01 nul:\0:end"s;
+  d.strings["empty"] = "";
+  return d;
 }
 
-TEST(Base64, DecodesConcatenatedPaddedPiecesAndSkipsWhitespace) {
-  EXPECT_EQ(vtu_detail::base64Decode("Zg==Zm8=\n  Zm9v"), "ffofoo");
-  EXPECT_THROW(vtu_detail::base64Decode("Zm9v!"), std::runtime_error);
-  EXPECT_THROW(vtu_detail::base64Decode("Zm9vY"), std::runtime_error);
-  EXPECT_THROW(vtu_detail::base64Decode("Z==="), std::runtime_error);
+/// Same names; numbers equal bit for bit (so -0.0 is not 0.0); texts equal byte for byte.
+void expectSameFieldData(const VtuFieldData& expected, const VtuFieldData& actual) {
+  ASSERT_EQ(expected.numbers.size(), actual.numbers.size());
+  for (const auto& [name, values] : expected.numbers) {
+    ASSERT_TRUE(actual.numbers.contains(name)) << name;
+    const std::vector<double>& read = actual.numbers.at(name);
+    ASSERT_EQ(read.size(), values.size()) << name;
+    for (std::size_t i = 0; i < values.size(); ++i)
+      EXPECT_EQ(std::bit_cast<std::uint64_t>(read[i]), std::bit_cast<std::uint64_t>(values[i]))
+          << name << "[" << i << "]: " << read[i] << " instead of " << values[i];
+  }
+  EXPECT_EQ(expected.strings, actual.strings);
+}
+
+class VtuFieldDataRoundTrip : public ::testing::TestWithParam<VtuEncoding> {};
+
+TEST_P(VtuFieldDataRoundTrip, NumbersAndTextComeBackExactly) {
+  // A finite cut, so that polydg_point_vertex is among the restore arrays too.
+  const PolyMesh mesh = finitelyCutGrid();
+  const VtuFieldData written = hostileFieldData();
+  const fs::path path = testDir() / "field_data.vtu";
+  writeVtu(mesh, path.string(), {.encoding = GetParam()}, {}, {}, {}, written);
+  VtuFieldData read;
+  read.numbers["stale"] = {1.0};  // replaced, not merged
+  read.strings["stale"] = "old";
+  const PolyMesh back = readVtu(path.string(), &read);
+  expectSameFieldData(written, read);
+  expectSameMesh(mesh, back);
+  expectSameMesh(mesh, readVtu(path.string()));
+}
+
+TEST_P(VtuFieldDataRoundTrip, FollowsTheRestoreArraysNumbersFirst) {
+  VtuFieldData data;
+  data.numbers["b_number"] = {1.0};
+  data.numbers["a_number"] = {2.0};
+  data.strings["a_text"] = "x";
+  const fs::path path = testDir() / "order.vtu";
+  writeVtu(finitelyCutGrid(), path.string(), {.encoding = GetParam()}, {}, {}, {}, data);
+  const std::string text = readText(path);
+  const auto at = [&](const std::string& name) { return text.find("Name=\"" + name + "\""); };
+  ASSERT_NE(at("polydg_point_vertex"), std::string::npos);
+  EXPECT_LT(at("polydg_point_vertex"), at("a_number"));
+  EXPECT_LT(at("a_number"), at("b_number"));
+  EXPECT_LT(at("b_number"), at("a_text.utf8"));
+  EXPECT_LT(at("a_text.utf8"), text.find("</FieldData>"));
+  EXPECT_NE(text.find("<DataArray type=\"Float64\" Name=\"a_number\" NumberOfTuples=\"1\""),
+            std::string::npos);
+  EXPECT_NE(text.find("<DataArray type=\"UInt8\" Name=\"a_text.utf8\" NumberOfTuples=\"1\""),
+            std::string::npos);
+}
+
+/// The Name and offset of each appended <DataArray> of `text`, in document order.
+std::vector<std::pair<std::string, std::size_t>> appendedOffsets(const std::string& text) {
+  std::vector<std::pair<std::string, std::size_t>> out;
+  const std::size_t end = text.find("<AppendedData");
+  for (std::size_t at = text.find("<DataArray"); at < end; at = text.find("<DataArray", at + 1)) {
+    const std::size_t name = text.find("Name=\"", at) + 6;
+    const std::size_t offset = text.find("offset=\"", at) + 8;
+    out.emplace_back(text.substr(name, text.find('"', name) - name),
+                     std::stoul(text.substr(offset)));
+  }
+  return out;
+}
+
+TEST(VtuFieldData, AppendedAfterTheMeshLastArrayFirst) {
+  // The caller's arrays follow every array of polydg's in the appended data, in reverse order
+  // (see mesh/vtu_writer.cpp), and polydg's arrays keep the offsets of a file without them.
+  const PolyMesh mesh = finitelyCutGrid();
+  const fs::path plain = testDir() / "plain.vtu", with = testDir() / "with.vtu";
+  writeVtu(mesh, plain.string());
+  writeVtu(mesh, with.string(), {}, {}, {}, {}, hostileFieldData());
+  const auto polydgArrays = appendedOffsets(readText(plain));
+  const auto all = appendedOffsets(readText(with));
+  std::vector<std::pair<std::string, std::size_t>> kept, caller;
+  for (const auto& a : all) {
+    const bool ours = std::any_of(polydgArrays.begin(), polydgArrays.end(),
+                                  [&](const auto& p) { return p.first == a.first; });
+    (ours ? kept : caller).push_back(a);
+  }
+  EXPECT_EQ(kept, polydgArrays);
+  ASSERT_EQ(caller.size(), 8u);  // five number arrays and three texts
+  // The last caller array in the document starts where polydg's appended bytes end.
+  const std::string plainText = readText(plain);
+  const std::size_t begin = plainText.find('_', plainText.find("<AppendedData")) + 1;
+  const std::size_t polydgBytes = plainText.rfind("\n  </AppendedData>") - begin;
+  EXPECT_EQ(caller.back().second, polydgBytes);
+  for (std::size_t i = 1; i < caller.size(); ++i)
+    EXPECT_LT(caller[i].second, caller[i - 1].second) << caller[i].first;
+}
+
+INSTANTIATE_TEST_SUITE_P(Encodings, VtuFieldDataRoundTrip,
+                         ::testing::Values(VtuEncoding::Ascii, VtuEncoding::Binary,
+                                           VtuEncoding::Appended),
+                         [](const auto& info) {
+                           switch (info.param) {
+                             case VtuEncoding::Ascii: return "Ascii";
+                             case VtuEncoding::Binary: return "Binary";
+                             case VtuEncoding::Appended: return "Appended";
+                           }
+                           return "Unknown";
+                         });
+
+/// The message of the std::invalid_argument that writing `data` throws ("" if none), after
+/// checking that the file at `path` (written before) is left as it was.
+std::string fieldDataError(const VtuFieldData& data) {
+  const fs::path path = testDir() / "refused.vtu";
+  writeText(path, "old contents");
+  std::string message;
+  try {
+    writeVtu(skewGrid(), path.string(), {}, {}, {}, {}, data);
+  } catch (const std::invalid_argument& e) {
+    message = e.what();
+  }
+  EXPECT_EQ(readText(path), "old contents");
+  EXPECT_FALSE(fs::exists(path.string() + ".tmp"));
+  return message;
+}
+
+TEST(VtuFieldData, NonFiniteNumbersAreRefusedNamingTheArray) {
+  for (double bad :
+       {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity(),
+        -std::numeric_limits<double>::infinity()}) {
+    VtuFieldData data;
+    data.numbers["cell_size"] = {0.5, bad};
+    const std::string message = fieldDataError(data);
+    EXPECT_NE(message.find("'cell_size'"), std::string::npos) << message;
+    EXPECT_NE(message.find("index 1"), std::string::npos) << message;
+  }
+}
+
+TEST(VtuFieldData, InvalidNamesAreRefused) {
+  const std::string kBadNames[] = {
+      "polydg_face_count",           "polydg_element", "polydg_elements",
+      "polydg_point_scale",          "two\nlines",     "tab\there",
+      std::string("nul\0inside", 10)};
+  for (const std::string& name : kBadNames) {
+    for (bool text : {false, true}) {
+      VtuFieldData data;
+      if (text)
+        data.strings[name] = "x";
+      else
+        data.numbers[name] = {1.0};
+      EXPECT_NE(fieldDataError(data), "") << name << (text ? " (text)" : " (numbers)");
+    }
+  }
+  VtuFieldData unnamed;
+  unnamed.numbers[""] = {1.0};
+  EXPECT_NE(fieldDataError(unnamed).find("no name"), std::string::npos);
+  VtuFieldData reserved;
+  reserved.strings["polydg_point_note"] = "x";
+  EXPECT_NE(fieldDataError(reserved).find("'polydg_point_note' is reserved"), std::string::npos);
+  // Text "a" is stored as "a.utf8", which the number array already names.
+  VtuFieldData clash;
+  clash.numbers["a.utf8"] = {1.0};
+  clash.strings["a"] = "x";
+  EXPECT_NE(fieldDataError(clash).find("'a.utf8'"), std::string::npos);
+}
+
+TEST(VtuFieldData, AFileWithoutAnyGivesNone) {
+  const fs::path path = testDir() / "plain.vtu";
+  writeVtu(skewGrid(), path.string());
+  VtuFieldData read;
+  read.numbers["stale"] = {1.0};
+  read.strings["stale"] = "old";
+  readVtu(path.string(), &read);
+  EXPECT_TRUE(read.numbers.empty());
+  EXPECT_TRUE(read.strings.empty());
+}
+
+/// A tetrahedron (points 0, 1, 3, 6 of handWrittenVtu) with `fieldData` inside <FieldData>.
+std::string tetrahedronWithFieldData(const std::string& fieldData) {
+  const std::string cells = asciiArray("Int32", "connectivity", "0 1 3 6") +
+                            asciiArray("Int32", "offsets", "4") +
+                            asciiArray("UInt8", "types", "10");
+  return handWrittenVtu(1, cells, fieldData);
+}
+
+TEST(VtuFieldData, OtherWritersArraysAreReadAsVtuIoHDescribes) {
+  // Numbers of any type, widened (2^53 + 1 rounds to 2^53) with components interleaved; UInt8
+  // NAME.utf8 and String arrays as text (String values joined by NUL); Bit arrays, restore
+  // prefixes and unnamed arrays skipped; of two arrays with one name, the later.
+  const std::string fieldData =
+      "<DataArray type=\"Int32\" Name=\"counts\" NumberOfComponents=\"2\" NumberOfTuples=\"2\" "
+      "format=\"ascii\">1 2 3 -4</DataArray>\n"
+      "<DataArray type=\"Float32\" Name=\"scale\" format=\"ascii\">0.5</DataArray>\n"
+      "<DataArray type=\"Float32\" Name=\"scale\" format=\"ascii\">0.75</DataArray>\n"
+      "<DataArray type=\"Int64\" Name=\"big\" format=\"ascii\">9007199254740993 -7</DataArray>\n"
+      "<DataArray type=\"UInt8\" Name=\"mask\" format=\"ascii\">0 1 255</DataArray>\n"
+      "<DataArray type=\"UInt8\" Name=\"path.utf8\" format=\"ascii\">97 195 188</DataArray>\n"
+      "<Array type=\"String\" Name=\"note\" NumberOfTuples=\"2\" format=\"ascii\">104 105 0 -61 "
+      "-87 0</Array>\n"
+      "<DataArray type=\"Bit\" Name=\"flags\" format=\"ascii\">1 0 1</DataArray>\n"
+      "<DataArray type=\"Int32\" Name=\"polydg_point_extra\" format=\"ascii\">5</DataArray>\n"
+      "<DataArray type=\"Int32\" format=\"ascii\">6</DataArray>\n";
+  const fs::path path = testDir() / "other.vtu";
+  writeText(path, tetrahedronWithFieldData(fieldData));
+  VtuFieldData read;
+  const PolyMesh mesh = readVtu(path.string(), &read);
+  EXPECT_NEAR(signedVolume(mesh, ElementId(0)), 1.0 / 6.0, kRelativeTolerance);
+  VtuFieldData expected;
+  expected.numbers["counts"] = {1, 2, 3, -4};
+  expected.numbers["scale"] = {0.75};
+  expected.numbers["big"] = {9007199254740992.0, -7};
+  expected.numbers["mask"] = {0, 1, 255};
+  expected.strings["path"] = "a\u00fc";
+  expected.strings["note"] = std::string("hi\0\u00e9", 5);  // é is two bytes
+  expectSameFieldData(expected, read);
+}
+
+TEST(VtuFieldData, ABrokenArrayFailsOnlyWhenFieldDataIsAsked) {
+  const fs::path path = testDir() / "broken.vtu";
+  writeText(path,
+            tetrahedronWithFieldData(
+                "<DataArray type=\"Float64\" Name=\"size\" format=\"ascii\">1 x</DataArray>\n"));
+  EXPECT_EQ(readVtu(path.string()).numElements(), 1u);
+  VtuFieldData read;
+  read.strings["kept"] = "as it was";
+  const std::string message = errorMessage([&] { readVtu(path.string(), &read); });
+  EXPECT_EQ(message, path.string() + ": array 'size' has an invalid number 'x'");
+  EXPECT_EQ(read.strings.at("kept"), "as it was");
 }
 
 // --- files written by VTK (ctest fixture: vtk_check.py --write-vtk) -------------------------
@@ -727,6 +955,26 @@ TEST_P(VtkWrittenFile, ReadsWithExactVolumes) {
         << "element " << e;
   for (const Face& f : mesh.faces())
     EXPECT_EQ(toString(f.origin), f.isBoundary() ? "imported" : "interior");
+}
+
+TEST_P(VtkWrittenFile, ReturnsItsFieldData) {
+  // vtk_check.py's add_field_data(): a vtkDoubleArray, a vtkFloatArray, a two-component
+  // vtkIntArray, a vtkUnsignedCharArray, a vtkIdTypeArray, two vtkStringArrays (one value with
+  // XML's special characters, a non-ASCII letter, a newline and a tab; two values), text by
+  // polydg's convention (UInt8 "input_file.utf8"), and a vtkBitArray (skipped).
+  REQUIRE_VTK_FILE(path, GetParam());
+  VtuFieldData read;
+  readVtu(path->string(), &read);
+  VtuFieldData expected;
+  expected.numbers["cell_size"] = {0.125};
+  expected.numbers["scale"] = {0.25};
+  expected.numbers["counts"] = {1, 2, 3, -4};
+  expected.numbers["mask"] = {0, 1, 255};
+  expected.numbers["ids"] = {-7, 2147483647};
+  expected.strings["note"] = "a \"q\" <b> & \u00e9\nx\ttab";
+  expected.strings["tags"] = std::string("first\0second", 12);
+  expected.strings["input_file"] = "torus \u00fc.obj";
+  expectSameFieldData(expected, read);
 }
 
 // Suffixes of vtk_check.py --write-vtk: defaults (appended, base64, zlib, UInt32 headers, Int64
@@ -801,6 +1049,52 @@ TEST(WriteForVtkCheck, HexGridHoledPrismAndMixedCells) {
   writeVtu(mixedCells(), (fs::path(dir) / "mixed_cells.vtu").string());
   writeVtu(cutBoxes(), (fs::path(dir) / "cut_boxes.vtu").string());
   writeVtu(finitelyCutGrid(), (fs::path(dir) / "finite_cut.vtu").string());
+}
+
+/// `bytes` as lowercase hex, two digits a byte.
+std::string hex(std::string_view bytes) {
+  static const char kDigits[] = "0123456789abcdef";
+  std::string out;
+  for (unsigned char c : bytes) {
+    out += kDigits[c >> 4];
+    out += kDigits[c & 15];
+  }
+  return out;
+}
+
+TEST(WriteForVtkCheck, FieldDataInEveryEncoding) {
+  const char* dir = std::getenv("POLYDG_VTU_OUT_DIR");
+  if (dir == nullptr || *dir == '\0')
+    GTEST_SKIP() << "POLYDG_VTU_OUT_DIR is not set; ctest runs this before vtk_check.py";
+  fs::create_directories(dir);
+  // The skew grid (6.12 in 12 cells) with hostileFieldData(), for vtk_check.py --field-data
+  // field_data.json: names and text as hex of their bytes, numbers as hex floats.
+  const VtuFieldData data = hostileFieldData();
+  const std::pair<const char*, VtuEncoding> kFiles[] = {
+      {"field_data_ascii", VtuEncoding::Ascii},
+      {"field_data_binary", VtuEncoding::Binary},
+      {"field_data_appended", VtuEncoding::Appended}};
+  for (const auto& [name, encoding] : kFiles)
+    writeVtu(skewGrid(), (fs::path(dir) / (std::string(name) + ".vtu")).string(),
+             {.encoding = encoding}, {}, {}, {}, data);
+  std::string json = "{\"numbers\": {";
+  for (const auto& [name, values] : data.numbers) {
+    if (json.back() != '{') json += ", ";
+    json += "\"" + hex(name) + "\": [";
+    for (std::size_t i = 0; i < values.size(); ++i) {
+      char number[64];
+      std::snprintf(number, sizeof number, "%a", values[i]);
+      json += (i > 0 ? ", \"" : "\"") + std::string(number) + "\"";
+    }
+    json += "]";
+  }
+  json += "}, \"strings\": {";
+  for (const auto& [name, text] : data.strings) {
+    if (json.back() != '{') json += ", ";
+    json += "\"" + hex(name) + "\": \"" + hex(text) + "\"";
+  }
+  json += "}}\n";
+  writeText(fs::path(dir) / "field_data.json", json);
 }
 
 }  // namespace

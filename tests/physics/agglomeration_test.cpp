@@ -9,12 +9,16 @@
 #include <algorithm>
 #include <vector>
 
+#include "cli/bench/problems.h"
 #include "polydg/physics/block_rows.h"
 #include "polydg/physics/dg_basis.h"
 #include "tests/support/dg_systems.h"
 
 namespace polydg {
 namespace {
+
+using bench::benchmarkB1Mesh;
+using bench::BenchmarkMesh;
 
 using SpMat = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
 
@@ -74,12 +78,12 @@ TEST(Agglomeration, CoarseFunctionsAreTheLinearDisplacementsOfEachGroup) {
   // Degree 2 on non-convex sliced elements: W maps each group's linear functions onto the
   // elements' first four basis functions (the degree-1 part of the hierarchical basis).
   const PolyMesh mesh = benchmarkB1Mesh(BenchmarkMesh::Sliced, 4);
-  const ManufacturedProblem problem = benchmarkB1Problem();
+  const bench::ManufacturedProblem problem = bench::benchmarkB1Problem();
   StaticOptions o;
   o.discretization.method = Method::IP;
   o.discretization.basis.degree = 2;
   StaticSolver solver(mesh, problem.material, o);
-  solver.assemble(benchmarkB1Loads(problem));
+  solver.assemble(bench::benchmarkB1Loads(problem));
   const DgBasis& basis = solver.basis();
   const ElementFrames frames = elementFrames(basis);
   const int n = basis.size();

@@ -7,13 +7,16 @@
 
 #include <random>
 
-#include "polydg/physics/benchmarks.h"
+#include "cli/bench/problems.h"
 #include "polydg/physics/linear_solver.h"
 #include "polydg/physics/static_solver.h"
 #include "tests/support/dg_systems.h"
 
 namespace polydg {
 namespace {
+
+using bench::benchmarkB1Mesh;
+using bench::BenchmarkMesh;
 
 Eigen::VectorXd randomVector(Eigen::Index size) {
   std::mt19937 rng(20261123);

@@ -10,7 +10,7 @@
 #include <cstdio>
 #include <random>
 
-#include "polydg/physics/benchmarks.h"
+#include "cli/bench/problems.h"
 #include "polydg/physics/linear_solver.h"
 #include "polydg/physics/static_solver.h"
 #include "tests/support/dg_systems.h"
@@ -18,6 +18,9 @@
 
 namespace polydg {
 namespace {
+
+using bench::benchmarkB1Mesh;
+using bench::BenchmarkMesh;
 
 /// CG stops at a relative residual of 1e-10 here; the solutions then agree far closer than this.
 constexpr double kCgTolerance = 1e-10;

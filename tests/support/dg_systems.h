@@ -1,9 +1,9 @@
-// DG systems for solver tests: K and F of benchmarks B1 and B2, with the element frames the
-// p-multigrid's agglomeration levels need.
+// DG systems for solver tests: K and F of benchmarks B1 and B2 (cli/bench/problems.h), with the
+// element frames the p-multigrid's agglomeration levels need.
 #pragma once
 
+#include "cli/bench/problems.h"
 #include "polydg/physics/agglomeration.h"
-#include "polydg/physics/benchmarks.h"
 #include "polydg/physics/static_solver.h"
 
 namespace polydg {
@@ -27,8 +27,8 @@ inline FramedSystem framedSystem(const PolyMesh& mesh, const Material& material,
 
 /// K, F and frames of B1 on `mesh` (Dirichlet on the whole boundary, so K is SPD).
 inline FramedSystem b1FramedSystem(const PolyMesh& mesh, Method method, int degree) {
-  const ManufacturedProblem problem = benchmarkB1Problem();
-  return framedSystem(mesh, problem.material, benchmarkB1Loads(problem), method, degree);
+  const bench::ManufacturedProblem problem = bench::benchmarkB1Problem();
+  return framedSystem(mesh, problem.material, bench::benchmarkB1Loads(problem), method, degree);
 }
 
 /// K and F of B1 on `mesh`.
@@ -39,7 +39,8 @@ inline LinearSystem b1System(const PolyMesh& mesh, Method method, int degree) {
 /// K, F and frames of B2 (the clamped cube under gravity: it bends, so rotations dominate
 /// the smooth part of the error).
 inline FramedSystem b2FramedSystem(Method method, int degree) {
-  return framedSystem(benchmarkB2Mesh(), benchmarkB2Material(), benchmarkB2Loads(), method, degree);
+  return framedSystem(bench::benchmarkB2Mesh(), bench::benchmarkB2Material(),
+                      bench::benchmarkB2Loads(), method, degree);
 }
 
 }  // namespace polydg

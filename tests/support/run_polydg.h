@@ -21,17 +21,21 @@ struct CommandResult {
   std::string out;  ///< stdout and stderr together
 };
 
-/// Runs `polydg ARGUMENTS` through the shell (POLYDG_BINARY, set by polydg_add_test).
-inline CommandResult runPolydg(const std::string& arguments) {
-  const std::string command = std::string(POLYDG_BINARY) + " " + arguments + " 2>&1";
+/// Runs `command` through the shell (/bin/sh), collecting what it prints on stdout and stderr.
+inline CommandResult runShell(const std::string& command) {
   CommandResult r;
-  FILE* pipe = popen(command.c_str(), "r");
+  FILE* pipe = popen(("(" + command + ") 2>&1").c_str(), "r");
   if (!pipe) return r;
   std::array<char, 4096> buffer;
   while (std::fgets(buffer.data(), buffer.size(), pipe)) r.out += buffer.data();
   const int status = pclose(pipe);
   r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return r;
+}
+
+/// Runs `polydg ARGUMENTS` through the shell (POLYDG_BINARY, set by polydg_add_test).
+inline CommandResult runPolydg(const std::string& arguments) {
+  return runShell(std::string(POLYDG_BINARY) + " " + arguments);
 }
 
 /// A file of testdata/ (POLYDG_TESTDATA_DIR, set by polydg_add_test).

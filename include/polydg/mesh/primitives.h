@@ -1,5 +1,6 @@
-// Meshes made in code, with known exact volumes and moments: hexahedral grids, boxes and
-// (sheared) prisms over non-convex polygons with holes. Used by tests and benchmarks.
+// Meshes made in code, with known exact volumes and moments: hexahedral grids, boxes, boxes of
+// different sizes meeting face to face, and (sheared) prisms over non-convex polygons with holes.
+// Used by tests and benchmarks.
 #pragma once
 
 #include <vector>
@@ -18,6 +19,13 @@ PolyMesh hexGridMesh(int nx, int ny, int nz, const Box3& box);
 
 /// One hexahedral element filling `box`.
 PolyMesh boxMesh(const Box3& box);
+
+/// A mesh of axis-aligned boxes that meet face to face, where a box side may touch several
+/// smaller boxes (hanging vertices are inserted into every face whose edge they lie on, so each
+/// element is closed). Each side of a box is tiled by its overlaps with the boxes across it;
+/// a side that touches none is a boundary face (tag Box). Element i is boxes[i]. Throws
+/// std::invalid_argument if a side is only partly covered.
+PolyMesh boxCellsMesh(const std::vector<Box3>& boxes);
 
 /// A polygon with holes in the plane: outer loop counter-clockwise, holes clockwise.
 struct Polygon2 {

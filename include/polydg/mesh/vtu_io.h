@@ -3,6 +3,7 @@
 #pragma once
 
 #include <functional>
+#include <map>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -44,17 +45,46 @@ struct CornerArray {
   std::function<void(ElementId, VertexId, double*)> value;
 };
 
+/// Named values a file carries for the mesh as a whole (VTK FieldData), written after polydg's
+/// own restore arrays: provenance that must travel with the mesh between commands (the grid cell
+/// size, the sliver rule, the input file).
+///
+/// Names must be non-empty, must hold no control character (bytes 0x00-0x1f and 0x7f, which an
+/// XML attribute cannot keep) and must not start with "polydg_face_", "polydg_element" or
+/// "polydg_point_" (reserved for the exact restore, see writeVtu).
+///
+/// numbers: each is a Float64 array of one component and numbers[name].size() tuples, values in
+/// order; it may be empty. Every value must be finite (writeVtu refuses NaN and infinities): in
+/// an ascii file VTK 9.1 reads "-inf" as +inf and silently drops an array holding "Infinity"
+/// (its own writer's spelling), and a NaN, which VTK and meshio do read, would lose its sign and
+/// payload there; provenance has no use for them, so one is a caller's bug, reported early and
+/// the same way in every encoding. Any finite double (-0.0, subnormals, 1e-300, 1e300) comes back
+/// bit for bit, in every encoding.
+///
+/// strings: each is stored as a UInt8 array named NAME + kVtuTextSuffix ("input_file" as
+/// "input_file.utf8") holding the text's bytes, without terminator: UTF-8 by convention, but
+/// any bytes, NUL included, come back unchanged. Not a VTK String array: meshio 7 (Debian 12's
+/// python3-meshio) refuses to open a file that has one ("Illegal data type 'String'"), while
+/// VTK and meshio both read UInt8 arrays.
+struct VtuFieldData {
+  std::map<std::string, std::vector<double>> numbers;  ///< Float64 arrays
+  std::map<std::string, std::string> strings;          ///< text values
+};
+
+/// The suffix that marks a UInt8 field data array as text (see VtuFieldData::strings).
+inline constexpr std::string_view kVtuTextSuffix = ".utf8";
+
 /// Writes `mesh` to `path` as a VTK XML UnstructuredGrid (version 1.0, UInt64 headers).
 ///
 /// Layout: points (Float64) are the mesh's vertices in id order, followed by extra copies of
 /// vertices: per vertex, its elements are grouped by connectivity through the interior faces
 /// that contain the vertex, and each group has its own point (the first group, in element
-/// order, the vertex itself). So elements coupled across interior faces share points, while the
-/// two sides of a FaceOrigin::Cut face (boundary faces of both, on the same vertex ids) do not:
-/// VTK and meshio see them as separate regions, and a finite cut shares points only along its
-/// front. Each element is one VTK_POLYHEDRON (type 42) cell, cells ordered by point count (see
-/// polydg_element). Cells/connectivity holds a cell's distinct point ids, Cells/faces per cell
-/// the number of face records and then, per record, its number of points and point ids;
+/// order, the vertex itself; polydg/mesh/point_groups.h). So elements coupled across interior faces
+/// share points, while the two sides of a FaceOrigin::Cut face (boundary faces of both, on the same
+/// vertex ids) do not: VTK and meshio see them as separate regions, and a finite cut shares points
+/// only along its front. Each element is one VTK_POLYHEDRON (type 42) cell, cells ordered by point
+/// count (see polydg_element). Cells/connectivity holds a cell's distinct point ids, Cells/faces
+/// per cell the number of face records and then, per record, its number of points and point ids;
 /// Cells/faceoffsets the end of each cell's run in `faces`. Integer arrays are stored as UInt8,
 /// Int32 or Int64, the smallest that holds their values. Every record is oriented so that its
 /// normal points out of the cell (the face's loop if the element uses it unreversed, the loop
@@ -64,7 +94,7 @@ struct CornerArray {
 ///
 /// Cell data: `volume` (signedVolume of each element) followed by `cellData`; point data:
 /// `pointData` (every copy of a vertex carries the vertex's value), then `cornerData` (each
-/// point the mean of its elements' values). Field data lets readVtu
+/// point the mean of its elements' values). polydg's field data lets readVtu
 /// restore the mesh exactly:
 ///   - polydg_face_group: per face record, in file order, the id of the face it belongs to;
 ///   - polydg_face_reversed: per face record, 1 if it runs against its face's orientation
@@ -73,16 +103,22 @@ struct CornerArray {
 ///   - polydg_element: per cell, in file order, the element it is;
 ///   - polydg_point_vertex: per point, the vertex it is a copy of (only when some vertex has
 ///     several points).
+/// `fieldData` follows: its numbers, then its strings, each in name order (see VtuFieldData). In
+/// appended files their bytes come after all of polydg's arrays, last array first, which keeps
+/// meshio 7 from mistaking one array for another (see mesh/vtu_writer.cpp) and leaves polydg's
+/// arrays where they are without field data.
 ///
 /// The file is written to `path + ".tmp"` and renamed over `path`, so `path` is never left
 /// half-written. Throws std::invalid_argument if an array has the wrong size, a component count
-/// other than 1 or 3, an empty name, or a name already used (`volume` is taken); throws
+/// other than 1 or 3, an empty name, or a name already used (`volume` is taken), or if a field
+/// data name breaks VtuFieldData's rules, a field data number is not finite, or a number array
+/// has the name a text is stored under (numbers "a.utf8" and strings "a"); throws
 /// std::runtime_error("cannot write PATH: reason") if the file cannot be written, and
 /// std::runtime_error if a face with holes cannot be triangulated.
 void writeVtu(const PolyMesh& mesh, const std::string& path, const VtuWriteOptions& options = {},
               const std::vector<CellArray>& cellData = {},
               const std::vector<PointArray>& pointData = {},
-              const std::vector<CornerArray>& cornerData = {});
+              const std::vector<CornerArray>& cornerData = {}, const VtuFieldData& fieldData = {});
 
 /// Reads a VTK XML UnstructuredGrid file into a PolyMesh.
 ///
@@ -105,20 +141,20 @@ void writeVtu(const PolyMesh& mesh, const std::string& path, const VtuWriteOptio
 /// back in another order, which does not change the face), the same front/back sides and
 /// origins. Point and cell data are not read.
 ///
+/// If `fieldData` is not null it is replaced by the file's FieldData arrays, except polydg's
+/// restore arrays (names with a reserved prefix) and arrays without a name:
+///   - a UInt8 (or UChar) array named NAME + kVtuTextSuffix as strings[NAME], its bytes;
+///   - a VTK String array (vtkStringArray, as VTK writes it) as strings[name], its values joined
+///     by NUL characters (one value: the value itself);
+///   - any other numeric array as numbers[name], values widened to double in file order
+///     (components interleaved; integers beyond 2^53 rounded);
+///   - arrays of other types (VTK's Bit arrays) are skipped.
+/// If two arrays give one name, the later in the file wins. If reading fails, `fieldData` is left
+/// as it was.
+///
 /// Throws std::runtime_error with one line naming the file and the problem, e.g.
 /// "FILE: not a VTK UnstructuredGrid file" or "FILE: cell 3 has VTK type 5, which polydg does not
 /// read; only 3D linear cells and polyhedra are supported".
-PolyMesh readVtu(const std::string& path);
-
-/// Base64 (RFC 4648, with '=' padding), as used for binary data in VTK XML files. Exposed for
-/// tests.
-namespace vtu_detail {
-std::string base64Encode(std::string_view bytes);
-/// Decodes groups of four characters, ignoring whitespace; a group may end in padding
-/// anywhere, so separately encoded pieces that were concatenated (as VTK writes headers and
-/// data) decode to the concatenated bytes. Throws std::runtime_error on any other character or
-/// an incomplete final group.
-std::string base64Decode(std::string_view text);
-}  // namespace vtu_detail
+PolyMesh readVtu(const std::string& path, VtuFieldData* fieldData = nullptr);
 
 }  // namespace polydg

@@ -1,4 +1,4 @@
-#include "cli/plot.h"
+#include "cli/bench/plot.h"
 
 #include <algorithm>
 #include <array>
@@ -9,7 +9,7 @@
 
 #include "polydg/mesh/xml_escape.h"
 
-namespace polydg::cli {
+namespace polydg::bench {
 
 namespace {
 
@@ -252,4 +252,4 @@ std::string renderSvg(const Plot& plot, const PlotLayout& l) {
   return svg.str();
 }
 
-}  // namespace polydg::cli
+}  // namespace polydg::bench

@@ -1,17 +1,16 @@
-#include "polydg/physics/benchmarks.h"
+#include "cli/bench/problems.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
 #include "polydg/mesh/merge_elements.h"
-#include "polydg/mesh/meshing.h"
 #include "polydg/mesh/primitives.h"
 #include "polydg/mesh/slice.h"
 #include "polydg/mesh/surface_shapes.h"
 #include "polydg/physics/face_quadrature.h"
-#include "polydg/util/stopwatch.h"
 
-namespace polydg {
+namespace polydg::bench {
 
 namespace {
 /// The B1 fields on the unit cube.
@@ -191,24 +190,4 @@ CantileverResult runBenchmarkB3(const CantileverSetup& setup, const StaticOption
   return r;
 }
 
-MeshingCostRun runMeshingCostCase(const std::string& model, const TriangleSurface& surface,
-                                  int cells) {
-  MeshingOptions options;
-  options.cellsAlongLongest = cells;
-  const MeshingResult result = meshSurface(surface, options);
-  MeshingCostRun run;
-  run.meshing = meshingBenchmarkRun(model, surface, cells, result.report);
-  for (const auto& [phase, seconds] : result.report.timings)
-    if (phase == "validate") run.geometricValidationSeconds += seconds;
-  const Stopwatch t0;
-  LocalDgCheckOptions checks;
-  MomentCache moments(result.mesh, 2 * checks.basis.degree);
-  moments.update();
-  const LocalDgCheck check = localDgChecks(result.mesh, moments, checks);
-  run.dgCheckSeconds = t0.seconds();
-  run.dgElements = check.elements;
-  run.dgPassed = check.passed();
-  return run;
-}
-
-}  // namespace polydg
+}  // namespace polydg::bench

@@ -4,49 +4,10 @@
 // cantilever (B3 as nu -> 1/2); and B1 and B3 scaled and translated.
 #pragma once
 
-#include <string>
+#include "cli/bench/problems.h"
+#include "polydg/physics/condition_estimate.h"
 
-#include <Eigen/SparseCore>
-
-#include "polydg/mesh/geometry.h"
-#include "polydg/physics/benchmarks.h"
-
-namespace polydg {
-
-/// Extreme eigenvalues of a symmetric matrix and their ratio.
-struct ConditionEstimate {
-  double lambdaMin = 0.0;
-  double lambdaMax = 0.0;
-  /// lambdaMax / lambdaMin; +infinity when the matrix is not positive definite.
-  double cond = 0.0;
-  bool positiveDefinite = false;
-  int matrixProducts = 0;  ///< products with K plus solves with K, both Lanczos runs
-};
-
-/// How conditionEstimate() works, as reported in the stability JSON (`cond_method`).
-inline constexpr const char* kConditionMethod =
-    "Lanczos (Spectra SymEigsSolver, relative tolerance 1e-8): largest eigenvalue of K, and "
-    "largest eigenvalue of K^-1 applied through a CHOLMOD Cholesky factorization";
-
-/// The 2-norm condition number of the symmetric positive definite `matrix` (both triangles
-/// stored, DOFs in element blocks of `blockSize` as LinearSystem): lambda_max by Lanczos on K,
-/// lambda_min = 1 / (largest eigenvalue of K^-1) by Lanczos with a Cholesky factorization of K.
-/// If the factorization fails the matrix is reported not positive definite with cond = +inf.
-/// Throws std::runtime_error if Lanczos does not converge.
-ConditionEstimate conditionEstimate(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix,
-                                    int blockSize);
-
-/// D^-1/2 K D^-1/2 with D = diag(K) (unit diagonal): the matrix a diagonally preconditioned
-/// iterative solver sees. Throws std::invalid_argument if a diagonal entry is not positive.
-Eigen::SparseMatrix<double, Eigen::ColMajor, int> jacobiScaled(
-    const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix);
-
-/// A mesh of axis-aligned boxes that meet face to face, where a box side may touch several
-/// smaller boxes (hanging vertices are inserted into every face whose edge they lie on, so each
-/// element is closed). Each side of a box is tiled by its overlaps with the boxes across it;
-/// a side that touches none is a boundary face (tag Box). Throws std::invalid_argument if a side
-/// is only partly covered.
-PolyMesh boxCellsMesh(const std::vector<Box3>& boxes);
+namespace polydg::bench {
 
 /// The sliver mesh of B4: the 3 x 3 x 3 grid of unit cubes on [0,3]^3 whose centre cell is split
 /// by the plane x = 1 + volumeRatio into a sliver of volume `volumeRatio` (relative to its
@@ -82,7 +43,7 @@ StabilityConditionRun runSliverCase(double volumeRatio, bool merge, int degree);
 /// B4 thin neck: thinNeckMesh(eps) clamped on x = 0.
 StabilityConditionRun runThinNeckCase(double eps, int degree);
 
-/// The cantilever meshes of the locking test (tests/physics/benchmarks_test.cpp, issue 4):
+/// The cantilever meshes of the locking test (tests/cli/bench/problems_test.cpp, issue 4):
 /// 40 x 4 x 4 with the trace-bound penalty for p = 2; 160 x 4 x 8 with penalty doubling for
 /// p = 1 (linear elements need the smaller penalty in bending). `quick` divides nx by 4 (a
 /// coarser, faster smoke test; the 5% locking criterion is not meant for it).
@@ -127,4 +88,4 @@ ScaleRun runScaleCase(ScaleProblem problem, double scale, const Vec3& offset, in
 /// solution then changes by up to about that times this condition number.
 double scaleProblemCondition(ScaleProblem problem, int degree, bool quick = false);
 
-}  // namespace polydg
+}  // namespace polydg::bench

@@ -1,16 +1,12 @@
-// The benchmark problems of shared/BENCHMARKS.md as library functions, used by `polydg bench`
-// and by the tests: B1 (manufactured solution on the unit cube), B2 (the thesis's Table 4.1
-// setup) and B3 (cantilever under an end load, and locking).
+// The benchmark problems B1 (manufactured solution on the unit cube), B2 (the thesis's Table 4.1
+// setup) and B3 (cantilever under an end load, and locking) of shared/BENCHMARKS.md: their
+// meshes, materials and loads, and one run of each, for `polydg bench` and the tests.
 #pragma once
 
-#include <string>
-
-#include "polydg/mesh/meshing_benchmark.h"
 #include "polydg/physics/post_process.h"
 #include "polydg/physics/static_solver.h"
-#include "polydg/physics/validation.h"
 
-namespace polydg {
+namespace polydg::bench {
 
 /// A similarity map x -> scale * x + offset of a benchmark's domain (B4's scale and position
 /// test). Lengths and displacements scale by `scale`; strains and stresses do not change.
@@ -94,21 +90,4 @@ double meanBoundaryDisplacement(const PolyMesh& mesh, const DgBasis& basis,
                                 const Eigen::VectorXd& coefficients, const FaceSelector& where,
                                 int axis);
 
-/// The meshing benchmark with the cost of validating the result: the meshing pipeline
-/// (meshSurface() with default options; its phases include the geometric validation
-/// "validate") followed by the local DG checks (degree 1) of every element, with the degree 2
-/// moments they need.
-struct MeshingCostRun {
-  MeshingBenchmarkRun meshing;
-  double geometricValidationSeconds = 0.0;  ///< the "validate" phase of meshing
-  double dgCheckSeconds = 0.0;              ///< moments + localDgChecks(), wall
-  std::size_t dgElements = 0;
-  bool dgPassed = false;
-};
-
-/// Meshes `surface` (named `model` in the run) with `cells` cells along its longest side.
-/// Throws InputError as meshSurface() does.
-MeshingCostRun runMeshingCostCase(const std::string& model, const TriangleSurface& surface,
-                                  int cells);
-
-}  // namespace polydg
+}  // namespace polydg::bench

@@ -5,7 +5,7 @@
 
 #include <nlohmann/json.hpp>
 
-namespace polydg::cli {
+namespace polydg::bench {
 
 /// RFC 4180 CSV of `rows`, an array of JSON objects: one header line, then one line per row.
 /// Columns are the keys of all rows in order of first appearance; nested objects are flattened
@@ -15,4 +15,4 @@ namespace polydg::cli {
 /// `rows` is not an array of objects.
 std::string toCsv(const nlohmann::json& rows);
 
-}  // namespace polydg::cli
+}  // namespace polydg::bench

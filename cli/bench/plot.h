@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-namespace polydg::cli {
+namespace polydg::bench {
 
 enum class AxisScale { Linear, Log };
 
@@ -50,4 +50,4 @@ std::string renderSvg(const Plot& plot, const PlotLayout& layout = {});
 /// 5 times a power of ten, about five of them.
 std::vector<double> axisTicks(double lo, double hi, AxisScale scale);
 
-}  // namespace polydg::cli
+}  // namespace polydg::bench

@@ -1,10 +1,10 @@
-#include "cli/csv.h"
+#include "cli/bench/csv.h"
 
 #include <map>
 #include <stdexcept>
 #include <vector>
 
-namespace polydg::cli {
+namespace polydg::bench {
 
 namespace {
 
@@ -62,4 +62,4 @@ std::string toCsv(const nlohmann::json& rows) {
   return csv;
 }
 
-}  // namespace polydg::cli
+}  // namespace polydg::bench

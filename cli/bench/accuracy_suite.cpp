@@ -1,0 +1,92 @@
+#include "cli/bench/suites.h"
+
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "polydg/model/names.h"
+
+namespace polydg::bench {
+
+
+namespace {
+
+/// Grid sizes of the accuracy suite per degree (at least three each; two with --quick).
+std::vector<int> accuracySizes(int degree, BenchmarkMesh mesh, bool quick) {
+  if (quick) return degree == 1 ? std::vector<int>{2, 4} : std::vector<int>{1, 2};
+  if (mesh == BenchmarkMesh::Sliced) {
+    switch (degree) {
+      case 1: return {4, 8, 12};
+      case 2: return {2, 4, 8};
+      default: return {2, 4, 6};
+    }
+  }
+  switch (degree) {
+    case 1: return {4, 8, 16, 24};
+    case 2: return {2, 4, 8, 12};
+    default: return {2, 3, 4, 6, 8};
+  }
+}
+
+/// B1's reference point (BENCHMARKS.md): continuous P2 tetrahedra with algebraic multigrid.
+PlotSeries referenceLibrarySeries() {
+  return {"reference: FEM P2 tets + AMG", {0.5, 8.0}, {9.4e-6, 1.2e-6}};
+}
+
+}  // namespace
+
+SuiteOutput accuracySuite(const BenchOptions& o, bool quiet) {
+  SuiteOutput s{"accuracy", nlohmann::json::array(), nlohmann::json::array(), {}};
+  std::vector<BenchmarkMesh> meshes{BenchmarkMesh::Hex};
+  if (!o.skipSliced) meshes.push_back(BenchmarkMesh::Sliced);
+  const int maxDegree = o.quick ? 2 : 3;
+  SeriesSet l2;
+  std::vector<std::string> labels;  // series labels with their last rates, in series order
+  for (BenchmarkMesh mesh : meshes)
+    for (Method method : {Method::IP, Method::BZ})
+      for (int p = 1; p <= maxDegree; ++p) {
+        const std::string key = upper(toString(method)) + " p=" + std::to_string(p) + " " +
+                                (mesh == BenchmarkMesh::Hex ? "hex" : "sliced");
+        std::optional<BenchmarkRun> previous;
+        double lastRate = std::numeric_limits<double>::quiet_NaN();
+        for (int n : accuracySizes(p, mesh, o.quick)) {
+          StaticOptions so;
+          so.discretization.method = method;
+          so.discretization.basis.degree = p;
+          const BenchmarkRun r = runBenchmarkB1(n, so, mesh);
+          if (!quiet) printRun(r);
+          nlohmann::json j = runJson(r);
+          if (previous) {
+            const double dh = std::log(static_cast<double>(r.n) / previous->n);
+            lastRate = std::log(previous->l2Error / r.l2Error) / dh;
+            j["l2_rate"] = lastRate;
+            j["h1_rate"] = std::log(previous->h1Error / r.h1Error) / dh;
+          }
+          s.json.push_back(j);
+          s.rows.push_back(j);
+          l2.add(key, r.report.integrateSeconds + r.report.assembleSeconds + r.report.solveSeconds,
+                 r.l2Error);
+          previous = r;
+        }
+        labels.push_back(key + ", L2 rate " + shortNumber(lastRate));
+      }
+  std::vector<PlotSeries> all = l2.series();
+  for (std::size_t i = 0; i < all.size(); ++i) all[i].label = labels[i];
+  for (BenchmarkMesh mesh : meshes) {
+    const std::string kind = mesh == BenchmarkMesh::Hex ? "hex" : "sliced";
+    std::vector<PlotSeries> series;
+    for (const PlotSeries& p : all)
+      if (p.label.find(" " + kind + ",") != std::string::npos) series.push_back(p);
+    series.push_back(referenceLibrarySeries());
+    s.plots.push_back({"accuracy_" + kind + ".svg",
+                       {"B1 accuracy on " + kind + " meshes: L2 error against time",
+                        {"wall time, integration + assembly + solve [s]", AxisScale::Log},
+                        {"L2 error of u (legend: rate over the last halving of h)", AxisScale::Log},
+                        series}});
+  }
+  return s;
+}
+
+}  // namespace polydg::bench

@@ -1,0 +1,44 @@
+// The suites of `polydg bench` (shared/BENCHMARKS.md), each a function from the options to the
+// files it writes (cli/bench/suite_output.h):
+//   accuracy   B1 with IP and BZ, degrees 1-3, hex grids (p = 1: n = 4, 8, 16, 24; p = 2: 2, 4,
+//              8, 12; p = 3: 2, 3, 4, 6, 8) and sliced cubes (p = 1: 4, 8, 12; p = 2: 2, 4, 8;
+//              p = 3: 2, 4, 6). Plot: L2 error against integration + assembly + solve time
+//              (everything from the mesh to the solution).
+//   table41    B2 (10^3 hexahedra) with BZ and IP, degrees 1 and 2, beside the thesis's Table 4.1.
+//              Each case runs five times; the fastest run (by total time) is reported.
+//   stability  B4: sliver (volume ratio 1 .. 1e-12 by factors of 10, and 0.05 and 0.02 near
+//              the merge threshold; merged or not, p = 1, 2), thin neck (eps
+//              1e-1 .. 1e-9), near-incompressible cantilever (nu 0.3 .. 0.4999, p = 1, 2),
+//              scale and position (B1 and B3 scaled by 1e-6, 1, 1e6, offsets 0 and
+//              (1e6, -1e6, 1e6), p = 2).
+//   meshing    the meshing pipeline and its validation (geometric, DG checks) for the bundled
+//              torus.obj and the generated sphere and torus knot at 16 .. 128 cells.
+//   cutting    plane cuts of growing size on a 47^3 hex grid (103,823 elements): time per cut
+//              against elements split, validation none and local, beside a full moment rebuild.
+// With `quick` each runs reduced sizes (a smoke test of every output, as the tests run it).
+#pragma once
+
+#include <string>
+
+#include "cli/bench/suite_output.h"
+
+namespace polydg::bench {
+
+struct BenchOptions {
+  std::string suite;        ///< accuracy, table41, stability, meshing, cutting or all
+  std::string out;          ///< the folder the files go to
+  bool skipSliced = false;  ///< accuracy: hex grids only
+  bool quick = false;
+  /// The folder of the bundled models the meshing suite reads (torus.obj); `polydg bench` uses
+  /// dataDirectory() (cli/bench/data_files.h) unless --data names another.
+  std::string dataDir;
+};
+
+SuiteOutput accuracySuite(const BenchOptions& options, bool quiet);
+SuiteOutput table41Suite(bool quiet);
+SuiteOutput stabilitySuite(const BenchOptions& options, bool quiet);
+/// Throws InputError if DATA_DIR/torus.obj does not exist.
+SuiteOutput meshingSuite(const BenchOptions& options, bool quiet);
+SuiteOutput cuttingSuite(const BenchOptions& options, bool quiet);
+
+}  // namespace polydg::bench

@@ -1,0 +1,55 @@
+// The points of a mesh file in which elements share a point only where they are joined: per
+// vertex, one point per group of its elements connected through interior faces that contain the
+// vertex, so that the two sides of a cut are separate regions for VTK and meshio.
+#pragma once
+
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "polydg/mesh/poly_mesh.h"
+
+namespace polydg {
+
+/// Each element's distinct vertices (its corners), flattened: element e's corners are
+/// vertices[begin[e] .. begin[e+1]), in an order the caller chooses (the VTU writer: order of
+/// first use by the element's face records). Entry i of `vertices` is corner i.
+struct ElementCorners {
+  std::vector<std::size_t> begin;  ///< numElements() + 1 entries, begin[0] = 0
+  std::vector<VertexId> vertices;
+
+  std::span<const VertexId> of(ElementId e) const {
+    return {vertices.data() + begin[e.index()], begin[e.index() + 1] - begin[e.index()]};
+  }
+  /// The corner of vertex v in element e (v must be one of e's vertices).
+  std::uint32_t find(ElementId e, VertexId v) const {
+    const auto vs = of(e);
+    return static_cast<std::uint32_t>(begin[e.index()] +
+                                      (std::find(vs.begin(), vs.end(), v) - vs.begin()));
+  }
+};
+
+/// The points of a file and which corners use them.
+struct PointGroups {
+  /// Per corner (index into ElementCorners::vertices), its point.
+  std::vector<std::uint32_t> cornerPoint;
+  /// Per point, the vertex it is a copy of. Points 0 .. numVertices()-1 are the vertices
+  /// themselves (pointVertex[p] = p); later points are further copies, in order of their first
+  /// corner.
+  std::vector<VertexId> pointVertex;
+
+  std::size_t numPoints() const { return pointVertex.size(); }
+};
+
+/// Groups the corners of each vertex: two elements' corners at vertex v are in one group when
+/// the elements are joined by a chain of interior faces (front and back both valid) that all
+/// contain v. Each group is one point: the group of v's first corner (in corner order) is v's
+/// own point, every further group a new point after all vertices. So elements coupled across
+/// interior faces share points, while the two sides of a FaceOrigin::Cut face (boundary faces of
+/// both, on the same vertex ids), or elements touching only at a vertex or an edge, do not; a
+/// finite cut shares points only along its front. A vertex of no element keeps its own point.
+PointGroups groupPoints(const PolyMesh& mesh, const ElementCorners& corners);
+
+}  // namespace polydg

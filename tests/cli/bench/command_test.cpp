@@ -1,0 +1,165 @@
+// `polydg bench` end to end through the binary, as a user runs it: the stability and cutting
+// suites with --quick (every file written, the B4 JSON keys and findings, incremental cuts),
+// the meshing suite finding its model in share/polydg beside the binary (build tree and an
+// installation's layout) or in --data, and an unknown suite refused with one line.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "tests/cli/bench/b4_measurements.h"
+#include "tests/support/run_polydg.h"
+
+namespace polydg::bench {
+namespace {
+
+namespace fs = std::filesystem;
+
+using Result = polydg::testing::CommandResult;
+
+Result run(const std::string& arguments) { return polydg::testing::runPolydg(arguments); }
+
+TEST(BenchCommand, StabilitySuiteWritesJsonCsvAndPlots) {
+  // Unique per process: two test runs at once must not share (and delete) the folder.
+  const fs::path dir =
+      fs::temp_directory_path() / ("polydg_bench_stability_" + std::to_string(getpid()));
+  fs::remove_all(dir);
+  const Result r = run("bench --suite stability --quick --quiet --out " + dir.string());
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  EXPECT_TRUE(r.out.empty()) << r.out;  // --quiet
+  for (const char* file :
+       {"stability.json", "stability.csv", "stability_sliver.svg", "stability_thin_neck.svg",
+        "stability_incompressible.svg", "stability_scale.svg"})
+    EXPECT_TRUE(fs::exists(dir / file)) << file;
+  std::ifstream in(dir / "stability.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_TRUE(j["cond_method"].get<std::string>().find("Lanczos") != std::string::npos);
+  ASSERT_FALSE(j["sliver"].empty());
+  // The figures of the quick cases against those measured (tests/cli/bench/b4_measurements.h):
+  // merged slivers (ratios 1e-4 and 1e-12) near the regular grid, the thin neck bounded.
+  for (const nlohmann::json& s : j["sliver"]) {
+    ASSERT_TRUE(s.contains("volume_ratio") && s.contains("merged") && s.contains("cond"));
+    const double ratio = s["volume_ratio"].get<double>();
+    const int p = s["degree"].get<int>();
+    if (ratio == 1.0) {
+      EXPECT_EQ(s["cond_over_regular"].get<double>(), 1.0) << s.dump();
+    } else if (s["merged"].get<bool>()) {
+      EXPECT_TRUE(measured::within(s["cond_over_regular"].get<double>(),
+                                   measured::kMergedSliverOverRegular[p - 1],
+                                   measured::kConditionMargin))
+          << s.dump();
+    }
+  }
+  for (const nlohmann::json& s : j["thin_neck"]) {
+    ASSERT_TRUE(s["positive_definite"].get<bool>()) << s.dump();
+    const int p = s["degree"].get<int>();
+    EXPECT_LE(s["cond"].get<double>(),
+              measured::kThinNeckCondMax[p - 1] * measured::kConditionMargin)
+        << s.dump();
+    EXPECT_GE(s["cond"].get<double>(),
+              measured::kThinNeckCondMin[p - 1] / measured::kConditionMargin)
+        << s.dump();
+  }
+  EXPECT_EQ(j["incompressible"].size(), 8u);  // 4 values of nu, p = 1 and 2
+  for (const nlohmann::json& s : j["incompressible"])
+    EXPECT_TRUE(s.contains("tip") && s.contains("reference") && s.contains("nu"));
+  EXPECT_EQ(j["scale"].size(), 12u);  // B1 and B3, 3 scales, 2 offsets
+  // Each scaled or translated run changes its figure by no more than measured (with the margin):
+  // the unscaled, untranslated run by nothing.
+  for (const nlohmann::json& s : j["scale"]) {
+    const double scale = s["scale"].get<double>();
+    const bool translated = s["offset"][0].get<double>() != 0.0;
+    const ScaleProblem problem =
+        s["problem"].get<std::string>() == "B1" ? ScaleProblem::B1 : ScaleProblem::B3;
+    double bound = 0.0;
+    for (const measured::ScaleCase& c : measured::kScaleCases)
+      if (c.problem == problem && c.scale == scale && c.translated == translated)
+        bound = measured::kScaleChangeMargin * c.measuredChange;
+    EXPECT_LE(s["change"].get<double>(), bound) << s.dump();
+  }
+  std::ifstream csv(dir / "stability.csv");
+  std::string header;
+  std::getline(csv, header);
+  EXPECT_NE(header.find("case"), std::string::npos);
+  EXPECT_NE(header.find("volume_ratio"), std::string::npos);
+  fs::remove_all(dir);
+}
+
+TEST(BenchCommand, CuttingSuiteReintegratesOnlyWhatEachCutTouched) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("polydg_bench_cutting_" + std::to_string(getpid()));
+  fs::remove_all(dir);
+  const Result r = run("bench --suite cutting --quick --quiet --out " + dir.string());
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  for (const char* file : {"cutting.json", "cutting.csv", "cutting.svg"})
+    EXPECT_TRUE(fs::exists(dir / file)) << file;
+  std::ifstream in(dir / "cutting.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  ASSERT_GE(j["runs"].size(), 4u);  // 3 cuts with validation none, at least 1 with local
+  for (const nlohmann::json& run : j["runs"]) {
+    EXPECT_TRUE(run["validation_passed"].get<bool>()) << run.dump();
+    EXPECT_GT(run["elements_split"].get<std::size_t>(), 0u) << run.dump();
+    // Each split element re-integrates its own faces only: far fewer than the mesh's faces.
+    EXPECT_LT(run["faces_reintegrated"].get<std::size_t>(),
+              run["faces_total"].get<std::size_t>() / 4)
+        << run.dump();
+  }
+  fs::remove_all(dir);
+}
+
+TEST(BenchCommand, UnknownSuiteIsRefusedWithOneLine) {
+  const Result r = run("bench --suite nonsense --out " +
+                       (fs::temp_directory_path() / "polydg_bench_unknown").string());
+  EXPECT_EQ(r.exitCode, 2);
+  EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << r.out;
+  EXPECT_FALSE(fs::exists(fs::temp_directory_path() / "polydg_bench_unknown"));
+}
+
+/// A scratch folder per test (polydg::testing::CommandTest).
+class BenchData : public polydg::testing::CommandTest {};
+
+TEST_F(BenchData, MeshingSuiteFindsItsModelBesideTheBinaryFromAnyFolder) {
+  // Run from the scratch folder: no path relative to the working directory can help.
+  const Result r = polydg::testing::runShell("cd '" + dir_.string() + "' && " + POLYDG_BINARY +
+                                             " bench --suite meshing --quick --quiet --out out");
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  const nlohmann::json j = readJson("out/meshing.json");
+  ASSERT_EQ(j.size(), 2u);  // torus.obj at 8 and 16 cells
+  for (const nlohmann::json& row : j) {
+    EXPECT_EQ(row["model"], "torus.obj");
+    EXPECT_TRUE(row["valid"].get<bool>()) << row.dump();
+    EXPECT_TRUE(row["dg_passed"].get<bool>()) << row.dump();
+  }
+}
+
+TEST_F(BenchData, CopiedBinaryLooksInItsOwnShareFolderOrInData) {
+  // An installation's layout, PREFIX/bin/polydg beside PREFIX/share/polydg/.
+  fs::create_directories(dir_ / "bin");
+  fs::copy_file(POLYDG_BINARY, dir_ / "bin" / "polydg");
+  const std::string polydg = (dir_ / "bin" / "polydg").string() + " bench --suite meshing --quick";
+  const std::string expected = (dir_ / "share" / "polydg" / "torus.obj").string();
+  const Result missing = polydg::testing::runShell(polydg + " --out " + path("a"));
+  EXPECT_EQ(missing.exitCode, 2) << missing.out;
+  EXPECT_NE(missing.out.find(expected + " not found"), std::string::npos) << missing.out;
+  EXPECT_EQ(std::count(missing.out.begin(), missing.out.end(), '\n'), 1) << missing.out;
+
+  const Result data = polydg::testing::runShell(polydg + " --quiet --data " + POLYDG_TESTDATA_DIR +
+                                                " --out " + path("b"));
+  EXPECT_EQ(data.exitCode, 0) << data.out;
+  EXPECT_TRUE(fs::exists(dir_ / "b" / "meshing.json"));
+
+  fs::create_directories(dir_ / "share" / "polydg");
+  fs::copy_file(polydg::testing::testData("torus.obj"), expected);
+  const Result installed = polydg::testing::runShell(polydg + " --quiet --out " + path("c"));
+  EXPECT_EQ(installed.exitCode, 0) << installed.out;
+  EXPECT_TRUE(fs::exists(dir_ / "c" / "meshing.json"));
+}
+
+}  // namespace
+}  // namespace polydg::bench

@@ -1,0 +1,171 @@
+// Tests of mesh/point_groups.h: one point per vertex and group of elements joined through
+// interior faces at that vertex.
+#include "polydg/mesh/point_groups.h"
+
+#include <algorithm>
+#include <array>
+#include <map>
+#include <set>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "polydg/mesh/primitives.h"
+
+namespace polydg {
+namespace {
+
+/// Unit cubes at integer positions on shared vertex ids. Faces between two cubes are shared
+/// (Interior) unless the pair is listed in `cuts`, where each cube gets its own Cut face.
+class CubeBuilder {
+ public:
+  using Cell = std::array<int, 3>;
+
+  explicit CubeBuilder(std::set<std::pair<Cell, Cell>> cuts = {}) : cuts_(std::move(cuts)) {}
+
+  VertexId vertex(int x, int y, int z) {
+    const auto [it, added] = index_.try_emplace({x, y, z});
+    if (added) it->second = mesh_.addVertex(Vec3(x, y, z));
+    return it->second;
+  }
+
+  void cube(const Cell& c, const std::set<Cell>& cells) {
+    const auto [x, y, z] = c;
+    auto v = [&](int i, int j, int k) { return vertex(x + i, y + j, z + k); };
+    // Outward faces, each with the neighbour across it.
+    const std::vector<std::pair<Loop, Cell>> faces{
+        {{v(0, 0, 0), v(0, 0, 1), v(0, 1, 1), v(0, 1, 0)}, {x - 1, y, z}},
+        {{v(1, 0, 0), v(1, 1, 0), v(1, 1, 1), v(1, 0, 1)}, {x + 1, y, z}},
+        {{v(0, 0, 0), v(1, 0, 0), v(1, 0, 1), v(0, 0, 1)}, {x, y - 1, z}},
+        {{v(0, 1, 0), v(0, 1, 1), v(1, 1, 1), v(1, 1, 0)}, {x, y + 1, z}},
+        {{v(0, 0, 0), v(0, 1, 0), v(1, 1, 0), v(1, 0, 0)}, {x, y, z - 1}},
+        {{v(0, 0, 1), v(1, 0, 1), v(1, 1, 1), v(0, 1, 1)}, {x, y, z + 1}}};
+    std::vector<std::vector<Loop>> boundary;
+    std::vector<FaceOrigin> origins;
+    for (const auto& [loop, neighbour] : faces) {
+      boundary.push_back({loop});
+      const bool cut = cuts_.contains({c, neighbour}) || cuts_.contains({neighbour, c});
+      origins.push_back(cells.contains(neighbour) && !cut ? FaceOrigin::Interior : FaceOrigin::Cut);
+    }
+    mesh_.addElement(boundary, origins);
+  }
+
+  /// The mesh of `cells`, in the given order.
+  PolyMesh build(const std::vector<Cell>& cells) {
+    const std::set<Cell> all(cells.begin(), cells.end());
+    for (const Cell& c : cells) cube(c, all);
+    return std::move(mesh_);
+  }
+
+ private:
+  std::set<std::pair<Cell, Cell>> cuts_;
+  std::map<std::array<int, 3>, VertexId> index_;
+  PolyMesh mesh_;
+};
+
+/// Each element's distinct vertices in order of first appearance in its faces' loops.
+ElementCorners cornersOf(const PolyMesh& mesh) {
+  ElementCorners corners;
+  corners.begin.push_back(0);
+  for (const Element& element : mesh.elements()) {
+    const std::size_t first = corners.vertices.size();
+    for (const FaceUse& use : element.faces)
+      for (VertexId v : mesh.face(use.face).vertices)
+        if (std::find(corners.vertices.begin() + static_cast<std::ptrdiff_t>(first),
+                      corners.vertices.end(), v) == corners.vertices.end())
+          corners.vertices.push_back(v);
+    corners.begin.push_back(corners.vertices.size());
+  }
+  return corners;
+}
+
+/// The invariants of any grouping: points stand for the vertices their corners are at; the
+/// first numVertices() points are the vertices; across an interior face, both elements' corners
+/// at each of its vertices are one point.
+void expectConsistent(const PolyMesh& mesh, const ElementCorners& corners,
+                      const PointGroups& groups) {
+  ASSERT_EQ(groups.cornerPoint.size(), corners.vertices.size());
+  ASSERT_GE(groups.numPoints(), mesh.numVertices());
+  for (std::size_t v = 0; v < mesh.numVertices(); ++v)
+    EXPECT_EQ(groups.pointVertex[v], VertexId(v));
+  for (std::size_t i = 0; i < corners.vertices.size(); ++i) {
+    ASSERT_LT(groups.cornerPoint[i], groups.numPoints());
+    EXPECT_EQ(groups.pointVertex[groups.cornerPoint[i]], corners.vertices[i]) << "corner " << i;
+  }
+  for (const Face& face : mesh.faces())
+    if (!face.isBoundary()) {
+      for (VertexId v : face.vertices)
+        EXPECT_EQ(groups.cornerPoint[corners.find(face.front, v)],
+                  groups.cornerPoint[corners.find(face.back, v)]);
+    }
+}
+
+TEST(PointGroups, JoinedElementsShareEveryPoint) {
+  const PolyMesh mesh = hexGridMesh(3, 2, 2, Box3(Vec3(0, 0, 0), Vec3(3, 2, 2)));
+  const ElementCorners corners = cornersOf(mesh);
+  const PointGroups groups = groupPoints(mesh, corners);
+  expectConsistent(mesh, corners, groups);
+  EXPECT_EQ(groups.numPoints(), mesh.numVertices());
+  for (std::size_t i = 0; i < corners.vertices.size(); ++i)
+    EXPECT_EQ(groups.cornerPoint[i], corners.vertices[i].value);
+}
+
+TEST(PointGroups, TheTwoSidesOfACutGetTheirOwnPoints) {
+  CubeBuilder builder({{{0, 0, 0}, {1, 0, 0}}});
+  const PolyMesh mesh = builder.build({{0, 0, 0}, {1, 0, 0}});
+  ASSERT_EQ(mesh.numVertices(), 12u);
+  const ElementCorners corners = cornersOf(mesh);
+  const PointGroups groups = groupPoints(mesh, corners);
+  expectConsistent(mesh, corners, groups);
+  // The four vertices at x = 1 are points of element 0; element 1 has copies 12 .. 15 of them,
+  // numbered in the order of its corners.
+  ASSERT_EQ(groups.numPoints(), 16u);
+  std::vector<VertexId> copied;
+  for (std::size_t i = corners.begin[1]; i < corners.begin[2]; ++i)
+    if (mesh.position(corners.vertices[i]).x() == 1.0) copied.push_back(corners.vertices[i]);
+  ASSERT_EQ(copied.size(), 4u);
+  for (std::size_t k = 0; k < 4; ++k) EXPECT_EQ(groups.pointVertex[12 + k], copied[k]);
+  for (std::size_t i = corners.begin[0]; i < corners.begin[1]; ++i)
+    EXPECT_EQ(groups.cornerPoint[i], corners.vertices[i].value);
+}
+
+TEST(PointGroups, AFiniteCutSharesPointsOnlyAlongItsFront) {
+  // 2 x 2 cubes, cut between (0, 0) and (1, 0): the cut's edge at x = 1, y = 1 is its front,
+  // where all four cubes stay joined through the other faces; its two corners at y = 0 split.
+  CubeBuilder builder({{{0, 0, 0}, {1, 0, 0}}});
+  const PolyMesh mesh = builder.build({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}});
+  ASSERT_EQ(mesh.numVertices(), 18u);
+  const ElementCorners corners = cornersOf(mesh);
+  const PointGroups groups = groupPoints(mesh, corners);
+  expectConsistent(mesh, corners, groups);
+  ASSERT_EQ(groups.numPoints(), 20u);
+  for (std::size_t p = 18; p < 20; ++p) {
+    const Vec3& x = mesh.position(groups.pointVertex[p]);
+    EXPECT_EQ(x.x(), 1.0);
+    EXPECT_EQ(x.y(), 0.0);
+  }
+}
+
+TEST(PointGroups, ElementsTouchingAtAnEdgeOnlyAreApart) {
+  // Two cubes on a diagonal share the edge x = y = 1 and nothing else.
+  CubeBuilder builder;
+  const PolyMesh mesh = builder.build({{0, 0, 0}, {1, 1, 0}});
+  ASSERT_EQ(mesh.numVertices(), 14u);
+  const ElementCorners corners = cornersOf(mesh);
+  const PointGroups groups = groupPoints(mesh, corners);
+  expectConsistent(mesh, corners, groups);
+  EXPECT_EQ(groups.numPoints(), 16u);
+}
+
+TEST(PointGroups, AVertexOfNoElementKeepsItsOwnPoint) {
+  PolyMesh mesh = hexGridMesh(1, 1, 1, Box3(Vec3(0, 0, 0), Vec3(1, 1, 1)));
+  const VertexId loose = mesh.addVertex(Vec3(5, 5, 5));
+  const ElementCorners corners = cornersOf(mesh);
+  const PointGroups groups = groupPoints(mesh, corners);
+  expectConsistent(mesh, corners, groups);
+  EXPECT_EQ(groups.numPoints(), 9u);
+  EXPECT_EQ(groups.pointVertex[loose.index()], loose);
+}
+
+}  // namespace
+}  // namespace polydg
