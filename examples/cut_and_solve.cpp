@@ -41,8 +41,8 @@ int main(int argc, char** argv) {
       std::cerr << "the new mesh failed its checks: " << meshed.failures().front() << '\n';
       return 1;
     }
-    std::cout << "meshed: " << model.mesh().numElements() << " elements, volume "
-              << model.volume() << " (surface " << meshed.meshing.inputVolume << ")\n";
+    std::cout << "meshed: " << model.mesh().numElements() << " elements, volume " << model.volume()
+              << " (surface " << meshed.meshing.inputVolume << ")\n";
 
     // 3. The cut: across the longest side, through the centre; the plus side is removed. The
     //    operation re-integrates only the faces it made and validates the region it touched.
@@ -68,8 +68,7 @@ int main(int argc, char** argv) {
       std::cerr << "check failed: " << check.failures().front() << '\n';
       return 1;
     }
-    std::cout << "check: valid, local patch test error " << check.local->maxPatchTestError
-              << '\n';
+    std::cout << "check: valid, local patch test error " << check.local->maxPatchTestError << '\n';
 
     // 5. The solve: clamped below the lowest tenth of the height, under gravity.
     const double z = box.min().z() + 0.1 * box.sizes().z();
@@ -87,7 +86,8 @@ int main(int argc, char** argv) {
     //    report has a JSON form (polydg/model/report_json.h), as the polydg commands write it.
     model.write(argv[2]);
     std::cout << "wrote " << argv[2] << "; faces integrated in all: " << model.facesIntegrated()
-              << "\n" << polydg::toJson(solved)["solver"].dump() << '\n';
+              << "\n"
+              << polydg::toJson(solved)["solver"].dump() << '\n';
     return 0;
   } catch (const polydg::Error& e) {  // bad input, or a check that failed
     std::cerr << "error: " << e.what() << '\n';

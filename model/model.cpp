@@ -38,6 +38,10 @@ struct Model::State {
   const MomentCache* currentMoments() const { return editor ? &editor->moments() : moments.get(); }
   MeshEditor& edit() {
     if (!editor) {
+      if (!(provenance.referenceVolume > 0.0))
+        throw InputError(
+            "the mesh's median element volume is not positive (inverted or flat "
+            "elements), so no sliver rule applies; run 'polydg check' on it");
       editor = std::make_unique<MeshEditor>(std::move(mesh), provenance.referenceVolume,
                                             std::move(moments));
       mesh = PolyMesh();
@@ -67,12 +71,9 @@ Model::Model(PolyMesh mesh, Provenance provenance) : state_(std::make_unique<Sta
   if (mesh.numElements() == 0)
     throw InputError("the mesh has no elements; there is nothing to model");
   if (!(provenance.referenceVolume > 0.0) || !std::isfinite(provenance.referenceVolume)) {
+    // Not positive for an inverted or flat mesh, which the checks report; edits refuse it.
     provenance.referenceVolume = medianElementVolume(mesh);
     provenance.referenceKind = ReferenceKind::MedianElement;
-    if (!(provenance.referenceVolume > 0.0))
-      throw InputError(
-          "the median element volume is not positive: the mesh is inverted or "
-          "flat; run 'polydg check' on it");
   }
   state_->provenance = std::move(provenance);
   state_->mesh = std::move(mesh);

@@ -27,7 +27,7 @@ class InverseOperator {
   Eigen::Index rows() const { return n_; }
   Eigen::Index cols() const { return n_; }
   void perform_op(const double* x, double* y) const {
-    SolveReport report;
+    LinearSolveReport report;
     Eigen::Map<Eigen::VectorXd>(y, n_) =
         solver_->solve(Eigen::Map<const Eigen::VectorXd>(x, n_), report);
     ++products;

@@ -10,7 +10,6 @@
 
 namespace polydg::bench {
 
-
 namespace {
 
 /// Grid sizes of the accuracy suite per degree (at least three each; two with --quick).

@@ -17,6 +17,7 @@
 #include "cli/bench/suites.h"
 #include "cli/commands.h"
 #include "polydg/model/files.h"
+#include "polydg/util/error.h"
 #include "polydg/util/stopwatch.h"
 
 namespace polydg::cli {

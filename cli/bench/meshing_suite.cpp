@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "cli/bench/meshing_benchmark.h"
-#include "polydg/model/files.h"
 #include "polydg/mesh/surface_io.h"
+#include "polydg/model/files.h"
 
 namespace polydg::bench {
 
@@ -21,8 +21,8 @@ SuiteOutput meshingSuite(const BenchOptions& o, bool quiet) {
   const std::string torusPath = (fs::path(o.dataDir) / "torus.obj").string();
   if (!fs::exists(torusPath))
     throw InputError(torusPath +
-                         " not found; pass the folder that holds polydg's bundled models "
-                         "(share/polydg of the build or installation) with --data");
+                     " not found; pass the folder that holds polydg's bundled models "
+                     "(share/polydg of the build or installation) with --data");
   std::vector<std::pair<std::string, TriangleSurface>> models;
   models.emplace_back("torus.obj", readSurface(torusPath));
   if (!o.quick) {

@@ -5,8 +5,8 @@
 #include <iostream>
 
 #include "cli/bench/csv.h"
-#include "polydg/model/names.h"
 #include "polydg/model/files.h"
+#include "polydg/model/names.h"
 
 namespace polydg::bench {
 

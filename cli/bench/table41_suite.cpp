@@ -10,7 +10,6 @@
 
 namespace polydg::bench {
 
-
 namespace {
 
 /// Runs of each B2 case; the table reports the fastest.

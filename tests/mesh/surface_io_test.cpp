@@ -5,8 +5,8 @@
 // (tests/mesh/surface_volume.py).
 #include "polydg/mesh/surface_io.h"
 #include "tests/support/assimp_models.h"
-#include "tests/support/temp_dir.h"
 #include "tests/support/packages.h"
+#include "tests/support/temp_dir.h"
 
 #include <gtest/gtest.h>
 
@@ -194,11 +194,12 @@ TEST(ReadSurface, WeldsBitwiseEqualCornersWithNegativeZeroAsZeroAndNothingCloser
   for (const Vec3& p : s.vertices)
     for (int i = 0; i < 3; ++i) EXPECT_FALSE(std::signbit(p[i])) << p.transpose();
 
-  // The same corners through assimp (an OBJ keyword CGAL does not know makes it the reader), in
-  // single precision: 1.0000000000000002 is 1.0f, so that corner welds too; -0 still welds to 0.
+  // The same corners through assimp (an unused homogeneous vertex with w != 1, which CGAL would
+  // misread, makes it the reader), in single precision: 1.0000000000000002 is 1.0f, so that
+  // corner welds too; -0 still welds to 0.
   SurfaceReadInfo single;
   const TriangleSurface t =
-      readSurface(dir.write("weld_rule_assimp.obj", corners + "bogus\n"), &single);
+      readSurface(dir.write("weld_rule_assimp.obj", corners + "v 5 5 5 2\n"), &single);
   EXPECT_EQ(single.reader, "assimp");
   ASSERT_EQ(t.vertices.size(), 3u);
   for (const Vec3& p : t.vertices)
