@@ -7,6 +7,7 @@
 #include <random>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -21,30 +22,55 @@ namespace polydg {
 namespace {
 
 constexpr std::uint64_t kSeed = 20261204;
-/// Cuts, each on a fresh copy of the sliced block (as `polydg cut b.vtu --plane ...` runs them).
+/// Cuts, each on a fresh copy of the sliced block (as `polydg cut b.vtu --plane ...` runs them),
+/// made in batches of kCutsPerBatch (one ctest entry each: full validation of every cut is
+/// most of the cost, ~2 s a cut on a loaded machine).
 constexpr int kCuts = 30;
+constexpr int kCutsPerBatch = 10;
 
-TEST(LocalValidation, AgreesWithFullOnRandomCutsThroughSwissCheese) {
-  std::printf("seed %llu\n", static_cast<unsigned long long>(kSeed));
-  MeshingOptions meshing;
-  meshing.cellsAlongLongest = 16;
-  const CheeseWalls walls =
-      testing::cheeseWallsOffGrid(Box3(Vec3::Zero(), Vec3(11, 10, 3)), meshing.cellsAlongLongest);
-  const MeshingResult block = meshSurface(swissCheeseBlock(walls), meshing);
-  ASSERT_TRUE(block.report.validation.passed);
-  const Box3 box = meshBounds(block.mesh);
+/// The cheese of the test, meshed once: 35 crossing holes, 16 cells along x.
+const MeshingResult& cheeseBlock() {
+  static const MeshingResult block = [] {
+    MeshingOptions meshing;
+    meshing.cellsAlongLongest = 16;
+    const CheeseWalls walls =
+        testing::cheeseWallsOffGrid(Box3(Vec3::Zero(), Vec3(11, 10, 3)), meshing.cellsAlongLongest);
+    return meshSurface(swissCheeseBlock(walls), meshing);
+  }();
+  return block;
+}
 
+/// The kCuts blades: a uniform point of the block's bounding box and a normal uniform in
+/// [-1, 1]^3, from kSeed.
+std::vector<Blade> randomBlades(const Box3& box) {
   std::mt19937_64 rng(kSeed);
   std::uniform_real_distribution<double> unit(0.0, 1.0), component(-1.0, 1.0);
-  int localFailures = 0, fullFailures = 0;
-  std::size_t split = 0, regionElements = 0, regionComponents = 0;
-  double localSeconds = 0.0, fullSeconds = 0.0;
-  const Stopwatch start;
+  std::vector<Blade> blades;
   for (int i = 0; i < kCuts; ++i) {
     const Vec3 p = box.min() + Vec3(unit(rng), unit(rng), unit(rng)).cwiseProduct(box.sizes());
     Vec3 n(component(rng), component(rng), component(rng));
     if (n.squaredNorm() == 0.0) n = Vec3::UnitX();
-    const Blade blade = Blade::plane(n, n.dot(p));
+    blades.push_back(Blade::plane(n, n.dot(p)));
+  }
+  return blades;
+}
+
+class LocalValidation : public ::testing::TestWithParam<int> {};
+
+TEST_P(LocalValidation, AgreesWithFullOnRandomCutsThroughSwissCheese) {
+  std::printf("seed %llu\n", static_cast<unsigned long long>(kSeed));
+  const MeshingResult& block = cheeseBlock();
+  ASSERT_TRUE(block.report.validation.passed);
+  const std::vector<Blade> blades = randomBlades(meshBounds(block.mesh));
+
+  int localFailures = 0, fullFailures = 0;
+  std::size_t split = 0, regionElements = 0, regionComponents = 0;
+  double localSeconds = 0.0, fullSeconds = 0.0;
+  const Stopwatch start;
+  const int first = GetParam() * kCutsPerBatch;
+  for (int i = first; i < first + kCutsPerBatch; ++i) {
+    const Blade& blade = blades[i];
+    const Vec3& n = blade.normal;
     std::ostringstream where;
     where.precision(17);
     where << "cut " << i << " (seed " << kSeed << "), --plane " << n.x() << "," << n.y() << ","
@@ -72,12 +98,14 @@ TEST(LocalValidation, AgreesWithFullOnRandomCutsThroughSwissCheese) {
     EXPECT_TRUE(l.validation.passed) << where.str() << ": " << l.validation.failure;
   }
   std::printf(
-      "%d cuts through %zu elements in %.1f s (cuts validated local %.1f s, full %.1f s): %zu "
+      "cuts %d-%d through %zu elements in %.1f s (cuts validated local %.1f s, full %.1f s): %zu "
       "elements split, regions of %zu elements in %zu components (summed); local failed %d, "
       "full failed %d\n",
-      kCuts, block.mesh.numElements(), start.seconds(), localSeconds, fullSeconds, split,
-      regionElements, regionComponents, localFailures, fullFailures);
+      first, first + kCutsPerBatch - 1, block.mesh.numElements(), start.seconds(), localSeconds,
+      fullSeconds, split, regionElements, regionComponents, localFailures, fullFailures);
 }
+
+INSTANTIATE_TEST_SUITE_P(Batches, LocalValidation, ::testing::Range(0, kCuts / kCutsPerBatch));
 
 }  // namespace
 }  // namespace polydg
