@@ -921,7 +921,10 @@ void validateOperation(const PolyMesh& mesh, const MomentCache& moments,
     if (members.empty()) return;
     LocalDgCheckOptions options;
     options.basis.degree = degree;
-    const RegionDgCheck dg = regionDgChecks(mesh, moments, region, options);
+    // Elements the region holds only through faces too narrow to hold their rotations count as
+    // bodies of their own: what holds them is the rest of the mesh, outside the region.
+    const RegionDgCheck dg =
+        regionDgChecks(mesh, moments, region, options, RegionCoupling::HoldingFaces);
     for (ElementId e : members) region[e.index()] = 0;
     v.regionElements = dg.elements;
     v.regionComponents = dg.components;

@@ -1,5 +1,6 @@
 #include "polydg/mesh/surface_shapes.h"
 
+#include <array>
 #include <cmath>
 #include <map>
 #include <numbers>
@@ -143,6 +144,102 @@ TriangleSurface boxSurface(const Box3& box) {
     s.triangles.push_back({q[0], q[2], q[3]});
   }
   return s;
+}
+
+namespace {
+/// Hole rows of swissCheeseBlock() along an axis with n cells.
+bool isHoleRow(int i, int n) { return i % 3 == 1 && i + 1 < n; }
+
+/// The cells along each axis; throws for fewer than 3 or walls not increasing.
+std::array<int, 3> cheeseCells(const CheeseWalls& walls) {
+  std::array<int, 3> cells{};
+  for (int a = 0; a < 3; ++a) {
+    if (walls[a].size() < 4)
+      throw std::invalid_argument("swissCheeseBlock: at least 3 cells along each axis");
+    for (std::size_t i = 1; i < walls[a].size(); ++i)
+      if (!(walls[a][i - 1] < walls[a][i]))
+        throw std::invalid_argument("swissCheeseBlock: the walls must be increasing");
+    cells[a] = static_cast<int>(walls[a].size()) - 1;
+  }
+  return cells;
+}
+
+/// True if cell c of swissCheeseBlock() is kept (false outside the block).
+bool isKeptCell(const std::array<int, 3>& c, const std::array<int, 3>& cells) {
+  int holes = 0;
+  for (int a = 0; a < 3; ++a) {
+    if (c[a] < 0 || c[a] >= cells[a]) return false;
+    holes += isHoleRow(c[a], cells[a]);
+  }
+  return holes < 2;
+}
+}  // namespace
+
+CheeseWalls uniformCheeseWalls(const Box3& box, const std::array<int, 3>& cells) {
+  CheeseWalls walls;
+  for (int a = 0; a < 3; ++a)
+    for (int i = 0; i <= cells[a]; ++i)
+      walls[a].push_back(box.min()[a] + box.sizes()[a] * i / cells[a]);
+  return walls;
+}
+
+double swissCheeseVolume(const CheeseWalls& walls) {
+  const std::array<int, 3> cells = cheeseCells(walls);
+  double volume = 0.0;
+  std::array<int, 3> c;
+  for (c[2] = 0; c[2] < cells[2]; ++c[2])
+    for (c[1] = 0; c[1] < cells[1]; ++c[1])
+      for (c[0] = 0; c[0] < cells[0]; ++c[0])
+        if (isKeptCell(c, cells))
+          volume += (walls[0][c[0] + 1] - walls[0][c[0]]) * (walls[1][c[1] + 1] - walls[1][c[1]]) *
+                    (walls[2][c[2] + 1] - walls[2][c[2]]);
+  return volume;
+}
+
+TriangleSurface swissCheeseBlock(const CheeseWalls& walls) {
+  const std::array<int, 3> cells = cheeseCells(walls);
+  // Wall crossings by their indices, created when first used.
+  TriangleSurface s;
+  std::map<std::array<int, 3>, std::uint32_t> ids;
+  const auto point = [&](const std::array<int, 3>& g) {
+    auto [it, inserted] = ids.try_emplace(g, 0);
+    if (inserted) {
+      s.vertices.emplace_back(walls[0][g[0]], walls[1][g[1]], walls[2][g[2]]);
+      it->second = static_cast<std::uint32_t>(s.vertices.size() - 1);
+    }
+    return it->second;
+  };
+  std::array<int, 3> c;
+  for (c[2] = 0; c[2] < cells[2]; ++c[2])
+    for (c[1] = 0; c[1] < cells[1]; ++c[1])
+      for (c[0] = 0; c[0] < cells[0]; ++c[0]) {
+        if (!isKeptCell(c, cells)) continue;
+        for (int a = 0; a < 3; ++a)
+          for (int side = 0; side < 2; ++side) {
+            std::array<int, 3> next = c;
+            next[a] += side ? 1 : -1;
+            if (isKeptCell(next, cells)) continue;
+            // The side's corners, counter-clockwise seen from outside (normal +-e_a).
+            const int b = (a + 1) % 3, d = (a + 2) % 3;
+            std::array<int, 3> g = c;
+            g[a] += side;
+            std::array<std::array<int, 3>, 4> corners{g, g, g, g};
+            corners[1][b] += 1;
+            corners[2][b] += 1;
+            corners[2][d] += 1;
+            corners[3][d] += 1;
+            if (!side) std::swap(corners[1], corners[3]);
+            const std::uint32_t q0 = point(corners[0]), q1 = point(corners[1]),
+                                q2 = point(corners[2]), q3 = point(corners[3]);
+            s.triangles.push_back({q0, q1, q2});
+            s.triangles.push_back({q0, q2, q3});
+          }
+      }
+  return s;
+}
+
+TriangleSurface swissCheeseBlock(const Box3& box, const std::array<int, 3>& cells) {
+  return swissCheeseBlock(uniformCheeseWalls(box, cells));
 }
 
 TriangleSurface combine(const TriangleSurface& a, const TriangleSurface& b) {

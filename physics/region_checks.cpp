@@ -14,7 +14,9 @@
 #include "polydg/physics/face_quadrature.h"
 #include "polydg/physics/linear_solver.h"
 #include "polydg/physics/post_process.h"
+#include "polydg/physics/validation.h"
 #include "polydg/util/stopwatch.h"
+#include "polydg/util/union_find.h"
 
 namespace polydg {
 
@@ -145,41 +147,178 @@ double regionPenalty(const PolyMesh& mesh, const SubMesh& sub, const DgBasis& ba
   return eta;
 }
 
-/// The region's stiffness with every face to the outside and every boundary face free: element
-/// terms and the interior faces between two of its elements (all of `sub`'s shared faces).
-SpMat freeRegionStiffness(const SubMesh& sub, const DgBasis& basis, const MomentCache& moments,
-                          const FormCoefficients& form) {
+/// The region's stiffness with every face to the outside and every boundary face free, and the
+/// graph it couples: block i is element i of `sub`, component[i] its component.
+struct RegionStiffness {
+  SpMat matrix;
+  std::vector<std::uint32_t> component;
+  std::size_t components = 0;
+  FaceData<char> joins;  ///< by face of `sub`: its terms are in `matrix`
+  std::size_t looseFaces = 0;
+};
+
+/// The IP terms of the face that element e uses as `use`, shared with `other` (faceRows()' self
+/// and other blocks); every face between two elements of `mesh` has face terms.
+void interiorFaceRows(const PolyMesh& mesh, const DgBasis& basis, const MomentCache& moments,
+                      const FormCoefficients& form, const std::vector<int>& coupled, ElementId e,
+                      const FaceUse& use, ElementId other, Eigen::MatrixXd& selfBlock,
+                      Eigen::MatrixXd& otherBlock) {
+  const FaceView view{.face = use.face,
+                      .kind = FaceKind::Interior,
+                      .self = e,
+                      .other = other,
+                      .selfIsFront = !use.reversed,
+                      .selfCoupledFaces = coupled[e.index()],
+                      .otherCoupledFaces = coupled[other.index()]};
+  faceRows(mesh, basis, moments, view, form, selfBlock, otherBlock);
+}
+
+/// The region's stiffness (`sub` holds the region only): element terms and the terms of the
+/// faces between two of its elements that `coupling` keeps; its components are the elements
+/// joined through exactly those faces. With HoldingFaces, a face is kept when it is not
+/// `released` and the two elements' rows through it alone (element terms and its face terms),
+/// scaled as the region's matrix with every face is scaled, have at most 6 eigenvalues below
+/// kZeroModeThreshold.
+RegionStiffness freeRegionStiffness(const SubMesh& sub, const DgBasis& basis,
+                                    const MomentCache& moments, const FormCoefficients& form,
+                                    RegionCoupling coupling, const FaceData<char>& released) {
   const PolyMesh& mesh = sub.mesh();
   const std::size_t n = sub.size();
+  const int bs = 3 * basis.size();
+  const bool holding = coupling == RegionCoupling::HoldingFaces;
+  // Every face between two elements of the region has face terms (the counts c_K of faceRows()).
   std::vector<int> coupled(n, 0);
   for (std::size_t i = 0; i < n; ++i)
     for (const FaceUse& use : mesh.element(ElementId(i)).faces)
       coupled[i] += across(mesh, use.face, ElementId(i)).valid();
-  Triplets triplets;
+
+  // HoldingFaces: the element terms and the Jacobi scaling of the matrix with every face.
+  std::vector<Eigen::MatrixXd> stiffness;
+  Eigen::VectorXd scale;
   Eigen::MatrixXd block, selfBlock, otherBlock;
+  if (holding) {
+    stiffness.resize(n);
+    Eigen::VectorXd diagonal(static_cast<Eigen::Index>(n) * bs);
+    for (std::size_t i = 0; i < n; ++i) {
+      const ElementId e(i);
+      elementStiffness(basis, moments, e, form.mu, form.lambda, stiffness[i]);
+      auto d = diagonal.segment(static_cast<Eigen::Index>(i) * bs, bs);
+      d = stiffness[i].diagonal();
+      for (const FaceUse& use : mesh.element(e).faces) {
+        const ElementId other = across(mesh, use.face, e);
+        if (!other.valid()) continue;
+        interiorFaceRows(mesh, basis, moments, form, coupled, e, use, other, selfBlock, otherBlock);
+        d += selfBlock.diagonal();
+      }
+    }
+    scale = zeroModeScaling(diagonal, bs);
+  }
+
+  // Each face between two elements once (from its front element): its terms, if it joins them.
+  RegionStiffness out;
+  out.joins = FaceData<char>(mesh.numFaces(), 0);
+  Triplets triplets;
+  UnionFind sets(n);
+  Eigen::MatrixXd backSelf, backOther, pair(2 * bs, 2 * bs);
+  Eigen::VectorXd pairScale(2 * bs);
   for (std::size_t i = 0; i < n; ++i) {
     const ElementId e(i);
-    elementStiffness(basis, moments, e, form.mu, form.lambda, block);
-    addBlock(triplets, i, i, block);
+    if (holding) {
+      addBlock(triplets, i, i, stiffness[i]);
+    } else {
+      elementStiffness(basis, moments, e, form.mu, form.lambda, block);
+      addBlock(triplets, i, i, block);
+    }
     for (const FaceUse& use : mesh.element(e).faces) {
       const ElementId other = across(mesh, use.face, e);
-      if (!other.valid()) continue;
-      const FaceView view{.face = use.face,
-                          .kind = FaceKind::Interior,
-                          .self = e,
-                          .other = other,
-                          .selfIsFront = !use.reversed,
-                          .selfCoupledFaces = coupled[i],
-                          .otherCoupledFaces = coupled[other.index()]};
-      faceRows(mesh, basis, moments, view, form, selfBlock, otherBlock);
+      if (!other.valid() || use.reversed) continue;
+      if (holding && released[use.face]) {
+        ++out.looseFaces;
+        continue;
+      }
+      interiorFaceRows(mesh, basis, moments, form, coupled, e, use, other, selfBlock, otherBlock);
+      interiorFaceRows(mesh, basis, moments, form, coupled, other, {use.face, true}, e, backSelf,
+                       backOther);
+      if (holding) {
+        pair << stiffness[i] + selfBlock, otherBlock, backOther,
+            stiffness[other.index()] + backSelf;
+        pairScale << scale.segment(static_cast<Eigen::Index>(i) * bs, bs),
+            scale.segment(static_cast<Eigen::Index>(other.index()) * bs, bs);
+        if (countZeroModes(pair, pairScale) > 6) {
+          ++out.looseFaces;
+          continue;
+        }
+      }
       addBlock(triplets, i, i, selfBlock);
       addBlock(triplets, i, other.index(), otherBlock);
+      addBlock(triplets, other.index(), other.index(), backSelf);
+      addBlock(triplets, other.index(), i, backOther);
+      sets.unite(static_cast<std::uint32_t>(i), other.value);
+      out.joins[use.face] = 1;
     }
   }
-  const auto dofs = static_cast<int>(n * 3 * basis.size());
-  SpMat k(dofs, dofs);
-  k.setFromTriplets(triplets.begin(), triplets.end());
-  return k;
+  out.components = sets.labels(out.component);
+  const auto dofs = static_cast<int>(n) * bs;
+  out.matrix = SpMat(dofs, dofs);
+  out.matrix.setFromTriplets(triplets.begin(), triplets.end());
+  return out;
+}
+
+/// Zero modes beyond one rigid body's 6, summed over the components.
+std::size_t surplusZeroModes(const ZeroModeReport& modes) {
+  std::size_t surplus = 0;
+  for (std::size_t m : modes.zeroModesPerComponent) surplus += m > 6 ? m - 6 : 0;
+  return surplus;
+}
+
+/// For each component of `k` with more than 6 zero modes, the joined face across which its zero
+/// modes slip most: fitted per element to rigid motions (6 x modes coefficients A_K, by least
+/// squares), the face with the largest |A_K - A_L|^2 / (|A_K|^2 + |A_L|^2). A component whose
+/// zero modes are one rigid motion has A_K = A_L across every face.
+std::vector<FaceId> mostSlippingFaces(const SubMesh& sub, const DgBasis& basis,
+                                      const RegionStiffness& k, const ZeroModeReport& modes,
+                                      const std::vector<Eigen::MatrixXd>& kernels) {
+  const PolyMesh& mesh = sub.mesh();
+  const Eigen::Index bs = 3 * basis.size();
+  const Box3 box = meshBounds(mesh);
+  const double length = std::max(box.diagonal().norm(), 1e-300);
+  // Each element's rows in its component's kernel, and its fitted rigid motions.
+  std::vector<Eigen::Index> row(sub.size());
+  std::vector<Eigen::Index> rows(k.components, 0);
+  for (std::size_t i = 0; i < sub.size(); ++i) {
+    row[i] = rows[k.component[i]];
+    rows[k.component[i]] += bs;
+  }
+  std::vector<Eigen::MatrixXd> fitted(sub.size());
+  auto fit = [&](std::size_t i) -> const Eigen::MatrixXd& {
+    if (fitted[i].size() == 0) {
+      const Eigen::MatrixXd r = rigidMotionCoefficients(basis, ElementId(i), box.center(), length);
+      fitted[i] = r.colPivHouseholderQr().solve(kernels[k.component[i]].middleRows(row[i], bs));
+    }
+    return fitted[i];
+  };
+  std::vector<FaceId> worst(k.components);
+  std::vector<double> slip(k.components, -1.0);
+  for (std::size_t i = 0; i < sub.size(); ++i) {
+    const std::uint32_t c = k.component[i];
+    if (modes.zeroModesPerComponent[c] <= 6) continue;
+    for (const FaceUse& use : mesh.element(ElementId(i)).faces) {
+      if (!k.joins[use.face] || use.reversed) continue;
+      const ElementId other = across(mesh, use.face, ElementId(i));
+      const Eigen::MatrixXd& a = fit(i);
+      const Eigen::MatrixXd& b = fit(other.index());
+      const double norm = a.squaredNorm() + b.squaredNorm();
+      const double s = norm > 0.0 ? (a - b).squaredNorm() / norm : 0.0;
+      if (s > slip[c]) {
+        slip[c] = s;
+        worst[c] = use.face;
+      }
+    }
+  }
+  std::vector<FaceId> out;
+  for (FaceId f : worst)
+    if (f.valid()) out.push_back(f);
+  return out;
 }
 
 /// int_F phi_i for element e's functions, by face quadrature exact to the basis degree.
@@ -275,7 +414,8 @@ double regionPatchTest(const SubMesh& sub, std::size_t regionSize, const DgBasis
 }  // namespace
 
 RegionDgCheck regionDgChecks(const PolyMesh& mesh, const MomentCache& moments,
-                             std::span<const char> region, const LocalDgCheckOptions& options) {
+                             std::span<const char> region, const LocalDgCheckOptions& options,
+                             RegionCoupling coupling) {
   const Stopwatch start;
   options.material.check();
   if (region.size() != mesh.numElements())
@@ -307,8 +447,28 @@ RegionDgCheck regionDgChecks(const PolyMesh& mesh, const MomentCache& moments,
   {
     const DgBasis basis(sub.mesh(), fresh, options.basis);
     form.eta = regionPenalty(mesh, sub, basis, fresh);
-    const ZeroModeReport modes =
-        zeroModes(sub.mesh(), basis, fresh, freeRegionStiffness(sub, basis, fresh, form));
+    const int bs = 3 * basis.size();
+    FaceData<char> released(sub.mesh().numFaces(), 0);
+    RegionStiffness k = freeRegionStiffness(sub, basis, fresh, form, coupling, released);
+    ZeroModeReport modes = zeroModes(k.matrix, bs, k.component, k.components);
+    // HoldingFaces: a face that holds its two elements alone may not hold the groups it joins
+    // (a strip holds one element's rotation about it but not a group's, whose inertia about it
+    // is larger). While a component has more than one body's zero modes, release the face its
+    // zero modes slip across most (counted again for their eigenvectors), as long as that
+    // lowers their surplus.
+    while (coupling == RegionCoupling::HoldingFaces && surplusZeroModes(modes) > 0) {
+      std::vector<Eigen::MatrixXd> kernels;
+      zeroModes(k.matrix, bs, k.component, k.components, &kernels);
+      FaceData<char> trial = released;
+      for (FaceId f : mostSlippingFaces(sub, basis, k, modes, kernels)) trial[f] = 1;
+      RegionStiffness k2 = freeRegionStiffness(sub, basis, fresh, form, coupling, trial);
+      ZeroModeReport modes2 = zeroModes(k2.matrix, bs, k2.component, k2.components);
+      if (surplusZeroModes(modes2) >= surplusZeroModes(modes)) break;
+      released = std::move(trial);
+      k = std::move(k2);
+      modes = std::move(modes2);
+    }
+    c.looseFaces = k.looseFaces;
     c.components = modes.components;
     c.zeroModesPerComponent = modes.zeroModesPerComponent;
     c.zeroModes = modes.zeroModes;

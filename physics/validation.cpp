@@ -6,6 +6,8 @@
 #include <limits>
 #include <random>
 #include <span>
+#include <stdexcept>
+#include <string>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -72,10 +74,29 @@ StaticOptions staticOptions(const PhysicsCheckOptions& o) {
   return s;
 }
 
-/// Smallest eigenvalues (ascending) of the symmetric matrix s.
-Eigen::VectorXd smallestEigenvalues(const SpMat& s) {
+/// The rigid motion d of zeroModes(): the translation e_d (d < 3), or the rotation
+/// e_(d-3) x (x - centre) / length.
+LinearField rigidField(int d, const Vec3& centre, double length) {
+  LinearField field;
+  field.x0 = centre;
+  if (d < 3) {
+    field.b[d] = 1.0;
+  } else {
+    Vec3 axis = Vec3::Zero();
+    axis[d - 3] = 1.0;
+    field.a << 0.0, -axis.z(), axis.y(), axis.z(), 0.0, -axis.x(), -axis.y(), axis.x(), 0.0;
+    field.a /= length;  // a v = axis x v / length
+  }
+  return field;
+}
+
+/// Smallest eigenvalues (ascending) of the symmetric matrix s, and their eigenvectors in the
+/// columns of `vectors` if not null.
+Eigen::VectorXd smallestEigenvalues(const SpMat& s, Eigen::MatrixXd* vectors = nullptr) {
+  const auto options = vectors ? Eigen::ComputeEigenvectors : Eigen::EigenvaluesOnly;
   if (s.rows() <= kDenseLimit) {
-    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(Eigen::MatrixXd(s), Eigen::EigenvaluesOnly);
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(Eigen::MatrixXd(s), options);
+    if (vectors) *vectors = eig.eigenvectors();
     return eig.eigenvalues();
   }
   SpMat shifted = s;
@@ -94,8 +115,8 @@ Eigen::VectorXd smallestEigenvalues(const SpMat& s) {
     x = qr.householderQ() * Eigen::MatrixXd::Identity(s.rows(), k);
   }
   const Eigen::MatrixXd h = x.transpose() * (s * x);
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(0.5 * (h + h.transpose()),
-                                                     Eigen::EigenvaluesOnly);
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(0.5 * (h + h.transpose()), options);
+  if (vectors) *vectors = x * eig.eigenvectors();  // the Ritz vectors
   return eig.eigenvalues();
 }
 
@@ -142,67 +163,53 @@ PatchTestResult patchTest(const PolyMesh& mesh, const PhysicsCheckOptions& optio
   return r;
 }
 
-ZeroModeReport zeroModes(const PolyMesh& mesh, const DgBasis& basis, const MomentCache& moments,
-                         const SpMat& matrix) {
+namespace {
+
+/// zeroModes() with the component of each block given; the vectors `rigid` (over all DOFs, or
+/// none) must be in each component's kernel.
+ZeroModeReport zeroModesOfComponents(const SpMat& matrix, int bs,
+                                     std::span<const std::uint32_t> component, std::size_t count,
+                                     std::span<const Eigen::VectorXd> rigid,
+                                     std::vector<Eigen::MatrixXd>* kernels) {
+  const Eigen::Index blocks = matrix.rows() / bs;
+  if (matrix.rows() != matrix.cols() || blocks * bs != matrix.rows() ||
+      static_cast<Eigen::Index>(component.size()) != blocks)
+    throw std::invalid_argument("zeroModes: one component per block of a square matrix");
+  // The components are the matrix's decoupled blocks: every entry stays within one. Each
+  // component's DOFs, and each DOF's place among them.
+  std::vector<std::vector<int>> dofs(count);
+  std::vector<int> local(matrix.rows(), -1);
+  for (Eigen::Index b = 0; b < blocks; ++b) {
+    if (component[b] >= count) throw std::invalid_argument("zeroModes: component out of range");
+    for (int k = 0; k < bs; ++k) {
+      local[b * bs + k] = static_cast<int>(dofs[component[b]].size());
+      dofs[component[b]].push_back(static_cast<int>(b * bs + k));
+    }
+  }
+  for (Eigen::Index col = 0; col < matrix.outerSize(); ++col)
+    for (SpMat::InnerIterator it(matrix, col); it; ++it)
+      if (component[it.row() / bs] != component[col / bs])
+        throw std::invalid_argument("zeroModes: the matrix couples blocks " +
+                                    std::to_string(it.row() / bs) + " and " +
+                                    std::to_string(col / bs) + " of different components");
+
   ZeroModeReport report;
-  std::size_t count = 0;
-  const ElementData<std::uint32_t> component = connectedComponents(mesh, count);
   report.components = count;
   report.zeroModesPerComponent.assign(count, 0);
   report.smallestNonzeroEigenvalue = std::numeric_limits<double>::infinity();
-  const int bs = 3 * basis.size();
-  // Jacobi scaling; a zero diagonal (the constant functions of an element without coupled
-  // faces) takes its element block's mean diagonal, which keeps the scaling scale-free.
-  const Eigen::VectorXd diagonal = matrix.diagonal();
-  Eigen::VectorXd scale(diagonal.size());
-  for (Eigen::Index b = 0; b < diagonal.size() / bs; ++b) {
-    const auto block = diagonal.segment(b * bs, bs);
-    const double mean = block.cwiseMax(0.0).mean();
-    for (int k = 0; k < bs; ++k) {
-      const double d = block[k] > 0.0 ? block[k] : mean;
-      scale[b * bs + k] = d > 0.0 ? 1.0 / std::sqrt(d) : 1.0;
-    }
-  }
-
-  // Rigid motions as coefficients: translations e_d and rotations e_d x (x - c) / length.
-  const Vec3 c = meshBounds(mesh).center();
-  const double length = std::max(meshBounds(mesh).diagonal().norm(), 1e-300);
-  std::vector<Eigen::VectorXd> rigid;
-  for (int d = 0; d < 6; ++d) {
-    LinearField field;
-    field.x0 = c;
-    if (d < 3) {
-      field.b[d] = 1.0;
-    } else {
-      Vec3 axis = Vec3::Zero();
-      axis[d - 3] = 1.0;
-      field.a << 0.0, -axis.z(), axis.y(), axis.z(), 0.0, -axis.x(), -axis.y(), axis.x(), 0.0;
-      field.a /= length;  // a v = axis x v / length
-    }
-    Eigen::VectorXd r(static_cast<Eigen::Index>(mesh.numElements()) * bs);
-    for (std::size_t i = 0; i < mesh.numElements(); ++i)
-      linearFieldCoefficients(basis, ElementId(i), field,
-                              {r.data() + i * bs, static_cast<std::size_t>(bs)});
-    rigid.push_back(std::move(r));
-  }
-
+  const Eigen::VectorXd scale = zeroModeScaling(matrix.diagonal(), bs);
+  if (kernels) kernels->assign(count, Eigen::MatrixXd());
+  Eigen::MatrixXd vectors;
   for (std::size_t comp = 0; comp < count; ++comp) {
-    std::vector<int> dofs;
-    for (std::size_t i = 0; i < mesh.numElements(); ++i)
-      if (component[ElementId(i)] == comp)
-        for (int k = 0; k < bs; ++k) dofs.push_back(static_cast<int>(i * bs + k));
-    std::vector<int> local(matrix.rows(), -1);
-    for (std::size_t k = 0; k < dofs.size(); ++k) local[dofs[k]] = static_cast<int>(k);
     std::vector<Eigen::Triplet<double>> triplets;
-    for (int col : dofs)
+    for (int col : dofs[comp])
       for (SpMat::InnerIterator it(matrix, col); it; ++it)
-        if (local[it.row()] >= 0)
-          triplets.emplace_back(local[it.row()], local[col],
-                                it.value() * scale[it.row()] * scale[col]);
-    const auto m = static_cast<int>(dofs.size());
+        triplets.emplace_back(local[it.row()], local[col],
+                              it.value() * scale[it.row()] * scale[col]);
+    const auto m = static_cast<int>(dofs[comp].size());
     SpMat s(m, m);
     s.setFromTriplets(triplets.begin(), triplets.end());
-    const Eigen::VectorXd values = smallestEigenvalues(s);
+    const Eigen::VectorXd values = smallestEigenvalues(s, kernels ? &vectors : nullptr);
     for (Eigen::Index k = 0; k < values.size(); ++k) {
       if (values[k] < kZeroModeThreshold) {
         ++report.zeroModesPerComponent[comp];
@@ -211,9 +218,15 @@ ZeroModeReport zeroModes(const PolyMesh& mesh, const DgBasis& basis, const Momen
         report.smallestNonzeroEigenvalue = std::min(report.smallestNonzeroEigenvalue, values[k]);
       }
     }
+    if (kernels) {  // eigenvalues ascending: the zero modes come first; unscaled
+      const auto zero = static_cast<Eigen::Index>(report.zeroModesPerComponent[comp]);
+      Eigen::MatrixXd& kernel = (*kernels)[comp];
+      kernel = vectors.leftCols(zero);
+      for (int k = 0; k < m; ++k) kernel.row(k) *= scale[dofs[comp][k]];
+    }
     for (const Eigen::VectorXd& r : rigid) {
       Eigen::VectorXd rs(m);
-      for (int k = 0; k < m; ++k) rs[k] = r[dofs[k]] / scale[dofs[k]];
+      for (int k = 0; k < m; ++k) rs[k] = r[dofs[comp][k]] / scale[dofs[comp][k]];
       const double norm = rs.norm();
       if (norm > 0.0)
         report.rigidMotionResidual = std::max(report.rigidMotionResidual, (s * rs).norm() / norm);
@@ -221,6 +234,67 @@ ZeroModeReport zeroModes(const PolyMesh& mesh, const DgBasis& basis, const Momen
     report.zeroModes += report.zeroModesPerComponent[comp];
   }
   return report;
+}
+
+}  // namespace
+
+ZeroModeReport zeroModes(const PolyMesh& mesh, const DgBasis& basis, const MomentCache& moments,
+                         const SpMat& matrix) {
+  std::size_t count = 0;
+  const ElementData<std::uint32_t> component = connectedComponents(mesh, count);
+  const int bs = 3 * basis.size();
+
+  // Rigid motions as coefficients: translations e_d and rotations e_d x (x - c) / length.
+  const Vec3 c = meshBounds(mesh).center();
+  const double length = std::max(meshBounds(mesh).diagonal().norm(), 1e-300);
+  std::vector<Eigen::VectorXd> rigid;
+  for (int d = 0; d < 6; ++d) {
+    const LinearField field = rigidField(d, c, length);
+    Eigen::VectorXd r(static_cast<Eigen::Index>(mesh.numElements()) * bs);
+    for (std::size_t i = 0; i < mesh.numElements(); ++i)
+      linearFieldCoefficients(basis, ElementId(i), field,
+                              {r.data() + i * bs, static_cast<std::size_t>(bs)});
+    rigid.push_back(std::move(r));
+  }
+  return zeroModesOfComponents(matrix, bs, component.raw(), count, rigid, nullptr);
+}
+
+ZeroModeReport zeroModes(const SpMat& matrix, int blockSize,
+                         std::span<const std::uint32_t> component, std::size_t components,
+                         std::vector<Eigen::MatrixXd>* kernels) {
+  return zeroModesOfComponents(matrix, blockSize, component, components, {}, kernels);
+}
+
+Eigen::MatrixXd rigidMotionCoefficients(const DgBasis& basis, ElementId e, const Vec3& centre,
+                                        double length) {
+  const int bs = 3 * basis.size();
+  Eigen::MatrixXd out(bs, 6);
+  for (int d = 0; d < 6; ++d)
+    linearFieldCoefficients(basis, e, rigidField(d, centre, length),
+                            {out.col(d).data(), static_cast<std::size_t>(bs)});
+  return out;
+}
+
+Eigen::VectorXd zeroModeScaling(const Eigen::VectorXd& diagonal, int blockSize) {
+  Eigen::VectorXd scale(diagonal.size());
+  for (Eigen::Index b = 0; b < diagonal.size() / blockSize; ++b) {
+    const auto block = diagonal.segment(b * blockSize, blockSize);
+    const double mean = block.cwiseMax(0.0).mean();
+    for (int k = 0; k < blockSize; ++k) {
+      const double d = block[k] > 0.0 ? block[k] : mean;
+      scale[b * blockSize + k] = d > 0.0 ? 1.0 / std::sqrt(d) : 1.0;
+    }
+  }
+  return scale;
+}
+
+std::size_t countZeroModes(const Eigen::MatrixXd& matrix, const Eigen::VectorXd& scale) {
+  Eigen::MatrixXd shifted = scale.asDiagonal() * matrix * scale.asDiagonal();
+  shifted.diagonal().array() -= kZeroModeThreshold;
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(shifted);
+  std::size_t count = 0;
+  for (const double d : ldlt.vectorD()) count += !(d >= 0.0);
+  return count;
 }
 
 ZeroModeReport rigidModes(const PolyMesh& mesh, const PhysicsCheckOptions& options,

@@ -8,12 +8,14 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <string>
 
 #include "polydg/integrate/moment_cache.h"
 #include "polydg/mesh/surface_shapes.h"
+#include "tests/support/shapes.h"
 
 namespace polydg {
 namespace {
@@ -211,6 +213,49 @@ TEST(MeshingScale, NonFiniteCoordinatesAreRefused) {
   s.vertices[3].x() = std::numeric_limits<double>::quiet_NaN();
   EXPECT_EQ(refusal(s, cells(4)),
             "a vertex has a non-finite coordinate (NaN or infinity); fix the surface");
+}
+
+TEST(Meshing, SwissCheeseBlockMeshesToItsKnownVolume) {
+  // 11 x 10 x 9 unit cells with 3 x 3 holes along each axis, crossing: integer vertices, so the
+  // volume is the count of kept cells. 16 cells along x puts no grid plane on a cell side.
+  const Box3 box(Vec3::Zero(), Vec3(11, 10, 9));
+  const std::array<int, 3> n{11, 10, 9};
+  const TriangleSurface cheese = swissCheeseBlock(box, n);
+  const SurfaceTopology topology = analyzeTopology(cheese);
+  EXPECT_TRUE(topology.closed());
+  EXPECT_EQ(topology.components, 1u);
+  EXPECT_EQ(topology.degenerateTriangles, 0u);
+  // Inclusion-exclusion: the 9 + 9 + 9 hole rows remove 99 + 90 + 81 unit cells, each pair of
+  // hole directions shares the 27 crossings, all three share them too.
+  const double volume = 11 * 10 * 9 - (99 + 90 + 81) + 3 * 27 - 27;
+  EXPECT_EQ(swissCheeseVolume(uniformCheeseWalls(box, n)), volume);
+  EXPECT_LT(std::abs(enclosedVolume(cheese) - volume) / volume, kVolumeTolerance);
+
+  const MeshingResult m = meshSurface(cheese, cells(16));
+  const MeshingReport& r = m.report;
+  EXPECT_TRUE(r.validation.passed);
+  EXPECT_TRUE(r.inputClosed);
+  EXPECT_TRUE(r.inputManifold);
+  EXPECT_TRUE(r.selfIntersectionsChecked);
+  EXPECT_EQ(r.selfIntersections, 0u);
+  EXPECT_EQ(r.shells, 1u);
+  EXPECT_EQ(r.cavities, 0u);
+  EXPECT_TRUE(r.repairs.empty());
+  EXPECT_EQ(r.validation.components, 1u);
+  EXPECT_LT(std::abs(r.outputVolume - volume) / volume, kVolumeTolerance);
+}
+
+TEST(Meshing, SwissCheeseWithWallsJustOffTheGridPlanes) {
+  // The walls a little beyond the grid planes (testing::cheeseWallsOffGrid): slivers of that
+  // thickness between each wall and its plane, merged, and faces that thin between elements.
+  const CheeseWalls walls = testing::cheeseWallsOffGrid(Box3(Vec3::Zero(), Vec3(11, 10, 9)), 16);
+  const MeshingResult m = meshSurface(swissCheeseBlock(walls), cells(16));
+  EXPECT_TRUE(m.report.validation.passed);
+  EXPECT_EQ(m.report.selfIntersections, 0u);
+  EXPECT_GT(m.report.slivers.merged, 0u);
+  const double volume = swissCheeseVolume(walls);
+  EXPECT_LT(std::abs(m.report.inputVolume - volume) / volume, kVolumeTolerance);
+  EXPECT_LT(std::abs(m.report.outputVolume - volume) / volume, kVolumeTolerance);
 }
 
 }  // namespace

@@ -2,17 +2,22 @@
 // of regions of 1, a few and many elements, connected or not, on a hex grid, a sliced sphere, a
 // grid with a sliver and a grid translated by 1e6; the same answer as the global checks on the
 // whole mesh; failures on a vertex moved off its faces' planes, a reversed face, an inverted
-// element and a stale moment cache, and none for a region away from a defect.
+// element and a stale moment cache, and none for a region away from a defect. With
+// RegionCoupling::HoldingFaces: slivers hanging by thin faces and elements touching through
+// strips a round-off wide (a Swiss cheese whose walls lie just off the grid planes) are bodies
+// of their own, every ring of the cheese passes as the whole mesh does, and defects still fail.
 #include "polydg/physics/region_checks.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <string>
 #include <vector>
 
 #include "polydg/mesh/geometry.h"
+#include "polydg/mesh/meshing.h"
 #include "polydg/mesh/primitives.h"
 #include "polydg/mesh/slice.h"
 #include "polydg/mesh/surface_shapes.h"
@@ -231,6 +236,106 @@ TEST(RegionChecks, SliversHangingByTheirThinFacesHaveSoftModes) {
 }
 
 using testing::withReversedFaces;
+
+RegionDgCheck checkHolding(const PolyMesh& mesh, const Region& region, int degree = 1) {
+  MomentCache moments(mesh, 2 * degree);
+  moments.update();
+  LocalDgCheckOptions options;
+  options.basis.degree = degree;
+  return regionDgChecks(mesh, moments, region, options, RegionCoupling::HoldingFaces);
+}
+
+TEST(RegionChecks, HoldingFacesMakeSliversHangingByThinFacesBodiesOfTheirOwn) {
+  // The layer of slivers of SliversHangingByTheirThinFacesHaveSoftModes: their thin faces
+  // (t = 1e-6) hinge, so they join nothing, and each sliver is one body with 6 zero modes; the
+  // 12 faces between neighbouring slivers of the 3 x 3 layer are loose.
+  PolyMesh sliver = hexGridMesh(3, 3, 3, Box3(Vec3::Zero(), Vec3::Ones()));
+  for (Vec3& p : sliver.positions().raw())
+    if (std::abs(p.x() - 1.0 / 3.0) < 1e-12) p.x() = 1e-6;
+  Region layer(sliver.numElements(), 0);
+  for (int j = 0; j < 3; ++j)
+    for (int k = 0; k < 3; ++k) layer[cell(3, 0, j, k)] = 1;
+  const RegionDgCheck hinged = checkHolding(sliver, layer, 1);
+  EXPECT_EQ(hinged.components, 9u);
+  EXPECT_EQ(hinged.looseFaces, 12u);
+  EXPECT_EQ(hinged.zeroModes, 54u);
+  EXPECT_TRUE(hinged.passed());
+  // Held through their large faces, the slivers join the grid: one body, as with AllFaces.
+  for (int degree : {1, 2}) {
+    const RegionDgCheck all = checkHolding(sliver, allOf(sliver), degree);
+    EXPECT_EQ(all.components, 1u) << degree;
+    EXPECT_EQ(all.zeroModes, 6u) << degree;
+    EXPECT_TRUE(all.passed()) << degree;
+  }
+  // A sliver's own soft modes (bending at ~3.7 t^2 from degree 2 on) are no face's: they count.
+  EXPECT_GT(checkHolding(sliver, only(sliver, {cell(3, 0, 1, 1)}), 2).zeroModes, 6u);
+}
+
+TEST(RegionChecks, HoldingFacesAgreeWithTheWholeMeshOnSwissCheesesWithThinFaces) {
+  // Swiss cheeses whose walls lie 2^-24 and 2^-7 beyond the grid planes (4e-8 and 6e-3 of a
+  // cell at 8 cells along 11 units): elements touch some of their neighbours through strips that
+  // narrow (or squares that small), which hold their translations but, below a width of about
+  // 1e-3 of a cell, not their rotations about the strip, whose stiffness goes as the width^4.
+  // Each whole mesh is one body (rigidModes()). Every element with its ring of neighbours
+  // passes with HoldingFaces, among them rings (at 2^-7) where a strip holds an element alone
+  // but not the group it belongs to; with AllFaces, the rings of elements held by the ring only
+  // through such strips count their rotations as zero modes.
+  for (const double offset : {testing::kCheeseWallOffset, 0x1p-7}) {
+    MeshingOptions meshing;
+    meshing.cellsAlongLongest = 8;
+    const Box3 box(Vec3::Zero(), Vec3(11, 10, 3));
+    const PolyMesh mesh =
+        meshSurface(swissCheeseBlock(testing::cheeseWallsOffGrid(box, 8, offset)), meshing).mesh;
+    ASSERT_TRUE(validate(mesh).passed) << offset;
+    const ZeroModeReport modes = rigidModes(mesh, PhysicsCheckOptions{});
+    ASSERT_EQ(modes.components, 1u) << offset;
+    ASSERT_EQ(modes.zeroModes, 6u) << offset;
+    const RegionDgCheck whole = checkHolding(mesh, allOf(mesh));
+    EXPECT_GT(whole.looseFaces, 0u) << offset;
+    EXPECT_EQ(whole.components, 1u) << offset;
+    EXPECT_EQ(whole.zeroModes, 6u) << offset;
+    EXPECT_TRUE(whole.passed()) << offset;
+    std::size_t softRings = 0;
+    for (std::size_t e = 0; e < mesh.numElements(); ++e) {
+      const Region ring = withRing(mesh, ElementId(e));
+      const RegionDgCheck holding = checkHolding(mesh, ring);
+      EXPECT_TRUE(holding.passed()) << offset << ", element " << e << ": " << holding.zeroModes
+                                    << " zero modes for " << holding.components << " components";
+      const RegionDgCheck all = check(mesh, ring);
+      EXPECT_EQ(all.components, regionComponents(mesh, ring)) << offset << ", element " << e;
+      softRings += all.zeroModes > 6 * all.components;
+    }
+    EXPECT_GT(softRings, 0u) << offset;
+    std::printf(
+        "offset %g: %zu elements, %zu loose faces; %zu rings count soft modes with "
+        "AllFaces\n",
+        offset, mesh.numElements(), whole.looseFaces, softRings);
+  }
+}
+
+TEST(RegionChecks, HoldingFacesStillFailOnDefects) {
+  // A reversed face, an inverted element and a stale cache fail as with AllFaces.
+  const PolyMesh grid = grid4();
+  const ElementId bad(cell(4, 1, 1, 0));
+  int k = -1;
+  for (std::size_t j = 0; j < grid.element(bad).faces.size(); ++j)
+    if (grid.face(grid.element(bad).faces[j].face).isBoundary()) k = static_cast<int>(j);
+  ASSERT_GE(k, 0);
+  const PolyMesh reversed = withReversedFaces(grid, bad, k);
+  EXPECT_FALSE(checkHolding(reversed, withRing(reversed, bad)).passed());
+  const PolyMesh inverted =
+      withReversedFaces(boxMesh(Box3(Vec3::Zero(), Vec3(1, 2, 3))), ElementId(0), -1);
+  const RegionDgCheck c = checkHolding(inverted, allOf(inverted));
+  EXPECT_FALSE(c.passed());
+  EXPECT_NE(c.zeroModes, 6u);
+  PolyMesh mesh = grid4();
+  MomentCache moments(mesh, 2);
+  moments.update();
+  transform(mesh, 1.5, Vec3::Zero());
+  EXPECT_FALSE(regionDgChecks(mesh, moments, withRing(mesh, ElementId(cell(4, 1, 1, 1))), {},
+                              RegionCoupling::HoldingFaces)
+                   .passed());
+}
 
 TEST(RegionChecks, FailsOnAVertexOffItsFacesPlanes) {
   // Grid node (1, 1, 1) of the 4^3 grid moved off the planes of its faces by 1e-3 of a cell.

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "polydg/mesh/primitives.h"
+#include "polydg/mesh/slice.h"
 #include "polydg/mesh/surface.h"
 #include "polydg/mesh/surface_shapes.h"
 
@@ -95,6 +96,33 @@ inline PolyMesh twoSeparateBlocks() {
   }
   two.addElement(boundary, FaceOrigin::Box);
   return two;
+}
+
+/// How far cheeseWallsOffGrid() moves each wall beyond its grid plane: 2^-24 ~ 6e-8, about
+/// 1e-7 of a grid cell of 11/16 (16 cells along 11 units), as coordinates written with 7
+/// significant digits put points that lie on a plane mathematically.
+inline constexpr double kCheeseWallOffset = 0x1p-24;
+
+/// The walls of a Swiss cheese (swissCheeseBlock()) on `box` whose cells are the cells of the
+/// grid that slices `box` at `cellsAlongLongest` cells along its longest side: the grid planes
+/// inside the box, each moved by `offset`. Every wall leaves a sliver that thin between itself
+/// and its grid plane (merged by meshSurface() below 1% of a cell), and faces that thin between
+/// the elements either side. Coordinates are dyadic for an integer box and a dyadic offset
+/// (grid planes are multiples of 2^-5 at 16 cells), so the volume is swissCheeseVolume() of the
+/// walls up to round-off.
+inline CheeseWalls cheeseWallsOffGrid(const Box3& box, int cellsAlongLongest,
+                                      double offset = kCheeseWallOffset) {
+  const Grid grid = Grid::withCellsAlongLongest(box, cellsAlongLongest);
+  CheeseWalls walls;
+  for (int a = 0; a < 3; ++a) {
+    walls[a].push_back(box.min()[a]);
+    for (int i = 0; i <= grid.cells[a]; ++i) {
+      const double plane = grid.plane(a, i);
+      if (plane > box.min()[a] && plane + offset < box.max()[a]) walls[a].push_back(plane + offset);
+    }
+    walls[a].push_back(box.max()[a]);
+  }
+  return walls;
 }
 
 }  // namespace polydg::testing

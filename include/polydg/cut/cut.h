@@ -36,7 +36,8 @@ struct Blade : Plane {
 enum class ValidationLevel {
   None,   ///< volume bookkeeping only
   Local,  ///< geometric checks of the touched elements; DG patch test and rigid-mode count on
-          ///< the touched elements plus one ring of neighbours; global volume balance
+          ///< the touched elements plus one ring of neighbours (regionDgChecks() with
+          ///< RegionCoupling::HoldingFaces); global volume balance
   Full,   ///< geometric validation of the whole mesh; global patch test and rigid modes
 };
 
@@ -62,6 +63,8 @@ struct OperationValidation {
   std::size_t elementsChecked = 0;  ///< geometric checks
   std::size_t regionElements = 0;   ///< DG region (touched elements plus one ring)
   double patchTestError = 0.0;      ///< relative, over the region (or the mesh, Full)
+  /// Local: components of the region's coupling graph, its elements joined through the faces
+  /// that hold them together (RegionCoupling::HoldingFaces); Full: of the mesh.
   std::size_t regionComponents = 0;
   std::size_t zeroModes = 0;    ///< expected: 6 * regionComponents
   double volumeRelError = 0.0;  ///< |V_before - V_removed - V_after| / V_before

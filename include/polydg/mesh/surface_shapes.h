@@ -1,7 +1,10 @@
 // Closed triangle surfaces made in code, whose enclosed volume is known exactly from their
-// vertices: spheres, tori, torus knots, boxes, plates, and their combinations (several shells,
-// cavities). Used by tests, benchmarks and examples.
+// vertices: spheres, tori, torus knots, boxes, blocks with through-holes, and their combinations
+// (several shells, cavities). Used by tests, benchmarks and examples.
 #pragma once
+
+#include <array>
+#include <vector>
 
 #include "polydg/mesh/surface.h"
 
@@ -26,6 +29,32 @@ TriangleSurface torusKnot(int p, int q, double R, double a, double r, int nu, in
 
 /// The surface of an axis-aligned box, two triangles per side.
 TriangleSurface boxSurface(const Box3& box);
+
+/// Cell walls along x, y and z of swissCheeseBlock(): each list increasing, first and last
+/// the block's sides, so walls[a].size() - 1 cells along axis a.
+using CheeseWalls = std::array<std::vector<double>, 3>;
+
+/// A "Swiss cheese": the block [walls[0].front(), walls[0].back()] x ... divided into cells by
+/// the walls, with square through-holes one cell wide along all three axes. Hole rows are the
+/// cell indices i with i % 3 == 1 and i + 1 < n_a (n_a cells along axis a: never two adjacent,
+/// never on the block's sides); every cell with at least two hole indices is removed: the
+/// x-holes are the rows (j, k) of hole indices in y and z, likewise along y and z, and each
+/// x-hole crosses the y- and z-holes it meets. Each side between a kept cell and a removed or
+/// outside cell gives two triangles, outward. The surface is closed, consistently oriented,
+/// edge- and vertex-manifold (no two hole rows are adjacent); its vertices are the walls'
+/// coordinates, so its enclosed volume is swissCheeseVolume(walls). Throws
+/// std::invalid_argument for fewer than 3 cells along an axis or walls not increasing.
+TriangleSurface swissCheeseBlock(const CheeseWalls& walls);
+
+/// swissCheeseBlock() with cells[a] equal cells along axis a of `box` (walls at
+/// box.min() + box.sizes() * i / cells, exact for an integer box with integer cells).
+TriangleSurface swissCheeseBlock(const Box3& box, const std::array<int, 3>& cells);
+
+/// The enclosed volume of swissCheeseBlock(walls): the sum of its kept cells' volumes.
+double swissCheeseVolume(const CheeseWalls& walls);
+
+/// The walls of `cells` equal cells along each axis of `box`.
+CheeseWalls uniformCheeseWalls(const Box3& box, const std::array<int, 3>& cells);
 
 /// The union of disjoint surfaces (several shells).
 TriangleSurface combine(const TriangleSurface& a, const TriangleSurface& b);

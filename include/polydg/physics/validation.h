@@ -4,6 +4,8 @@
 // cheap element-local forms, run on every mesh polydg makes (localDgChecks()).
 #pragma once
 
+#include <cstdint>
+#include <span>
 #include <vector>
 
 #include "polydg/physics/static_solver.h"
@@ -57,8 +59,38 @@ struct ZeroModeReport {
 /// blocks of K): the smallest eigenvalues of each component's Jacobi-scaled block, all of them
 /// by a dense eigensolver up to 1500 DOFs, else the 12 smallest by subspace iteration with a
 /// CHOLMOD factorization of S + 1e-10 I. Also checks that the rigid motions are in the kernel.
+/// Throws std::invalid_argument if `matrix` couples elements of two components.
 ZeroModeReport zeroModes(const PolyMesh& mesh, const DgBasis& basis, const MomentCache& moments,
                          const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix);
+
+/// The same count per component of a coupling graph the caller built along with `matrix`:
+/// block b (DOFs b * blockSize .. (b + 1) * blockSize - 1) belongs to component[b], in
+/// 0 .. components - 1. The components must be decoupled blocks of `matrix`, so that each zero
+/// mode belongs to one of them: throws std::invalid_argument if `matrix` has an entry between
+/// two components. Rigid motions are not checked (rigidMotionResidual is 0). If `kernels` is
+/// not null, (*kernels)[c] holds component c's zero modes as columns (eigenvectors of the scaled
+/// matrix, unscaled to coefficients), its rows the component's DOFs in increasing order.
+ZeroModeReport zeroModes(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix,
+                         int blockSize, std::span<const std::uint32_t> component,
+                         std::size_t components, std::vector<Eigen::MatrixXd>* kernels = nullptr);
+
+/// Element e's coefficients (3n x 6, LinearSystem's order) of the rigid motions zeroModes()
+/// checks: the translations along x, y and z, then the rotations about x, y and z through
+/// `centre`, divided by `length` (so that all six have the size of a translation).
+Eigen::MatrixXd rigidMotionCoefficients(const DgBasis& basis, ElementId e, const Vec3& centre,
+                                        double length);
+
+/// The Jacobi scaling of zeroModes(), D^(-1/2), for a matrix with diagonal `diagonal` in blocks
+/// of `blockSize`: 1 / sqrt(d_i), where an entry that is not positive (the constant functions
+/// of an element without coupled faces) takes its block's mean diagonal (negative entries
+/// counted as 0), which keeps the scaling scale-free.
+Eigen::VectorXd zeroModeScaling(const Eigen::VectorXd& diagonal, int blockSize);
+
+/// The zero modes of a small dense symmetric `matrix` under the scaling `scale` (as
+/// zeroModeScaling()): the eigenvalues of diag(scale) matrix diag(scale) below
+/// kZeroModeThreshold, counted by Sylvester's law of inertia as the negative pivots of the
+/// pivoted LDL^T of that matrix minus kZeroModeThreshold I (a NaN pivot counts too).
+std::size_t countZeroModes(const Eigen::MatrixXd& matrix, const Eigen::VectorXd& scale);
 
 /// The stiffness matrix without boundary conditions (every boundary face free): expected
 /// exactly 6 zero modes per component. `moments` as for patchTest().
