@@ -55,7 +55,8 @@ VolumeMeshInfo inspectVolumeMesh(const std::string& path) {
   i.valid = v.passed;
   i.bounds = meshBounds(mesh);
   i.volume = v.volume;
-  i.provenance = read.provenanceRestored;
+  i.provenance = model.provenance();
+  i.provenanceStored = read.provenanceRestored;
   return i;
 }
 
@@ -94,7 +95,8 @@ nlohmann::json toJson(const VolumeMeshInfo& i) {
           {"valid", i.valid},
           {"bounding_box", toJson(i.bounds)},
           {"volume", i.volume},
-          {"provenance", i.provenance}};
+          {"provenance", toJson(i.provenance)},
+          {"provenance_stored", i.provenanceStored}};
 }
 
 }  // namespace polydg

@@ -183,6 +183,14 @@ TEST_F(Commands, MeshThenCutUsesTheThresholdOfARun) {
   const auto provenance = readJson("cut.json")["provenance"];
   EXPECT_EQ(provenance["reference"], "grid_cell");
   EXPECT_EQ(provenance["sliver_fraction"], 0.02);
+  // The cut mesh keeps it: `polydg info` reads back the grid cell and the rule.
+  ASSERT_EQ(runPolydg("info " + path("c.vtu") + " --quiet --report " + path("i.json")).exitCode,
+            0);
+  const auto info = readJson("i.json");
+  EXPECT_EQ(info["provenance_stored"], true);
+  EXPECT_EQ(info["provenance"]["cell_size"], provenance["cell_size"]);
+  EXPECT_EQ(info["provenance"]["sliver_threshold"], separate["sliver_threshold"]);
+  EXPECT_NE(info["provenance"]["source"].get<std::string>().find("torus.obj"), std::string::npos);
 }
 
 // --solver auto: Cholesky up to 3000 DOFs, CG with the p-multigrid above.

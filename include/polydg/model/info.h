@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "polydg/mesh/geometry.h"
+#include "polydg/model/model.h"
 
 namespace polydg {
 
@@ -32,7 +33,10 @@ struct VolumeMeshInfo {
   bool valid = false;   ///< validate() passed
   Box3 bounds;
   double volume = 0.0;
-  bool provenance = false;  ///< polydg's provenance field data present
+  /// The provenance (model/model.h): as stored in the file's field data if polydg wrote it,
+  /// else the defaults a command reading the file applies (reference: median element).
+  Provenance provenance;
+  bool provenanceStored = false;  ///< the file carried polydg's provenance field data
 };
 
 /// Reads `path` as a surface (throws InputError with the reader's one-line message).
