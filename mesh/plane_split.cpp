@@ -65,9 +65,15 @@ int locate(const Point2& p, const std::vector<Point2>& loop) {
 
 }  // namespace
 
-PlaneSplitter::PlaneSplitter(const std::vector<Vec3>& points) {
+PlaneSplitter::PlaneSplitter(const std::vector<Vec3>& points) : PlaneSplitter(points, {}) {}
+
+PlaneSplitter::PlaneSplitter(const std::vector<Vec3>& points,
+                             const std::vector<std::uint32_t>& onPlane) {
+  if (!onPlane.empty() && onPlane.size() != points.size())
+    throw std::invalid_argument("PlaneSplitter: one plane id per point");
   records_.reserve(2 * points.size());
-  for (const Vec3& p : points) records_.push_back({p, kNoPlane, 0, 0});
+  for (std::size_t i = 0; i < points.size(); ++i)
+    records_.push_back({points[i], onPlane.empty() ? kNoPlane : onPlane[i], 0, 0});
 }
 
 void PlaneSplitter::reserve(std::size_t points) {
@@ -87,7 +93,7 @@ int PlaneSplitter::compareExactly(std::uint32_t v, std::uint32_t w, int k) const
   using Q = CGAL::Exact_rational;
   auto exact = [&](std::uint32_t id) -> Q {
     const PointRecord& r = records_[id];
-    if (r.onPlane == kNoPlane) return Q(r.position[k]);
+    if (r.a == r.b) return Q(r.position[k]);  // a given point: exactly where it is
     decltype(planes_)::const_accessor found;
     if (!planes_.find(found, r.onPlane)) throw std::logic_error("compareExactly: unknown plane");
     const SplitPlane& plane = found->second;

@@ -184,8 +184,7 @@ TEST_F(Commands, MeshThenCutUsesTheThresholdOfARun) {
   EXPECT_EQ(provenance["reference"], "grid_cell");
   EXPECT_EQ(provenance["sliver_fraction"], 0.02);
   // The cut mesh keeps it: `polydg info` reads back the grid cell and the rule.
-  ASSERT_EQ(runPolydg("info " + path("c.vtu") + " --quiet --report " + path("i.json")).exitCode,
-            0);
+  ASSERT_EQ(runPolydg("info " + path("c.vtu") + " --quiet --report " + path("i.json")).exitCode, 0);
   const auto info = readJson("i.json");
   EXPECT_EQ(info["provenance_stored"], true);
   EXPECT_EQ(info["provenance"]["cell_size"], provenance["cell_size"]);

@@ -265,6 +265,43 @@ TEST(Cut, PolygonBladeSplitsOnlyInside) {
   EXPECT_EQ(components, 1u);  // a slit, not a separation
 }
 
+// A polygon cut leaves the elements at its edge whole, with its new points inserted on their
+// edges: on its plane by construction, though rounded off it. The whole plane's cut after it
+// splits those elements, and the splitter sees those points on the plane as the cut does (one
+// answer to "is this vertex on the plane?"): no edge of round-off length appears beside them.
+TEST(Cut, PlaneThroughPointsAnEarlierPolygonCutMadeOnIt) {
+  MeshEditor editor(unitGrid(5));
+  // Corners on z = 0.45 - 0.3 x + 0.2 y.
+  const Blade polygon = Blade::fromPolygon({Vec3(0.13, 0.11, 0.433), Vec3(0.71, 0.17, 0.271),
+                                            Vec3(0.67, 0.69, 0.387), Vec3(0.09, 0.63, 0.549)});
+  const auto first = editor.cut(polygon, noMerging());
+  ASSERT_TRUE(first.validation.passed) << first.validation.failure;
+  ASSERT_FALSE(first.leftWhole.empty());
+  // The case at hand: points the polygon cut made that round off its plane.
+  const Plane plane = Plane::make(polygon.normal, polygon.offset);
+  std::size_t rounded = 0;
+  for (std::size_t v = 0; v < editor.mesh().numVertices(); ++v) {
+    const Vec3& p = editor.mesh().position(VertexId(v));
+    rounded += plane.side(p) != 0 && std::abs(plane.normal.dot(p) - plane.offset) < 1e-12;
+  }
+  ASSERT_GT(rounded, 0u);
+
+  const auto whole = editor.cut(Blade::plane(polygon.normal, polygon.offset), noMerging());
+  EXPECT_TRUE(whole.validation.passed) << whole.validation.failure;
+  EXPECT_GT(whole.elementsSplit, 0u);
+  expectConsistent(editor, 1.0);
+  double shortest = 1.0;
+  for (const Face& face : editor.mesh().faces())
+    for (std::size_t k = 0; k < face.numLoops(); ++k) {
+      const auto loop = face.loop(k);
+      for (std::size_t i = 0; i < loop.size(); ++i)
+        shortest = std::min(shortest, (editor.mesh().position(loop[i]) -
+                                       editor.mesh().position(loop[(i + 1) % loop.size()]))
+                                          .norm());
+    }
+  EXPECT_GT(shortest, 1e-9);
+}
+
 TEST(Blade, RejectsBadInput) {
   EXPECT_THROW(Blade::plane(Vec3::Zero(), 1.0), std::invalid_argument);
   EXPECT_THROW(Blade::plane(Vec3(1, 0, 0), std::nan("")), std::invalid_argument);

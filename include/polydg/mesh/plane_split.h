@@ -58,7 +58,15 @@ struct PieceSplit {
 /// made under that key's lock. Point coordinates do not depend on the order of calls.
 class PlaneSplitter {
  public:
+  /// The plane id of a point on no plane by construction.
+  static constexpr std::uint32_t kNoPlane = 0xffffffffu;
+
+  /// Starts from `points`, none of them on a plane by construction.
   explicit PlaneSplitter(const std::vector<Vec3>& points);
+  /// Starts from `points`, point i lying by construction on the plane with id onPlane[i] (or on
+  /// none: kNoPlane): a point an earlier split made there, whose rounded position may be off
+  /// it. side() says 0 for it on that plane, as for the points this splitter makes.
+  PlaneSplitter(const std::vector<Vec3>& points, const std::vector<std::uint32_t>& onPlane);
 
   /// Sizes the point array and the tables of shared points for about `points` points in all
   /// (a hint: they grow as needed either way, but growing them costs time).
@@ -83,8 +91,6 @@ class PlaneSplitter {
   static std::vector<Piece> components(Piece piece);
 
  private:
-  static constexpr std::uint32_t kNoPlane = 0xffffffffu;
-
   std::uint32_t edgePoint(std::uint32_t u, std::uint32_t v, const SplitPlane& plane);
   /// Records `plane` under its id (for compareExactly) before points are made on it.
   void rememberPlane(const SplitPlane& plane);
@@ -99,8 +105,8 @@ class PlaneSplitter {
 
   struct PointRecord {
     Vec3 position;
-    std::uint32_t onPlane = kNoPlane;  ///< id of the plane that made it, or kNoPlane
-    std::uint32_t a = 0, b = 0;        ///< the edge it was made on (a's point <= b's)
+    std::uint32_t onPlane = kNoPlane;  ///< id of the plane it lies on by construction
+    std::uint32_t a = 0, b = 0;  ///< the edge it was made on (a's point <= b's); a == b: given
   };
   tbb::concurrent_vector<PointRecord> records_;
 
