@@ -416,7 +416,12 @@ void PlaneSplitter::splitPolygon(const PiecePolygon& polygon, const SplitPlane& 
   std::sort(toggles.begin(), toggles.end());
   std::sort(alongLine.begin(), alongLine.end());
 
-  // 4. Directed edges of each side: boundary pieces plus closing segments along L.
+  // 4. Directed edges of each side: boundary pieces plus closing segments along L. A boundary
+  //    edge on L running along t has the polygon, and so the minus side, on its left: it goes to
+  //    minus. Its direction is taken from the order the closing segments use (exact on ties): an
+  //    edge whose ends tie in rounded coordinate k (an edge of round-off length, as from a
+  //    surface vertex on one grid plane within round-off of another) must fall on the side its
+  //    closing segments expect, or that side's loop stays open.
   EdgeList minusEdges, plusEdges;
   for (const auto& loop : loops) {
     const std::size_t m = loop.size();
@@ -429,7 +434,7 @@ void PlaneSplitter::splitPolygon(const PiecePolygon& polygon, const SplitPlane& 
       else if (a.side > 0 || b.side > 0)
         plusEdges.push_back(e);
       else
-        (key(b.v) > key(a.v) ? minusEdges : plusEdges).push_back(e);
+        (before({key(a.v), a.v}, {key(b.v), b.v}) ? minusEdges : plusEdges).push_back(e);
     }
   }
   std::size_t crossings = 0;

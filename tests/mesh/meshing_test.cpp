@@ -14,6 +14,7 @@
 #include <string>
 
 #include "polydg/integrate/moment_cache.h"
+#include "polydg/mesh/surface_io.h"
 #include "polydg/mesh/surface_shapes.h"
 #include "tests/support/shapes.h"
 
@@ -256,6 +257,22 @@ TEST(Meshing, SwissCheeseWithWallsJustOffTheGridPlanes) {
   const double volume = swissCheeseVolume(walls);
   EXPECT_LT(std::abs(m.report.inputVolume - volume) / volume, kVolumeTolerance);
   EXPECT_LT(std::abs(m.report.outputVolume - volume) / volume, kVolumeTolerance);
+}
+
+TEST(Meshing, TorusObjAtCellCountsPuttingAVertexOnOneGridPlaneAndNearAnother) {
+  // At 14 cells (and multiples) a vertex of testdata/torus.obj lies on the grid plane
+  // y = -0.6 and 1.1e-16 from x = 0: the points x = 0 makes on its edges round onto y = -0.6
+  // (PlaneSplit.VertexOnOnePlaneAndWithinRoundOffOfAnother). Slicing once stopped there with
+  // "traceLoops: open chain of edges".
+  const TriangleSurface torus = readSurface(std::string(POLYDG_TESTDATA_DIR) + "/torus.obj");
+  for (const int n : {14, 28}) {
+    SCOPED_TRACE("cells " + std::to_string(n));
+    const MeshingResult m = meshSurface(torus, cells(n));
+    EXPECT_TRUE(m.report.validation.passed);
+    EXPECT_EQ(m.report.validation.components, 1u);
+    EXPECT_LT(std::abs(m.report.outputVolume - m.report.inputVolume) / m.report.inputVolume,
+              kVolumeTolerance);
+  }
 }
 
 }  // namespace
