@@ -462,24 +462,73 @@ PieceSplit PlaneSplitter::split(Piece piece, const SplitPlane& plane, FaceOrigin
   PieceSplit out;
   out.minus.reserve(piece.size() + 8);
   out.plus.reserve(piece.size() + 8);
-  for (PiecePolygon& polygon : piece) {
+  // Where each polygon goes: wholly on one side (touching the plane or not), in the plane, or
+  // across it.
+  enum class Place : signed char { Minus, Plus, InPlane, Across };
+  Small<Place, 64> place(piece.size());
+  Small<char, 64> touches(piece.size(), 0);  // has a corner in the plane
+  bool anyInPlane = false;
+  for (std::size_t i = 0; i < piece.size(); ++i) {
     int lo = 1, hi = -1;
-    for (std::uint32_t v : polygon.vertices) {
+    for (std::uint32_t v : piece[i].vertices) {
       const int s = side(v, plane);
       lo = std::min(lo, s);
       hi = std::max(hi, s);
     }
-    if (hi <= 0 && lo < 0)
-      out.minus.push_back(std::move(polygon));
-    else if (lo >= 0 && hi > 0)
-      out.plus.push_back(std::move(polygon));
-    else if (lo == 0 && hi == 0)  // in the plane: it bounds the side it faces away from
-      (polygonNormal(polygon).dot(plane.normal) > 0 ? out.minus : out.plus)
-          .push_back(std::move(polygon));
-    else {
-      if (out.polygonsSplit == 0) rememberPlane(plane);
-      splitPolygon(polygon, plane, out.minus, out.plus);
-      ++out.polygonsSplit;
+    place[i] = hi <= 0 && lo < 0    ? Place::Minus
+               : lo >= 0 && hi > 0  ? Place::Plus
+               : lo == 0 && hi == 0 ? Place::InPlane
+                                    : Place::Across;
+    touches[i] = lo <= 0 && hi >= 0;
+    anyInPlane = anyInPlane || place[i] == Place::InPlane;
+  }
+  if (anyInPlane) {
+    // A connected set of polygons lying wholly in the plane (the points of a tip of round-off
+    // size beyond another plane, all rounded onto this one) encloses nothing: it goes whole to
+    // the minus side. Sent polygon by polygon to the sides they face away from, it would leave
+    // on each side a fold that no cap in this plane closes. Polygons are joined across the
+    // edges in the plane that they share (all edges of a polygon in the plane).
+    Small<std::pair<std::uint64_t, std::uint32_t>, 32> edges;  // (edge in the plane, polygon)
+    for (std::size_t i = 0; i < piece.size(); ++i) {
+      if (!touches[i]) continue;
+      const PiecePolygon& polygon = piece[i];
+      for (std::size_t k = 0; k < polygon.numLoops(); ++k) {
+        const std::size_t begin = polygon.loopBegin(k), end = polygon.loopEnd[k];
+        for (std::size_t j = begin; j < end; ++j) {
+          const std::uint32_t a = polygon.vertices[j];
+          const std::uint32_t b = polygon.vertices[j + 1 == end ? begin : j + 1];
+          if (place[i] == Place::InPlane || (side(a, plane) == 0 && side(b, plane) == 0))
+            edges.emplace_back(std::uint64_t(std::min(a, b)) << 32 | std::max(a, b),
+                               static_cast<std::uint32_t>(i));
+        }
+      }
+    }
+    std::sort(edges.begin(), edges.end());
+    UnionFind joined(piece.size());
+    for (std::size_t e = 1; e < edges.size(); ++e)
+      if (edges[e].first == edges[e - 1].first) joined.unite(edges[e].second, edges[e - 1].second);
+    Small<char, 64> anchored(piece.size(), 0);  // joined to a polygon not in the plane
+    for (std::size_t i = 0; i < piece.size(); ++i)
+      if (touches[i] && place[i] != Place::InPlane)
+        anchored[joined.find(static_cast<std::uint32_t>(i))] = 1;
+    for (std::size_t i = 0; i < piece.size(); ++i)
+      if (place[i] == Place::InPlane && !anchored[joined.find(static_cast<std::uint32_t>(i))])
+        place[i] = Place::Minus;
+  }
+  for (std::size_t i = 0; i < piece.size(); ++i) {
+    PiecePolygon& polygon = piece[i];
+    switch (place[i]) {
+      case Place::Minus: out.minus.push_back(std::move(polygon)); break;
+      case Place::Plus: out.plus.push_back(std::move(polygon)); break;
+      case Place::InPlane:  // it bounds the side it faces away from
+        (polygonNormal(polygon).dot(plane.normal) > 0 ? out.minus : out.plus)
+            .push_back(std::move(polygon));
+        break;
+      case Place::Across:
+        if (out.polygonsSplit == 0) rememberPlane(plane);
+        splitPolygon(polygon, plane, out.minus, out.plus);
+        ++out.polygonsSplit;
+        break;
     }
   }
   if (out.minus.empty() || out.plus.empty()) return out;

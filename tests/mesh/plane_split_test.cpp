@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <map>
 
 #include "polydg/mesh/primitives.h"
@@ -73,6 +74,21 @@ SplitPlane generalPlane(const Vec3& n, double d, std::uint32_t id) {
   p.offset = d;
   p.id = id;
   return p;
+}
+
+/// The tetrahedron on points 0..3 as a piece, its faces outward whatever the points' order.
+Piece tetrahedron(const std::vector<Vec3>& p) {
+  const bool positive = (p[1] - p[0]).cross(p[2] - p[0]).dot(p[3] - p[0]) > 0;
+  std::vector<std::array<std::uint32_t, 3>> faces{{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+  Piece piece;
+  for (auto f : faces) {
+    if (!positive) std::swap(f[1], f[2]);
+    PiecePolygon polygon;
+    polygon.vertices.assign(f.begin(), f.end());
+    polygon.loopEnd = {3};
+    piece.push_back(polygon);
+  }
+  return piece;
 }
 
 TEST(PlaneSplit, CubeThroughItsMiddle) {
@@ -201,6 +217,41 @@ TEST(PlaneSplit, SplittingTwiceByTheSamePlaneIsANoOp) {
   EXPECT_TRUE(again.plus.empty());
   EXPECT_EQ(again.minus.size(), first.minus.size());
   EXPECT_EQ(splitter.numPoints(), points);
+}
+
+TEST(PlaneSplit, VertexOnOnePlaneAndWithinRoundOffOfAnother) {
+  // Corner 0 lies on y = -0.6 and 1e-16 on the minus side of x = 0 (as a vertex of
+  // testdata/torus.obj does at 14 cells). x = 0 cuts its three edges within round-off of it:
+  // the new points round onto y = -0.6 and tie in x. On the plus side of x = 0, a face through
+  // two of them has an edge of round-off length on the cut line of y = -0.6, whose side must
+  // follow the (exact) order of the points on that line, or that side stays open. On the minus
+  // side, the tip of round-off size lies wholly in y = -0.6 and must stay whole.
+  constexpr double kY = -0.6;
+  // Volumes here are cone sums about the origin, 0.6 away, over faces of area ~1e-2: their
+  // round-off is about 1e-16 * 0.6 * 1e-2.
+  constexpr double kVolumeTolerance = 1e-17;
+  for (const double zSign : {1.0, -1.0})
+    for (const double apexY : {-0.59, -0.61}) {
+      SCOPED_TRACE("zSign " + std::to_string(zSign) + ", apexY " + std::to_string(apexY));
+      const std::vector<Vec3> points{Vec3(-1e-16, kY, 0.0), Vec3(0.06, -0.597, 0.0),
+                                     Vec3(0.06, -0.605, -0.08 * zSign),
+                                     Vec3(0.05, apexY, 0.08 * zSign)};
+      PlaneSplitter splitter(points);
+      const Piece tet = tetrahedron(points);
+      const PieceSplit sx =
+          splitter.split(tet, SplitPlane::axisAligned(0, 0.0, 1), FaceOrigin::Interior);
+      ASSERT_TRUE(closed(sx.minus));
+      ASSERT_TRUE(closed(sx.plus));
+      double sum = 0.0;
+      for (const Piece& side : {sx.minus, sx.plus}) {
+        const PieceSplit sy =
+            splitter.split(side, SplitPlane::axisAligned(1, kY, 2), FaceOrigin::Interior);
+        EXPECT_TRUE(closed(sy.minus));
+        EXPECT_TRUE(closed(sy.plus));
+        sum += volume(sy.minus, splitter.points()) + volume(sy.plus, splitter.points());
+      }
+      EXPECT_NEAR(sum, volume(tet, points), kVolumeTolerance);
+    }
 }
 
 }  // namespace
