@@ -174,12 +174,16 @@ namespace {
 /// Traces closed loops from directed edges; where several edges leave a vertex (a pinch), takes
 /// the first one clockwise from the reversed incoming edge, so the region to the left of each
 /// loop is a proper face (the loops at a pinch are kept apart). `normal` orients the plane.
+/// Loops come in the order of their first edge in `edges` and start with it, so callers give
+/// the edges in an order that follows the geometry: point ids do not, since the ids of points
+/// made by splits running in parallel depend on the schedule.
 template <class PointOf>
 LoopList traceLoops(const EdgeList& edges, const PointOf& points, const Vec3& normal) {
-  Small<std::size_t> order(edges.size());
+  Small<std::size_t> order(edges.size());  // by start point, for finding the edges leaving one
   std::iota(order.begin(), order.end(), 0);
-  std::sort(order.begin(), order.end(),
-            [&](std::size_t i, std::size_t j) { return edges[i].from < edges[j].from; });
+  std::sort(order.begin(), order.end(), [&](std::size_t i, std::size_t j) {
+    return edges[i].from != edges[j].from ? edges[i].from < edges[j].from : i < j;
+  });
   auto outgoing = [&](std::uint32_t v) {
     auto lo = std::lower_bound(order.begin(), order.end(), v,
                                [&](std::size_t i, std::uint32_t x) { return edges[i].from < x; });
@@ -199,7 +203,7 @@ LoopList traceLoops(const EdgeList& edges, const PointOf& points, const Vec3& no
 
   Small<char> used(edges.size(), 0);
   LoopList loops;
-  for (std::size_t start : order) {
+  for (std::size_t start = 0; start < edges.size(); ++start) {
     if (used[start]) continue;
     Small<std::uint32_t> loop{edges[start].from};
     used[start] = 1;
@@ -560,9 +564,19 @@ PieceSplit PlaneSplitter::split(Piece piece, const SplitPlane& plane, FaceOrigin
   }
   if (capEdges.empty()) return out;
   const auto pointOf = [this](std::uint32_t v) -> const Vec3& { return point(v); };
-  std::sort(capEdges.begin(), capEdges.end(), [](const DirectedEdge& a, const DirectedEdge& b) {
-    return a.from != b.from ? a.from < b.from : a.to < b.to;
-  });  // deterministic output, whatever the hash order
+  // The caps' loops start where traceLoops meets them in this order: by the positions of the
+  // edges' ends, so that the output does not depend on the point ids (schedule-dependent).
+  // Ids only break ties between distinct points at one position (an intersection that rounded
+  // onto a surface vertex: the vertex's id is the smaller whatever the schedule).
+  auto byPosition = [this](std::uint32_t u, std::uint32_t v) {
+    const Vec3& p = point(u);
+    const Vec3& q = point(v);
+    if (p != q) return std::lexicographical_compare(p.data(), p.data() + 3, q.data(), q.data() + 3);
+    return u < v;
+  };
+  std::sort(capEdges.begin(), capEdges.end(), [&](const DirectedEdge& a, const DirectedEdge& b) {
+    return a.from != b.from ? byPosition(a.from, b.from) : byPosition(a.to, b.to);
+  });
   for (PiecePolygon& cap :
        groupLoops(traceLoops(capEdges, pointOf, plane.normal), pointOf, plane.normal, capOrigin)) {
     out.plus.push_back(reversed(cap));

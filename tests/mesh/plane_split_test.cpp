@@ -9,6 +9,7 @@
 #include <map>
 
 #include "polydg/mesh/primitives.h"
+#include "polydg/mesh/surface_shapes.h"
 
 namespace polydg {
 namespace {
@@ -252,6 +253,55 @@ TEST(PlaneSplit, VertexOnOnePlaneAndWithinRoundOffOfAnother) {
       }
       EXPECT_NEAR(sum, volume(tet, points), kVolumeTolerance);
     }
+}
+
+TEST(PlaneSplit, OutputDoesNotDependOnTheOrderOfSplits) {
+  // Slicing splits pieces in parallel, so the ids of the points it makes depend on the
+  // schedule. Two splitters split the halves of a torus (by x = 0.1) by y = 0.2 and then by
+  // z = 0.05 in opposite orders: the pieces must be the same polygons, in the same order, with
+  // corners at the same positions from the same first corner.
+  const TriangleSurface torus = polydg::torus(Vec3::Zero(), 1.0, 0.4, 24, 12);
+  Piece surface;
+  for (const auto& t : torus.triangles) {
+    PiecePolygon p;
+    p.vertices.assign(t.begin(), t.end());
+    p.loopEnd = {3};
+    surface.push_back(p);
+  }
+  auto pieces = [&](bool minusFirst) {
+    PlaneSplitter splitter(torus.vertices);
+    const PieceSplit halves =
+        splitter.split(surface, SplitPlane::axisAligned(0, 0.1, 1), FaceOrigin::Interior);
+    std::vector<Piece> out;
+    const Piece* order[2] = {&halves.minus, &halves.plus};
+    if (!minusFirst) std::swap(order[0], order[1]);
+    for (const Piece* half : order) {
+      const PieceSplit quarters =
+          splitter.split(*half, SplitPlane::axisAligned(1, 0.2, 2), FaceOrigin::Interior);
+      for (const Piece* quarter : {&quarters.minus, &quarters.plus}) {
+        const PieceSplit eighths =
+            splitter.split(*quarter, SplitPlane::axisAligned(2, 0.05, 3), FaceOrigin::Interior);
+        out.push_back(eighths.minus);
+        out.push_back(eighths.plus);
+      }
+    }
+    if (!minusFirst) std::rotate(out.begin(), out.begin() + 4, out.end());
+    // Each piece as its polygons' corner positions and loop ends.
+    std::vector<std::vector<std::pair<std::vector<Vec3>, std::vector<std::uint32_t>>>> shapes;
+    for (const Piece& piece : out) {
+      EXPECT_TRUE(closed(piece));
+      auto& shape = shapes.emplace_back();
+      for (const PiecePolygon& p : piece) {
+        auto& [corners, loopEnds] = shape.emplace_back();
+        for (std::uint32_t v : p.vertices) corners.push_back(splitter.point(v));
+        loopEnds.assign(p.loopEnd.begin(), p.loopEnd.end());
+      }
+    }
+    return shapes;
+  };
+  const auto a = pieces(true), b = pieces(false);
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) EXPECT_TRUE(a[i] == b[i]) << "piece " << i;
 }
 
 }  // namespace
