@@ -180,12 +180,16 @@ namespace {
 /// Traces closed loops from directed edges; where several edges leave a vertex (a pinch), takes
 /// the first one clockwise from the reversed incoming edge, so the region to the left of each
 /// loop is a proper face (the loops at a pinch are kept apart). `normal` orients the plane.
+/// Loops come in the order of their first edge in `edges` and start with it, so callers give
+/// the edges in an order that follows the geometry: point ids do not, since the ids of points
+/// made by splits running in parallel depend on the schedule.
 template <class PointOf>
 LoopList traceLoops(const EdgeList& edges, const PointOf& points, const Vec3& normal) {
-  Small<std::size_t> order(edges.size());
+  Small<std::size_t> order(edges.size());  // by start point, for finding the edges leaving one
   std::iota(order.begin(), order.end(), 0);
-  std::sort(order.begin(), order.end(),
-            [&](std::size_t i, std::size_t j) { return edges[i].from < edges[j].from; });
+  std::sort(order.begin(), order.end(), [&](std::size_t i, std::size_t j) {
+    return edges[i].from != edges[j].from ? edges[i].from < edges[j].from : i < j;
+  });
   auto outgoing = [&](std::uint32_t v) {
     auto lo = std::lower_bound(order.begin(), order.end(), v,
                                [&](std::size_t i, std::uint32_t x) { return edges[i].from < x; });
@@ -205,7 +209,7 @@ LoopList traceLoops(const EdgeList& edges, const PointOf& points, const Vec3& no
 
   Small<char> used(edges.size(), 0);
   LoopList loops;
-  for (std::size_t start : order) {
+  for (std::size_t start = 0; start < edges.size(); ++start) {
     if (used[start]) continue;
     Small<std::uint32_t> loop{edges[start].from};
     used[start] = 1;
@@ -422,7 +426,12 @@ void PlaneSplitter::splitPolygon(const PiecePolygon& polygon, const SplitPlane& 
   std::sort(toggles.begin(), toggles.end());
   std::sort(alongLine.begin(), alongLine.end());
 
-  // 4. Directed edges of each side: boundary pieces plus closing segments along L.
+  // 4. Directed edges of each side: boundary pieces plus closing segments along L. A boundary
+  //    edge on L running along t has the polygon, and so the minus side, on its left: it goes to
+  //    minus. Its direction is taken from the order the closing segments use (exact on ties): an
+  //    edge whose ends tie in rounded coordinate k (an edge of round-off length, as from a
+  //    surface vertex on one grid plane within round-off of another) must fall on the side its
+  //    closing segments expect, or that side's loop stays open.
   EdgeList minusEdges, plusEdges;
   for (const auto& loop : loops) {
     const std::size_t m = loop.size();
@@ -435,7 +444,7 @@ void PlaneSplitter::splitPolygon(const PiecePolygon& polygon, const SplitPlane& 
       else if (a.side > 0 || b.side > 0)
         plusEdges.push_back(e);
       else
-        (key(b.v) > key(a.v) ? minusEdges : plusEdges).push_back(e);
+        (before({key(a.v), a.v}, {key(b.v), b.v}) ? minusEdges : plusEdges).push_back(e);
     }
   }
   std::size_t crossings = 0;
@@ -463,24 +472,73 @@ PieceSplit PlaneSplitter::split(Piece piece, const SplitPlane& plane, FaceOrigin
   PieceSplit out;
   out.minus.reserve(piece.size() + 8);
   out.plus.reserve(piece.size() + 8);
-  for (PiecePolygon& polygon : piece) {
+  // Where each polygon goes: wholly on one side (touching the plane or not), in the plane, or
+  // across it.
+  enum class Place : signed char { Minus, Plus, InPlane, Across };
+  Small<Place, 64> place(piece.size());
+  Small<char, 64> touches(piece.size(), 0);  // has a corner in the plane
+  bool anyInPlane = false;
+  for (std::size_t i = 0; i < piece.size(); ++i) {
     int lo = 1, hi = -1;
-    for (std::uint32_t v : polygon.vertices) {
+    for (std::uint32_t v : piece[i].vertices) {
       const int s = side(v, plane);
       lo = std::min(lo, s);
       hi = std::max(hi, s);
     }
-    if (hi <= 0 && lo < 0)
-      out.minus.push_back(std::move(polygon));
-    else if (lo >= 0 && hi > 0)
-      out.plus.push_back(std::move(polygon));
-    else if (lo == 0 && hi == 0)  // in the plane: it bounds the side it faces away from
-      (polygonNormal(polygon).dot(plane.normal) > 0 ? out.minus : out.plus)
-          .push_back(std::move(polygon));
-    else {
-      if (out.polygonsSplit == 0) rememberPlane(plane);
-      splitPolygon(polygon, plane, out.minus, out.plus);
-      ++out.polygonsSplit;
+    place[i] = hi <= 0 && lo < 0    ? Place::Minus
+               : lo >= 0 && hi > 0  ? Place::Plus
+               : lo == 0 && hi == 0 ? Place::InPlane
+                                    : Place::Across;
+    touches[i] = lo <= 0 && hi >= 0;
+    anyInPlane = anyInPlane || place[i] == Place::InPlane;
+  }
+  if (anyInPlane) {
+    // A connected set of polygons lying wholly in the plane (the points of a tip of round-off
+    // size beyond another plane, all rounded onto this one) encloses nothing: it goes whole to
+    // the minus side. Sent polygon by polygon to the sides they face away from, it would leave
+    // on each side a fold that no cap in this plane closes. Polygons are joined across the
+    // edges in the plane that they share (all edges of a polygon in the plane).
+    Small<std::pair<std::uint64_t, std::uint32_t>, 32> edges;  // (edge in the plane, polygon)
+    for (std::size_t i = 0; i < piece.size(); ++i) {
+      if (!touches[i]) continue;
+      const PiecePolygon& polygon = piece[i];
+      for (std::size_t k = 0; k < polygon.numLoops(); ++k) {
+        const std::size_t begin = polygon.loopBegin(k), end = polygon.loopEnd[k];
+        for (std::size_t j = begin; j < end; ++j) {
+          const std::uint32_t a = polygon.vertices[j];
+          const std::uint32_t b = polygon.vertices[j + 1 == end ? begin : j + 1];
+          if (place[i] == Place::InPlane || (side(a, plane) == 0 && side(b, plane) == 0))
+            edges.emplace_back(std::uint64_t(std::min(a, b)) << 32 | std::max(a, b),
+                               static_cast<std::uint32_t>(i));
+        }
+      }
+    }
+    std::sort(edges.begin(), edges.end());
+    UnionFind joined(piece.size());
+    for (std::size_t e = 1; e < edges.size(); ++e)
+      if (edges[e].first == edges[e - 1].first) joined.unite(edges[e].second, edges[e - 1].second);
+    Small<char, 64> anchored(piece.size(), 0);  // joined to a polygon not in the plane
+    for (std::size_t i = 0; i < piece.size(); ++i)
+      if (touches[i] && place[i] != Place::InPlane)
+        anchored[joined.find(static_cast<std::uint32_t>(i))] = 1;
+    for (std::size_t i = 0; i < piece.size(); ++i)
+      if (place[i] == Place::InPlane && !anchored[joined.find(static_cast<std::uint32_t>(i))])
+        place[i] = Place::Minus;
+  }
+  for (std::size_t i = 0; i < piece.size(); ++i) {
+    PiecePolygon& polygon = piece[i];
+    switch (place[i]) {
+      case Place::Minus: out.minus.push_back(std::move(polygon)); break;
+      case Place::Plus: out.plus.push_back(std::move(polygon)); break;
+      case Place::InPlane:  // it bounds the side it faces away from
+        (polygonNormal(polygon).dot(plane.normal) > 0 ? out.minus : out.plus)
+            .push_back(std::move(polygon));
+        break;
+      case Place::Across:
+        if (out.polygonsSplit == 0) rememberPlane(plane);
+        splitPolygon(polygon, plane, out.minus, out.plus);
+        ++out.polygonsSplit;
+        break;
     }
   }
   if (out.minus.empty() || out.plus.empty()) return out;
@@ -512,9 +570,19 @@ PieceSplit PlaneSplitter::split(Piece piece, const SplitPlane& plane, FaceOrigin
   }
   if (capEdges.empty()) return out;
   const auto pointOf = [this](std::uint32_t v) -> const Vec3& { return point(v); };
-  std::sort(capEdges.begin(), capEdges.end(), [](const DirectedEdge& a, const DirectedEdge& b) {
-    return a.from != b.from ? a.from < b.from : a.to < b.to;
-  });  // deterministic output, whatever the hash order
+  // The caps' loops start where traceLoops meets them in this order: by the positions of the
+  // edges' ends, so that the output does not depend on the point ids (schedule-dependent).
+  // Ids only break ties between distinct points at one position (an intersection that rounded
+  // onto a surface vertex: the vertex's id is the smaller whatever the schedule).
+  auto byPosition = [this](std::uint32_t u, std::uint32_t v) {
+    const Vec3& p = point(u);
+    const Vec3& q = point(v);
+    if (p != q) return std::lexicographical_compare(p.data(), p.data() + 3, q.data(), q.data() + 3);
+    return u < v;
+  };
+  std::sort(capEdges.begin(), capEdges.end(), [&](const DirectedEdge& a, const DirectedEdge& b) {
+    return a.from != b.from ? byPosition(a.from, b.from) : byPosition(a.to, b.to);
+  });
   for (PiecePolygon& cap :
        groupLoops(traceLoops(capEdges, pointOf, plane.normal), pointOf, plane.normal, capOrigin)) {
     out.plus.push_back(reversed(cap));

@@ -14,6 +14,7 @@
 #include "polydg/mesh/slice.h"
 #include "polydg/mesh/surface_shapes.h"
 #include "polydg/mesh/validate.h"
+#include "tests/support/identical_meshes.h"
 
 namespace polydg {
 namespace {
@@ -21,32 +22,7 @@ namespace {
 /// Relative volume change allowed by merging: only the summation order of the cones changes.
 constexpr double kVolumeTolerance = 1e-12;
 
-void expectSameMesh(const PolyMesh& a, const PolyMesh& b) {
-  ASSERT_EQ(a.numVertices(), b.numVertices());
-  ASSERT_EQ(a.numFaces(), b.numFaces());
-  ASSERT_EQ(a.numElements(), b.numElements());
-  for (std::size_t i = 0; i < a.numFaces(); ++i) {
-    const Face& x = a.face(FaceId(i));
-    const Face& y = b.face(FaceId(i));
-    EXPECT_TRUE(
-        std::equal(x.vertices.begin(), x.vertices.end(), y.vertices.begin(), y.vertices.end()))
-        << "face " << i;
-    EXPECT_TRUE(std::equal(x.loopEnd.begin(), x.loopEnd.end(), y.loopEnd.begin(), y.loopEnd.end()))
-        << "face " << i;
-    EXPECT_EQ(x.front, y.front) << "face " << i;
-    EXPECT_EQ(x.back, y.back) << "face " << i;
-    EXPECT_EQ(x.origin, y.origin) << "face " << i;
-  }
-  for (std::size_t e = 0; e < a.numElements(); ++e) {
-    const FaceList& x = a.element(ElementId(e)).faces;
-    const FaceList& y = b.element(ElementId(e)).faces;
-    ASSERT_EQ(x.size(), y.size()) << "element " << e;
-    for (std::size_t j = 0; j < x.size(); ++j) {
-      EXPECT_EQ(x[j].face, y[j].face) << "element " << e;
-      EXPECT_EQ(x[j].reversed, y[j].reversed) << "element " << e;
-    }
-  }
-}
+using testing::expectIdenticalMeshes;
 
 TEST(MergeElements, BuildsTheMeshOfMergeElementGroups) {
   // Grids of 4^3 and 24^3 cells (the larger one has faces for several parallel blocks): a
@@ -71,7 +47,7 @@ TEST(MergeElements, BuildsTheMeshOfMergeElementGroups) {
     PolyMesh expected = grid;
     expected.mergeElementGroups(group, groups);
     const PolyMesh merged = mergeElements(grid, group, groups);
-    expectSameMesh(merged, expected);
+    expectIdenticalMeshes(merged, expected);
     EXPECT_EQ(merged.numElements(), ne - 4);
   }
 }

@@ -6,6 +6,7 @@
 #include "polydg/mesh/meshing.h"
 
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
 #include <algorithm>
 #include <array>
@@ -14,7 +15,9 @@
 #include <string>
 
 #include "polydg/integrate/moment_cache.h"
+#include "polydg/mesh/surface_io.h"
 #include "polydg/mesh/surface_shapes.h"
+#include "tests/support/identical_meshes.h"
 #include "tests/support/shapes.h"
 
 namespace polydg {
@@ -256,6 +259,38 @@ TEST(Meshing, SwissCheeseWithWallsJustOffTheGridPlanes) {
   const double volume = swissCheeseVolume(walls);
   EXPECT_LT(std::abs(m.report.inputVolume - volume) / volume, kVolumeTolerance);
   EXPECT_LT(std::abs(m.report.outputVolume - volume) / volume, kVolumeTolerance);
+}
+
+TEST(Meshing, TorusObjAtCellCountsPuttingAVertexOnOneGridPlaneAndNearAnother) {
+  // At 14 cells (and multiples) a vertex of testdata/torus.obj lies on the grid plane
+  // y = -0.6 and 1.1e-16 from x = 0: the points x = 0 makes on its edges round onto y = -0.6
+  // (PlaneSplit.VertexOnOnePlaneAndWithinRoundOffOfAnother). Slicing once stopped there with
+  // "traceLoops: open chain of edges".
+  const TriangleSurface torus = readSurface(std::string(POLYDG_TESTDATA_DIR) + "/torus.obj");
+  for (const int n : {14, 28}) {
+    SCOPED_TRACE("cells " + std::to_string(n));
+    const MeshingResult m = meshSurface(torus, cells(n));
+    EXPECT_TRUE(m.report.validation.passed);
+    EXPECT_EQ(m.report.validation.components, 1u);
+    EXPECT_LT(std::abs(m.report.outputVolume - m.report.inputVolume) / m.report.inputVolume,
+              kVolumeTolerance);
+  }
+}
+
+TEST(Meshing, SameInputGivesTheSameMeshWhateverTheSchedule) {
+  // Slicing runs in parallel, and the ids of the points it makes follow the schedule; the mesh
+  // must not. One run on one thread, then runs on all threads: the same mesh in every detail.
+  const TriangleSurface torus = readSurface(std::string(POLYDG_TESTDATA_DIR) + "/torus.obj");
+  MeshingResult serial;
+  {
+    const tbb::global_control oneThread(tbb::global_control::max_allowed_parallelism, 1);
+    serial = meshSurface(torus, cells(20));
+  }
+  for (int run = 0; run < 3; ++run) {
+    SCOPED_TRACE("parallel run " + std::to_string(run));
+    const MeshingResult parallel = meshSurface(torus, cells(20));
+    testing::expectIdenticalMeshes(serial.mesh, parallel.mesh);
+  }
 }
 
 }  // namespace

@@ -5,9 +5,11 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <map>
 
 #include "polydg/mesh/primitives.h"
+#include "polydg/mesh/surface_shapes.h"
 
 namespace polydg {
 namespace {
@@ -73,6 +75,21 @@ SplitPlane generalPlane(const Vec3& n, double d, std::uint32_t id) {
   p.offset = d;
   p.id = id;
   return p;
+}
+
+/// The tetrahedron on points 0..3 as a piece, its faces outward whatever the points' order.
+Piece tetrahedron(const std::vector<Vec3>& p) {
+  const bool positive = (p[1] - p[0]).cross(p[2] - p[0]).dot(p[3] - p[0]) > 0;
+  std::vector<std::array<std::uint32_t, 3>> faces{{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+  Piece piece;
+  for (auto f : faces) {
+    if (!positive) std::swap(f[1], f[2]);
+    PiecePolygon polygon;
+    polygon.vertices.assign(f.begin(), f.end());
+    polygon.loopEnd = {3};
+    piece.push_back(polygon);
+  }
+  return piece;
 }
 
 TEST(PlaneSplit, CubeThroughItsMiddle) {
@@ -201,6 +218,90 @@ TEST(PlaneSplit, SplittingTwiceByTheSamePlaneIsANoOp) {
   EXPECT_TRUE(again.plus.empty());
   EXPECT_EQ(again.minus.size(), first.minus.size());
   EXPECT_EQ(splitter.numPoints(), points);
+}
+
+TEST(PlaneSplit, VertexOnOnePlaneAndWithinRoundOffOfAnother) {
+  // Corner 0 lies on y = -0.6 and 1e-16 on the minus side of x = 0 (as a vertex of
+  // testdata/torus.obj does at 14 cells). x = 0 cuts its three edges within round-off of it:
+  // the new points round onto y = -0.6 and tie in x. On the plus side of x = 0, a face through
+  // two of them has an edge of round-off length on the cut line of y = -0.6, whose side must
+  // follow the (exact) order of the points on that line, or that side stays open. On the minus
+  // side, the tip of round-off size lies wholly in y = -0.6 and must stay whole.
+  constexpr double kY = -0.6;
+  // Volumes here are cone sums about the origin, 0.6 away, over faces of area ~1e-2: their
+  // round-off is about 1e-16 * 0.6 * 1e-2.
+  constexpr double kVolumeTolerance = 1e-17;
+  for (const double zSign : {1.0, -1.0})
+    for (const double apexY : {-0.59, -0.61}) {
+      SCOPED_TRACE("zSign " + std::to_string(zSign) + ", apexY " + std::to_string(apexY));
+      const std::vector<Vec3> points{Vec3(-1e-16, kY, 0.0), Vec3(0.06, -0.597, 0.0),
+                                     Vec3(0.06, -0.605, -0.08 * zSign),
+                                     Vec3(0.05, apexY, 0.08 * zSign)};
+      PlaneSplitter splitter(points);
+      const Piece tet = tetrahedron(points);
+      const PieceSplit sx =
+          splitter.split(tet, SplitPlane::axisAligned(0, 0.0, 1), FaceOrigin::Interior);
+      ASSERT_TRUE(closed(sx.minus));
+      ASSERT_TRUE(closed(sx.plus));
+      double sum = 0.0;
+      for (const Piece& side : {sx.minus, sx.plus}) {
+        const PieceSplit sy =
+            splitter.split(side, SplitPlane::axisAligned(1, kY, 2), FaceOrigin::Interior);
+        EXPECT_TRUE(closed(sy.minus));
+        EXPECT_TRUE(closed(sy.plus));
+        sum += volume(sy.minus, splitter.points()) + volume(sy.plus, splitter.points());
+      }
+      EXPECT_NEAR(sum, volume(tet, points), kVolumeTolerance);
+    }
+}
+
+TEST(PlaneSplit, OutputDoesNotDependOnTheOrderOfSplits) {
+  // Slicing splits pieces in parallel, so the ids of the points it makes depend on the
+  // schedule. Two splitters split the halves of a torus (by x = 0.1) by y = 0.2 and then by
+  // z = 0.05 in opposite orders: the pieces must be the same polygons, in the same order, with
+  // corners at the same positions from the same first corner.
+  const TriangleSurface torus = polydg::torus(Vec3::Zero(), 1.0, 0.4, 24, 12);
+  Piece surface;
+  for (const auto& t : torus.triangles) {
+    PiecePolygon p;
+    p.vertices.assign(t.begin(), t.end());
+    p.loopEnd = {3};
+    surface.push_back(p);
+  }
+  auto pieces = [&](bool minusFirst) {
+    PlaneSplitter splitter(torus.vertices);
+    const PieceSplit halves =
+        splitter.split(surface, SplitPlane::axisAligned(0, 0.1, 1), FaceOrigin::Interior);
+    std::vector<Piece> out;
+    const Piece* order[2] = {&halves.minus, &halves.plus};
+    if (!minusFirst) std::swap(order[0], order[1]);
+    for (const Piece* half : order) {
+      const PieceSplit quarters =
+          splitter.split(*half, SplitPlane::axisAligned(1, 0.2, 2), FaceOrigin::Interior);
+      for (const Piece* quarter : {&quarters.minus, &quarters.plus}) {
+        const PieceSplit eighths =
+            splitter.split(*quarter, SplitPlane::axisAligned(2, 0.05, 3), FaceOrigin::Interior);
+        out.push_back(eighths.minus);
+        out.push_back(eighths.plus);
+      }
+    }
+    if (!minusFirst) std::rotate(out.begin(), out.begin() + 4, out.end());
+    // Each piece as its polygons' corner positions and loop ends.
+    std::vector<std::vector<std::pair<std::vector<Vec3>, std::vector<std::uint32_t>>>> shapes;
+    for (const Piece& piece : out) {
+      EXPECT_TRUE(closed(piece));
+      auto& shape = shapes.emplace_back();
+      for (const PiecePolygon& p : piece) {
+        auto& [corners, loopEnds] = shape.emplace_back();
+        for (std::uint32_t v : p.vertices) corners.push_back(splitter.point(v));
+        loopEnds.assign(p.loopEnd.begin(), p.loopEnd.end());
+      }
+    }
+    return shapes;
+  };
+  const auto a = pieces(true), b = pieces(false);
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) EXPECT_TRUE(a[i] == b[i]) << "piece " << i;
 }
 
 }  // namespace

@@ -122,5 +122,27 @@ TEST(Slice, FarFromTheOriginAndAtSmallScale) {
   }
 }
 
+TEST(Slice, TipOfRoundOffSizeBeyondAGridPlane) {
+  // A tetrahedron whose corner lies on the grid plane y = -0.5 and pokes 1e-16 beyond x = 0:
+  // the tip cut off by x = 0 rounds wholly into y = -0.5 (a closed piece lying in the plane),
+  // and on the other side a face has an edge of round-off length along y = -0.5. The tip goes
+  // whole to one side, and welding removes it.
+  Grid grid;
+  grid.cellSize = 0.25;
+  grid.cells = {8, 8, 8};
+  ASSERT_EQ(grid.plane(0, 4), 0.0);
+  ASSERT_EQ(grid.plane(1, 2), -0.5);
+  for (const double zSign : {1.0, -1.0})
+    for (const double apexY : {-0.49, -0.51}) {
+      SCOPED_TRACE("zSign " + std::to_string(zSign) + ", apexY " + std::to_string(apexY));
+      TriangleSurface tet;
+      tet.vertices = {Vec3(-1e-16, -0.5, 0.0), Vec3(0.06, -0.497, 0.0),
+                      Vec3(0.06, -0.505, -0.08 * zSign), Vec3(0.05, apexY, 0.08 * zSign)};
+      tet.triangles = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+      if (enclosedVolume(tet) < 0) tet = reversedSurface(tet);
+      expectGood(slice(tet, grid), enclosedVolume(tet), 1);
+    }
+}
+
 }  // namespace
 }  // namespace polydg

@@ -82,9 +82,11 @@ class PlaneSplitter {
   int side(std::uint32_t v, const SplitPlane& plane) const;
 
   /// Splits a closed piece. Polygons wholly on one side (touching the plane or not) go to that
-  /// side; polygons lying in the plane go to the side they face away from; polygons crossing it
-  /// are split. The new faces in the plane ("caps", tagged `capOrigin`) close both sides:
-  /// minus's caps face along +normal, plus's are the same polygons reversed.
+  /// side; polygons lying in the plane go to the side they face away from, except that polygons
+  /// joined (across edges in the plane) to no polygon off the plane enclose nothing and go
+  /// together to minus; polygons crossing it are split. The new faces in the plane ("caps", tagged
+  /// `capOrigin`) close both sides: minus's caps face along +normal, plus's are the same polygons
+  /// reversed.
   PieceSplit split(Piece piece, const SplitPlane& plane, FaceOrigin capOrigin);
 
   /// The connected components of a piece (polygons joined across shared edges).
