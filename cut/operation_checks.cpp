@@ -79,8 +79,7 @@ void validateOperation(const PolyMesh& mesh, const MomentCache& moments,
   options.local = false;
   options.patchTest = GlobalCheck::Always;
   options.rigidModes = GlobalCheck::Always;
-  const MeshCheck c =
-      checkMesh(mesh, options, moments.degree() >= 2 * degree ? &moments : nullptr);
+  const MeshCheck c = checkMesh(mesh, options, moments.degree() >= 2 * degree ? &moments : nullptr);
   v.elementsChecked = mesh.numElements();
   if (c.patch) {
     v.regionElements = mesh.numElements();
