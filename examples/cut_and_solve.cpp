@@ -89,7 +89,10 @@ int main(int argc, char** argv) {
               << "\n"
               << polydg::toJson(solved)["solver"].dump() << '\n';
     return 0;
-  } catch (const polydg::Error& e) {  // bad input, or a check that failed
+  } catch (const polydg::CheckFailure& e) {  // an operation ran, and its result failed a check
+    std::cerr << "check failed: " << e.what() << '\n';
+    return 1;
+  } catch (const polydg::Error& e) {  // bad input: nothing was changed or written
     std::cerr << "error: " << e.what() << '\n';
     return 2;
   } catch (const std::exception& e) {
