@@ -196,8 +196,9 @@ class Model {
   std::size_t facesIntegrated() const;
 
   /// Cuts the model in place and validates the operation. Throws InputError for bad options.
-  /// A failed validation (or a cut that would leave nothing) throws CheckFailure naming the
-  /// operation and the check; the model must then not be used further.
+  /// A failed validation, or a cut that leaves nothing, is reported (validation.passed false,
+  /// validation.failure naming the check); the model must then not be used further: its
+  /// operations throw CheckFailure naming the failed one.
   OperationReport cut(const CutRequest& request);
   /// Merges slivers (see MergeRequest), validated like a cut.
   OperationReport mergeSlivers(const MergeRequest& request);
