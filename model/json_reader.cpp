@@ -22,7 +22,8 @@ JsonObjectReader::JsonObjectReader(const json& object, std::string place, std::s
 }
 
 void JsonObjectReader::fail(const std::string& place, const std::string& what) const {
-  throw InputError(file_ + ": " + place + ": " + what + (hint_.empty() ? "" : "; " + hint_));
+  throw InputError(file_ + ": " + (place.empty() ? "" : place + ": ") + what +
+                   (hint_.empty() ? "" : "; " + hint_));
 }
 
 bool JsonObjectReader::has(const std::string& key) {

@@ -195,6 +195,15 @@ Pipeline parsePipeline(const json& document, const std::string& file, const fs::
   return p;
 }
 
+PipelineStep parsePipelineStep(const json& step, const std::string& caller,
+                               const std::string& hint) {
+  if (!step.is_object()) throw InputError(caller + ": expected an object of step keys");
+  JsonObjectReader r(step, "", caller, hint);
+  PipelineStep out = parseStep(r);
+  r.finish();
+  return out;
+}
+
 Pipeline readPipeline(const std::string& file) {
   std::ifstream in(file);
   if (!in) throw InputError(file + ": cannot open the pipeline file");

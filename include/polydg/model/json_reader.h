@@ -26,7 +26,7 @@ class JsonObjectReader {
 
   [[noreturn]] void fail(const std::string& place, const std::string& what) const;
   /// "PLACE.key".
-  std::string at(const std::string& key) const { return place_ + "." + key; }
+  std::string at(const std::string& key) const { return place_.empty() ? key : place_ + "." + key; }
   const std::string& place() const { return place_; }
 
   bool has(const std::string& key);

@@ -61,6 +61,12 @@ Pipeline readPipeline(const std::string& file);
 Pipeline parsePipeline(const nlohmann::json& document, const std::string& file,
                        const std::filesystem::path& base);
 
+/// Parses one step object of the pipeline format (a `steps` entry) on its own, checked as in a
+/// pipeline; messages start with `caller` ("Model.cut(): plane: ...; see `hint`"). The Python
+/// module passes its keyword arguments through it.
+PipelineStep parsePipelineStep(const nlohmann::json& step, const std::string& caller,
+                               const std::string& hint);
+
 /// The outcome of one input.
 struct InputOutcome {
   std::string input, stem;

@@ -1,0 +1,335 @@
+// The compiled part of the Python module `polydg` (polydg._polydg): surfaces, the Model and its
+// operations, each a thin layer over the library (polydg/model/model.h). Keyword arguments of
+// the operations are checked by the pipeline format's step parser (parsePipelineStep), so a
+// Python call, a pipeline step and a `polydg` command accept and refuse the same values; reports
+// are the JSON of model/report_json.h as Python dicts. Long operations release the GIL.
+#include <pybind11/functional.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <cstring>
+#include <filesystem>
+#include <string>
+#include <variant>
+
+#include "polydg/mesh/surface_io.h"
+#include "polydg/model/model.h"
+#include "polydg/model/pipeline.h"
+#include "polydg/model/report_json.h"
+#include "polydg/util/error.h"
+#include "polydg/version.h"
+
+namespace py = pybind11;
+
+namespace polydg::python {
+
+namespace {
+
+/// A JSON value as the Python object json.loads makes of it (dicts, lists, floats, ...).
+py::object toPython(const nlohmann::json& j) {
+  return py::module_::import("json").attr("loads")(j.dump());
+}
+
+/// A Python value of JSON types as JSON (for the step parser).
+nlohmann::json jsonOf(const py::handle& value) {
+  const std::string text = py::str(py::module_::import("json").attr("dumps")(value));
+  return nlohmann::json::parse(text);
+}
+
+/// The keyword arguments a caller gave (None means "not given"), as a pipeline step object.
+nlohmann::json stepObject(const char* step, const py::dict& kwargs) {
+  nlohmann::json object = nlohmann::json::object();
+  object["step"] = step;
+  for (const auto& [key, value] : kwargs)
+    if (!value.is_none()) object[py::str(key).cast<std::string>()] = jsonOf(value);
+  return object;
+}
+
+template <class Step>
+Step parseStep(const char* step, const char* caller, const py::dict& kwargs) {
+  const PipelineStep parsed = parsePipelineStep(
+      stepObject(step, kwargs), caller,
+      "see help(polydg." + std::string(caller).substr(0, std::strlen(caller) - 2) +
+          ") or README.md");
+  return std::get<Step>(parsed);
+}
+
+/// A read-only float64 array of shape (n, 3) copied from Vec3s.
+py::array_t<double> pointsArray(const std::vector<Vec3>& points) {
+  py::array_t<double> out({static_cast<py::ssize_t>(points.size()), py::ssize_t(3)});
+  auto a = out.mutable_unchecked<2>();
+  for (std::size_t i = 0; i < points.size(); ++i)
+    for (int k = 0; k < 3; ++k) a(i, k) = points[i][k];
+  return out;
+}
+
+TriangleSurface surfaceFromArrays(const py::array_t<double, py::array::c_style>& v,
+                                  const py::array_t<std::int64_t, py::array::c_style>& f) {
+  if (v.ndim() != 2 || v.shape(1) != 3)
+    throw InputError("Surface(V, F): V must be an n x 3 array of coordinates");
+  if (f.ndim() != 2 || f.shape(1) != 3)
+    throw InputError("Surface(V, F): F must be an m x 3 array of vertex indices");
+  TriangleSurface s;
+  auto va = v.unchecked<2>();
+  s.vertices.reserve(v.shape(0));
+  for (py::ssize_t i = 0; i < v.shape(0); ++i) {
+    const Vec3 p(va(i, 0), va(i, 1), va(i, 2));
+    if (!p.allFinite())
+      throw InputError("Surface(V, F): V[" + std::to_string(i) +
+                       "] is not finite; fix the coordinates");
+    s.vertices.push_back(p);
+  }
+  auto fa = f.unchecked<2>();
+  s.triangles.reserve(f.shape(0));
+  for (py::ssize_t t = 0; t < f.shape(0); ++t) {
+    std::array<std::uint32_t, 3> tri{};
+    for (int k = 0; k < 3; ++k) {
+      const std::int64_t index = fa(t, k);
+      if (index < 0 || index >= v.shape(0))
+        throw InputError("Surface(V, F): F[" + std::to_string(t) + "] refers to vertex " +
+                         std::to_string(index) + ", but V has " + std::to_string(v.shape(0)) +
+                         " rows");
+      tri[k] = static_cast<std::uint32_t>(index);
+    }
+    s.triangles.push_back(tri);
+  }
+  return s;
+}
+
+/// A progress callback called with the GIL held, or none.
+ProgressFn progressFn(const py::object& callback) {
+  if (callback.is_none()) return {};
+  return [callback](double fraction) {
+    py::gil_scoped_acquire gil;
+    callback(fraction);
+  };
+}
+
+}  // namespace
+}  // namespace polydg::python
+
+PYBIND11_MODULE(_polydg, m) {
+  using namespace polydg;
+  using namespace polydg::python;
+  m.doc() = "polydg's compiled core; use the package `polydg`";
+  m.attr("__version__") = kVersion;
+
+  // Errors: polydg.Error (bad input, nothing changed), polydg.CheckFailure (a result failed a
+  // check; a Model it happened to must not be used further).
+  static py::exception<Error> error(m, "Error");
+  static py::exception<CheckFailure> checkFailure(m, "CheckFailure", error.ptr());
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const CheckFailure& e) {
+      PyErr_SetString(checkFailure.ptr(), e.what());
+    } catch (const Error& e) {
+      PyErr_SetString(error.ptr(), e.what());
+    }
+  });
+
+  py::class_<TriangleSurface>(m, "Surface", py::dynamic_attr(),
+                              "A triangle surface: vertices V (n x 3 float64) and triangles F "
+                              "(m x 3 vertex indices).")
+      .def(py::init(&surfaceFromArrays), py::arg("V"), py::arg("F"),
+           "Surface(V, F): V an n x 3 array of coordinates (float64, model units), F an m x 3 "
+           "array of 0-based vertex indices, counter-clockwise seen from outside. Copied.")
+      .def_property_readonly(
+          "V", [](const TriangleSurface& s) { return pointsArray(s.vertices); },
+          "The vertices, an n x 3 float64 array (a copy).")
+      .def_property_readonly(
+          "F",
+          [](const TriangleSurface& s) {
+            py::array_t<std::int64_t> out(
+                {static_cast<py::ssize_t>(s.triangles.size()), py::ssize_t(3)});
+            auto a = out.mutable_unchecked<2>();
+            for (std::size_t t = 0; t < s.triangles.size(); ++t)
+              for (int k = 0; k < 3; ++k) a(t, k) = s.triangles[t][k];
+            return out;
+          },
+          "The triangles, an m x 3 int64 array of vertex indices (a copy).")
+      .def("__repr__", [](const TriangleSurface& s) {
+        return "<polydg.Surface: " + std::to_string(s.vertices.size()) + " vertices, " +
+               std::to_string(s.triangles.size()) + " triangles>";
+      });
+
+  m.def(
+      "read_surface",
+      [](const std::string& path) {
+        SurfaceReadInfo info;
+        TriangleSurface s;
+        {
+          py::gil_scoped_release release;
+          try {
+            s = readSurface(path, &info);
+          } catch (const std::runtime_error& e) {
+            throw InputError(e.what());
+          }
+        }
+        return py::make_tuple(s, info.warnings);
+      },
+      py::arg("path"));
+
+  py::class_<Model>(m, "Model", py::dynamic_attr(),
+                    "A simulation mesh with its cached integrals and provenance (polydg::Model).")
+      .def_property_readonly(
+          "points", [](const Model& model) { return pointsArray(model.mesh().positions().raw()); },
+          "The mesh's points, an n x 3 float64 array (a copy).")
+      .def_property_readonly("num_elements",
+                             [](const Model& model) { return model.mesh().numElements(); })
+      .def_property_readonly("num_faces",
+                             [](const Model& model) { return model.mesh().numFaces(); })
+      .def_property_readonly("volume", &Model::volume, "The sum of the element volumes.")
+      .def_property_readonly(
+          "element_volumes",
+          [](Model& model) {
+            const MomentCache& moments = model.moments();
+            py::array_t<double> out(static_cast<py::ssize_t>(model.mesh().numElements()));
+            auto a = out.mutable_unchecked<1>();
+            for (std::size_t e = 0; e < model.mesh().numElements(); ++e)
+              a(e) = moments.volume(ElementId(e));
+            return out;
+          },
+          "The element volumes, a float64 array (exact moments; model units cubed).")
+      .def_property_readonly(
+          "element_centroids",
+          [](Model& model) {
+            const MomentCache& moments = model.moments();
+            std::vector<Vec3> c(model.mesh().numElements());
+            for (std::size_t e = 0; e < c.size(); ++e) c[e] = moments.centroid(ElementId(e));
+            return pointsArray(c);
+          },
+          "The element centroids, an n x 3 float64 array.")
+      .def_property_readonly(
+          "faces_integrated", &Model::facesIntegrated,
+          "Faces integrated over the model's life (each integration of each face counts).")
+      .def_property_readonly(
+          "provenance", [](const Model& model) { return toPython(toJson(model.provenance())); })
+      .def("_cut",
+           [](Model& model, const py::kwargs& kwargs) {
+             CutStep step = parseStep<CutStep>("cut", "Model.cut()", kwargs);
+             OperationReport r;
+             {
+               py::gil_scoped_release release;
+               r = model.cut(step.request);
+             }
+             if (!r.validation.passed)
+               throw CheckFailure(r.op + " failed: " + r.validation.failure);
+             return toPython(toJson(r));
+           })
+      .def("_merge_slivers",
+           [](Model& model, const py::kwargs& kwargs) {
+             MergeStep step = parseStep<MergeStep>("merge", "Model.merge_slivers()", kwargs);
+             OperationReport r;
+             {
+               py::gil_scoped_release release;
+               r = model.mergeSlivers(step.request);
+             }
+             if (!r.validation.passed)
+               throw CheckFailure(r.op + " failed: " + r.validation.failure);
+             return toPython(toJson(r));
+           })
+      .def("_check",
+           [](Model& model, const py::kwargs& kwargs) {
+             CheckStep step = parseStep<CheckStep>("check", "Model.check()", kwargs);
+             MeshCheck c;
+             {
+               py::gil_scoped_release release;
+               c = model.check(step.options);
+             }
+             return toPython(toJson(c));
+           })
+      .def("_solve",
+           [](Model& model, const py::kwargs& kwargs) {
+             SolveStep step = parseStep<SolveStep>("solve", "Model.solve()", kwargs);
+             SolveReport r;
+             {
+               py::gil_scoped_release release;
+               r = model.solve(step.options);
+             }
+             return toPython(toJson(r));
+           })
+      .def(
+          "_write",
+          [](const Model& model, const std::string& path, bool solution) {
+            WriteOptions options;
+            options.solution = solution;
+            WriteReport r;
+            {
+              py::gil_scoped_release release;
+              r = model.write(path, options);
+            }
+            return toPython(toJson(r));
+          },
+          py::arg("path"), py::arg("solution") = true);
+
+  m.def(
+      "mesh",
+      [](const TriangleSurface& surface, const py::dict& kwargs, const std::string& source,
+         const py::object& progress) {
+        MeshStep step = parseStep<MeshStep>("mesh", "polydg.mesh()", kwargs);
+        step.options.progress = progressFn(progress);
+        MeshReport report;
+        std::optional<Model> model;
+        {
+          py::gil_scoped_release release;
+          model.emplace(Model::fromSurface(surface, step.options, report, source));
+        }
+        if (!report.passed())
+          throw CheckFailure("the new mesh failed: " + report.failures().front());
+        return py::make_tuple(std::move(*model), toPython(toJson(report)));
+      },
+      py::arg("surface"), py::arg("kwargs"), py::arg("source") = "",
+      py::arg("progress") = py::none());
+
+  m.def(
+      "read",
+      [](const std::string& path) {
+        ReadReport report;
+        std::optional<Model> model;
+        {
+          py::gil_scoped_release release;
+          model.emplace(Model::read(path, &report));
+        }
+        return py::make_tuple(std::move(*model), toPython(toJson(report)));
+      },
+      py::arg("path"));
+
+  m.def(
+      "run_input",
+      [](const std::string& pipelineText, const std::string& pipelineFile, const std::string& base,
+         const std::string& input, const std::string& stem, const std::string& out) {
+        const Pipeline pipeline =
+            parsePipeline(nlohmann::json::parse(pipelineText), pipelineFile, base);
+        InputOutcome outcome;
+        {
+          py::gil_scoped_release release;
+          outcome = runPipelineInput(pipeline, input, stem, out);
+        }
+        return toPython(outcome.report);
+      },
+      py::arg("pipeline"), py::arg("pipeline_file"), py::arg("base"), py::arg("input"),
+      py::arg("stem"), py::arg("out"));
+
+  m.def(
+      "check_pipeline",
+      [](const std::string& pipelineText, const std::string& pipelineFile,
+         const std::string& base) {
+        nlohmann::json document;
+        try {
+          document = nlohmann::json::parse(pipelineText);
+        } catch (const nlohmann::json::parse_error& e) {
+          throw InputError(pipelineFile + ": not valid JSON (" + std::string(e.what()) + ")");
+        }
+        return parsePipeline(document, pipelineFile, base).inputs;
+      },
+      py::arg("pipeline"), py::arg("pipeline_file"), py::arg("base"));
+
+  m.def("unique_stems", &uniqueStems, py::arg("inputs"));
+  m.def(
+      "refuse_inputs_in_outputs",
+      [](const std::vector<std::string>& inputs, const std::vector<std::string>& stems,
+         const std::string& out) { refuseInputsInOutputs(inputs, stems, out); },
+      py::arg("inputs"), py::arg("stems"), py::arg("out"));
+}

@@ -1,0 +1,180 @@
+"""polydg from Python: surfaces in, polyhedral DG simulation meshes out, cut, checked and solved.
+
+The same library operations as the ``polydg`` command line (one implementation of each):
+
+    import polydg
+    surface = polydg.read_surface("part.stl")           # or polydg.Surface(V, F)
+    model = polydg.mesh(surface, cells=32)               # a Model: mesh + integrals + provenance
+    report = model.cut(plane=[0, 0, 1, 0.5], remove_side="+")
+    model.check()
+    model.solve(degree=2, E=1e6, nu=0.3, gravity=[0, 0, -9.81], clamp=[{"below": [0, 0, 1, 0.1]}])
+    model.write("part.vtu")
+
+Every operation returns its report as a dict with the keys of the command line's JSON report.
+Bad input raises ``polydg.Error`` with the command line's one-line message; a result that fails
+a check raises ``polydg.CheckFailure`` (a subclass). ``polydg.batch`` runs a pipeline over many
+inputs, locally or on a Dask cluster.
+"""
+
+import os as _os
+
+from . import _polydg
+from ._polydg import CheckFailure, Error, Surface
+from .batch import batch
+
+__version__ = _polydg.__version__
+
+__all__ = [
+    "CheckFailure",
+    "Error",
+    "Model",
+    "Surface",
+    "batch",
+    "mesh",
+    "read",
+    "read_surface",
+]
+
+
+def read_surface(path):
+    """Reads a triangle surface from a file (OBJ, STL, PLY, OFF with CGAL; glTF, FBX and the rest
+    with assimp), welding vertices by exact position.
+
+    Returns a ``Surface``; lines of the file that were skipped are in ``surface.warnings`` (a list
+    of "FILE:LINE: what" strings). Raises ``Error`` for a file that cannot be read.
+    """
+    surface, warnings = _polydg.read_surface(_os.fspath(path))
+    surface.warnings = warnings
+    return surface
+
+
+def mesh(surface, cells=None, cell=None, repair="none", merge_slivers=None, dg_checks=None,
+         progress=None, source=""):
+    """Meshes a closed surface into a ``Model`` of polyhedral elements (``polydg mesh``).
+
+    surface: a ``Surface`` (from ``read_surface`` or ``Surface(V, F)``).
+    cells: about this many grid cells along the bounding box's longest side; or
+    cell: the grid cell's edge length (model units). Give exactly one.
+    repair: "none", "fill" (close holes) or "wrap" (alpha-wrap any soup).
+    merge_slivers: elements below this fraction of a cell's volume are merged (default 0.01).
+    dg_checks: run the element-local DG checks of the result (default True).
+    progress: a callable taking the slicing progress in [0, 1], or None.
+    source: the name recorded in the model's provenance (the file it came from).
+
+    Returns the Model; its ``report`` attribute holds the command line's mesh report as a dict.
+    Raises ``Error`` for a surface it refuses (naming the defect), ``CheckFailure`` if the new
+    mesh fails its validation or DG checks.
+    """
+    kwargs = {"cells": cells, "cell": cell, "repair": repair, "merge_slivers": merge_slivers,
+              "dg_checks": dg_checks}
+    model, report = _polydg.mesh(surface, kwargs, source=source or getattr(surface, "source", ""),
+                                 progress=progress)
+    model.report = report
+    return model
+
+
+def read(path):
+    """Reads a simulation mesh (VTU) into a ``Model``, with its provenance if polydg wrote it.
+    Raises ``Error`` for a file it cannot read."""
+    model, report = _polydg.read(_os.fspath(path))
+    model.report = report
+    return model
+
+
+Model = _polydg.Model
+
+
+def _to_meshio(self):
+    """The mesh as a ``meshio.Mesh`` (polyhedron cells, with the solution's fields if solved),
+    by way of a VTU file that meshio reads."""
+    import tempfile
+
+    import meshio
+
+    with tempfile.TemporaryDirectory(prefix="polydg-") as folder:
+        path = _os.path.join(folder, "model.vtu")
+        self.write(path)
+        return meshio.read(path)
+
+
+def _given(**kwargs):
+    return {k: v for k, v in kwargs.items() if v is not None}
+
+
+def _cut(self, plane=None, remove_side=None, polygon=None, validate="local",
+         sliver_fraction=None):
+    """Cuts the model in place (``polydg cut``) and validates the operation.
+
+    plane: [nx, ny, nz, d], the plane {x : n.x = d} (n need not be unit length); or
+    polygon: [[x, y, z], ...], a convex planar blade (elements whose section lies inside it are
+    split; those at its edge stay whole). Give exactly one.
+    remove_side: "+" deletes what lies where n.x > d, "-" the other side, None keeps both.
+    validate: "none", "local" (the touched elements and one ring) or "full".
+    sliver_fraction: new pieces below this fraction of the reference volume are merged
+    (default: the mesh's sliver rule, see ``provenance``).
+
+    Returns the operation's report (elements_split, pieces_created, elements_removed,
+    volume_removed, sliver_threshold, slivers_merged, faces_reintegrated, validation, ...).
+    Raises ``Error`` for bad arguments, ``CheckFailure`` if the validation fails or the cut leaves
+    nothing (the model must then not be used further).
+    """
+    return self._cut(**_given(plane=plane, polygon=polygon, remove_side=remove_side,
+                              validate=validate, sliver_fraction=sliver_fraction))
+
+
+def _merge_slivers(self, fraction=None, validate="local"):
+    """Merges elements below ``fraction`` (default: the mesh's sliver rule) of the reference
+    volume into the neighbour they share the most face area with; validated like a cut.
+    Returns the operation's report."""
+    return self._merge_slivers(**_given(fraction=fraction, validate=validate))
+
+
+def _check(self, degree=1):
+    """The checks of ``polydg check``: geometric validation, the element-local DG checks (patch
+    test, rigid modes, definiteness) of the given degree (1-3), and the global zero-mode count up
+    to 25k DOFs. Returns the report; ``report["passed"]`` says whether all passed."""
+    return self._check(degree=degree)
+
+
+def _solve(self, method="ip", degree=1, E=None, nu=None, density=None, gravity=None,
+           clamp=None, traction=None, solver=None, penalty=None, eta=None):
+    """Static linear elasticity with DG (``polydg solve``) on the model; keeps the solution for
+    ``write``.
+
+    method: "ip" (interior penalty) or "bz" (Babuska-Zlamal); degree: 1-3.
+    E: Young's modulus (default 1), nu: Poisson's ratio in (-1, 0.5) (default 0.3),
+    density: mass density (default 1; with gravity), gravity: [gx, gy, gz] (acceleration).
+    clamp: where u = 0 (weakly); a region or a list of regions (at least one). A region is a dict:
+    {"below": [a, b, c, d]} (boundary faces with (a, b, c).x <= d), {"plane": [a, b, c, d]},
+    {"box": [[x0, y0, z0], [x1, y1, z1]]} or {"axis": "z", "value": 0}.
+    traction: a region dict with "traction": [tx, ty, tz] (force per area), or a list of them.
+    solver: "auto", "cholesky" or "cg"; penalty: "bound", "doubling" or "fixed" (with eta).
+
+    Returns the solve's report (dofs, energy, max_displacement, max_von_mises, solver, ...).
+    Raises ``Error`` for bad arguments or a region that selects no face, ``CheckFailure`` for an
+    invalid mesh or a body that is not held (singular stiffness).
+    """
+    if isinstance(clamp, dict):
+        clamp = [clamp]
+    if isinstance(traction, dict):
+        traction = [traction]
+    material = _given(E=E, nu=nu, density=density)
+    return self._solve(**_given(method=method, degree=degree, material=material or None,
+                                gravity=gravity, clamp=clamp, traction=traction, solver=solver,
+                                penalty=penalty, eta=eta))
+
+
+def _write(self, path, solution=True):
+    """Writes the model as a VTU file (every cell a VTK_POLYHEDRON) with its provenance and, if
+    ``solution`` and the model was solved, the displacement (per point and per element), von
+    Mises stress and largest jump. Atomic: the file appears complete or not at all. Returns the
+    write report."""
+    return self._write(_os.fspath(path), solution)
+
+
+Model.cut = _cut
+Model.write = _write
+Model.merge_slivers = _merge_slivers
+Model.check = _check
+Model.solve = _solve
+Model.to_meshio = _to_meshio
