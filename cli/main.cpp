@@ -15,11 +15,11 @@
 #include <iostream>
 
 #include <dlfcn.h>
-#include <malloc.h>
 #include <unistd.h>
 
 #include "cli/commands.h"
 #include "polydg/util/error.h"
+#include "polydg/util/process.h"
 
 namespace {
 
@@ -53,19 +53,6 @@ void useMatchingBlasKernels(char** argv) {
 #endif
 }
 
-/// Keeps freed memory in the process for reuse instead of returning it to the kernel:
-/// polydg allocates and frees large arrays again and again (a stiffness matrix per solve, per
-/// pipeline input, per cut's region check), and memory fresh from the kernel must first be
-/// faulted in and zeroed, about 0.15 ms per MB here: B2's assembly with BZ and p = 2 (a 30 MB
-/// matrix) took 8 ms with fresh pages and 3 ms with reused ones. The price: the process keeps
-/// its peak footprint until it exits (glibc only; elsewhere the default policy stays).
-void keepFreedMemory() {
-#ifdef M_MMAP_THRESHOLD
-  mallopt(M_MMAP_THRESHOLD, 1 << 30);  // blocks up to 1 GiB from the heap, not fresh mmaps
-  mallopt(M_TRIM_THRESHOLD, 1 << 30);  // and keep up to 1 GiB of free heap
-#endif
-}
-
 /// The first argument that is not an option: the subcommand a user asked for.
 const char* requestedCommand(int argc, char** argv) {
   for (int i = 1; i < argc; ++i)
@@ -77,7 +64,7 @@ const char* requestedCommand(int argc, char** argv) {
 
 int main(int argc, char** argv) {
   useMatchingBlasKernels(argv);
-  keepFreedMemory();
+  polydg::keepFreedMemory();
   CLI::App app{"polydg: turn surface meshes into polyhedral DG simulation meshes"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "polydg 0.1.0");

@@ -31,12 +31,22 @@ def _pipeline_text(pipeline):
         raise _polydg.Error(f"pipeline: not representable as JSON ({e})") from None
 
 
+def _worker_threads():
+    """The threads of the Dask worker running this task (0 outside a worker: no limit)."""
+    try:
+        from distributed import get_worker
+
+        return int(get_worker().nthreads)
+    except (ImportError, ValueError, AttributeError):
+        return 0
+
+
 def _run_one(text, name, base, path, stem, out):
     """One input, as a task: never raises (a failure is the input's report)."""
     try:
         from polydg import _polydg as core  # on a Dask worker: its own import
 
-        return core.run_input(text, name, base, path, stem, out)
+        return core.run_input(text, name, base, path, stem, out, threads=_worker_threads())
     except Exception as e:  # the folder could not be written, or the module is missing
         return {"input": path, "status": "failed", "error": str(e), "steps": []}
 
