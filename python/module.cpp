@@ -8,6 +8,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <cstring>
 #include <filesystem>
 #include <optional>
@@ -208,6 +209,70 @@ PYBIND11_MODULE(_polydg, m) {
             return pointsArray(c);
           },
           "The element centroids, an n x 3 float64 array.")
+      .def_property_readonly(
+          "faces",
+          [](const Model& model) {
+            const PolyMesh& mesh = model.mesh();
+            const std::size_t n = mesh.numFaces();
+            std::size_t corners = 0, loops = 0;
+            for (const Face& face : mesh.faces()) {
+              corners += face.vertices.size();
+              loops += face.numLoops();
+            }
+            py::array_t<std::int64_t> vertices(static_cast<py::ssize_t>(corners));
+            py::array_t<std::int64_t> loopOffsets(static_cast<py::ssize_t>(loops + 1));
+            py::array_t<std::int64_t> faceLoops(static_cast<py::ssize_t>(n + 1));
+            py::array_t<std::int64_t> elements({static_cast<py::ssize_t>(n), py::ssize_t(2)});
+            auto v = vertices.mutable_unchecked<1>();
+            auto lo = loopOffsets.mutable_unchecked<1>();
+            auto fl = faceLoops.mutable_unchecked<1>();
+            auto el = elements.mutable_unchecked<2>();
+            std::size_t c = 0, l = 0;
+            lo(0) = 0;
+            for (std::size_t f = 0; f < n; ++f) {
+              const Face& face = mesh.face(FaceId(f));
+              fl(f) = static_cast<std::int64_t>(l);
+              for (std::size_t k = 0; k < face.numLoops(); ++k) {
+                for (VertexId x : face.loop(k)) v(c++) = x.value;
+                lo(++l) = static_cast<std::int64_t>(c);
+              }
+              el(f, 0) = face.front.valid() ? std::int64_t(face.front.value) : -1;
+              el(f, 1) = face.back.valid() ? std::int64_t(face.back.value) : -1;
+            }
+            fl(n) = static_cast<std::int64_t>(l);
+            py::dict out;
+            out["vertices"] = vertices;
+            out["loop_offsets"] = loopOffsets;
+            out["face_loops"] = faceLoops;
+            out["elements"] = elements;
+            return out;
+          },
+          "The faces as flat arrays (int64): loop j's point indices are "
+          "vertices[loop_offsets[j]:loop_offsets[j + 1]], counter-clockwise about the normal "
+          "pointing out of elements[f, 0]; face f's loops are face_loops[f]:face_loops[f + 1] "
+          "(the outer loop first, then holes); elements[f] = (front, back), back -1 on the "
+          "boundary.")
+      .def_property_readonly(
+          "element_displacements",
+          [](const Model& model) -> py::object {
+            const Solution* s = model.solution();
+            if (!s) return py::none();
+            return pointsArray(s->fields.meanDisplacement.raw());
+          },
+          "The last solve's mean displacement per element, an n x 3 float64 array (model "
+          "units), or None before a solve and after an edit.")
+      .def_property_readonly(
+          "element_von_mises",
+          [](const Model& model) -> py::object {
+            const Solution* s = model.solution();
+            if (!s) return py::none();
+            const auto& vm = s->fields.vonMises.raw();
+            py::array_t<double> out(static_cast<py::ssize_t>(vm.size()));
+            std::copy(vm.begin(), vm.end(), out.mutable_data());
+            return out;
+          },
+          "The last solve's von Mises stress per element (of the element's mean stress; units "
+          "of E), or None before a solve and after an edit.")
       .def_property_readonly(
           "faces_integrated", &Model::facesIntegrated,
           "Faces integrated over the model's life (each integration of each face counts).")

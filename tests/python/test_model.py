@@ -122,3 +122,30 @@ def test_progress_is_reported():
     seen = []
     polydg.mesh(polydg.read_surface(TORUS), cells=16, progress=seen.append)
     assert seen and 0.0 <= min(seen) and max(seen) <= 1.0 and seen == sorted(seen)
+
+
+def test_faces_and_solution_arrays():
+    model = polydg.mesh(polydg.read_surface(TORUS), cells=8)
+    faces = model.faces
+    points = model.points
+    assert faces["face_loops"][-1] == len(faces["loop_offsets"]) - 1
+    assert faces["loop_offsets"][-1] == len(faces["vertices"])
+    assert faces["elements"].shape == (model.num_faces, 2)
+    # The divergence theorem over the faces' loops: the volume of the mesh.
+    volume = 0.0
+    front = faces["elements"][:, 0]
+    for f in range(model.num_faces):
+        for j in range(faces["face_loops"][f], faces["face_loops"][f + 1]):
+            loop = points[faces["vertices"][faces["loop_offsets"][j]:faces["loop_offsets"][j + 1]]]
+            area = sum(np.cross(loop[i] - loop[0], loop[i + 1] - loop[0])
+                       for i in range(1, len(loop) - 1))
+            scale = 1.0 if faces["elements"][f, 1] < 0 else 0.0  # interior faces cancel
+            volume += scale * np.dot(area, loop[0]) / 6.0
+    assert volume == pytest.approx(model.volume, rel=1e-12)
+    assert (front >= 0).all()
+
+    assert model.element_displacements is None
+    model.solve(degree=1, gravity=[0, 0, -1], clamp={"below": [0, 0, 1, -0.2]})
+    u = model.element_displacements
+    assert u.shape == (model.num_elements, 3) and (u[:, 2] <= 1e-12).all()
+    assert model.element_von_mises.shape == (model.num_elements,)
