@@ -60,6 +60,27 @@ Step parseStep(const char* step, const char* caller, const py::dict& kwargs) {
   return std::get<Step>(parsed);
 }
 
+/// Parses `kwargs` as a `step` of the pipeline format, runs `run(model, step)` with the GIL
+/// released and returns its JSON report as a dict.
+template <class Step, class Run>
+py::object operate(Model& model, const char* step, const char* caller, const py::dict& kwargs,
+                   Run run) {
+  const Step parsed = parseStep<Step>(step, caller, kwargs);
+  nlohmann::json report;
+  {
+    py::gil_scoped_release release;
+    report = run(model, parsed);
+  }
+  return toPython(report);
+}
+
+/// The report of a cut or merge; one that failed its validation (or left nothing) raises
+/// CheckFailure naming it, as `polydg cut` exits 1.
+nlohmann::json editReport(const OperationReport& r) {
+  if (!r.validation.passed) throw CheckFailure(r.op + " failed: " + r.validation.failure);
+  return toJson(r);
+}
+
 /// A read-only float64 array of shape (n, 3) copied from Vec3s.
 py::array_t<double> pointsArray(const std::vector<Vec3>& points) {
   py::array_t<double> out({static_cast<py::ssize_t>(points.size()), py::ssize_t(3)});
@@ -184,10 +205,12 @@ PYBIND11_MODULE(_polydg, m) {
       .def_property_readonly(
           "points", [](const Model& model) { return pointsArray(model.mesh().positions().raw()); },
           "The mesh's points, an n x 3 float64 array (a copy).")
-      .def_property_readonly("num_elements",
-                             [](const Model& model) { return model.mesh().numElements(); })
-      .def_property_readonly("num_faces",
-                             [](const Model& model) { return model.mesh().numFaces(); })
+      .def_property_readonly(
+          "num_elements", [](const Model& model) { return model.mesh().numElements(); },
+          "The number of elements (polyhedra).")
+      .def_property_readonly(
+          "num_faces", [](const Model& model) { return model.mesh().numFaces(); },
+          "The number of faces (each interior face once).")
       .def_property_readonly("volume", &Model::volume, "The sum of the element volumes.")
       .def_property_readonly(
           "element_volumes",
@@ -277,50 +300,33 @@ PYBIND11_MODULE(_polydg, m) {
           "faces_integrated", &Model::facesIntegrated,
           "Faces integrated over the model's life (each integration of each face counts).")
       .def_property_readonly(
-          "provenance", [](const Model& model) { return toPython(toJson(model.provenance())); })
+          "provenance", [](const Model& model) { return toPython(toJson(model.provenance())); },
+          "Where the mesh came from and the scale of its sliver rule, as `polydg info` prints it: "
+          "source, cell_size, reference_volume, reference, sliver_fraction, sliver_threshold.")
       .def("_cut",
            [](Model& model, const py::kwargs& kwargs) {
-             CutStep step = parseStep<CutStep>("cut", "Model.cut()", kwargs);
-             OperationReport r;
-             {
-               py::gil_scoped_release release;
-               r = model.cut(step.request);
-             }
-             if (!r.validation.passed)
-               throw CheckFailure(r.op + " failed: " + r.validation.failure);
-             return toPython(toJson(r));
+             return operate<CutStep>(
+                 model, "cut", "Model.cut()", kwargs,
+                 [](Model& m, const CutStep& s) { return editReport(m.cut(s.request)); });
            })
       .def("_merge_slivers",
            [](Model& model, const py::kwargs& kwargs) {
-             MergeStep step = parseStep<MergeStep>("merge", "Model.merge_slivers()", kwargs);
-             OperationReport r;
-             {
-               py::gil_scoped_release release;
-               r = model.mergeSlivers(step.request);
-             }
-             if (!r.validation.passed)
-               throw CheckFailure(r.op + " failed: " + r.validation.failure);
-             return toPython(toJson(r));
+             return operate<MergeStep>(model, "merge", "Model.merge_slivers()", kwargs,
+                                       [](Model& m, const MergeStep& s) {
+                                         return editReport(m.mergeSlivers(s.request));
+                                       });
            })
       .def("_check",
            [](Model& model, const py::kwargs& kwargs) {
-             CheckStep step = parseStep<CheckStep>("check", "Model.check()", kwargs);
-             MeshCheck c;
-             {
-               py::gil_scoped_release release;
-               c = model.check(step.options);
-             }
-             return toPython(toJson(c));
+             return operate<CheckStep>(
+                 model, "check", "Model.check()", kwargs,
+                 [](Model& m, const CheckStep& s) { return toJson(m.check(s.options)); });
            })
       .def("_solve",
            [](Model& model, const py::kwargs& kwargs) {
-             SolveStep step = parseStep<SolveStep>("solve", "Model.solve()", kwargs);
-             SolveReport r;
-             {
-               py::gil_scoped_release release;
-               r = model.solve(step.options);
-             }
-             return toPython(toJson(r));
+             return operate<SolveStep>(
+                 model, "solve", "Model.solve()", kwargs,
+                 [](Model& m, const SolveStep& s) { return toJson(m.solve(s.options)); });
            })
       .def(
           "_write",
