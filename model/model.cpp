@@ -53,7 +53,34 @@ struct Model::State {
       throw CheckFailure("the model cannot be used after a failed operation (" + broken +
                          "); start again from its input");
   }
+  /// What follows every edit (cut or merge): the solution no longer fits the mesh; an edit that
+  /// left no element fails; a failed one breaks the model; an unvalidated one leaves its
+  /// validity unknown.
+  void finishEdit(OperationReport& report, ValidationLevel validation) {
+    solution.reset();
+    if (currentMesh().numElements() == 0 && report.validation.passed) {
+      report.validation.passed = false;
+      report.validation.failure =
+          "the " + report.op + " left no element (everything was removed); nothing to write";
+    }
+    if (!report.validation.passed)
+      broken = report.op + " failed: " + report.validation.failure;
+    else if (validation == ValidationLevel::None)
+      valid.reset();
+  }
 };
+
+namespace {
+
+/// The options cuts and merges share, checked before the mesh is touched.
+void checkEditOptions(double sliverFraction, int validationDegree) {
+  if (!(sliverFraction >= 0.0 && sliverFraction <= 1.0))
+    throw InputError("the sliver fraction must be a number in [0, 1]");
+  if (validationDegree < 1 || validationDegree > 3)
+    throw InputError("the validation degree must be 1, 2 or 3");
+}
+
+}  // namespace
 
 double medianElementVolume(const PolyMesh& mesh) {
   if (mesh.numElements() == 0) return 0.0;
@@ -270,20 +297,6 @@ Model Model::read(const std::string& path, ReadReport* report) {
 
 // --- editing -------------------------------------------------------------------------------
 
-namespace {
-
-/// The checks an edit's report asks of the model: a validation that failed or an edit that
-/// left no element makes the operation fail.
-void judgeEdit(OperationReport& report, const PolyMesh& mesh) {
-  if (mesh.numElements() == 0 && report.validation.passed) {
-    report.validation.passed = false;
-    report.validation.failure =
-        "the " + report.op + " left no element (everything was removed); nothing to write";
-  }
-}
-
-}  // namespace
-
 OperationReport Model::cut(const CutRequest& request) {
   State& s = *state_;
   s.requireUsable();
@@ -294,17 +307,9 @@ OperationReport Model::cut(const CutRequest& request) {
   options.validationDegree = request.validationDegree;
   if (request.removeSide < -1 || request.removeSide > 1)
     throw InputError("the side to remove must be +, - or none");
-  if (!(options.sliverFraction >= 0.0 && options.sliverFraction <= 1.0))
-    throw InputError("the sliver fraction must be a number in [0, 1]");
-  if (options.validationDegree < 1 || options.validationDegree > 3)
-    throw InputError("the validation degree must be 1, 2 or 3");
+  checkEditOptions(options.sliverFraction, options.validationDegree);
   OperationReport report = s.edit().cut(request.blade, options);
-  s.solution.reset();
-  judgeEdit(report, mesh());
-  if (!report.validation.passed)
-    s.broken = report.op + " failed: " + report.validation.failure;
-  else if (request.validation == ValidationLevel::None)
-    s.valid.reset();
+  s.finishEdit(report, request.validation);
   return report;
 }
 
@@ -312,18 +317,10 @@ OperationReport Model::mergeSlivers(const MergeRequest& request) {
   State& s = *state_;
   s.requireUsable();
   const double fraction = request.fraction.value_or(s.provenance.sliverFraction);
-  if (!(fraction >= 0.0 && fraction <= 1.0))
-    throw InputError("the sliver fraction must be a number in [0, 1]");
-  if (request.validationDegree < 1 || request.validationDegree > 3)
-    throw InputError("the validation degree must be 1, 2 or 3");
+  checkEditOptions(fraction, request.validationDegree);
   OperationReport report =
       s.edit().mergeSlivers(fraction, request.validation, request.validationDegree);
-  s.solution.reset();
-  judgeEdit(report, mesh());
-  if (!report.validation.passed)
-    s.broken = "merge failed: " + report.validation.failure;
-  else if (request.validation == ValidationLevel::None)
-    s.valid.reset();
+  s.finishEdit(report, request.validation);
   return report;
 }
 
