@@ -191,8 +191,15 @@ ElementData<double> elementPenaltyThresholds(const PolyMesh& mesh, const DgBasis
   return required;
 }
 
-LocalMatrices localMatrices(const PolyMesh& mesh, const DgBasis& basis, const MomentCache& moments,
-                            const FaceRoles& roles, const FormCoefficients& form) {
+namespace {
+
+/// localMatrices() with a choice of terms: the element stiffness if `element`, the face terms
+/// `diagonalTerms` (FaceTerms bits) in the diagonal blocks and `couplingTerms` in the coupling
+/// blocks.
+LocalMatrices localMatricesOf(const PolyMesh& mesh, const DgBasis& basis,
+                              const MomentCache& moments, const FaceRoles& roles,
+                              const FormCoefficients& form, bool element, int diagonalTerms,
+                              int couplingTerms) {
   const std::size_t ne = mesh.numElements();
   LocalMatrices local;
   local.functions = basis.size();
@@ -235,15 +242,30 @@ LocalMatrices localMatrices(const PolyMesh& mesh, const DgBasis& basis, const Mo
           double* coupling = local.coupling.data() + local.couplingStart[i] * bb;
           std::fill(coupling, coupling + (local.couplingStart[i + 1] - local.couplingStart[i]) * bb,
                     0.0);
-          elementStiffness(basis, moments, e, form.mu, form.lambda, self);
+          if (element)
+            elementStiffness(basis, moments, e, form.mu, form.lambda, self);
+          else
+            self.setZero(bs, bs);
           for (const FaceUse& use : mesh.element(e).faces) {
             const FaceKind kind = roles.kind[use.face];
             if (kind == FaceKind::Free) continue;
             const FaceView view = viewOf(roles, use.face, sideOf(roles, use.face, e));
             // The coupling block of a face is computed from its smaller element only.
-            const bool withOther = kind == FaceKind::Interior && view.other.value > e.value;
-            faceRows(mesh, basis, moments, view, form, faceSelf, faceOther, withOther);
-            self += faceSelf;
+            const bool withOther = kind == FaceKind::Interior && view.other.value > e.value &&
+                                   couplingTerms != 0;
+            if (diagonalTerms == couplingTerms || !withOther) {
+              if (diagonalTerms == 0 && !withOther) continue;
+              faceRows(mesh, basis, moments, view, form, faceSelf, faceOther, withOther,
+                       diagonalTerms == 0 ? couplingTerms : diagonalTerms);
+              if (diagonalTerms != 0) self += faceSelf;
+            } else {  // different terms: two passes
+              if (diagonalTerms != 0) {
+                faceRows(mesh, basis, moments, view, form, faceSelf, faceOther, false,
+                         diagonalTerms);
+                self += faceSelf;
+              }
+              faceRows(mesh, basis, moments, view, form, faceSelf, faceOther, true, couplingTerms);
+            }
             if (!withOther) continue;
             const auto t = std::lower_bound(firstGreater, b.end(), view.other.value) - firstGreater;
             // Row-major: column (e, c) of K reads row c of the block.
@@ -256,12 +278,61 @@ LocalMatrices localMatrices(const PolyMesh& mesh, const DgBasis& basis, const Mo
   return local;
 }
 
+}  // namespace
+
+LocalMatrices localMatrices(const PolyMesh& mesh, const DgBasis& basis, const MomentCache& moments,
+                            const FaceRoles& roles, const FormCoefficients& form) {
+  return localMatricesOf(mesh, basis, moments, roles, form, true, kAllFaceTerms, kAllFaceTerms);
+}
+
+SplitLocalMatrices splitLocalMatrices(const PolyMesh& mesh, const DgBasis& basis,
+                                      const MomentCache& moments, const FaceRoles& roles,
+                                      const FormCoefficients& form) {
+  SplitLocalMatrices split;
+  split.rowStrain = localMatricesOf(mesh, basis, moments, roles, form, true,
+                                    kTrialStrainTerms | kTestStrainTerms, kTestStrainTerms);
+  split.columnStrain = localMatricesOf(mesh, basis, moments, roles, form, false, 0,
+                                       kTrialStrainTerms | kOtherLiftingTerms);
+  split.jumps = localMatricesOf(mesh, basis, moments, roles, form, false, kJumpTerms, kJumpTerms);
+
+  // The neighbours' lifting terms in each diagonal block, one block per neighbour.
+  const std::size_t ne = mesh.numElements();
+  const int bs = split.jumps.blockSize;
+  const std::size_t bb = static_cast<std::size_t>(bs) * static_cast<std::size_t>(bs);
+  split.neighbourStart.assign(ne + 1, 0);
+  for (std::size_t i = 0; i < ne; ++i)
+    split.neighbourStart[i + 1] = split.neighbourStart[i] + split.jumps.neighbours[i].size() - 1;
+  split.neighbourLifting.assign(split.neighbourStart[ne] * bb, 0.0);
+  if (form.method != Method::IP) return split;
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, ne, 16), [&](const tbb::blocked_range<std::size_t>& r) {
+        Eigen::MatrixXd faceSelf, faceOther;
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+          const ElementId e(i);
+          const auto& b = split.jumps.neighbours[i];
+          for (const FaceUse& use : mesh.element(e).faces) {
+            if (roles.kind[use.face] != FaceKind::Interior) continue;
+            const FaceView view = viewOf(roles, use.face, sideOf(roles, use.face, e));
+            faceRows(mesh, basis, moments, view, form, faceSelf, faceOther, false,
+                     kOtherLiftingTerms);
+            // Slot of the neighbour among e's neighbours without e itself.
+            auto t = static_cast<std::size_t>(
+                std::lower_bound(b.begin(), b.end(), view.other.value) - b.begin());
+            if (view.other.value > e.value) --t;
+            Eigen::Map<Eigen::MatrixXd>(
+                split.neighbourLifting.data() + (split.neighbourStart[i] + t) * bb, bs, bs) +=
+                faceSelf;
+          }
+        }
+      });
+  return split;
+}
+
 Eigen::SparseMatrix<double, Eigen::ColMajor, int> assembleStiffness(const LocalMatrices& local) {
   const std::size_t ne = local.neighbours.size();
   const int bs = local.blockSize;
   const int n = local.functions;
   const bool bz = local.componentDiagonalCoupling;
-  const std::size_t bb = static_cast<std::size_t>(bs) * static_cast<std::size_t>(bs);
 
   // Column pointers: column (e, c) holds all 3n rows of e and of IP neighbours, n rows of
   // BZ neighbours (component c only).
@@ -288,6 +359,20 @@ Eigen::SparseMatrix<double, Eigen::ColMajor, int> assembleStiffness(const LocalM
   adviseHugePages(k.innerIndexPtr(), static_cast<std::size_t>(columnStart[ndof]) * sizeof(int));
   int* outer = k.outerIndexPtr();
   for (std::size_t c = 0; c <= ndof; ++c) outer[c] = static_cast<int>(columnStart[c]);
+  refillStiffness(local, k);
+  return k;
+}
+
+void refillStiffness(const LocalMatrices& local,
+                     Eigen::SparseMatrix<double, Eigen::ColMajor, int>& k) {
+  const std::size_t ne = local.neighbours.size();
+  const int bs = local.blockSize;
+  const int n = local.functions;
+  const bool bz = local.componentDiagonalCoupling;
+  const std::size_t bb = static_cast<std::size_t>(bs) * static_cast<std::size_t>(bs);
+  if (static_cast<std::size_t>(k.cols()) != ne * static_cast<std::size_t>(bs))
+    throw std::invalid_argument("refillStiffness: the matrix has another size");
+  const int* columnStart = k.outerIndexPtr();
   int* inner = k.innerIndexPtr();
   double* values = k.valuePtr();
 
@@ -329,6 +414,7 @@ Eigen::SparseMatrix<double, Eigen::ColMajor, int> assembleStiffness(const LocalM
           }
           for (int c = 0; c < bs; ++c) {
             std::int64_t pos = columnStart[i * bs + c];
+            const std::int64_t end = columnStart[i * bs + c + 1];
             for (std::size_t t = 0; t < b.size(); ++t) {
               const Source& s = src[t];
               const double* row = s.row0 + static_cast<std::size_t>(c) * s.rowStep;
@@ -337,6 +423,8 @@ Eigen::SparseMatrix<double, Eigen::ColMajor, int> assembleStiffness(const LocalM
                 first = (c / n) * n;
                 last = first + n;
               }
+              if (pos + (last - first) > end)
+                throw std::invalid_argument("refillStiffness: the matrix has another pattern");
               for (int d = first; d < last; ++d) {
                 inner[pos] = s.base + d;
                 values[pos++] = row[static_cast<std::size_t>(d) * s.entryStep];
@@ -345,7 +433,6 @@ Eigen::SparseMatrix<double, Eigen::ColMajor, int> assembleStiffness(const LocalM
           }
         }
       });
-  return k;
 }
 
 Eigen::SparseMatrix<double, Eigen::ColMajor, int> assembleStiffness(const PolyMesh& mesh,

@@ -140,4 +140,51 @@ void DgBasis::gradients(ElementId e, const Vec3& x, std::span<double> out) const
     }
 }
 
+Eigen::VectorXd affineCoefficients(const DgBasis& basis, ElementId e, double value,
+                                   const Vec3& gradient, const Vec3& origin) {
+  // In scaled monomials: value + g.(c - o) + h g.y, y = (x - c) / h.
+  const int n = basis.size();
+  const double h = basis.scale(e);
+  Eigen::VectorXd a = Eigen::VectorXd::Zero(n);
+  a(0) = value + gradient.dot(basis.centre(e) - origin);
+  for (int k = 0; k < 3; ++k) a(1 + k) = h * gradient[k];
+  // phi = T m: sum_a a_a m_a = sum_i c_i phi_i with T^T c = a.
+  return basis.coefficients(e).transpose().triangularView<Eigen::Upper>().solve(a);
+}
+
+Eigen::MatrixXd transferMatrix(const DgBasis& source, ElementId from, const DgBasis& target,
+                               ElementId to) {
+  if (source.degree() != target.degree())
+    throw std::invalid_argument("transferMatrix: the bases have different degrees");
+  const int p = source.degree(), n = source.size();
+  // m_a((x - c) / h) = sum_b S(a, b) m'_b((x - c') / h'): with x = c' + h' y,
+  // (x - c) / h = sigma y + d, sigma = h' / h, d = (c' - c) / h; binomial expansion per axis.
+  const double h = source.scale(from);
+  const double sigma = target.scale(to) / h;
+  const Vec3 d = (target.centre(to) - source.centre(from)) / h;
+  double sp[4], dp[3][4];
+  sp[0] = 1.0;
+  for (int k = 0; k < 3; ++k) dp[k][0] = 1.0;
+  for (int m = 1; m <= p; ++m) {
+    sp[m] = sp[m - 1] * sigma;
+    for (int k = 0; k < 3; ++k) dp[k][m] = dp[k][m - 1] * d[k];
+  }
+  Eigen::MatrixXd shift = Eigen::MatrixXd::Zero(n, n);
+  for (int a = 0; a < n; ++a) {
+    const Exponents ea = monomialExponents(a);
+    const int pa[3] = {ea.a, ea.b, ea.c};
+    for (int b = 0; b < n; ++b) {
+      const Exponents eb = monomialExponents(b);
+      const int pb[3] = {eb.a, eb.b, eb.c};
+      double v = 1.0;
+      for (int k = 0; k < 3 && v != 0.0; ++k)
+        v = pb[k] > pa[k] ? 0.0 : v * kBinomial<3>[pa[k]][pb[k]] * sp[pb[k]] * dp[k][pa[k] - pb[k]];
+      shift(a, b) = v;
+    }
+  }
+  // f = c^T T m = c^T T S m' = c^T T S T'^-1 phi': Q = T'^-T S^T T^T.
+  const Eigen::MatrixXd rhs = shift.transpose() * source.coefficients(from).transpose();
+  return target.coefficients(to).transpose().triangularView<Eigen::Upper>().solve(rhs);
+}
+
 }  // namespace polydg

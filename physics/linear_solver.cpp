@@ -165,7 +165,8 @@ struct LinearSolver::Impl {
     });
   }
 
-  Eigen::VectorXd conjugateGradient(const Eigen::VectorXd& f, LinearSolveReport& report) const {
+  Eigen::VectorXd conjugateGradient(const Eigen::VectorXd& f, LinearSolveReport& report,
+                                    const Eigen::VectorXd* guess) const {
     const double fNorm = std::sqrt(parallelDot(f, f));
     Eigen::VectorXd u = Eigen::VectorXd::Zero(f.size());
     if (fNorm == 0.0) {
@@ -173,12 +174,17 @@ struct LinearSolver::Impl {
       return u;
     }
     Eigen::VectorXd r = f, z, p, q;
+    if (guess && guess->size() == f.size()) {  // warm start: r = f - K u0
+      u = *guess;
+      productDot(u, q);
+      r -= q;
+    }
     precondition(r, z);
     p = z;
     double rz = parallelDot(r, z);
     const double target = options.tolerance * fNorm;
     int it = 0;
-    double rNorm = fNorm;
+    double rNorm = std::sqrt(parallelDot(r, r));
     while (it < options.maxIterations && rNorm > target) {
       ++it;
       const double alpha = rz / productDot(p, q);
@@ -233,7 +239,33 @@ bool LinearSolver::compute(const SpMat& matrix, int blockSize, const ElementFram
   return ok;
 }
 
+bool LinearSolver::update(const SpMat& matrix, bool refreshPreconditioner,
+                          const ElementFrames* frames) {
+  Impl& m = *impl_;
+  if (!m.matrix) return compute(matrix, m.blockSize, frames);
+  if (matrix.rows() != m.matrix->rows() || matrix.nonZeros() != m.matrix->nonZeros())
+    throw std::invalid_argument("LinearSolver::update: the matrix has another pattern");
+  m.matrix = &matrix;
+  const Stopwatch t0;
+  bool ok = true;
+  if (m.kind == SolverKind::Cholesky) {
+    m.cholesky->factorize(matrix);  // the symbolic analysis (ordering, supernodes) is kept
+    ok = m.cholesky->info() == Eigen::Success;
+  } else if (refreshPreconditioner) {
+    ok = m.buildPreconditioner(frames);
+  } else if (m.useProductBlocks) {
+    m.useProductBlocks = m.productBlocks.build(matrix, m.blockSize / 3, 1.0);
+  }
+  m.factorSeconds = t0.seconds();
+  return ok;
+}
+
 Eigen::VectorXd LinearSolver::solve(const Eigen::VectorXd& rhs, LinearSolveReport& report) {
+  return solve(rhs, report, nullptr);
+}
+
+Eigen::VectorXd LinearSolver::solve(const Eigen::VectorXd& rhs, LinearSolveReport& report,
+                                    const Eigen::VectorXd* guess) {
   Impl& m = *impl_;
   report = LinearSolveReport{};
   report.used = m.kind;
@@ -246,7 +278,7 @@ Eigen::VectorXd LinearSolver::solve(const Eigen::VectorXd& rhs, LinearSolveRepor
     u = report.success ? Eigen::VectorXd(m.cholesky->solve(rhs))
                        : Eigen::VectorXd::Zero(rhs.size());
   } else {
-    u = m.conjugateGradient(rhs, report);
+    u = m.conjugateGradient(rhs, report, guess);
   }
   report.solveSeconds = t0.seconds();
   Eigen::VectorXd ku;

@@ -149,7 +149,10 @@ struct Kernel {
 
   static void faceRows(const PolyMesh& mesh, const DgBasis& basis, const MomentCache& moments,
                        const FaceView& view, const FormCoefficients& form,
-                       Eigen::MatrixXd& selfBlock, Eigen::MatrixXd& otherBlock, bool withOther) {
+                       Eigen::MatrixXd& selfBlock, Eigen::MatrixXd& otherBlock, bool withOther,
+                       int terms) {
+    const bool trialStrain = terms & kTrialStrainTerms, testStrain = terms & kTestStrainTerms,
+               jump = terms & kJumpTerms, otherLift = terms & kOtherLiftingTerms;
     const bool interior = view.kind == FaceKind::Interior;
     const FaceFrame fr = frame(mesh, moments, view.face);
     const Vec3 n =
@@ -184,8 +187,11 @@ struct Kernel {
     auto block = [&](const Side& b, const Mat& cb, double sb, const Mat1* liftK, const Mat1* liftL,
                      Eigen::MatrixXd& out) {
       out.setZero(3 * N, 3 * N);
-      const Mat m = sk.p.lazyProduct(cb);
-      for (int d = 0; d < 3; ++d) out.template block<N, N>(d * N, d * N) += (mu * etaF * sb) * m;
+      if (jump) {
+        const Mat m = sk.p.lazyProduct(cb);
+        for (int d = 0; d < 3; ++d)
+          out.template block<N, N>(d * N, d * N) += (mu * etaF * sb) * m;
+      }
       if (!ip) return;
       Mat wk[3], vk[3];  // wk: int phi^K_i d_k phi^B_j; vk: int d_k phi^K_i phi^B_j
       for (int k = 0; k < 3; ++k) {
@@ -195,14 +201,19 @@ struct Kernel {
       const Mat wn = n.x() * wk[0] + n.y() * wk[1] + n.z() * wk[2];
       const Mat vn = n.x() * vk[0] + n.y() * vk[1] + n.z() * vk[2];
       // Lifting: sum_E c_E (psi_E phi_K)^T (psi_E phi_B).
-      Mat lift = cK * liftK[0].transpose().lazyProduct(liftK[1]);
-      if (liftL) lift += cL * liftL[0].transpose().lazyProduct(liftL[1]);
+      // Groups (see FaceTerms): the consistency terms hold the strain of the trial function
+      // (of element B), the symmetry terms that of the test function (of self); the lifting
+      // terms complete the square of each element's lambda terms and go with that element.
+      Mat lift = Mat::Zero();
+      if (testStrain) lift += cK * liftK[0].transpose().lazyProduct(liftK[1]);
+      if (liftL && otherLift) lift += cL * liftL[0].transpose().lazyProduct(liftL[1]);
+      const double ct = trialStrain ? 1.0 : 0.0, cv = testStrain ? 1.0 : 0.0;
       for (int d = 0; d < 3; ++d)
         for (int c = 0; c < 3; ++c) {
-          Mat blk = (-w * mu * n[c]) * wk[d] + (-w * lambda * n[d]) * wk[c] +
-                    (-w * sb * mu * n[d]) * vk[c] + (-w * sb * lambda * n[c]) * vk[d] +
+          Mat blk = (-ct * w * mu * n[c]) * wk[d] + (-ct * w * lambda * n[d]) * wk[c] +
+                    (-cv * w * sb * mu * n[d]) * vk[c] + (-cv * w * sb * lambda * n[c]) * vk[d] +
                     (lambda * w * w * sb * n[d] * n[c]) * lift;
-          if (c == d) blk += (-w * mu) * wn + (-w * sb * mu) * vn;
+          if (c == d) blk += (-ct * w * mu) * wn + (-cv * w * sb * mu) * vn;
           out.template block<N, N>(d * N, c * N) += blk;
         }
     };
@@ -257,9 +268,10 @@ double facePenalty(const FormCoefficients& form, const MomentCache& moments, Fac
 
 void faceRows(const PolyMesh& mesh, const DgBasis& basis, const MomentCache& moments,
               const FaceView& view, const FormCoefficients& form, Eigen::MatrixXd& selfBlock,
-              Eigen::MatrixXd& otherBlock, bool withOther) {
+              Eigen::MatrixXd& otherBlock, bool withOther, int terms) {
   detail::dispatchBasisDegree(basis.degree(), [&](auto p) {
-    Kernel<p()>::faceRows(mesh, basis, moments, view, form, selfBlock, otherBlock, withOther);
+    Kernel<p()>::faceRows(mesh, basis, moments, view, form, selfBlock, otherBlock, withOther,
+                          terms);
   });
 }
 

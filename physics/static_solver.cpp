@@ -43,6 +43,33 @@ void StaticSolver::integrate() {
   report_.basisFallbacks = basis_->fallbackElements();
 }
 
+FormCoefficients formCoefficients(const PolyMesh& mesh, const DgBasis& basis,
+                                  const MomentCache& moments, const FaceRoles& roles,
+                                  const Material& material, const DiscretizationOptions& disc,
+                                  ElementData<double>& elementEta, double& threshold) {
+  FormCoefficients form;
+  form.method = disc.method;
+  form.mu = material.mu();
+  form.lambda = material.lambda();
+  elementEta = elementPenaltyThresholds(mesh, basis, moments, roles);
+  threshold = elementEta.size() == 0 ? 0.0 : *std::max_element(elementEta.begin(), elementEta.end());
+  switch (disc.penalty.rule) {
+    case PenaltyRule::TraceBound:
+      form.eta = disc.penalty.safety * threshold;
+      if (form.eta <= 0.0) form.eta = 1.0;  // no coupled faces: any positive value
+      if (disc.penalty.local) {
+        // Elements without coupled faces have no penalty terms; any positive value does.
+        for (double& eta : elementEta) eta = eta > 0.0 ? disc.penalty.safety * eta : form.eta;
+        form.elementEta = &elementEta;
+      }
+      break;
+    case PenaltyRule::Fixed: form.eta = disc.penalty.eta; break;
+    case PenaltyRule::Doubling: form.eta = disc.penalty.eta; break;
+  }
+  if (!(form.eta > 0.0)) throw std::invalid_argument("the penalty eta must be positive");
+  return form;
+}
+
 void StaticSolver::assemble(const LoadCase& loads) {
   if (!basis_) integrate();
   const Stopwatch t0;
@@ -50,34 +77,14 @@ void StaticSolver::assemble(const LoadCase& loads) {
   roles_ = classifyFaces(*mesh_, loads);
   report_.dirichletFaces = roles_.dirichletFaces;
   report_.tractionFaces = roles_.tractionFaces;
-  form_.method = disc.method;
-  form_.mu = material_.mu();
-  form_.lambda = material_.lambda();
-  elementEta_ = std::make_unique<ElementData<double>>(
-      elementPenaltyThresholds(*mesh_, *basis_, *moments_, roles_));
-  report_.etaThreshold =
-      elementEta_->size() == 0 ? 0.0 : *std::max_element(elementEta_->begin(), elementEta_->end());
-  form_.elementEta = nullptr;
+  elementEta_ = std::make_unique<ElementData<double>>();
+  form_ = formCoefficients(*mesh_, *basis_, *moments_, roles_, material_, disc, *elementEta_,
+                           report_.etaThreshold);
   const int quadrature =
       disc.quadratureDegree >= 0 ? disc.quadratureDegree : 2 * basis_->degree() + 2;
   system_.blockSize = 3 * basis_->size();
   factorized_ = false;
   report_.penaltyAttempts = 1;
-
-  switch (disc.penalty.rule) {
-    case PenaltyRule::TraceBound:
-      form_.eta = disc.penalty.safety * report_.etaThreshold;
-      if (form_.eta <= 0.0) form_.eta = 1.0;  // no coupled faces: any positive value
-      if (disc.penalty.local) {
-        // Elements without coupled faces have no penalty terms; any positive value does.
-        for (double& eta : *elementEta_) eta = eta > 0.0 ? disc.penalty.safety * eta : form_.eta;
-        form_.elementEta = elementEta_.get();
-      }
-      break;
-    case PenaltyRule::Fixed: form_.eta = disc.penalty.eta; break;
-    case PenaltyRule::Doubling: form_.eta = disc.penalty.eta; break;
-  }
-  if (!(form_.eta > 0.0)) throw std::invalid_argument("the penalty eta must be positive");
   // The thesis's phases (Table 4.1): "integration" computes the element and face matrices,
   // "assembly" accumulates them into K and F.
   LocalMatrices local = localMatrices(*mesh_, *basis_, *moments_, roles_, form_);

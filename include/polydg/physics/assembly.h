@@ -106,10 +106,42 @@ struct LocalMatrices {
 LocalMatrices localMatrices(const PolyMesh& mesh, const DgBasis& basis, const MomentCache& moments,
                             const FaceRoles& roles, const FormCoefficients& form);
 
+/// The local matrices of a form split by the element whose strain each term holds, for
+/// stiffness warping (Kaufmann et al. 2008, section 7; physics/dynamics.h). Their sum, block by
+/// block, is localMatrices(); all three have its layout (the same neighbours).
+struct SplitLocalMatrices {
+  /// Strain of the rows' element: the element stiffness and the face terms of the diagonal
+  /// blocks with strain (K_K, K_f1 and K_f2 of the element with itself), and the symmetry
+  /// terms of the coupling blocks (K_f2 of the row element); with the element's own lifting
+  /// terms.
+  LocalMatrices rowStrain;
+  /// Strain of the columns' element: the consistency terms of the coupling blocks (K_f1 of the
+  /// column element) and its lifting term; the diagonal blocks are zero.
+  LocalMatrices columnStrain;
+  /// No strain: the jump penalty (K_f3), not warped.
+  LocalMatrices jumps;
+  /// IP: the lifting terms of each neighbour L in element K's diagonal block (they complete
+  /// L's lambda terms, warped with L's rotation): for element K, one block (3n x 3n,
+  /// column-major) per neighbour in the order of `neighbours` without K, from block
+  /// neighbourStart[K]. Zero for BZ.
+  std::vector<std::size_t> neighbourStart;
+  std::vector<double> neighbourLifting;
+};
+
+SplitLocalMatrices splitLocalMatrices(const PolyMesh& mesh, const DgBasis& basis,
+                                      const MomentCache& moments, const FaceRoles& roles,
+                                      const FormCoefficients& form);
+
 /// K from the local matrices: both triangles, each column written once, in parallel over
 /// elements. With BZ, blocks between neighbours couple equal components only and are stored
 /// so (the paper's sparser BZ matrices).
 Eigen::SparseMatrix<double, Eigen::ColMajor, int> assembleStiffness(const LocalMatrices& local);
+
+/// Writes K from `local` into `matrix`, which has the pattern assembleStiffness() made for
+/// local matrices of the same layout: new values (a warped stiffness, a time step's system
+/// matrix) without a new matrix. Throws std::invalid_argument for another size or pattern.
+void refillStiffness(const LocalMatrices& local,
+                     Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix);
 
 /// K of `form`: localMatrices() then assembleStiffness().
 Eigen::SparseMatrix<double, Eigen::ColMajor, int> assembleStiffness(const PolyMesh& mesh,

@@ -83,6 +83,22 @@ class DgBasis {
   std::size_t fallbacks_ = 0;
 };
 
+/// Coefficients (one displacement component, size() values) of the affine function
+/// x -> value + gradient . (x - origin) in element e's basis: exact, for every element, since
+/// the basis spans the linear polynomials (the undeformed state X^0 of stiffness warping,
+/// rigid velocities).
+Eigen::VectorXd affineCoefficients(const DgBasis& basis, ElementId e, double value,
+                                   const Vec3& gradient, const Vec3& origin);
+
+/// The size() x size() matrix Q that re-expresses a polynomial of element `from` of `source`,
+/// sum_i c_i phi_i, in element `to`'s basis of `target` (same degree): sum_i (Q c)_i phi'_i is
+/// the same polynomial, exactly up to round-off, wherever the two are evaluated (a shift of
+/// the scaled monomials, then the target's triangular coefficients). A piece of a cut element
+/// takes its parent's fields this way without any change. Throws std::invalid_argument for
+/// bases of different degrees.
+Eigen::MatrixXd transferMatrix(const DgBasis& source, ElementId from, const DgBasis& target,
+                               ElementId to);
+
 /// Scaled monomials m_a(y) for |a| <= degree at y (already centred and scaled).
 void scaledMonomials(int degree, const Vec3& y, std::span<double> out);
 

@@ -86,8 +86,20 @@ class LinearSolver {
   /// p-multigrid build its agglomeration levels.
   bool compute(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix, int blockSize,
                const ElementFrames* frames = nullptr);
+  /// New values of the matrix (`matrix`, with the pattern of the one given to compute(), must
+  /// stay alive): Cholesky factorizes them numerically again, keeping the symbolic analysis;
+  /// CG multiplies with them, and rebuilds its preconditioner only if `refreshPreconditioner`
+  /// (the old one, built for nearby values, still preconditions: a time step's system changes
+  /// a little with the rotations). Returns false as compute() does. Throws
+  /// std::invalid_argument for another pattern.
+  bool update(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix,
+              bool refreshPreconditioner, const ElementFrames* frames = nullptr);
   /// Solves K U = F; fills `report` (times of this solve; factorSeconds from compute()).
   Eigen::VectorXd solve(const Eigen::VectorXd& rhs, LinearSolveReport& report);
+  /// The same with CG starting from `guess` (if not null; Cholesky ignores it): the last time
+  /// step's solution saves iterations.
+  Eigen::VectorXd solve(const Eigen::VectorXd& rhs, LinearSolveReport& report,
+                        const Eigen::VectorXd* guess);
 
   SolverKind kind() const;
 

@@ -96,9 +96,29 @@ void elementMass(const DgBasis& basis, const MomentCache& moments, ElementId e,
 /// their right-hand side is dirichletLoad().
 /// With `withOther` false, `otherBlock` is not computed (left empty): the assembly computes
 /// each coupling block once, from one side, and uses its transpose for the other.
+/// `terms` (FaceTerms bits) selects groups of terms; their sum is the whole face form.
 void faceRows(const PolyMesh& mesh, const DgBasis& basis, const MomentCache& moments,
               const FaceView& view, const FormCoefficients& form, Eigen::MatrixXd& selfBlock,
-              Eigen::MatrixXd& otherBlock, bool withOther = true);
+              Eigen::MatrixXd& otherBlock, bool withOther = true, int terms = 15);
+
+/// The face terms of faceRows() grouped by the element whose strain they hold, for stiffness
+/// warping (Kaufmann et al. 2008, section 7: K_f1 and K_f2 split by side, K_f3 not warped). The
+/// IP lambda lifting term of an element E completes the square of E's lambda terms (the
+/// consistency terms with div u_E): it goes with E, so that the warped lambda part stays a
+/// square (positive semi-definite) when neighbours turn differently.
+enum FaceTerms : int {
+  /// Consistency terms, int ({sigma(u)} n).[v]: the strain of the trial function, i.e. of the
+  /// element of the block's columns (K_f1^+-).
+  kTrialStrainTerms = 1,
+  /// Symmetry terms, int ({sigma(v)} n).[u]: the strain of the test function, i.e. of `self`,
+  /// the element of the rows (K_f2^+-); with self's lifting term.
+  kTestStrainTerms = 2,
+  /// The jump penalty (K_f3): no strain, not warped.
+  kJumpTerms = 4,
+  /// The lifting term of the face's other element (interior faces): warped with its rotation.
+  kOtherLiftingTerms = 8,
+  kAllFaceTerms = 15,
+};
 
 /// int_F psi_q psi_r for element e's lifting basis psi (orthonormal on e, spanning the
 /// polynomials of degree <= p-1): liftingSize() x liftingSize(). Its largest eigenvalue is the

@@ -78,6 +78,15 @@ struct StaticSolution {
   StaticReport report;
 };
 
+/// The coefficients of the form of `disc` for `material`: the penalty by its rule (TraceBound:
+/// the coercivity bounds of penaltyThreshold(), per element into `elementEta`, which the form
+/// then points to and which must outlive it; Fixed and Doubling: the given eta). `threshold` is
+/// the largest bound. Throws std::invalid_argument for a non-positive eta.
+FormCoefficients formCoefficients(const PolyMesh& mesh, const DgBasis& basis,
+                                  const MomentCache& moments, const FaceRoles& roles,
+                                  const Material& material, const DiscretizationOptions& disc,
+                                  ElementData<double>& elementEta, double& threshold);
+
 /// The stages of a static solve, each callable again (e.g. assemble() with new loads reuses
 /// the moments and bases; solve() reuses the factorization when only F changed).
 class StaticSolver {

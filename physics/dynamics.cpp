@@ -1,0 +1,777 @@
+#include "polydg/physics/dynamics.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+#include <Eigen/Cholesky>
+#include <Eigen/SVD>
+
+#include "polydg/integrate/quadrature.h"
+#include "polydg/physics/agglomeration.h"
+#include "polydg/physics/assembly.h"
+#include "polydg/physics/local_integrators.h"
+#include "polydg/physics/post_process.h"
+#include "polydg/util/stopwatch.h"
+
+namespace polydg {
+
+namespace {
+
+using SpMat = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
+using RowMap = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>;
+using ColMap = Eigen::Map<const Eigen::MatrixXd>;
+
+constexpr double kNewmarkBeta = 0.25, kNewmarkGamma = 0.5;
+/// Solves per step of the automatic corrections of the second-order integrators with corotation
+/// (the modified Newton iteration gains 1-2 digits per solve on B7's spinning cube).
+constexpr int kMaxAutomaticSolves = 12;
+
+/// out = (R (x) I_n) v for a 3n vector in component-major order (component d, function i at
+/// d n + i): each function's three components rotated.
+void rotate(const Eigen::Matrix3d& r, const double* v, int n, double* out) {
+  for (int i = 0; i < n; ++i) {
+    const double a = v[i], b = v[n + i], c = v[2 * n + i];
+    out[i] = r(0, 0) * a + r(0, 1) * b + r(0, 2) * c;
+    out[n + i] = r(1, 0) * a + r(1, 1) * b + r(1, 2) * c;
+    out[2 * n + i] = r(2, 0) * a + r(2, 1) * b + r(2, 2) * c;
+  }
+}
+
+/// out += (R1 (x) I) B (R2 (x) I)^T for a bs x bs block B (entry (r, c) at b[r * rs + c * cs]),
+/// written column-major into out (bs x bs) scaled by s.
+void addRotatedBlock(const Eigen::Matrix3d& r1, const double* b, std::size_t rs, std::size_t cs,
+                     const Eigen::Matrix3d& r2, int n, double s, double* out) {
+  const int bs = 3 * n;
+  // t = B (R2 (x) I)^T: column (c, j) of t = sum_b R2(c, b) column (b, j) of B.
+  thread_local std::vector<double> t;
+  t.resize(static_cast<std::size_t>(bs) * bs);
+  for (int c = 0; c < 3; ++c)
+    for (int j = 0; j < n; ++j) {
+      double* tc = t.data() + static_cast<std::size_t>(c * n + j) * bs;
+      const double w0 = r2(c, 0), w1 = r2(c, 1), w2 = r2(c, 2);
+      for (int row = 0; row < bs; ++row)
+        tc[row] = w0 * b[row * rs + static_cast<std::size_t>(j) * cs] +
+                  w1 * b[row * rs + static_cast<std::size_t>(n + j) * cs] +
+                  w2 * b[row * rs + static_cast<std::size_t>(2 * n + j) * cs];
+    }
+  // out += s (R1 (x) I) t, column by column.
+  for (int col = 0; col < bs; ++col) {
+    const double* tc = t.data() + static_cast<std::size_t>(col) * bs;
+    double* oc = out + static_cast<std::size_t>(col) * bs;
+    for (int i = 0; i < n; ++i) {
+      const double a = tc[i], bb = tc[n + i], c = tc[2 * n + i];
+      oc[i] += s * (r1(0, 0) * a + r1(0, 1) * bb + r1(0, 2) * c);
+      oc[n + i] += s * (r1(1, 0) * a + r1(1, 1) * bb + r1(1, 2) * c);
+      oc[2 * n + i] += s * (r1(2, 0) * a + r1(2, 1) * bb + r1(2, 2) * c);
+    }
+  }
+}
+
+}  // namespace
+
+Eigen::Matrix3d polarRotation(const Eigen::Matrix3d& f) {
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(f, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d u = svd.matrixU();
+  const Eigen::Matrix3d v = svd.matrixV();
+  if ((u * v.transpose()).determinant() < 0.0) u.col(2) = -u.col(2);  // smallest singular value
+  return u * v.transpose();
+}
+
+/// One block of an element's rows: against element `other`, read from `block` of the split
+/// matrices (diagonal: the element's own; else a coupling block, transposed when stored by
+/// the other element).
+struct RowSlot {
+  std::uint32_t other = 0;
+  std::size_t block = 0;  ///< diagonal: the element; coupling: the coupling block's index
+  bool diagonal = false;
+  bool transposed = false;
+};
+
+struct DynamicSolver::Impl {
+  const PolyMesh* mesh = nullptr;
+  const MomentCache* moments = nullptr;
+  DynamicsOptions options;
+  std::unique_ptr<DgBasis> basis;
+  FaceRoles roles;
+  ElementData<double> elementEta;
+  FormCoefficients form;
+  SplitLocalMatrices parts;
+  int n = 0, bs = 0;
+  std::size_t ne = 0;
+  std::vector<std::size_t> rowStart;
+  std::vector<RowSlot> slots;
+  std::vector<double> mass;       ///< rho int phi_i phi_j, n x n per element
+  std::vector<double> massOne;    ///< rho int phi_i, n per element
+  std::vector<double> gradients;  ///< (1/|K|) int d_k phi_i at k * n + i, 3n per element
+  std::vector<Eigen::LLT<Eigen::MatrixXd>> massInverse;
+  Eigen::VectorXd x0;  ///< coefficients of x - o
+  Vec3 origin = Vec3::Zero();
+  double totalMass = 0.0;
+  Eigen::VectorXd gravityForce;
+  std::vector<Eigen::VectorXd> tractionForces;
+  std::vector<std::size_t> clampFaces, tractionFaces;
+  ElementFrames frames;
+  LocalMatrices system;
+  SpMat matrix;
+  LinearSolver solver;
+  bool assembled = false;
+  int baselineIterations = -1, lastIterations = 0;
+  double t = 0.0;
+  Eigen::VectorXd u, v, a;
+  /// BDF2: the state one step back, once there is one.
+  Eigen::VectorXd uPrevious, vPrevious;
+  bool hasPrevious = false;
+  double lastCK = 0.0;
+
+  // --- setup ---------------------------------------------------------------------------
+  void setup(const PolyMesh& m, const MomentCache& mc, const DynamicLoads& loads,
+             const DynamicsOptions& o) {
+    mesh = &m;
+    moments = &mc;
+    options = o;
+    options.material.check();
+    if (!(o.dt > 0.0) || !std::isfinite(o.dt))
+      throw std::invalid_argument("the time step must be positive");
+    if (!(o.massDamping >= 0.0) || !(o.stiffnessDamping >= 0.0))
+      throw std::invalid_argument("damping coefficients must not be negative");
+    const int p = o.discretization.basis.degree;
+    if (mc.degree() < 2 * p)
+      throw std::invalid_argument("DynamicSolver: the moments must be of degree >= 2p");
+    basis = std::make_unique<DgBasis>(m, mc, o.discretization.basis);
+    n = basis->size();
+    bs = 3 * n;
+    ne = m.numElements();
+
+    LoadCase lc;
+    for (const FaceSelector& c : loads.clamps) lc.dirichlet.push_back({c, {}});
+    for (const TimedTraction& tr : loads.tractions) lc.tractions.push_back({tr.where, tr.traction});
+    roles = classifyFaces(m, lc);
+    clampFaces.assign(loads.clamps.size(), 0);
+    tractionFaces.assign(loads.tractions.size(), 0);
+    for (std::size_t f = 0; f < m.numFaces(); ++f) {
+      const FaceId id(f);
+      if (roles.dirichlet[id] >= 0) ++clampFaces[static_cast<std::size_t>(roles.dirichlet[id])];
+      if (roles.traction[id] >= 0) ++tractionFaces[static_cast<std::size_t>(roles.traction[id])];
+    }
+    double threshold = 0.0;
+    form = formCoefficients(m, *basis, mc, roles, options.material, o.discretization, elementEta,
+                            threshold);
+    parts = splitLocalMatrices(m, *basis, mc, roles, form);
+    buildSlots();
+    elementTerms();
+
+    const int quadrature = o.discretization.quadratureDegree >= 0
+                               ? o.discretization.quadratureDegree
+                               : 2 * p + 2;
+    LoadCase gravity = lc;
+    for (auto& tr : gravity.tractions) tr.traction = Vec3::Zero();
+    gravity.gravity = loads.gravity;
+    gravityForce = assembleLoad(m, *basis, mc, roles, form, options.material, gravity, quadrature);
+    for (std::size_t k = 0; k < loads.tractions.size(); ++k) {
+      LoadCase one = gravity;
+      one.gravity = Vec3::Zero();
+      one.tractions[k].traction = loads.tractions[k].traction;
+      tractionForces.push_back(
+          assembleLoad(m, *basis, mc, roles, form, options.material, one, quadrature));
+    }
+    until.clear();
+    for (const TimedTraction& tr : loads.tractions) until.push_back(tr.until);
+
+    system = parts.jumps;  // layout; values are written per step
+    frames = elementFrames(*basis);
+    solver = LinearSolver(options.solver);
+    u = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(ne) * bs);
+    v = u;
+    a = u;
+  }
+  std::vector<double> until;
+
+  void buildSlots() {
+    const LocalMatrices& l = parts.jumps;
+    rowStart.assign(ne + 1, 0);
+    slots.clear();
+    for (std::size_t i = 0; i < ne; ++i) {
+      const auto& b = l.neighbours[i];
+      const auto firstGreater =
+          std::upper_bound(b.begin(), b.end(), static_cast<std::uint32_t>(i));
+      for (std::uint32_t f : b) {
+        RowSlot s;
+        s.other = f;
+        if (f == i) {
+          s.diagonal = true;
+          s.block = i;
+        } else if (f > i) {
+          s.block = l.couplingStart[i] + static_cast<std::size_t>(
+                                             std::lower_bound(firstGreater, b.end(), f) -
+                                             firstGreater);
+        } else {
+          const auto& bf = l.neighbours[f];
+          const auto fg = std::upper_bound(bf.begin(), bf.end(), f);
+          s.block = l.couplingStart[f] +
+                    static_cast<std::size_t>(
+                        std::lower_bound(fg, bf.end(), static_cast<std::uint32_t>(i)) - fg);
+          s.transposed = true;
+        }
+        slots.push_back(s);
+      }
+      rowStart[i + 1] = slots.size();
+    }
+  }
+
+  void elementTerms() {
+    const double rho = options.material.density;
+    mass.assign(ne * n * n, 0.0);
+    massOne.assign(ne * n, 0.0);
+    gradients.assign(ne * 3 * n, 0.0);
+    massInverse.assign(ne, Eigen::LLT<Eigen::MatrixXd>());
+    x0.resize(static_cast<Eigen::Index>(ne) * bs);
+    // o: the undeformed centre of mass (bounded coordinates far from the world's origin).
+    Vec3 first = Vec3::Zero();
+    double volume = 0.0;
+    for (std::size_t i = 0; i < ne; ++i) {
+      volume += moments->volume(ElementId(i));
+      first += moments->volume(ElementId(i)) * moments->centroid(ElementId(i));
+    }
+    origin = volume > 0.0 ? Vec3(first / volume) : Vec3::Zero();
+    totalMass = rho * volume;
+    tbb::parallel_for(std::size_t(0), ne, [&](std::size_t i) {
+      const ElementId e(i);
+      Eigen::MatrixXd me;
+      elementMass(*basis, *moments, e, me);
+      me *= rho;
+      Eigen::Map<Eigen::MatrixXd>(mass.data() + i * n * n, n, n) = me;
+      massInverse[i].compute(me);
+      const Eigen::VectorXd one = affineCoefficients(*basis, e, 1.0, Vec3::Zero(), origin);
+      Eigen::Map<Eigen::VectorXd>(massOne.data() + i * n, n) = me * one;
+      for (int d = 0; d < 3; ++d)
+        x0.segment(static_cast<Eigen::Index>(i) * bs + d * n, n) =
+            affineCoefficients(*basis, e, 0.0, Vec3::Unit(d), origin);
+      // Mean gradients: (1/|K|) int d_k phi_i = (1/|K|) sum_a T(i, a) int d_k m_a.
+      const auto t = basis->coefficients(e);
+      const auto em = moments->element(e);
+      const double h = basis->scale(e), vol = moments->volume(e);
+      for (int k = 0; k < 3; ++k)
+        for (int aIdx = 0; aIdx < n; ++aIdx) {
+          const Exponents ex = monomialExponents(aIdx);
+          int pw[3] = {ex.a, ex.b, ex.c};
+          if (pw[k] == 0) continue;
+          const double factor = pw[k] / h;
+          --pw[k];
+          const int b = monomialIndex(pw[0], pw[1], pw[2]);
+          const double integral = factor * em[b] / std::pow(h, pw[0] + pw[1] + pw[2]);
+          for (int fn = 0; fn < n; ++fn)
+            gradients[i * 3 * n + k * n + fn] += t(fn, aIdx) * integral / vol;
+        }
+    });
+  }
+
+  // --- per step ------------------------------------------------------------------------
+  std::vector<Eigen::Matrix3d> rotationsOf(const Eigen::VectorXd& disp) const {
+    std::vector<Eigen::Matrix3d> r(ne, Eigen::Matrix3d::Identity());
+    if (!options.corotational) return r;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ne, 256),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+                        for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                          Eigen::Matrix3d f = Eigen::Matrix3d::Identity();
+                          const double* g = gradients.data() + i * 3 * n;
+                          const double* ue = disp.data() + i * bs;
+                          for (int d = 0; d < 3; ++d)
+                            for (int k = 0; k < 3; ++k) {
+                              double s = 0.0;
+                              for (int fn = 0; fn < n; ++fn) s += g[k * n + fn] * ue[d * n + fn];
+                              f(d, k) += s;
+                            }
+                          r[i] = polarRotation(f);
+                        }
+                      });
+    return r;
+  }
+
+  /// The parts of the block of row element i in `slot`: pointers, strides and the element
+  /// whose rotation warps it (-1: none).
+  struct Part {
+    const double* b;
+    std::size_t rs, cs;
+    std::int64_t source;
+  };
+  int partsOf(std::size_t i, const RowSlot& s, Part out[3]) const {
+    const std::size_t bb = static_cast<std::size_t>(bs) * bs;
+    const std::size_t ubs = static_cast<std::size_t>(bs);
+    if (s.diagonal) {
+      out[0] = {parts.rowStrain.diagonal.data() + i * bb, 1, ubs, static_cast<std::int64_t>(i)};
+      out[1] = {parts.jumps.diagonal.data() + i * bb, 1, ubs, -1};
+      return 2;
+    }
+    const std::size_t off = s.block * bb;
+    const auto self = static_cast<std::int64_t>(i), other = static_cast<std::int64_t>(s.other);
+    if (!s.transposed) {  // row-major, stored by i
+      out[0] = {parts.rowStrain.coupling.data() + off, ubs, 1, self};
+      out[1] = {parts.columnStrain.coupling.data() + off, ubs, 1, other};
+      out[2] = {parts.jumps.coupling.data() + off, ubs, 1, -1};
+    } else {  // stored by `other` as its rows: read transposed
+      out[0] = {parts.rowStrain.coupling.data() + off, 1, ubs, other};
+      out[1] = {parts.columnStrain.coupling.data() + off, 1, ubs, self};
+      out[2] = {parts.jumps.coupling.data() + off, 1, ubs, -1};
+    }
+    return 3;
+  }
+
+  /// out = sum over blocks of R_S B (R_S^T x_C - z_C) (z null: 0), and if `energy`, the form's
+  /// energy 1/2 sum (R_S^T x_A - z_A) . B (R_S^T x_C - z_C).
+  void warpedProduct(const std::vector<Eigen::Matrix3d>& r, const Eigen::VectorXd& x,
+                     const Eigen::VectorXd* z, Eigen::VectorXd& out, double* energy) const {
+    out.setZero(x.size());
+    const bool bz = parts.jumps.componentDiagonalCoupling;
+    const std::size_t bb = static_cast<std::size_t>(bs) * bs;
+    const double e = tbb::parallel_deterministic_reduce(
+        tbb::blocked_range<std::size_t>(0, ne, 64), 0.0,
+        [&](const tbb::blocked_range<std::size_t>& range, double sum) {
+          std::vector<double> w(bs), y(bs), wa(bs), ry(bs);
+          for (std::size_t i = range.begin(); i != range.end(); ++i) {
+            double* oa = out.data() + i * bs;
+            const double* xa = x.data() + i * bs;
+            const double* za = z ? z->data() + i * bs : nullptr;
+            // Row i's block B against column element `col`, warped with element `source`'s
+            // rotation (-1: not warped).
+            auto apply = [&](const double* b, std::size_t rs, std::size_t cs, std::int64_t source,
+                             std::size_t col) {
+              const bool warp = source >= 0 && options.corotational;
+              const Eigen::Matrix3d& rs3 = warp ? r[static_cast<std::size_t>(source)] : r[i];
+              const double* xc = x.data() + col * bs;
+              if (warp)
+                rotate(rs3.transpose(), xc, n, w.data());
+              else
+                std::copy(xc, xc + bs, w.begin());
+              if (z)
+                for (int c = 0; c < bs; ++c) w[c] -= (*z)[static_cast<Eigen::Index>(col * bs + c)];
+              for (int row = 0; row < bs; ++row) {
+                double acc = 0.0;
+                const double* br = b + row * rs;
+                for (int c = 0; c < bs; ++c) acc += br[c * cs] * w[c];
+                y[row] = acc;
+              }
+              if (warp) {
+                rotate(rs3, y.data(), n, ry.data());
+                for (int c = 0; c < bs; ++c) oa[c] += ry[c];
+              } else {
+                for (int c = 0; c < bs; ++c) oa[c] += y[c];
+              }
+              if (energy) {
+                if (warp)
+                  rotate(rs3.transpose(), xa, n, wa.data());
+                else
+                  std::copy(xa, xa + bs, wa.begin());
+                double dot = 0.0;
+                for (int c = 0; c < bs; ++c) dot += (wa[c] - (za ? za[c] : 0.0)) * y[c];
+                sum += 0.5 * dot;
+              }
+            };
+            std::size_t neighbour = 0;
+            for (std::size_t k = rowStart[i]; k < rowStart[i + 1]; ++k) {
+              const RowSlot& s = slots[k];
+              if (!s.diagonal && !bz)  // the neighbour's lifting terms in i's diagonal block
+                apply(parts.neighbourLifting.data() + (parts.neighbourStart[i] + neighbour++) * bb,
+                      1, static_cast<std::size_t>(bs), s.other, i);
+              Part ps[3];
+              const int np = partsOf(i, s, ps);
+              for (int q = 0; q < np; ++q) {
+                if (ps[q].source >= 0 && !s.diagonal && bz) continue;  // BZ: no coupling strain
+                apply(ps[q].b, ps[q].rs, ps[q].cs, ps[q].source, s.other);
+              }
+            }
+          }
+          return sum;
+        },
+        std::plus<double>());
+    if (energy) *energy = e;
+  }
+
+  /// The system matrix cM M + cK K_w with the rotations `r`, into `system` and `matrix`.
+  void assembleSystem(const std::vector<Eigen::Matrix3d>& r, double cM, double cK) {
+    const std::size_t bb = static_cast<std::size_t>(bs) * bs;
+    const bool bz = parts.jumps.componentDiagonalCoupling;
+    const bool warp = options.corotational;
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, ne, 32), [&](const tbb::blocked_range<std::size_t>& range) {
+          for (std::size_t i = range.begin(); i != range.end(); ++i) {
+            double* d = system.diagonal.data() + i * bb;
+            const double* js = parts.jumps.diagonal.data() + i * bb;
+            const double* ss = parts.rowStrain.diagonal.data() + i * bb;
+            for (std::size_t k = 0; k < bb; ++k) d[k] = cK * js[k];
+            if (warp)
+              addRotatedBlock(r[i], ss, 1, static_cast<std::size_t>(bs), r[i], n, cK, d);
+            else
+              for (std::size_t k = 0; k < bb; ++k) d[k] += cK * ss[k];
+            if (!bz) {
+              const std::size_t first = parts.neighbourStart[i];
+              std::size_t k = 0;
+              for (std::uint32_t f : parts.jumps.neighbours[i]) {
+                if (f == i) continue;
+                const double* nl = parts.neighbourLifting.data() + (first + k++) * bb;
+                if (warp)
+                  addRotatedBlock(r[f], nl, 1, static_cast<std::size_t>(bs), r[f], n, cK, d);
+                else
+                  for (std::size_t q = 0; q < bb; ++q) d[q] += cK * nl[q];
+              }
+            }
+            const double* me = mass.data() + i * n * n;
+            for (int c = 0; c < 3; ++c)
+              for (int fi = 0; fi < n; ++fi)
+                for (int fj = 0; fj < n; ++fj)
+                  d[static_cast<std::size_t>(c * n + fj) * bs + c * n + fi] +=
+                      cM * me[fj * n + fi];
+            const auto& nb = parts.jumps.neighbours[i];
+            const auto firstGreater =
+                std::upper_bound(nb.begin(), nb.end(), static_cast<std::uint32_t>(i));
+            std::size_t slot = parts.jumps.couplingStart[i];
+            for (auto it = firstGreater; it != nb.end(); ++it, ++slot) {
+              // Coupling blocks are row-major: as column-major they are the transposed block,
+              // (R1 B R2^T)^T = R2 B^T R1^T.
+              double* c = system.coupling.data() + slot * bb;
+              const double* jc = parts.jumps.coupling.data() + slot * bb;
+              for (std::size_t k = 0; k < bb; ++k) c[k] = cK * jc[k];
+              if (bz) continue;
+              const double* rc = parts.rowStrain.coupling.data() + slot * bb;
+              const double* oc = parts.columnStrain.coupling.data() + slot * bb;
+              if (warp) {
+                const Eigen::Matrix3d& rf = r[*it];
+                // Read each row-major block column-major (its transpose) and write the
+                // transpose of the warped block: R_f B^T R_f^T etc. with the roles swapped.
+                addRotatedBlock(r[i], rc, 1, static_cast<std::size_t>(bs), r[i], n, cK, c);
+                addRotatedBlock(rf, oc, 1, static_cast<std::size_t>(bs), rf, n, cK, c);
+              } else {
+                for (std::size_t k = 0; k < bb; ++k) c[k] += cK * (rc[k] + oc[k]);
+              }
+            }
+          }
+        });
+    if (!assembled) {
+      SpMat k = assembleStiffness(system);
+      matrix.swap(k);
+    } else {
+      refillStiffness(system, matrix);
+    }
+  }
+
+  void massProduct(const Eigen::VectorXd& x, Eigen::VectorXd& out) const {
+    out.resize(x.size());
+    tbb::parallel_for(std::size_t(0), ne, [&](std::size_t i) {
+      const ColMap me(mass.data() + i * n * n, n, n);
+      for (int d = 0; d < 3; ++d) {
+        const Eigen::Index base = static_cast<Eigen::Index>(i * bs + d * n);
+        out.segment(base, n).noalias() = me * x.segment(base, n);
+      }
+    });
+  }
+
+  Eigen::VectorXd external(double time) const {
+    Eigen::VectorXd f = gravityForce;
+    for (std::size_t k = 0; k < tractionForces.size(); ++k)
+      if (time <= until[k] * (1.0 + 1e-12) + 1e-12 * options.dt) f += tractionForces[k];
+    return f;
+  }
+
+  Eigen::VectorXd elasticForce(const std::vector<Eigen::Matrix3d>& r, double* energy) const {
+    const Eigen::VectorXd x = x0 + u;
+    Eigen::VectorXd f;
+    warpedProduct(r, x, &x0, f, energy);
+    return f;
+  }
+
+  /// Newmark: A from M A = F - D V - f(U).
+  void equilibriumAcceleration() {
+    const auto r = rotationsOf(u);
+    Eigen::VectorXd rhs = external(t) - elasticForce(r, nullptr);
+    if (options.massDamping > 0.0 || options.stiffnessDamping > 0.0) {
+      Eigen::VectorXd mv, kv;
+      massProduct(v, mv);
+      warpedProduct(r, v, nullptr, kv, nullptr);
+      rhs -= options.massDamping * mv + options.stiffnessDamping * kv;
+    }
+    tbb::parallel_for(std::size_t(0), ne, [&](std::size_t i) {
+      for (int d = 0; d < 3; ++d) {
+        const Eigen::Index base = static_cast<Eigen::Index>(i * bs + d * n);
+        a.segment(base, n) = massInverse[i].solve(rhs.segment(base, n));
+      }
+    });
+  }
+
+  /// The state the solution x of a step's system gives: U_{n+1} (and V, A through `vOut`,
+  /// `aOut` if not null).
+  Eigen::VectorXd advance(const Eigen::VectorXd& x, bool bdf2, double c, Eigen::VectorXd* vOut,
+                          Eigen::VectorXd* aOut) const {
+    const double dt = options.dt;
+    switch (options.integrator) {
+      case TimeIntegrator::Newmark:
+        if (vOut) *vOut = v + dt * ((1.0 - kNewmarkGamma) * a + kNewmarkGamma * x);
+        if (aOut) *aOut = x;
+        return u + dt * v + dt * dt * ((0.5 - kNewmarkBeta) * a + kNewmarkBeta * x);
+      case TimeIntegrator::Bdf2:
+        if (vOut) *vOut = x;
+        return bdf2 ? Eigen::VectorXd((4.0 * u - uPrevious) / 3.0 + c * x)
+                    : Eigen::VectorXd(u + dt * x);
+      case TimeIntegrator::BackwardEuler: break;
+    }
+    if (vOut) *vOut = x;
+    return u + dt * x;
+  }
+
+  StepReport step() {
+    StepReport rep;
+    const double dt = options.dt, alpha = options.massDamping, beta = options.stiffnessDamping;
+    const bool newmark = options.integrator == TimeIntegrator::Newmark;
+    const Stopwatch t0;
+    const std::vector<Eigen::Matrix3d> r = rotationsOf(u);
+    rep.rotationSeconds = t0.seconds();
+
+    const Stopwatch t1;
+    // BDF2 needs one step behind it; its first step is backward Euler.
+    const bool bdf2 = options.integrator == TimeIntegrator::Bdf2 && hasPrevious;
+    const double c = bdf2 ? 2.0 * dt / 3.0 : dt;
+    const double cM = newmark ? 1.0 + kNewmarkGamma * dt * alpha : 1.0 + c * alpha;
+    const double cK = newmark ? kNewmarkGamma * dt * beta + kNewmarkBeta * dt * dt
+                              : c * beta + c * c;
+    // A new matrix with new rotations, and when BDF2's coefficients replace its first step's.
+    const bool newMatrix = !assembled || options.corotational || cK != lastCK;
+    lastCK = cK;
+    if (newMatrix) assembleSystem(r, cM, cK);
+    const double t1Time = t + dt;
+    // The right-hand side without the elastic force: it enters as g = f(U_n), or, in the
+    // corrections of a corotated step, as f(U^k) - K_w (U^k - U_n).
+    Eigen::VectorXd base, mv;
+    double forceScale = 0.0;  // the elastic force's factor in the right-hand side
+    if (bdf2) {
+      Eigen::VectorXd kd;
+      warpedProduct(r, (u - uPrevious) / 3.0, nullptr, kd, nullptr);
+      massProduct((4.0 * v - vPrevious) / 3.0, mv);
+      base = mv + c * (external(t1Time) - kd);
+      forceScale = c;
+    } else if (!newmark) {
+      massProduct(v, mv);
+      base = mv + dt * external(t1Time);
+      forceScale = dt;
+    } else {
+      const Eigen::VectorXd w1 = v + (1.0 - kNewmarkGamma) * dt * a;
+      const Eigen::VectorXd w2 = beta * w1 + dt * v + (0.5 - kNewmarkBeta) * dt * dt * a;
+      Eigen::VectorXd kw;
+      warpedProduct(r, w2, nullptr, kw, nullptr);
+      base = external(t1Time) - kw;
+      if (alpha > 0.0) {
+        massProduct(w1, mv);
+        base -= alpha * mv;
+      }
+      forceScale = 1.0;
+    }
+    Eigen::VectorXd rhs = base - forceScale * elasticForce(r, nullptr);
+    rep.assemblySeconds = t1.seconds();
+
+    const Stopwatch t2;
+    if (!assembled) {
+      const bool direct = chooseSolver(matrix, options.solver) == SolverKind::Cholesky;
+      if (!solver.compute(matrix, bs, direct ? nullptr : &frames) && direct)
+        throw std::runtime_error(
+            "the time step's system matrix is not positive definite (a corotated element "
+            "turned inside out?)");
+      rep.refactorized = direct;
+      rep.preconditionerRebuilt = !direct;
+      assembled = true;
+      baselineIterations = -1;
+    } else if (newMatrix) {
+      const bool direct = solver.kind() == SolverKind::Cholesky;
+      const bool refresh = !direct && baselineIterations >= 0 &&
+                           lastIterations > options.refreshRatio * std::max(baselineIterations, 1);
+      if (!solver.update(matrix, refresh, &frames) && direct)
+        throw std::runtime_error(
+            "the time step's system matrix is not positive definite (a corotated element "
+            "turned inside out?)");
+      rep.refactorized = direct;
+      rep.preconditionerRebuilt = refresh;
+      if (refresh) baselineIterations = -1;
+    }
+    auto solve = [&](const Eigen::VectorXd& b, const Eigen::VectorXd& guess) {
+      LinearSolveReport lr;
+      Eigen::VectorXd x = solver.solve(b, lr, &guess);
+      if (!lr.success)
+        throw std::runtime_error("the time step's solve failed (CG did not converge, residual " +
+                                 std::to_string(lr.residual) + ")");
+      rep.iterations += lr.iterations;
+      rep.residual = lr.residual;
+      return x;
+    };
+    Eigen::VectorXd x = solve(rhs, newmark ? a : v);
+    rep.solveSeconds = t2.seconds();
+    // Corotation: correct the once-linearized force (modified Newton with the step's matrix):
+    // f(U_{n+1}) ~ f(U^k) + K_w (U_{n+1} - U^k), U^k the last solution's state.
+    const int maxSolves = corrections();
+    rep.solves = 1;
+    for (int k = 1; k < maxSolves; ++k) {
+      const Stopwatch tc;
+      const Eigen::VectorXd uk = advance(x, bdf2, c, nullptr, nullptr);
+      const std::vector<Eigen::Matrix3d> rk = rotationsOf(uk);
+      rep.rotationSeconds += tc.seconds();
+      const Stopwatch tf;
+      Eigen::VectorXd fk, kd;
+      const Eigen::VectorXd xk = x0 + uk;
+      warpedProduct(rk, xk, &x0, fk, nullptr);
+      warpedProduct(r, uk - u, nullptr, kd, nullptr);
+      rhs = base - forceScale * (fk - kd);
+      rep.assemblySeconds += tf.seconds();
+      const Stopwatch ts;
+      Eigen::VectorXd next = solve(rhs, x);
+      rep.solveSeconds += ts.seconds();
+      ++rep.solves;
+      const double change = (next - x).norm(), size = next.norm();
+      x = std::move(next);
+      rep.correction = size > 0.0 ? change / size : change;
+      if (options.corotationSolves <= 0 && rep.correction <= options.correctionTolerance) break;
+    }
+    lastIterations = rep.iterations;
+    if (baselineIterations < 0) baselineIterations = rep.iterations;
+
+    Eigen::VectorXd vNew, aNew;
+    Eigen::VectorXd uNew = advance(x, bdf2, c, &vNew, newmark ? &aNew : nullptr);
+    if (options.integrator == TimeIntegrator::Bdf2) {
+      uPrevious = std::move(u);
+      vPrevious = std::move(v);
+      hasPrevious = true;
+    }
+    u = std::move(uNew);
+    v = std::move(vNew);
+    if (newmark) a = std::move(aNew);
+    t = t1Time;
+    rep.t = t;
+    return rep;
+  }
+
+  /// The most solves per step (see DynamicsOptions::corotationSolves).
+  int corrections() const {
+    if (!options.corotational) return 1;
+    if (options.corotationSolves > 0) return options.corotationSolves;
+    return options.integrator == TimeIntegrator::BackwardEuler ? 1 : kMaxAutomaticSolves;
+  }
+
+  BodyState bodyState() const {
+    BodyState s;
+    const auto r = rotationsOf(u);
+    elasticForce(r, &s.elastic);
+    s.gravity = -gravityForce.dot(u);
+    for (std::size_t k = 0; k < tractionForces.size(); ++k)
+      if (t <= until[k] * (1.0 + 1e-12) + 1e-12 * options.dt)
+        s.tractionPotential -= tractionForces[k].dot(u);
+    const Eigen::VectorXd q = x0 + u;  // x - o + u
+    Eigen::VectorXd mv, mq;
+    massProduct(v, mv);
+    massProduct(q, mq);
+    s.kinetic = 0.5 * v.dot(mv);
+    Vec3 first = Vec3::Zero();
+    for (std::size_t i = 0; i < ne; ++i) {
+      const Eigen::Map<const Eigen::VectorXd> one(massOne.data() + i * n, n);
+      for (int d = 0; d < 3; ++d) {
+        const Eigen::Index base = static_cast<Eigen::Index>(i * bs + d * n);
+        s.momentum[d] += one.dot(v.segment(base, n));
+        first[d] += one.dot(q.segment(base, n));
+      }
+      // int rho q_a v_b = Q_a . (M V_b)
+      Eigen::Matrix3d qv;
+      for (int aa = 0; aa < 3; ++aa)
+        for (int b = 0; b < 3; ++b)
+          qv(aa, b) = q.segment(static_cast<Eigen::Index>(i * bs + aa * n), n)
+                          .dot(mv.segment(static_cast<Eigen::Index>(i * bs + b * n), n));
+      s.angularMomentum += Vec3(qv(1, 2) - qv(2, 1), qv(2, 0) - qv(0, 2), qv(0, 1) - qv(1, 0));
+    }
+    s.centreOfMass = origin + (totalMass > 0.0 ? Vec3(first / totalMass) : Vec3::Zero());
+    return s;
+  }
+
+  double deformedVolume() const {
+    const int p = basis->degree();
+    return tbb::parallel_deterministic_reduce(
+        tbb::blocked_range<std::size_t>(0, ne, 64), 0.0,
+        [&](const tbb::blocked_range<std::size_t>& range, double sum) {
+          for (std::size_t i = range.begin(); i != range.end(); ++i) {
+            const ElementId e(i);
+            if (p == 1) {  // constant gradient
+              Eigen::Matrix3d f = Eigen::Matrix3d::Identity();
+              const double* g = gradients.data() + i * 3 * n;
+              for (int d = 0; d < 3; ++d)
+                for (int k = 0; k < 3; ++k)
+                  for (int fn = 0; fn < n; ++fn) f(d, k) += g[k * n + fn] * u[static_cast<Eigen::Index>(i * bs + d * n + fn)];
+              sum += f.determinant() * moments->volume(e);
+              continue;
+            }
+            for (const QuadraturePoint& qp : elementQuadrature(*mesh, e, 3 * (p - 1)))
+              sum += qp.weight *
+                     (Eigen::Matrix3d::Identity() + displacementGradientAt(*basis, u, e, qp.point))
+                         .determinant();
+          }
+          return sum;
+        },
+        std::plus<double>());
+  }
+};
+
+DynamicSolver::DynamicSolver(const PolyMesh& mesh, const MomentCache& moments,
+                             const DynamicLoads& loads, const DynamicsOptions& options)
+    : impl_(std::make_unique<Impl>()) {
+  impl_->setup(mesh, moments, loads, options);
+  if (options.integrator == TimeIntegrator::Newmark) impl_->equilibriumAcceleration();
+}
+DynamicSolver::~DynamicSolver() = default;
+DynamicSolver::DynamicSolver(DynamicSolver&&) noexcept = default;
+DynamicSolver& DynamicSolver::operator=(DynamicSolver&&) noexcept = default;
+
+const DgBasis& DynamicSolver::basis() const { return *impl_->basis; }
+const DynamicsOptions& DynamicSolver::options() const { return impl_->options; }
+std::size_t DynamicSolver::dofs() const { return static_cast<std::size_t>(impl_->u.size()); }
+double DynamicSolver::time() const { return impl_->t; }
+const Eigen::VectorXd& DynamicSolver::displacement() const { return impl_->u; }
+const Eigen::VectorXd& DynamicSolver::velocity() const { return impl_->v; }
+const std::vector<std::size_t>& DynamicSolver::clampFaces() const { return impl_->clampFaces; }
+const std::vector<std::size_t>& DynamicSolver::tractionFaces() const {
+  return impl_->tractionFaces;
+}
+const Vec3& DynamicSolver::referencePoint() const { return impl_->origin; }
+double DynamicSolver::mass() const { return impl_->totalMass; }
+
+void DynamicSolver::setState(double t, const Eigen::VectorXd& displacement,
+                             const Eigen::VectorXd& velocity) {
+  Impl& m = *impl_;
+  if (displacement.size() != m.u.size() || velocity.size() != m.v.size())
+    throw std::invalid_argument("DynamicSolver::setState: vectors of the wrong size");
+  m.t = t;
+  m.u = displacement;
+  m.v = velocity;
+  m.hasPrevious = false;  // BDF2 starts again with a backward Euler step
+  if (m.options.integrator == TimeIntegrator::Newmark) m.equilibriumAcceleration();
+}
+
+StepReport DynamicSolver::step() { return impl_->step(); }
+BodyState DynamicSolver::state() const { return impl_->bodyState(); }
+
+Eigen::VectorXd DynamicSolver::elasticForce() const {
+  return impl_->elasticForce(impl_->rotationsOf(impl_->u), nullptr);
+}
+Eigen::VectorXd DynamicSolver::externalForce(double t) const { return impl_->external(t); }
+double DynamicSolver::deformedVolume() const { return impl_->deformedVolume(); }
+
+Eigen::VectorXd DynamicSolver::affineField(const Eigen::Matrix3d& a, const Vec3& b,
+                                           const Vec3& c) const {
+  const Impl& m = *impl_;
+  Eigen::VectorXd out(static_cast<Eigen::Index>(m.ne) * m.bs);
+  tbb::parallel_for(std::size_t(0), m.ne, [&](std::size_t i) {
+    for (int d = 0; d < 3; ++d)
+      out.segment(static_cast<Eigen::Index>(i * m.bs + d * m.n), m.n) =
+          affineCoefficients(*m.basis, ElementId(i), b[d], a.row(d).transpose(), c);
+  });
+  return out;
+}
+
+std::vector<Eigen::Matrix3d> DynamicSolver::rotations() const {
+  return impl_->rotationsOf(impl_->u);
+}
+
+}  // namespace polydg
