@@ -327,6 +327,7 @@ OperationReport MeshEditor::cutInPlace(const Blade& blade, const CutOptions& opt
   }
   s.volume = volumeBefore - oldVolume + newVolume;
   report.leftWhole = edit.leftWhole().sorted();
+  report.lineage = edit.lineage();
   report.facesTotal = s.mesh.numFaces();
 
   // 7. Checks.
@@ -372,6 +373,7 @@ OperationReport MeshEditor::mergeSlivers(double fraction, ValidationLevel valida
     s.grid.insert(e, elementBounds(s.mesh, e));
   }
   s.volume = volumeBefore - oldVolume + newVolume;
+  report.lineage = edit.lineage();
   report.facesTotal = s.mesh.numFaces();
   validateOperation(s.mesh, *s.moments, touched, s.region, validation, validationDegree,
                     fraction * s.referenceVolume, report.validation);

@@ -87,9 +87,11 @@ class Edit {
     if (e.index() >= oldElements_) return;
     if (oldVolume_.emplace(e.value, cache_.volume(e)).second) changed_.insert(e);
   }
-  ElementId addElement(std::span<const FaceUse> uses) {
+  /// A new element made of part of `parent` (lineage).
+  ElementId addElement(std::span<const FaceUse> uses, ElementId parent) {
     const ElementId e = mesh_.addElementFromFaces(uses);
     created_.insert(e);
+    sources_[e.value] = sourcesOf(parent);
     return e;
   }
   FaceId addFace(std::span<const VertexId> vertices, std::span<const std::uint32_t> loopEnd,
@@ -162,6 +164,9 @@ class Edit {
         mesh_.attachFace(t, use);
       }
     }
+    std::vector<ElementId> joined = sourcesOf(t);
+    for (ElementId e : sourcesOf(s)) joined.push_back(e);
+    sources_[t.value] = std::move(joined);
     markDead(s);
     if (!created_.contains(t)) changed_.insert(t);
     cache_.invalidateElement(t);
@@ -193,7 +198,12 @@ class Edit {
     for (auto it = deadElements_.rbegin(); it != deadElements_.rend(); ++it) {
       grid_.erase(*it);
       const ElementId moved = mesh_.removeElement(*it);
-      if (!moved.valid()) continue;
+      if (!moved.valid()) {
+        sources_.erase(it->value);
+        continue;
+      }
+      sources_[it->value] = sourcesOf(moved);
+      sources_.erase(moved.value);
       cache_.moveElement(moved, *it);
       grid_.move(moved, *it);
       created_.move(moved, *it);
@@ -212,6 +222,14 @@ class Edit {
     return v;
   }
 
+  /// The lineage of the elements (call after compact()).
+  ElementLineage lineage() const {
+    ElementLineage l;
+    for (const auto& [id, sources] : sources_)
+      if (sources.size() != 1 || sources[0].value != id) l.changed.emplace(id, sources);
+    return l;
+  }
+
   IdSet<ElementId>& created() { return created_; }
   IdSet<ElementId>& changed() { return changed_; }
   IdSet<ElementId>& leftWhole() { return leftWhole_; }
@@ -226,6 +244,12 @@ class Edit {
   IdSet<ElementId> created_, changed_, leftWhole_;
   IdSet<FaceId> newFaces_;
   std::vector<FaceId> pendingFaces_;  ///< created since the last updateMoments()
+  /// Elements of the mesh before the operation that element id covers, where not just itself.
+  std::unordered_map<std::uint32_t, std::vector<ElementId>> sources_;
+  std::vector<ElementId> sourcesOf(ElementId e) const {
+    const auto it = sources_.find(e.value);
+    return it == sources_.end() ? std::vector<ElementId>{e} : it->second;
+  }
   std::vector<FaceId> deadFaces_;
   std::vector<ElementId> deadElements_;
 };

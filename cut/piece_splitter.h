@@ -205,7 +205,7 @@ class Splitter {
           const FaceUse use = faceFor(parts[i], side);
           if (use.face.valid()) faces.push_back(use);
         }
-        pieces.emplace_back(edit_.addElement({faces.data(), faces.size()}), side);
+        pieces.emplace_back(edit_.addElement({faces.data(), faces.size()}, e), side);
       }
     }
     return pieces;

@@ -62,6 +62,52 @@ TEST(Cut, ObliquePlaneSplitsCrossedElements) {
   EXPECT_EQ(components, 2u);
 }
 
+TEST(Cut, LineageNamesEachElementsSources) {
+  // Every element after a cut covers part of its sources: the volumes of the elements that
+  // came from an old element add up to its volume, with and without sliver merging (merged
+  // slivers name both sources; removed pieces are gone).
+  for (double sliver : {0.0, 0.2}) {
+    for (int removeSide : {0, 1}) {
+      const PolyMesh before = unitGrid(4);
+      MeshEditor editor(before);
+      std::vector<double> oldVolumes(before.numElements());
+      for (std::size_t e = 0; e < before.numElements(); ++e)
+        oldVolumes[e] = editor.moments().volume(ElementId(e));
+      CutOptions options;
+      options.sliverFraction = sliver;
+      options.removeSide = removeSide;
+      const auto r = editor.cut(Blade::plane(Vec3(1, 2, 3), 2.9), options);
+      ASSERT_TRUE(r.validation.passed) << r.validation.failure;
+      EXPECT_FALSE(r.lineage.changed.empty());
+      std::vector<double> covered(before.numElements(), 0.0);
+      std::size_t merged = 0;
+      std::vector<bool> inMerged(before.numElements(), false);
+      for (std::size_t e = 0; e < editor.mesh().numElements(); ++e) {
+        const auto sources = r.lineage.sources(ElementId(e));
+        ASSERT_FALSE(sources.empty());
+        for (ElementId s : sources) ASSERT_LT(s.index(), before.numElements());
+        if (sources.size() > 1) {
+          ++merged;
+          for (ElementId s : sources) inMerged[s.index()] = true;
+          continue;
+        }
+        covered[sources[0].index()] += editor.moments().volume(ElementId(e));
+      }
+      EXPECT_EQ(merged > 0, r.sliversMerged > 0);
+      const Plane plane = Plane::make(Vec3(1, 2, 3), 2.9);
+      for (std::size_t e = 0; e < before.numElements(); ++e) {
+        if (covered[e] == 0.0 || inMerged[e]) continue;  // removed, or merged with a sliver
+        // A source wholly on the kept side is covered completely.
+        // (The normal's components are positive: the box's max corner is its highest point.)
+        const bool crossed = plane.normal.dot(elementBounds(before, ElementId(e)).max()) > plane.offset;
+        if (!crossed || removeSide == 0) {
+          EXPECT_NEAR(covered[e], oldVolumes[e], 1e-12) << "element " << e;
+        }
+      }
+    }
+  }
+}
+
 CutOptions noMerging() {
   CutOptions options;
   options.sliverFraction = 0.0;

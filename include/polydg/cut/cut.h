@@ -10,6 +10,7 @@
 #include <cstddef>
 #include <memory>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "polydg/integrate/moment_cache.h"
@@ -71,6 +72,18 @@ struct OperationValidation {
   std::string failure;          ///< first failed check, one line; empty when passed
 };
 
+/// Where the elements after an operation come from: element e of the result covers all or part
+/// of the elements sources(e) of the mesh before it (a piece: its parent; a sliver merged into
+/// a neighbour: the neighbour's sources first, then the sliver's). Elements the operation did
+/// not change keep their id and come from themselves.
+struct ElementLineage {
+  std::unordered_map<std::uint32_t, std::vector<ElementId>> changed;  ///< ids not from themselves
+  std::vector<ElementId> sources(ElementId e) const {
+    const auto it = changed.find(e.value);
+    return it == changed.end() ? std::vector<ElementId>{e} : it->second;
+  }
+};
+
 /// What one operation did.
 struct OperationReport {
   std::string op;                   ///< "cut", "cut_polygon" or "merge"
@@ -87,6 +100,7 @@ struct OperationReport {
   /// Finite blade: elements the blade's plane crosses at the polygon's edge, left whole.
   std::vector<ElementId> leftWhole;
   OperationValidation validation;
+  ElementLineage lineage;
   double seconds = 0.0;
 };
 
