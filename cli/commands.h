@@ -20,6 +20,8 @@ void addSolveCommand(CLI::App& app, const CommonOptions& common, int& exitCode);
 void addCutCommand(CLI::App& app, const CommonOptions& common, int& exitCode);
 /// `polydg run PIPELINE.json`: a JSON pipeline of steps on one input or many.
 void addRunCommand(CLI::App& app, const CommonOptions& common, int& exitCode);
+/// `polydg simulate MESH.vtu --scene SCENE.json -o OUTDIR`: dynamics (model/scene.h).
+void addSimulateCommand(CLI::App& app, const CommonOptions& common, int& exitCode);
 void addBenchCommand(CLI::App& app, const CommonOptions& common, int& exitCode);
 
 }  // namespace polydg::cli

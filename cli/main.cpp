@@ -76,6 +76,7 @@ int main(int argc, char** argv) {
   polydg::cli::addMeshCommand(app, common, exitCode);
   polydg::cli::addCheckCommand(app, common, exitCode);
   polydg::cli::addSolveCommand(app, common, exitCode);
+  polydg::cli::addSimulateCommand(app, common, exitCode);
   polydg::cli::addCutCommand(app, common, exitCode);
   polydg::cli::addRunCommand(app, common, exitCode);
   polydg::cli::addBenchCommand(app, common, exitCode);

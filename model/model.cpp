@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include "polydg/mesh/geometry.h"
+#include "model_state.h"
 #include "polydg/model/provenance.h"
 #include "polydg/util/error.h"
 #include "polydg/util/stopwatch.h"
@@ -18,57 +19,6 @@
 namespace polydg {
 
 namespace fs = std::filesystem;
-
-/// The model's parts. Until the first edit the model holds the mesh and its moment cache
-/// itself; the first cut or merge hands both to a MeshEditor, which owns them from then on.
-struct Model::State {
-  Provenance provenance;
-  PolyMesh mesh;                         ///< until the first edit
-  std::unique_ptr<MomentCache> moments;  ///< until the first edit (null until needed)
-  std::unique_ptr<MeshEditor> editor;    ///< from the first edit
-  std::size_t retiredIntegrations = 0;   ///< faces integrated by caches replaced before it
-  /// Whether the mesh is known to pass validate(): set by a passed validation, kept by edits
-  /// whose own validation passed, unknown (nullopt) after an unvalidated edit.
-  std::optional<bool> valid;
-  /// Set by an operation that failed part-way: the mesh must not be used further.
-  std::string broken;
-  std::optional<Solution> solution;
-
-  const PolyMesh& currentMesh() const { return editor ? editor->mesh() : mesh; }
-  const MomentCache* currentMoments() const { return editor ? &editor->moments() : moments.get(); }
-  MeshEditor& edit() {
-    if (!editor) {
-      if (!(provenance.referenceVolume > 0.0))
-        throw InputError(
-            "the mesh's median element volume is not positive (inverted or flat "
-            "elements), so no sliver rule applies; run 'polydg check' on it");
-      editor = std::make_unique<MeshEditor>(std::move(mesh), provenance.referenceVolume,
-                                            std::move(moments));
-      mesh = PolyMesh();
-    }
-    return *editor;
-  }
-  void requireUsable() const {
-    if (!broken.empty())
-      throw CheckFailure("the model cannot be used after a failed operation (" + broken +
-                         "); start again from its input");
-  }
-  /// What follows every edit (cut or merge): the solution no longer fits the mesh; an edit that
-  /// left no element fails; a failed one breaks the model; an unvalidated one leaves its
-  /// validity unknown.
-  void finishEdit(OperationReport& report, ValidationLevel validation) {
-    solution.reset();
-    if (currentMesh().numElements() == 0 && report.validation.passed) {
-      report.validation.passed = false;
-      report.validation.failure =
-          "the " + report.op + " left no element (everything was removed); nothing to write";
-    }
-    if (!report.validation.passed)
-      broken = report.op + " failed: " + report.validation.failure;
-    else if (validation == ValidationLevel::None)
-      valid.reset();
-  }
-};
 
 namespace {
 
@@ -364,6 +314,50 @@ std::string boxText(const Box3& box) {
 
 }  // namespace
 
+void Model::State::requireValid() {
+  const PolyMesh& m = currentMesh();
+  if (!valid.has_value()) valid = validate(m).passed;
+  if (*valid) return;
+  const ValidationReport v = validate(m);
+  throw CheckFailure(
+      "the mesh is invalid (" +
+      (v.messages.empty() ? std::string("see 'polydg check'") : v.messages.front()) +
+      "); run 'polydg check' for details");
+}
+
+void Model::State::checkSelections(const std::vector<FaceSelector>& clamps,
+                                   const std::vector<const FaceSelector*>& loads,
+                                   std::vector<std::size_t>& clampFaces,
+                                   std::vector<std::size_t>& loadFaces) const {
+  const PolyMesh& m = currentMesh();
+  std::vector<const FaceSelector*> selections;
+  for (const FaceSelector& c : clamps) selections.push_back(&c);
+  for (const FaceSelector* t : loads) selections.push_back(t);
+  const std::vector<std::size_t> counts = countSelected(m, selections);
+  clampFaces.clear();
+  loadFaces.clear();
+  for (std::size_t i = 0; i < counts.size(); ++i) {
+    const bool clamp = i < clamps.size();
+    (clamp ? clampFaces : loadFaces).push_back(counts[i]);
+    if (counts[i] == 0)
+      throw InputError(std::string(clamp ? "the clamp " : "the traction on ") +
+                       selections[i]->describe() + " selects no boundary face (the mesh spans " +
+                       boxText(meshBounds(m)) + "); use a region that meets the boundary");
+  }
+}
+
+void Model::State::adoptSolution(std::unique_ptr<DgBasis> basis, Eigen::VectorXd coefficients,
+                                 const Material& material, const MomentCache& moments) {
+  const PolyMesh& m = currentMesh();
+  Solution u;
+  u.material = material;
+  u.basis = std::move(basis);
+  u.coefficients = std::move(coefficients);
+  u.corners = cornerDisplacements(m, *u.basis, u.coefficients);
+  u.fields = elementFields(m, *u.basis, moments, u.coefficients, material);
+  solution = std::move(u);
+}
+
 SolveReport Model::solve(const SolveOptions& options) {
   State& s = *state_;
   s.requireUsable();
@@ -379,30 +373,12 @@ SolveReport Model::solve(const SolveOptions& options) {
   if (options.clamps.empty())
     throw InputError("nothing holds the body: give at least one clamp (a plane, below or box)");
   const PolyMesh& m = mesh();
-  if (!s.valid.has_value()) s.valid = validate(m).passed;
-  if (!*s.valid) {
-    const ValidationReport v = validate(m);
-    throw CheckFailure(
-        "the mesh is invalid (" +
-        (v.messages.empty() ? std::string("see 'polydg check'") : v.messages.front()) +
-        "); run 'polydg check' for details");
-  }
-
-  // Every selection must pick something.
-  std::vector<const FaceSelector*> selections;
-  for (const FaceSelector& c : options.clamps) selections.push_back(&c);
-  for (const TractionLoad& t : options.tractions) selections.push_back(&t.where);
-  const std::vector<std::size_t> counts = countSelected(m, selections);
+  s.requireValid();
   SolveReport report;
   report.options = options;
-  for (std::size_t i = 0; i < counts.size(); ++i) {
-    const bool clamp = i < options.clamps.size();
-    (clamp ? report.clampFaces : report.tractionFaces).push_back(counts[i]);
-    if (counts[i] == 0)
-      throw InputError(std::string(clamp ? "the clamp " : "the traction on ") +
-                       selections[i]->describe() + " selects no boundary face (the mesh spans " +
-                       boxText(meshBounds(m)) + "); use a region that meets the boundary");
-  }
+  std::vector<const FaceSelector*> tractions;
+  for (const TractionLoad& t : options.tractions) tractions.push_back(&t.where);
+  s.checkSelections(options.clamps, tractions, report.clampFaces, report.tractionFaces);
 
   LoadCase loads;
   for (const FaceSelector& c : options.clamps) loads.dirichlet.push_back({c, {}});
@@ -437,17 +413,12 @@ SolveReport Model::solve(const SolveOptions& options) {
   report.facesIntegrated = facesIntegrated() - before;
 
   StaticSolution solved = solver.release();
-  Solution solution;
-  solution.material = options.material;
-  solution.basis = std::move(solved.basis);
-  solution.coefficients = std::move(solved.coefficients);
-  solution.corners = cornerDisplacements(m, *solution.basis, solution.coefficients);
-  solution.fields =
-      elementFields(m, *solution.basis, moments, solution.coefficients, options.material);
+  s.adoptSolution(std::move(solved.basis), std::move(solved.coefficients), options.material,
+                  moments);
+  const Solution& solution = *s.solution;
   report.maxDisplacement = solution.corners.largestNorm();
   for (double j : solution.fields.largestJump) report.maxJump = std::max(report.maxJump, j);
   for (double v : solution.fields.vonMises) report.maxVonMises = std::max(report.maxVonMises, v);
-  s.solution = std::move(solution);
   return report;
 }
 

@@ -43,6 +43,41 @@ int Pipeline::momentDegree() const {
 
 // --- reading -------------------------------------------------------------------------------
 
+CutRequest readCutRequest(JsonObjectReader& r) {
+  CutStep s;
+  const bool plane = r.has("plane"), polygon = r.has("polygon");
+  if (plane == polygon)
+    r.fail(r.place(), "a cut needs exactly one of \"plane\" and \"polygon\"");
+  try {
+    if (plane) {
+      const auto v = r.numbers(r.get("plane"), r.at("plane"), 4);
+      s.request.blade = Blade::plane(Vec3(v[0], v[1], v[2]), v[3]);
+    } else {
+      const json& corners = r.get("polygon");
+      if (!corners.is_array()) r.fail(r.at("polygon"), "expected a list of [x, y, z] corners");
+      std::vector<Vec3> points;
+      for (std::size_t k = 0; k < corners.size(); ++k)
+        points.push_back(r.vec3(corners[k], r.at("polygon") + "[" + std::to_string(k) + "]"));
+      s.request.blade = Blade::fromPolygon(std::move(points));
+    }
+  } catch (const std::invalid_argument& e) {
+    r.fail(r.at(plane ? "plane" : "polygon"), e.what());
+  }
+  if (r.has("remove_side")) s.request.removeSide = r.choice("remove_side", removeSideNames());
+  if (r.has("validate")) s.request.validation = r.choice("validate", validationNames());
+  if (r.has("sliver_fraction")) s.request.sliverFraction = r.number("sliver_fraction", 0.0, 1.0);
+  return s.request;
+}
+
+Material readMaterial(JsonObjectReader& r, Material material) {
+  JsonObjectReader m = r.object("material");
+  if (m.has("E")) material.youngsModulus = m.number("E", 1e-300, 1e300);
+  if (m.has("nu")) material.poissonRatio = m.number("nu", -0.999999, 0.499999999);
+  if (m.has("density")) material.density = m.number("density", 0.0, 1e300);
+  m.finish();
+  return material;
+}
+
 namespace {
 
 constexpr const char* kHint = "see the pipeline format in README.md";
@@ -74,31 +109,7 @@ MeshStep meshStep(JsonObjectReader& r) {
   return s;
 }
 
-CutStep cutStep(JsonObjectReader& r) {
-  CutStep s;
-  const bool plane = r.has("plane"), polygon = r.has("polygon");
-  if (plane == polygon)
-    r.fail(r.place(), "a cut step needs exactly one of \"plane\" and \"polygon\"");
-  try {
-    if (plane) {
-      const auto v = r.numbers(r.get("plane"), r.at("plane"), 4);
-      s.request.blade = Blade::plane(Vec3(v[0], v[1], v[2]), v[3]);
-    } else {
-      const json& corners = r.get("polygon");
-      if (!corners.is_array()) r.fail(r.at("polygon"), "expected a list of [x, y, z] corners");
-      std::vector<Vec3> points;
-      for (std::size_t k = 0; k < corners.size(); ++k)
-        points.push_back(r.vec3(corners[k], r.at("polygon") + "[" + std::to_string(k) + "]"));
-      s.request.blade = Blade::fromPolygon(std::move(points));
-    }
-  } catch (const std::invalid_argument& e) {
-    r.fail(r.at(plane ? "plane" : "polygon"), e.what());
-  }
-  if (r.has("remove_side")) s.request.removeSide = r.choice("remove_side", removeSideNames());
-  if (r.has("validate")) s.request.validation = r.choice("validate", validationNames());
-  if (r.has("sliver_fraction")) s.request.sliverFraction = r.number("sliver_fraction", 0.0, 1.0);
-  return s;
-}
+CutStep cutStep(JsonObjectReader& r) { return {readCutRequest(r)}; }
 
 MergeStep mergeStep(JsonObjectReader& r) {
   MergeStep s;
@@ -118,13 +129,7 @@ SolveStep solveStep(JsonObjectReader& r) {
   SolveOptions& o = s.options;
   if (r.has("method")) o.method = r.choice("method", methodNames());
   if (r.has("degree")) o.degree = r.integer("degree", 1, 3);
-  if (r.has("material")) {
-    JsonObjectReader m = r.object("material");
-    if (m.has("E")) o.material.youngsModulus = m.number("E", 1e-300, 1e300);
-    if (m.has("nu")) o.material.poissonRatio = m.number("nu", -0.999999, 0.499999999);
-    if (m.has("density")) o.material.density = m.number("density", 0.0, 1e300);
-    m.finish();
-  }
+  if (r.has("material")) o.material = readMaterial(r, o.material);
   if (r.has("gravity")) o.gravity = r.vec3(r.get("gravity"), r.at("gravity"));
   for (const char* key : {"clamp", "traction"}) {
     if (!r.has(key)) continue;

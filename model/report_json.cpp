@@ -1,5 +1,7 @@
 #include "polydg/model/report_json.h"
 
+#include "polydg/model/scene.h"
+
 #include "polydg/model/names.h"
 
 namespace polydg {
@@ -302,6 +304,110 @@ json toJson(const ReadReport& r) {
 
 json toJson(const WriteReport& r) {
   return {{"file", r.file}, {"with_solution", r.withSolution}, {"time_s", r.seconds}};
+}
+
+namespace {
+
+json stateJson(const BodyState& s) {
+  return {{"kinetic", s.kinetic},
+          {"elastic", s.elastic},
+          {"gravity", s.gravity},
+          {"traction_potential", s.tractionPotential},
+          {"momentum", vectorJson(s.momentum)},
+          {"angular_momentum", vectorJson(s.angularMomentum)},
+          {"centre_of_mass", vectorJson(s.centreOfMass)}};
+}
+
+}  // namespace
+
+json toJson(const Scene& s) {
+  json j;
+  j["material"] = {{"E", s.material.youngsModulus},
+                   {"nu", s.material.poissonRatio},
+                   {"density", s.material.density}};
+  j["method"] = toString(s.method);
+  j["degree"] = s.degree;
+  j["corotational"] = s.corotational;
+  j["integrator"] = nameOf(integratorNames(), s.integrator);
+  j["solver"] = toString(s.solver);
+  j["dt"] = s.dt;
+  j["steps"] = s.steps;
+  j["duration"] = s.steps * s.dt;
+  j["gravity"] = vectorJson(s.gravity);
+  j["damping"] = {{"mass", s.massDamping}, {"stiffness", s.stiffnessDamping}};
+  j["fixed"] = json::array();
+  for (const FaceSelector& f : s.fixed) j["fixed"].push_back(selectionJson(f));
+  j["loads"] = json::array();
+  for (const TimedTraction& t : s.loads) {
+    json l = {{"traction", vectorJson(t.traction)}, {"on", selectionJson(t.where)}};
+    if (std::isfinite(t.until)) l["until"] = t.until;
+    j["loads"].push_back(l);
+  }
+  j["initial"] = {{"velocity", vectorJson(s.velocity)}, {"angular_velocity", vectorJson(s.angularVelocity)}};
+  j["output"] = {{"every", s.outputEvery}};
+  j["cuts"] = json::array();
+  for (const TimedCut& c : s.cuts) {
+    json cut = {{"time", c.time}, {"remove_side", nameOf(removeSideNames(), c.request.removeSide)}};
+    const Blade& b = c.request.blade;
+    if (b.finite()) {
+      json corners = json::array();
+      for (const Vec3& p : b.polygon) corners.push_back(vectorJson(p));
+      cut["polygon"] = corners;
+    } else {
+      cut["plane"] = {b.normal.x(), b.normal.y(), b.normal.z(), b.offset};
+    }
+    j["cuts"].push_back(cut);
+  }
+  return j;
+}
+
+json toJson(const SimulationReport& r) {
+  json j;
+  j["scene"] = toJson(r.scene);
+  j["elements"] = r.elements;
+  j["dofs"] = r.dofs;
+  j["fixed_faces"] = r.fixedFaces;
+  j["load_faces"] = r.loadFaces;
+  j["initial"] = stateJson(r.initial);
+  json steps = json::array();
+  for (const SimulationStep& s : r.steps) {
+    json step = stateJson(s.state);
+    step["t"] = s.step.t;
+    step["cg_iterations"] = s.step.iterations;
+    step["solves"] = s.step.solves;
+    step["correction"] = s.step.correction;
+    step["residual"] = s.step.residual;
+    step["solver"] = s.solver;
+    step["seconds"] = s.seconds;
+    steps.push_back(std::move(step));
+  }
+  j["steps"] = std::move(steps);
+  json cuts = json::array();
+  for (const SimulationCut& c : r.cuts)
+    cuts.push_back({{"time", c.time},
+                    {"elements_before", c.elementsBefore},
+                    {"elements_after", c.elementsAfter},
+                    {"exact", c.exact},
+                    {"extended", c.extended},
+                    {"operation", toJson(c.report)},
+                    {"seconds", c.seconds}});
+  j["cuts"] = std::move(cuts);
+  json frames = json::array();
+  for (const SimulationFrame& f : r.frames)
+    frames.push_back({{"step", f.step}, {"t", f.t}, {"file", f.file}});
+  j["frames"] = std::move(frames);
+  j["pvd"] = r.pvd.empty() ? json(nullptr) : json(r.pvd);
+  j["faces_integrated"] = r.facesIntegrated;
+  const double n = std::max<double>(1.0, static_cast<double>(r.steps.size()));
+  j["timings_s"] = {{"setup", r.setupSeconds},
+                    {"rotation", r.rotationSeconds},
+                    {"assembly", r.assemblySeconds},
+                    {"solve", r.solveSeconds},
+                    {"cut", r.cutSeconds},
+                    {"output", r.outputSeconds},
+                    {"wall", r.wallSeconds},
+                    {"per_step", (r.rotationSeconds + r.assemblySeconds + r.solveSeconds) / n}};
+  return j;
 }
 
 }  // namespace polydg

@@ -199,7 +199,7 @@ namespace {
 LocalMatrices localMatricesOf(const PolyMesh& mesh, const DgBasis& basis,
                               const MomentCache& moments, const FaceRoles& roles,
                               const FormCoefficients& form, bool element, int diagonalTerms,
-                              int couplingTerms) {
+                              int couplingTerms, bool dirichletFaces = true) {
   const std::size_t ne = mesh.numElements();
   LocalMatrices local;
   local.functions = basis.size();
@@ -248,7 +248,8 @@ LocalMatrices localMatricesOf(const PolyMesh& mesh, const DgBasis& basis,
             self.setZero(bs, bs);
           for (const FaceUse& use : mesh.element(e).faces) {
             const FaceKind kind = roles.kind[use.face];
-            if (kind == FaceKind::Free) continue;
+            if (kind == FaceKind::Free || (kind == FaceKind::Dirichlet && !dirichletFaces))
+              continue;
             const FaceView view = viewOf(roles, use.face, sideOf(roles, use.face, e));
             // The coupling block of a face is computed from its smaller element only.
             const bool withOther = kind == FaceKind::Interior && view.other.value > e.value &&
@@ -290,7 +291,8 @@ SplitLocalMatrices splitLocalMatrices(const PolyMesh& mesh, const DgBasis& basis
                                       const FormCoefficients& form) {
   SplitLocalMatrices split;
   split.rowStrain = localMatricesOf(mesh, basis, moments, roles, form, true,
-                                    kTrialStrainTerms | kTestStrainTerms, kTestStrainTerms);
+                                    kTrialStrainTerms | kTestStrainTerms, kTestStrainTerms,
+                                    false);
   split.columnStrain = localMatricesOf(mesh, basis, moments, roles, form, false, 0,
                                        kTrialStrainTerms | kOtherLiftingTerms);
   split.jumps = localMatricesOf(mesh, basis, moments, roles, form, false, kJumpTerms, kJumpTerms);
@@ -303,6 +305,8 @@ SplitLocalMatrices splitLocalMatrices(const PolyMesh& mesh, const DgBasis& basis
   for (std::size_t i = 0; i < ne; ++i)
     split.neighbourStart[i + 1] = split.neighbourStart[i] + split.jumps.neighbours[i].size() - 1;
   split.neighbourLifting.assign(split.neighbourStart[ne] * bb, 0.0);
+  split.dirichletTrial.assign(ne * bb, 0.0);
+  split.dirichletTest.assign(ne * bb, 0.0);
   if (form.method != Method::IP) return split;
   tbb::parallel_for(
       tbb::blocked_range<std::size_t>(0, ne, 16), [&](const tbb::blocked_range<std::size_t>& r) {
@@ -311,6 +315,15 @@ SplitLocalMatrices splitLocalMatrices(const PolyMesh& mesh, const DgBasis& basis
           const ElementId e(i);
           const auto& b = split.jumps.neighbours[i];
           for (const FaceUse& use : mesh.element(e).faces) {
+            if (roles.kind[use.face] == FaceKind::Dirichlet) {
+              const FaceView view = viewOf(roles, use.face, sideOf(roles, use.face, e));
+              for (auto [terms, out] : {std::pair{kTrialStrainTerms, &split.dirichletTrial},
+                                        std::pair{kTestStrainTerms, &split.dirichletTest}}) {
+                faceRows(mesh, basis, moments, view, form, faceSelf, faceOther, false, terms);
+                Eigen::Map<Eigen::MatrixXd>(out->data() + i * bb, bs, bs) += faceSelf;
+              }
+              continue;
+            }
             if (roles.kind[use.face] != FaceKind::Interior) continue;
             const FaceView view = viewOf(roles, use.face, sideOf(roles, use.face, e));
             faceRows(mesh, basis, moments, view, form, faceSelf, faceOther, false,

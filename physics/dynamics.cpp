@@ -333,21 +333,36 @@ struct DynamicSolver::Impl {
           std::vector<double> w(bs), y(bs), wa(bs), ry(bs);
           for (std::size_t i = range.begin(); i != range.end(); ++i) {
             double* oa = out.data() + i * bs;
-            const double* xa = x.data() + i * bs;
-            const double* za = z ? z->data() + i * bs : nullptr;
             // Row i's block B against column element `col`, warped with element `source`'s
             // rotation (-1: not warped).
+            // The vector a side of a block reads: R^T x - z (positions against the undeformed
+            // state, the strain side and interior jumps) or R^T (x - z) (the displacement,
+            // the jump against a Dirichlet face's fixed outside).
+            auto side = [&](const Eigen::Matrix3d* rot, std::size_t e, bool difference,
+                            std::vector<double>& out) {
+              const double* xe = x.data() + e * bs;
+              const double* ze = z ? z->data() + e * bs : nullptr;
+              if (difference && ze) {
+                for (int c = 0; c < bs; ++c) ry[c] = xe[c] - ze[c];
+                if (rot)
+                  rotate(rot->transpose(), ry.data(), n, out.data());
+                else
+                  std::copy(ry.begin(), ry.end(), out.begin());
+                return;
+              }
+              if (rot)
+                rotate(rot->transpose(), xe, n, out.data());
+              else
+                std::copy(xe, xe + bs, out.begin());
+              if (ze)
+                for (int c = 0; c < bs; ++c) out[c] -= ze[c];
+            };
             auto apply = [&](const double* b, std::size_t rs, std::size_t cs, std::int64_t source,
-                             std::size_t col) {
+                             std::size_t col, bool rowDifference = false,
+                             bool columnDifference = false) {
               const bool warp = source >= 0 && options.corotational;
               const Eigen::Matrix3d& rs3 = warp ? r[static_cast<std::size_t>(source)] : r[i];
-              const double* xc = x.data() + col * bs;
-              if (warp)
-                rotate(rs3.transpose(), xc, n, w.data());
-              else
-                std::copy(xc, xc + bs, w.begin());
-              if (z)
-                for (int c = 0; c < bs; ++c) w[c] -= (*z)[static_cast<Eigen::Index>(col * bs + c)];
+              side(warp ? &rs3 : nullptr, col, columnDifference, w);
               for (int row = 0; row < bs; ++row) {
                 double acc = 0.0;
                 const double* br = b + row * rs;
@@ -361,15 +376,19 @@ struct DynamicSolver::Impl {
                 for (int c = 0; c < bs; ++c) oa[c] += y[c];
               }
               if (energy) {
-                if (warp)
-                  rotate(rs3.transpose(), xa, n, wa.data());
-                else
-                  std::copy(xa, xa + bs, wa.begin());
+                side(warp ? &rs3 : nullptr, i, rowDifference, wa);
                 double dot = 0.0;
-                for (int c = 0; c < bs; ++c) dot += (wa[c] - (za ? za[c] : 0.0)) * y[c];
+                for (int c = 0; c < bs; ++c) dot += wa[c] * y[c];
                 sum += 0.5 * dot;
               }
             };
+            if (!bz) {  // the Dirichlet faces' strain terms
+              const auto self = static_cast<std::int64_t>(i);
+              apply(parts.dirichletTrial.data() + i * bb, 1, static_cast<std::size_t>(bs), self, i,
+                    true, false);
+              apply(parts.dirichletTest.data() + i * bb, 1, static_cast<std::size_t>(bs), self, i,
+                    false, true);
+            }
             std::size_t neighbour = 0;
             for (std::size_t k = rowStart[i]; k < rowStart[i + 1]; ++k) {
               const RowSlot& s = slots[k];
@@ -407,6 +426,13 @@ struct DynamicSolver::Impl {
             else
               for (std::size_t k = 0; k < bb; ++k) d[k] += cK * ss[k];
             if (!bz) {
+              for (const std::vector<double>* dir : {&parts.dirichletTrial, &parts.dirichletTest}) {
+                if (warp)
+                  addRotatedBlock(r[i], dir->data() + i * bb, 1, static_cast<std::size_t>(bs), r[i],
+                                  n, cK, d);
+                else
+                  for (std::size_t q = 0; q < bb; ++q) d[q] += cK * (*dir)[i * bb + q];
+              }
               const std::size_t first = parts.neighbourStart[i];
               std::size_t k = 0;
               for (std::uint32_t f : parts.jumps.neighbours[i]) {
@@ -725,6 +751,7 @@ DynamicSolver::DynamicSolver(DynamicSolver&&) noexcept = default;
 DynamicSolver& DynamicSolver::operator=(DynamicSolver&&) noexcept = default;
 
 const DgBasis& DynamicSolver::basis() const { return *impl_->basis; }
+SolverKind DynamicSolver::solverKind() const { return impl_->solver.kind(); }
 const DynamicsOptions& DynamicSolver::options() const { return impl_->options; }
 std::size_t DynamicSolver::dofs() const { return static_cast<std::size_t>(impl_->u.size()); }
 double DynamicSolver::time() const { return impl_->t; }
@@ -766,6 +793,26 @@ Eigen::VectorXd DynamicSolver::affineField(const Eigen::Matrix3d& a, const Vec3&
     for (int d = 0; d < 3; ++d)
       out.segment(static_cast<Eigen::Index>(i * m.bs + d * m.n), m.n) =
           affineCoefficients(*m.basis, ElementId(i), b[d], a.row(d).transpose(), c);
+  });
+  return out;
+}
+
+std::vector<double> DynamicSolver::vonMises() const {
+  const Impl& m = *impl_;
+  std::vector<double> out(m.ne);
+  const double mu = m.options.material.mu(), lambda = m.options.material.lambda();
+  tbb::parallel_for(std::size_t(0), m.ne, [&](std::size_t i) {
+    Eigen::Matrix3d f = Eigen::Matrix3d::Identity();
+    const double* g = m.gradients.data() + i * 3 * m.n;
+    for (int d = 0; d < 3; ++d)
+      for (int k = 0; k < 3; ++k)
+        for (int fn = 0; fn < m.n; ++fn)
+          f(d, k) += g[k * m.n + fn] * m.u[static_cast<Eigen::Index>(i * m.bs + d * m.n + fn)];
+    const Eigen::Matrix3d local = m.options.corotational ? Eigen::Matrix3d(polarRotation(f).transpose() * f) : f;
+    const Eigen::Matrix3d eps = 0.5 * (local + local.transpose()) - Eigen::Matrix3d::Identity();
+    const Eigen::Matrix3d sigma = 2 * mu * eps + lambda * eps.trace() * Eigen::Matrix3d::Identity();
+    const Eigen::Matrix3d dev = sigma - sigma.trace() / 3.0 * Eigen::Matrix3d::Identity();
+    out[i] = std::sqrt(1.5 * dev.squaredNorm());
   });
   return out;
 }

@@ -261,7 +261,7 @@ TEST_F(Run, InvalidPipelinesAreRefusedUpFront) {
   expectRefused(run("run " + write("c.json", R"({"steps": [{"step": "mesh", "cells": 4},
       {"step": "cut", "plnae": [0, 0, 1, 0]}]})") +
                     inputs),
-                "steps[1]: a cut step needs exactly one of");
+                "steps[1]: a cut needs exactly one of");
   expectRefused(run("run " + write("d.json", R"({"steps": [{"step": "mesh", "cells": 4,
       "cels": 3}]})") +
                     inputs),

@@ -155,6 +155,11 @@ struct WriteOptions {
   bool solution = true;
 };
 
+// Simulation (model/scene.h defines these).
+struct Scene;
+struct SimulateOptions;
+struct SimulationReport;
+
 struct WriteReport {
   std::string file;
   bool withSolution = false;
@@ -213,6 +218,14 @@ class Model {
   SolveReport solve(const SolveOptions& options);
   /// The last solve's solution; null after an edit or before any solve.
   const Solution* solution() const;
+
+  /// Moves the body in time through `scene` (model/scene.h): validates the mesh and the scene's
+  /// selections (InputError naming one that picks no face), steps, cuts at the scene's times
+  /// through cut() (each new element takes its parent's displacement and velocity polynomials
+  /// exactly), writes frames if asked. Afterwards the model holds the cut mesh and, as its
+  /// solution, the final displacement. Throws CheckFailure if the mesh is invalid, a cut fails
+  /// its validation (the model is then broken, as after cut()), or a step's solve fails.
+  SimulationReport simulate(const Scene& scene, const SimulateOptions& options);
 
   /// Writes the model as a VTU file with its provenance (and the solution's fields, see
   /// WriteOptions), atomically: `path` is never left half-written.

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "polydg/model/model.h"
+#include "polydg/model/scene.h"
 
 namespace polydg {
 
@@ -42,5 +43,15 @@ nlohmann::json toJson(const OperationReport& r);
 nlohmann::json toJson(const SolveReport& r);
 nlohmann::json toJson(const ReadReport& r);
 nlohmann::json toJson(const WriteReport& r);
+
+/// A scene in its own format, every key explicit.
+nlohmann::json toJson(const Scene& scene);
+/// A simulation: scene (every key explicit), elements, dofs, fixed_faces, load_faces, initial
+/// {state}, steps [{t, kinetic, elastic, gravity, traction_potential, momentum,
+/// angular_momentum, centre_of_mass, cg_iterations, solves, correction, residual, solver,
+/// seconds}], cuts [{time, elements_before, elements_after, exact, extended, operation (as
+/// toJson(OperationReport)), seconds}], frames [{step, t, file}], pvd, faces_integrated,
+/// timings_s {setup, rotation, assembly, solve, cut, output, wall, per_step}.
+nlohmann::json toJson(const SimulationReport& r);
 
 }  // namespace polydg

@@ -113,7 +113,7 @@ struct SplitLocalMatrices {
   /// Strain of the rows' element: the element stiffness and the face terms of the diagonal
   /// blocks with strain (K_K, K_f1 and K_f2 of the element with itself), and the symmetry
   /// terms of the coupling blocks (K_f2 of the row element); with the element's own lifting
-  /// terms.
+  /// terms. Without the terms of Dirichlet faces, which are apart (dirichletTrial, -Test).
   LocalMatrices rowStrain;
   /// Strain of the columns' element: the consistency terms of the coupling blocks (K_f1 of the
   /// column element) and its lifting term; the diagonal blocks are zero.
@@ -126,6 +126,11 @@ struct SplitLocalMatrices {
   /// neighbourStart[K]. Zero for BZ.
   std::vector<std::size_t> neighbourStart;
   std::vector<double> neighbourLifting;
+  /// IP, per element (3n x 3n, column-major): the terms of its Dirichlet faces with the strain
+  /// of the trial function (consistency) and with that of the test function (symmetry, and
+  /// the lifting). Apart because the jump on a Dirichlet face is against the fixed outside:
+  /// warped, it is R^T (X - X0) = R^T U, where an interior face's is R^T X - X0 on both sides.
+  std::vector<double> dirichletTrial, dirichletTest;
 };
 
 SplitLocalMatrices splitLocalMatrices(const PolyMesh& mesh, const DgBasis& basis,

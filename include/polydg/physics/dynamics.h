@@ -127,6 +127,8 @@ class DynamicSolver {
   DynamicSolver& operator=(DynamicSolver&&) noexcept;
 
   const DgBasis& basis() const;
+  /// The solver the steps use (known after the first step; Auto before).
+  SolverKind solverKind() const;
   const DynamicsOptions& options() const;
   std::size_t dofs() const;
   double time() const;
@@ -160,6 +162,9 @@ class DynamicSolver {
   Eigen::VectorXd affineField(const Eigen::Matrix3d& a, const Vec3& b, const Vec3& c) const;
   /// The current rotation R_K of every element (the identity without corotation).
   std::vector<Eigen::Matrix3d> rotations() const;
+  /// Von Mises stress of every element from its mean deformation gradient F: of the strain
+  /// sym(R^T F) - I in the element's rotated frame with corotation, of sym(F) - I without.
+  std::vector<double> vonMises() const;
 
  private:
   struct Impl;

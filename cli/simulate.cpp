@@ -1,0 +1,101 @@
+// polydg simulate: a body in time (model/scene.h): Model::simulate() on a simulation mesh, with
+// the scene from a JSON file, a ParaView time series in the output folder and a JSON report.
+//
+// Sample run:
+//   polydg simulate beam.vtu --scene fall.json -o beam_fall --report fall.json
+#include <filesystem>
+#include <iostream>
+
+#include "cli/commands.h"
+#include "cli/options.h"
+#include "cli/progress.h"
+#include "polydg/model/files.h"
+#include "polydg/model/report_json.h"
+#include "polydg/model/scene.h"
+
+namespace polydg::cli {
+
+namespace {
+
+struct SimulateCommandOptions {
+  std::string input, scene, output, report;
+};
+
+void run(const SimulateCommandOptions& o, const CommonOptions& common) {
+  if (!isVolumeMeshPath(o.input))
+    throw InputError(o.input +
+                     ": simulate reads simulation meshes (.vtu); make one with 'polydg mesh'");
+  if (!o.report.empty()) {
+    requireDistinct(o.report, o.input);
+    requireDistinct(o.report, o.scene);
+  }
+  const Scene scene = readScene(o.scene);  // every key checked before anything runs
+  // The frames are OUTDIR/scene_NNNNNN.vtu and OUTDIR/scene.pvd: no input may be one of them.
+  namespace fs = std::filesystem;
+  for (const std::string& in : {o.input, o.scene}) {
+    const fs::path folder = fs::absolute(in).parent_path();
+    const std::string name = fs::path(in).filename().string();
+    std::error_code ec;
+    if (fs::equivalent(folder, o.output, ec) &&
+        (name.rfind("scene_", 0) == 0 || name == "scene.pvd"))
+      throw InputError(in + " lies in the output folder under a name the frames take; choose "
+                            "another -o");
+  }
+  ReadReport read;
+  Model model = Model::read(o.input, &read);
+  ProgressBar bar("simulate", common.quiet);
+  SimulateOptions options;
+  options.outputDir = o.output;
+  options.progress = [&bar](const SimulationProgress& p) {
+    bar.update(static_cast<double>(p.step) / p.steps);
+  };
+  const SimulationReport r = model.simulate(scene, options);
+  bar.finish();
+  if (!o.report.empty()) {
+    nlohmann::json j{{"command", "simulate"}, {"input", o.input}, {"scene_file", o.scene},
+                     {"output", o.output}};
+    j.update(toJson(r));
+    j["timings_s"]["read"] = read.seconds;
+    writeJsonFile(o.report, j);
+  }
+  if (!common.quiet) {
+    const BodyState& last = r.steps.back().state;
+    int iterations = 0;
+    for (const SimulationStep& s : r.steps) iterations += s.step.iterations;
+    const double n = static_cast<double>(r.steps.size());
+    std::cout << o.input << ": " << r.elements << " elements, " << r.dofs << " DOFs, "
+              << r.steps.size() << " steps of dt " << scene.dt << " ("
+              << (scene.corotational ? "corotational" : "linear") << ", "
+              << nameOf(integratorNames(), scene.integrator) << ")"
+              << (iterations ? ", " + std::to_string(iterations) + " CG iterations" : "") << '\n'
+              << "  per step: rotation " << r.rotationSeconds / n << " s, assembly "
+              << r.assemblySeconds / n << " s, solve " << r.solveSeconds / n << " s; "
+              << r.cuts.size() << " cuts, " << r.frames.size() << " frames\n"
+              << "  at t = " << r.steps.back().step.t
+              << ": kinetic " << last.kinetic << ", elastic " << last.elastic << ", gravity "
+              << last.gravity << '\n'
+              << "  wrote " << (r.pvd.empty() ? std::string("nothing") : r.pvd) << '\n';
+  }
+}
+
+}  // namespace
+
+void addSimulateCommand(CLI::App& app, const CommonOptions& common, int& exitCode) {
+  auto o = std::make_shared<SimulateCommandOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "simulate", "Move a body in time (corotational DG dynamics, cuts while it moves)");
+  cmd->add_option("mesh", o->input, "simulation mesh (.vtu)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--scene", o->scene, "the scene (JSON; see README.md, Scenes)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("-o,--output", o->output,
+                  "output folder: scene.pvd and one VTU per frame (created if missing)")
+      ->required();
+  cmd->add_option("--report", o->report, "write the figures as JSON to this file");
+  cmd->callback([o, &common, &exitCode] {
+    run(*o, common);
+    exitCode = 0;
+  });
+}
+
+}  // namespace polydg::cli

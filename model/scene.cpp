@@ -1,0 +1,134 @@
+#include "polydg/model/scene.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+
+#include "polydg/model/json_reader.h"
+#include "polydg/model/names.h"
+#include "polydg/model/pipeline.h"
+#include "polydg/util/error.h"
+
+namespace polydg {
+
+using nlohmann::json;
+
+namespace {
+
+constexpr const char* kHint = "see the scene format in README.md";
+constexpr double kHuge = 1e300;
+
+}  // namespace
+
+const Names<TimeIntegrator>& integratorNames() {
+  static const Names<TimeIntegrator> names{{"euler", TimeIntegrator::BackwardEuler},
+                                           {"bdf2", TimeIntegrator::Bdf2},
+                                           {"newmark", TimeIntegrator::Newmark}};
+  return names;
+}
+
+Scene parseScene(const json& document, const std::string& file) {
+  JsonObjectReader r(document, "", file, kHint);
+  Scene s;
+  s.material = readMaterial(r, s.material);  // "material" is required
+  try {
+    s.material.check();
+  } catch (const std::invalid_argument& e) {
+    r.fail("material", e.what());
+  }
+  if (r.has("method")) s.method = r.choice("method", methodNames());
+  if (r.has("degree")) s.degree = r.integer("degree", 1, 3);
+  if (r.has("corotational")) s.corotational = r.boolean("corotational");
+  if (r.has("integrator")) s.integrator = r.choice("integrator", integratorNames());
+  if (r.has("solver")) s.solver = r.choice("solver", solverNames());
+  s.dt = r.number("dt", 1e-300, kHuge);
+  const bool duration = r.has("duration"), steps = r.has("steps");
+  if (duration == steps) r.fail("", "give exactly one of \"duration\" and \"steps\"");
+  if (steps) {
+    s.steps = r.integer("steps", 1, 100000000);
+  } else {
+    const double d = r.number("duration", 1e-300, kHuge);
+    const double n = std::round(d / s.dt);
+    if (n < 1 || n > 1e8 || std::abs(n * s.dt - d) > 1e-9 * d)
+      r.fail("duration", "must be a whole number (1 to 1e8) of time steps dt (" +
+                             std::to_string(d / s.dt) + " steps); or give \"steps\"");
+    s.steps = static_cast<int>(n);
+  }
+  if (r.has("gravity")) s.gravity = r.vec3(r.get("gravity"), "gravity");
+  if (r.has("damping")) {
+    JsonObjectReader d = r.object("damping");
+    if (d.has("mass")) s.massDamping = d.number("mass", 0.0, kHuge);
+    if (d.has("stiffness")) s.stiffnessDamping = d.number("stiffness", 0.0, kHuge);
+    d.finish();
+  }
+  if (r.has("fixed")) {
+    const json& list = r.get("fixed");
+    if (!list.is_array()) r.fail("fixed", "expected a list of regions ([] for a free body)");
+    for (std::size_t k = 0; k < list.size(); ++k) {
+      JsonObjectReader item = r.element(list, "fixed", k);
+      s.fixed.push_back(item.selection());
+      item.finish();
+    }
+  }
+  if (r.has("loads")) {
+    const json& list = r.get("loads");
+    if (!list.is_array()) r.fail("loads", "expected a list of tractions");
+    for (std::size_t k = 0; k < list.size(); ++k) {
+      JsonObjectReader item = r.element(list, "loads", k);
+      TimedTraction t;
+      t.traction = item.vec3(item.get("traction"), item.at("traction"));
+      JsonObjectReader on = item.object("on");
+      t.where = on.selection();
+      on.finish();
+      if (item.has("until")) t.until = item.number("until", 0.0, kHuge);
+      item.finish();
+      s.loads.push_back(t);
+    }
+  }
+  if (r.has("initial")) {
+    JsonObjectReader i = r.object("initial");
+    if (i.has("velocity")) s.velocity = i.vec3(i.get("velocity"), i.at("velocity"));
+    if (i.has("angular_velocity"))
+      s.angularVelocity = i.vec3(i.get("angular_velocity"), i.at("angular_velocity"));
+    i.finish();
+  }
+  if (r.has("output")) {
+    JsonObjectReader o = r.object("output");
+    if (o.has("every")) s.outputEvery = o.integer("every", 1, 100000000);
+    o.finish();
+  }
+  const double end = s.steps * s.dt;
+  if (r.has("cuts")) {
+    const json& list = r.get("cuts");
+    if (!list.is_array()) r.fail("cuts", "expected a list of cuts");
+    for (std::size_t k = 0; k < list.size(); ++k) {
+      JsonObjectReader item = r.element(list, "cuts", k);
+      TimedCut c;
+      c.time = item.number("time", 0.0, kHuge);
+      if (c.time > end * (1 + 1e-12))
+        item.fail(item.at("time"), "after the end of the simulation (t = " +
+                                       std::to_string(end) + "); it would never happen");
+      c.request = readCutRequest(item);
+      item.finish();
+      s.cuts.push_back(c);
+    }
+    std::stable_sort(s.cuts.begin(), s.cuts.end(),
+                     [](const TimedCut& a, const TimedCut& b) { return a.time < b.time; });
+  }
+  r.finish();
+  return s;
+}
+
+Scene readScene(const std::string& file) {
+  std::ifstream in(file);
+  if (!in) throw InputError(file + ": cannot open the scene file");
+  json document;
+  try {
+    document = json::parse(in);
+  } catch (const json::parse_error& e) {
+    throw InputError(file + ": not valid JSON (" + std::string(e.what()) + ")");
+  }
+  return parseScene(document, file);
+}
+
+}  // namespace polydg
