@@ -1,0 +1,255 @@
+// Model::simulate: B10 (a beam cut while it moves: the freed part falls with g, nothing jumps,
+// volume is kept), the damped static limit against Model::solve, scenes read strictly, and the
+// time series on disk.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <regex>
+
+#include "polydg/mesh/surface_shapes.h"
+#include "polydg/model/report_json.h"
+#include "polydg/model/scene.h"
+#include "polydg/util/error.h"
+
+namespace polydg {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+/// B3's beam [0,10] x [0,1] x [0,1], 20 cells along it.
+Model beam() {
+  MeshOptions options;
+  options.cells = 20;
+  MeshReport report;
+  Model m = Model::fromSurface(boxSurface(Box3(Vec3::Zero(), Vec3(10, 1, 1))), options, report,
+                               "beam.obj");
+  EXPECT_TRUE(report.passed());
+  return m;
+}
+
+/// B10's scene: the clamped beam under gravity (0, 0, -1), cut through x = 5.1 at t = 1.
+json b10Scene(double duration, bool cut = true) {
+  json s = json::parse(R"({"material": {"E": 1000, "nu": 0.3, "density": 1},
+      "method": "ip", "degree": 1, "corotational": true, "integrator": "euler", "dt": 0.05,
+      "gravity": [0, 0, -1], "fixed": [{"plane": [1, 0, 0, 0]}],
+      "cuts": [{"time": 1.0, "plane": [1, 0, 0, 5.1], "remove_side": "none"}]})");
+  s["duration"] = duration;
+  if (!cut) s["cuts"] = json::array();
+  return s;
+}
+
+/// The integral of the displacement and the volume of the elements whose centroid lies on
+/// one side of x = 5.1, from the model's solution (the final displacement).
+struct Half {
+  Vec3 first = Vec3::Zero();  ///< int u
+  double volume = 0.0;
+  Vec3 centroid = Vec3::Zero();  ///< undeformed, volume-weighted
+};
+Half half(Model& model, bool freed) {
+  const MomentCache& moments = model.moments(2);
+  const Solution* u = model.solution();
+  EXPECT_NE(u, nullptr);
+  Half h;
+  for (std::size_t i = 0; i < model.mesh().numElements(); ++i) {
+    const ElementId e(i);
+    const Vec3 c = moments.centroid(e);
+    if ((c.x() > 5.1) != freed) continue;
+    const double v = moments.volume(e);
+    h.first += v * u->fields.meanDisplacement[e];
+    h.volume += v;
+    h.centroid += v * c;
+  }
+  h.centroid /= h.volume;
+  return h;
+}
+
+TEST(Simulate, CutWhileMovingFreesAHalfThatFallsWithGravity) {
+  // B10. The freed half's centre of mass z at t = 1 + k m dt for k = 1, 2, 3: backward Euler
+  // moves it by g dt^2 n (n + 1) / 2 after n free steps, so its second difference over m steps
+  // is -g (m dt)^2 exactly whatever it did before (the internal forces of a free piece sum to
+  // zero).
+  const double dt = 0.05;
+  const int m = 10;
+  double z[3];
+  for (int k = 1; k <= 3; ++k) {
+    Model model = beam();
+    const SimulationReport r = model.simulate(parseScene(b10Scene(1.0 + k * m * dt), "b10"), {});
+    ASSERT_EQ(r.cuts.size(), 1u);
+    const SimulationCut& cut = r.cuts[0];
+    EXPECT_TRUE(cut.report.validation.passed) << cut.report.validation.failure;
+    EXPECT_LT(cut.report.validation.volumeRelError, 1e-10);
+    EXPECT_NEAR(model.volume(), 10.0, 1e-10 * 10);
+    EXPECT_GT(cut.elementsAfter, cut.elementsBefore);
+    EXPECT_EQ(cut.exact, cut.elementsAfter);  // no sliver here: every element took its parent's
+    const Half freed = half(model, true);
+    EXPECT_NEAR(freed.volume, 4.9, 1e-10);
+    z[k - 1] = freed.centroid.z() + freed.first.z() / freed.volume;
+  }
+  const double acceleration = -(z[2] - 2 * z[1] + z[0]) / std::pow(m * dt, 2);
+  EXPECT_NEAR(acceleration, 1.0, 0.01);
+}
+
+/// int u and the volume over the elements whose centroid x lies in [lo, hi).
+std::pair<Vec3, double> band(Model& model, double lo, double hi) {
+  const MomentCache& moments = model.moments(2);
+  const Solution* u = model.solution();
+  Vec3 first = Vec3::Zero();
+  double volume = 0.0;
+  for (std::size_t i = 0; i < model.mesh().numElements(); ++i) {
+    const ElementId e(i);
+    const double x = moments.centroid(e).x();
+    if (x < lo || x >= hi) continue;
+    first += moments.volume(e) * u->fields.meanDisplacement[e];
+    volume += moments.volume(e);
+  }
+  return {first, volume};
+}
+
+TEST(Simulate, CutCarriesTheFieldsOverExactly) {
+  // Cut at the end of the last step (t = 1): the displacement integrated over the elements the
+  // cut split (the band 5 < x < 5.5) and over the others is the uncut simulation's to
+  // round-off: the pieces took their parents' polynomials exactly. Nothing pops.
+  Model cut = beam(), whole = beam();
+  cut.simulate(parseScene(b10Scene(1.0), "b10"), {});
+  whole.simulate(parseScene(b10Scene(1.0, false), "b10"), {});
+  EXPECT_GT(cut.mesh().numElements(), whole.mesh().numElements());
+  for (auto [lo, hi] : {std::pair{-1.0, 5.0}, std::pair{5.0, 5.5}, std::pair{5.5, 11.0}}) {
+    const auto [a, va] = band(cut, lo, hi);
+    const auto [b, vb] = band(whole, lo, hi);
+    EXPECT_NEAR(va, vb, 1e-12);
+    EXPECT_LT((a - b).norm(), 1e-10 * b.norm()) << "band " << lo << " " << hi;
+    EXPECT_GT(b.norm(), 1e-3);  // it moved
+  }
+}
+
+TEST(Simulate, DampedSimulationSettlesToTheStaticSolve) {
+  // The static limit: linear, heavily damped backward Euler under gravity against
+  // Model::solve with the same clamp, load and discretization.
+  Model dynamic = beam(), statics = beam();
+  SolveOptions so;
+  so.degree = 1;
+  so.material = {1000, 0.3, 1};
+  so.gravity = Vec3(0, 0, -1);
+  so.clamps = {FaceSelector::inPlane(0, 0.0)};
+  statics.solve(so);
+  json scene = json::parse(R"({"material": {"E": 1000, "nu": 0.3, "density": 1},
+      "corotational": false, "dt": 5, "steps": 120, "damping": {"mass": 1},
+      "gravity": [0, 0, -1], "fixed": [{"plane": [1, 0, 0, 0]}]})");
+  const SimulationReport r = dynamic.simulate(parseScene(scene, "static"), {});
+  const Eigen::VectorXd& a = dynamic.solution()->coefficients;
+  const Eigen::VectorXd& b = statics.solution()->coefficients;
+  ASSERT_EQ(a.size(), b.size());
+  EXPECT_LT((a - b).norm(), 1e-6 * b.norm());
+  // At rest the energies balance as for the static solution: elastic = -gravity / 2.
+  const BodyState& last = r.steps.back().state;
+  EXPECT_NEAR(last.elastic, -0.5 * last.gravity, 1e-6 * last.elastic);
+  EXPECT_LT(last.kinetic, 1e-12 * last.elastic);
+}
+
+/// The message of the InputError parsing `scene` throws ("" if none).
+std::string refusal(const std::string& scene) {
+  try {
+    parseScene(json::parse(scene), "scene.json");
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(Simulate, ScenesAreReadStrictly) {
+  const std::string base = R"("material": {"E": 1000, "nu": 0.3, "density": 1}, "dt": 0.1)";
+  EXPECT_EQ(refusal("{" + base + R"(, "steps": 3})"), "");
+  // The issue's example, key for key.
+  EXPECT_EQ(refusal(R"({"material": {"E": 1000, "nu": 0.3, "density": 1}, "method": "ip",
+      "degree": 2, "corotational": true, "integrator": "euler", "dt": 0.1, "duration": 40,
+      "gravity": [0, 0, -1], "damping": {"mass": 0.0, "stiffness": 0.0},
+      "fixed": [{"plane": [1, 0, 0, 0]}, {"below": [0, 0, 1, 0.1]},
+                {"box": [[0, 0, 0], [1, 1, 0.2]]}],
+      "loads": [{"traction": [0, 0, -0.01], "on": {"plane": [1, 0, 0, 10]}, "until": 5.0}],
+      "initial": {"velocity": [0, 0, 0], "angular_velocity": [0, 0, 0]},
+      "output": {"every": 1},
+      "cuts": [{"time": 1.0, "plane": [1, 0, 0, 5.1], "remove_side": "none"}]})"),
+            "");
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {"{" + base + R"(, "steps": 3, "gravty": [0, 0, -1]})", "scene.json: gravty: unknown key"},
+      {"{" + base + R"(, "steps": 3, "duration": 1})", "exactly one of \"duration\" and \"steps\""},
+      {"{" + base + "}", "exactly one of \"duration\" and \"steps\""},
+      {"{" + base + R"(, "duration": 0.25})", "duration: must be a whole number"},
+      {"{" + base + R"(, "steps": 3, "integrator": "rk4"})",
+       "integrator: 'rk4' is not one of euler, bdf2, newmark"},
+      {"{" + base + R"(, "steps": 3, "fixed": [{"plane": [1, 0, 0]}]})", "fixed[0].plane"},
+      {"{" + base + R"(, "steps": 3, "loads": [{"traction": [0, 0, 1], "on": {}}]})",
+       "loads[0].on"},
+      {"{" + base + R"(, "steps": 3, "cuts": [{"time": 5, "plane": [1, 0, 0, 1]}]})",
+       "cuts[0].time: after the end of the simulation"},
+      {"{" + base + R"(, "steps": 3, "cuts": [{"time": 0.1, "plane": [0, 0, 0, 1]}]})",
+       "cuts[0].plane"},
+      {"{" + base + R"(, "steps": 3, "initial": {"spin": [0, 0, 1]}})", "initial.spin: unknown key"},
+      {R"({"material": {"E": -1, "nu": 0.3, "density": 1}, "dt": 0.1, "steps": 1})",
+       "material.E"},
+      {R"({"dt": 0.1, "steps": 1})", "material: missing"},
+  };
+  for (const auto& [scene, message] : bad) {
+    const std::string got = refusal(scene);
+    EXPECT_NE(got.find(message), std::string::npos) << scene << "\n -> " << got;
+    EXPECT_NE(got.find("see the scene format in README.md"), std::string::npos) << got;
+  }
+}
+
+TEST(Simulate, SelectionsThatPickNothingAreRefusedBeforeAnyStep) {
+  Model model = beam();
+  json scene = b10Scene(0.1, false);
+  scene["fixed"] = json::parse(R"([{"plane": [1, 0, 0, -3]}])");
+  try {
+    model.simulate(parseScene(scene, "s"), {});
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("selects no boundary face"), std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(Simulate, WritesAParaViewTimeSeries) {
+  const fs::path dir = fs::temp_directory_path() / ("polydg_simulate_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  Model model = beam();
+  json scene = b10Scene(1.5);
+  scene["output"] = {{"every", 4}};
+  SimulateOptions options;
+  options.outputDir = (dir / "out").string();
+  int calls = 0;
+  options.progress = [&](const SimulationProgress& p) { EXPECT_EQ(p.step, ++calls); };
+  const SimulationReport r = model.simulate(parseScene(scene, "s"), options);
+  EXPECT_EQ(calls, 30);
+  // Frames at step 0, every 4 steps, right after the cut (step 20 is both) and at the end.
+  std::vector<int> steps;
+  for (const SimulationFrame& f : r.frames) steps.push_back(f.step);
+  EXPECT_EQ(steps, (std::vector<int>{0, 4, 8, 12, 16, 20, 24, 28, 30}));
+  std::ifstream in(dir / "out" / "scene.pvd");
+  std::stringstream pvd;
+  pvd << in.rdbuf();
+  const std::string text = pvd.str();
+  const std::regex dataset("<DataSet timestep=\"([^\"]+)\"[^>]*file=\"([^\"]+)\"");
+  std::size_t n = 0;
+  for (auto it = std::sregex_iterator(text.begin(), text.end(), dataset);
+       it != std::sregex_iterator(); ++it, ++n) {
+    ASSERT_LT(n, r.frames.size());
+    EXPECT_EQ((*it)[2].str(), r.frames[n].file);
+    EXPECT_NEAR(std::stod((*it)[1].str()), r.frames[n].t, 1e-12);
+    // Each frame is a mesh polydg reads back, with its point data.
+    const Model frame = Model::read((dir / "out" / r.frames[n].file).string());
+    EXPECT_EQ(frame.mesh().numElements(), r.frames[n].step < 20 ? 80u : model.mesh().numElements());
+  }
+  EXPECT_EQ(n, r.frames.size());
+  const json report = toJson(r);
+  EXPECT_EQ(report["steps"].size(), 30u);
+  for (const char* key : {"t", "kinetic", "elastic", "gravity", "momentum", "angular_momentum",
+                          "cg_iterations", "seconds"})
+    EXPECT_TRUE(report["steps"][0].contains(key)) << key;
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace polydg
