@@ -328,7 +328,8 @@ void Model::State::requireValid() {
 void Model::State::checkSelections(const std::vector<FaceSelector>& clamps,
                                    const std::vector<const FaceSelector*>& loads,
                                    std::vector<std::size_t>& clampFaces,
-                                   std::vector<std::size_t>& loadFaces) const {
+                                   std::vector<std::size_t>& loadFaces, const char* clampWord,
+                                   const char* loadWord) const {
   const PolyMesh& m = currentMesh();
   std::vector<const FaceSelector*> selections;
   for (const FaceSelector& c : clamps) selections.push_back(&c);
@@ -340,7 +341,7 @@ void Model::State::checkSelections(const std::vector<FaceSelector>& clamps,
     const bool clamp = i < clamps.size();
     (clamp ? clampFaces : loadFaces).push_back(counts[i]);
     if (counts[i] == 0)
-      throw InputError(std::string(clamp ? "the clamp " : "the traction on ") +
+      throw InputError(std::string(clamp ? clampWord : loadWord) + " " +
                        selections[i]->describe() + " selects no boundary face (the mesh spans " +
                        boxText(meshBounds(m)) + "); use a region that meets the boundary");
   }

@@ -49,11 +49,12 @@ struct Model::State {
   /// Validates the mesh unless known valid; throws CheckFailure naming the first defect.
   void requireValid();
   /// Counts the boundary faces each clamp and load selects; throws InputError naming a
-  /// selection that picks none.
+  /// selection that picks none ("CLAMPWORD REGION selects no boundary face ...").
   void checkSelections(const std::vector<FaceSelector>& clamps,
                        const std::vector<const FaceSelector*>& loads,
                        std::vector<std::size_t>& clampFaces,
-                       std::vector<std::size_t>& loadFaces) const;
+                       std::vector<std::size_t>& loadFaces, const char* clampWord = "the clamp",
+                       const char* loadWord = "the traction on") const;
   /// Makes `coefficients` in `basis` the model's solution (corner values and element fields).
   void adoptSolution(std::unique_ptr<DgBasis> basis, Eigen::VectorXd coefficients,
                      const Material& material, const MomentCache& moments);

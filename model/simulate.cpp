@@ -136,7 +136,8 @@ SimulationReport Model::simulate(const Scene& scene, const SimulateOptions& opti
   report.scene = scene;
   std::vector<const FaceSelector*> loadRegions;
   for (const TimedTraction& t : scene.loads) loadRegions.push_back(&t.where);
-  s.checkSelections(scene.fixed, loadRegions, report.fixedFaces, report.loadFaces);
+  s.checkSelections(scene.fixed, loadRegions, report.fixedFaces, report.loadFaces,
+                    "the fixed region", "the load on");
   std::unique_ptr<TimeSeries> series;
   if (!options.outputDir.empty()) {
     series = std::make_unique<TimeSeries>(options.outputDir, options.encoding);

@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <utility>
 #include <variant>
 
 #include <tbb/global_control.h>
@@ -21,6 +22,7 @@
 #include "polydg/model/model.h"
 #include "polydg/model/pipeline.h"
 #include "polydg/model/report_json.h"
+#include "polydg/model/scene.h"
 #include "polydg/util/error.h"
 #include "polydg/util/process.h"
 #include "polydg/version.h"
@@ -130,6 +132,53 @@ ProgressFn progressFn(const py::object& callback) {
     py::gil_scoped_acquire gil;
     callback(fraction);
   };
+}
+
+/// Thrown through the library when a Python callback raised. Not a std::exception, so no
+/// handler in the library converts or swallows it on the way out.
+struct CallbackRaised {};
+
+/// A Python callable called from code that runs without the GIL: each call takes the GIL; if the
+/// callable raises, its exception is kept and the library unwound with CallbackRaised, and
+/// reraise() (with the GIL held again, after the library returned) raises the callable's own
+/// exception, traceback and all.
+class GuardedCallback {
+ public:
+  explicit GuardedCallback(py::object callable) : callable_(std::move(callable)) {}
+
+  /// Calls the callable (if not None), then lets Python handle pending signals: Ctrl-C stops a
+  /// long run with KeyboardInterrupt like any Python code.
+  template <class... Args>
+  void operator()(Args&&... args) {
+    py::gil_scoped_acquire gil;
+    try {
+      if (!callable_.is_none()) callable_(std::forward<Args>(args)...);
+      if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+    } catch (py::error_already_set& e) {
+      raised_.emplace(std::move(e));
+      throw CallbackRaised{};
+    }
+  }
+
+  [[noreturn]] void reraise() { throw *raised_; }
+
+ private:
+  py::object callable_;
+  std::optional<py::error_already_set> raised_;
+};
+
+/// A scene given to Model.simulate(): a path (str) to a scene file, or a dict of the same
+/// format, named "scene" in messages.
+Scene sceneOf(const py::handle& scene) {
+  if (py::isinstance<py::str>(scene)) return readScene(scene.cast<std::string>());
+  nlohmann::json document;
+  try {
+    document = jsonOf(scene);
+  } catch (const nlohmann::json::parse_error&) {  // json.dumps wrote NaN or Infinity
+    throw InputError("scene: holds a number that is not finite (NaN or infinity); see the scene "
+                     "format in README.md");
+  }
+  return parseScene(document, "scene");
 }
 
 }  // namespace
@@ -328,6 +377,27 @@ PYBIND11_MODULE(_polydg, m) {
                  model, "solve", "Model.solve()", kwargs,
                  [](Model& m, const SolveStep& s) { return toJson(m.solve(s.options)); });
            })
+      .def(
+          "_simulate",
+          [](Model& model, const py::object& scene, const std::string& output,
+             const py::object& progress) {
+            const Scene parsed = sceneOf(scene);
+            SimulateOptions options;
+            options.outputDir = output;
+            GuardedCallback callback(progress);  // also without progress: Ctrl-C
+            options.progress = [&callback](const SimulationProgress& p) {
+              callback(p.step, p.steps, p.t);
+            };
+            std::optional<SimulationReport> report;
+            try {
+              py::gil_scoped_release release;
+              report.emplace(model.simulate(parsed, options));
+            } catch (const CallbackRaised&) {
+              callback.reraise();
+            }
+            return toPython(toJson(*report));
+          },
+          py::arg("scene"), py::arg("output") = "", py::arg("progress") = py::none())
       .def(
           "_write",
           [](const Model& model, const std::string& path, bool solution) {

@@ -188,6 +188,33 @@ def _solve(self, method="ip", degree=1, E=None, nu=None, density=None, gravity=N
                                 penalty=penalty, eta=eta))
 
 
+def _simulate(self, scene, output=None, progress=None):
+    """Moves the body in time (``polydg simulate``): dynamic DG elasticity through the steps of
+    ``scene``, with its cuts made at their times on this model. Afterwards the model holds the
+    cut mesh and, as its solution, the final displacement (``element_displacements``, ``write``).
+
+    scene: a dict in the scene format of README.md (material, dt, steps or duration, gravity,
+    fixed, loads, initial, cuts, ...), or the path (str or os.PathLike) of a scene JSON file.
+    Every key is checked before the run starts.
+    output: a folder for the ParaView time series (scene.pvd and one VTU per frame, with point
+    data "displacement" and "velocity"), created if missing; None writes no file.
+    progress: a callable progress(step, steps, t), called after each step; an exception it
+    raises stops the simulation and reaches the caller. None: no calls.
+
+    Returns the report: scene (every key explicit), elements, dofs, steps (per step: t, kinetic,
+    elastic, gravity, momentum, angular_momentum, centre_of_mass, cg_iterations, ...), cuts
+    (each with its operation's report), frames, pvd (None without output), timings_s.
+    Raises ``Error`` for a bad scene (naming the key, e.g. "scene: dt: ...") or a region that
+    selects no face, ``CheckFailure`` for an invalid mesh, a step whose solve fails, or a cut that
+    fails its validation (the model must then not be used further, as after ``cut``).
+    """
+    if isinstance(scene, (str, bytes, _os.PathLike)):
+        scene = _os.fsdecode(scene)
+    if progress is not None and not callable(progress):
+        raise TypeError(f"progress must be callable or None, not {type(progress).__name__}")
+    return self._simulate(scene, "" if output is None else _os.fsdecode(output), progress)
+
+
 def _write(self, path, solution=True):
     """Writes the model as a VTU file (every cell a VTK_POLYHEDRON) with its provenance and, if
     ``solution`` and the model was solved, the displacement (per point and per element), von
@@ -201,4 +228,5 @@ Model.write = _write
 Model.merge_slivers = _merge_slivers
 Model.check = _check
 Model.solve = _solve
+Model.simulate = _simulate
 Model.to_meshio = _to_meshio

@@ -119,7 +119,7 @@ TEST_F(Commands, NonFiniteAndOutOfRangeValuesNameTheirOption) {
 }
 
 TEST_F(Commands, UnknownCommandsAndChoicesAreNamed) {
-  expectRefused(runPolydg("simulate x.vtu"), "unknown command 'simulate'");
+  expectRefused(runPolydg("animate x.vtu"), "unknown command 'animate'");
   const CommandResult help = runPolydg("mesh --help");
   EXPECT_EQ(help.exitCode, 0);
   EXPECT_NE(help.out.find("none|fill|wrap"), std::string::npos) << help.out;

@@ -225,6 +225,8 @@ class Model {
   /// exactly), writes frames if asked. Afterwards the model holds the cut mesh and, as its
   /// solution, the final displacement. Throws CheckFailure if the mesh is invalid, a cut fails
   /// its validation (the model is then broken, as after cut()), or a step's solve fails.
+  /// If it stops early (an error, or an exception from the progress callback), the cuts made
+  /// so far stay and the solution is the one before the simulation (none after a cut).
   SimulationReport simulate(const Scene& scene, const SimulateOptions& options);
 
   /// Writes the model as a VTU file with its provenance (and the solution's fields, see

@@ -90,7 +90,7 @@ struct SimulationReport {
   std::vector<SimulationStep> steps;
   std::vector<SimulationCut> cuts;
   std::vector<SimulationFrame> frames;
-  std::string pvd;  ///< the collection file, "" without output
+  std::string pvd;  ///< the collection file, "" without output (null in the JSON report)
   /// Totals of the phases: setup (bases, matrices, loads, after each cut too), rotation,
   /// assembly, solve, cut, output.
   double setupSeconds = 0.0, rotationSeconds = 0.0, assemblySeconds = 0.0, solveSeconds = 0.0,
