@@ -14,6 +14,7 @@
 #include "polydg/physics/agglomeration.h"
 #include "polydg/physics/assembly.h"
 #include "polydg/physics/local_integrators.h"
+#include "polydg/physics/polynomial_tables.h"
 #include "polydg/physics/post_process.h"
 #include "polydg/util/stopwatch.h"
 
@@ -30,45 +31,26 @@ constexpr double kNewmarkBeta = 0.25, kNewmarkGamma = 0.5;
 /// (the modified Newton iteration gains 1-2 digits per solve on B7's spinning cube).
 constexpr int kMaxAutomaticSolves = 12;
 
-/// out = (R (x) I_n) v for a 3n vector in component-major order (component d, function i at
-/// d n + i): each function's three components rotated.
-void rotate(const Eigen::Matrix3d& r, const double* v, int n, double* out) {
-  for (int i = 0; i < n; ++i) {
-    const double a = v[i], b = v[n + i], c = v[2 * n + i];
-    out[i] = r(0, 0) * a + r(0, 1) * b + r(0, 2) * c;
-    out[n + i] = r(1, 0) * a + r(1, 1) * b + r(1, 2) * c;
-    out[2 * n + i] = r(2, 0) * a + r(2, 1) * b + r(2, 2) * c;
-  }
-}
-
-/// out += (R1 (x) I) B (R2 (x) I)^T for a bs x bs block B (entry (r, c) at b[r * rs + c * cs]),
-/// written column-major into out (bs x bs) scaled by s.
-void addRotatedBlock(const Eigen::Matrix3d& r1, const double* b, std::size_t rs, std::size_t cs,
-                     const Eigen::Matrix3d& r2, int n, double s, double* out) {
-  const int bs = 3 * n;
-  // t = B (R2 (x) I)^T: column (c, j) of t = sum_b R2(c, b) column (b, j) of B.
-  thread_local std::vector<double> t;
-  t.resize(static_cast<std::size_t>(bs) * bs);
-  for (int c = 0; c < 3; ++c)
-    for (int j = 0; j < n; ++j) {
-      double* tc = t.data() + static_cast<std::size_t>(c * n + j) * bs;
-      const double w0 = r2(c, 0), w1 = r2(c, 1), w2 = r2(c, 2);
-      for (int row = 0; row < bs; ++row)
-        tc[row] = w0 * b[row * rs + static_cast<std::size_t>(j) * cs] +
-                  w1 * b[row * rs + static_cast<std::size_t>(n + j) * cs] +
-                  w2 * b[row * rs + static_cast<std::size_t>(2 * n + j) * cs];
-    }
-  // out += s (R1 (x) I) t, column by column.
-  for (int col = 0; col < bs; ++col) {
-    const double* tc = t.data() + static_cast<std::size_t>(col) * bs;
-    double* oc = out + static_cast<std::size_t>(col) * bs;
-    for (int i = 0; i < n; ++i) {
-      const double a = tc[i], bb = tc[n + i], c = tc[2 * n + i];
-      oc[i] += s * (r1(0, 0) * a + r1(0, 1) * bb + r1(0, 2) * c);
-      oc[n + i] += s * (r1(1, 0) * a + r1(1, 1) * bb + r1(1, 2) * c);
-      oc[2 * n + i] += s * (r1(2, 0) * a + r1(2, 1) * bb + r1(2, 2) * c);
-    }
-  }
+/// out += s (R (x) I_N) B (R (x) I_N)^T for a 3N x 3N column-major block B, into the
+/// column-major out: N x N blocks, B'_dc = sum_ab R(d, a) B_ab R(c, b).
+template <int N>
+void addWarped(const Eigen::Matrix3d& r, const double* b, double s, double* out) {
+  constexpr int BS = 3 * N;
+  const Eigen::Map<const Eigen::Matrix<double, BS, BS>> in(b);
+  Eigen::Map<Eigen::Matrix<double, BS, BS>> o(out);
+  Eigen::Matrix<double, BS, BS> t;  // (R (x) I) B
+  for (int d = 0; d < 3; ++d)
+    for (int c = 0; c < 3; ++c)
+      t.template block<N, N>(d * N, c * N).noalias() =
+          r(d, 0) * in.template block<N, N>(0, c * N) +
+          r(d, 1) * in.template block<N, N>(N, c * N) +
+          r(d, 2) * in.template block<N, N>(2 * N, c * N);
+  for (int d = 0; d < 3; ++d)
+    for (int c = 0; c < 3; ++c)
+      o.template block<N, N>(d * N, c * N) +=
+          (s * r(c, 0)) * t.template block<N, N>(d * N, 0) +
+          (s * r(c, 1)) * t.template block<N, N>(d * N, N) +
+          (s * r(c, 2)) * t.template block<N, N>(d * N, 2 * N);
 }
 
 }  // namespace
@@ -324,82 +306,82 @@ struct DynamicSolver::Impl {
   /// energy 1/2 sum (R_S^T x_A - z_A) . B (R_S^T x_C - z_C).
   void warpedProduct(const std::vector<Eigen::Matrix3d>& r, const Eigen::VectorXd& x,
                      const Eigen::VectorXd* z, Eigen::VectorXd& out, double* energy) const {
+    detail::dispatchBasisDegree(basis->degree(), [&](auto p) {
+      warpedProductOf<numMonomials(p())>(r, x, z, out, energy);
+    });
+  }
+
+  /// warpedProduct() for n = N functions per component (fixed-size kernels).
+  template <int N>
+  void warpedProductOf(const std::vector<Eigen::Matrix3d>& r, const Eigen::VectorXd& x,
+                       const Eigen::VectorXd* z, Eigen::VectorXd& out, double* energy) const {
+    constexpr int BS = 3 * N;
+    using Vec = Eigen::Matrix<double, BS, 1>;
+    using Components = Eigen::Matrix<double, N, 3>;  // column d: component d
+    using Block = Eigen::Matrix<double, BS, BS>;
+    using RowBlock = Eigen::Matrix<double, BS, BS, Eigen::RowMajor>;
     out.setZero(x.size());
     const bool bz = parts.jumps.componentDiagonalCoupling;
-    const std::size_t bb = static_cast<std::size_t>(bs) * bs;
+    const std::size_t bb = static_cast<std::size_t>(BS) * BS;
     const double e = tbb::parallel_deterministic_reduce(
         tbb::blocked_range<std::size_t>(0, ne, 64), 0.0,
         [&](const tbb::blocked_range<std::size_t>& range, double sum) {
-          std::vector<double> w(bs), y(bs), wa(bs), ry(bs);
+          Vec w, y, wa, v;
           for (std::size_t i = range.begin(); i != range.end(); ++i) {
-            double* oa = out.data() + i * bs;
-            // Row i's block B against column element `col`, warped with element `source`'s
-            // rotation (-1: not warped).
+            Eigen::Map<Vec> oa(out.data() + i * BS);
             // The vector a side of a block reads: R^T x - z (positions against the undeformed
-            // state, the strain side and interior jumps) or R^T (x - z) (the displacement,
-            // the jump against a Dirichlet face's fixed outside).
-            auto side = [&](const Eigen::Matrix3d* rot, std::size_t e, bool difference,
-                            std::vector<double>& out) {
-              const double* xe = x.data() + e * bs;
-              const double* ze = z ? z->data() + e * bs : nullptr;
-              if (difference && ze) {
-                for (int c = 0; c < bs; ++c) ry[c] = xe[c] - ze[c];
-                if (rot)
-                  rotate(rot->transpose(), ry.data(), n, out.data());
-                else
-                  std::copy(ry.begin(), ry.end(), out.begin());
-                return;
-              }
+            // state: the strain side and interior jumps) or R^T (x - z) (the displacement: the
+            // jump against a Dirichlet face's fixed outside). (R (x) I)^T acts on the
+            // components as V R.
+            auto side = [&](const Eigen::Matrix3d* rot, std::size_t el, bool difference,
+                            Vec& o) {
+              v = Eigen::Map<const Vec>(x.data() + el * BS);
+              if (z && difference) v -= Eigen::Map<const Vec>(z->data() + el * BS);
               if (rot)
-                rotate(rot->transpose(), xe, n, out.data());
+                Eigen::Map<Components>(o.data()).noalias() =
+                    Eigen::Map<const Components>(v.data()) * (*rot);
               else
-                std::copy(xe, xe + bs, out.begin());
-              if (ze)
-                for (int c = 0; c < bs; ++c) out[c] -= ze[c];
+                o = v;
+              if (z && !difference) o -= Eigen::Map<const Vec>(z->data() + el * BS);
             };
-            auto apply = [&](const double* b, std::size_t rs, std::size_t cs, std::int64_t source,
+            // Row i's block B against column element `col`, warped with element `source`'s
+            // rotation (-1: not warped); B column-major (rs == 1) or row-major.
+            auto apply = [&](const double* b, std::size_t rs, std::int64_t source,
                              std::size_t col, bool rowDifference = false,
                              bool columnDifference = false) {
               const bool warp = source >= 0 && options.corotational;
-              const Eigen::Matrix3d& rs3 = warp ? r[static_cast<std::size_t>(source)] : r[i];
-              side(warp ? &rs3 : nullptr, col, columnDifference, w);
-              for (int row = 0; row < bs; ++row) {
-                double acc = 0.0;
-                const double* br = b + row * rs;
-                for (int c = 0; c < bs; ++c) acc += br[c * cs] * w[c];
-                y[row] = acc;
-              }
-              if (warp) {
-                rotate(rs3, y.data(), n, ry.data());
-                for (int c = 0; c < bs; ++c) oa[c] += ry[c];
-              } else {
-                for (int c = 0; c < bs; ++c) oa[c] += y[c];
-              }
+              const Eigen::Matrix3d* rot = warp ? &r[static_cast<std::size_t>(source)] : nullptr;
+              side(rot, col, columnDifference, w);
+              if (rs == 1)
+                y.noalias() = Eigen::Map<const Block>(b) * w;
+              else
+                y.noalias() = Eigen::Map<const RowBlock>(b) * w;
+              if (rot)
+                Eigen::Map<Components>(oa.data()).noalias() +=
+                    Eigen::Map<const Components>(y.data()) * rot->transpose();
+              else
+                oa += y;
               if (energy) {
-                side(warp ? &rs3 : nullptr, i, rowDifference, wa);
-                double dot = 0.0;
-                for (int c = 0; c < bs; ++c) dot += wa[c] * y[c];
-                sum += 0.5 * dot;
+                side(rot, i, rowDifference, wa);
+                sum += 0.5 * wa.dot(y);
               }
             };
             if (!bz) {  // the Dirichlet faces' strain terms
               const auto self = static_cast<std::int64_t>(i);
-              apply(parts.dirichletTrial.data() + i * bb, 1, static_cast<std::size_t>(bs), self, i,
-                    true, false);
-              apply(parts.dirichletTest.data() + i * bb, 1, static_cast<std::size_t>(bs), self, i,
-                    false, true);
+              apply(parts.dirichletTrial.data() + i * bb, 1, self, i, true, false);
+              apply(parts.dirichletTest.data() + i * bb, 1, self, i, false, true);
             }
             std::size_t neighbour = 0;
             for (std::size_t k = rowStart[i]; k < rowStart[i + 1]; ++k) {
               const RowSlot& s = slots[k];
               if (!s.diagonal && !bz)  // the neighbour's lifting terms in i's diagonal block
                 apply(parts.neighbourLifting.data() + (parts.neighbourStart[i] + neighbour++) * bb,
-                      1, static_cast<std::size_t>(bs), s.other, i);
+                      1, s.other, i);
               Part ps[3];
               const int np = partsOf(i, s, ps);
               for (int q = 0; q < np; ++q) {
                 if (ps[q].source >= 0 && !s.diagonal && bz) continue;  // BZ: no coupling strain
-                apply(ps[q].b, ps[q].rs, ps[q].cs, ps[q].source, s.other);
+                apply(ps[q].b, ps[q].rs, ps[q].source, s.other);
               }
             }
           }
@@ -411,6 +393,19 @@ struct DynamicSolver::Impl {
 
   /// The system matrix cM M + cK K_w with the rotations `r`, into `system` and `matrix`.
   void assembleSystem(const std::vector<Eigen::Matrix3d>& r, double cM, double cK) {
+    detail::dispatchBasisDegree(basis->degree(), [&](auto p) {
+      assembleSystemOf<numMonomials(p())>(r, cM, cK);
+    });
+    if (!assembled) {
+      SpMat k = assembleStiffness(system);
+      matrix.swap(k);
+    } else {
+      refillStiffness(system, matrix);
+    }
+  }
+
+  template <int N>
+  void assembleSystemOf(const std::vector<Eigen::Matrix3d>& r, double cM, double cK) {
     const std::size_t bb = static_cast<std::size_t>(bs) * bs;
     const bool bz = parts.jumps.componentDiagonalCoupling;
     const bool warp = options.corotational;
@@ -422,14 +417,13 @@ struct DynamicSolver::Impl {
             const double* ss = parts.rowStrain.diagonal.data() + i * bb;
             for (std::size_t k = 0; k < bb; ++k) d[k] = cK * js[k];
             if (warp)
-              addRotatedBlock(r[i], ss, 1, static_cast<std::size_t>(bs), r[i], n, cK, d);
+              addWarped<N>(r[i], ss, cK, d);
             else
               for (std::size_t k = 0; k < bb; ++k) d[k] += cK * ss[k];
             if (!bz) {
               for (const std::vector<double>* dir : {&parts.dirichletTrial, &parts.dirichletTest}) {
                 if (warp)
-                  addRotatedBlock(r[i], dir->data() + i * bb, 1, static_cast<std::size_t>(bs), r[i],
-                                  n, cK, d);
+                  addWarped<N>(r[i], dir->data() + i * bb, cK, d);
                 else
                   for (std::size_t q = 0; q < bb; ++q) d[q] += cK * (*dir)[i * bb + q];
               }
@@ -439,7 +433,7 @@ struct DynamicSolver::Impl {
                 if (f == i) continue;
                 const double* nl = parts.neighbourLifting.data() + (first + k++) * bb;
                 if (warp)
-                  addRotatedBlock(r[f], nl, 1, static_cast<std::size_t>(bs), r[f], n, cK, d);
+                  addWarped<N>(r[f], nl, cK, d);
                 else
                   for (std::size_t q = 0; q < bb; ++q) d[q] += cK * nl[q];
               }
@@ -467,20 +461,14 @@ struct DynamicSolver::Impl {
                 const Eigen::Matrix3d& rf = r[*it];
                 // Read each row-major block column-major (its transpose) and write the
                 // transpose of the warped block: R_f B^T R_f^T etc. with the roles swapped.
-                addRotatedBlock(r[i], rc, 1, static_cast<std::size_t>(bs), r[i], n, cK, c);
-                addRotatedBlock(rf, oc, 1, static_cast<std::size_t>(bs), rf, n, cK, c);
+                addWarped<N>(r[i], rc, cK, c);
+                addWarped<N>(rf, oc, cK, c);
               } else {
                 for (std::size_t k = 0; k < bb; ++k) c[k] += cK * (rc[k] + oc[k]);
               }
             }
           }
         });
-    if (!assembled) {
-      SpMat k = assembleStiffness(system);
-      matrix.swap(k);
-    } else {
-      refillStiffness(system, matrix);
-    }
   }
 
   void massProduct(const Eigen::VectorXd& x, Eigen::VectorXd& out) const {
