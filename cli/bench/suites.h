@@ -15,6 +15,12 @@
 //              torus.obj and the generated sphere and torus knot at 16 .. 128 cells.
 //   cutting    plane cuts of growing size on a 47^3 hex grid (103,823 elements): time per cut
 //              against elements split, validation none and local, beside a full moment rebuild.
+//   dynamics   B6 (linear, p = 2, 10 periods of dt = T/200: energy against time and the first
+//              period, per integrator), B7 (b) (the spinning cube, one turn: volume change and
+//              angular momentum, linear against corotational, per integrator), and wall time per
+//              step against DOFs (B10's beam under gravity, p = 1, corotational, 7.7k, 87k and
+//              960k DOFs, with rotation, assembly and solve apart). 17 minutes on 2 cores
+//              shared with a build (2026-12-02; 15 of them the 960k-DOF steps), 5 GB at most.
 // With `quick` each runs reduced sizes (a smoke test of every output, as the tests run it).
 #pragma once
 
@@ -25,7 +31,7 @@
 namespace polydg::bench {
 
 struct BenchOptions {
-  std::string suite;        ///< accuracy, table41, stability, meshing, cutting or all
+  std::string suite;        ///< accuracy, table41, stability, meshing, cutting, dynamics or all
   std::string out;          ///< the folder the files go to
   bool skipSliced = false;  ///< accuracy: hex grids only
   bool quick = false;
@@ -40,5 +46,6 @@ SuiteOutput stabilitySuite(const BenchOptions& options, bool quiet);
 /// Throws InputError if DATA_DIR/torus.obj does not exist.
 SuiteOutput meshingSuite(const BenchOptions& options, bool quiet);
 SuiteOutput cuttingSuite(const BenchOptions& options, bool quiet);
+SuiteOutput dynamicsSuite(const BenchOptions& options, bool quiet);
 
 }  // namespace polydg::bench

@@ -1,5 +1,6 @@
-// `polydg bench` end to end through the binary, as a user runs it: the stability and cutting
-// suites with --quick (every file written, the B4 JSON keys and findings, incremental cuts),
+// `polydg bench` end to end through the binary, as a user runs it: the stability, cutting and
+// dynamics suites with --quick (every file written, the B4 JSON keys and findings, incremental
+// cuts, B6's energy and period, B7's volume with and without corotation, the speed rows),
 // the meshing suite finding its model in share/polydg beside the binary (build tree and an
 // installation's layout) or in --data, and an unknown suite refused with one line.
 #include <gtest/gtest.h>
@@ -110,6 +111,80 @@ TEST(BenchCommand, CuttingSuiteReintegratesOnlyWhatEachCutTouched) {
               run["faces_total"].get<std::size_t>() / 4)
         << run.dump();
   }
+  fs::remove_all(dir);
+}
+
+TEST(BenchCommand, DynamicsSuiteKeepsEnergyAndVolumeWhereItShould) {
+  // B6 over one period of dt = T/200: Newmark (undamped, linear) keeps the energy, backward
+  // Euler loses some, every integrator sees two zero crossings, half a period apart.
+  constexpr double kNewmarkEnergyChange = 0.01;
+  constexpr double kPeriodTolerance = 0.05;  // of Euler-Bernoulli's 19.58 (Timoshenko: +2%)
+  // B7 over a quarter turn of 50 steps: the linear model's infinitesimal rotation grows the
+  // volume by theta^2 (2.47 at pi/2); with corotation the change is of the order of
+  // (omega dt)^2 = 9.9e-4 (backward Euler's step moves along the tangent) or below.
+  constexpr double kCorotationalVolumeChange = 1.5e-3;
+  constexpr double kLinearVolumeChange = 1.0;
+  constexpr double kAngularMomentumChange = 0.01;
+  const fs::path dir =
+      fs::temp_directory_path() / ("polydg_bench_dynamics_" + std::to_string(getpid()));
+  fs::remove_all(dir);
+  const Result r = run("bench --suite dynamics --quick --quiet --out " + dir.string());
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  EXPECT_TRUE(r.out.empty()) << r.out;  // --quiet
+  for (const char* file :
+       {"dynamics.json", "dynamics.csv", "dynamics_energy.svg", "dynamics_volume.svg",
+        "dynamics_momentum.svg", "dynamics_speed.svg", "dynamics_speed_phases.svg"})
+    EXPECT_TRUE(fs::exists(dir / file)) << file;
+  std::ifstream in(dir / "dynamics.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+
+  const nlohmann::json& b6 = j["b6"];
+  EXPECT_EQ(b6["steps"].get<int>(), 200);
+  ASSERT_EQ(b6["runs"].size(), 3u);
+  for (const nlohmann::json& run : b6["runs"]) {
+    const std::string integrator = run["integrator"].get<std::string>();
+    ASSERT_FALSE(run["period"].is_null()) << run.dump();
+    EXPECT_GE(run["zero_crossings"].get<int>(), 2) << run.dump();
+    EXPECT_NEAR(run["period_over_euler_bernoulli"].get<double>(), 1.0, kPeriodTolerance)
+        << run.dump();
+    EXPECT_LE(run["energy_max"].get<double>(), 1.0 + kNewmarkEnergyChange) << run.dump();
+    if (integrator == "newmark") {
+      EXPECT_LT(run["energy_worst_change"].get<double>(), kNewmarkEnergyChange) << run.dump();
+    }
+    if (integrator == "euler") {
+      EXPECT_LT(run["energy_final"].get<double>(), 0.99) << run.dump();
+    }
+  }
+
+  const nlohmann::json& b7 = j["b7"];
+  ASSERT_EQ(b7["runs"].size(), 6u);  // 3 integrators, linear and corotational
+  for (const nlohmann::json& run : b7["runs"]) {
+    const double change = run["volume_change_max"].get<double>();
+    if (run["corotational"].get<bool>()) {
+      EXPECT_LT(change, kCorotationalVolumeChange) << run.dump();
+    } else {
+      EXPECT_GT(change, kLinearVolumeChange) << run.dump();
+    }
+    // Free body: no momentum appears, the angular momentum stays.
+    EXPECT_LT(run["momentum_max"].get<double>(), 1e-9) << run.dump();
+    EXPECT_LT(run["angular_momentum_change_max"].get<double>(), kAngularMomentumChange)
+        << run.dump();
+  }
+
+  const nlohmann::json& speed = j["speed"]["runs"];
+  ASSERT_EQ(speed.size(), 3u);  // the smallest grid, 3 integrators
+  for (const nlohmann::json& run : speed) {
+    EXPECT_EQ(run["grid"], "40x4x4") << run.dump();
+    EXPECT_EQ(run["dofs"].get<std::size_t>(), 12u * 40 * 4 * 4) << run.dump();
+    EXPECT_GE(run["solves"].get<double>(), 1.0) << run.dump();
+    for (const char* phase : {"t_step", "t_rotation", "t_assembly", "t_solve", "steps_per_second"})
+      EXPECT_TRUE(run[phase].is_number()) << phase << ": " << run.dump();
+  }
+  std::ifstream csv(dir / "dynamics.csv");
+  std::string header;
+  std::getline(csv, header);
+  for (const char* column : {"part", "integrator", "energy", "volume_change", "t_rotation"})
+    EXPECT_NE(header.find(column), std::string::npos) << column;
   fs::remove_all(dir);
 }
 
