@@ -7,6 +7,7 @@
 
 #include "model_state.h"
 #include "polydg/model/files.h"
+#include "polydg/model/names.h"
 #include "polydg/model/scene.h"
 #include "polydg/physics/post_process.h"
 #include "polydg/util/stopwatch.h"
@@ -63,9 +64,8 @@ std::string solverAction(const StepReport& r, SolverKind kind, bool first) {
   if (kind == SolverKind::Cholesky)
     return first ? "cholesky: factorized" : r.refactorized ? "cholesky: refactorized"
                                                            : "cholesky: factorization reused";
-  return first ? "cg: preconditioner built"
-               : r.preconditionerRebuilt ? "cg: preconditioner rebuilt"
-                                         : "cg: preconditioner reused";
+  const std::string cg = "cg (" + toString(r.preconditioner) + "): ";
+  return cg + (first || r.preconditionerRebuilt ? "preconditioner built" : "preconditioner reused");
 }
 
 /// The time series: one VTU per frame and the ParaView collection listing them, rewritten

@@ -280,5 +280,35 @@ TEST(Dynamics, FreeFallAcceleratesWithGravityExactly) {
   }
 }
 
+TEST(Dynamics, ConjugateGradientStepsAgreeWithCholeskyAndSwitchPreconditioner) {
+  // The beam under gravity, corotational, with CG forced: the same states as CHOLMOD's to the
+  // CG tolerance. Small steps (mass-dominated systems) stay with block-Jacobi; large steps
+  // need many block-Jacobi iterations and switch to the p-multigrid for the next step.
+  const Beam beam;
+  for (double dt : {0.01, 2.0}) {
+    Eigen::VectorXd u[2];
+    for (SolverKind kind : {SolverKind::Cholesky, SolverKind::ConjugateGradient}) {
+      DynamicsOptions o = options(1, true, TimeIntegrator::BackwardEuler, dt);
+      o.solver.kind = kind;
+      DynamicSolver solver(beam.mesh, beam.moments,
+                           {{FaceSelector::inPlane(0, 0.0)}, {}, Vec3(0, 0, -1)}, o);
+      std::vector<StepReport> steps;
+      for (int k = 0; k < 5; ++k) steps.push_back(solver.step());
+      u[kind == SolverKind::ConjugateGradient] = solver.displacement();
+      if (kind == SolverKind::Cholesky) continue;
+      EXPECT_EQ(steps[0].preconditioner, CgPreconditioner::BlockJacobi);
+      if (dt < 0.1) {
+        for (const StepReport& r : steps) EXPECT_EQ(r.preconditioner, CgPreconditioner::BlockJacobi);
+      } else {
+        EXPECT_GT(steps[0].iterations, 80);
+        EXPECT_EQ(steps[1].preconditioner, CgPreconditioner::PMultigrid);
+        EXPECT_TRUE(steps[1].preconditionerRebuilt);
+        EXPECT_LT(steps[1].iterations, steps[0].iterations);
+      }
+    }
+    EXPECT_LT((u[1] - u[0]).norm(), 1e-6 * u[0].norm()) << "dt " << dt;
+  }
+}
+
 }  // namespace
 }  // namespace polydg

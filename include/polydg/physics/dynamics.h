@@ -65,7 +65,17 @@ struct DynamicLoads {
 struct DynamicsOptions {
   Material material;
   DiscretizationOptions discretization;  ///< method, basis degree, penalty
-  SolverOptions solver;
+  /// The step's solver. CG's tolerance is 1e-8 here (relative to the right-hand side, which
+  /// the momentum M V dominates: 1e-8 of the velocity per step), not the static 1e-10.
+  SolverOptions solver = [] {
+    SolverOptions s;
+    s.tolerance = 1e-8;
+    return s;
+  }();
+  /// CG: start with the block-Jacobi preconditioner (a step's matrix M + c K is dominated by
+  /// the mass for small steps, where its iterations are few and cheap) and switch to the
+  /// p-multigrid once a solve needs more than 80 iterations; false: solver.preconditioner.
+  bool adaptivePreconditioner = true;
   bool corotational = true;
   TimeIntegrator integrator = TimeIntegrator::BackwardEuler;
   double dt = 0.01;
@@ -96,6 +106,7 @@ struct StepReport {
   double residual = 0.0;           ///< relative residual of the step's solve
   bool refactorized = false;       ///< Cholesky: the matrix was factorized (numerically) again
   bool preconditionerRebuilt = false;  ///< CG: the preconditioner was rebuilt for this step
+  CgPreconditioner preconditioner = CgPreconditioner::BlockJacobi;  ///< CG: the one used
   double rotationSeconds = 0.0;    ///< polar decompositions
   double assemblySeconds = 0.0;    ///< warping the blocks, the system matrix, the forces
   double solveSeconds = 0.0;       ///< factorization or preconditioner, and the solve
