@@ -38,8 +38,9 @@ void run(const SimulateCommandOptions& o, const CommonOptions& common) {
     std::error_code ec;
     if (fs::equivalent(folder, o.output, ec) &&
         (name.rfind("scene_", 0) == 0 || name == "scene.pvd"))
-      throw InputError(in + " lies in the output folder under a name the frames take; choose "
-                            "another -o");
+      throw InputError(in +
+                       " lies in the output folder under a name the frames take; choose "
+                       "another -o");
   }
   ReadReport read;
   Model model = Model::read(o.input, &read);
@@ -52,8 +53,8 @@ void run(const SimulateCommandOptions& o, const CommonOptions& common) {
   const SimulationReport r = model.simulate(scene, options);
   bar.finish();
   if (!o.report.empty()) {
-    nlohmann::json j{{"command", "simulate"}, {"input", o.input}, {"scene_file", o.scene},
-                     {"output", o.output}};
+    nlohmann::json j{
+        {"command", "simulate"}, {"input", o.input}, {"scene_file", o.scene}, {"output", o.output}};
     j.update(toJson(r));
     j["timings_s"]["read"] = read.seconds;
     writeJsonFile(o.report, j);
@@ -71,9 +72,8 @@ void run(const SimulateCommandOptions& o, const CommonOptions& common) {
               << "  per step: rotation " << r.rotationSeconds / n << " s, assembly "
               << r.assemblySeconds / n << " s, solve " << r.solveSeconds / n << " s; "
               << r.cuts.size() << " cuts, " << r.frames.size() << " frames\n"
-              << "  at t = " << r.steps.back().step.t
-              << ": kinetic " << last.kinetic << ", elastic " << last.elastic << ", gravity "
-              << last.gravity << '\n'
+              << "  at t = " << r.steps.back().step.t << ": kinetic " << last.kinetic
+              << ", elastic " << last.elastic << ", gravity " << last.gravity << '\n'
               << "  wrote " << (r.pvd.empty() ? std::string("nothing") : r.pvd) << '\n';
   }
 }

@@ -10,8 +10,8 @@
 #include <tbb/parallel_invoke.h>
 #include <unistd.h>
 
-#include "polydg/mesh/geometry.h"
 #include "model_state.h"
+#include "polydg/mesh/geometry.h"
 #include "polydg/model/provenance.h"
 #include "polydg/util/error.h"
 #include "polydg/util/stopwatch.h"
@@ -319,10 +319,9 @@ void Model::State::requireValid() {
   if (!valid.has_value()) valid = validate(m).passed;
   if (*valid) return;
   const ValidationReport v = validate(m);
-  throw CheckFailure(
-      "the mesh is invalid (" +
-      (v.messages.empty() ? std::string("see 'polydg check'") : v.messages.front()) +
-      "); run 'polydg check' for details");
+  throw CheckFailure("the mesh is invalid (" +
+                     (v.messages.empty() ? std::string("see 'polydg check'") : v.messages.front()) +
+                     "); run 'polydg check' for details");
 }
 
 void Model::State::checkSelections(const std::vector<FaceSelector>& clamps,
@@ -341,9 +340,9 @@ void Model::State::checkSelections(const std::vector<FaceSelector>& clamps,
     const bool clamp = i < clamps.size();
     (clamp ? clampFaces : loadFaces).push_back(counts[i]);
     if (counts[i] == 0)
-      throw InputError(std::string(clamp ? clampWord : loadWord) + " " +
-                       selections[i]->describe() + " selects no boundary face (the mesh spans " +
-                       boxText(meshBounds(m)) + "); use a region that meets the boundary");
+      throw InputError(std::string(clamp ? clampWord : loadWord) + " " + selections[i]->describe() +
+                       " selects no boundary face (the mesh spans " + boxText(meshBounds(m)) +
+                       "); use a region that meets the boundary");
   }
 }
 

@@ -52,8 +52,8 @@ struct Model::State {
   /// selection that picks none ("CLAMPWORD REGION selects no boundary face ...").
   void checkSelections(const std::vector<FaceSelector>& clamps,
                        const std::vector<const FaceSelector*>& loads,
-                       std::vector<std::size_t>& clampFaces,
-                       std::vector<std::size_t>& loadFaces, const char* clampWord = "the clamp",
+                       std::vector<std::size_t>& clampFaces, std::vector<std::size_t>& loadFaces,
+                       const char* clampWord = "the clamp",
                        const char* loadWord = "the traction on") const;
   /// Makes `coefficients` in `basis` the model's solution (corner values and element fields).
   void adoptSolution(std::unique_ptr<DgBasis> basis, Eigen::VectorXd coefficients,

@@ -46,8 +46,7 @@ int Pipeline::momentDegree() const {
 CutRequest readCutRequest(JsonObjectReader& r) {
   CutStep s;
   const bool plane = r.has("plane"), polygon = r.has("polygon");
-  if (plane == polygon)
-    r.fail(r.place(), "a cut needs exactly one of \"plane\" and \"polygon\"");
+  if (plane == polygon) r.fail(r.place(), "a cut needs exactly one of \"plane\" and \"polygon\"");
   try {
     if (plane) {
       const auto v = r.numbers(r.get("plane"), r.at("plane"), 4);

@@ -343,7 +343,8 @@ json toJson(const Scene& s) {
     if (std::isfinite(t.until)) l["until"] = t.until;
     j["loads"].push_back(l);
   }
-  j["initial"] = {{"velocity", vectorJson(s.velocity)}, {"angular_velocity", vectorJson(s.angularVelocity)}};
+  j["initial"] = {{"velocity", vectorJson(s.velocity)},
+                  {"angular_velocity", vectorJson(s.angularVelocity)}};
   j["output"] = {{"every", s.outputEvery}};
   j["cuts"] = json::array();
   for (const TimedCut& c : s.cuts) {

@@ -106,8 +106,8 @@ Scene parseScene(const json& document, const std::string& file) {
       TimedCut c;
       c.time = item.number("time", 0.0, kHuge);
       if (c.time > end * (1 + 1e-12))
-        item.fail(item.at("time"), "after the end of the simulation (t = " +
-                                       std::to_string(end) + "); it would never happen");
+        item.fail(item.at("time"), "after the end of the simulation (t = " + std::to_string(end) +
+                                       "); it would never happen");
       c.request = readCutRequest(item);
       item.finish();
       s.cuts.push_back(c);

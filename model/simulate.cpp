@@ -62,8 +62,9 @@ void checkScene(const Scene& scene) {
 /// What the step did with its matrix, in words.
 std::string solverAction(const StepReport& r, SolverKind kind, bool first) {
   if (kind == SolverKind::Cholesky)
-    return first ? "cholesky: factorized" : r.refactorized ? "cholesky: refactorized"
-                                                           : "cholesky: factorization reused";
+    return first            ? "cholesky: factorized"
+           : r.refactorized ? "cholesky: refactorized"
+                            : "cholesky: factorization reused";
   const std::string cg = "cg (" + toString(r.preconditioner) + "): ";
   return cg + (first || r.preconditionerRebuilt ? "preconditioner built" : "preconditioner reused");
 }
@@ -195,7 +196,8 @@ SimulationReport Model::simulate(const Scene& scene, const SimulateOptions& opti
       for (std::size_t e = 0; e < record.elementsAfter; ++e) {
         const std::vector<ElementId> sources = record.report.lineage.sources(ElementId(e));
         (sources.size() == 1 ? record.exact : record.extended) += 1;
-        const Eigen::MatrixXd q = transferMatrix(oldBasis, sources.front(), solver.basis(), ElementId(e));
+        const Eigen::MatrixXd q =
+            transferMatrix(oldBasis, sources.front(), solver.basis(), ElementId(e));
         const Eigen::Index from = static_cast<Eigen::Index>(sources.front().index()) * bs;
         const Eigen::Index to = static_cast<Eigen::Index>(e) * bs;
         for (int d = 0; d < 3; ++d) {
@@ -242,8 +244,8 @@ SimulationReport Model::simulate(const Scene& scene, const SimulateOptions& opti
     if (options.progress) options.progress({k, scene.steps, solver.time()});
   }
 
-  s.adoptSolution(std::make_unique<DgBasis>(solver.basis()), solver.displacement(),
-                  scene.material, moments(2 * scene.degree));
+  s.adoptSolution(std::make_unique<DgBasis>(solver.basis()), solver.displacement(), scene.material,
+                  moments(2 * scene.degree));
   report.facesIntegrated = facesIntegrated() - integratedBefore;
   report.wallSeconds = wall.seconds();
   return report;

@@ -252,8 +252,8 @@ LocalMatrices localMatricesOf(const PolyMesh& mesh, const DgBasis& basis,
               continue;
             const FaceView view = viewOf(roles, use.face, sideOf(roles, use.face, e));
             // The coupling block of a face is computed from its smaller element only.
-            const bool withOther = kind == FaceKind::Interior && view.other.value > e.value &&
-                                   couplingTerms != 0;
+            const bool withOther =
+                kind == FaceKind::Interior && view.other.value > e.value && couplingTerms != 0;
             if (diagonalTerms == couplingTerms || !withOther) {
               if (diagonalTerms == 0 && !withOther) continue;
               faceRows(mesh, basis, moments, view, form, faceSelf, faceOther, withOther,
@@ -291,8 +291,7 @@ SplitLocalMatrices splitLocalMatrices(const PolyMesh& mesh, const DgBasis& basis
                                       const FormCoefficients& form) {
   SplitLocalMatrices split;
   split.rowStrain = localMatricesOf(mesh, basis, moments, roles, form, true,
-                                    kTrialStrainTerms | kTestStrainTerms, kTestStrainTerms,
-                                    false);
+                                    kTrialStrainTerms | kTestStrainTerms, kTestStrainTerms, false);
   split.columnStrain = localMatricesOf(mesh, basis, moments, roles, form, false, 0,
                                        kTrialStrainTerms | kOtherLiftingTerms);
   split.jumps = localMatricesOf(mesh, basis, moments, roles, form, false, kJumpTerms, kJumpTerms);

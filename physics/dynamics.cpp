@@ -23,7 +23,8 @@ namespace polydg {
 namespace {
 
 using SpMat = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
-using RowMap = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>;
+using RowMap =
+    Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>;
 using ColMap = Eigen::Map<const Eigen::MatrixXd>;
 
 constexpr double kNewmarkBeta = 0.25, kNewmarkGamma = 0.5;
@@ -51,10 +52,9 @@ void addWarped(const Eigen::Matrix3d& r, const double* b, double s, double* out)
           r(d, 2) * in.template block<N, N>(2 * N, c * N);
   for (int d = 0; d < 3; ++d)
     for (int c = 0; c < 3; ++c)
-      o.template block<N, N>(d * N, c * N) +=
-          (s * r(c, 0)) * t.template block<N, N>(d * N, 0) +
-          (s * r(c, 1)) * t.template block<N, N>(d * N, N) +
-          (s * r(c, 2)) * t.template block<N, N>(d * N, 2 * N);
+      o.template block<N, N>(d * N, c * N) += (s * r(c, 0)) * t.template block<N, N>(d * N, 0) +
+                                              (s * r(c, 1)) * t.template block<N, N>(d * N, N) +
+                                              (s * r(c, 2)) * t.template block<N, N>(d * N, 2 * N);
 }
 
 }  // namespace
@@ -108,7 +108,7 @@ struct DynamicSolver::Impl {
   int baselineIterations = -1, lastIterations = 0;
   double t = 0.0;
   Eigen::VectorXd u, v, a;
-  SolverOptions activeSolver;      ///< options.solver with the preconditioner in use
+  SolverOptions activeSolver;       ///< options.solver with the preconditioner in use
   Eigen::VectorXd previousUnknown;  ///< the step's unknown one step back (warm start)
   bool hasGuessHistory = false;
   bool solverReady = false;        ///< factorized, or preconditioner built, for `matrix`
@@ -155,9 +155,8 @@ struct DynamicSolver::Impl {
     buildSlots();
     elementTerms();
 
-    const int quadrature = o.discretization.quadratureDegree >= 0
-                               ? o.discretization.quadratureDegree
-                               : 2 * p + 2;
+    const int quadrature =
+        o.discretization.quadratureDegree >= 0 ? o.discretization.quadratureDegree : 2 * p + 2;
     LoadCase gravity = lc;
     for (auto& tr : gravity.tractions) tr.traction = Vec3::Zero();
     gravity.gravity = loads.gravity;
@@ -175,8 +174,7 @@ struct DynamicSolver::Impl {
     system = parts.jumps;  // layout; values are written per step
     frames = elementFrames(*basis);
     activeSolver = options.solver;
-    if (options.adaptivePreconditioner)
-      activeSolver.preconditioner = CgPreconditioner::BlockJacobi;
+    if (options.adaptivePreconditioner) activeSolver.preconditioner = CgPreconditioner::BlockJacobi;
     solver = LinearSolver(activeSolver);
     solverReady = false;
     u = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(ne) * bs);
@@ -191,8 +189,7 @@ struct DynamicSolver::Impl {
     slots.clear();
     for (std::size_t i = 0; i < ne; ++i) {
       const auto& b = l.neighbours[i];
-      const auto firstGreater =
-          std::upper_bound(b.begin(), b.end(), static_cast<std::uint32_t>(i));
+      const auto firstGreater = std::upper_bound(b.begin(), b.end(), static_cast<std::uint32_t>(i));
       for (std::uint32_t f : b) {
         RowSlot s;
         s.other = f;
@@ -200,9 +197,9 @@ struct DynamicSolver::Impl {
           s.diagonal = true;
           s.block = i;
         } else if (f > i) {
-          s.block = l.couplingStart[i] + static_cast<std::size_t>(
-                                             std::lower_bound(firstGreater, b.end(), f) -
-                                             firstGreater);
+          s.block =
+              l.couplingStart[i] +
+              static_cast<std::size_t>(std::lower_bound(firstGreater, b.end(), f) - firstGreater);
         } else {
           const auto& bf = l.neighbours[f];
           const auto fg = std::upper_bound(bf.begin(), bf.end(), f);
@@ -319,9 +316,8 @@ struct DynamicSolver::Impl {
   /// energy 1/2 sum (R_S^T x_A - z_A) . B (R_S^T x_C - z_C).
   void warpedProduct(const std::vector<Eigen::Matrix3d>& r, const Eigen::VectorXd& x,
                      const Eigen::VectorXd* z, Eigen::VectorXd& out, double* energy) const {
-    detail::dispatchBasisDegree(basis->degree(), [&](auto p) {
-      warpedProductOf<numMonomials(p())>(r, x, z, out, energy);
-    });
+    detail::dispatchBasisDegree(
+        basis->degree(), [&](auto p) { warpedProductOf<numMonomials(p())>(r, x, z, out, energy); });
   }
 
   /// warpedProduct() for n = N functions per component (fixed-size kernels).
@@ -346,8 +342,7 @@ struct DynamicSolver::Impl {
             // state: the strain side and interior jumps) or R^T (x - z) (the displacement: the
             // jump against a Dirichlet face's fixed outside). (R (x) I)^T acts on the
             // components as V R.
-            auto side = [&](const Eigen::Matrix3d* rot, std::size_t el, bool difference,
-                            Vec& o) {
+            auto side = [&](const Eigen::Matrix3d* rot, std::size_t el, bool difference, Vec& o) {
               v = Eigen::Map<const Vec>(x.data() + el * BS);
               if (z && difference) v -= Eigen::Map<const Vec>(z->data() + el * BS);
               if (rot)
@@ -359,9 +354,8 @@ struct DynamicSolver::Impl {
             };
             // Row i's block B against column element `col`, warped with element `source`'s
             // rotation (-1: not warped); B column-major (rs == 1) or row-major.
-            auto apply = [&](const double* b, std::size_t rs, std::int64_t source,
-                             std::size_t col, bool rowDifference = false,
-                             bool columnDifference = false) {
+            auto apply = [&](const double* b, std::size_t rs, std::int64_t source, std::size_t col,
+                             bool rowDifference = false, bool columnDifference = false) {
               const bool warp = source >= 0 && options.corotational;
               const Eigen::Matrix3d* rot = warp ? &r[static_cast<std::size_t>(source)] : nullptr;
               side(rot, col, columnDifference, w);
@@ -406,9 +400,8 @@ struct DynamicSolver::Impl {
 
   /// The system matrix cM M + cK K_w with the rotations `r`, into `system` and `matrix`.
   void assembleSystem(const std::vector<Eigen::Matrix3d>& r, double cM, double cK) {
-    detail::dispatchBasisDegree(basis->degree(), [&](auto p) {
-      assembleSystemOf<numMonomials(p())>(r, cM, cK);
-    });
+    detail::dispatchBasisDegree(basis->degree(),
+                                [&](auto p) { assembleSystemOf<numMonomials(p())>(r, cM, cK); });
     if (!assembled) {
       SpMat k = assembleStiffness(system);
       matrix.swap(k);
@@ -423,7 +416,8 @@ struct DynamicSolver::Impl {
     const bool bz = parts.jumps.componentDiagonalCoupling;
     const bool warp = options.corotational;
     tbb::parallel_for(
-        tbb::blocked_range<std::size_t>(0, ne, 32), [&](const tbb::blocked_range<std::size_t>& range) {
+        tbb::blocked_range<std::size_t>(0, ne, 32),
+        [&](const tbb::blocked_range<std::size_t>& range) {
           for (std::size_t i = range.begin(); i != range.end(); ++i) {
             double* d = system.diagonal.data() + i * bb;
             const double* js = parts.jumps.diagonal.data() + i * bb;
@@ -455,8 +449,7 @@ struct DynamicSolver::Impl {
             for (int c = 0; c < 3; ++c)
               for (int fi = 0; fi < n; ++fi)
                 for (int fj = 0; fj < n; ++fj)
-                  d[static_cast<std::size_t>(c * n + fj) * bs + c * n + fi] +=
-                      cM * me[fj * n + fi];
+                  d[static_cast<std::size_t>(c * n + fj) * bs + c * n + fi] += cM * me[fj * n + fi];
             const auto& nb = parts.jumps.neighbours[i];
             const auto firstGreater =
                 std::upper_bound(nb.begin(), nb.end(), static_cast<std::uint32_t>(i));
@@ -560,8 +553,8 @@ struct DynamicSolver::Impl {
     const bool bdf2 = options.integrator == TimeIntegrator::Bdf2 && hasPrevious;
     const double c = bdf2 ? 2.0 * dt / 3.0 : dt;
     const double cM = newmark ? 1.0 + kNewmarkGamma * dt * alpha : 1.0 + c * alpha;
-    const double cK = newmark ? kNewmarkGamma * dt * beta + kNewmarkBeta * dt * dt
-                              : c * beta + c * c;
+    const double cK =
+        newmark ? kNewmarkGamma * dt * beta + kNewmarkBeta * dt * dt : c * beta + c * c;
     // A new matrix with new rotations, and when BDF2's coefficients replace its first step's.
     const bool newMatrix = !assembled || options.corotational || cK != lastCK;
     lastCK = cK;
@@ -744,7 +737,8 @@ struct DynamicSolver::Impl {
               const double* g = gradients.data() + i * 3 * n;
               for (int d = 0; d < 3; ++d)
                 for (int k = 0; k < 3; ++k)
-                  for (int fn = 0; fn < n; ++fn) f(d, k) += g[k * n + fn] * u[static_cast<Eigen::Index>(i * bs + d * n + fn)];
+                  for (int fn = 0; fn < n; ++fn)
+                    f(d, k) += g[k * n + fn] * u[static_cast<Eigen::Index>(i * bs + d * n + fn)];
               sum += f.determinant() * moments->volume(e);
               continue;
             }
@@ -828,7 +822,8 @@ std::vector<double> DynamicSolver::vonMises() const {
       for (int k = 0; k < 3; ++k)
         for (int fn = 0; fn < m.n; ++fn)
           f(d, k) += g[k * m.n + fn] * m.u[static_cast<Eigen::Index>(i * m.bs + d * m.n + fn)];
-    const Eigen::Matrix3d local = m.options.corotational ? Eigen::Matrix3d(polarRotation(f).transpose() * f) : f;
+    const Eigen::Matrix3d local =
+        m.options.corotational ? Eigen::Matrix3d(polarRotation(f).transpose() * f) : f;
     const Eigen::Matrix3d eps = 0.5 * (local + local.transpose()) - Eigen::Matrix3d::Identity();
     const Eigen::Matrix3d sigma = 2 * mu * eps + lambda * eps.trace() * Eigen::Matrix3d::Identity();
     const Eigen::Matrix3d dev = sigma - sigma.trace() / 3.0 * Eigen::Matrix3d::Identity();

@@ -189,8 +189,7 @@ struct Kernel {
       out.setZero(3 * N, 3 * N);
       if (jump) {
         const Mat m = sk.p.lazyProduct(cb);
-        for (int d = 0; d < 3; ++d)
-          out.template block<N, N>(d * N, d * N) += (mu * etaF * sb) * m;
+        for (int d = 0; d < 3; ++d) out.template block<N, N>(d * N, d * N) += (mu * etaF * sb) * m;
       }
       if (!ip) return;
       Mat wk[3], vk[3];  // wk: int phi^K_i d_k phi^B_j; vk: int d_k phi^K_i phi^B_j

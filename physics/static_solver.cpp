@@ -52,7 +52,8 @@ FormCoefficients formCoefficients(const PolyMesh& mesh, const DgBasis& basis,
   form.mu = material.mu();
   form.lambda = material.lambda();
   elementEta = elementPenaltyThresholds(mesh, basis, moments, roles);
-  threshold = elementEta.size() == 0 ? 0.0 : *std::max_element(elementEta.begin(), elementEta.end());
+  threshold =
+      elementEta.size() == 0 ? 0.0 : *std::max_element(elementEta.begin(), elementEta.end());
   switch (disc.penalty.rule) {
     case PenaltyRule::TraceBound:
       form.eta = disc.penalty.safety * threshold;

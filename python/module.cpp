@@ -175,8 +175,9 @@ Scene sceneOf(const py::handle& scene) {
   try {
     document = jsonOf(scene);
   } catch (const nlohmann::json::parse_error&) {  // json.dumps wrote NaN or Infinity
-    throw InputError("scene: holds a number that is not finite (NaN or infinity); see the scene "
-                     "format in README.md");
+    throw InputError(
+        "scene: holds a number that is not finite (NaN or infinity); see the scene "
+        "format in README.md");
   }
   return parseScene(document, "scene");
 }

@@ -288,8 +288,8 @@ TEST_F(Cli, SimulateRunsTheExampleSceneAndWritesATimeSeries) {
             0);
   const std::string before = fileText(path("beam.vtu"));
   const std::string scene = std::string(POLYDG_SOURCE_DIR) + "/examples/scenes/beam_cut.json";
-  const Result r = run("simulate " + path("beam.vtu") + " --scene " + scene + " -o " +
-                       path("out") + " --report " + path("r.json"));
+  const Result r = run("simulate " + path("beam.vtu") + " --scene " + scene + " -o " + path("out") +
+                       " --report " + path("r.json"));
   ASSERT_EQ(r.exitCode, 0) << r.out;
   EXPECT_NE(r.out.find("wrote"), std::string::npos) << r.out;
   EXPECT_EQ(fileText(path("beam.vtu")), before);  // the input is never touched
@@ -304,8 +304,8 @@ TEST_F(Cli, SimulateRunsTheExampleSceneAndWritesATimeSeries) {
   for (const char* phase : {"rotation", "assembly", "solve", "cut", "output", "setup"})
     EXPECT_TRUE(j["timings_s"].contains(phase)) << phase;
 
-  const Result quiet = run("-q simulate " + path("beam.vtu") + " --scene " + scene + " -o " +
-                           path("out2"));
+  const Result quiet =
+      run("-q simulate " + path("beam.vtu") + " --scene " + scene + " -o " + path("out2"));
   EXPECT_EQ(quiet.exitCode, 0) << quiet.out;
   EXPECT_EQ(quiet.out, "");
 }
@@ -316,20 +316,20 @@ TEST_F(Cli, SimulateRefusesABadSceneBeforeRunning) {
   std::ofstream(path("bad.json"))
       << R"({"material": {"E": 1000, "nu": 0.3, "density": 1}, "dt": 0.1, "steps": 5,
             "fixed": [{"plane": [1, 0, 0, 0]}], "cuts": [{"time": 0.2, "plnae": [1, 0, 0, 5]}]})";
-  const Result r = run("simulate " + path("beam.vtu") + " --scene " + path("bad.json") + " -o " +
-                       path("out"));
+  const Result r =
+      run("simulate " + path("beam.vtu") + " --scene " + path("bad.json") + " -o " + path("out"));
   expectOneLineError(r, "cuts[0]: a cut needs exactly one of");
   EXPECT_FALSE(fs::exists(dir_ / "out"));  // nothing ran
 
   std::ofstream(path("away.json"))
       << R"({"material": {"E": 1000, "nu": 0.3, "density": 1}, "dt": 0.1, "steps": 5,
             "fixed": [{"below": [1, 0, 0, -1]}]})";
-  expectOneLineError(run("simulate " + path("beam.vtu") + " --scene " + path("away.json") +
-                         " -o " + path("out")),
-                     "selects no boundary face");
-  expectOneLineError(run("simulate " + data("beam.obj") + " --scene " + path("away.json") +
-                         " -o " + path("out")),
-                     "simulate reads simulation meshes (.vtu)");
+  expectOneLineError(
+      run("simulate " + path("beam.vtu") + " --scene " + path("away.json") + " -o " + path("out")),
+      "selects no boundary face");
+  expectOneLineError(
+      run("simulate " + data("beam.obj") + " --scene " + path("away.json") + " -o " + path("out")),
+      "simulate reads simulation meshes (.vtu)");
 }
 
 }  // namespace

@@ -99,7 +99,8 @@ TEST(Cut, LineageNamesEachElementsSources) {
         if (covered[e] == 0.0 || inMerged[e]) continue;  // removed, or merged with a sliver
         // A source wholly on the kept side is covered completely.
         // (The normal's components are positive: the box's max corner is its highest point.)
-        const bool crossed = plane.normal.dot(elementBounds(before, ElementId(e)).max()) > plane.offset;
+        const bool crossed =
+            plane.normal.dot(elementBounds(before, ElementId(e)).max()) > plane.offset;
         if (!crossed || removeSide == 0) {
           EXPECT_NEAR(covered[e], oldVolumes[e], 1e-12) << "element " << e;
         }

@@ -111,7 +111,7 @@ TEST_F(PipelineTest, ErrorsNameTheFileAndThePlace) {
     return "accepted";
   };
   EXPECT_EQ(refused(R"({"steps": [{"step": "cut", "plnae": [0, 0, 1, 0]}]})").substr(0, 32),
-            "p.json: steps[0]: a cut step nee");
+            "p.json: steps[0]: a cut needs ex");
   EXPECT_NE(
       refused(R"({"steps": [{"step": "check", "degre": 2}]})").find("steps[0].degre: unknown key"),
       std::string::npos);

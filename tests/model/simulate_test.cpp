@@ -10,9 +10,9 @@
 
 #include "polydg/mesh/surface_io.h"
 #include "polydg/mesh/surface_shapes.h"
-#include "polydg/physics/dynamics.h"
 #include "polydg/model/report_json.h"
 #include "polydg/model/scene.h"
+#include "polydg/physics/dynamics.h"
 #include "polydg/util/error.h"
 
 namespace polydg {
@@ -189,9 +189,9 @@ TEST(Simulate, ScenesAreReadStrictly) {
        "cuts[0].time: after the end of the simulation"},
       {"{" + base + R"(, "steps": 3, "cuts": [{"time": 0.1, "plane": [0, 0, 0, 1]}]})",
        "cuts[0].plane"},
-      {"{" + base + R"(, "steps": 3, "initial": {"spin": [0, 0, 1]}})", "initial.spin: unknown key"},
-      {R"({"material": {"E": -1, "nu": 0.3, "density": 1}, "dt": 0.1, "steps": 1})",
-       "material.E"},
+      {"{" + base + R"(, "steps": 3, "initial": {"spin": [0, 0, 1]}})",
+       "initial.spin: unknown key"},
+      {R"({"material": {"E": -1, "nu": 0.3, "density": 1}, "dt": 0.1, "steps": 1})", "material.E"},
       {R"({"dt": 0.1, "steps": 1})", "material: missing"},
   };
   for (const auto& [scene, message] : bad) {
@@ -215,7 +215,8 @@ TEST(Simulate, SelectionsThatPickNothingAreRefusedBeforeAnyStep) {
 }
 
 TEST(Simulate, WritesAParaViewTimeSeries) {
-  const fs::path dir = fs::temp_directory_path() / ("polydg_simulate_" + std::to_string(::getpid()));
+  const fs::path dir =
+      fs::temp_directory_path() / ("polydg_simulate_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   Model model = beam();
   json scene = b10Scene(1.5);
@@ -302,9 +303,9 @@ TEST(Simulate, TorusRotatedRigidlyHasNoCorotatedForceAndKeepsItsVolumeSpinning) 
     const double bound = integrator == TimeIntegrator::Newmark ? 1e-3 : 2 * dtOmega * dtOmega;
     EXPECT_LT(change[1], bound) << "linear " << change[0];
     EXPECT_GT(change[0], 1.0);
-    RecordProperty(integrator == TimeIntegrator::Newmark ? "newmark_volume_change"
-                                                         : "euler_volume_change",
-                   std::to_string(change[1]));
+    RecordProperty(
+        integrator == TimeIntegrator::Newmark ? "newmark_volume_change" : "euler_volume_change",
+        std::to_string(change[1]));
   }
 }
 

@@ -72,7 +72,8 @@ TEST(Dynamics, RigidRotationHasNoCorotatedElasticForce) {
       DynamicSolver solver(mesh, moments, {},
                            options(p, corotational, TimeIntegrator::BackwardEuler, 0.01));
       const Vec3 c(0.5, 0.5, 0.5);
-      const Eigen::VectorXd u = solver.affineField(r - Eigen::Matrix3d::Identity(), Vec3::Zero(), c);
+      const Eigen::VectorXd u =
+          solver.affineField(r - Eigen::Matrix3d::Identity(), Vec3::Zero(), c);
       solver.setState(0.0, u, Eigen::VectorXd::Zero(u.size()));
       forces[corotational] = solver.elasticForce().norm();
       if (corotational) {
@@ -182,30 +183,31 @@ TEST(Dynamics, CantileverPeriodMatchesItsEigenproblemAndEulerBernoulli) {
   EXPECT_NEAR(discretePeriod, 19.58, 0.03 * 19.58);
 
   for (TimeIntegrator integrator : {TimeIntegrator::Newmark, TimeIntegrator::Bdf2}) {
-  DynamicSolver solver(beam.mesh, beam.moments, {{FaceSelector::inPlane(0, 0.0)}, {}, Vec3::Zero()},
-                       options(p, false, integrator, discretePeriod / 200));
-  solver.setState(0.0, u0, Eigen::VectorXd::Zero(u0.size()));
-  const BodyState s0 = solver.state();
-  const double e0 = s0.kinetic + s0.elastic;
-  std::vector<double> crossings;
-  double previous = tipDeflection(beam.mesh, solver.basis(), u0), worst = 0.0;
-  for (int k = 0; k < 2000; ++k) {
-    const double t0 = solver.time();
-    solver.step();
-    const double z = tipDeflection(beam.mesh, solver.basis(), solver.displacement());
-    if ((previous < 0) != (z < 0))
-      crossings.push_back(t0 + solver.options().dt * previous / (previous - z));
-    previous = z;
-    const BodyState s = solver.state();
-    worst = std::max(worst, std::abs(s.kinetic + s.elastic - e0) / e0);
-  }
-  ASSERT_GE(crossings.size(), 19u);
-  const double period = 2 * (crossings.back() - crossings.front()) / (crossings.size() - 1);
-  EXPECT_NEAR(period, discretePeriod, 0.01 * discretePeriod);
-  EXPECT_NEAR(period, 19.58, 0.03 * 19.58);
-  // Undamped, Newmark's energy stays within 1% over 10 periods; BDF2 dissipates the higher
-  // modes of the initial shape, (omega dt)^4 per step (2.5% of the energy here).
-  EXPECT_LT(worst, integrator == TimeIntegrator::Newmark ? 0.01 : 0.05);
+    DynamicSolver solver(beam.mesh, beam.moments,
+                         {{FaceSelector::inPlane(0, 0.0)}, {}, Vec3::Zero()},
+                         options(p, false, integrator, discretePeriod / 200));
+    solver.setState(0.0, u0, Eigen::VectorXd::Zero(u0.size()));
+    const BodyState s0 = solver.state();
+    const double e0 = s0.kinetic + s0.elastic;
+    std::vector<double> crossings;
+    double previous = tipDeflection(beam.mesh, solver.basis(), u0), worst = 0.0;
+    for (int k = 0; k < 2000; ++k) {
+      const double t0 = solver.time();
+      solver.step();
+      const double z = tipDeflection(beam.mesh, solver.basis(), solver.displacement());
+      if ((previous < 0) != (z < 0))
+        crossings.push_back(t0 + solver.options().dt * previous / (previous - z));
+      previous = z;
+      const BodyState s = solver.state();
+      worst = std::max(worst, std::abs(s.kinetic + s.elastic - e0) / e0);
+    }
+    ASSERT_GE(crossings.size(), 19u);
+    const double period = 2 * (crossings.back() - crossings.front()) / (crossings.size() - 1);
+    EXPECT_NEAR(period, discretePeriod, 0.01 * discretePeriod);
+    EXPECT_NEAR(period, 19.58, 0.03 * 19.58);
+    // Undamped, Newmark's energy stays within 1% over 10 periods; BDF2 dissipates the higher
+    // modes of the initial shape, (omega dt)^4 per step (2.5% of the energy here).
+    EXPECT_LT(worst, integrator == TimeIntegrator::Newmark ? 0.01 : 0.05);
   }
 }
 
@@ -248,8 +250,8 @@ TEST(Dynamics, DampedMotionSettlesToTheStaticSolution) {
       solveStatic(beam.mesh, {1000.0, 0.3, 1.0}, loads, so, &beam.moments).coefficients;
   DynamicsOptions o = options(1, false, TimeIntegrator::BackwardEuler, 5.0);
   o.massDamping = 1.0;
-  DynamicSolver solver(beam.mesh, beam.moments, {{FaceSelector::inPlane(0, 0.0)}, {}, Vec3(0, 0, -1)},
-                       o);
+  DynamicSolver solver(beam.mesh, beam.moments,
+                       {{FaceSelector::inPlane(0, 0.0)}, {}, Vec3(0, 0, -1)}, o);
   double error = 1.0;
   for (int k = 0; k < 300 && error > 1e-7; ++k) {
     solver.step();
@@ -261,7 +263,8 @@ TEST(Dynamics, DampedMotionSettlesToTheStaticSolution) {
 TEST(Dynamics, FreeFallAcceleratesWithGravityExactly) {
   // No clamp: the centre of mass follows g t^2 / 2 (both integrators are exact for constant
   // acceleration of the centre of mass), the body stays undeformed.
-  const PolyMesh mesh = hexGridMesh(2, 2, 2, Box3(Vec3(1e5, 1e5, 1e5), Vec3(1e5 + 1, 1e5 + 1, 1e5 + 1)));
+  const PolyMesh mesh =
+      hexGridMesh(2, 2, 2, Box3(Vec3(1e5, 1e5, 1e5), Vec3(1e5 + 1, 1e5 + 1, 1e5 + 1)));
   MomentCache moments(mesh, 2);
   moments.update();
   for (TimeIntegrator integrator : {TimeIntegrator::BackwardEuler, TimeIntegrator::Newmark}) {
@@ -298,7 +301,8 @@ TEST(Dynamics, ConjugateGradientStepsAgreeWithCholeskyAndSwitchPreconditioner) {
       if (kind == SolverKind::Cholesky) continue;
       EXPECT_EQ(steps[0].preconditioner, CgPreconditioner::BlockJacobi);
       if (dt < 0.1) {
-        for (const StepReport& r : steps) EXPECT_EQ(r.preconditioner, CgPreconditioner::BlockJacobi);
+        for (const StepReport& r : steps)
+          EXPECT_EQ(r.preconditioner, CgPreconditioner::BlockJacobi);
       } else {
         EXPECT_GT(steps[0].iterations, 80);
         EXPECT_EQ(steps[1].preconditioner, CgPreconditioner::PMultigrid);

@@ -32,12 +32,12 @@ struct Scene {
   int steps = 0;  ///< "steps", or "duration" / dt rounded to the nearest whole step
   Vec3 gravity = Vec3::Zero();
   double massDamping = 0.0, stiffnessDamping = 0.0;
-  std::vector<FaceSelector> fixed;     ///< regions held at u = 0; none: a free body
-  std::vector<TimedTraction> loads;    ///< tractions, each until its time
-  Vec3 velocity = Vec3::Zero();        ///< initial linear velocity
+  std::vector<FaceSelector> fixed;      ///< regions held at u = 0; none: a free body
+  std::vector<TimedTraction> loads;     ///< tractions, each until its time
+  Vec3 velocity = Vec3::Zero();         ///< initial linear velocity
   Vec3 angularVelocity = Vec3::Zero();  ///< initial, about the centre of mass
-  int outputEvery = 1;                 ///< a frame every this many steps (and the last)
-  std::vector<TimedCut> cuts;          ///< in time order
+  int outputEvery = 1;                  ///< a frame every this many steps (and the last)
+  std::vector<TimedCut> cuts;           ///< in time order
   SolverKind solver = SolverKind::Auto;
 };
 

@@ -99,17 +99,17 @@ struct DynamicsOptions {
 
 /// One time step. Times are wall seconds.
 struct StepReport {
-  double t = 0.0;                  ///< time at the step's end
-  int iterations = 0;              ///< CG iterations of all solves (0 with Cholesky)
-  int solves = 1;                  ///< linear solves (corotation's corrections)
-  double correction = 0.0;         ///< relative size of the last correction (0 if none)
-  double residual = 0.0;           ///< relative residual of the step's solve
-  bool refactorized = false;       ///< Cholesky: the matrix was factorized (numerically) again
+  double t = 0.0;                      ///< time at the step's end
+  int iterations = 0;                  ///< CG iterations of all solves (0 with Cholesky)
+  int solves = 1;                      ///< linear solves (corotation's corrections)
+  double correction = 0.0;             ///< relative size of the last correction (0 if none)
+  double residual = 0.0;               ///< relative residual of the step's solve
+  bool refactorized = false;           ///< Cholesky: the matrix was factorized (numerically) again
   bool preconditionerRebuilt = false;  ///< CG: the preconditioner was rebuilt for this step
   CgPreconditioner preconditioner = CgPreconditioner::BlockJacobi;  ///< CG: the one used
-  double rotationSeconds = 0.0;    ///< polar decompositions
-  double assemblySeconds = 0.0;    ///< warping the blocks, the system matrix, the forces
-  double solveSeconds = 0.0;       ///< factorization or preconditioner, and the solve
+  double rotationSeconds = 0.0;                                     ///< polar decompositions
+  double assemblySeconds = 0.0;  ///< warping the blocks, the system matrix, the forces
+  double solveSeconds = 0.0;     ///< factorization or preconditioner, and the solve
 };
 
 /// Energies and momenta of the current state. Energies are relative to the undeformed body at
