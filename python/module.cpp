@@ -125,15 +125,6 @@ TriangleSurface surfaceFromArrays(const py::array_t<double, py::array::c_style>&
   return s;
 }
 
-/// A progress callback called with the GIL held, or none.
-ProgressFn progressFn(const py::object& callback) {
-  if (callback.is_none()) return {};
-  return [callback](double fraction) {
-    py::gil_scoped_acquire gil;
-    callback(fraction);
-  };
-}
-
 /// Thrown through the library when a Python callback raised. Not a std::exception, so no
 /// handler in the library converts or swallows it on the way out.
 struct CallbackRaised {};
@@ -151,6 +142,7 @@ class GuardedCallback {
   template <class... Args>
   void operator()(Args&&... args) {
     py::gil_scoped_acquire gil;
+    if (raised_) throw CallbackRaised{};  // once stopped, never called again (other threads)
     try {
       if (!callable_.is_none()) callable_(std::forward<Args>(args)...);
       if (PyErr_CheckSignals() != 0) throw py::error_already_set();
@@ -418,12 +410,17 @@ PYBIND11_MODULE(_polydg, m) {
       [](const TriangleSurface& surface, const py::dict& kwargs, const std::string& source,
          const py::object& progress) {
         MeshStep step = parseStep<MeshStep>("mesh", "polydg.mesh()", kwargs);
-        step.options.progress = progressFn(progress);
+        // Guarded: an exception from the callback is re-raised as itself, whatever handlers
+        // the slicing has on the way out (and Ctrl-C stops the slicing).
+        GuardedCallback callback(progress);
+        step.options.progress = [&callback](double fraction) { callback(fraction); };
         MeshReport report;
         std::optional<Model> model;
-        {
+        try {
           py::gil_scoped_release release;
           model.emplace(Model::fromSurface(surface, step.options, report, source));
+        } catch (const CallbackRaised&) {
+          callback.reraise();
         }
         if (!report.passed())
           throw CheckFailure("the new mesh failed: " + report.failures().front());

@@ -124,6 +124,21 @@ def test_progress_is_reported():
     assert seen and 0.0 <= min(seen) and max(seen) <= 1.0 and seen == sorted(seen)
 
 
+def test_a_progress_callback_that_raises_stops_the_meshing_with_its_own_exception():
+    class Stop(Exception):
+        pass
+
+    calls = []
+
+    def stop(fraction):
+        calls.append(fraction)
+        raise Stop(f"stopped at {fraction}")
+
+    with pytest.raises(Stop, match="stopped at"):
+        polydg.mesh(polydg.read_surface(TORUS), cells=16, progress=stop)
+    assert len(calls) == 1  # the first call stopped it
+
+
 def test_faces_and_solution_arrays():
     model = polydg.mesh(polydg.read_surface(TORUS), cells=8)
     faces = model.faces
