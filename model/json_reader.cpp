@@ -1,6 +1,7 @@
 #include "polydg/model/json_reader.h"
 
 #include <cmath>
+#include <fstream>
 #include <sstream>
 
 namespace polydg {
@@ -123,6 +124,22 @@ JsonObjectReader JsonObjectReader::element(const json& list, const std::string& 
 void JsonObjectReader::finish() const {
   for (const auto& [key, value] : object_.items())
     if (!known_.count(key)) fail(at(key), "unknown key");
+}
+
+const json& JsonObjectReader::list(const std::string& key, const std::string& expected) {
+  const json& v = get(key);
+  if (!v.is_array()) fail(at(key), expected);
+  return v;
+}
+
+json readJsonDocument(const std::string& file, const std::string& what) {
+  std::ifstream in(file);
+  if (!in) throw InputError(file + ": cannot open the " + what + " file");
+  try {
+    return json::parse(in);
+  } catch (const json::parse_error& e) {
+    throw InputError(file + ": not valid JSON (" + std::string(e.what()) + ")");
+  }
 }
 
 }  // namespace polydg

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <fstream>
 #include <iomanip>
 #include <mutex>
 #include <set>
@@ -52,8 +51,7 @@ CutRequest readCutRequest(JsonObjectReader& r) {
       const auto v = r.numbers(r.get("plane"), r.at("plane"), 4);
       s.request.blade = Blade::plane(Vec3(v[0], v[1], v[2]), v[3]);
     } else {
-      const json& corners = r.get("polygon");
-      if (!corners.is_array()) r.fail(r.at("polygon"), "expected a list of [x, y, z] corners");
+      const json& corners = r.list("polygon", "expected a list of [x, y, z] corners");
       std::vector<Vec3> points;
       for (std::size_t k = 0; k < corners.size(); ++k)
         points.push_back(r.vec3(corners[k], r.at("polygon") + "[" + std::to_string(k) + "]"));
@@ -132,8 +130,7 @@ SolveStep solveStep(JsonObjectReader& r) {
   if (r.has("gravity")) o.gravity = r.vec3(r.get("gravity"), r.at("gravity"));
   for (const char* key : {"clamp", "traction"}) {
     if (!r.has(key)) continue;
-    const json& list = r.get(key);
-    if (!list.is_array()) r.fail(r.at(key), "expected a list of objects");
+    const json& list = r.list(key, "expected a list of objects");
     for (std::size_t k = 0; k < list.size(); ++k) {
       JsonObjectReader item = r.element(list, r.at(key), k);
       const FaceSelector where = item.selection();
@@ -176,8 +173,7 @@ Pipeline parsePipeline(const json& document, const std::string& file, const fs::
   p.file = file;
   if (r.has("description")) p.description = r.string("description");
   if (r.has("inputs")) {
-    const json& inputs = r.get("inputs");
-    if (!inputs.is_array()) r.fail(r.at("inputs"), "expected a list of file names");
+    const json& inputs = r.list("inputs", "expected a list of file names");
     for (std::size_t k = 0; k < inputs.size(); ++k) {
       if (!inputs[k].is_string() || inputs[k].get<std::string>().empty())
         r.fail(r.at("inputs") + "[" + std::to_string(k) + "]", "expected a file name");
@@ -209,15 +205,7 @@ PipelineStep parsePipelineStep(const json& step, const std::string& caller,
 }
 
 Pipeline readPipeline(const std::string& file) {
-  std::ifstream in(file);
-  if (!in) throw InputError(file + ": cannot open the pipeline file");
-  json document;
-  try {
-    document = json::parse(in);
-  } catch (const json::parse_error& e) {
-    throw InputError(file + ": not valid JSON (" + std::string(e.what()) + ")");
-  }
-  return parsePipeline(document, file, fs::path(file).parent_path());
+  return parsePipeline(readJsonDocument(file, "pipeline"), file, fs::path(file).parent_path());
 }
 
 // --- running one input ---------------------------------------------------------------------

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 
 #include "polydg/model/json_reader.h"
 #include "polydg/model/names.h"
@@ -62,8 +61,7 @@ Scene parseScene(const json& document, const std::string& file) {
     d.finish();
   }
   if (r.has("fixed")) {
-    const json& list = r.get("fixed");
-    if (!list.is_array()) r.fail("fixed", "expected a list of regions ([] for a free body)");
+    const json& list = r.list("fixed", "expected a list of regions ([] for a free body)");
     for (std::size_t k = 0; k < list.size(); ++k) {
       JsonObjectReader item = r.element(list, "fixed", k);
       s.fixed.push_back(item.selection());
@@ -71,8 +69,7 @@ Scene parseScene(const json& document, const std::string& file) {
     }
   }
   if (r.has("loads")) {
-    const json& list = r.get("loads");
-    if (!list.is_array()) r.fail("loads", "expected a list of tractions");
+    const json& list = r.list("loads", "expected a list of tractions");
     for (std::size_t k = 0; k < list.size(); ++k) {
       JsonObjectReader item = r.element(list, "loads", k);
       TimedTraction t;
@@ -99,8 +96,7 @@ Scene parseScene(const json& document, const std::string& file) {
   }
   const double end = s.steps * s.dt;
   if (r.has("cuts")) {
-    const json& list = r.get("cuts");
-    if (!list.is_array()) r.fail("cuts", "expected a list of cuts");
+    const json& list = r.list("cuts", "expected a list of cuts");
     for (std::size_t k = 0; k < list.size(); ++k) {
       JsonObjectReader item = r.element(list, "cuts", k);
       TimedCut c;
@@ -120,15 +116,7 @@ Scene parseScene(const json& document, const std::string& file) {
 }
 
 Scene readScene(const std::string& file) {
-  std::ifstream in(file);
-  if (!in) throw InputError(file + ": cannot open the scene file");
-  json document;
-  try {
-    document = json::parse(in);
-  } catch (const json::parse_error& e) {
-    throw InputError(file + ": not valid JSON (" + std::string(e.what()) + ")");
-  }
-  return parseScene(document, file);
+  return parseScene(readJsonDocument(file, "scene"), file);
 }
 
 }  // namespace polydg

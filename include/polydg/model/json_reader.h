@@ -1,4 +1,4 @@
-// Reading polydg's JSON documents (pipelines today, simulation scenes next) strictly: every key
+// Reading polydg's JSON documents (pipelines and simulation scenes) strictly: every key
 // is checked, values must have the expected type and range, and every error is one line naming
 // the file and the place ("pipeline.json: steps[1].plnae: unknown key; see ...").
 #pragma once
@@ -56,6 +56,9 @@ class JsonObjectReader {
   FaceSelector selection();
   /// A reader of the object under `key` (fails unless it is an object).
   JsonObjectReader object(const std::string& key);
+  /// The value of a required key that must be a JSON array (else fails with `expected`, e.g.
+  /// "expected a list of regions").
+  const nlohmann::json& list(const std::string& key, const std::string& expected);
   /// A reader of element i of the list `list` (named `place` in errors).
   JsonObjectReader element(const nlohmann::json& list, const std::string& place,
                            std::size_t i) const;
@@ -67,5 +70,9 @@ class JsonObjectReader {
   std::string place_, file_, hint_;
   std::set<std::string> known_;
 };
+
+/// The JSON document in `file` (a `what` file: "pipeline", "scene"). Throws InputError
+/// ("FILE: cannot open the WHAT file", "FILE: not valid JSON (...)").
+nlohmann::json readJsonDocument(const std::string& file, const std::string& what);
 
 }  // namespace polydg
