@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 
 #include <tbb/blocked_range.h>
@@ -262,52 +263,78 @@ struct DynamicSolver::Impl {
   }
 
   // --- per step ------------------------------------------------------------------------
+  /// Element i's mean deformation gradient I + (1/|K|) int_K grad u for the displacement `disp`.
+  Eigen::Matrix3d deformationGradient(std::size_t i, const Eigen::VectorXd& disp) const {
+    Eigen::Matrix3d f = Eigen::Matrix3d::Identity();
+    const double* g = gradients.data() + i * 3 * n;
+    const double* ue = disp.data() + i * bs;
+    for (int d = 0; d < 3; ++d)
+      for (int k = 0; k < 3; ++k) {
+        double sum = 0.0;
+        for (int fn = 0; fn < n; ++fn) sum += g[k * n + fn] * ue[d * n + fn];
+        f(d, k) += sum;
+      }
+    return f;
+  }
+
   std::vector<Eigen::Matrix3d> rotationsOf(const Eigen::VectorXd& disp) const {
     std::vector<Eigen::Matrix3d> r(ne, Eigen::Matrix3d::Identity());
     if (!options.corotational) return r;
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ne, 256),
                       [&](const tbb::blocked_range<std::size_t>& range) {
-                        for (std::size_t i = range.begin(); i != range.end(); ++i) {
-                          Eigen::Matrix3d f = Eigen::Matrix3d::Identity();
-                          const double* g = gradients.data() + i * 3 * n;
-                          const double* ue = disp.data() + i * bs;
-                          for (int d = 0; d < 3; ++d)
-                            for (int k = 0; k < 3; ++k) {
-                              double s = 0.0;
-                              for (int fn = 0; fn < n; ++fn) s += g[k * n + fn] * ue[d * n + fn];
-                              f(d, k) += s;
-                            }
-                          r[i] = polarRotation(f);
-                        }
+                        for (std::size_t i = range.begin(); i != range.end(); ++i)
+                          r[i] = polarRotation(deformationGradient(i, disp));
                       });
     return r;
   }
 
-  /// The parts of the block of row element i in `slot`: pointers, strides and the element
+  /// The rotations and the elastic force (with its energy) of the current displacement, kept
+  /// until it changes: the report's state() after a step and the next step share them.
+  struct ForceAtU {
+    std::vector<Eigen::Matrix3d> r;
+    Eigen::VectorXd f;
+    double energy = 0.0;
+    double rotationSeconds = 0.0, forceSeconds = 0.0;
+  };
+  mutable std::optional<ForceAtU> current;
+  const ForceAtU& forceAtU() const {
+    if (!current) {
+      ForceAtU c;
+      const Stopwatch tr;
+      c.r = rotationsOf(u);
+      c.rotationSeconds = tr.seconds();
+      const Stopwatch tf;
+      c.f = elasticForce(c.r, u, &c.energy);
+      c.forceSeconds = tf.seconds();
+      current = std::move(c);
+    }
+    return *current;
+  }
+
+  /// The parts of the block of row element i in `slot`: pointers, layouts and the element
   /// whose rotation warps it (-1: none).
   struct Part {
     const double* b;
-    std::size_t rs, cs;
+    bool columnMajor;  ///< else row-major (read transposed: the other layout)
     std::int64_t source;
   };
   int partsOf(std::size_t i, const RowSlot& s, Part out[3]) const {
     const std::size_t bb = static_cast<std::size_t>(bs) * bs;
-    const std::size_t ubs = static_cast<std::size_t>(bs);
     if (s.diagonal) {
-      out[0] = {parts.rowStrain.diagonal.data() + i * bb, 1, ubs, static_cast<std::int64_t>(i)};
-      out[1] = {parts.jumps.diagonal.data() + i * bb, 1, ubs, -1};
+      out[0] = {parts.rowStrain.diagonal.data() + i * bb, true, static_cast<std::int64_t>(i)};
+      out[1] = {parts.jumps.diagonal.data() + i * bb, true, -1};
       return 2;
     }
     const std::size_t off = s.block * bb;
     const auto self = static_cast<std::int64_t>(i), other = static_cast<std::int64_t>(s.other);
     if (!s.transposed) {  // row-major, stored by i
-      out[0] = {parts.rowStrain.coupling.data() + off, ubs, 1, self};
-      out[1] = {parts.columnStrain.coupling.data() + off, ubs, 1, other};
-      out[2] = {parts.jumps.coupling.data() + off, ubs, 1, -1};
+      out[0] = {parts.rowStrain.coupling.data() + off, false, self};
+      out[1] = {parts.columnStrain.coupling.data() + off, false, other};
+      out[2] = {parts.jumps.coupling.data() + off, false, -1};
     } else {  // stored by `other` as its rows: read transposed
-      out[0] = {parts.rowStrain.coupling.data() + off, 1, ubs, other};
-      out[1] = {parts.columnStrain.coupling.data() + off, 1, ubs, self};
-      out[2] = {parts.jumps.coupling.data() + off, 1, ubs, -1};
+      out[0] = {parts.rowStrain.coupling.data() + off, true, other};
+      out[1] = {parts.columnStrain.coupling.data() + off, true, self};
+      out[2] = {parts.jumps.coupling.data() + off, true, -1};
     }
     return 3;
   }
@@ -353,13 +380,14 @@ struct DynamicSolver::Impl {
               if (z && !difference) o -= Eigen::Map<const Vec>(z->data() + el * BS);
             };
             // Row i's block B against column element `col`, warped with element `source`'s
-            // rotation (-1: not warped); B column-major (rs == 1) or row-major.
-            auto apply = [&](const double* b, std::size_t rs, std::int64_t source, std::size_t col,
-                             bool rowDifference = false, bool columnDifference = false) {
+            // rotation (-1: not warped); B column-major or row-major.
+            auto apply = [&](const double* b, bool columnMajor, std::int64_t source,
+                             std::size_t col, bool rowDifference = false,
+                             bool columnDifference = false) {
               const bool warp = source >= 0 && options.corotational;
               const Eigen::Matrix3d* rot = warp ? &r[static_cast<std::size_t>(source)] : nullptr;
               side(rot, col, columnDifference, w);
-              if (rs == 1)
+              if (columnMajor)
                 y.noalias() = Eigen::Map<const Block>(b) * w;
               else
                 y.noalias() = Eigen::Map<const RowBlock>(b) * w;
@@ -375,20 +403,20 @@ struct DynamicSolver::Impl {
             };
             if (!bz) {  // the Dirichlet faces' strain terms
               const auto self = static_cast<std::int64_t>(i);
-              apply(parts.dirichletTrial.data() + i * bb, 1, self, i, true, false);
-              apply(parts.dirichletTest.data() + i * bb, 1, self, i, false, true);
+              apply(parts.dirichletTrial.data() + i * bb, true, self, i, true, false);
+              apply(parts.dirichletTest.data() + i * bb, true, self, i, false, true);
             }
             std::size_t neighbour = 0;
             for (std::size_t k = rowStart[i]; k < rowStart[i + 1]; ++k) {
               const RowSlot& s = slots[k];
               if (!s.diagonal && !bz)  // the neighbour's lifting terms in i's diagonal block
                 apply(parts.neighbourLifting.data() + (parts.neighbourStart[i] + neighbour++) * bb,
-                      1, s.other, i);
+                      true, s.other, i);
               Part ps[3];
               const int np = partsOf(i, s, ps);
               for (int q = 0; q < np; ++q) {
                 if (ps[q].source >= 0 && !s.diagonal && bz) continue;  // BZ: no coupling strain
-                apply(ps[q].b, ps[q].rs, ps[q].source, s.other);
+                apply(ps[q].b, ps[q].columnMajor, ps[q].source, s.other);
               }
             }
           }
@@ -495,8 +523,10 @@ struct DynamicSolver::Impl {
     return f;
   }
 
-  Eigen::VectorXd elasticForce(const std::vector<Eigen::Matrix3d>& r, double* energy) const {
-    const Eigen::VectorXd x = x0 + u;
+  /// f(disp) with the rotations `r` (and the form's energy if `energy`).
+  Eigen::VectorXd elasticForce(const std::vector<Eigen::Matrix3d>& r, const Eigen::VectorXd& disp,
+                               double* energy) const {
+    const Eigen::VectorXd x = x0 + disp;
     Eigen::VectorXd f;
     warpedProduct(r, x, &x0, f, energy);
     return f;
@@ -504,8 +534,8 @@ struct DynamicSolver::Impl {
 
   /// Newmark: A from M A = F - D V - f(U).
   void equilibriumAcceleration() {
-    const auto r = rotationsOf(u);
-    Eigen::VectorXd rhs = external(t) - elasticForce(r, nullptr);
+    const std::vector<Eigen::Matrix3d>& r = forceAtU().r;
+    Eigen::VectorXd rhs = external(t) - forceAtU().f;
     if (options.massDamping > 0.0 || options.stiffnessDamping > 0.0) {
       Eigen::VectorXd mv, kv;
       massProduct(v, mv);
@@ -544,9 +574,12 @@ struct DynamicSolver::Impl {
     StepReport rep;
     const double dt = options.dt, alpha = options.massDamping, beta = options.stiffnessDamping;
     const bool newmark = options.integrator == TimeIntegrator::Newmark;
-    const Stopwatch t0;
-    const std::vector<Eigen::Matrix3d> r = rotationsOf(u);
-    rep.rotationSeconds = t0.seconds();
+    // The rotations and f(U_n): computed here, unless state() already did after the last step;
+    // counted in this step's phases either way.
+    const ForceAtU& at = forceAtU();
+    const std::vector<Eigen::Matrix3d>& r = at.r;
+    rep.rotationSeconds = at.rotationSeconds;
+    rep.assemblySeconds = at.forceSeconds;
 
     const Stopwatch t1;
     // BDF2 needs one step behind it; its first step is backward Euler.
@@ -586,8 +619,8 @@ struct DynamicSolver::Impl {
       }
       forceScale = 1.0;
     }
-    Eigen::VectorXd rhs = base - forceScale * elasticForce(r, nullptr);
-    rep.assemblySeconds = t1.seconds();
+    Eigen::VectorXd rhs = base - forceScale * at.f;
+    rep.assemblySeconds += t1.seconds();
 
     const Stopwatch t2;
     if (switchToMultigrid) {  // block-Jacobi took too many iterations: the p-multigrid pays
@@ -647,9 +680,8 @@ struct DynamicSolver::Impl {
       const std::vector<Eigen::Matrix3d> rk = rotationsOf(uk);
       rep.rotationSeconds += tc.seconds();
       const Stopwatch tf;
-      Eigen::VectorXd fk, kd;
-      const Eigen::VectorXd xk = x0 + uk;
-      warpedProduct(rk, xk, &x0, fk, nullptr);
+      Eigen::VectorXd kd;
+      const Eigen::VectorXd fk = elasticForce(rk, uk, nullptr);
       warpedProduct(r, uk - u, nullptr, kd, nullptr);
       rhs = base - forceScale * (fk - kd);
       rep.assemblySeconds += tf.seconds();
@@ -678,6 +710,7 @@ struct DynamicSolver::Impl {
       hasPrevious = true;
     }
     u = std::move(uNew);
+    current.reset();  // r, and `at`, belong to the old displacement
     v = std::move(vNew);
     if (newmark) a = std::move(aNew);
     t = t1Time;
@@ -694,16 +727,14 @@ struct DynamicSolver::Impl {
 
   BodyState bodyState() const {
     BodyState s;
-    const auto r = rotationsOf(u);
-    elasticForce(r, &s.elastic);
+    s.elastic = forceAtU().energy;
     s.gravity = -gravityForce.dot(u);
     for (std::size_t k = 0; k < tractionForces.size(); ++k)
       if (t <= until[k] * (1.0 + 1e-12) + 1e-12 * options.dt)
         s.tractionPotential -= tractionForces[k].dot(u);
     const Eigen::VectorXd q = x0 + u;  // x - o + u
-    Eigen::VectorXd mv, mq;
+    Eigen::VectorXd mv;
     massProduct(v, mv);
-    massProduct(q, mq);
     s.kinetic = 0.5 * v.dot(mv);
     Vec3 first = Vec3::Zero();
     for (std::size_t i = 0; i < ne; ++i) {
@@ -733,13 +764,7 @@ struct DynamicSolver::Impl {
           for (std::size_t i = range.begin(); i != range.end(); ++i) {
             const ElementId e(i);
             if (p == 1) {  // constant gradient
-              Eigen::Matrix3d f = Eigen::Matrix3d::Identity();
-              const double* g = gradients.data() + i * 3 * n;
-              for (int d = 0; d < 3; ++d)
-                for (int k = 0; k < 3; ++k)
-                  for (int fn = 0; fn < n; ++fn)
-                    f(d, k) += g[k * n + fn] * u[static_cast<Eigen::Index>(i * bs + d * n + fn)];
-              sum += f.determinant() * moments->volume(e);
+              sum += deformationGradient(i, u).determinant() * moments->volume(e);
               continue;
             }
             for (const QuadraturePoint& qp : elementQuadrature(*mesh, e, 3 * (p - 1)))
@@ -784,6 +809,7 @@ void DynamicSolver::setState(double t, const Eigen::VectorXd& displacement,
     throw std::invalid_argument("DynamicSolver::setState: vectors of the wrong size");
   m.t = t;
   m.u = displacement;
+  m.current.reset();
   m.v = velocity;
   m.hasPrevious = false;  // BDF2 starts again with a backward Euler step
   m.hasGuessHistory = false;
@@ -793,9 +819,7 @@ void DynamicSolver::setState(double t, const Eigen::VectorXd& displacement,
 StepReport DynamicSolver::step() { return impl_->step(); }
 BodyState DynamicSolver::state() const { return impl_->bodyState(); }
 
-Eigen::VectorXd DynamicSolver::elasticForce() const {
-  return impl_->elasticForce(impl_->rotationsOf(impl_->u), nullptr);
-}
+Eigen::VectorXd DynamicSolver::elasticForce() const { return impl_->forceAtU().f; }
 Eigen::VectorXd DynamicSolver::externalForce(double t) const { return impl_->external(t); }
 double DynamicSolver::deformedVolume() const { return impl_->deformedVolume(); }
 
@@ -816,12 +840,7 @@ std::vector<double> DynamicSolver::vonMises() const {
   std::vector<double> out(m.ne);
   const double mu = m.options.material.mu(), lambda = m.options.material.lambda();
   tbb::parallel_for(std::size_t(0), m.ne, [&](std::size_t i) {
-    Eigen::Matrix3d f = Eigen::Matrix3d::Identity();
-    const double* g = m.gradients.data() + i * 3 * m.n;
-    for (int d = 0; d < 3; ++d)
-      for (int k = 0; k < 3; ++k)
-        for (int fn = 0; fn < m.n; ++fn)
-          f(d, k) += g[k * m.n + fn] * m.u[static_cast<Eigen::Index>(i * m.bs + d * m.n + fn)];
+    const Eigen::Matrix3d f = m.deformationGradient(i, m.u);
     const Eigen::Matrix3d local =
         m.options.corotational ? Eigen::Matrix3d(polarRotation(f).transpose() * f) : f;
     const Eigen::Matrix3d eps = 0.5 * (local + local.transpose()) - Eigen::Matrix3d::Identity();
@@ -832,8 +851,6 @@ std::vector<double> DynamicSolver::vonMises() const {
   return out;
 }
 
-std::vector<Eigen::Matrix3d> DynamicSolver::rotations() const {
-  return impl_->rotationsOf(impl_->u);
-}
+std::vector<Eigen::Matrix3d> DynamicSolver::rotations() const { return impl_->forceAtU().r; }
 
 }  // namespace polydg

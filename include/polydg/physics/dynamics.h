@@ -107,7 +107,9 @@ struct StepReport {
   bool refactorized = false;           ///< Cholesky: the matrix was factorized (numerically) again
   bool preconditionerRebuilt = false;  ///< CG: the preconditioner was rebuilt for this step
   CgPreconditioner preconditioner = CgPreconditioner::BlockJacobi;  ///< CG: the one used
-  double rotationSeconds = 0.0;                                     ///< polar decompositions
+  /// Polar decompositions. The rotations and the force of the step's start count here and in
+  /// assemblySeconds also when state() computed them after the last step.
+  double rotationSeconds = 0.0;
   double assemblySeconds = 0.0;  ///< warping the blocks, the system matrix, the forces
   double solveSeconds = 0.0;     ///< factorization or preconditioner, and the solve
 };
@@ -126,7 +128,9 @@ struct BodyState {
 };
 
 /// A moving elastic body on a fixed mesh. Holds the bases, the split element and face blocks,
-/// the mass, the load vectors and the solver; steps the state (U, V, A) in time.
+/// the mass, the load vectors and the solver; steps the state (U, V, A) in time. One thread at
+/// a time, const members included: the rotations and force of the current displacement are
+/// kept for the next step.
 class DynamicSolver {
  public:
   /// `mesh` and `moments` (up to date, degree >= 2p) must outlive the solver. Throws
