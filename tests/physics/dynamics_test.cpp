@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 #include <Eigen/Geometry>
 
+#include "cli/bench/problems.h"
 #include "polydg/mesh/primitives.h"
 #include "polydg/physics/dynamics.h"
 #include "polydg/physics/linear_solver.h"
@@ -123,18 +124,9 @@ TEST(Dynamics, SpinningCubeKeepsItsVolumeWithCorotation) {
   }
 }
 
-/// The mean u_z over the beam's end x = 10 (sampled at the end face's element centres).
+/// The mean u_z over the beam's end x = 10 (bench::meanBoundaryDisplacement).
 double tipDeflection(const PolyMesh& mesh, const DgBasis& basis, const Eigen::VectorXd& u) {
-  double sum = 0.0;
-  int count = 0;
-  for (std::size_t i = 0; i < mesh.numElements(); ++i) {
-    const ElementId e(i);
-    const Vec3 c = basis.centre(e);
-    if (c.x() < 9.7) continue;
-    sum += displacementAt(basis, u, e, Vec3(10.0, c.y(), c.z())).z();
-    ++count;
-  }
-  return sum / count;
+  return bench::meanBoundaryDisplacement(mesh, basis, u, FaceSelector::inPlane(0, 10.0), 2);
 }
 
 struct Beam {

@@ -24,6 +24,7 @@
 
 #include <gtest/gtest.h>
 
+#include "cli/bench/problems.h"
 #include "polydg/mesh/primitives.h"
 #include "polydg/physics/dynamics.h"
 #include "polydg/physics/post_process.h"
@@ -101,25 +102,12 @@ struct Cantilever {
   Cantilever() { moments.update(); }
 };
 
-/// The mean displacement of the end face x = L: 2 x 2 Gauss points on each end element's face
-/// (exact for the face mean of a quadratic).
+/// The mean displacement of the end face x = L (bench::meanBoundaryDisplacement: face
+/// quadrature exact for the basis degree).
 Tip tipDisplacement(const PolyMesh& mesh, const DgBasis& basis, const Eigen::VectorXd& u) {
-  const double g = 0.5 / std::sqrt(3.0), hx = kLength / Cantilever::kCells;
-  Vec3 sum = Vec3::Zero();
-  int count = 0;
-  for (std::size_t i = 0; i < mesh.numElements(); ++i) {
-    const ElementId e(i);
-    const Vec3 c = basis.centre(e);
-    if (c.x() < kLength - hx) continue;
-    for (double sy : {-g, g})
-      for (double sz : {-g, g}) {
-        sum += displacementAt(basis, u, e, Vec3(kLength, c.y() + sy * kSide, c.z() + sz * kSide));
-        ++count;
-      }
-  }
-  EXPECT_EQ(count, 4);
-  sum /= count;
-  return {-sum.z(), -sum.x()};
+  const FaceSelector end = FaceSelector::inPlane(0, kLength);
+  return {-bench::meanBoundaryDisplacement(mesh, basis, u, end, 2),
+          -bench::meanBoundaryDisplacement(mesh, basis, u, end, 0)};
 }
 
 struct Rest {
