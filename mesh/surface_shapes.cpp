@@ -90,6 +90,58 @@ TriangleSurface uvSphere(const Vec3& centre, double radius, int rings, int segme
   return s;
 }
 
+TriangleSurface bowlSurface(const Vec3& centre, double inner, double outer, int segments) {
+  if (!(0 < inner && inner < outer && std::isfinite(outer)))
+    throw std::invalid_argument("bowlSurface: the radii must satisfy 0 < inner < outer");
+  if (segments < 4) throw std::invalid_argument("bowlSurface: at least 4 segments");
+  const int rings = segments / 4;
+  TriangleSurface s;
+  // Per radius: the bottom pole, then rings 1..rings at polar angle (pi / 2) k / rings from it,
+  // the last one in the rim's plane z = centre.z exactly.
+  const auto hemisphere = [&](double r) {
+    const auto pole = static_cast<std::uint32_t>(s.vertices.size());
+    s.vertices.push_back(centre - Vec3(0, 0, r));
+    for (int k = 1; k <= rings; ++k) {
+      const double theta = 0.5 * kPi * k / rings;
+      const double rho = k == rings ? r : r * std::sin(theta);
+      const double z = k == rings ? 0.0 : -r * std::cos(theta);
+      for (int j = 0; j < segments; ++j) {
+        const double phi = 2 * kPi * j / segments;
+        s.vertices.push_back(centre + Vec3(rho * std::cos(phi), rho * std::sin(phi), z));
+      }
+    }
+    return pole;
+  };
+  const std::uint32_t outerPole = hemisphere(outer), innerPole = hemisphere(inner);
+  const auto id = [&](std::uint32_t pole, int ring, int j) {
+    return pole + 1 + static_cast<std::uint32_t>((ring - 1) * segments + (j % segments));
+  };
+  // Counter-clockwise seen from outside: the outer hemisphere from below and around, the inner
+  // one from the hollow (each of its triangles the outer's reversed), the rim from above.
+  for (int j = 0; j < segments; ++j) {
+    s.triangles.push_back({outerPole, id(outerPole, 1, j + 1), id(outerPole, 1, j)});
+    s.triangles.push_back({innerPole, id(innerPole, 1, j), id(innerPole, 1, j + 1)});
+  }
+  for (int k = 1; k < rings; ++k)
+    for (int j = 0; j < segments; ++j) {
+      const std::uint32_t a = id(outerPole, k, j), b = id(outerPole, k, j + 1),
+                          c = id(outerPole, k + 1, j + 1), d = id(outerPole, k + 1, j);
+      s.triangles.push_back({a, b, c});
+      s.triangles.push_back({a, c, d});
+      const std::uint32_t e = id(innerPole, k, j), f = id(innerPole, k, j + 1),
+                          g = id(innerPole, k + 1, j + 1), h = id(innerPole, k + 1, j);
+      s.triangles.push_back({e, g, f});
+      s.triangles.push_back({e, h, g});
+    }
+  for (int j = 0; j < segments; ++j) {
+    const std::uint32_t a = id(outerPole, rings, j), b = id(outerPole, rings, j + 1),
+                        c = id(innerPole, rings, j + 1), d = id(innerPole, rings, j);
+    s.triangles.push_back({a, b, c});
+    s.triangles.push_back({a, c, d});
+  }
+  return s;
+}
+
 TriangleSurface torus(const Vec3& centre, double R, double r, int nu, int nv) {
   TriangleSurface s;
   for (int i = 0; i < nu; ++i) {

@@ -104,6 +104,8 @@ struct DynamicSolver::Impl {
   ElementFrames frames;
   LocalMatrices system;
   SpMat matrix;
+  SpMat contactMatrix;  ///< matrix plus the step's contact terms
+  ContactModel* contact = nullptr;
   LinearSolver solver;
   bool assembled = false;
   int baselineIterations = -1, lastIterations = 0;
@@ -619,8 +621,29 @@ struct DynamicSolver::Impl {
       }
       forceScale = 1.0;
     }
-    Eigen::VectorXd rhs = base - forceScale * at.f;
     rep.assemblySeconds += t1.seconds();
+
+    // Contact (physics/contact.h): K_c and the friction damping C_t enter like K and D. With
+    // U_{n+1} = U0 + cU x and V_{n+1} = V0 + cV x (advance() of x = 0 gives U0, V0), the
+    // contact force f_c - K_c (U_{n+1} - U_n) - C_t V_{n+1} adds forceScale (cU K_c + cV C_t)
+    // to the matrix and forceScale (f_c - K_c (U0 - U_n) - C_t V0) to the right-hand side.
+    ContactLinearization contactTerms;
+    Eigen::VectorXd u0, v0;
+    double cU = 0.0, cV = 0.0;
+    if (contact) {
+      const Stopwatch tq;
+      contactTerms = contact->linearize(u, v, t1Time, dt);
+      const Eigen::VectorXd zero = Eigen::VectorXd::Zero(u.size());
+      u0 = advance(zero, bdf2, c, &v0, nullptr);
+      cU = newmark ? kNewmarkBeta * dt * dt : c;
+      cV = newmark ? kNewmarkGamma * dt : 1.0;
+      rep.assemblySeconds += tq.seconds();
+    }
+    auto contactRhs = [&]() {
+      Eigen::VectorXd add = contactTerms.force - contactTerms.stiffness * (u0 - u);
+      if (contactTerms.damping.nonZeros() > 0) add -= contactTerms.damping * v0;
+      return Eigen::VectorXd(forceScale * add);
+    };
 
     const Stopwatch t2;
     if (switchToMultigrid) {  // block-Jacobi took too many iterations: the p-multigrid pays
@@ -629,29 +652,49 @@ struct DynamicSolver::Impl {
       solverReady = false;
       switchToMultigrid = false;
     }
-    if (!solverReady) {
-      const bool direct = chooseSolver(matrix, activeSolver) == SolverKind::Cholesky;
-      if (!solver.compute(matrix, bs, direct ? nullptr : &frames) && direct)
+    // The solver for the matrix without contact terms: factorized, or updated.
+    auto prepare = [&]() {
+      if (!solverReady) {
+        const bool direct = chooseSolver(matrix, activeSolver) == SolverKind::Cholesky;
+        if (!solver.compute(matrix, bs, direct ? nullptr : &frames) && direct)
+          throw std::runtime_error(
+              "the time step's system matrix is not positive definite (a corotated element "
+              "turned inside out?)");
+        rep.refactorized = direct;
+        rep.preconditionerRebuilt = !direct;
+        assembled = true;
+        solverReady = true;
+        baselineIterations = -1;
+      } else if (newMatrix) {
+        const bool direct = solver.kind() == SolverKind::Cholesky;
+        const bool refresh =
+            !direct && baselineIterations >= 0 &&
+            lastIterations > options.refreshRatio * std::max(baselineIterations, 1);
+        if (!solver.update(matrix, refresh, &frames) && direct)
+          throw std::runtime_error(
+              "the time step's system matrix is not positive definite (a corotated element "
+              "turned inside out?)");
+        rep.refactorized = direct;
+        rep.preconditionerRebuilt = refresh;
+        if (refresh) baselineIterations = -1;
+      }
+    };
+    // With contacts: the matrix plus the contact terms, another pattern: factorized (or its
+    // preconditioner built) anew; the next step without contacts starts over as well.
+    auto prepareWithContact = [&]() {
+      contactMatrix = matrix + (forceScale * cU) * contactTerms.stiffness;
+      if (contactTerms.damping.nonZeros() > 0)
+        contactMatrix += (forceScale * cV) * contactTerms.damping;
+      const bool direct = chooseSolver(contactMatrix, activeSolver) == SolverKind::Cholesky;
+      if (!solver.compute(contactMatrix, bs, direct ? nullptr : &frames) && direct)
         throw std::runtime_error(
-            "the time step's system matrix is not positive definite (a corotated element "
-            "turned inside out?)");
+            "the time step's system matrix with contacts is not positive definite");
       rep.refactorized = direct;
       rep.preconditionerRebuilt = !direct;
       assembled = true;
-      solverReady = true;
+      solverReady = false;
       baselineIterations = -1;
-    } else if (newMatrix) {
-      const bool direct = solver.kind() == SolverKind::Cholesky;
-      const bool refresh = !direct && baselineIterations >= 0 &&
-                           lastIterations > options.refreshRatio * std::max(baselineIterations, 1);
-      if (!solver.update(matrix, refresh, &frames) && direct)
-        throw std::runtime_error(
-            "the time step's system matrix is not positive definite (a corotated element "
-            "turned inside out?)");
-      rep.refactorized = direct;
-      rep.preconditionerRebuilt = refresh;
-      if (refresh) baselineIterations = -1;
-    }
+    };
     auto solve = [&](const Eigen::VectorXd& b, const Eigen::VectorXd& guess) {
       LinearSolveReport lr;
       Eigen::VectorXd x = solver.solve(b, lr, &guess);
@@ -665,35 +708,63 @@ struct DynamicSolver::Impl {
     // Warm start: the unknown (Newmark: A, else V) extrapolated linearly from the last two
     // steps (the last step's alone after a start or a cut).
     const Eigen::VectorXd& last = newmark ? a : v;
-    Eigen::VectorXd x =
-        solve(rhs, hasGuessHistory ? Eigen::VectorXd(2.0 * last - previousUnknown) : last);
+    const Eigen::VectorXd firstGuess =
+        hasGuessHistory ? Eigen::VectorXd(2.0 * last - previousUnknown) : last;
+    const int maxSolves = corrections();
+    const int maxPasses = contact ? contact->options().maxPasses : 1;
+    const Eigen::VectorXd base0 = std::move(base);
+    rep.solves = 0;
+    double notSolving = 0.0;  // rotations and forces of the corrections, contact updates
+    Eigen::VectorXd x;
+    for (int pass = 1;; ++pass) {
+      rep.contacts = contactTerms.contacts;
+      rep.contactPasses = pass;
+      base = contactTerms.empty() ? base0 : Eigen::VectorXd(base0 + contactRhs());
+      Eigen::VectorXd rhs = base - forceScale * at.f;
+      if (contactTerms.empty())
+        prepare();
+      else
+        prepareWithContact();
+      x = solve(rhs, pass == 1 ? firstGuess : x);
+      ++rep.solves;
+      // Corotation: correct the once-linearized force (modified Newton with the step's matrix):
+      // f(U_{n+1}) ~ f(U^k) + K_w (U_{n+1} - U^k), U^k the last solution's state.
+      for (int k = 1; k < maxSolves; ++k) {
+        const Stopwatch tc;
+        const Eigen::VectorXd uk = advance(x, bdf2, c, nullptr, nullptr);
+        const std::vector<Eigen::Matrix3d> rk = rotationsOf(uk);
+        const double rotating = tc.seconds();
+        rep.rotationSeconds += rotating;
+        notSolving += rotating;
+        const Stopwatch tf;
+        Eigen::VectorXd kd;
+        const Eigen::VectorXd fk = elasticForce(rk, uk, nullptr);
+        warpedProduct(r, uk - u, nullptr, kd, nullptr);
+        rhs = base - forceScale * (fk - kd);
+        const double forcing = tf.seconds();
+        rep.assemblySeconds += forcing;
+        notSolving += forcing;
+        Eigen::VectorXd next = solve(rhs, x);
+        ++rep.solves;
+        const double change = (next - x).norm(), size = next.norm();
+        x = std::move(next);
+        rep.correction = size > 0.0 ? change / size : change;
+        if (options.corotationSolves <= 0 && rep.correction <= options.correctionTolerance) break;
+      }
+      // The active set: contacts that would pull leave, points that ended inside join.
+      if (!contact || pass >= maxPasses) break;
+      const Stopwatch tq;
+      const bool changed = contact->adjust(advance(x, bdf2, c, nullptr, nullptr));
+      if (changed) contactTerms = contact->relinearize();
+      const double adjusting = tq.seconds();
+      rep.assemblySeconds += adjusting;
+      notSolving += adjusting;
+      if (!changed) break;
+    }
     previousUnknown = last;
     hasGuessHistory = true;
-    rep.solveSeconds = t2.seconds();
-    // Corotation: correct the once-linearized force (modified Newton with the step's matrix):
-    // f(U_{n+1}) ~ f(U^k) + K_w (U_{n+1} - U^k), U^k the last solution's state.
-    const int maxSolves = corrections();
-    rep.solves = 1;
-    for (int k = 1; k < maxSolves; ++k) {
-      const Stopwatch tc;
-      const Eigen::VectorXd uk = advance(x, bdf2, c, nullptr, nullptr);
-      const std::vector<Eigen::Matrix3d> rk = rotationsOf(uk);
-      rep.rotationSeconds += tc.seconds();
-      const Stopwatch tf;
-      Eigen::VectorXd kd;
-      const Eigen::VectorXd fk = elasticForce(rk, uk, nullptr);
-      warpedProduct(r, uk - u, nullptr, kd, nullptr);
-      rhs = base - forceScale * (fk - kd);
-      rep.assemblySeconds += tf.seconds();
-      const Stopwatch ts;
-      Eigen::VectorXd next = solve(rhs, x);
-      rep.solveSeconds += ts.seconds();
-      ++rep.solves;
-      const double change = (next - x).norm(), size = next.norm();
-      x = std::move(next);
-      rep.correction = size > 0.0 ? change / size : change;
-      if (options.corotationSolves <= 0 && rep.correction <= options.correctionTolerance) break;
-    }
+    rep.solveSeconds = t2.seconds() - notSolving;
+    if (contact) rep.contactQuerySeconds = contact->takeQuerySeconds();
     lastIterations = rep.iterations;
     if (baselineIterations < 0) baselineIterations = rep.iterations;
     rep.preconditioner = activeSolver.preconditioner;
@@ -817,6 +888,10 @@ void DynamicSolver::setState(double t, const Eigen::VectorXd& displacement,
 }
 
 StepReport DynamicSolver::step() { return impl_->step(); }
+void DynamicSolver::setContact(ContactModel* contact) {
+  impl_->contact = contact;
+  impl_->solverReady = false;
+}
 BodyState DynamicSolver::state() const { return impl_->bodyState(); }
 
 Eigen::VectorXd DynamicSolver::elasticForce() const { return impl_->forceAtU().f; }

@@ -5,7 +5,8 @@ set -euo pipefail
 
 packages=(
   build-essential cmake ninja-build ccache pkg-config
-  libcgal-dev libeigen3-dev libpugixml-dev zlib1g-dev libopenvdb-dev libassimp-dev
+  libcgal-dev libeigen3-dev libpugixml-dev zlib1g-dev libassimp-dev
+  libopenvdb-dev libboost-iostreams-dev
   libsuitesparse-dev libopenblas0-pthread libopenblas-pthread-dev
   libtbb-dev libcli11-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev libspectra-dev clang-format

@@ -1,6 +1,6 @@
 // Closed triangle surfaces made in code, whose enclosed volume is known exactly from their
-// vertices: spheres, tori, torus knots, boxes, blocks with through-holes, and their combinations
-// (several shells, cavities). Used by tests, benchmarks and examples.
+// vertices: spheres, a bowl, tori, torus knots, boxes, blocks with through-holes, and their
+// combinations (several shells, cavities). Used by tests, benchmarks and examples.
 #pragma once
 
 #include <array>
@@ -17,6 +17,16 @@ TriangleSurface icosphere(const Vec3& centre, double radius, int levels);
 /// A latitude-longitude sphere with `rings` rings and `segments` segments (2 * segments *
 /// (rings - 1) triangles): sizes between the icosphere's powers of four.
 TriangleSurface uvSphere(const Vec3& centre, double radius, int rings, int segments);
+
+/// A hemispherical bowl: the solid shell between the spheres of radii `inner` < `outer` about
+/// `centre`, below the plane z = centre.z, where it ends in a flat annular rim. `segments`
+/// (>= 4) around the z axis and segments / 4 rings from each bottom pole up to the rim (the two
+/// hemispheres' vertices on the same rays): 4 segments rings triangles.
+/// Closed, outward-oriented (the inner hemisphere faces the bowl's hollow, the rim faces +z),
+/// edge- and vertex-manifold. Its enclosed volume approaches (2/3) pi (outer^3 - inner^3) from
+/// below as `segments` grows (the vertices are on the spheres). Throws std::invalid_argument for
+/// radii not 0 < inner < outer or fewer than 4 segments.
+TriangleSurface bowlSurface(const Vec3& centre, double inner, double outer, int segments);
 
 /// A torus about the z axis through `centre`: tube radius r around a circle of radius R, with
 /// `nu` segments around the axis and `nv` around the tube (2 nu nv triangles).

@@ -32,6 +32,7 @@
 
 #include <Eigen/Core>
 
+#include "polydg/physics/contact.h"
 #include "polydg/physics/loads.h"
 #include "polydg/physics/static_solver.h"
 
@@ -112,6 +113,12 @@ struct StepReport {
   double rotationSeconds = 0.0;
   double assemblySeconds = 0.0;  ///< warping the blocks, the system matrix, the forces
   double solveSeconds = 0.0;     ///< factorization or preconditioner, and the solve
+  /// Contact (setContact()): points in contact at the step's last pass, passes of the active
+  /// set (solves of the step's matrix, each with its corrections), and the seconds spent in
+  /// obstacle queries and point positions (also counted in assemblySeconds).
+  std::size_t contacts = 0;
+  int contactPasses = 0;
+  double contactQuerySeconds = 0.0;
 };
 
 /// Energies and momenta of the current state. Energies are relative to the undeformed body at
@@ -159,6 +166,10 @@ class DynamicSolver {
   /// Sets time, displacement and velocity (Newmark's acceleration then follows from the
   /// equation of motion). Throws std::invalid_argument for vectors of the wrong size.
   void setState(double t, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity);
+
+  /// Collisions for the following steps (physics/contact.h), or none (null). The model must
+  /// outlive its use and have this solver's DOF layout (make it again after a cut).
+  void setContact(ContactModel* contact);
 
   /// Advances one step of options().dt. Throws std::runtime_error if the step's system is not
   /// positive definite or CG does not converge.
