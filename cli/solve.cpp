@@ -5,12 +5,18 @@
 //   polydg solve beam.vtu -o beam_out.vtu --method ip --degree 2 --E 1000 --nu 0.3
 //       --clamp x=0 --traction x=10:0,0,-1 --report solve.json   (one line)
 //   polydg solve scan.vtu -o out.vtu --clamp-below 0,0,1,0.1 --gravity 0,0,-9.81
+//   polydg solve beam.vtu -o out.vtu --clamp x=0 --gravity 0,0,-1 --surface deformed.vtp
+//       (the surface the mesh was sliced from, carried by the MLS embedding; --embed FILE for
+//       another)
+#include <filesystem>
 #include <iostream>
 
 #include "cli/commands.h"
 #include "cli/options.h"
+#include "polydg/mesh/vtp_io.h"
 #include "polydg/model/files.h"
 #include "polydg/model/report_json.h"
+#include "polydg/util/stopwatch.h"
 
 namespace polydg::cli {
 
@@ -18,6 +24,7 @@ namespace {
 
 struct SolveCommandOptions {
   std::string input, output, report;
+  std::string surfaceOutput, embed;  ///< --surface, --embed
   SolveOptions solve = [] {
     SolveOptions s;
     s.degree = 2;  // the command's default (pipelines and the library default to 1)
@@ -32,6 +39,14 @@ void run(const SolveCommandOptions& o, const CommonOptions& common) {
   if (!isVolumeMeshPath(o.output)) throw InputError(o.output + ": the output must be a .vtu file");
   requireDistinct(o.output, o.input);
   if (!o.report.empty()) requireDistinct(o.report, o.input);
+  if (!o.embed.empty() && o.surfaceOutput.empty())
+    throw InputError("--embed names the surface --surface writes: add --surface OUT.vtp");
+  if (!o.surfaceOutput.empty()) {
+    if (std::filesystem::path(o.surfaceOutput).extension() != ".vtp")
+      throw InputError(o.surfaceOutput + ": the deformed surface is written as a .vtp file");
+    requireDistinct(o.surfaceOutput, o.input);
+    if (!o.embed.empty()) requireDistinct(o.surfaceOutput, o.embed);
+  }
   if (o.solve.clamps.empty())
     throw InputError(
         "nothing holds the body: add at least one --clamp, --clamp-plane, "
@@ -40,9 +55,40 @@ void run(const SolveCommandOptions& o, const CommonOptions& common) {
   Model model = Model::read(o.input, &read);
   const SolveReport r = model.solve(o.solve);
   const WriteReport written = model.write(o.output);
+  // The deformed embedded surface (physics/embedding.h), written atomically.
+  nlohmann::json surfaceJson;
+  if (!o.surfaceOutput.empty()) {
+    const Stopwatch watch;
+    const EmbeddedSurface e = model.embedSurface(o.embed, o.solve.degree);
+    const Eigen::Matrix<double, Eigen::Dynamic, 3> u =
+        e.embedding->displacements(model.solution()->coefficients);
+    std::vector<Vec3> deformed(e.surface.vertices.size());
+    std::vector<double> values(3 * deformed.size());
+    for (std::size_t p = 0; p < deformed.size(); ++p) {
+      deformed[p] = e.surface.vertices[p] + u.row(static_cast<Eigen::Index>(p)).transpose();
+      for (int k = 0; k < 3; ++k)
+        values[3 * p + static_cast<std::size_t>(k)] = u(static_cast<Eigen::Index>(p), k);
+    }
+    try {
+      writeVtp(o.surfaceOutput, deformed, e.surface.triangles,
+               {SurfacePointArray{"displacement", 3, values}});
+    } catch (const std::runtime_error& err) {
+      throw InputError(err.what());
+    }
+    surfaceJson = {{"surface", e.file},
+                   {"output", o.surfaceOutput},
+                   {"points", e.surface.vertices.size()},
+                   {"triangles", e.surface.triangles.size()},
+                   {"outside", e.embedding->outside()},
+                   {"weight_nonzeros", e.embedding->weightNonzeros()},
+                   {"max_displacement", u.rows() ? u.rowwise().norm().maxCoeff() : 0.0},
+                   {"setup_seconds", e.embedding->setupSeconds()},
+                   {"seconds", watch.seconds()}};
+  }
   if (!o.report.empty()) {
     nlohmann::json j{{"command", "solve"}, {"input", o.input}, {"output", o.output}};
     j.update(toJson(r));
+    j["embedded_surface"] = surfaceJson;
     j["timings_s"]["read"] = read.seconds;
     j["timings_s"]["write"] = written.seconds;
     writeJsonFile(o.report, j);
@@ -58,6 +104,11 @@ void run(const SolveCommandOptions& o, const CommonOptions& common) {
               << " s, solve " << s.solveSeconds << " s; max |u| " << r.maxDisplacement
               << ", energy " << s.energy << '\n'
               << "  wrote " << o.output << '\n';
+    if (!surfaceJson.is_null())
+      std::cout << "  wrote " << o.surfaceOutput << " (the deformed "
+                << surfaceJson["surface"].get<std::string>() << ", "
+                << surfaceJson["points"].get<std::size_t>() << " points, embedding "
+                << surfaceJson["setup_seconds"].get<double>() << " s)\n";
   }
 }
 
@@ -102,6 +153,11 @@ void addSolveCommand(CLI::App& app, const CommonOptions& common, int& exitCode) 
          "the penalty: fixed, or the first value of doubling")
       ->check(kPositive);
   cmd->add_option("--report", o->report, "write the figures as JSON to this file");
+  cmd->add_option("--surface", o->surfaceOutput,
+                  "write the deformed embedded surface (MLS embedding) to this .vtp file");
+  cmd->add_option("--embed", o->embed,
+                  "the surface --surface carries (default: the one the mesh was sliced from)")
+      ->check(CLI::ExistingFile);
   cmd->callback([o, &common, &exitCode] {
     run(*o, common);
     exitCode = 0;

@@ -12,6 +12,7 @@
 
 #include "model_state.h"
 #include "polydg/mesh/geometry.h"
+#include "polydg/mesh/surface_io.h"
 #include "polydg/model/provenance.h"
 #include "polydg/util/error.h"
 #include "polydg/util/stopwatch.h"
@@ -423,6 +424,41 @@ SolveReport Model::solve(const SolveOptions& options) {
 }
 
 const Solution* Model::solution() const { return state_->solution ? &*state_->solution : nullptr; }
+
+EmbeddedSurface Model::embedSurface(const std::string& file, int degree,
+                                    const EmbeddingOptions& options, const DgBasis* given) {
+  State& s = *state_;
+  s.requireUsable();
+  if (degree < 1 || degree > 3) throw InputError("the degree must be 1, 2 or 3");
+  EmbeddedSurface out;
+  out.file = file.empty() ? provenance().source : file;
+  if (out.file.empty())
+    throw InputError("the mesh records no surface it was sliced from; name the surface to embed");
+  try {
+    out.surface = readSurface(out.file);
+  } catch (const std::runtime_error& e) {
+    throw InputError(std::string(e.what()) +
+                     (file.empty() ? " (the surface the mesh was sliced from); name the surface "
+                                     "to embed instead"
+                                   : ""));
+  }
+  const Solution* u = solution();
+  std::unique_ptr<DgBasis> own;
+  const DgBasis* basis = given                               ? given
+                         : u && u->basis->degree() == degree ? u->basis.get()
+                                                             : nullptr;
+  if (!basis) {
+    own = std::make_unique<DgBasis>(mesh(), moments(2 * degree), BasisOptions{degree});
+    basis = own.get();
+  }
+  try {
+    out.embedding =
+        std::make_shared<SurfaceEmbedding>(mesh(), *basis, out.surface.vertices, options);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(e.what());
+  }
+  return out;
+}
 
 // --- writing -------------------------------------------------------------------------------
 

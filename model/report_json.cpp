@@ -359,6 +359,26 @@ json toJson(const Scene& s) {
     }
     j["cuts"].push_back(cut);
   }
+  if (s.embed.enabled) j["embed"] = s.embed.file.empty() ? json(true) : json(s.embed.file);
+  if (!s.obstacles.empty()) {
+    j["obstacles"] = json::array();
+    for (const SceneObstacle& o : s.obstacles) {
+      json ob;
+      if (o.below)
+        ob["below"] = {o.below->normal.x(), o.below->normal.y(), o.below->normal.z(),
+                       o.below->offset};
+      else
+        ob["mesh"] = o.mesh;
+      if (o.voxel > 0.0) ob["voxel"] = o.voxel;
+      ob["velocity"] = vectorJson(o.velocity);
+      j["obstacles"].push_back(ob);
+    }
+    json c = {{"friction", s.contact.friction},
+              {"points", nameOf(contactPointNames(), s.contact.points)}};
+    if (s.contact.stiffness > 0.0) c["stiffness"] = s.contact.stiffness;
+    if (s.contact.slipSpeed > 0.0) c["slip_speed"] = s.contact.slipSpeed;
+    j["contact"] = c;
+  }
   return j;
 }
 
@@ -379,6 +399,14 @@ json toJson(const SimulationReport& r) {
     step["correction"] = s.step.correction;
     step["residual"] = s.step.residual;
     step["solver"] = s.solver;
+    if (!r.scene.obstacles.empty()) {
+      step["contacts"] = s.contact.contacts;
+      step["deepest_penetration"] = s.contact.deepest;
+      step["contact_energy"] = s.contact.energy;
+      step["contacts_linearized"] = s.step.contacts;
+      step["contact_passes"] = s.step.contactPasses;
+      step["collision_seconds"] = s.collisionSeconds;
+    }
     step["seconds"] = s.seconds;
     steps.push_back(std::move(step));
   }
@@ -395,10 +423,40 @@ json toJson(const SimulationReport& r) {
   j["cuts"] = std::move(cuts);
   json frames = json::array();
   for (const SimulationFrame& f : r.frames)
-    frames.push_back({{"step", f.step}, {"t", f.t}, {"file", f.file}});
+    frames.push_back({{"step", f.step},
+                      {"t", f.t},
+                      {"file", f.file},
+                      {"surface", f.surfaceFile.empty() ? json(nullptr) : json(f.surfaceFile)}});
   j["frames"] = std::move(frames);
   j["pvd"] = r.pvd.empty() ? json(nullptr) : json(r.pvd);
   j["faces_integrated"] = r.facesIntegrated;
+  const SimulationEmbedding& e = r.embedding;
+  if (!e.surface.empty() || !e.contactPointKind.empty()) {
+    json embedding;
+    if (!e.surface.empty()) {
+      embedding = {{"surface", e.surface},
+                   {"points", e.points},
+                   {"triangles", e.triangles},
+                   {"samples", e.samples},
+                   {"pieces", e.pieces},
+                   {"outside", e.outside},
+                   {"weight_nonzeros", e.weightNonzeros},
+                   {"stored_nonzeros", e.storedNonzeros},
+                   {"setup_seconds", e.setupSeconds}};
+      json updates = json::array();
+      for (const EmbeddingUpdate& u : e.updates)
+        updates.push_back({{"recomputed", u.recomputed}, {"kept", u.kept}, {"seconds", u.seconds}});
+      embedding["updates"] = updates;
+    }
+    j["embedding"] = embedding.is_null() ? json(nullptr) : embedding;
+    if (!e.contactPointKind.empty())
+      j["contact"] = {{"points", e.contactPointKind},
+                      {"count", e.contactPoints},
+                      {"stiffness", e.contactStiffness},
+                      {"slip_speed", e.slipSpeed},
+                      {"obstacle_setup_seconds", e.obstacleSetupSeconds},
+                      {"obstacle_voxels", e.obstacleVoxels}};
+  }
   const double n = std::max<double>(1.0, static_cast<double>(r.steps.size()));
   j["timings_s"] = {{"setup", r.setupSeconds},
                     {"rotation", r.rotationSeconds},
@@ -406,6 +464,7 @@ json toJson(const SimulationReport& r) {
                     {"solve", r.solveSeconds},
                     {"cut", r.cutSeconds},
                     {"output", r.outputSeconds},
+                    {"surface", r.surfaceSeconds},
                     {"wall", r.wallSeconds},
                     {"per_step", (r.rotationSeconds + r.assemblySeconds + r.solveSeconds) / n}};
   return j;

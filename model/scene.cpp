@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 
 #include "polydg/model/json_reader.h"
 #include "polydg/model/names.h"
@@ -111,12 +112,70 @@ Scene parseScene(const json& document, const std::string& file) {
     std::stable_sort(s.cuts.begin(), s.cuts.end(),
                      [](const TimedCut& a, const TimedCut& b) { return a.time < b.time; });
   }
+  if (r.has("embed")) {
+    const json& e = r.get("embed");
+    if (e.is_boolean()) {
+      s.embed.enabled = e.get<bool>();
+    } else if (e.is_string() && !e.get<std::string>().empty()) {
+      s.embed.enabled = true;
+      s.embed.file = e.get<std::string>();
+    } else {
+      r.fail("embed", "expected a surface file or true (the surface the mesh was sliced from)");
+    }
+  }
+  if (r.has("obstacles")) {
+    const json& list = r.list("obstacles", "expected a list of obstacles");
+    for (std::size_t k = 0; k < list.size(); ++k) {
+      JsonObjectReader item = r.element(list, "obstacles", k);
+      SceneObstacle o;
+      const bool below = item.has("below"), mesh = item.has("mesh");
+      if (below == mesh)
+        item.fail(item.place(), "an obstacle needs exactly one of \"below\" and \"mesh\"");
+      if (below) {
+        const std::vector<double> v = item.numbers(item.get("below"), item.at("below"), 4);
+        try {
+          o.below = Plane::make(Vec3(v[0], v[1], v[2]), v[3]);
+        } catch (const std::invalid_argument& e) {
+          item.fail(item.at("below"), e.what());
+        }
+      } else {
+        o.mesh = item.string("mesh");
+        if (item.has("voxel")) o.voxel = item.number("voxel", 1e-300, kHuge);
+      }
+      if (item.has("velocity")) o.velocity = item.vec3(item.get("velocity"), item.at("velocity"));
+      item.finish();
+      s.obstacles.push_back(o);
+    }
+  }
+  if (r.has("contact")) {
+    JsonObjectReader c = r.object("contact");
+    if (c.has("stiffness")) s.contact.stiffness = c.number("stiffness", 1e-300, kHuge);
+    if (c.has("friction")) s.contact.friction = c.number("friction", 0.0, kHuge);
+    if (c.has("slip_speed")) s.contact.slipSpeed = c.number("slip_speed", 1e-300, kHuge);
+    if (c.has("points")) s.contact.points = c.choice("points", contactPointNames());
+    c.finish();
+    if (s.obstacles.empty()) r.fail("contact", "there are no \"obstacles\" to touch");
+  }
   r.finish();
   return s;
 }
 
+const Names<ContactPoints>& contactPointNames() {
+  static const Names<ContactPoints> names{{"surface", ContactPoints::Surface},
+                                          {"nodes", ContactPoints::Nodes}};
+  return names;
+}
+
 Scene readScene(const std::string& file) {
-  return parseScene(readJsonDocument(file, "scene"), file);
+  Scene s = parseScene(readJsonDocument(file, "scene"), file);
+  // Files a scene names are relative to the scene's folder.
+  const std::filesystem::path folder = std::filesystem::path(file).parent_path();
+  auto resolve = [&](std::string& name) {
+    if (!name.empty() && std::filesystem::path(name).is_relative()) name = (folder / name).string();
+  };
+  resolve(s.embed.file);
+  for (SceneObstacle& o : s.obstacles) resolve(o.mesh);
+  return s;
 }
 
 }  // namespace polydg

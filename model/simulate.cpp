@@ -6,9 +6,13 @@
 #include <sstream>
 
 #include "model_state.h"
+#include "polydg/mesh/geometry.h"
+#include "polydg/mesh/surface_io.h"
+#include "polydg/mesh/vtp_io.h"
 #include "polydg/model/files.h"
 #include "polydg/model/names.h"
 #include "polydg/model/scene.h"
+#include "polydg/physics/contact.h"
 #include "polydg/physics/post_process.h"
 #include "polydg/util/stopwatch.h"
 
@@ -59,6 +63,52 @@ void checkScene(const Scene& scene) {
     if (!t.traction.allFinite()) throw InputError("a traction must be three finite numbers");
 }
 
+/// Each vertex's share of the surface area: a third of its triangles' areas.
+std::vector<double> vertexAreas(const TriangleSurface& surface) {
+  std::vector<double> areas(surface.vertices.size(), 0.0);
+  for (const auto& t : surface.triangles) {
+    const Vec3 &a = surface.vertices[t[0]], &b = surface.vertices[t[1]],
+               &c = surface.vertices[t[2]];
+    const double third = (b - a).cross(c - a).norm() / 6.0;
+    for (std::uint32_t v : t) areas[v] += third;
+  }
+  return areas;
+}
+
+/// The scene's obstacles; `diagonal` is the body's bounding-box diagonal.
+std::vector<Obstacle> makeObstacles(const Scene& scene, double diagonal,
+                                    SimulationEmbedding& info) {
+  std::vector<Obstacle> obstacles;
+  for (std::size_t k = 0; k < scene.obstacles.size(); ++k) {
+    const SceneObstacle& o = scene.obstacles[k];
+    const std::string name = "obstacles[" + std::to_string(k) + "]";
+    try {
+      if (o.below) {
+        obstacles.push_back(Obstacle::halfSpace(*o.below, o.velocity));
+      } else {
+        TriangleSurface surface;
+        try {
+          surface = readSurface(o.mesh);
+        } catch (const std::runtime_error& e) {
+          throw InputError(name + ": " + e.what());
+        }
+        DistanceFieldOptions field;
+        field.voxel =
+            o.voxel > 0.0 ? o.voxel : std::min(bounds(surface).diagonal().norm(), diagonal) / 100.0;
+        field.exteriorBand = 3.0 * field.voxel;
+        // Deep enough for any penetration worth simulating: a quarter of the body.
+        field.interiorBand = std::max(3.0 * field.voxel, 0.25 * diagonal);
+        obstacles.push_back(Obstacle::fromSurface(surface, field, o.velocity));
+      }
+    } catch (const std::invalid_argument& e) {
+      throw InputError(name + (o.mesh.empty() ? "" : " (" + o.mesh + ")") + ": " + e.what());
+    }
+    info.obstacleSetupSeconds.push_back(obstacles.back().setupSeconds());
+    info.obstacleVoxels.push_back(obstacles.back().activeVoxels());
+  }
+  return obstacles;
+}
+
 /// What the step did with its matrix, in words.
 std::string solverAction(const StepReport& r, SolverKind kind, bool first) {
   if (kind == SolverKind::Cholesky)
@@ -83,7 +133,10 @@ class TimeSeries {
 
   std::string pvd() const { return (folder_ / "scene.pvd").string(); }
 
-  SimulationFrame write(const PolyMesh& mesh, const DynamicSolver& solver, int step) {
+  /// One frame; with `surface`, also its deformed surface (`displacement`: #V by 3).
+  SimulationFrame write(const PolyMesh& mesh, const DynamicSolver& solver, int step,
+                        const TriangleSurface* surface,
+                        const Eigen::Matrix<double, Eigen::Dynamic, 3>* displacement) {
     SimulationFrame frame;
     frame.step = step;
     frame.t = solver.time();
@@ -101,6 +154,23 @@ class TimeSeries {
     } catch (const std::runtime_error& e) {
       throw InputError(e.what());
     }
+    if (surface) {
+      std::snprintf(name, sizeof name, "scene_%06d.vtp", step);
+      frame.surfaceFile = name;
+      std::vector<Vec3> deformed(surface->vertices.size());
+      std::vector<double> u(3 * deformed.size());
+      for (std::size_t p = 0; p < deformed.size(); ++p) {
+        const Vec3 d = displacement->row(static_cast<Eigen::Index>(p)).transpose();
+        deformed[p] = surface->vertices[p] + d;
+        for (int k = 0; k < 3; ++k) u[3 * p + static_cast<std::size_t>(k)] = d[k];
+      }
+      try {
+        writeVtp((folder_ / name).string(), deformed, surface->triangles,
+                 {SurfacePointArray{"displacement", 3, u}}, encoding_);
+      } catch (const std::runtime_error& e) {
+        throw InputError(e.what());
+      }
+    }
     frames_.push_back(frame);
     writeCollection();
     return frame;
@@ -113,9 +183,15 @@ class TimeSeries {
             "<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
             "  <Collection>\n";
       os.precision(17);
-      for (const SimulationFrame& f : frames_)
+      // Part 0 is the mesh, part 1 the deformed embedded surface (ParaView shows them as one
+      // multiblock data set per time).
+      for (const SimulationFrame& f : frames_) {
         os << "    <DataSet timestep=\"" << f.t << "\" group=\"\" part=\"0\" file=\"" << f.file
            << "\"/>\n";
+        if (!f.surfaceFile.empty())
+          os << "    <DataSet timestep=\"" << f.t << "\" group=\"\" part=\"1\" file=\""
+             << f.surfaceFile << "\"/>\n";
+      }
       os << "  </Collection>\n</VTKFile>\n";
     });
   }
@@ -164,10 +240,74 @@ SimulationReport Model::simulate(const Scene& scene, const SimulateOptions& opti
   }
   report.initial = solver.state();
 
+  // The embedded surface, the contact points and the obstacles.
+  const double diagonal = meshBounds(mesh()).diagonal().norm();
+  SimulationEmbedding& info = report.embedding;
+  const bool contacts = !scene.obstacles.empty();
+  const bool onSurface = contacts && scene.contact.points == ContactPoints::Surface;
+  EmbeddedSurface surface;
+  if (scene.embed.enabled || onSurface) {
+    const Stopwatch te;
+    EmbeddingOptions eo;
+    eo.support = scene.embed.support;
+    surface = embedSurface(scene.embed.file, scene.degree, eo, &solver.basis());
+    info.surface = surface.file;
+    info.points = surface.surface.vertices.size();
+    info.triangles = surface.surface.triangles.size();
+    info.samples = surface.embedding->numSamples();
+    info.pieces = surface.embedding->numPieces();
+    info.outside = surface.embedding->outside();
+    info.weightNonzeros = surface.embedding->weightNonzeros();
+    info.storedNonzeros = surface.embedding->storedNonzeros();
+    info.setupSeconds = te.seconds();
+    report.setupSeconds += info.setupSeconds;
+  }
+  const bool showSurface = scene.embed.enabled;
+  std::vector<double> areas;
+  std::unique_ptr<SurfaceEmbedding> nodes;
+  std::unique_ptr<ContactModel> contact;
+  ContactOptions contactOptions;
+  std::vector<Obstacle> obstacles;
+  auto makeContact = [&]() {
+    const SurfaceEmbedding* points = surface.embedding.get();
+    if (!onSurface) {
+      nodes = std::make_unique<SurfaceEmbedding>(
+          SurfaceEmbedding::boundaryNodes(mesh(), solver.basis(), areas));
+      points = nodes.get();
+    }
+    contact = std::make_unique<ContactModel>(*points, areas, obstacles, contactOptions);
+    solver.setContact(contact.get());
+    info.contactPoints = points->numPoints();
+  };
+  if (contacts) {
+    const Stopwatch to;
+    obstacles = makeObstacles(scene, diagonal, info);
+    contactOptions.stiffness = scene.contact.stiffness > 0.0
+                                   ? scene.contact.stiffness
+                                   : 100.0 * scene.material.youngsModulus / diagonal;
+    contactOptions.friction = scene.contact.friction;
+    contactOptions.slipSpeed =
+        scene.contact.slipSpeed > 0.0 ? scene.contact.slipSpeed : 0.01 * diagonal;
+    if (onSurface) areas = vertexAreas(surface.surface);
+    makeContact();
+    info.contactPointKind = onSurface ? "surface" : "nodes";
+    info.contactStiffness = contactOptions.stiffness;
+    info.slipSpeed = contactOptions.slipSpeed;
+    report.setupSeconds += to.seconds();
+  }
+
   auto writeFrame = [&](int step) {
     if (!series) return;
     const Stopwatch t;
-    report.frames.push_back(series->write(mesh(), solver, step));
+    Eigen::Matrix<double, Eigen::Dynamic, 3> displacement;
+    if (showSurface) {
+      const Stopwatch ts;
+      displacement = surface.embedding->displacements(solver.displacement());
+      report.surfaceSeconds += ts.seconds();
+    }
+    report.frames.push_back(series->write(mesh(), solver, step,
+                                          showSurface ? &surface.surface : nullptr,
+                                          showSurface ? &displacement : nullptr));
     report.outputSeconds += t.seconds();
   };
 
@@ -206,6 +346,22 @@ SimulationReport Model::simulate(const Scene& scene, const SimulateOptions& opti
         }
       }
       solver.setState(record.time, u, v);
+      if (surface.embedding || contact) {
+        std::vector<ElementId> sources(record.elementsAfter);
+        for (std::size_t e = 0; e < record.elementsAfter; ++e) {
+          const std::vector<ElementId> from = record.report.lineage.sources(ElementId(e));
+          sources[e] = from.size() == 1 ? from.front() : ElementId();
+        }
+        if (surface.embedding)
+          info.updates.push_back(surface.embedding->update(mesh(), solver.basis(), sources));
+        if (contact) {
+          if (onSurface)
+            contact->refresh();  // the same points, new weights
+          else
+            makeContact();  // the boundary nodes changed
+          solver.setContact(contact.get());
+        }
+      }
       record.seconds = tc.seconds();
       report.cutSeconds += tt.seconds();
       report.cuts.push_back(std::move(record));
@@ -230,6 +386,10 @@ SimulationReport Model::simulate(const Scene& scene, const SimulateOptions& opti
     step.solver = solverAction(step.step, solver.solverKind(), first);
     first = false;
     step.state = solver.state();
+    if (contact) {
+      step.contact = contact->measure(solver.displacement(), solver.time());
+      step.collisionSeconds = step.step.contactQuerySeconds + contact->takeQuerySeconds();
+    }
     report.rotationSeconds += step.step.rotationSeconds;
     report.assemblySeconds += step.step.assemblySeconds;
     report.solveSeconds += step.step.solveSeconds;

@@ -370,6 +370,85 @@ PYBIND11_MODULE(_polydg, m) {
                  model, "solve", "Model.solve()", kwargs,
                  [](Model& m, const SolveStep& s) { return toJson(m.solve(s.options)); });
            })
+      .def_property_readonly(
+          "coefficients",
+          [](const Model& model) -> py::object {
+            const Solution* s = model.solution();
+            if (!s) return py::none();
+            py::array_t<double> out(static_cast<py::ssize_t>(s->coefficients.size()));
+            std::copy(s->coefficients.data(), s->coefficients.data() + s->coefficients.size(),
+                      out.mutable_data());
+            return out;
+          },
+          "The last solution's DG coefficients U (float64), in the layout U[(e * 3 + d) * n + i] "
+          "(element e, component d, basis function i of n), or None before a solve and after an "
+          "edit.")
+      .def(
+          "_embed",
+          [](Model& model, const std::string& surface, int degree, double support, bool deformed) {
+            EmbeddingOptions options;
+            options.support = support;
+            if (deformed && !model.solution())
+              throw InputError("the model has no solution to deform the surface with; solve first");
+            const int p = degree > 0         ? degree
+                          : model.solution() ? model.solution()->basis->degree()
+                                             : 1;
+            EmbeddedSurface e;
+            Eigen::Matrix<double, Eigen::Dynamic, 3> u;
+            Eigen::SparseMatrix<double, Eigen::RowMajor, int> w;
+            {
+              py::gil_scoped_release release;
+              e = model.embedSurface(surface, p, options);
+              if (deformed)
+                u = e.embedding->displacements(model.solution()->coefficients);
+              else
+                w = e.embedding->weights();
+            }
+            py::dict out;
+            out["points"] = pointsArray(e.surface.vertices);
+            py::array_t<std::int64_t> tris(
+                {static_cast<py::ssize_t>(e.surface.triangles.size()), py::ssize_t(3)});
+            auto t = tris.mutable_unchecked<2>();
+            for (std::size_t k = 0; k < e.surface.triangles.size(); ++k)
+              for (int j = 0; j < 3; ++j) t(k, j) = e.surface.triangles[k][j];
+            out["triangles"] = tris;
+            out["surface"] = e.file;
+            out["degree"] = p;
+            out["setup_seconds"] = e.embedding->setupSeconds();
+            if (deformed) {
+              py::array_t<double> disp({static_cast<py::ssize_t>(u.rows()), py::ssize_t(3)});
+              auto d = disp.mutable_unchecked<2>();
+              for (Eigen::Index i = 0; i < u.rows(); ++i)
+                for (int j = 0; j < 3; ++j) d(i, j) = u(i, j);
+              out["displacement"] = disp;
+              return out;
+            }
+            // The scalar weights W (eq. 19) spread to the three components: row 3 v + d, column
+            // (e * 3 + d) * n + i, so that u = W @ U.
+            const std::size_t n = static_cast<std::size_t>(e.embedding->basisSize());
+            const py::ssize_t nnz = static_cast<py::ssize_t>(3 * w.nonZeros());
+            py::array_t<std::int64_t> rows(nnz), cols(nnz);
+            py::array_t<double> values(nnz);
+            auto r = rows.mutable_unchecked<1>();
+            auto c = cols.mutable_unchecked<1>();
+            auto v = values.mutable_unchecked<1>();
+            py::ssize_t k = 0;
+            for (int row = 0; row < w.outerSize(); ++row)
+              for (Eigen::SparseMatrix<double, Eigen::RowMajor, int>::InnerIterator it(w, row); it;
+                   ++it)
+                for (std::size_t d = 0; d < 3; ++d, ++k) {
+                  const std::size_t col = static_cast<std::size_t>(it.col());
+                  r(k) = 3 * static_cast<std::int64_t>(row) + static_cast<std::int64_t>(d);
+                  c(k) = static_cast<std::int64_t>(((col / n) * 3 + d) * n + col % n);
+                  v(k) = it.value();
+                }
+            out["rows"] = rows;
+            out["cols"] = cols;
+            out["values"] = values;
+            out["shape"] = py::make_tuple(3 * w.rows(), 3 * static_cast<py::ssize_t>(w.cols()));
+            return out;
+          },
+          py::arg("surface"), py::arg("degree"), py::arg("support"), py::arg("deformed"))
       .def(
           "_simulate",
           [](Model& model, const py::object& scene, const std::string& output,

@@ -65,10 +65,13 @@ def read_surface(path):
     with assimp), welding vertices by exact position.
 
     Returns a ``Surface``; lines of the file that were skipped are in ``surface.warnings`` (a list
-    of "FILE:LINE: what" strings). Raises ``Error`` for a file that cannot be read.
+    of "FILE:LINE: what" strings), the file in ``surface.source`` (which ``mesh`` records as the
+    model's source: the surface an embedding carries by default). Raises ``Error`` for a file
+    that cannot be read.
     """
     surface, warnings = _polydg.read_surface(_os.fspath(path))
     surface.warnings = warnings
+    surface.source = _os.fspath(path)
     return surface
 
 
@@ -194,16 +197,20 @@ def _simulate(self, scene, output=None, progress=None):
     cut mesh and, as its solution, the final displacement (``element_displacements``, ``write``).
 
     scene: a dict in the scene format of README.md (material, dt, steps or duration, gravity,
-    fixed, loads, initial, cuts, ...), or the path (str or os.PathLike) of a scene JSON file.
-    Every key is checked before the run starts.
+    fixed, loads, initial, cuts, embed, obstacles, contact, ...), or the path (str or
+    os.PathLike) of a scene JSON file (files it names are relative to its folder; a dict's,
+    to the working directory). Every key is checked before the run starts.
     output: a folder for the ParaView time series (scene.pvd and one VTU per frame, with point
-    data "displacement" and "velocity"), created if missing; None writes no file.
+    data "displacement" and "velocity"; with "embed", also the deformed surface as a VTP per
+    frame with point data "displacement"), created if missing; None writes no file.
     progress: a callable progress(step, steps, t), called after each step; an exception it
     raises stops the simulation and reaches the caller. None: no calls.
 
     Returns the report: scene (every key explicit), elements, dofs, steps (per step: t, kinetic,
-    elastic, gravity, momentum, angular_momentum, centre_of_mass, cg_iterations, ...), cuts
-    (each with its operation's report), frames, pvd (None without output), timings_s.
+    elastic, gravity, momentum, angular_momentum, centre_of_mass, cg_iterations, ...; with
+    obstacles contacts, deepest_penetration, contact_energy, collision_seconds), cuts (each
+    with its operation's report), frames, pvd (None without output), embedding and contact
+    (with "embed" or obstacles), timings_s.
     Raises ``Error`` for a bad scene (naming the key, e.g. "scene: dt: ...") or a region that
     selects no face, ``CheckFailure`` for an invalid mesh, a step whose solve fails, or a cut that
     fails its validation (the model must then not be used further, as after ``cut``).
@@ -213,6 +220,36 @@ def _simulate(self, scene, output=None, progress=None):
     if progress is not None and not callable(progress):
         raise TypeError(f"progress must be callable or None, not {type(progress).__name__}")
     return self._simulate(scene, "" if output is None else _os.fsdecode(output), progress)
+
+
+def _surface_arg(surface):
+    return "" if surface is None else _os.fsdecode(surface)
+
+
+def _embedding_weights(self, surface=None, degree=None, support=2.0):
+    """The MLS embedding of a surface's vertices into the DG displacement (paper section 8,
+    eq. 19), as a sparse matrix in triplet form, without scipy.
+
+    surface: a surface file (any format ``read_surface`` reads), or None for the surface the
+    mesh was sliced from (its provenance's source). degree: of the DG basis (default: the last
+    solution's, else 1). support: the kernels' support in element sizes (README, "Embedding").
+
+    Returns a dict: rows, cols (int64) and values (float64), the nonzeros of W with shape
+    ``shape`` = (3 V, dofs), so that the surface's displacement is u = W @ U
+    (u[3 v + d] component d of vertex v; U as ``coefficients``), e.g.
+    ``scipy.sparse.coo_matrix((values, (rows, cols)), shape)``; points (V x 3, undeformed)
+    and triangles (T x 3) of the surface; surface (its file), degree, setup_seconds.
+    """
+    return self._embed(_surface_arg(surface), 0 if degree is None else int(degree),
+                       float(support), False)
+
+
+def _deformed_surface(self, surface=None, support=2.0):
+    """The surface carried by the last solution (``solve`` or ``simulate``): a dict with points
+    (V x 3, undeformed), displacement (V x 3, by the MLS embedding), triangles (T x 3), surface
+    (its file), degree and setup_seconds. ``points + displacement`` is the deformed surface.
+    surface: as in ``embedding_weights``. Raises ``Error`` before a solve."""
+    return self._embed(_surface_arg(surface), 0, float(support), True)
 
 
 def _write(self, path, solution=True):
@@ -229,4 +266,6 @@ Model.merge_slivers = _merge_slivers
 Model.check = _check
 Model.solve = _solve
 Model.simulate = _simulate
+Model.embedding_weights = _embedding_weights
+Model.deformed_surface = _deformed_surface
 Model.to_meshio = _to_meshio

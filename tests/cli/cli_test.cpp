@@ -310,6 +310,48 @@ TEST_F(Cli, SimulateRunsTheExampleSceneAndWritesATimeSeries) {
   EXPECT_EQ(quiet.out, "");
 }
 
+TEST_F(Cli, SolveAndSimulateWriteTheDeformedEmbeddedSurface) {
+  ASSERT_EQ(run("mesh " + data("ball.obj") + " --cells 6 --quiet -o " + path("ball.vtu")).exitCode,
+            0);
+  // solve --surface: the surface the mesh was sliced from, deformed.
+  const Result solved = run("solve " + path("ball.vtu") + " -o " + path("s.vtu") +
+                            " --degree 1 --E 1e6 --density 1000 --gravity 100,0,0 "
+                            "--clamp-below 0,0,1,0.7 --surface " +
+                            path("s.vtp") + " --report " + path("s.json"));
+  ASSERT_EQ(solved.exitCode, 0) << solved.out;
+  EXPECT_NE(solved.out.find("wrote " + path("s.vtp")), std::string::npos) << solved.out;
+  const auto s = readJson("s.json");
+  EXPECT_EQ(s["embedded_surface"]["surface"], data("ball.obj"));
+  EXPECT_EQ(s["embedded_surface"]["points"], 642);
+  EXPECT_GT(s["embedded_surface"]["max_displacement"].get<double>(), 0.0);
+  EXPECT_NE(fileText(path("s.vtp")).find("<VTKFile type=\"PolyData\""), std::string::npos);
+  expectOneLineError(run("solve " + path("ball.vtu") + " -o " + path("t.vtu") +
+                         " --clamp-below 0,0,1,0.7 --surface " + path("t.ply")),
+                     "the deformed surface is written as a .vtp file");
+
+  // simulate: the bundled drop scene, shortened; each frame lists the surface as part 1.
+  nlohmann::json scene;
+  std::ifstream(std::string(POLYDG_SOURCE_DIR) + "/examples/scenes/ball_drop.json") >> scene;
+  scene.erase("duration");
+  scene["steps"] = 100;
+  std::ofstream(path("drop.json")) << scene.dump();
+  const Result r = run("-q simulate " + path("ball.vtu") + " --scene " + path("drop.json") +
+                       " -o " + path("drop") + " --report " + path("r.json"));
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  const auto j = readJson("r.json");
+  EXPECT_EQ(j["embedding"]["points"], 642);
+  EXPECT_EQ(j["contact"]["points"], "surface");
+  bool touched = false;
+  for (const auto& step : j["steps"]) touched = touched || step["contacts"].get<int>() > 0;
+  EXPECT_TRUE(touched);  // it reaches the ground at t = 0.33 (with its mass damping)
+  const std::string pvd = fileText((dir_ / "drop" / "scene.pvd").string());
+  for (const auto& frame : j["frames"]) {
+    const std::string vtp = frame["surface"].get<std::string>();
+    EXPECT_TRUE(fs::exists(dir_ / "drop" / vtp)) << vtp;
+    EXPECT_NE(pvd.find("part=\"1\" file=\"" + vtp + "\""), std::string::npos) << vtp;
+  }
+}
+
 TEST_F(Cli, SimulateRefusesABadSceneBeforeRunning) {
   ASSERT_EQ(run("mesh " + data("beam.obj") + " --cells 10 --quiet -o " + path("beam.vtu")).exitCode,
             0);

@@ -13,7 +13,9 @@
 
 #include "polydg/cut/cut.h"
 #include "polydg/mesh/meshing.h"
+#include "polydg/mesh/surface.h"
 #include "polydg/mesh/vtu_io.h"
+#include "polydg/physics/embedding.h"
 #include "polydg/physics/loads.h"
 #include "polydg/physics/mesh_checks.h"
 #include "polydg/physics/post_process.h"
@@ -155,6 +157,13 @@ struct WriteOptions {
   bool solution = true;
 };
 
+/// A surface carried by the model's displacement (physics/embedding.h).
+struct EmbeddedSurface {
+  std::string file;  ///< the surface's file
+  TriangleSurface surface;
+  std::shared_ptr<SurfaceEmbedding> embedding;  ///< its vertices, in the basis it was made for
+};
+
 // Simulation (model/scene.h defines these).
 struct Scene;
 struct SimulateOptions;
@@ -228,6 +237,14 @@ class Model {
   /// If it stops early (an error, or an exception from the progress callback), the cuts made
   /// so far stay and the solution is the one before the simulation (none after a cut).
   SimulationReport simulate(const Scene& scene, const SimulateOptions& options);
+
+  /// Reads `file` (or, if "", the surface the mesh was sliced from: the provenance's source)
+  /// and embeds its vertices into `basis` if given (a basis of the current mesh), else the DG
+  /// basis of degree `degree` (the last solution's basis when it has that degree). Throws
+  /// InputError naming a surface it cannot read, or a mesh that records no source.
+  EmbeddedSurface embedSurface(const std::string& file, int degree,
+                               const EmbeddingOptions& options = {},
+                               const DgBasis* basis = nullptr);
 
   /// Writes the model as a VTU file with its provenance (and the solution's fields, see
   /// WriteOptions), atomically: `path` is never left half-written.

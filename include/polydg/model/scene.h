@@ -4,6 +4,7 @@
 #pragma once
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -19,6 +20,42 @@ namespace polydg {
 struct TimedCut {
   double time = 0.0;
   CutRequest request;
+};
+
+/// The surface carried along (scene "embed"): a file `polydg` reads, or the surface the mesh
+/// was sliced from (its provenance's source: "embed": true).
+struct SceneEmbed {
+  bool enabled = false;
+  std::string file;      ///< "" for the mesh's source
+  double support = 2.0;  ///< EmbeddingOptions::support
+};
+
+/// An obstacle (scene "obstacles"): the half-space "below" [a, b, c, d] (a x + b y + c z <= d
+/// is solid) or the inside of a closed surface "mesh", moving with "velocity".
+struct SceneObstacle {
+  std::optional<Plane> below;
+  std::string mesh;
+  Vec3 velocity = Vec3::Zero();
+  /// Distance field voxel ("voxel"); 0: the smaller of the obstacle's and the body's
+  /// bounding-box diagonals over 100.
+  double voxel = 0.0;
+};
+
+/// Which points collide (scene "contact": "points").
+enum class ContactPoints {
+  Surface,  ///< the embedded surface's vertices (the default)
+  Nodes,    ///< the mesh's boundary vertices, eq. (17) (section 9's cheap option)
+};
+
+/// Penalty contact (scene "contact").
+struct SceneContact {
+  /// Pressure per unit penetration; 0: 100 E / the body's bounding-box diagonal.
+  double stiffness = 0.0;
+  double friction = 0.0;
+  /// The slip speed below which friction is viscous (regularized Coulomb); 0: 1% of the
+  /// body's bounding-box diagonal per unit time.
+  double slipSpeed = 0.0;
+  ContactPoints points = ContactPoints::Surface;
 };
 
 /// Everything a simulation needs besides the mesh.
@@ -39,6 +76,9 @@ struct Scene {
   int outputEvery = 1;                  ///< a frame every this many steps (and the last)
   std::vector<TimedCut> cuts;           ///< in time order
   SolverKind solver = SolverKind::Auto;
+  SceneEmbed embed;
+  std::vector<SceneObstacle> obstacles;
+  SceneContact contact;
 };
 
 /// Progress of a simulation, after each step.
@@ -61,6 +101,10 @@ struct SimulationStep {
   StepReport step;
   BodyState state;
   std::string solver;  ///< what the step did with the matrix (see report_json.cpp)
+  /// With obstacles: contacts, deepest penetration and penalty energy at the step's end.
+  ContactMeasure contact;
+  /// Obstacle queries and contact point positions, during the step and for its end state.
+  double collisionSeconds = 0.0;
   double seconds = 0.0;
 };
 
@@ -80,6 +124,23 @@ struct SimulationFrame {
   int step = 0;
   double t = 0.0;
   std::string file;
+  std::string surfaceFile;  ///< the deformed embedded surface (.vtp), "" without "embed"
+};
+
+/// The embedded surface and the contact points of a simulation.
+struct SimulationEmbedding {
+  std::string surface;  ///< the file, "" without "embed"
+  std::size_t points = 0, triangles = 0, samples = 0, pieces = 0, outside = 0;
+  std::size_t weightNonzeros = 0;  ///< of W (eq. 19)
+  std::size_t storedNonzeros = 0;  ///< of Phi and S, what a surface update reads
+  double setupSeconds = 0.0;
+  std::size_t contactPoints = 0;
+  std::string contactPointKind;  ///< "surface" or "nodes", "" without obstacles
+  double contactStiffness = 0.0, slipSpeed = 0.0;
+  std::vector<double> obstacleSetupSeconds;  ///< per obstacle (distance fields)
+  std::vector<std::size_t> obstacleVoxels;
+  /// After each cut: surface points whose weights were computed again, and kept.
+  std::vector<EmbeddingUpdate> updates;
 };
 
 struct SimulationReport {
@@ -91,6 +152,9 @@ struct SimulationReport {
   std::vector<SimulationCut> cuts;
   std::vector<SimulationFrame> frames;
   std::string pvd;  ///< the collection file, "" without output (null in the JSON report)
+  SimulationEmbedding embedding;
+  /// Seconds of surface updates for output frames (embedding displacements), all frames.
+  double surfaceSeconds = 0.0;
   /// Totals of the phases: setup (bases, matrices, loads, after each cut too), rotation,
   /// assembly, solve, cut, output.
   double setupSeconds = 0.0, rotationSeconds = 0.0, assemblySeconds = 0.0, solveSeconds = 0.0,
@@ -104,6 +168,7 @@ Scene parseScene(const nlohmann::json& document, const std::string& file);
 /// The same from a file.
 Scene readScene(const std::string& file);
 
-const Names<TimeIntegrator>& integratorNames();  ///< euler, bdf2, newmark
+const Names<TimeIntegrator>& integratorNames();   ///< euler, bdf2, newmark
+const Names<ContactPoints>& contactPointNames();  ///< surface, nodes
 
 }  // namespace polydg
