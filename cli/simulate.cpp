@@ -3,6 +3,7 @@
 //
 // Sample run:
 //   polydg simulate beam.vtu --scene fall.json -o beam_fall --report fall.json
+#include <algorithm>
 #include <filesystem>
 #include <iostream>
 
@@ -73,8 +74,25 @@ void run(const SimulateCommandOptions& o, const CommonOptions& common) {
               << r.assemblySeconds / n << " s, solve " << r.solveSeconds / n << " s; "
               << r.cuts.size() << " cuts, " << r.frames.size() << " frames\n"
               << "  at t = " << r.steps.back().step.t << ": kinetic " << last.kinetic
-              << ", elastic " << last.elastic << ", gravity " << last.gravity << '\n'
-              << "  wrote " << (r.pvd.empty() ? std::string("nothing") : r.pvd) << '\n';
+              << ", elastic " << last.elastic << ", gravity " << last.gravity << '\n';
+    const SimulationEmbedding& e = r.embedding;
+    if (!e.surface.empty())
+      std::cout << "  surface " << e.surface << ": " << e.points << " points, " << e.samples
+                << " samples, W " << e.weightNonzeros << " nonzeros, set up in " << e.setupSeconds
+                << " s\n";
+    if (!e.contactPointKind.empty()) {
+      double deepest = 0.0, collision = 0.0;
+      for (const SimulationStep& s : r.steps) {
+        deepest = std::max(deepest, s.contact.deepest);
+        collision += s.collisionSeconds;
+      }
+      const ContactMeasure& c = r.steps.back().contact;
+      std::cout << "  contact (" << e.contactPoints << " " << e.contactPointKind
+                << " points): at the end " << c.contacts << " in contact, penetration " << c.deepest
+                << " (deepest over the run " << deepest << "); collisions " << collision / n
+                << " s per step\n";
+    }
+    std::cout << "  wrote " << (r.pvd.empty() ? std::string("nothing") : r.pvd) << '\n';
   }
 }
 
