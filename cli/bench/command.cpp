@@ -3,11 +3,14 @@
 //
 // Sample runs:
 //   polydg bench --suite all --out bench/          (every suite; about a minute on 2 cores,
-//                                                   plus 17 minutes for dynamics)
+//                                                   plus 17 minutes for dynamics and 2 for
+//                                                   contact)
 //   polydg bench --suite stability --out bench/    (B4: conditioning, locking, scale)
 //   polydg bench --suite stability --out b/ --quick   (reduced sizes, as the tests run it)
 //   polydg bench --suite dynamics --out bench/     (B6, B7, time per step up to 1M DOFs;
 //                                                   17 minutes and 5 GB)
+//   polydg bench --suite contact --out bench/      (B9, embedding and collision speed; 2
+//                                                   minutes)
 //   polydg bench --suite meshing --out b/ --data DIR  (torus.obj from DIR instead of the
 //                                                      share/polydg folder beside the binary)
 #include <filesystem>
@@ -54,6 +57,8 @@ void runBench(BenchOptions o, const CommonOptions& common) {
     timed("cutting", [&] { return bench::cuttingSuite(o, common.quiet); });
   if (all || o.suite == "dynamics")
     timed("dynamics", [&] { return bench::dynamicsSuite(o, common.quiet); });
+  if (all || o.suite == "contact")
+    timed("contact", [&] { return bench::contactSuite(o, common.quiet); });
   if (!common.quiet && all) std::cout << "all suites: " << total.seconds() << " s" << std::endl;
 }
 
@@ -64,12 +69,13 @@ void addBenchCommand(CLI::App& app, const CommonOptions& common, int& exitCode) 
   CLI::App* cmd = app.add_subcommand(
       "bench",
       "Benchmark suites as JSON, CSV and SVG plots: accuracy (B1), table41 (B2), "
-      "stability (B4), meshing, cutting, dynamics (B6, B7, time per step), or all");
+      "stability (B4), meshing, cutting, dynamics (B6, B7, time per step), contact (B9, "
+      "embedding and collision speed), or all");
   cmd->add_option("--suite", o->suite,
-                  "accuracy, table41, stability, meshing, cutting, dynamics or all")
+                  "accuracy, table41, stability, meshing, cutting, dynamics, contact or all")
       ->required()
-      ->check(CLI::IsMember(
-          {"accuracy", "table41", "stability", "meshing", "cutting", "dynamics", "all"}));
+      ->check(CLI::IsMember({"accuracy", "table41", "stability", "meshing", "cutting", "dynamics",
+                             "contact", "all"}));
   cmd->add_option("--out", o->out, "folder for NAME.json, NAME.csv and NAME*.svg")->required();
   cmd->add_flag("--skip-sliced", o->skipSliced, "accuracy: hex grids only");
   cmd->add_flag("--quick", o->quick,

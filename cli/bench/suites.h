@@ -21,6 +21,14 @@
 //              step against DOFs (B10's beam under gravity, p = 1, corotational, 7.7k, 87k and
 //              960k DOFs, with rotation, assembly and solve apart). 17 minutes on 2 cores
 //              shared with a build (2026-12-02; 15 of them the 960k-DOF steps), 5 GB at most.
+//   contact    B9 and collision handling: the MLS embedding of a 74,884-triangle sphere in a
+//              mesh of 4 cells per side (p = 1, 2: setup, W's nonzeros, time per surface update),
+//              100k obstacle queries against the ground and B9's bowl as distance fields (voxel
+//              diagonal / 100, simulate's default, and / 200), a step of the drop with that
+//              surface's vertices as contact points against its collision time and the surface
+//              update (the goal: each below 10%), and B9's drops onto the ground and into the
+//              bowl (contacts, penetration, energies per step). 80 to 120 s on 2 cores shared
+//              with builds (2026-12-02), 2.9 GB at most.
 // With `quick` each runs reduced sizes (a smoke test of every output, as the tests run it).
 #pragma once
 
@@ -31,8 +39,8 @@
 namespace polydg::bench {
 
 struct BenchOptions {
-  std::string suite;        ///< accuracy, table41, stability, meshing, cutting, dynamics or all
-  std::string out;          ///< the folder the files go to
+  std::string suite;  ///< accuracy, table41, stability, meshing, cutting, dynamics, contact or all
+  std::string out;    ///< the folder the files go to
   bool skipSliced = false;  ///< accuracy: hex grids only
   bool quick = false;
   /// The folder of the bundled models the meshing suite reads (torus.obj); `polydg bench` uses
@@ -47,5 +55,6 @@ SuiteOutput stabilitySuite(const BenchOptions& options, bool quiet);
 SuiteOutput meshingSuite(const BenchOptions& options, bool quiet);
 SuiteOutput cuttingSuite(const BenchOptions& options, bool quiet);
 SuiteOutput dynamicsSuite(const BenchOptions& options, bool quiet);
+SuiteOutput contactSuite(const BenchOptions& options, bool quiet);
 
 }  // namespace polydg::bench

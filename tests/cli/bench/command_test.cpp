@@ -1,6 +1,7 @@
-// `polydg bench` end to end through the binary, as a user runs it: the stability, cutting and
-// dynamics suites with --quick (every file written, the B4 JSON keys and findings, incremental
-// cuts, B6's energy and period, B7's volume with and without corotation, the speed rows),
+// `polydg bench` end to end through the binary, as a user runs it: the stability, cutting,
+// dynamics and contact suites with --quick (every file written, the B4 JSON keys and findings,
+// incremental cuts, B6's energy and period, B7's volume with and without corotation, the speed
+// rows, B9's contacts, penetration and energy, the embedding's and the queries' figures),
 // the meshing suite finding its model in share/polydg beside the binary (build tree and an
 // installation's layout) or in --data, and an unknown suite refused with one line.
 #include <gtest/gtest.h>
@@ -184,6 +185,80 @@ TEST(BenchCommand, DynamicsSuiteKeepsEnergyAndVolumeWhereItShould) {
   std::string header;
   std::getline(csv, header);
   for (const char* column : {"part", "integrator", "energy", "volume_change", "t_rotation"})
+    EXPECT_NE(header.find(column), std::string::npos) << column;
+  fs::remove_all(dir);
+}
+
+TEST(BenchCommand, ContactSuiteDetectsContactAndKeepsEnergyFromGrowing) {
+  // The quick drops (0.4 s) reach the ground and the bowl at t = 0.356 (mass damping slows the
+  // fall): about 12 steps in contact, the sphere still moving. Measured: penetration 1.3e-3 at
+  // the end (below B9's limit already); the total energy falls at every step (damping).
+  constexpr double kPenetrationLimit = 0.005;  // B9: 1% of the radius
+  constexpr double kEnergyRoundoff = 1e-9;     // of weight x radius (the suite's allowance)
+  const fs::path dir =
+      fs::temp_directory_path() / ("polydg_bench_contact_" + std::to_string(getpid()) + "_out");
+  fs::remove_all(dir);
+  const Result r = run("bench --suite contact --quick --quiet --out " + dir.string());
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  EXPECT_TRUE(r.out.empty()) << r.out;  // --quiet
+  for (const char* file : {"contact.json", "contact.csv", "contact_step_time.svg",
+                           "contact_penetration.svg", "contact_energy.svg"})
+    EXPECT_TRUE(fs::exists(dir / file)) << file;
+  std::ifstream in(dir / "contact.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+
+  const nlohmann::json& embedding = j["embedding"];
+  EXPECT_GT(embedding["elements"].get<std::size_t>(), 0u);
+  ASSERT_EQ(embedding["runs"].size(), 2u);  // p = 1, 2
+  for (const nlohmann::json& run : embedding["runs"]) {
+    EXPECT_EQ(run["points"], embedding["vertices"]) << run.dump();
+    EXPECT_EQ(run["outside"].get<std::size_t>(), 0u) << run.dump();  // on the sliced surface
+    // Each point reads at least one element's functions.
+    EXPECT_GE(run["weight_nonzeros"].get<std::size_t>(),
+              run["points"].get<std::size_t>() * (run["degree"] == 1 ? 4u : 10u))
+        << run.dump();
+    EXPECT_GT(run["update_seconds"].get<double>(), 0.0) << run.dump();
+  }
+
+  ASSERT_EQ(j["queries"]["runs"].size(), 2u);  // the ground, the bowl
+  for (const nlohmann::json& run : j["queries"]["runs"]) {
+    EXPECT_GT(run["query_seconds"].get<double>(), 0.0) << run.dump();
+    EXPECT_GT(run["inside"].get<std::size_t>(), 0u) << run.dump();
+    if (run["obstacle"] == "bowl") {
+      EXPECT_GT(run["active_voxels"].get<std::size_t>(), 0u) << run.dump();
+      EXPECT_GT(run["checked_points"].get<std::size_t>(), 0u) << run.dump();
+      // Against the spheres: the faceting of the bowl and a voxel's interpolation at most.
+      EXPECT_LT(run["max_distance_error"].get<double>(),
+                run["facet_sag"].get<double>() + run["voxel"].get<double>())
+          << run.dump();
+    }
+  }
+
+  const nlohmann::json& step = j["step"];
+  EXPECT_GT(step["contact_steps"].get<int>(), 0) << step.dump();
+  EXPECT_EQ(step["contact_points"], embedding["vertices"]) << step.dump();
+  for (const char* key :
+       {"t_step_contact", "t_collision_contact", "collision_over_step", "update_over_step"})
+    EXPECT_GT(step[key].get<double>(), 0.0) << key << ": " << step.dump();
+
+  ASSERT_EQ(j["b9"]["runs"].size(), 2u);  // the ground, the bowl
+  for (const nlohmann::json& run : j["b9"]["runs"]) {
+    EXPECT_TRUE(run["energies_finite"].get<bool>()) << run.dump();
+    EXPECT_GT(run["contact_steps"].get<int>(), 0) << run.dump();
+    EXPECT_GT(run["final_contacts"].get<std::size_t>(), 0u) << run.dump();
+    EXPECT_GT(run["final_penetration"].get<double>(), 0.0) << run.dump();
+    EXPECT_LT(run["final_penetration"].get<double>(), kPenetrationLimit) << run.dump();
+    EXPECT_LE(run["max_energy_growth"].get<double>(),
+              kEnergyRoundoff * run["energy_scale"].get<double>())
+        << run.dump();
+    EXPECT_TRUE(run["energy_never_grows"].get<bool>()) << run.dump();
+  }
+  std::ifstream csv(dir / "contact.csv");
+  std::string header;
+  std::getline(csv, header);
+  for (const char* column :
+       {"part", "obstacle", "deepest", "kinetic", "elastic", "gravity", "contact_energy", "total",
+        "com_z", "weight_nonzeros", "query_seconds"})
     EXPECT_NE(header.find(column), std::string::npos) << column;
   fs::remove_all(dir);
 }
