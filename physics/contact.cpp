@@ -42,6 +42,18 @@ void ContactModel::refresh() {
     throw std::invalid_argument("ContactModel: the embedding's points changed; make it again");
   dofs_ = e.numElements() * 3 * static_cast<std::size_t>(e.basisSize());
   active_.clear();
+  cachedCoefficients_.resize(0);
+}
+
+const Eigen::Matrix<double, Eigen::Dynamic, 3>& ContactModel::displacementsOf(
+    const Eigen::VectorXd& u) {
+  // A step's end state is measured, then linearized about at the next step's start: the same
+  // coefficients, one surface update.
+  if (cachedCoefficients_.size() != u.size() || cachedCoefficients_ != u) {
+    cachedDisplacement_ = embedding_->displacements(u);
+    cachedCoefficients_ = u;
+  }
+  return cachedDisplacement_;
 }
 
 double ContactModel::takeQuerySeconds() {
@@ -85,7 +97,7 @@ ContactLinearization ContactModel::linearize(const Eigen::VectorXd& u, const Eig
   const SurfaceEmbedding& e = *embedding_;
   tNext_ = tNext;
   dt_ = dt;
-  startDisplacement_ = e.displacements(u);
+  startDisplacement_ = displacementsOf(u);
   const Eigen::Matrix<double, Eigen::Dynamic, 3> velocity = e.displacements(v);
   const std::size_t np = e.numPoints();
   Eigen::Matrix<double, Eigen::Dynamic, 3> predicted(static_cast<Eigen::Index>(np), 3);
@@ -117,7 +129,7 @@ ContactLinearization ContactModel::linearize(const Eigen::VectorXd& u, const Eig
 bool ContactModel::adjust(const Eigen::VectorXd& uNew) {
   const Stopwatch watch;
   const SurfaceEmbedding& e = *embedding_;
-  const Eigen::Matrix<double, Eigen::Dynamic, 3> disp = e.displacements(uNew);
+  const Eigen::Matrix<double, Eigen::Dynamic, 3> disp = displacementsOf(uNew);
   const std::size_t np = e.numPoints();
   bool changed = false;
   // Drop contacts whose linearized force pulls at the new state.
@@ -245,7 +257,7 @@ ContactLinearization ContactModel::build() const {
 ContactMeasure ContactModel::measure(const Eigen::VectorXd& u, double t) {
   const Stopwatch watch;
   const SurfaceEmbedding& e = *embedding_;
-  const Eigen::Matrix<double, Eigen::Dynamic, 3> disp = e.displacements(u);
+  const Eigen::Matrix<double, Eigen::Dynamic, 3> disp = displacementsOf(u);
   Eigen::Matrix<double, Eigen::Dynamic, 3> positions(disp.rows(), 3);
   for (std::size_t p = 0; p < e.numPoints(); ++p)
     positions.row(static_cast<Eigen::Index>(p)) =

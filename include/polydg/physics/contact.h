@@ -98,6 +98,8 @@ class ContactModel {
   void queryAll(const Eigen::Matrix<double, Eigen::Dynamic, 3>& positions, double t,
                 std::vector<ObstacleQuery>& out, std::vector<std::uint32_t>& which);
   ContactLinearization build() const;
+  /// The points' displacements for coefficients u (the last result kept: see contact.cpp).
+  const Eigen::Matrix<double, Eigen::Dynamic, 3>& displacementsOf(const Eigen::VectorXd& u);
 
   const SurfaceEmbedding* embedding_;
   std::vector<double> areas_;
@@ -105,6 +107,8 @@ class ContactModel {
   ContactOptions options_;
   std::vector<Active> active_;
   Eigen::Matrix<double, Eigen::Dynamic, 3> startDisplacement_;  ///< u~_n of every point
+  Eigen::VectorXd cachedCoefficients_;
+  Eigen::Matrix<double, Eigen::Dynamic, 3> cachedDisplacement_;
   double tNext_ = 0.0, dt_ = 0.0, querySeconds_ = 0.0;
   std::size_t dofs_ = 0;
 };
