@@ -3,9 +3,12 @@
 #include <algorithm>
 #include <array>
 #include <bit>
+#include <cerrno>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
+#include <fstream>
 #include <limits>
 #include <optional>
 #include <sstream>
@@ -243,6 +246,32 @@ void writeDataArray(std::ostream& os, const ArrayOut& a, VtuEncoding encoding, s
     out.finish();
   }
   os << '\n' << a.indent << "</DataArray>\n";
+}
+
+void writeReplacing(const std::string& path, const std::function<void(std::ostream&)>& contents) {
+  const std::string tmp = path + ".tmp";
+  auto fail = [&](int error) {
+    std::remove(tmp.c_str());
+    throw std::runtime_error("cannot write " + path + ": " +
+                             (error != 0 ? std::strerror(error) : "I/O error"));
+  };
+  {
+    std::ofstream os(tmp, std::ios::binary | std::ios::trunc);
+    if (!os) fail(errno);
+    errno = 0;
+    try {
+      contents(os);
+    } catch (...) {
+      os.close();
+      std::remove(tmp.c_str());
+      throw;
+    }
+    os.flush();
+    if (!os) fail(errno);
+    os.close();
+    if (os.fail()) fail(errno);
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) fail(errno);
 }
 
 void writeAppendedBytes(std::ostream& os, const ArrayOut& a) {

@@ -1,8 +1,4 @@
 // writeVtp(): triangle surfaces as VTK XML PolyData (mesh/vtp_io.h).
-#include <cerrno>
-#include <cstdio>
-#include <cstring>
-#include <fstream>
 #include <stdexcept>
 #include <unordered_set>
 
@@ -54,16 +50,7 @@ void writeVtp(const std::string& path, std::span<const Vec3> points,
     offset += a.binaryBytes();
   }
 
-  const std::string tmp = path + ".tmp";
-  auto fail = [&](int error) {
-    std::remove(tmp.c_str());
-    throw std::runtime_error("cannot write " + path + ": " +
-                             (error != 0 ? std::strerror(error) : "I/O error"));
-  };
-  {
-    std::ofstream os(tmp, std::ios::binary | std::ios::trunc);
-    if (!os) fail(errno);
-    errno = 0;
+  vtk_format::writeReplacing(path, [&](std::ostream& os) {
     auto put = [&](std::size_t k) {
       vtk_format::writeDataArray(os, arrays[k], encoding, offsetOf[k]);
     };
@@ -87,12 +74,7 @@ void writeVtp(const std::string& path, std::span<const Vec3> points,
       os << "\n  </AppendedData>\n";
     }
     os << "</VTKFile>\n";
-    os.flush();
-    if (!os) fail(errno);
-    os.close();
-    if (os.fail()) fail(errno);
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) fail(errno);
+  });
 }
 
 }  // namespace polydg

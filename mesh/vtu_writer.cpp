@@ -406,8 +406,6 @@ void writeContents(std::ostream& os, const PolyMesh& mesh, const CellStreams& s,
   os << "</VTKFile>\n";
 }
 
-std::string errnoText(int error) { return error != 0 ? std::strerror(error) : "I/O error"; }
-
 }  // namespace
 
 void writeVtu(const PolyMesh& mesh, const std::string& path, const VtuWriteOptions& options,
@@ -426,29 +424,10 @@ void writeVtu(const PolyMesh& mesh, const std::string& path, const VtuWriteOptio
   const CellStreams streams = buildCellStreams(mesh);
   const FileValues values = fileValues(mesh, streams, cellData, pointData, cornerData);
 
-  const std::string tmp = path + ".tmp";
-  auto fail = [&](int error) {
-    std::remove(tmp.c_str());
-    throw std::runtime_error("cannot write " + path + ": " + errnoText(error));
-  };
-  {
-    std::ofstream os(tmp, std::ios::binary | std::ios::trunc);
-    if (!os) fail(errno);
-    errno = 0;
-    try {
-      writeContents(os, mesh, streams, values, cellData, pointData, cornerData, fieldData,
-                    options.encoding);
-    } catch (...) {
-      os.close();
-      std::remove(tmp.c_str());
-      throw;
-    }
-    os.flush();
-    if (!os) fail(errno);
-    os.close();
-    if (os.fail()) fail(errno);
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) fail(errno);
+  vtk_format::writeReplacing(path, [&](std::ostream& os) {
+    writeContents(os, mesh, streams, values, cellData, pointData, cornerData, fieldData,
+                  options.encoding);
+  });
 }
 
 }  // namespace polydg

@@ -56,6 +56,27 @@ const Eigen::Matrix<double, Eigen::Dynamic, 3>& ContactModel::displacementsOf(
   return cachedDisplacement_;
 }
 
+Eigen::Matrix<double, Eigen::Dynamic, 3> ContactModel::positionsOf(
+    const Eigen::Matrix<double, Eigen::Dynamic, 3>& displacement) const {
+  Eigen::Matrix<double, Eigen::Dynamic, 3> x(displacement.rows(), 3);
+  for (std::size_t p = 0; p < embedding_->numPoints(); ++p)
+    x.row(static_cast<Eigen::Index>(p)) =
+        embedding_->points()[p].transpose() + displacement.row(static_cast<Eigen::Index>(p));
+  return x;
+}
+
+ContactModel::Active ContactModel::contact(std::size_t point, std::uint32_t obstacle,
+                                           const ObstacleQuery& q,
+                                           const Eigen::Matrix<double, Eigen::Dynamic, 3>& at) {
+  Active a;
+  a.point = static_cast<std::uint32_t>(point);
+  a.obstacle = obstacle;
+  a.distance = q.distance;
+  a.normal = q.normal;
+  a.position = at.row(static_cast<Eigen::Index>(point)).transpose();
+  return a;
+}
+
 double ContactModel::takeQuerySeconds() {
   const double s = querySeconds_;
   querySeconds_ = 0.0;
@@ -100,23 +121,15 @@ ContactLinearization ContactModel::linearize(const Eigen::VectorXd& u, const Eig
   startDisplacement_ = displacementsOf(u);
   const Eigen::Matrix<double, Eigen::Dynamic, 3> velocity = e.displacements(v);
   const std::size_t np = e.numPoints();
-  Eigen::Matrix<double, Eigen::Dynamic, 3> predicted(static_cast<Eigen::Index>(np), 3);
-  for (std::size_t p = 0; p < np; ++p) {
-    const auto i = static_cast<Eigen::Index>(p);
-    predicted.row(i) = e.points()[p].transpose() + startDisplacement_.row(i) + dt * velocity.row(i);
-  }
+  const Eigen::Matrix<double, Eigen::Dynamic, 3> predicted =
+      positionsOf(startDisplacement_ + dt * velocity);
   std::vector<ObstacleQuery> q;
   std::vector<std::uint32_t> which;
   queryAll(predicted, tNext, q, which);
   active_.clear();
   for (std::size_t p = 0; p < np; ++p) {
     if (!(q[p].distance < 0.0) || q[p].normal.isZero()) continue;
-    Active a;
-    a.point = static_cast<std::uint32_t>(p);
-    a.obstacle = which[p];
-    a.distance = q[p].distance;
-    a.normal = q[p].normal;
-    a.position = predicted.row(static_cast<Eigen::Index>(p)).transpose();
+    Active a = contact(p, which[p], q[p], predicted);
     const Vec3 relative =
         velocity.row(static_cast<Eigen::Index>(p)).transpose() - obstacles_[which[p]].velocity();
     a.slip = relative - a.normal * a.normal.dot(relative);
@@ -129,7 +142,7 @@ ContactLinearization ContactModel::linearize(const Eigen::VectorXd& u, const Eig
 bool ContactModel::adjust(const Eigen::VectorXd& uNew) {
   const Stopwatch watch;
   const SurfaceEmbedding& e = *embedding_;
-  const Eigen::Matrix<double, Eigen::Dynamic, 3> disp = displacementsOf(uNew);
+  const Eigen::Matrix<double, Eigen::Dynamic, 3>& disp = displacementsOf(uNew);
   const std::size_t np = e.numPoints();
   bool changed = false;
   // Drop contacts whose linearized force pulls at the new state.
@@ -146,22 +159,13 @@ bool ContactModel::adjust(const Eigen::VectorXd& uNew) {
     isActive[a.point] = 1;
   }
   // Add points that end inside an obstacle.
-  Eigen::Matrix<double, Eigen::Dynamic, 3> positions(static_cast<Eigen::Index>(np), 3);
-  for (std::size_t p = 0; p < np; ++p)
-    positions.row(static_cast<Eigen::Index>(p)) =
-        e.points()[p].transpose() + disp.row(static_cast<Eigen::Index>(p));
+  const Eigen::Matrix<double, Eigen::Dynamic, 3> positions = positionsOf(disp);
   std::vector<ObstacleQuery> q;
   std::vector<std::uint32_t> which;
   queryAll(positions, tNext_, q, which);
   for (std::size_t p = 0; p < np; ++p) {
     if (isActive[p] || !(q[p].distance < 0.0) || q[p].normal.isZero()) continue;
-    Active a;
-    a.point = static_cast<std::uint32_t>(p);
-    a.obstacle = which[p];
-    a.distance = q[p].distance;
-    a.normal = q[p].normal;
-    a.position = positions.row(static_cast<Eigen::Index>(p)).transpose();
-    kept.push_back(a);
+    kept.push_back(contact(p, which[p], q[p], positions));  // no slip yet: full friction
     changed = true;
   }
   active_ = std::move(kept);
@@ -256,12 +260,7 @@ ContactLinearization ContactModel::build() const {
 
 ContactMeasure ContactModel::measure(const Eigen::VectorXd& u, double t) {
   const Stopwatch watch;
-  const SurfaceEmbedding& e = *embedding_;
-  const Eigen::Matrix<double, Eigen::Dynamic, 3> disp = displacementsOf(u);
-  Eigen::Matrix<double, Eigen::Dynamic, 3> positions(disp.rows(), 3);
-  for (std::size_t p = 0; p < e.numPoints(); ++p)
-    positions.row(static_cast<Eigen::Index>(p)) =
-        e.points()[p].transpose() + disp.row(static_cast<Eigen::Index>(p));
+  const Eigen::Matrix<double, Eigen::Dynamic, 3> positions = positionsOf(displacementsOf(u));
   std::vector<ObstacleQuery> q;
   std::vector<std::uint32_t> which;
   queryAll(positions, t, q, which);

@@ -243,8 +243,12 @@ struct Obstacle::Field {
       // No active voxel among the eight around x: outside the band, or deeper in.
       if (!openvdb::tools::BoxSampler::sample(distance_, ijk, d))
         return {d < 0 ? -options_.interiorBand : options_.exteriorBand, Vec3::Zero()};
+      // The outermost voxel layer of a band interpolates with the background: no normal there,
+      // as beyond the band.
+      if (d >= options_.exteriorBand - field_.voxel) return {options_.exteriorBand, Vec3::Zero()};
+      if (d <= -options_.interiorBand + field_.voxel) return {-options_.interiorBand, Vec3::Zero()};
       ObstacleQuery q;
-      q.distance = std::clamp<double>(d, -options_.interiorBand, options_.exteriorBand);
+      q.distance = d;
       const openvdb::Vec3s g = openvdb::tools::BoxSampler::sample(gradient_, ijk);
       const Vec3 gradient(g.x(), g.y(), g.z());
       const double length = gradient.norm();

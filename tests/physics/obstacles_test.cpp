@@ -196,6 +196,20 @@ TEST(ObstacleSurface, BeyondTheBandNoContactAndDeepInsideStillANormal) {
     EXPECT_EQ(q.distance, kSphereField.exteriorBand) << "r " << r;
     EXPECT_EQ(q.normal, Vec3::Zero()) << "r " << r;
   }
+  // In the band's outermost voxel layer (whose values blend with the background): none either;
+  // two voxels further in, a distance and a normal.
+  for (double r : {1.0 + kSphereField.exteriorBand - 0.5 * kVoxel,
+                   1.0 + kSphereField.exteriorBand - 0.1 * kVoxel}) {
+    const ObstacleQuery q = sphere.query(r * u, 0.0);
+    EXPECT_EQ(q.distance, kSphereField.exteriorBand) << "r " << r;
+    EXPECT_EQ(q.normal, Vec3::Zero()) << "r " << r;
+  }
+  {
+    const double r = 1.0 + kSphereField.exteriorBand - 2.0 * kVoxel;
+    const ObstacleQuery q = sphere.query(r * u, 0.0);
+    EXPECT_NEAR(q.distance, r - 1.0, tolerance);
+    EXPECT_LT(degreesBetween(q.normal, u), kNormalDegrees);
+  }
   // Deeper than the exterior band, within the interior band (0.3): distance and outward normal.
   for (double depth : {0.15, 0.2, 0.25}) {
     const ObstacleQuery q = sphere.query((1.0 - depth) * u, 0.0);

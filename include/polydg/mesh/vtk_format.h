@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <ostream>
 #include <span>
 #include <stdexcept>
@@ -120,6 +121,12 @@ void writeDataArray(std::ostream& os, const ArrayOut& a, VtuEncoding encoding, s
 
 /// Writes the binary form of `a` (binaryBytes() bytes) raw, for the AppendedData section.
 void writeAppendedBytes(std::ostream& os, const ArrayOut& a);
+
+/// Writes a file through `contents` to `path + ".tmp"`, then renames it over `path`, so `path`
+/// is never left half-written; on any failure the temporary file is removed. Throws
+/// std::runtime_error("cannot write PATH: reason") for an I/O error, and lets what `contents`
+/// throws through.
+void writeReplacing(const std::string& path, const std::function<void(std::ostream&)>& contents);
 
 // --- reading --------------------------------------------------------------------------------
 

@@ -98,6 +98,12 @@ class ContactModel {
   void queryAll(const Eigen::Matrix<double, Eigen::Dynamic, 3>& positions, double t,
                 std::vector<ObstacleQuery>& out, std::vector<std::uint32_t>& which);
   ContactLinearization build() const;
+  /// Undeformed points plus `displacement`.
+  Eigen::Matrix<double, Eigen::Dynamic, 3> positionsOf(
+      const Eigen::Matrix<double, Eigen::Dynamic, 3>& displacement) const;
+  /// A contact of `point` with `obstacle`, linearized about its position in `at`.
+  static Active contact(std::size_t point, std::uint32_t obstacle, const ObstacleQuery& q,
+                        const Eigen::Matrix<double, Eigen::Dynamic, 3>& at);
   /// The points' displacements for coefficients u (the last result kept: see contact.cpp).
   const Eigen::Matrix<double, Eigen::Dynamic, 3>& displacementsOf(const Eigen::VectorXd& u);
 

@@ -67,8 +67,9 @@ class Obstacle {
                               const Vec3& velocity = Vec3::Zero());
 
   /// Distance and normal at each point at time t (out[i] for points[i]), in parallel. Points
-  /// outside the exterior band get distance options.exteriorBand and a zero normal (no contact);
-  /// points deeper inside than the interior band get -options.interiorBand and a zero normal.
+  /// outside the exterior band, or in its outermost voxel layer (whose values blend with the
+  /// field's background), get distance options.exteriorBand and a zero normal (no contact);
+  /// points that deep in the interior band get -options.interiorBand and a zero normal.
   /// Throws std::invalid_argument if the spans differ in size.
   void query(std::span<const Vec3> points, double t, std::span<ObstacleQuery> out) const;
   /// query() of one point.
