@@ -282,7 +282,8 @@ nlohmann::json queryPart(const Sizes& z, double bodyDiagonal, const TriangleSurf
       // The exact signed distance to the shell where a hemisphere is the nearest surface.
       const double r = (points[i] - kBowlCentre).norm();
       const double exact = std::max(kBowlInner - r, r - outer);
-      if (exact < band) {
+      // Where the field gives a normal (a distance without one says only "no contact").
+      if (exact < band && hasNormal) {
         distanceError = std::max(distanceError, std::abs(out[i].distance - exact));
         ++checked;
       }
@@ -344,7 +345,7 @@ nlohmann::json queryPart(const Sizes& z, double bodyDiagonal, const TriangleSurf
            shortNumber(kIssueVoxelDivisor) +
            "); query seconds are the median wall time of one query of all points at t = 0; "
            "max_distance_error against the exact distance to the shell's spheres, over "
-           "points within the exterior band of them and at least " +
+           "points within the exterior band of them that get a normal and at least " +
            shortNumber(kRimClearance) +
            " below the rim: it includes the faceting of the bowl, whose triangles lie up to "
            "facet_sag = outer pi^2 / segments^2 inside the spheres; beyond_band_with_normal counts "
