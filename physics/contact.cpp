@@ -117,7 +117,6 @@ ContactLinearization ContactModel::linearize(const Eigen::VectorXd& u, const Eig
   const Stopwatch watch;
   const SurfaceEmbedding& e = *embedding_;
   tNext_ = tNext;
-  dt_ = dt;
   startDisplacement_ = displacementsOf(u);
   const Eigen::Matrix<double, Eigen::Dynamic, 3> velocity = e.displacements(v);
   const std::size_t np = e.numPoints();

@@ -575,36 +575,6 @@ SurfaceEmbedding SurfaceEmbedding::boundaryNodes(const PolyMesh& mesh, const DgB
   return m;
 }
 
-SparseRow SurfaceEmbedding::sampleRow(std::size_t s) const {
-  const std::size_t b = sampleStart_[s], e = sampleStart_[s + 1];
-  return {{sampleColumns_.data() + b, e - b}, {sampleValues_.data() + b, e - b}};
-}
-
-SparseRow SurfaceEmbedding::pointRow(std::size_t p) const {
-  const std::size_t b = pointStart_[p], e = pointStart_[p + 1];
-  return {{pointColumns_.data() + b, e - b}, {pointValues_.data() + b, e - b}};
-}
-
-Eigen::Matrix<double, Eigen::Dynamic, 3> SurfaceEmbedding::sampleValues(
-    const Eigen::VectorXd& coefficients) const {
-  const std::size_t ns = numSamples();
-  const std::size_t n = static_cast<std::size_t>(n_);
-  Eigen::Matrix<double, Eigen::Dynamic, 3> out(static_cast<Eigen::Index>(ns), 3);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ns, 256),
-                    [&](const tbb::blocked_range<std::size_t>& range) {
-                      for (std::size_t s = range.begin(); s != range.end(); ++s) {
-                        Eigen::RowVector3d sum = Eigen::RowVector3d::Zero();
-                        for (std::size_t q = sampleStart_[s]; q < sampleStart_[s + 1]; ++q) {
-                          const std::size_t c = sampleColumns_[q], e = c / n, i = c % n;
-                          const double* u = coefficients.data() + e * 3 * n + i;
-                          sum += sampleValues_[q] * Eigen::RowVector3d(u[0], u[n], u[2 * n]);
-                        }
-                        out.row(static_cast<Eigen::Index>(s)) = sum;
-                      }
-                    });
-  return out;
-}
-
 Eigen::Matrix<double, Eigen::Dynamic, 3> SurfaceEmbedding::displacements(
     const Eigen::VectorXd& coefficients) const {
   const std::size_t np = numPoints();

@@ -131,8 +131,8 @@ struct SimulationFrame {
 struct SimulationEmbedding {
   std::string surface;  ///< the file, "" without "embed"
   std::size_t points = 0, triangles = 0, samples = 0, pieces = 0, outside = 0;
-  std::size_t weightNonzeros = 0;  ///< of W (eq. 19)
-  std::size_t storedNonzeros = 0;  ///< of Phi and S, what a surface update reads
+  std::size_t weightNonzeros = 0;  ///< of W (eq. 19), what a surface update reads
+  std::size_t storedNonzeros = 0;  ///< of Phi and S, kept for updates after cuts
   double setupSeconds = 0.0;
   std::size_t contactPoints = 0;
   std::string contactPointKind;  ///< "surface" or "nodes", "" without obstacles

@@ -115,7 +115,7 @@ class ContactModel {
   Eigen::Matrix<double, Eigen::Dynamic, 3> startDisplacement_;  ///< u~_n of every point
   Eigen::VectorXd cachedCoefficients_;
   Eigen::Matrix<double, Eigen::Dynamic, 3> cachedDisplacement_;
-  double tNext_ = 0.0, dt_ = 0.0, querySeconds_ = 0.0;
+  double tNext_ = 0.0, querySeconds_ = 0.0;
   std::size_t dofs_ = 0;
 };
 

@@ -102,14 +102,8 @@ class SurfaceEmbedding {
   /// The displacement of every point for DG coefficients in LinearSystem's layout
   /// (U[(e * 3 + d) * n + i]); #points by 3.
   Eigen::Matrix<double, Eigen::Dynamic, 3> displacements(const Eigen::VectorXd& coefficients) const;
-  /// The sample values u_s (eq. 17 means and centre values); #samples by 3.
-  Eigen::Matrix<double, Eigen::Dynamic, 3> sampleValues(const Eigen::VectorXd& coefficients) const;
 
   const std::vector<Vec3>& samplePositions() const { return samplePositions_; }
-  /// Row s of S: scalar coefficient columns e * n + i and their weights.
-  SparseRow sampleRow(std::size_t s) const;
-  /// Row p of Phi: samples and their MLS shape functions (summing to 1).
-  SparseRow pointRow(std::size_t p) const;
   /// Row p of W = Phi S (eq. 19): scalar coefficient columns e * n + i (ascending) and weights
   /// W_i(x_p); component d of the point's displacement is sum_i W_i U[(e * 3 + d) * n + i].
   SparseRow weightRow(std::size_t p) const;
