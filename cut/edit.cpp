@@ -1,7 +1,10 @@
 #include "edit.h"
 
 #include <algorithm>
+#include <optional>
 #include <unordered_set>
+
+#include "polydg/mesh/merge_elements.h"
 
 namespace polydg::cut_detail {
 
@@ -39,41 +42,50 @@ void decouple(Edit& edit, FaceId f) {
 
 void mergeSliverPieces(Edit& edit, std::vector<ElementId> candidates, double threshold,
                        OperationReport& report) {
-  report.sliverThreshold = threshold;
-  PolyMesh& mesh = edit.mesh();
-  MomentCache& cache = edit.cache();
-  std::unordered_set<std::uint32_t> dead;
-  std::sort(candidates.begin(), candidates.end(), [&](ElementId a, ElementId b) {
-    const double va = cache.volume(a), vb = cache.volume(b);
-    return va != vb ? va < vb : a < b;
-  });
-  for (ElementId e : candidates) report.slivers += cache.volume(e) < threshold;
-  for (ElementId g : candidates) {
-    if (dead.count(g.value)) continue;
-    bool merged = false;
-    while (cache.volume(g) < threshold) {
-      std::map<std::uint32_t, double> shared;
-      for (const FaceUse& use : mesh.element(g).faces) {
+  // The elements of the mesh being edited as the groups of mergeSliverGroups (the rule and the
+  // merge slicing runs): a merged element is gone, its faces moved to the target.
+  class Groups {
+   public:
+    explicit Groups(Edit& edit) : edit_(edit) {}
+    std::optional<std::uint32_t> group(std::uint32_t e) const {
+      return dead_.count(e) ? std::nullopt : std::optional<std::uint32_t>(e);
+    }
+    double volume(std::uint32_t g) const { return edit_.cache().volume(ElementId(g)); }
+    double area(std::uint32_t g) const {
+      double a = 0.0;
+      for (const FaceUse& use : edit_.mesh().element(ElementId(g)).faces)
+        a += edit_.cache().area(use.face);
+      return a;
+    }
+    void sharedAreas(std::uint32_t g, std::map<std::uint32_t, double>& shared) const {
+      const PolyMesh& mesh = edit_.mesh();
+      for (const FaceUse& use : mesh.element(ElementId(g)).faces) {
         const Face& face = mesh.face(use.face);
         if (!face.front.valid() || !face.back.valid()) continue;
         const ElementId other = use.reversed ? face.front : face.back;
-        shared[other.value] += cache.area(use.face);
+        shared[other.value] += edit_.cache().area(use.face);
       }
-      if (shared.empty()) {
-        if (!merged) ++report.isolatedSlivers;
-        break;
-      }
-      const auto best = std::max_element(shared.begin(), shared.end(),
-                                         [](auto& a, auto& b) { return a.second < b.second; });
-      const ElementId target(best->first);
-      edit.merge(g, target);
-      dead.insert(g.value);
-      cache.update();  // the target's moments from its faces (no face is integrated)
-      ++report.sliversMerged;
-      merged = true;
-      g = target;
     }
-  }
+    std::uint32_t merge(std::uint32_t g, std::uint32_t target, double /*sharedArea*/) {
+      edit_.merge(ElementId(g), ElementId(target));
+      dead_.insert(g);
+      edit_.cache().update();  // the target's moments from its faces (no face is integrated)
+      return target;
+    }
+
+   private:
+    Edit& edit_;
+    std::unordered_set<std::uint32_t> dead_;
+  };
+  Groups groups(edit);
+  std::vector<std::uint32_t> ids;
+  ids.reserve(candidates.size());
+  for (ElementId e : candidates) ids.push_back(e.value);
+  const SliverMergeSummary counts = mergeSliverGroups(ids, threshold, groups);
+  report.sliverThreshold = threshold;
+  report.slivers += counts.slivers;
+  report.sliversMerged += counts.merged;
+  report.isolatedSlivers += counts.isolated;
 }
 
 }  // namespace polydg::cut_detail

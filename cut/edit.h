@@ -258,9 +258,13 @@ class Edit {
 /// faces tagged Cut.
 void decouple(Edit& edit, FaceId f);
 
-/// Merges the slivers among `candidates` (smallest first) into the neighbour across their
-/// largest shared face area (interior faces), until each is above the threshold or has no
-/// neighbour. Counts go to `report`.
+/// Merges the slivers among `candidates` by the sliver rule and greedy merge slicing uses
+/// (isSliver and mergeSliverGroups, polydg/mesh/merge_elements.h): `threshold` is the volume
+/// threshold T (sliver fraction times the reference volume); a piece is a sliver if its volume V
+/// is below T or its 6 V / A (A: its surface area) is below T^(1/3). Thinnest first, each into
+/// the neighbour across its largest shared interior face area, until it is no sliver or has no
+/// neighbour.
+/// Counts are added to `report`.
 void mergeSliverPieces(Edit& edit, std::vector<ElementId> candidates, double threshold,
                        OperationReport& report);
 

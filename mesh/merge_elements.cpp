@@ -1,6 +1,7 @@
 #include "polydg/mesh/merge_elements.h"
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <numeric>
 #include <stdexcept>
@@ -56,79 +57,100 @@ PolyMesh mergeElements(const PolyMesh& mesh, const std::vector<std::uint32_t>& g
   return out;
 }
 
+double sliverSize(double volume, double area) {
+  return std::min(std::cbrt(volume), 6.0 * volume / area);
+}
+
+bool isSliver(double volume, double area, double volumeThreshold) {
+  const double size = sliverSize(volume, area);
+  return size * size * size < volumeThreshold;
+}
+
 PolyMesh mergeSlivers(PolyMesh mesh, double volumeThreshold, SliverMergeReport* report) {
   const std::size_t n = mesh.numElements();
   // Each face's area vector once; element volumes from them (signed cones from the element's
-  // reference point).
-  std::vector<Vec3> area(mesh.numFaces());
+  // reference point) and element surface areas.
+  std::vector<Vec3> areaVectors(mesh.numFaces());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.numFaces(), 1024),
                     [&](const tbb::blocked_range<std::size_t>& r) {
                       for (std::size_t f = r.begin(); f != r.end(); ++f)
-                        area[f] = areaVector(mesh, FaceId(f));
+                        areaVectors[f] = areaVector(mesh, FaceId(f));
                     });
-  std::vector<double> volume(n);
+  auto faceArea = [&](std::size_t f) { return areaVectors[f].norm(); };
+  std::vector<double> volume(n), area(n);
   tbb::parallel_for(
       tbb::blocked_range<std::size_t>(0, n, 512), [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t e = r.begin(); e != r.end(); ++e) {
           const Vec3 o = elementReferencePoint(mesh, ElementId(e));
-          double threeVolume = 0.0;
+          double threeVolume = 0.0, surface = 0.0;
           for (const FaceUse& use : mesh.element(ElementId(e)).faces) {
-            const double h = area[use.face.index()].dot(faceReferencePoint(mesh, use.face) - o);
+            const double h =
+                areaVectors[use.face.index()].dot(faceReferencePoint(mesh, use.face) - o);
             threeVolume += use.reversed ? -h : h;
+            surface += faceArea(use.face.index());
           }
           volume[e] = threeVolume / 3.0;
+          area[e] = surface;
         }
       });
-  auto faceArea = [&](std::size_t f) { return area[f].norm(); };
 
-  UnionFind groups(n);
-  // Members of each group that took in another (a group never merged is its element alone).
-  std::vector<std::vector<std::size_t>> members(n);
+  // Groups of elements by union-find; a group's volume and area are kept at its representative.
+  class Groups {
+   public:
+    Groups(const PolyMesh& mesh, const std::vector<Vec3>& areaVectors, std::vector<double> volume,
+           std::vector<double> area)
+        : mesh_(mesh),
+          areaVectors_(areaVectors),
+          volume_(std::move(volume)),
+          area_(std::move(area)),
+          sets_(volume_.size()),
+          members_(volume_.size()) {}
+    std::optional<std::uint32_t> group(std::uint32_t e) { return sets_.find(e); }
+    double volume(std::uint32_t g) const { return volume_[g]; }
+    double area(std::uint32_t g) const { return area_[g]; }
+    void sharedAreas(std::uint32_t g, std::map<std::uint32_t, double>& shared) {
+      for (std::uint32_t m : membersOf(g))
+        for (const FaceUse& use : mesh_.element(ElementId(m)).faces) {
+          const Face& face = mesh_.face(use.face);
+          if (!face.front.valid() || !face.back.valid()) continue;
+          const std::uint32_t other = sets_.find((use.reversed ? face.front : face.back).value);
+          if (other != g) shared[other] += areaVectors_[use.face.index()].norm();
+        }
+    }
+    std::uint32_t merge(std::uint32_t g, std::uint32_t target, double sharedArea) {
+      sets_.unite(g, target);  // target stays the representative
+      volume_[target] += volume_[g];
+      area_[target] += area_[g] - 2.0 * sharedArea;
+      std::vector<std::uint32_t>& into = membersOf(target);
+      const std::vector<std::uint32_t>& from = membersOf(g);
+      into.insert(into.end(), from.begin(), from.end());
+      members_[g].clear();
+      return target;
+    }
+    std::size_t labels(std::vector<std::uint32_t>& out) { return sets_.labels(out); }
+
+   private:
+    // Members of each group that took in another (a group never merged is its element alone).
+    std::vector<std::uint32_t>& membersOf(std::uint32_t g) {
+      if (members_[g].empty()) members_[g].push_back(g);
+      return members_[g];
+    }
+    const PolyMesh& mesh_;
+    const std::vector<Vec3>& areaVectors_;
+    std::vector<double> volume_, area_;
+    UnionFind sets_;
+    std::vector<std::vector<std::uint32_t>> members_;
+  };
+  Groups groups(mesh, areaVectors, std::move(volume), std::move(area));
+  std::vector<std::uint32_t> all(n);
+  std::iota(all.begin(), all.end(), std::uint32_t(0));
+  const SliverMergeSummary counts = mergeSliverGroups(all, volumeThreshold, groups);
 
   SliverMergeReport r;
-  r.threshold = volumeThreshold;
-  // Only slivers start merging (volumes only grow), smallest first.
-  std::vector<std::size_t> order;
-  for (std::size_t e = 0; e < n; ++e)
-    if (volume[e] < volumeThreshold) order.push_back(e);
-  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-    return volume[a] != volume[b] ? volume[a] < volume[b] : a < b;
-  });
-  r.slivers = order.size();
-  auto membersOf = [&](std::size_t g) -> std::vector<std::size_t>& {
-    if (members[g].empty()) members[g].push_back(g);
-    return members[g];
-  };
-
-  for (std::size_t e : order) {
-    std::size_t g = groups.find(static_cast<std::uint32_t>(e));
-    while (volume[g] < volumeThreshold) {
-      // Shared area with each neighbouring group.
-      std::map<std::size_t, double> shared;
-      for (std::size_t m : membersOf(g))
-        for (const FaceUse& use : mesh.element(ElementId(m)).faces) {
-          const Face& face = mesh.face(use.face);
-          if (!face.front.valid() || !face.back.valid()) continue;
-          const std::size_t other = groups.find((use.reversed ? face.front : face.back).value);
-          if (other != g) shared[other] += faceArea(use.face.index());
-        }
-      if (shared.empty()) {
-        if (membersOf(g).size() == 1) ++r.isolated;
-        break;
-      }
-      const auto best = std::max_element(shared.begin(), shared.end(),
-                                         [](auto& a, auto& b) { return a.second < b.second; });
-      const std::size_t target = best->first;
-      groups.unite(static_cast<std::uint32_t>(g), static_cast<std::uint32_t>(target));
-      volume[target] += volume[g];
-      std::vector<std::size_t>& into = membersOf(target);
-      const std::vector<std::size_t>& from = membersOf(g);
-      into.insert(into.end(), from.begin(), from.end());
-      members[g].clear();
-      ++r.merged;
-      g = target;
-    }
-  }
+  r.threshold = counts.threshold;
+  r.slivers = counts.slivers;
+  r.merged = counts.merged;
+  r.isolated = counts.isolated;
   // Number the groups in order of their first element.
   const std::size_t count = groups.labels(r.group);
   PolyMesh out = count == n ? std::move(mesh) : mergeElements(mesh, r.group, count);

@@ -18,7 +18,8 @@ PolyMesh sliverMesh(double volumeRatio);
 /// joined by the neck [1,2] x [0,eps] x [0,1] (a prism over an 8-gon).
 PolyMesh thinNeckMesh(double eps);
 
-/// Sliver merging as in meshing (MeshingOptions::sliverTau = 0.01 of a unit cell).
+/// Sliver merging as in meshing (MeshingOptions::sliverTau = 0.01 of a unit cell; the rule is
+/// isSliver in polydg/mesh/merge_elements.h).
 inline constexpr double kStabilitySliverTau = 0.01;
 
 /// One stiffness condition estimate of a stability case.
@@ -36,8 +37,8 @@ struct StabilityConditionRun {
 StabilityConditionRun stiffnessCondition(const PolyMesh& mesh, int degree,
                                          const FaceSelector& clamp);
 
-/// B4 sliver: sliverMesh(volumeRatio), merged with kStabilitySliverTau if `merge`, clamped on
-/// the whole boundary.
+/// B4 sliver: sliverMesh(volumeRatio), merged by mergeSlivers with kStabilitySliverTau times
+/// the unit cell's volume if `merge`, clamped on the whole boundary.
 StabilityConditionRun runSliverCase(double volumeRatio, bool merge, int degree);
 
 /// B4 thin neck: thinNeckMesh(eps) clamped on x = 0.

@@ -279,7 +279,8 @@ TEST(RegionChecks, HoldingFacesAgreeWithTheWholeMeshOnSwissCheesesWithThinFaces)
   // Each whole mesh is one body (rigidModes()). Every element with its ring of neighbours
   // passes with HoldingFaces, among them rings (at 2^-7) where a strip holds an element alone
   // but not the group it belongs to; with AllFaces, the rings of elements held by the ring only
-  // through such strips count their rotations as zero modes.
+  // through such strips count their rotations as zero modes (at 2^-24; at 2^-7 the sliver rule
+  // merges the elements that would hang on such strips).
   for (const double offset : {testing::kCheeseWallOffset, 0x1p-7}) {
     MeshingOptions meshing;
     meshing.cellsAlongLongest = 8;
@@ -305,7 +306,13 @@ TEST(RegionChecks, HoldingFacesAgreeWithTheWholeMeshOnSwissCheesesWithThinFaces)
       EXPECT_EQ(all.components, regionComponents(mesh, ring)) << offset << ", element " << e;
       softRings += all.zeroModes > 6 * all.components;
     }
-    EXPECT_GT(softRings, 0u) << offset;
+    // At 2^-7 the sliver rule (6 V / A below 0.215 of a cell: thin pieces merge) has merged the
+    // elements that hung on narrow strips, so AllFaces now agrees everywhere; at 2^-24 strips
+    // remain that hold an element alone but not its group.
+    if (offset < 1e-6)
+      EXPECT_GT(softRings, 0u) << offset;
+    else
+      EXPECT_EQ(softRings, 0u) << offset;
     std::printf(
         "offset %g: %zu elements, %zu loose faces; %zu rings count soft modes with "
         "AllFaces\n",

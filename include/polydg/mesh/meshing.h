@@ -50,9 +50,12 @@ struct MeshingOptions {
   std::optional<double> cellSize;
   int cellsAlongLongest = 0;
   RepairMode repair = RepairMode::None;
-  /// Elements smaller than sliverTau * cell volume are merged into a neighbour. The default,
-  /// 1% of a cell, removes the slivers that make the DG stiffness ill-conditioned while
-  /// leaving nearly every boundary element as sliced. 0 disables merging.
+  /// Slivers by isSliver (polydg/mesh/merge_elements.h) with the volume threshold sliverTau *
+  /// cell volume (volume below it, or 6 volume / area below its cube root) are merged into a
+  /// neighbour. The default, 1% of a cell, removes the small and thin elements that make the DG
+  /// stiffness ill-conditioned (the condition estimate stays within 100x of the regular grid's
+  /// for every piece size, B4) while leaving nearly every boundary element as sliced. 0
+  /// disables merging.
   double sliverTau = 0.01;
   ProgressFn progress;
   /// Validate the result and count its shapes at the end of meshSurface(). A caller that

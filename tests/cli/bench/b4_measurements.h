@@ -21,11 +21,16 @@ inline constexpr double kConditionMargin = 1.1;
 /// The regular 3 x 3 x 3 grid of unit cubes (sliverMesh(1)), IP, clamped: cond(K), p = 1 and 2.
 inline constexpr double kRegularCond[] = {17.498, 123.15};
 
-/// sliverMesh(r) merged with kStabilitySliverTau (1% of a cell), cond(K) / regular grid's, for
-/// every r from 1e-4 to 1e-12 (19.025-19.026 and 138.35-138.37): p = 1 and 2.
+/// Issue 5's bound: a merged sliver mesh's cond(K) within this factor of the regular grid's.
+inline constexpr double kMergedSliverBound = 100.0;
+
+/// sliverMesh(r) merged with kStabilitySliverTau (the sliver rule at 1% of a cell), cond(K) /
+/// regular grid's, for every r from 1e-4 to 1e-12 (19.025-19.026 and 138.35-138.37): p = 1
+/// and 2.
 inline constexpr double kMergedSliverOverRegular[] = {1.0873, 1.1236};
 
-/// sliverMesh(0.1): a tenth of a cell is no sliver by the 1% rule and is left alone; cond(K) /
+/// sliverMesh(0.1): a slab a tenth of a cell thick is no sliver by the rule at 1% (6 V / A =
+/// 0.25 of a cell, above 0.01^(1/3) = 0.215) and is left alone; cond(K) /
 /// regular grid's (372.78 and 2455.8), p = 1 and 2.
 inline constexpr double kTenthCellOverRegular[] = {21.304, 19.941};
 
