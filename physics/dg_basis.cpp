@@ -140,6 +140,32 @@ void DgBasis::gradients(ElementId e, const Vec3& x, std::span<double> out) const
     }
 }
 
+void DgBasis::hessians(ElementId e, const Vec3& x, std::span<double> out) const {
+  double m[numMonomials(detail::kMaxBasisDegree)];
+  const double h = scales_[e];
+  scaledMonomials(degree_, (x - centres_[e]) / h, {m, static_cast<std::size_t>(n_)});
+  const double* t = coefficients_.data() + e.index() * n_ * n_;
+  const double h2 = h * h;
+  for (int k = 0; k < 3; ++k)
+    for (int l = k; l < 3; ++l) {
+      // d^2 m_a / (dy_k dy_l) = c_a m_(a - e_k - e_l), c_a = a_k a_l (k != l) or a_k (a_k - 1).
+      double dm[numMonomials(detail::kMaxBasisDegree)];
+      for (int a = 0; a < n_; ++a) {
+        const Exponents ea = monomialExponents(a);
+        int pw[3] = {ea.a, ea.b, ea.c};
+        const int first = pw[k]--;
+        const int second = pw[l]--;
+        dm[a] =
+            pw[k] < 0 || pw[l] < 0 ? 0.0 : first * second * m[monomialIndex(pw[0], pw[1], pw[2])];
+      }
+      for (int i = 0; i < n_; ++i) {
+        double s = 0.0;
+        for (int a = 0; a <= i; ++a) s += t[i * n_ + a] * dm[a];
+        out[(3 * k + l) * n_ + i] = out[(3 * l + k) * n_ + i] = s / h2;
+      }
+    }
+}
+
 Eigen::VectorXd affineCoefficients(const DgBasis& basis, ElementId e, double value,
                                    const Vec3& gradient, const Vec3& origin) {
   // In scaled monomials: value + g.(c - o) + h g.y, y = (x - c) / h.

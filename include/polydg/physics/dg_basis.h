@@ -68,6 +68,9 @@ class DgBasis {
   void values(ElementId e, const Vec3& x, std::span<double> out) const;
   /// d phi_i / d x_k (x) at out[k * size() + i].
   void gradients(ElementId e, const Vec3& x, std::span<double> out) const;
+  /// d^2 phi_i / (d x_k d x_l) (x) at out[(3 k + l) * size() + i] (9 size() values, symmetric
+  /// in k and l; zero for p = 1).
+  void hessians(ElementId e, const Vec3& x, std::span<double> out) const;
 
   /// Elements whose monomial Gram matrix was not numerically positive definite (degenerate
   /// elements); their basis falls back to the scaled monomials divided by their norms.
