@@ -13,6 +13,7 @@
 #include <unordered_set>
 
 #include "edit.h"
+#include "editor_state.h"
 #include "operation_checks.h"
 #include "piece_splitter.h"
 #include "polydg/cut/element_grid.h"
@@ -23,24 +24,6 @@
 namespace polydg {
 
 using namespace cut_detail;
-
-// --- MeshEditor state --------------------------------------------------------------------
-
-struct MeshEditor::State {
-  PolyMesh mesh;
-  std::unique_ptr<MomentCache> moments;
-  ElementGrid grid;
-  double referenceVolume = 0.0;
-  double volume = 0.0;
-  std::vector<char> region;  ///< scratch for the DG region, by element (kept all zero)
-  /// The planes each vertex lies on by construction (indices into `planes`): the plane of the
-  /// cut that made it, and the planes both ends of its edge lay on. A later cut by one of them
-  /// sees it on the plane (its rounded position may not be).
-  std::vector<PlaneTags> vertexPlane;
-  std::vector<Plane> planes;  ///< the plane of every cut so far
-  /// Faces integrated by caches this editor has replaced with ones of higher degree.
-  std::size_t retiredIntegrations = 0;
-};
 
 std::size_t MeshEditor::raiseMomentDegree(int degree) {
   State& s = *state_;
@@ -157,9 +140,7 @@ OperationReport MeshEditor::cutInPlace(const Blade& blade, const CutOptions& opt
   report.facesReintegrated += raiseMomentDegree(2 * options.validationDegree);
   const double volumeBefore = s.volume;
   Edit edit(s.mesh, *s.moments, s.grid);
-  std::uint32_t planeId = 0;
-  while (planeId < s.planes.size() && !s.planes[planeId].sameAs(blade)) ++planeId;
-  if (planeId == s.planes.size()) s.planes.push_back(blade);
+  const std::uint32_t planeId = planeIdOf(s, blade);
   s.vertexPlane.resize(s.mesh.numVertices());
   const std::size_t oldVertices = s.mesh.numVertices();
   VertexSides sides(s.mesh, blade, s.vertexPlane, planeId);
@@ -235,63 +216,12 @@ OperationReport MeshEditor::cutInPlace(const Blade& blade, const CutOptions& opt
   }
   report.elementsSplit = toSplit.size();
   report.piecesCreated = pieces.size();
-  // Split faces still used by an element left whole: that element takes all the parts.
-  for (auto& [id, parts] : splitter.splitFaces()) {
-    const FaceId f(id);
-    const ElementId front = s.mesh.face(f).front, back = s.mesh.face(f).back;
-    for (const ElementId n : {front, back}) {
-      if (!n.valid()) continue;
-      const bool reversed = n == back;
-      edit.touch(n);
-      s.mesh.detachFace(n, f);
-      for (int side : {-1, 1})
-        for (std::size_t i = 0; i < (side < 0 ? parts.minus : parts.plus).size(); ++i)
-          if (const FaceId part = splitter.subFace(f, side, i); part.valid())
-            s.mesh.attachFace(n, {part, reversed});
-    }
-    edit.markDeadIfUnused(f);
-  }
-  // A new point on an edge whose ends both lie on an earlier plane lies on it too.
-  std::map<std::pair<std::uint32_t, std::uint32_t>, VertexId> points;
+  attachSplitFaceParts(edit, splitter);
+  EdgePoints points;
   if (!toSplit.empty()) points = splitter.edgePoints();
-  // (An end lies on a plane if it was made on it or lies on it exactly.)
-  auto onPlane = [&](std::uint32_t v, std::uint32_t t) {
-    const PlaneTags& tags = s.vertexPlane[v];
-    if (std::find(tags.begin(), tags.end(), t) != tags.end()) return true;
-    return s.planes[t].side(s.mesh.position(VertexId(v))) == 0;
-  };
-  for (const auto& [edge, p] : points) {
-    if (p.index() < oldVertices) continue;
-    PlaneTags candidates = s.vertexPlane[edge.first];
-    candidates.insert(candidates.end(), s.vertexPlane[edge.second].begin(),
-                      s.vertexPlane[edge.second].end());
-    PlaneTags& tags = s.vertexPlane[p.index()];
-    for (std::uint32_t t : candidates)
-      if (std::find(tags.begin(), tags.end(), t) == tags.end() && onPlane(edge.first, t) &&
-          onPlane(edge.second, t))
-        tags.push_back(t);
-  }
-  // Edges the cut divided also bound faces of crossed elements kept whole: insert the new
-  // points there too, so every element stays closed (no T-junctions).
-  if (!unsplit.empty() && !toSplit.empty()) {
-    for (ElementId e : unsplit) {
-      const FaceList uses = s.mesh.element(e).faces;
-      for (const FaceUse& use : uses) {
-        bool changed = false;
-        const Face face = s.mesh.face(use.face);
-        for (std::size_t k = 0; k < face.numLoops(); ++k) {
-          const auto loop = face.loop(k);
-          for (std::size_t i = 0; i < loop.size(); ++i) {
-            const VertexId a = loop[i], b = loop[(i + 1) % loop.size()];
-            const auto it = points.find({std::min(a.value, b.value), std::max(a.value, b.value)});
-            if (it != points.end()) changed |= s.mesh.splitEdge(use.face, a, b, it->second);
-          }
-        }
-        if (!changed) continue;
-        edit.refresh(use.face);
-      }
-    }
-  }
+  tagEdgePoints(s, points, oldVertices);
+  // Edges the cut divided also bound faces of crossed elements kept whole.
+  if (!unsplit.empty() && !toSplit.empty()) insertEdgePoints(edit, unsplit, points);
   report.facesReintegrated += edit.updateMoments();
 
   // 4. Removal of one side: whole elements (infinite blade) and pieces.
@@ -313,8 +243,85 @@ OperationReport MeshEditor::cutInPlace(const Blade& blade, const CutOptions& opt
     mergeSliverPieces(edit, std::move(alive), options.sliverFraction * s.referenceVolume, report);
   }
 
-  // 6. Compaction, the grid, the volume.
+  // 6. Compaction, the grid, the volume, and 7. the checks.
   report.facesReintegrated += edit.updateMoments();
+  finishOperation(s, edit, volumeBefore, options.validation, options.validationDegree,
+                  options.sliverFraction * s.referenceVolume, report);
+  report.seconds = start.seconds();
+  return report;
+}
+
+namespace cut_detail {
+
+std::uint32_t planeIdOf(MeshEditor::State& s, const Plane& plane) {
+  std::uint32_t id = 0;
+  while (id < s.planes.size() && !s.planes[id].sameAs(plane)) ++id;
+  if (id == s.planes.size()) s.planes.push_back(plane);
+  return id;
+}
+
+void attachSplitFaceParts(Edit& edit, Splitter& splitter) {
+  PolyMesh& mesh = edit.mesh();
+  for (auto& [id, parts] : splitter.splitFaces()) {
+    const FaceId f(id);
+    const ElementId front = mesh.face(f).front, back = mesh.face(f).back;
+    for (const ElementId n : {front, back}) {
+      if (!n.valid()) continue;
+      const bool reversed = n == back;
+      edit.touch(n);
+      mesh.detachFace(n, f);
+      for (int side : {-1, 1})
+        for (std::size_t i = 0; i < (side < 0 ? parts.minus : parts.plus).size(); ++i)
+          if (const FaceId part = splitter.subFace(f, side, i); part.valid())
+            mesh.attachFace(n, {part, reversed});
+    }
+    edit.markDeadIfUnused(f);
+  }
+}
+
+void tagEdgePoints(MeshEditor::State& s, const EdgePoints& points, std::size_t oldVertices) {
+  // An end lies on a plane if it was made on it or lies on it exactly.
+  auto onPlane = [&](std::uint32_t v, std::uint32_t t) {
+    const PlaneTags& tags = s.vertexPlane[v];
+    if (std::find(tags.begin(), tags.end(), t) != tags.end()) return true;
+    return s.planes[t].side(s.mesh.position(VertexId(v))) == 0;
+  };
+  for (const auto& [edge, p] : points) {
+    if (p.index() < oldVertices) continue;
+    PlaneTags candidates = s.vertexPlane[edge.first];
+    candidates.insert(candidates.end(), s.vertexPlane[edge.second].begin(),
+                      s.vertexPlane[edge.second].end());
+    PlaneTags& tags = s.vertexPlane[p.index()];
+    for (std::uint32_t t : candidates)
+      if (std::find(tags.begin(), tags.end(), t) == tags.end() && onPlane(edge.first, t) &&
+          onPlane(edge.second, t))
+        tags.push_back(t);
+  }
+}
+
+void insertEdgePoints(Edit& edit, const std::vector<ElementId>& elements,
+                      const EdgePoints& points) {
+  PolyMesh& mesh = edit.mesh();
+  for (ElementId e : elements) {
+    const FaceList uses = mesh.element(e).faces;
+    for (const FaceUse& use : uses) {
+      bool changed = false;
+      const Face face = mesh.face(use.face);
+      for (std::size_t k = 0; k < face.numLoops(); ++k) {
+        const auto loop = face.loop(k);
+        for (std::size_t i = 0; i < loop.size(); ++i) {
+          const VertexId a = loop[i], b = loop[(i + 1) % loop.size()];
+          const auto it = points.find({std::min(a.value, b.value), std::max(a.value, b.value)});
+          if (it != points.end()) changed |= mesh.splitEdge(use.face, a, b, it->second);
+        }
+      }
+      if (changed) edit.refresh(use.face);
+    }
+  }
+}
+
+void finishOperation(MeshEditor::State& s, Edit& edit, double volumeBefore, ValidationLevel level,
+                     int degree, double sliverThreshold, OperationReport& report) {
   const double oldVolume = edit.oldVolume();
   edit.compact();
   double newVolume = 0.0;
@@ -329,11 +336,8 @@ OperationReport MeshEditor::cutInPlace(const Blade& blade, const CutOptions& opt
   report.leftWhole = edit.leftWhole().sorted();
   report.lineage = edit.lineage();
   report.facesTotal = s.mesh.numFaces();
-
-  // 7. Checks.
   OperationValidation& v = report.validation;
-  validateOperation(s.mesh, *s.moments, touched, s.region, options.validation,
-                    options.validationDegree, options.sliverFraction * s.referenceVolume, v);
+  validateOperation(s.mesh, *s.moments, touched, s.region, level, degree, sliverThreshold, v);
   v.volumeRelError =
       std::abs(volumeBefore - report.volumeRemoved - s.volume) / std::abs(volumeBefore);
   if (!(v.volumeRelError <= kVolumeBalanceTolerance)) {
@@ -342,9 +346,9 @@ OperationReport MeshEditor::cutInPlace(const Blade& blade, const CutOptions& opt
     if (v.passed) v.failure = msg.str();
     v.passed = false;
   }
-  report.seconds = start.seconds();
-  return report;
 }
+
+}  // namespace cut_detail
 
 OperationReport MeshEditor::mergeSlivers(double fraction, ValidationLevel validation,
                                          int validationDegree) {
@@ -364,26 +368,8 @@ OperationReport MeshEditor::mergeSlivers(double fraction, ValidationLevel valida
   for (std::size_t e = 0; e < all.size(); ++e) all[e] = ElementId(e);
   if (fraction > 0.0) mergeSliverPieces(edit, std::move(all), fraction * s.referenceVolume, report);
   report.facesReintegrated += edit.updateMoments();
-  const double oldVolume = edit.oldVolume();
-  edit.compact();
-  double newVolume = 0.0;
-  const std::vector<ElementId> touched = edit.changed().sorted();
-  for (ElementId e : touched) {
-    newVolume += s.moments->volume(e);
-    s.grid.insert(e, elementBounds(s.mesh, e));
-  }
-  s.volume = volumeBefore - oldVolume + newVolume;
-  report.lineage = edit.lineage();
-  report.facesTotal = s.mesh.numFaces();
-  validateOperation(s.mesh, *s.moments, touched, s.region, validation, validationDegree,
-                    fraction * s.referenceVolume, report.validation);
-  report.validation.volumeRelError = std::abs(volumeBefore - s.volume) / std::abs(volumeBefore);
-  if (!(report.validation.volumeRelError <= kVolumeBalanceTolerance)) {
-    if (report.validation.passed)
-      report.validation.failure =
-          "volume balance: relative error " + std::to_string(report.validation.volumeRelError);
-    report.validation.passed = false;
-  }
+  finishOperation(s, edit, volumeBefore, validation, validationDegree, fraction * s.referenceVolume,
+                  report);
   report.seconds = start.seconds();
   return report;
 }

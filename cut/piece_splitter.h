@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <stdexcept>
 #include <unordered_map>
 #include <vector>
 
@@ -159,6 +160,10 @@ class Splitter {
   }
 
   const Vec3& point(std::uint32_t local) const { return splitter_->point(local); }
+
+  /// Caps become interior faces that the pieces on their two sides share (refinement), not a
+  /// boundary face of each (a cut). Call before splitElement().
+  void coupleCaps() { coupled_ = true; }
 
   /// Replaces e by its pieces; returns them with their sides. `caps` from caps(e).
   std::vector<std::pair<ElementId, int>> splitElement(ElementId e,
@@ -349,9 +354,32 @@ class Splitter {
     switch (part.kind) {
       case Part::Kind::Whole: return part.use;
       case Part::Kind::Sub: return {subFace(part.use.face, side, part.index), part.use.reversed};
-      case Part::Kind::Cap: return {makeFace(*part.polygon, FaceOrigin::Cut), false};
+      case Part::Kind::Cap:
+        return coupled_ ? sharedCap(*part.polygon, side)
+                        : FaceUse{makeFace(*part.polygon, FaceOrigin::Cut), false};
     }
     return {};
+  }
+
+  /// The interior face of a coupled cap: made on the minus side (outward there), used reversed
+  /// by the plus side, whose cap is the same polygon the other way round.
+  FaceUse sharedCap(const PiecePolygon& polygon, int side) {
+    boost::container::small_vector<VertexId, 8> vertices;
+    boost::container::small_vector<std::uint32_t, 2> loopEnd;
+    if (!meshLoops(polygon, vertices, loopEnd)) return {};
+    std::vector<std::uint32_t> key;
+    for (VertexId v : vertices) key.push_back(v.value);
+    std::sort(key.begin(), key.end());
+    if (side < 0) {
+      const FaceId f = edit_.addFace({vertices.data(), vertices.size()},
+                                     {loopEnd.data(), loopEnd.size()}, FaceOrigin::Interior);
+      capFaces_[std::move(key)] = f;
+      return {f, false};
+    }
+    const auto it = capFaces_.find(key);
+    if (it == capFaces_.end())
+      throw std::logic_error("refine: an element's section differs on the plane's two sides");
+    return {it->second, true};
   }
 
   /// Connected components of a side's parts, joined across shared edges (mesh vertex ids).
@@ -415,6 +443,8 @@ class Splitter {
   };
   std::unordered_map<std::array<double, 3>, std::uint32_t, PositionHash> byPosition_;
   std::map<std::uint32_t, FaceParts> faces_;
+  bool coupled_ = false;
+  std::map<std::vector<std::uint32_t>, FaceId> capFaces_;  ///< coupled caps by vertex set
 };
 
 }  // namespace polydg::cut_detail

@@ -9,6 +9,7 @@
 
 #include <cstddef>
 #include <memory>
+#include <span>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -84,10 +85,25 @@ struct ElementLineage {
   }
 };
 
+/// One element to refine: split by each plane in turn, every piece made so far by the next
+/// (three mid-planes: 1-to-8; one plane: 1-to-2). The new faces are interior faces.
+struct ElementRefinement {
+  ElementId element;
+  std::vector<Plane> planes;  ///< 1 to 3
+};
+
+struct RefineOptions {
+  /// A piece below this fraction of its element's volume / 2^planes is merged into the
+  /// neighbour it shares most area with (0: never).
+  double sliverFraction = kDefaultSliverFraction;
+  ValidationLevel validation = ValidationLevel::Local;
+  int validationDegree = 1;
+};
+
 /// What one operation did.
 struct OperationReport {
-  std::string op;                   ///< "cut", "cut_polygon" or "merge"
-  std::size_t elementsSplit = 0;    ///< elements the blade divided
+  std::string op;                   ///< "cut", "cut_polygon", "merge" or "refine"
+  std::size_t elementsSplit = 0;    ///< elements the blade (refine: their planes) divided
   std::size_t piecesCreated = 0;    ///< elements made from them (before sliver merging)
   std::size_t elementsRemoved = 0;  ///< pieces deleted by removeSide
   double volumeRemoved = 0.0;
@@ -141,6 +157,13 @@ class MeshEditor {
   /// Throws std::invalid_argument for invalid options.
   OperationReport cut(const Blade& blade, const CutOptions& options = {});
 
+  /// Splits each listed element by its planes (no plane may miss it), keeping the new faces
+  /// coupled: neighbours' faces are split so faces stay shared exactly, and only what changed
+  /// is integrated again. Checked like a cut (a failure is reported, as by cut()). Throws
+  /// std::invalid_argument for an element listed twice, an invalid id or bad options.
+  OperationReport refine(std::span<const ElementRefinement> elements,
+                         const RefineOptions& options = {});
+
   /// Merges every element below `fraction` * referenceVolume() into a neighbour, as after a cut.
   OperationReport mergeSlivers(double fraction, ValidationLevel validation = ValidationLevel::Local,
                                int validationDegree = 1);
@@ -148,13 +171,16 @@ class MeshEditor {
   /// Gives the mesh back (the editor is empty afterwards).
   PolyMesh release();
 
+  struct State;  ///< defined in cut/editor_state.h (private to cut/)
+
  private:
   OperationReport cutInPlace(const Blade& blade, const CutOptions& options);
+  OperationReport refineInPlace(std::span<const ElementRefinement> elements,
+                                const RefineOptions& options);
   /// Replaces the moment cache with one of at least `degree` (every face integrated again,
   /// once) if it holds less; returns the number of faces integrated.
   std::size_t raiseMomentDegree(int degree);
 
-  struct State;
   std::unique_ptr<State> state_;
 };
 
