@@ -133,9 +133,10 @@ void addCutCommand(CLI::App& app, const CommonOptions& common, int& exitCode) {
             "delete what lies on this side of each plane: + (n.x > d) or -");
   cmd->add_option_function<double>(
          "--merge-slivers", [o](double f) { o->sliverFraction = f; },
-         "merge pieces below this fraction of the mesh's reference volume (its grid cell, or "
-         "the median element of a mesh polydg did not slice; 0: never; default: the mesh's "
-         "sliver rule, 0.01 unless meshed otherwise)")
+         "merge sliver pieces: volume below this fraction of the mesh's reference volume V (its "
+         "grid cell, or the median element of a mesh polydg did not slice), or 6 volume / area "
+         "below (TAU V)^(1/3); 0: never; default: the mesh's sliver rule, 0.01 unless meshed "
+         "otherwise")
       ->check(finiteRange(0.0, 1.0));
   addChoice(*cmd, "--validate", o->validation, validationNames(), "checks after each operation");
   cmd->add_option("--report", o->report, "write a JSON report to this file");

@@ -31,6 +31,12 @@ void printSummary(const MeshReport& report) {
             << r.volumeRelError << "), slivers merged " << r.slivers.merged << ", validation "
             << (r.validation.passed ? "passed" : "FAILED") << "\n";
   for (const std::string& repair : r.repairs) std::cout << "  repair: " << repair << "\n";
+  if (report.coarseCellSize > 0.0) {
+    std::cout << "  octree: " << report.levels << " levels below cells of " << report.coarseCellSize
+              << "; elements per level";
+    for (std::size_t n : report.elementsPerLevel) std::cout << ' ' << n;
+    std::cout << "; refinement " << report.refineSeconds << " s\n";
+  }
   if (report.dg.local) {
     const LocalDgCheck& c = *report.dg.local;
     std::cout << "  DG checks (degree " << c.degree << ", " << c.elements
@@ -109,10 +115,15 @@ void addMeshCommand(CLI::App& app, const CommonOptions& common, int& exitCode) {
   cmd->add_option("--report", o->report, "write a JSON report to this file");
   addChoice(*cmd, "--repair", o->mesh.repair, repairNames(),
             "repair broken input: fill closes holes, wrap alpha-wraps any soup");
-  cmd->add_option("--merge-slivers", o->mesh.sliverFraction,
-                  "merge elements smaller than TAU x cell volume into a neighbour (0: off)")
+  cmd->add_option(
+         "--merge-slivers", o->mesh.sliverFraction,
+         "merge slivers into a neighbour: volume below TAU cells, or 6 volume / area below "
+         "TAU^(1/3) of a cell edge (thin slabs; 0: off)")
       ->check(finiteRange(0.0, 1.0))
       ->capture_default_str();
+  cmd->add_flag("--adaptive", o->mesh.adaptive,
+                "octree slicing: --cell/--cells give the finest cells, used where the surface "
+                "passes; inside, cells as coarse as one level between face neighbours allows");
   cmd->add_flag("--no-dg", o->skipDg, "skip the DG checks (patch test, rigid modes) of the result");
   cmd->callback([o, &common, &exitCode] { run(*o, common, exitCode); });
 }

@@ -8,6 +8,8 @@
 //   polydg solve beam.vtu -o out.vtu --clamp x=0 --gravity 0,0,-1 --surface deformed.vtp
 //       (the surface the mesh was sliced from, carried by the MLS embedding; --embed FILE for
 //       another)
+//   polydg solve bar.vtu -o bar_adapted.vtu --clamp x=0 --traction x=9:0,0,-1 --adapt
+//       --target-error 0.05 --max-dofs 200000   (solve, estimate, mark, refine; one line)
 #include <filesystem>
 #include <iostream>
 
@@ -25,6 +27,8 @@ namespace {
 struct SolveCommandOptions {
   std::string input, output, report;
   std::string surfaceOutput, embed;  ///< --surface, --embed
+  bool adapt = false;                ///< --adapt
+  AdaptOptions adaptOptions;
   SolveOptions solve = [] {
     SolveOptions s;
     s.degree = 2;  // the command's default (pipelines and the library default to 1)
@@ -53,7 +57,9 @@ void run(const SolveCommandOptions& o, const CommonOptions& common) {
         "--clamp-below or --clamp-box");
   ReadReport read;
   Model model = Model::read(o.input, &read);
-  const SolveReport r = model.solve(o.solve);
+  SolveOptions options = o.solve;
+  if (o.adapt) options.adapt = o.adaptOptions;
+  const SolveReport r = model.solve(options);
   const WriteReport written = model.write(o.output);
   // The deformed embedded surface (physics/embedding.h), written atomically.
   nlohmann::json surfaceJson;
@@ -104,6 +110,18 @@ void run(const SolveCommandOptions& o, const CommonOptions& common) {
               << " s, solve " << s.solveSeconds << " s; max |u| " << r.maxDisplacement
               << ", energy " << s.energy << '\n'
               << "  wrote " << o.output << '\n';
+    for (std::size_t i = 0; i < r.rounds.size(); ++i) {
+      const AdaptRound& a = r.rounds[i];
+      std::cout << "  round " << i << ": " << a.elements << " elements, " << a.dofs << " DOFs";
+      if (o.adaptOptions.criterion == AdaptCriterion::Error)
+        std::cout << ", estimate " << a.estimate << " (" << a.estimate / a.energyNorm
+                  << " of the energy norm)";
+      else
+        std::cout << ", largest principal stress " << a.largestStress;
+      if (a.marked) std::cout << "; refined " << a.marked;
+      if (!a.stop.empty()) std::cout << "; stopped: " << a.stop;
+      std::cout << '\n';
+    }
     if (!surfaceJson.is_null())
       std::cout << "  wrote " << o.surfaceOutput << " (the deformed "
                 << surfaceJson["surface"].get<std::string>() << ", "
@@ -152,6 +170,36 @@ void addSolveCommand(CLI::App& app, const CommonOptions& common, int& exitCode) 
          },
          "the penalty: fixed, or the first value of doubling")
       ->check(kPositive);
+  AdaptOptions& a = o->adaptOptions;
+  cmd->add_flag("--adapt", o->adapt,
+                "solve adaptively: solve, estimate, mark, refine until --target-error, "
+                "--max-dofs or --max-rounds; writes the adapted mesh");
+  addChoice(*cmd, "--adapt-by", a.criterion, adaptCriterionNames(),
+            "what --adapt refines by: the error estimate, or the principal stress (the paper's)");
+  addChoice(*cmd, "--split", a.split, refineSplitNames(),
+            "how --adapt splits an element: 1-to-8 octants, or 1-to-2 halves across the "
+            "principal stress");
+  cmd->add_option_function<double>(
+         "--target-error", [&a](double e) { a.targetError = e; },
+         "--adapt: stop once the estimate is below this fraction of the energy norm")
+      ->check(kPositive);
+  cmd->add_option_function<std::size_t>(
+         "--max-dofs", [&a](std::size_t n) { a.maxDofs = n; },
+         "--adapt: stop before a refinement would exceed this many DOFs")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--max-rounds", a.maxRounds, "--adapt: refinement rounds at most")
+      ->check(CLI::Range(0, 20))
+      ->capture_default_str();
+  cmd->add_option("--bulk", a.bulk,
+                  "--adapt-by error: refine the fewest elements holding this share of the "
+                  "squared estimate")
+      ->check(CLI::Range(1e-6, 1.0))
+      ->capture_default_str();
+  cmd->add_option("--stress-fraction", a.stressFraction,
+                  "--adapt-by stress: refine where the principal stress exceeds this fraction "
+                  "of the first solve's largest")
+      ->check(CLI::Range(1e-6, 1.0))
+      ->capture_default_str();
   cmd->add_option("--report", o->report, "write the figures as JSON to this file");
   cmd->add_option("--surface", o->surfaceOutput,
                   "write the deformed embedded surface (MLS embedding) to this .vtp file");

@@ -21,18 +21,6 @@ namespace polydg {
 
 namespace fs = std::filesystem;
 
-namespace {
-
-/// The options cuts and merges share, checked before the mesh is touched.
-void checkEditOptions(double sliverFraction, int validationDegree) {
-  if (!(sliverFraction >= 0.0 && sliverFraction <= 1.0))
-    throw InputError("the sliver fraction must be a number in [0, 1]");
-  if (validationDegree < 1 || validationDegree > 3)
-    throw InputError("the validation degree must be 1, 2 or 3");
-}
-
-}  // namespace
-
 double medianElementVolume(const PolyMesh& mesh) {
   if (mesh.numElements() == 0) return 0.0;
   std::vector<double> volumes(mesh.numElements());
@@ -145,6 +133,22 @@ Model Model::fromSurface(const TriangleSurface& surface, const MeshOptions& opti
   meshing.cellsAlongLongest = options.cells;
   meshing.repair = options.repair;
   meshing.sliverTau = options.sliverFraction;
+  // Octree slicing: the grid 2^levels times coarser than the finest cell, with at least two
+  // cells along the longest side; its slivers are merged once, at the finest cell's scale.
+  double finest = 0.0;
+  int levels = 0;
+  if (options.adaptive) {
+    const Box3 box = bounds(surface);
+    const double longest = box.diagonal().maxCoeff();
+    if (!(longest > 0.0)) throw InputError("the surface is flat; there is no volume to mesh");
+    if (!options.cellSize && options.cells < 1)
+      throw InputError("the number of cells must be at least 1");
+    finest = options.cellSize ? *options.cellSize : longest / options.cells;
+    while (levels < 10 && std::ldexp(finest, levels + 1) * 2.0 <= longest) ++levels;
+    meshing.cellSize = std::ldexp(finest, levels);
+    meshing.cellsAlongLongest = 0;
+    meshing.sliverTau = 0.0;
+  }
   meshing.progress = options.progress;
   meshing.validate = false;  // below, beside the checks and the writing
   MeshingResult meshed = meshSurface(surface, meshing);
@@ -153,11 +157,12 @@ Model Model::fromSurface(const TriangleSurface& surface, const MeshOptions& opti
 
   Provenance provenance;
   provenance.source = source;
-  provenance.cellSize = grid.cellSize;
-  provenance.referenceVolume = grid.cellSize * grid.cellSize * grid.cellSize;
+  provenance.cellSize = options.adaptive ? finest : grid.cellSize;
+  provenance.referenceVolume = provenance.cellSize * provenance.cellSize * provenance.cellSize;
   provenance.referenceKind = ReferenceKind::GridCell;
   provenance.sliverFraction = options.sliverFraction;
   Model model(std::move(meshed.mesh), provenance);
+  if (options.adaptive) refineAtSurface(model, grid, levels, options.sliverFraction, report);
   const PolyMesh& mesh = model.mesh();
 
   // The mesh is validated, DG-checked and written side by side: all three only read it, and
@@ -176,7 +181,7 @@ Model Model::fromSurface(const TriangleSurface& surface, const MeshOptions& opti
           MeshCheckOptions checks;
           checks.degree = 1;
           checks.geometry = false;
-          checks.oneGridCellForAll = true;
+          checks.oneGridCellForAll = !options.adaptive;  // an octree's cells differ in size
           checks.rigidModes = GlobalCheck::Never;
           const MomentCache* moments =
               options.momentDegree > 0 ? &model.moments(options.momentDegree) : nullptr;
@@ -360,6 +365,7 @@ void Model::State::adoptSolution(std::unique_ptr<DgBasis> basis, Eigen::VectorXd
 }
 
 SolveReport Model::solve(const SolveOptions& options) {
+  if (options.adapt) return solveAdaptively(*this, options);
   State& s = *state_;
   s.requireUsable();
   try {
@@ -371,18 +377,26 @@ SolveReport Model::solve(const SolveOptions& options) {
   if (!options.gravity.allFinite()) throw InputError("gravity must be three finite numbers");
   for (const TractionLoad& t : options.tractions)
     if (!t.traction.allFinite()) throw InputError("a traction must be three finite numbers");
-  if (options.clamps.empty())
+  if (options.clamps.empty() && options.displacements.empty())
     throw InputError("nothing holds the body: give at least one clamp (a plane, below or box)");
+  if (!options.exactDisplacement != !options.exactGradient)
+    throw InputError("an exact solution needs both its displacement and its gradient");
+  if (options.estimate && options.method != Method::IP)
+    throw InputError("the error estimate is for the IP method; use --method ip");
   const PolyMesh& m = mesh();
   s.requireValid();
   SolveReport report;
   report.options = options;
   std::vector<const FaceSelector*> tractions;
   for (const TractionLoad& t : options.tractions) tractions.push_back(&t.where);
-  s.checkSelections(options.clamps, tractions, report.clampFaces, report.tractionFaces);
+  std::vector<FaceSelector> held = options.clamps;
+  for (const DirichletCondition& d : options.displacements) held.push_back(d.where);
+  s.checkSelections(held, tractions, report.clampFaces, report.tractionFaces);
 
   LoadCase loads;
   for (const FaceSelector& c : options.clamps) loads.dirichlet.push_back({c, {}});
+  for (const DirichletCondition& d : options.displacements) loads.dirichlet.push_back(d);
+  loads.bodyForce = options.bodyForce;
   for (const TractionLoad& t : options.tractions) loads.tractions.push_back({t.where, t.traction});
   loads.gravity = options.gravity;
   StaticOptions so;
@@ -401,8 +415,9 @@ SolveReport Model::solve(const SolveOptions& options) {
   StaticSolver solver(m, options.material, so, &moments);
   solver.integrate();
   solver.assemble(loads);
+  const Eigen::VectorXd* u = nullptr;
   try {
-    solver.solve();
+    u = &solver.solve();
   } catch (const std::runtime_error& e) {
     throw CheckFailure(std::string(e.what()) + "; hold every piece of the body with a clamp");
   }
@@ -412,6 +427,19 @@ SolveReport Model::solve(const SolveOptions& options) {
                        std::to_string(report.solve.solver.residual) +
                        "); is every piece of the body clamped?");
   report.facesIntegrated = facesIntegrated() - before;
+  if (options.estimate) {
+    report.estimate = estimateError(m, solver, options.material, loads, *u);
+    report.energyNorm = std::sqrt(std::max(0.0, u->dot(solver.system().matrix * *u)));
+  }
+
+  if (options.exactDisplacement && options.exactGradient) {
+    const int q = std::max(options.degree + 4, 2 * options.degree + 2);
+    report.error =
+        errorNorms(m, solver.basis(), *u, options.exactDisplacement, options.exactGradient, q);
+    report.energyError =
+        energyError(m, solver.basis(), solver.moments(), solver.roles(), solver.form(), *u,
+                    options.exactDisplacement, options.exactGradient, q);
+  }
 
   StaticSolution solved = solver.release();
   s.adoptSolution(std::move(solved.basis), std::move(solved.coefficients), options.material,

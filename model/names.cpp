@@ -7,6 +7,18 @@ const Names<Method>& methodNames() {
   return names;
 }
 
+const Names<RefineSplit>& refineSplitNames() {
+  static const Names<RefineSplit> names{{"octants", RefineSplit::Octants},
+                                        {"halves", RefineSplit::Halves}};
+  return names;
+}
+
+const Names<AdaptCriterion>& adaptCriterionNames() {
+  static const Names<AdaptCriterion> names{{"error", AdaptCriterion::Error},
+                                           {"stress", AdaptCriterion::Stress}};
+  return names;
+}
+
 const Names<SolverKind>& solverNames() {
   static const Names<SolverKind> names{{"auto", SolverKind::Auto},
                                        {"cholesky", SolverKind::Cholesky},

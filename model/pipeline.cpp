@@ -103,6 +103,7 @@ MeshStep meshStep(JsonObjectReader& r) {
   if (r.has("repair")) s.options.repair = r.choice("repair", repairNames());
   if (r.has("merge_slivers")) s.options.sliverFraction = r.number("merge_slivers", 0.0, 1.0);
   if (r.has("dg_checks")) s.options.dgChecks = r.boolean("dg_checks");
+  if (r.has("adaptive")) s.options.adaptive = r.boolean("adaptive");
   return s;
 }
 
@@ -119,6 +120,25 @@ CheckStep checkStep(JsonObjectReader& r) {
   CheckStep s;
   if (r.has("degree")) s.options.degree = r.integer("degree", 1, 3);
   return s;
+}
+
+/// The "adapt" key of a solve: true (the defaults), false, or an object of "by" ("error",
+/// "stress"), "split" ("octants", "halves"), "target_error", "max_dofs", "max_rounds", "bulk",
+/// "stress_fraction".
+std::optional<AdaptOptions> adaptOptions(JsonObjectReader& r) {
+  const json& value = r.get("adapt");
+  if (value.is_boolean()) return value.get<bool>() ? std::optional(AdaptOptions{}) : std::nullopt;
+  JsonObjectReader o = r.object("adapt");
+  AdaptOptions a;
+  if (o.has("by")) a.criterion = o.choice("by", adaptCriterionNames());
+  if (o.has("split")) a.split = o.choice("split", refineSplitNames());
+  if (o.has("target_error")) a.targetError = o.number("target_error", 1e-300, 1e300);
+  if (o.has("max_dofs")) a.maxDofs = static_cast<std::size_t>(o.number("max_dofs", 1.0, 1e15));
+  if (o.has("max_rounds")) a.maxRounds = o.integer("max_rounds", 0, 20);
+  if (o.has("bulk")) a.bulk = o.number("bulk", 1e-6, 1.0);
+  if (o.has("stress_fraction")) a.stressFraction = o.number("stress_fraction", 1e-6, 1.0);
+  o.finish();
+  return a;
 }
 
 SolveStep solveStep(JsonObjectReader& r) {
@@ -148,6 +168,8 @@ SolveStep solveStep(JsonObjectReader& r) {
   if (r.has("eta")) o.eta = r.number("eta", 1e-300, 1e300);
   if (o.penalty == PenaltyRule::Fixed && o.eta <= 0.0)
     r.fail(r.at("eta"), "a fixed penalty needs \"eta\"");
+  if (r.has("adapt")) o.adapt = adaptOptions(r);
+  if (r.has("estimate")) o.estimate = r.boolean("estimate");
   if (r.has("output")) s.output = outputPath(r, "output");
   return s;
 }

@@ -185,6 +185,13 @@ json toJson(const MeshReport& report) {
        {{"origin", vectorJson(r.grid.origin())},
         {"cell_size", r.grid.cellSize},
         {"cells", r.grid.cells}}},
+      {"octree", report.levels == 0 && report.coarseCellSize == 0.0
+                     ? json(nullptr)
+                     : json{{"levels", report.levels},
+                            {"coarse_cell_size", report.coarseCellSize},
+                            {"finest_cell_size", std::ldexp(report.coarseCellSize, -report.levels)},
+                            {"elements_per_level", report.elementsPerLevel},
+                            {"refine_seconds", report.refineSeconds}}},
       {"output",
        {{"file", report.output.empty() ? json(nullptr) : json(report.output)},
         {"elements", r.elements},
@@ -237,6 +244,45 @@ json toJson(const OperationReport& r) {
           {"time_s", r.seconds}};
 }
 
+namespace {
+
+/// An adaptive solve's options and rounds; null for one solve.
+json adaptJson(const SolveReport& report) {
+  if (!report.options.adapt) return nullptr;
+  const AdaptOptions& a = *report.options.adapt;
+  const bool exact = static_cast<bool>(report.options.exactDisplacement);
+  json rounds = json::array();
+  for (const AdaptRound& r : report.rounds)
+    rounds.push_back(
+        {{"elements", r.elements},
+         {"dofs", r.dofs},
+         {"estimate", r.estimate},
+         {"energy_norm", r.energyNorm},
+         {"relative_estimate", r.energyNorm > 0.0 ? r.estimate / r.energyNorm : 0.0},
+         {"l2_error", exact ? json(r.l2Error) : json(nullptr)},
+         {"energy_error", exact ? json(r.energyError) : json(nullptr)},
+         {"effectivity",
+          exact && r.energyError > 0.0 ? json(r.estimate / r.energyError) : json(nullptr)},
+         {"largest_principal_stress", r.largestStress},
+         {"marked", r.marked},
+         {"elements_after", r.elementsAfter},
+         {"stop", r.stop.empty() ? json(nullptr) : json(r.stop)},
+         {"timings_s",
+          {{"solve", r.solveSeconds},
+           {"estimate", r.estimateSeconds},
+           {"refine", r.refineSeconds}}}});
+  return {{"criterion", nameOf(adaptCriterionNames(), a.criterion)},
+          {"split", nameOf(refineSplitNames(), a.split)},
+          {"target_error", a.targetError ? json(*a.targetError) : json(nullptr)},
+          {"max_dofs", a.maxDofs ? json(*a.maxDofs) : json(nullptr)},
+          {"bulk", a.bulk},
+          {"stress_fraction", a.stressFraction},
+          {"max_rounds", a.maxRounds},
+          {"rounds", rounds}};
+}
+
+}  // namespace
+
 json toJson(const SolveReport& report) {
   const StaticReport& r = report.solve;
   const SolveOptions& o = report.options;
@@ -253,44 +299,61 @@ json toJson(const SolveReport& report) {
     t["faces"] = i < report.tractionFaces.size() ? report.tractionFaces[i] : 0;
     tractions.push_back(t);
   }
-  return {{"method", toString(o.method)},
-          {"degree", o.degree},
-          {"material",
-           {{"E", o.material.youngsModulus},
-            {"nu", o.material.poissonRatio},
-            {"density", o.material.density}}},
-          {"gravity", vectorJson(o.gravity)},
-          {"penalty_rule", toString(o.penalty)},
-          {"clamps", clamps},
-          {"tractions", tractions},
-          {"elements", r.elements},
-          {"dofs", r.dofs},
-          {"nonzeros", r.nonzeros},
-          {"sparsity", dofs > 0 ? static_cast<double>(r.nonzeros) / (dofs * dofs) : 0.0},
-          {"eta", r.eta},
-          {"eta_threshold", r.etaThreshold},
-          {"penalty_attempts", r.penaltyAttempts},
-          {"dirichlet_faces", r.dirichletFaces},
-          {"traction_faces", r.tractionFaces},
-          {"basis_fallbacks", r.basisFallbacks},
-          {"solver",
-           {{"kind", toString(r.solver.used)},
-            {"preconditioner", r.solver.used == SolverKind::ConjugateGradient
-                                   ? json(toString(r.solver.preconditioner))
-                                   : json("none")},
-            {"success", r.solver.success},
-            {"iterations", r.solver.iterations},
-            {"residual", r.solver.residual}}},
-          {"energy", r.energy},
-          {"max_displacement", report.maxDisplacement},
-          {"max_von_mises", report.maxVonMises},
-          {"max_jump", report.maxJump},
-          {"faces_integrated", report.facesIntegrated},
-          {"timings_s",
-           {{"integrate", r.integrateSeconds},
-            {"assemble", r.assembleSeconds},
-            {"solve", r.solveSeconds},
-            {"factorize", r.solver.factorSeconds}}}};
+  return {
+      {"method", toString(o.method)},
+      {"degree", o.degree},
+      {"material",
+       {{"E", o.material.youngsModulus},
+        {"nu", o.material.poissonRatio},
+        {"density", o.material.density}}},
+      {"gravity", vectorJson(o.gravity)},
+      {"penalty_rule", toString(o.penalty)},
+      {"clamps", clamps},
+      {"tractions", tractions},
+      {"elements", r.elements},
+      {"dofs", r.dofs},
+      {"nonzeros", r.nonzeros},
+      {"sparsity", dofs > 0 ? static_cast<double>(r.nonzeros) / (dofs * dofs) : 0.0},
+      {"eta", r.eta},
+      {"eta_threshold", r.etaThreshold},
+      {"penalty_attempts", r.penaltyAttempts},
+      {"dirichlet_faces", r.dirichletFaces},
+      {"traction_faces", r.tractionFaces},
+      {"basis_fallbacks", r.basisFallbacks},
+      {"solver",
+       {{"kind", toString(r.solver.used)},
+        {"preconditioner", r.solver.used == SolverKind::ConjugateGradient
+                               ? json(toString(r.solver.preconditioner))
+                               : json("none")},
+        {"success", r.solver.success},
+        {"iterations", r.solver.iterations},
+        {"residual", r.solver.residual}}},
+      {"energy", r.energy},
+      {"max_displacement", report.maxDisplacement},
+      {"max_von_mises", report.maxVonMises},
+      {"max_jump", report.maxJump},
+      {"faces_integrated", report.facesIntegrated},
+      {"timings_s",
+       {{"integrate", r.integrateSeconds},
+        {"assemble", r.assembleSeconds},
+        {"solve", r.solveSeconds},
+        {"factorize", r.solver.factorSeconds}}},
+      {"estimate", report.estimate
+                       ? json{{"total", report.estimate->total},
+                              {"energy_norm", report.energyNorm},
+                              {"residual", std::sqrt(report.estimate->residual)},
+                              {"traction_jump", std::sqrt(report.estimate->tractionJump)},
+                              {"displacement_jump", std::sqrt(report.estimate->displacementJump)},
+                              {"dirichlet", std::sqrt(report.estimate->dirichlet)}}
+                       : json(nullptr)},
+      {"adapt", adaptJson(report)}};
+}
+
+json toJson(const RefineReport& r) {
+  json j = toJson(r.operation);
+  j["solution_exact"] = r.solutionExact;
+  j["solution_extended"] = r.solutionExtended;
+  return j;
 }
 
 json toJson(const ReadReport& r) {
@@ -360,6 +423,11 @@ json toJson(const Scene& s) {
     j["cuts"].push_back(cut);
   }
   if (s.embed.enabled) j["embed"] = s.embed.file.empty() ? json(true) : json(s.embed.file);
+  if (s.adapt.enabled)
+    j["adapt"] = {{"stress", s.adapt.stress},
+                  {"split", nameOf(refineSplitNames(), s.adapt.split)},
+                  {"every", s.adapt.every},
+                  {"max_level", s.adapt.maxLevel}};
   if (!s.obstacles.empty()) {
     j["obstacles"] = json::array();
     for (const SceneObstacle& o : s.obstacles) {
@@ -421,6 +489,19 @@ json toJson(const SimulationReport& r) {
                     {"operation", toJson(c.report)},
                     {"seconds", c.seconds}});
   j["cuts"] = std::move(cuts);
+  json refinements = json::array();
+  for (const SimulationRefinement& f : r.refinements)
+    refinements.push_back({{"time", f.time},
+                           {"marked", f.marked},
+                           {"elements_before", f.elementsBefore},
+                           {"elements_after", f.elementsAfter},
+                           {"exact", f.exact},
+                           {"extended", f.extended},
+                           {"momentum_change", f.momentumChange},
+                           {"kinetic_energy_change", f.kineticChange},
+                           {"elastic_energy_change", f.elasticChange},
+                           {"seconds", f.seconds}});
+  j["refinements"] = std::move(refinements);
   json frames = json::array();
   for (const SimulationFrame& f : r.frames)
     frames.push_back({{"step", f.step},

@@ -147,6 +147,15 @@ Scene parseScene(const json& document, const std::string& file) {
       s.obstacles.push_back(o);
     }
   }
+  if (r.has("adapt")) {
+    JsonObjectReader a = r.object("adapt");
+    s.adapt.enabled = true;
+    s.adapt.stress = a.number("stress", 1e-300, kHuge);
+    if (a.has("split")) s.adapt.split = a.choice("split", refineSplitNames());
+    if (a.has("every")) s.adapt.every = a.integer("every", 1, 100000000);
+    if (a.has("max_level")) s.adapt.maxLevel = a.integer("max_level", 1, 8);
+    a.finish();
+  }
   if (r.has("contact")) {
     JsonObjectReader c = r.object("contact");
     if (c.has("stiffness")) s.contact.stiffness = c.number("stiffness", 1e-300, kHuge);

@@ -4,7 +4,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <sstream>
+#include <unordered_set>
 
+#include "field_transfer.h"
 #include "model_state.h"
 #include "polydg/mesh/geometry.h"
 #include "polydg/mesh/surface_io.h"
@@ -314,6 +316,86 @@ SimulationReport Model::simulate(const Scene& scene, const SimulateOptions& opti
   // Cuts: at the first step boundary at or after their time.
   std::size_t nextCut = 0;
   bool cutSinceFrame = false;
+  // After an edit: the new solver takes the displacement and velocity through the lineage, the
+  // embedded surface's weights and the contact points follow the new elements.
+  auto afterEdit = [&](const ElementLineage& lineage, const DgBasis& oldBasis,
+                       const Eigen::VectorXd& oldU, const Eigen::VectorXd& oldV, double time) {
+    TransferCounts counts;
+    const std::vector<Eigen::VectorXd> moved =
+        transferFields(oldBasis, {&oldU, &oldV}, solver.basis(), lineage, &counts);
+    solver.setState(time, moved[0], moved[1]);
+    if (surface.embedding || contact) {
+      const std::size_t elements = mesh().numElements();
+      std::vector<ElementId> sources(elements);
+      for (std::size_t e = 0; e < elements; ++e) {
+        const std::vector<ElementId> from = lineage.sources(ElementId(e));
+        sources[e] = from.size() == 1 ? from.front() : ElementId();
+      }
+      if (surface.embedding)
+        info.updates.push_back(surface.embedding->update(mesh(), solver.basis(), sources));
+      if (contact) {
+        if (onSurface)
+          contact->refresh();  // the same points, new weights
+        else
+          makeContact();  // the boundary nodes changed
+        solver.setContact(contact.get());
+      }
+    }
+    return counts;
+  };
+
+  // Refinement by stress (scene "adapt"): each element's level, and the refinement due after a
+  // step.
+  std::vector<int> level(mesh().numElements(), 0);
+  auto refineDue = [&](int k) {
+    const SceneAdapt& a = scene.adapt;
+    if (!a.enabled || k % a.every != 0) return false;
+    const Stopwatch tr;
+    const ElementFields fields = elementFields(mesh(), solver.basis(), moments(2 * scene.degree),
+                                               solver.displacement(), scene.material);
+    RefineRequest request;
+    request.split = a.split;
+    request.validation = ValidationLevel::None;
+    for (std::size_t e = 0; e < level.size(); ++e)
+      if (level[e] < a.maxLevel && std::abs(fields.principalStress[ElementId(e)]) > a.stress) {
+        request.elements.push_back(ElementId(e));
+        request.directions.push_back(fields.principalDirection[ElementId(e)]);
+      }
+    if (request.elements.empty()) return false;
+    if (a.split == RefineSplit::Octants) request.directions.clear();
+    SimulationRefinement record;
+    record.time = solver.time();
+    record.marked = request.elements.size();
+    record.elementsBefore = mesh().numElements();
+    const BodyState before = solver.state();
+    const DgBasis oldBasis = solver.basis();
+    const Eigen::VectorXd oldU = solver.displacement(), oldV = solver.velocity();
+    const RefineReport r = refine(request);
+    if (!r.operation.validation.passed)
+      throw CheckFailure("the refinement at t = " + std::to_string(record.time) + " failed (" +
+                         r.operation.validation.failure + "); the simulation stops there");
+    std::unordered_set<std::uint32_t> refined;
+    for (ElementId e : request.elements) refined.insert(e.value);
+    level = levelsAfter(level, r.operation.lineage, mesh().numElements(), refined);
+    record.elementsAfter = mesh().numElements();
+    solver = build();
+    const TransferCounts counts = afterEdit(r.operation.lineage, oldBasis, oldU, oldV, record.time);
+    record.exact = counts.exact;
+    record.extended = counts.extended;
+    const BodyState after = solver.state();
+    auto relative = [](double a, double b) {
+      return std::abs(a - b) / std::max(std::abs(a), 1e-300);
+    };
+    record.momentumChange =
+        (after.momentum - before.momentum).norm() / std::max(before.momentum.norm(), 1e-300);
+    record.kineticChange = relative(before.kinetic, after.kinetic);
+    record.elasticChange = relative(before.elastic, after.elastic);
+    record.seconds = tr.seconds();
+    report.cutSeconds += record.seconds;
+    report.refinements.push_back(record);
+    return true;
+  };
+
   auto cutsDue = [&](double t) {
     while (nextCut < scene.cuts.size() && scene.cuts[nextCut].time <= t + 1e-9 * scene.dt) {
       const TimedCut& timed = scene.cuts[nextCut++];
@@ -329,39 +411,13 @@ SimulationReport Model::simulate(const Scene& scene, const SimulateOptions& opti
                            record.report.validation.failure + "); the simulation stops there");
       record.elementsAfter = mesh().numElements();
       report.cutSeconds += tc.seconds();
+      level = levelsAfter(level, record.report.lineage, record.elementsAfter, {});
       solver = build();
       const Stopwatch tt;
-      const int n = solver.basis().size(), bs = 3 * n;
-      Eigen::VectorXd u(static_cast<Eigen::Index>(record.elementsAfter) * bs), v(u.size());
-      for (std::size_t e = 0; e < record.elementsAfter; ++e) {
-        const std::vector<ElementId> sources = record.report.lineage.sources(ElementId(e));
-        (sources.size() == 1 ? record.exact : record.extended) += 1;
-        const Eigen::MatrixXd q =
-            transferMatrix(oldBasis, sources.front(), solver.basis(), ElementId(e));
-        const Eigen::Index from = static_cast<Eigen::Index>(sources.front().index()) * bs;
-        const Eigen::Index to = static_cast<Eigen::Index>(e) * bs;
-        for (int d = 0; d < 3; ++d) {
-          u.segment(to + d * n, n) = q * oldU.segment(from + d * n, n);
-          v.segment(to + d * n, n) = q * oldV.segment(from + d * n, n);
-        }
-      }
-      solver.setState(record.time, u, v);
-      if (surface.embedding || contact) {
-        std::vector<ElementId> sources(record.elementsAfter);
-        for (std::size_t e = 0; e < record.elementsAfter; ++e) {
-          const std::vector<ElementId> from = record.report.lineage.sources(ElementId(e));
-          sources[e] = from.size() == 1 ? from.front() : ElementId();
-        }
-        if (surface.embedding)
-          info.updates.push_back(surface.embedding->update(mesh(), solver.basis(), sources));
-        if (contact) {
-          if (onSurface)
-            contact->refresh();  // the same points, new weights
-          else
-            makeContact();  // the boundary nodes changed
-          solver.setContact(contact.get());
-        }
-      }
+      const TransferCounts counts =
+          afterEdit(record.report.lineage, oldBasis, oldU, oldV, record.time);
+      record.exact = counts.exact;
+      record.extended = counts.extended;
       record.seconds = tc.seconds();
       report.cutSeconds += tt.seconds();
       report.cuts.push_back(std::move(record));
@@ -397,6 +453,10 @@ SimulationReport Model::simulate(const Scene& scene, const SimulateOptions& opti
     const std::size_t cutsBefore = report.cuts.size();
     cutsDue(solver.time());
     if (report.cuts.size() != cutsBefore) first = true;  // a new solver after the cut
+    if (refineDue(k)) {
+      first = true;
+      cutSinceFrame = true;
+    }
     if (k % scene.outputEvery == 0 || k == scene.steps || cutSinceFrame) {
       writeFrame(k);
       cutSinceFrame = false;

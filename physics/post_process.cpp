@@ -7,6 +7,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 
 #include "polydg/integrate/quadrature.h"
 #include "polydg/mesh/geometry.h"
@@ -94,6 +95,8 @@ ElementFields elementFields(const PolyMesh& mesh, const DgBasis& basis, const Mo
   ElementFields out;
   out.meanDisplacement.resize(ne, Vec3::Zero());
   out.vonMises.resize(ne, 0.0);
+  out.principalStress.resize(ne, 0.0);
+  out.principalDirection.resize(ne, Vec3::UnitX());
   out.largestJump.resize(ne, 0.0);
   const double mu = material.mu(), lambda = material.lambda();
   tbb::parallel_for(std::size_t(0), ne, [&](std::size_t i) {
@@ -113,6 +116,11 @@ ElementFields elementFields(const PolyMesh& mesh, const DgBasis& basis, const Mo
         2.0 * mu * eps + lambda * eps.trace() * Eigen::Matrix3d::Identity();
     const Eigen::Matrix3d dev = sigma - sigma.trace() / 3.0 * Eigen::Matrix3d::Identity();
     out.vonMises[e] = std::sqrt(1.5 * dev.squaredNorm());
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen;
+    eigen.computeDirect(sigma);
+    const int k = std::abs(eigen.eigenvalues()[0]) > std::abs(eigen.eigenvalues()[2]) ? 0 : 2;
+    out.principalStress[e] = eigen.eigenvalues()[k];
+    out.principalDirection[e] = eigen.eigenvectors().col(k);
   });
   // Jumps at the vertices of interior faces.
   for (std::size_t i = 0; i < ne; ++i) {

@@ -9,8 +9,10 @@
 #include <pybind11/stl.h>
 
 #include <algorithm>
+#include <array>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <optional>
 #include <string>
 #include <utility>
@@ -20,6 +22,7 @@
 
 #include "polydg/mesh/surface_io.h"
 #include "polydg/model/model.h"
+#include "polydg/model/names.h"
 #include "polydg/model/pipeline.h"
 #include "polydg/model/report_json.h"
 #include "polydg/model/scene.h"
@@ -358,6 +361,42 @@ PYBIND11_MODULE(_polydg, m) {
                                          return editReport(m.mergeSlivers(s.request));
                                        });
            })
+      .def(
+          "_refine",
+          [](Model& model, const std::vector<std::int64_t>& elements, const std::string& split,
+             const std::optional<std::vector<std::array<double, 3>>>& directions,
+             std::optional<double> mergeSlivers, const std::string& validate) {
+            RefineRequest request;
+            const auto kind = parseName(refineSplitNames(), split);
+            if (!kind)
+              throw InputError("split must be one of " + listNames(refineSplitNames()) + ", not '" +
+                               split + "'");
+            request.split = *kind;
+            const auto level = parseName(validationNames(), validate);
+            if (!level)
+              throw InputError("validate must be one of " + listNames(validationNames()) +
+                               ", not '" + validate + "'");
+            request.validation = *level;
+            for (std::int64_t e : elements) {
+              if (e < 0 || e > std::numeric_limits<std::uint32_t>::max() - 1)
+                throw InputError("element " + std::to_string(e) + " is not in the mesh");
+              request.elements.push_back(ElementId(static_cast<std::uint32_t>(e)));
+            }
+            if (directions)
+              for (const auto& d : *directions)
+                request.directions.push_back(Vec3(d[0], d[1], d[2]));
+            request.sliverFraction = mergeSlivers;
+            RefineReport r;
+            {
+              py::gil_scoped_release release;
+              r = model.refine(request);
+            }
+            if (!r.operation.validation.passed)
+              throw CheckFailure("refine failed: " + r.operation.validation.failure);
+            return toPython(toJson(r));
+          },
+          py::arg("elements"), py::arg("split") = "octants", py::arg("directions") = py::none(),
+          py::arg("merge_slivers") = py::none(), py::arg("validate") = "local")
       .def("_check",
            [](Model& model, const py::kwargs& kwargs) {
              return operate<CheckStep>(

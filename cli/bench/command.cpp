@@ -11,6 +11,8 @@
 //                                                   17 minutes and 5 GB)
 //   polydg bench --suite contact --out bench/      (B9, embedding and collision speed; 2
 //                                                   minutes)
+//   polydg bench --suite adaptivity --out bench/   (B11 and B12: refinement by stress and by
+//                                                   the error estimate)
 //   polydg bench --suite meshing --out b/ --data DIR  (torus.obj from DIR instead of the
 //                                                      share/polydg folder beside the binary)
 #include <filesystem>
@@ -59,6 +61,8 @@ void runBench(BenchOptions o, const CommonOptions& common) {
     timed("dynamics", [&] { return bench::dynamicsSuite(o, common.quiet); });
   if (all || o.suite == "contact")
     timed("contact", [&] { return bench::contactSuite(o, common.quiet); });
+  if (all || o.suite == "adaptivity")
+    timed("adaptivity", [&] { return bench::adaptivitySuite(o, common.quiet); });
   if (!common.quiet && all) std::cout << "all suites: " << total.seconds() << " s" << std::endl;
 }
 
@@ -70,12 +74,13 @@ void addBenchCommand(CLI::App& app, const CommonOptions& common, int& exitCode) 
       "bench",
       "Benchmark suites as JSON, CSV and SVG plots: accuracy (B1), table41 (B2), "
       "stability (B4), meshing, cutting, dynamics (B6, B7, time per step), contact (B9, "
-      "embedding and collision speed), or all");
-  cmd->add_option("--suite", o->suite,
-                  "accuracy, table41, stability, meshing, cutting, dynamics, contact or all")
+      "embedding and collision speed), adaptivity (B11, B12), or all");
+  cmd->add_option(
+         "--suite", o->suite,
+         "accuracy, table41, stability, meshing, cutting, dynamics, contact, adaptivity or all")
       ->required()
       ->check(CLI::IsMember({"accuracy", "table41", "stability", "meshing", "cutting", "dynamics",
-                             "contact", "all"}));
+                             "contact", "adaptivity", "all"}));
   cmd->add_option("--out", o->out, "folder for NAME.json, NAME.csv and NAME*.svg")->required();
   cmd->add_flag("--skip-sliced", o->skipSliced, "accuracy: hex grids only");
   cmd->add_flag("--quick", o->quick,

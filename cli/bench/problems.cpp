@@ -64,6 +64,30 @@ ManufacturedProblem benchmarkB1Problem(const DomainTransform& t) {
   return p;
 }
 
+ManufacturedProblem benchmarkB12Problem(double width) {
+  ManufacturedProblem p;
+  p.material.youngsModulus = 1.0;
+  p.material.poissonRatio = 0.3;
+  const Vec3 c(0.5, 0.5, 0.5);
+  const double a = 0.01, w2 = width * width;
+  auto g = [c, w2](const Vec3& x) { return std::exp(-(x - c).squaredNorm() / (2.0 * w2)); };
+  p.displacement = [a, g](const Vec3& x) -> Vec3 { return a * g(x) * Vec3::Ones(); };
+  p.gradient = [a, g, c, w2](const Vec3& x) -> Eigen::Matrix3d {
+    const Vec3 dg = -(x - c) / w2 * g(x);
+    return a * Vec3::Ones() * dg.transpose();
+  };
+  // div sigma(u)_i = a (mu Lap g + (mu + lambda) d_i sum_k d_k g), with the Hessian of g
+  // (r r^T / w^4 - I / w^2) g.
+  const double mu = p.material.mu(), lambda = p.material.lambda();
+  p.bodyForce = [a, g, c, w2, mu, lambda](const Vec3& x) -> Vec3 {
+    const Vec3 r = x - c;
+    const Eigen::Matrix3d hessian =
+        (r * r.transpose() / (w2 * w2) - Eigen::Matrix3d::Identity() / w2) * g(x);
+    return -a * (mu * hessian.trace() * Vec3::Ones() + (mu + lambda) * hessian * Vec3::Ones());
+  };
+  return p;
+}
+
 LoadCase benchmarkB1Loads(const ManufacturedProblem& problem) {
   LoadCase loads;
   loads.dirichlet.push_back({FaceSelector::allBoundary(), problem.displacement});

@@ -27,6 +27,10 @@ struct ManufacturedProblem {
 };
 ManufacturedProblem benchmarkB1Problem(const DomainTransform& transform = {});
 
+/// B12: E = 1, nu = 0.3 on [0,1]^3, u = 0.01 (1, 1, 1) g(x), g = exp(-|x - c|^2 / (2 w^2)),
+/// c = (0.5, 0.5, 0.5), w = `width` (0.05 in BENCHMARKS.md), f = -div sigma(u).
+ManufacturedProblem benchmarkB12Problem(double width = 0.05);
+
 /// The load case of B1 (Dirichlet on every boundary face, body force by quadrature).
 LoadCase benchmarkB1Loads(const ManufacturedProblem& problem);
 

@@ -29,6 +29,10 @@
 //              update (the goal: each below 10%), and B9's drops onto the ground and into the
 //              bowl (contacts, penetration, energies per step). 80 to 120 s on 2 cores shared
 //              with builds (2026-12-02), 2.9 GB at most.
+//   adaptivity B11 (the bent bar of thesis Fig. 4.9 refined by principal stress, 1-to-8 and 1-to-2
+//              at tau = 0.25, 0.5, 0.75, beside the thesis's 274 and 77) and B12 (the steep
+//              bump: uniform 8, 16, 32 against solve --adapt from 4; DOFs to each uniform L2
+//              error, effectivity of the estimate on every mesh).
 // With `quick` each runs reduced sizes (a smoke test of every output, as the tests run it).
 #pragma once
 
@@ -39,8 +43,8 @@
 namespace polydg::bench {
 
 struct BenchOptions {
-  std::string suite;  ///< accuracy, table41, stability, meshing, cutting, dynamics, contact or all
-  std::string out;    ///< the folder the files go to
+  std::string suite;        ///< accuracy, ..., contact, adaptivity or all
+  std::string out;          ///< the folder the files go to
   bool skipSliced = false;  ///< accuracy: hex grids only
   bool quick = false;
   /// The folder of the bundled models the meshing suite reads (torus.obj); `polydg bench` uses
@@ -56,5 +60,6 @@ SuiteOutput meshingSuite(const BenchOptions& options, bool quiet);
 SuiteOutput cuttingSuite(const BenchOptions& options, bool quiet);
 SuiteOutput dynamicsSuite(const BenchOptions& options, bool quiet);
 SuiteOutput contactSuite(const BenchOptions& options, bool quiet);
+SuiteOutput adaptivitySuite(const BenchOptions& options, bool quiet);
 
 }  // namespace polydg::bench

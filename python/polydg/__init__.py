@@ -76,24 +76,28 @@ def read_surface(path):
 
 
 def mesh(surface, cells=None, cell=None, repair="none", merge_slivers=None, dg_checks=None,
-         progress=None, source=""):
+         progress=None, source="", adaptive=None):
     """Meshes a closed surface into a ``Model`` of polyhedral elements (``polydg mesh``).
 
     surface: a ``Surface`` (from ``read_surface`` or ``Surface(V, F)``).
     cells: about this many grid cells along the bounding box's longest side; or
     cell: the grid cell's edge length (model units). Give exactly one.
     repair: "none", "fill" (close holes) or "wrap" (alpha-wrap any soup).
-    merge_slivers: elements below this fraction of a cell's volume are merged (default 0.01).
+    merge_slivers: slivers are merged: elements below this fraction T of a cell's volume, or with
+    6 volume / area below T^(1/3) of a cell edge (thin slabs) (default 0.01).
     dg_checks: run the element-local DG checks of the result (default True).
     progress: a callable taking the slicing progress in [0, 1], or None.
     source: the name recorded in the model's provenance (the file it came from).
+    adaptive: octree slicing (``polydg mesh --adaptive``): cells/cell give the finest cells, used
+    only where the surface passes; inside, cells as coarse as a one-level jump between face
+    neighbours allows.
 
     Returns the Model; its ``report`` attribute holds the command line's mesh report as a dict.
     Raises ``Error`` for a surface it refuses (naming the defect), ``CheckFailure`` if the new
     mesh fails its validation or DG checks.
     """
     kwargs = {"cells": cells, "cell": cell, "repair": repair, "merge_slivers": merge_slivers,
-              "dg_checks": dg_checks}
+              "dg_checks": dg_checks, "adaptive": adaptive}
     model, report = _polydg.mesh(surface, kwargs, source=source or getattr(surface, "source", ""),
                                  progress=progress)
     model.report = report
@@ -164,7 +168,8 @@ def _check(self, degree=1):
 
 
 def _solve(self, method="ip", degree=1, E=None, nu=None, density=None, gravity=None,
-           clamp=None, traction=None, solver=None, penalty=None, eta=None):
+           clamp=None, traction=None, solver=None, penalty=None, eta=None, adapt=None,
+           estimate=None):
     """Static linear elasticity with DG (``polydg solve``) on the model; keeps the solution for
     ``write``.
 
@@ -176,6 +181,13 @@ def _solve(self, method="ip", degree=1, E=None, nu=None, density=None, gravity=N
     {"box": [[x0, y0, z0], [x1, y1, z1]]} or {"axis": "z", "value": 0}.
     traction: a region dict with "traction": [tx, ty, tz] (force per area), or a list of them.
     solver: "auto", "cholesky" or "cg"; penalty: "bound", "doubling" or "fixed" (with eta).
+    adapt: solve adaptively (``polydg solve --adapt``), refining the model in place: True, or a
+    dict of "by" ("error": the a posteriori estimate, or "stress": the largest principal
+    stress), "split" ("octants" 1-to-8 or "halves" 1-to-2), "target_error" (stop below this
+    fraction of the energy norm), "max_dofs", "max_rounds" (default 3), "bulk" (share of the
+    squared estimate to refine, default 0.5), "stress_fraction" (default 0.5). The report's
+    "adapt" holds every round.
+    estimate: add the a posteriori error estimate to the report (IP only).
 
     Returns the solve's report (dofs, energy, max_displacement, max_von_mises, solver, ...).
     Raises ``Error`` for bad arguments or a region that selects no face, ``CheckFailure`` for an
@@ -188,7 +200,21 @@ def _solve(self, method="ip", degree=1, E=None, nu=None, density=None, gravity=N
     material = _given(E=E, nu=nu, density=density)
     return self._solve(**_given(method=method, degree=degree, material=material or None,
                                 gravity=gravity, clamp=clamp, traction=traction, solver=solver,
-                                penalty=penalty, eta=eta))
+                                penalty=penalty, eta=eta, adapt=adapt, estimate=estimate))
+
+
+def _refine(self, elements, split="octants", directions=None, merge_slivers=None,
+            validate="local"):
+    """Refines the model in place: each element in ``elements`` (ids) is split by the three
+    mid-planes of its bounding box ("octants", 1-to-8) or by the plane through its centroid across
+    a direction ("halves", 1-to-2; ``directions`` one [x, y, z] per element, default: the last
+    solution's largest principal stress direction). The new faces are interior faces; neighbours'
+    faces are split so faces stay shared exactly. The last solution, if any, goes to the children
+    exactly and stays the model's solution. Validated like a cut (``validate``: "none", "local",
+    "full"). Returns the operation's report (with "solution_exact")."""
+    return self._refine(**_given(elements=[int(e) for e in elements], split=split,
+                                 directions=directions, merge_slivers=merge_slivers,
+                                 validate=validate))
 
 
 def _simulate(self, scene, output=None, progress=None):
@@ -265,6 +291,7 @@ Model.write = _write
 Model.merge_slivers = _merge_slivers
 Model.check = _check
 Model.solve = _solve
+Model.refine = _refine
 Model.simulate = _simulate
 Model.embedding_weights = _embedding_weights
 Model.deformed_surface = _deformed_surface

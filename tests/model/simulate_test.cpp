@@ -10,6 +10,7 @@
 
 #include "polydg/mesh/surface_io.h"
 #include "polydg/mesh/surface_shapes.h"
+#include "polydg/mesh/validate.h"
 #include "polydg/model/report_json.h"
 #include "polydg/model/scene.h"
 #include "polydg/physics/dynamics.h"
@@ -124,6 +125,37 @@ TEST(Simulate, CutCarriesTheFieldsOverExactly) {
     EXPECT_NEAR(va, vb, 1e-12);
     EXPECT_LT((a - b).norm(), 1e-10 * b.norm()) << "band " << lo << " " << hi;
     EXPECT_GT(b.norm(), 1e-3);  // it moved
+  }
+}
+
+TEST(Simulate, RefinesByStressWithoutAPop) {
+  // B10's beam under gravity, refined where the mean stress exceeds a threshold (scene "adapt"):
+  // the clamped end refines, each element at most max_level times; the fields go to the
+  // children exactly, so momentum and kinetic energy right after each refinement equal those
+  // before.
+  for (const char* split : {"octants", "halves"}) {
+    Model model = beam();
+    json scene = b10Scene(1.0, false);
+    scene["adapt"] = {{"stress", 1.0}, {"split", split}, {"every", 5}, {"max_level", 2}};
+    const SimulationReport r = model.simulate(parseScene(scene, "adapt"), {});
+    ASSERT_FALSE(r.refinements.empty()) << split;
+    std::size_t elements = r.elements;
+    for (const SimulationRefinement& f : r.refinements) {
+      EXPECT_EQ(f.elementsBefore, elements);
+      EXPECT_EQ(f.elementsAfter,
+                f.elementsBefore + f.marked * (std::string(split) == "octants" ? 7 : 1));
+      EXPECT_EQ(f.exact, f.elementsAfter);
+      EXPECT_LT(f.momentumChange, 1e-10);
+      EXPECT_LT(f.kineticChange, 1e-10);
+      // The DG elastic energy is the mesh's form: the penalty of a split face grows with the
+      // children's smaller size, and corotation takes each child's own rotation (not asserted).
+      elements = f.elementsAfter;
+    }
+    EXPECT_EQ(model.mesh().numElements(), elements);
+    // At most max_level = 2 refinements of each element: 8^2 (or 2^2) children per cell.
+    const std::size_t perCell = std::string(split) == "octants" ? 64 : 4;
+    EXPECT_LE(model.mesh().numElements(), r.elements * perCell);
+    EXPECT_TRUE(validate(model.mesh()).passed);
   }
 }
 

@@ -220,46 +220,14 @@ TEST(ErrorEstimator, VanishesForAnAffineSolutionWithTractionsAndGravity) {
   }
 }
 
-/// B12's field with bump width w: u = 0.01 (1, 1, 1) g, g = exp(-|x - c|^2 / (2 w^2)),
-/// c = (0.5, 0.5, 0.5), and f = -div sigma(u) = -0.01 (mu Lap g + (mu + lambda) grad(sum_k
-/// d_k g)) per component.
-struct GaussianBump {
-  double width = 0.05;
-  Vec3 centre = Vec3(0.5, 0.5, 0.5);
-  double amplitude = 0.01;
+/// B12's field (cli/bench/problems.h) with bump width `width`, centred at c.
+const Vec3 kBumpCentre(0.5, 0.5, 0.5);
 
-  double g(const Vec3& x) const {
-    return std::exp(-(x - centre).squaredNorm() / (2.0 * width * width));
-  }
-  Vec3 displacement(const Vec3& x) const { return amplitude * g(x) * Vec3::Ones(); }
-  Eigen::Matrix3d gradient(const Vec3& x) const {
-    const Vec3 dg = -(x - centre) / (width * width) * g(x);
-    return amplitude * Vec3::Ones() * dg.transpose();
-  }
-  Vec3 bodyForce(const Vec3& x, const Material& m) const {
-    const Vec3 r = x - centre;
-    const double w2 = width * width;
-    // Hessian of g: (r r^T / w^4 - I / w^2) g.
-    const Eigen::Matrix3d hess =
-        (r * r.transpose() / (w2 * w2) - Eigen::Matrix3d::Identity() / w2) * g(x);
-    const Vec3 gradDiv = hess * Vec3::Ones();  // d_d sum_k d_k g
-    return -amplitude * (m.mu() * hess.trace() * Vec3::Ones() + (m.mu() + m.lambda()) * gradDiv);
-  }
-  LoadCase loads(const Material& m) const {
-    LoadCase l;
-    l.dirichlet.push_back(
-        {FaceSelector::allBoundary(), [*this](const Vec3& x) { return displacement(x); }});
-    l.bodyForce = [*this, m](const Vec3& x) { return bodyForce(x, m); };
-    return l;
-  }
-};
-
-EstimatedSolve solveBump(const GaussianBump& bump, int n, int quadratureDegree) {
-  const Material material = unitMaterial();
+EstimatedSolve solveBump(double width, int n, int quadratureDegree) {
+  const bench::ManufacturedProblem bump = bench::benchmarkB12Problem(width);
   const PolyMesh mesh = hexGridMesh(n, n, n, Box3(Vec3::Zero(), Vec3::Ones()));
-  return solveAndEstimate(
-      mesh, material, bump.loads(material), [bump](const Vec3& x) { return bump.displacement(x); },
-      [bump](const Vec3& x) { return bump.gradient(x); }, 2, quadratureDegree);
+  return solveAndEstimate(mesh, bump.material, bench::benchmarkB1Loads(bump), bump.displacement,
+                          bump.gradient, 2, quadratureDegree);
 }
 
 // B12's field with a bump wide enough (w = 0.15) to be resolved from n = 4 on, p = 2.
@@ -273,10 +241,9 @@ constexpr double kBumpWidth = 0.15;
 constexpr int kBumpQuadrature = 8;
 
 TEST(ErrorEstimator, BoundsTheErrorOfAGaussianBumpAndIsLargestAtTheBump) {
-  const GaussianBump bump{kBumpWidth};
   for (int n : {4, 8}) {
     SCOPED_TRACE("n = " + std::to_string(n));
-    const EstimatedSolve s = solveBump(bump, n, kBumpQuadrature);
+    const EstimatedSolve s = solveBump(kBumpWidth, n, kBumpQuadrature);
     const double effectivity = s.estimate.total / s.error.total();
     std::printf("n = %d: %zu DOFs, estimate %.4e, error %.4e (broken %.4e), effectivity %.3f\n", n,
                 s.dofs, s.estimate.total, s.error.total(), s.error.broken, effectivity);
@@ -289,11 +256,11 @@ TEST(ErrorEstimator, BoundsTheErrorOfAGaussianBumpAndIsLargestAtTheBump) {
     const std::size_t largest =
         static_cast<std::size_t>(std::max_element(eta2.begin(), eta2.end()) - eta2.begin());
     const double h = 1.0 / n;
-    EXPECT_LE((elementBounds(mesh, ElementId(largest)).center() - bump.centre).norm(),
+    EXPECT_LE((elementBounds(mesh, ElementId(largest)).center() - kBumpCentre).norm(),
               0.5 * std::sqrt(3.0) * h * (1.0 + 1e-9));
     double near = 0.0;
     for (std::size_t i = 0; i < eta2.size(); ++i)
-      if ((elementBounds(mesh, ElementId(i)).center() - bump.centre).norm() <= 2.0 * kBumpWidth)
+      if ((elementBounds(mesh, ElementId(i)).center() - kBumpCentre).norm() <= 2.0 * kBumpWidth)
         near += eta2[i];
     std::printf("  share of the estimate within 2 w: %.3f\n",
                 near / (s.estimate.total * s.estimate.total));
@@ -302,9 +269,8 @@ TEST(ErrorEstimator, BoundsTheErrorOfAGaussianBumpAndIsLargestAtTheBump) {
 }
 
 TEST(ErrorEstimator, FallsAtTheRateOfTheErrorUnderUniformRefinement) {
-  const GaussianBump bump{kBumpWidth};
-  const EstimatedSolve coarse = solveBump(bump, 4, kBumpQuadrature);
-  const EstimatedSolve fine = solveBump(bump, 8, kBumpQuadrature);
+  const EstimatedSolve coarse = solveBump(kBumpWidth, 4, kBumpQuadrature);
+  const EstimatedSolve fine = solveBump(kBumpWidth, 8, kBumpQuadrature);
   const double estimateRate = std::log2(coarse.estimate.total / fine.estimate.total);
   const double errorRate = std::log2(coarse.error.total() / fine.error.total());
   std::printf("rates from n = 4 to 8: estimate %.3f, error %.3f\n", estimateRate, errorRate);

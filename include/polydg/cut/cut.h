@@ -50,7 +50,8 @@ struct CutOptions {
   /// +1: delete the pieces on the plus side (normal . x > offset) of the cut, -1: the minus
   /// side, 0: keep both. With a finite blade only pieces of split elements are removed.
   int removeSide = 0;
-  /// Pieces smaller than sliverFraction * the editor's reference volume are merged into the
+  /// Sliver pieces (isSliver(), mesh/merge_elements.h, with T = sliverFraction * the editor's
+  /// reference volume: volume below T or 6 volume / area below T^(1/3)) are merged into the
   /// neighbour across their largest shared face (0: no merging).
   double sliverFraction = kDefaultSliverFraction;
   ValidationLevel validation = ValidationLevel::Local;

@@ -16,6 +16,7 @@
 #include "polydg/mesh/surface.h"
 #include "polydg/mesh/vtu_io.h"
 #include "polydg/physics/embedding.h"
+#include "polydg/physics/error_estimator.h"
 #include "polydg/physics/loads.h"
 #include "polydg/physics/mesh_checks.h"
 #include "polydg/physics/post_process.h"
@@ -52,8 +53,14 @@ struct MeshOptions {
   std::optional<double> cellSize;
   int cells = 0;
   RepairMode repair = RepairMode::None;
-  /// Elements below this fraction of a cell's volume are merged into a neighbour (0: off).
+  /// Slivers by isSliver() (mesh/merge_elements.h) with T = this fraction of a cell's volume
+  /// (volume below T, or 6 volume / area below T^(1/3)) are merged into a neighbour (0: off).
   double sliverFraction = kDefaultSliverFraction;
+  /// Octree slicing: the cell size above (cellSize or cells) is the finest, used only where the
+  /// surface passes; the grid starts 2^levels times coarser and each round splits the elements
+  /// the surface passes into the octants of their cell, and any neighbour more than one level
+  /// coarser than a neighbour, so face neighbours differ by at most one level.
+  bool adaptive = false;
   /// The element-local DG checks (degree 1) of the new mesh, besides the geometric validation.
   bool dgChecks = true;
   /// Moments to keep on the model: 0 integrates only what the DG checks read (for a mesh that is
@@ -71,6 +78,12 @@ struct MeshReport {
   /// The DG checks of the new mesh (no geometry: that is meshing.validation); empty local
   /// check when skipped (MeshOptions::dgChecks false, or the geometry failed).
   MeshCheck dg;
+  /// MeshOptions::adaptive: the levels below the coarse grid (its cell edge: the finest *
+  /// 2^levels), the elements of each level at the end, and the time the refinement took.
+  int levels = 0;
+  double coarseCellSize = 0.0;
+  std::vector<std::size_t> elementsPerLevel;
+  double refineSeconds = 0.0;
   std::string output;         ///< the file written, "" if none
   double readSeconds = 0.0;   ///< set by callers that read the surface (fromFile)
   double writeSeconds = 0.0;  ///< overlapped with the checks
@@ -110,6 +123,61 @@ struct MergeRequest {
   int validationDegree = 1;
 };
 
+/// How refinement splits an element (paper section 10, thesis Fig. 4.9).
+enum class RefineSplit {
+  Octants,  ///< 1-to-8: the three mid-planes of the element's bounding box
+  Halves,   ///< 1-to-2: the plane through the centroid across a direction
+};
+
+/// A refinement of the model (Model.refine in Python, `solve --adapt`, the `adapt` scene key).
+struct RefineRequest {
+  std::vector<ElementId> elements;  ///< the elements to split, each once
+  RefineSplit split = RefineSplit::Octants;
+  /// Halves: the direction across which each element is split, one per element; empty: the
+  /// direction of the largest absolute principal stress of the last solution.
+  std::vector<Vec3> directions;
+  /// If not empty: each element's own planes (1 to 3, every piece so far split by the next),
+  /// instead of `split`'s.
+  std::vector<std::vector<Plane>> planes;
+  /// A piece below this fraction of its element's volume / number of children is merged into
+  /// a neighbour; unset: the mesh's sliver rule (Provenance::sliverFraction).
+  std::optional<double> sliverFraction;
+  ValidationLevel validation = ValidationLevel::Local;
+  int validationDegree = 1;
+};
+
+/// What a refinement did, with the fate of the last solution.
+struct RefineReport {
+  OperationReport operation;
+  /// The last solution, if there was one, went to the children exactly (a polynomial
+  /// restricted to a piece is the same polynomial): elements that took it exactly, and
+  /// elements made of pieces of several (a merged sliver) that took their first source's.
+  std::size_t solutionExact = 0, solutionExtended = 0;
+};
+
+/// What `solve --adapt` refines by.
+enum class AdaptCriterion {
+  Error,   ///< the a posteriori error estimate (physics/error_estimator.h), bulk marking
+  Stress,  ///< the largest absolute principal stress above a threshold (the paper's)
+};
+
+/// Adaptive static solves: solve, estimate or measure, mark, refine, until the goal is met.
+struct AdaptOptions {
+  AdaptCriterion criterion = AdaptCriterion::Error;
+  RefineSplit split = RefineSplit::Octants;
+  /// Error: stop once the estimate falls below this fraction of the solution's energy norm.
+  std::optional<double> targetError;
+  /// Stop before a refinement that would make more DOFs than this.
+  std::optional<std::size_t> maxDofs;
+  /// Error: mark the fewest elements that hold this share of the squared estimate (Dörfler).
+  double bulk = 0.5;
+  /// Stress: refine elements whose largest absolute principal stress exceeds this fraction of
+  /// the first solve's largest.
+  double stressFraction = 0.5;
+  /// Refinement rounds at most (Stress: the levels of Fig. 4.9).
+  int maxRounds = 3;
+};
+
 /// A traction (force per area) on a region of the boundary.
 struct TractionLoad {
   FaceSelector where;
@@ -127,6 +195,33 @@ struct SolveOptions {
   SolverKind solver = SolverKind::Auto;
   PenaltyRule penalty = PenaltyRule::TraceBound;
   double eta = 0.0;  ///< PenaltyRule::Fixed: the penalty; Doubling: the first value (0: 1)
+  /// A body force per volume besides density * gravity (library and Python; empty: none).
+  VectorField bodyForce;
+  /// u = value (weakly) on each selection, besides the clamps (library and Python).
+  std::vector<DirichletCondition> displacements;
+  /// Estimate the solution's error (physics/error_estimator.h; IP only).
+  bool estimate = false;
+  /// A known solution to measure the error against (verification, library and Python): the
+  /// report's error and energyError, and each adaptive round's. Both or neither.
+  VectorField exactDisplacement;
+  GradientField exactGradient;
+  /// Solve adaptively (the model is refined in place); unset: one solve.
+  std::optional<AdaptOptions> adapt;
+};
+
+/// One round of an adaptive solve: the mesh it solved on and what it did next.
+struct AdaptRound {
+  std::size_t elements = 0, dofs = 0;
+  double estimate = 0.0;       ///< Error: the estimate of the energy-norm error
+  double energyNorm = 0.0;     ///< Error: the solution's energy norm
+  double largestStress = 0.0;  ///< largest absolute principal stress (element means)
+  /// With an exact solution (SolveOptions::exactDisplacement): the L2 error and the energy
+  /// error (estimate / energyError is the estimator's effectivity index).
+  double l2Error = 0.0, energyError = 0.0;
+  std::size_t marked = 0;  ///< elements marked for refinement (0: the last round)
+  std::size_t elementsAfter = 0;
+  std::string stop;  ///< the last round: why it stopped
+  double solveSeconds = 0.0, estimateSeconds = 0.0, refineSeconds = 0.0;
 };
 
 /// What a solve did, with the figures of its solution.
@@ -139,6 +234,13 @@ struct SolveReport {
   double maxVonMises = 0.0;                ///< largest element von Mises stress
   double maxJump = 0.0;                    ///< largest displacement jump across interior faces
   std::size_t facesIntegrated = 0;         ///< by this solve (0 when the model's moments sufficed)
+  std::vector<AdaptRound> rounds;          ///< an adaptive solve's rounds, the last one solved
+  /// SolveOptions::estimate: the error estimate, and the solution's energy norm sqrt(U.K.U).
+  std::optional<ErrorEstimate> estimate;
+  double energyNorm = 0.0;
+  /// With an exact solution: L2 and H1 errors, and the error in the estimate's energy norm.
+  std::optional<ErrorNorms> error;
+  std::optional<EnergyError> energyError;
 };
 
 /// The solution of the model's last solve, until the mesh changes.
@@ -216,6 +318,11 @@ class Model {
   OperationReport cut(const CutRequest& request);
   /// Merges slivers (see MergeRequest), validated like a cut.
   OperationReport mergeSlivers(const MergeRequest& request);
+  /// Splits elements (see RefineRequest) with the new faces coupled, validated like a cut; the
+  /// last solution, if any, goes to the children exactly and stays the model's solution.
+  /// Throws InputError for an element id not in the mesh, one listed twice, or Halves without
+  /// directions or a solution.
+  RefineReport refine(const RefineRequest& request);
 
   /// The checks of `options` (physics/mesh_checks.h) with the model's moments.
   MeshCheck check(const MeshCheckOptions& options);

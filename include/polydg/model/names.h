@@ -10,6 +10,7 @@
 
 #include "polydg/cut/cut.h"
 #include "polydg/mesh/meshing.h"
+#include "polydg/model/model.h"
 #include "polydg/physics/static_solver.h"
 
 namespace polydg {
@@ -24,6 +25,8 @@ const Names<PenaltyRule>& penaltyNames();              ///< bound, doubling, fix
 const Names<RepairMode>& repairNames();                ///< none, fill, wrap
 const Names<ValidationLevel>& validationNames();       ///< none, local, full
 const Names<CgPreconditioner>& preconditionerNames();  ///< p-multigrid, block-jacobi
+const Names<RefineSplit>& refineSplitNames();          ///< octants, halves
+const Names<AdaptCriterion>& adaptCriterionNames();    ///< error, stress
 /// Which side of a cut to delete: "+" (normal . x > d) is +1, "-" is -1, "none" is 0.
 const Names<int>& removeSideNames();
 

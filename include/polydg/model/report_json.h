@@ -35,6 +35,8 @@ nlohmann::json toJson(const MeshReport& r);
 /// elements_checked, region_elements, patch_test_error, region_components, zero_modes,
 /// volume_rel_error, failure}, time_s.
 nlohmann::json toJson(const OperationReport& r);
+/// toJson(OperationReport) with solution_exact and solution_extended.
+nlohmann::json toJson(const RefineReport& r);
 /// A static solve: method, degree, material, penalty_rule, selections {clamps, tractions: each
 /// region and faces}, elements, dofs, nonzeros, sparsity, eta, eta_threshold, penalty_attempts,
 /// dirichlet_faces, traction_faces, basis_fallbacks, solver {kind, preconditioner, success,

@@ -58,6 +58,17 @@ struct SceneContact {
   ContactPoints points = ContactPoints::Surface;
 };
 
+/// Refinement by stress during a run (scene "adapt"; paper section 10): every `every` steps,
+/// elements whose mean stress has a principal value above `stress` in absolute value are split,
+/// up to `maxLevel` times each.
+struct SceneAdapt {
+  bool enabled = false;
+  double stress = 0.0;  ///< the threshold, in units of E
+  RefineSplit split = RefineSplit::Octants;
+  int every = 1;
+  int maxLevel = 2;
+};
+
 /// Everything a simulation needs besides the mesh.
 struct Scene {
   Material material;
@@ -79,6 +90,7 @@ struct Scene {
   SceneEmbed embed;
   std::vector<SceneObstacle> obstacles;
   SceneContact contact;
+  SceneAdapt adapt;
 };
 
 /// Progress of a simulation, after each step.
@@ -119,6 +131,16 @@ struct SimulationCut {
   double seconds = 0.0;
 };
 
+/// A refinement during a simulation (scene "adapt"): the fields went to the children exactly,
+/// so the momenta and energies after it equal those before it to round-off (relative changes).
+struct SimulationRefinement {
+  double time = 0.0;
+  std::size_t marked = 0, elementsBefore = 0, elementsAfter = 0;
+  std::size_t exact = 0, extended = 0;
+  double momentumChange = 0.0, kineticChange = 0.0, elasticChange = 0.0;
+  double seconds = 0.0;
+};
+
 /// A frame of the time series.
 struct SimulationFrame {
   int step = 0;
@@ -150,6 +172,7 @@ struct SimulationReport {
   BodyState initial;
   std::vector<SimulationStep> steps;
   std::vector<SimulationCut> cuts;
+  std::vector<SimulationRefinement> refinements;
   std::vector<SimulationFrame> frames;
   std::string pvd;  ///< the collection file, "" without output (null in the JSON report)
   SimulationEmbedding embedding;

@@ -48,7 +48,11 @@ CornerArray displacementPointData(const CornerValues& corners, std::string name 
 struct ElementFields {
   ElementData<Vec3> meanDisplacement;  ///< (1/vol) int_K u_h
   ElementData<double> vonMises;        ///< von Mises stress of the element's mean stress
-  ElementData<double> largestJump;     ///< max |u_K - u_L| at the vertices of interior faces
+  /// The mean stress's eigenvalue of largest absolute value (signed) and its unit eigenvector:
+  /// the stress refinement measures (paper section 10).
+  ElementData<double> principalStress;
+  ElementData<Vec3> principalDirection;
+  ElementData<double> largestJump;  ///< max |u_K - u_L| at the vertices of interior faces
 };
 
 /// Per-element fields of a solution (moments up to degree p, e.g. the solve's cache).

@@ -265,6 +265,39 @@ TEST(BenchCommand, ContactSuiteDetectsContactAndKeepsEnergyFromGrowing) {
   fs::remove_all(dir);
 }
 
+TEST(BenchCommand, AdaptivitySuiteRefinesWhereItShould) {
+  // Quick sizes: B11 at tau = 0.5 (2 rounds), B13 at 32 cells of a 5,120-triangle sphere, B12 on
+  // uniform 4^3 and 8^3 and 2 adaptive rounds from 4^3.
+  const fs::path dir =
+      fs::temp_directory_path() / ("polydg_bench_adaptivity_" + std::to_string(getpid()) + "_out");
+  fs::remove_all(dir);
+  const Result r = run("bench --suite adaptivity --quick --quiet --out " + dir.string());
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  for (const char* file : {"adaptivity.json", "adaptivity.csv", "adaptivity_b12.svg"})
+    EXPECT_TRUE(fs::exists(dir / file)) << file;
+  std::ifstream in(dir / "adaptivity.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  std::size_t octants = 0, halves = 0;
+  for (const auto& b11 : j["B11"]) {
+    const std::size_t n = b11["elements"].get<std::size_t>();
+    EXPECT_GT(n, 36u) << b11.dump();
+    (b11["split"] == "octants" ? octants : halves) = n;
+  }
+  EXPECT_GT(octants, halves);
+  const auto& b13 = j["B13"];
+  ASSERT_EQ(b13.size(), 2u);
+  EXPECT_TRUE(b13[0]["passed"].get<bool>() && b13[1]["passed"].get<bool>());
+  EXPECT_LT(b13[1]["elements"].get<std::size_t>(), b13[0]["elements"].get<std::size_t>());
+  EXPECT_NEAR(b13[1]["volume"].get<double>(), b13[0]["volume"].get<double>(),
+              1e-10 * b13[0]["volume"].get<double>());
+  // The estimate bounds the error (effectivity >= 1) and adaptive rounds lower the error.
+  const auto& adaptive = j["B12"]["adaptive"];
+  ASSERT_GE(adaptive.size(), 2u);
+  for (const auto& round : adaptive) EXPECT_GE(round["effectivity"].get<double>(), 1.0);
+  EXPECT_LT(adaptive.back()["l2_error"].get<double>(), adaptive.front()["l2_error"].get<double>());
+  fs::remove_all(dir);
+}
+
 TEST(BenchCommand, UnknownSuiteIsRefusedWithOneLine) {
   const Result r = run("bench --suite nonsense --out " +
                        (fs::temp_directory_path() / "polydg_bench_unknown").string());

@@ -1,0 +1,251 @@
+// The adaptivity suite: B11 (thesis Fig. 4.9's bent bar refined by principal stress, 1-to-8 and
+// 1-to-2, beside the thesis's counts) and B12 (a steep Gaussian bump: uniform grids against
+// `solve --adapt` by the error estimate, DOFs to reach each uniform grid's L2 error, and the
+// estimator's effectivity on every mesh). Both run through Model::solve(), as `polydg solve
+// --adapt` does.
+#include <algorithm>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "cli/bench/suites.h"
+#include "polydg/mesh/primitives.h"
+#include "polydg/mesh/surface_shapes.h"
+#include "polydg/model/model.h"
+#include "polydg/model/names.h"
+#include "polydg/util/stopwatch.h"
+
+namespace polydg::bench {
+
+namespace {
+
+/// Thesis Fig. 4.9: the bar's element counts after refinement.
+constexpr std::size_t kThesisOctants = 274, kThesisHalves = 77;
+
+nlohmann::json roundJson(const AdaptRound& r) {
+  return {{"elements", r.elements},
+          {"dofs", r.dofs},
+          {"estimate", r.estimate},
+          {"energy_norm", r.energyNorm},
+          {"l2_error", r.l2Error},
+          {"energy_error", r.energyError},
+          {"effectivity", r.energyError > 0.0 ? r.estimate / r.energyError : 0.0},
+          {"largest_stress", r.largestStress},
+          {"marked", r.marked},
+          {"elements_after", r.elementsAfter},
+          {"stop", r.stop},
+          {"solve_seconds", r.solveSeconds},
+          {"estimate_seconds", r.estimateSeconds},
+          {"refine_seconds", r.refineSeconds}};
+}
+
+/// B12's solve options on the unit cube (IP, p = 2, u = u_exact weakly on the boundary), with
+/// the exact solution for the errors.
+SolveOptions b12Options(const ManufacturedProblem& problem) {
+  SolveOptions o;
+  o.degree = 2;
+  o.material = problem.material;
+  o.displacements = {{FaceSelector::allBoundary(), problem.displacement}};
+  o.bodyForce = problem.bodyForce;
+  o.exactDisplacement = problem.displacement;
+  o.exactGradient = problem.gradient;
+  o.estimate = true;
+  return o;
+}
+
+Model unitCube(int n) { return Model(hexGridMesh(n, n, n, Box3(Vec3::Zero(), Vec3::Ones()))); }
+
+}  // namespace
+
+SuiteOutput adaptivitySuite(const BenchOptions& o, bool quiet) {
+  SuiteOutput s{"adaptivity", nlohmann::json::object(), nlohmann::json::array(), {}};
+  auto log = [&](const std::string& line) {
+    if (!quiet) std::cout << line << std::endl;
+  };
+  s.json["setup"] = {
+      {"B11",
+       "bar [0,9]x[0,2]x[0,2] of 36 unit hexahedra, E = 1000, nu = 0.3, clamped on x = 0, "
+       "traction (0,0,-1) on x = 9, IP p = 1; refine where the element's mean stress has a "
+       "principal value above tau * the unrefined mesh's largest, until none does or 3 rounds"},
+      {"B12",
+       "unit cube, E = 1, nu = 0.3, u = 0.01 (1,1,1) exp(-|x-c|^2/(2 w^2)), w = 0.05, IP p = 2; "
+       "uniform n^3 hex grids against solve --adapt from n = 4 (Doerfler bulk 0.5, 1-to-8)"}};
+
+  // B11.
+  nlohmann::json b11 = nlohmann::json::array();
+  const std::vector<double> taus =
+      o.quick ? std::vector<double>{0.5} : std::vector<double>{0.25, 0.5, 0.75};
+  for (RefineSplit split : {RefineSplit::Octants, RefineSplit::Halves})
+    for (double tau : taus) {
+      Model model(hexGridMesh(9, 2, 2, Box3(Vec3::Zero(), Vec3(9, 2, 2))));
+      SolveOptions so;
+      so.degree = 1;
+      so.material.youngsModulus = 1000.0;
+      so.material.poissonRatio = 0.3;
+      so.clamps = {FaceSelector::inPlane(0, 0.0)};
+      so.tractions = {{FaceSelector::inPlane(0, 9.0), Vec3(0, 0, -1)}};
+      AdaptOptions a;
+      a.criterion = AdaptCriterion::Stress;
+      a.split = split;
+      a.stressFraction = tau;
+      a.maxRounds = o.quick ? 2 : 3;
+      so.adapt = a;
+      const Stopwatch watch;
+      const SolveReport r = model.solve(so);
+      nlohmann::json rounds = nlohmann::json::array();
+      for (const AdaptRound& round : r.rounds) rounds.push_back(roundJson(round));
+      const std::size_t elements = model.mesh().numElements();
+      const std::size_t thesis = split == RefineSplit::Octants ? kThesisOctants : kThesisHalves;
+      const std::string name = nameOf(refineSplitNames(), split);
+      b11.push_back({{"split", name},
+                     {"tau", tau},
+                     {"elements", elements},
+                     {"thesis_elements", thesis},
+                     {"rounds", rounds},
+                     {"seconds", watch.seconds()}});
+      s.rows.push_back({{"benchmark", "B11"},
+                        {"case", name + " tau " + shortNumber(tau)},
+                        {"elements", elements},
+                        {"dofs", r.solve.dofs},
+                        {"reference", thesis},
+                        {"l2_error", nullptr},
+                        {"effectivity", nullptr}});
+      log("B11 " + name + " tau " + shortNumber(tau) + ": " + std::to_string(elements) +
+          " elements after " + std::to_string(r.rounds.size() - 1) + " rounds (thesis " +
+          std::to_string(thesis) + ")");
+    }
+  s.json["B11"] = b11;
+
+  // B13: octree slicing of a sphere against the uniform grid, one after the other.
+  {
+    const TriangleSurface sphere = icosphere(Vec3::Zero(), 1.0, o.quick ? 4 : 6);
+    nlohmann::json b13 = nlohmann::json::array();
+    for (bool adaptive : {false, true}) {
+      MeshOptions options;
+      options.cells = o.quick ? 32 : 128;
+      options.adaptive = adaptive;
+      MeshReport report;
+      const Stopwatch watch;
+      const Model model = Model::fromSurface(sphere, options, report);
+      const double seconds = watch.seconds();
+      const MeshingReport& m = report.meshing;
+      b13.push_back({{"mesh", adaptive ? "octree" : "uniform"},
+                     {"triangles", sphere.triangles.size()},
+                     {"cells", options.cells},
+                     {"elements", model.mesh().numElements()},
+                     {"faces", m.faces},
+                     {"volume", m.outputVolume},
+                     {"volume_relative_error", m.volumeRelError},
+                     {"passed", report.passed()},
+                     {"levels", report.levels},
+                     {"elements_per_level", report.elementsPerLevel},
+                     {"refine_seconds", report.refineSeconds},
+                     {"seconds", seconds}});
+      s.rows.push_back({{"benchmark", "B13"},
+                        {"case", adaptive ? "octree" : "uniform"},
+                        {"elements", model.mesh().numElements()},
+                        {"dofs", nullptr},
+                        {"reference", nullptr},
+                        {"l2_error", nullptr},
+                        {"effectivity", nullptr}});
+      log(std::string("B13 ") + (adaptive ? "octree" : "uniform") + ": " +
+          std::to_string(model.mesh().numElements()) + " elements, " + std::to_string(m.faces) +
+          " faces, volume error " + shortNumber(m.volumeRelError) + ", " + shortNumber(seconds) +
+          " s");
+    }
+    s.json["B13"] = b13;
+  }
+
+  // B12: uniform grids.
+  const ManufacturedProblem problem = benchmarkB12Problem();
+  const SolveOptions base = b12Options(problem);
+  nlohmann::json uniform = nlohmann::json::array();
+  SeriesSet plot;
+  struct Point {
+    std::size_t dofs;
+    double l2;
+  };
+  std::vector<Point> uniformPoints;
+  for (int n : o.quick ? std::vector<int>{4, 8} : std::vector<int>{8, 16, 32}) {
+    Model model = unitCube(n);
+    const Stopwatch watch;
+    const SolveReport r = model.solve(base);
+    const double seconds = watch.seconds();
+    const double effectivity = r.estimate->total / r.energyError->total();
+    uniform.push_back({{"n", n},
+                       {"dofs", r.solve.dofs},
+                       {"l2_error", r.error->l2},
+                       {"energy_error", r.energyError->total()},
+                       {"estimate", r.estimate->total},
+                       {"effectivity", effectivity},
+                       {"seconds", seconds}});
+    s.rows.push_back({{"benchmark", "B12"},
+                      {"case", "uniform n " + std::to_string(n)},
+                      {"elements", model.mesh().numElements()},
+                      {"dofs", r.solve.dofs},
+                      {"reference", nullptr},
+                      {"l2_error", r.error->l2},
+                      {"effectivity", effectivity}});
+    uniformPoints.push_back({r.solve.dofs, r.error->l2});
+    plot.add("uniform", static_cast<double>(r.solve.dofs), r.error->l2);
+    log("B12 uniform n " + std::to_string(n) + ": " + std::to_string(r.solve.dofs) +
+        " DOFs, L2 error " + shortNumber(r.error->l2) + ", effectivity " +
+        shortNumber(effectivity) + ", " + shortNumber(seconds) + " s");
+  }
+  // B12: adaptive from n = 4, up to a fifth of the finest uniform grid's DOFs.
+  Model model = unitCube(4);
+  SolveOptions so = base;
+  AdaptOptions a;
+  a.criterion = AdaptCriterion::Error;
+  a.bulk = 0.5;
+  a.maxRounds = o.quick ? 2 : 12;
+  a.maxDofs = uniformPoints.back().dofs / 5;
+  so.adapt = a;
+  const Stopwatch watch;
+  const SolveReport r = model.solve(so);
+  nlohmann::json rounds = nlohmann::json::array();
+  double lowestEffectivity = 1e300, highestEffectivity = 0.0;
+  for (const AdaptRound& round : r.rounds) {
+    rounds.push_back(roundJson(round));
+    const double effectivity = round.estimate / round.energyError;
+    lowestEffectivity = std::min(lowestEffectivity, effectivity);
+    highestEffectivity = std::max(highestEffectivity, effectivity);
+    plot.add("adaptive", static_cast<double>(round.dofs), round.l2Error);
+    s.rows.push_back({{"benchmark", "B12"},
+                      {"case", "adaptive"},
+                      {"elements", round.elements},
+                      {"dofs", round.dofs},
+                      {"reference", nullptr},
+                      {"l2_error", round.l2Error},
+                      {"effectivity", effectivity}});
+    log("B12 adaptive: " + std::to_string(round.elements) + " elements, " +
+        std::to_string(round.dofs) + " DOFs, L2 error " + shortNumber(round.l2Error) +
+        ", effectivity " + shortNumber(effectivity));
+  }
+  // DOFs the adaptive run needed to reach each uniform grid's L2 error.
+  nlohmann::json reach = nlohmann::json::array();
+  for (const Point& u : uniformPoints) {
+    nlohmann::json j{{"uniform_dofs", u.dofs}, {"uniform_l2_error", u.l2}};
+    j["adaptive_dofs"] = nullptr;
+    for (const AdaptRound& round : r.rounds)
+      if (round.l2Error <= u.l2) {
+        j["adaptive_dofs"] = round.dofs;
+        j["dof_ratio"] = static_cast<double>(u.dofs) / static_cast<double>(round.dofs);
+        break;
+      }
+    reach.push_back(j);
+  }
+  s.json["B12"] = {{"uniform", uniform},
+                   {"adaptive", rounds},
+                   {"adaptive_seconds", watch.seconds()},
+                   {"dofs_to_reach_uniform_error", reach},
+                   {"effectivity_range", {lowestEffectivity, highestEffectivity}}};
+  s.plots.push_back({"adaptivity_b12.svg",
+                     {"B12 steep bump: L2 error against DOFs (IP, p = 2)",
+                      {"DOFs", AxisScale::Log},
+                      {"L2 error", AxisScale::Log},
+                      plot.series()}});
+  return s;
+}
+
+}  // namespace polydg::bench

@@ -1,0 +1,206 @@
+// Model::refine and adaptive solves: the solution goes to the children exactly (a polynomial of
+// degree p survives 1-to-8 and 1-to-2 unchanged), refined meshes pass the DG checks and keep
+// their volume, bad requests are refused with InputError, and B11 (thesis Fig. 4.9's bent bar)
+// refines where the principal stress is large, by either split.
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "polydg/integrate/quadrature.h"
+#include "polydg/mesh/geometry.h"
+#include "polydg/mesh/primitives.h"
+#include "polydg/mesh/surface_io.h"
+#include "polydg/mesh/surface_shapes.h"
+#include "polydg/mesh/validate.h"
+#include "polydg/model/model.h"
+#include "polydg/util/error.h"
+
+namespace polydg {
+namespace {
+
+/// A bar [0,9] x [0,2] x [0,2] of unit hexahedra, translated by `offset`.
+Model barModel(const Vec3& offset = Vec3::Zero()) {
+  return Model(hexGridMesh(9, 2, 2, Box3(offset, offset + Vec3(9, 2, 2))));
+}
+
+/// B11's loads: E = 1000, nu = 0.3, clamped on x = 0, traction (0, 0, -1) on x = 9.
+SolveOptions barLoads(int degree, const Vec3& offset = Vec3::Zero()) {
+  SolveOptions o;
+  o.degree = degree;
+  o.material.youngsModulus = 1000.0;
+  o.material.poissonRatio = 0.3;
+  o.clamps = {FaceSelector::inPlane(0, offset.x())};
+  o.tractions = {{FaceSelector::inPlane(0, offset.x() + 9.0), Vec3(0, 0, -1)}};
+  return o;
+}
+
+/// Largest |u_before(x) - u_after(x)| / largest |u| over quadrature points of every element
+/// after a refinement, each compared with the element it came from.
+double transferError(const Model& model, const DgBasis& oldBasis, const Eigen::VectorXd& oldU,
+                     const ElementLineage& lineage) {
+  const Solution& u = *model.solution();
+  double largest = 0.0, error = 0.0;
+  for (std::size_t e = 0; e < model.mesh().numElements(); ++e) {
+    const std::vector<ElementId> sources = lineage.sources(ElementId(e));
+    EXPECT_EQ(sources.size(), 1u);
+    for (const QuadraturePoint& q : elementQuadrature(model.mesh(), ElementId(e), 3)) {
+      const Vec3 a = displacementAt(oldBasis, oldU, sources[0], q.point);
+      const Vec3 b = displacementAt(*u.basis, u.coefficients, ElementId(e), q.point);
+      largest = std::max(largest, a.norm());
+      error = std::max(error, (a - b).norm());
+    }
+  }
+  return error / largest;
+}
+
+TEST(ModelRefine, SolutionSurvivesOctantsAndHalvesExactly) {
+  for (int degree : {1, 2, 3}) {
+    for (RefineSplit split : {RefineSplit::Octants, RefineSplit::Halves}) {
+      // Far from the origin: the transfer is about each element's own centre.
+      const Vec3 offset(1e4, -2e4, 3e4);
+      Model model = barModel(offset);
+      model.solve(barLoads(degree, offset));
+      const DgBasis oldBasis = *model.solution()->basis;
+      const Eigen::VectorXd oldU = model.solution()->coefficients;
+      RefineRequest request;
+      request.split = split;
+      request.sliverFraction = 0.0;
+      request.validation = ValidationLevel::Full;
+      for (std::uint32_t e : {0u, 5u, 17u, 35u}) request.elements.push_back(ElementId(e));
+      const double volume = model.volume();
+      const RefineReport r = model.refine(request);
+      ASSERT_TRUE(r.operation.validation.passed) << r.operation.validation.failure;
+      EXPECT_EQ(model.mesh().numElements(), 36u + 4u * (split == RefineSplit::Octants ? 7 : 1));
+      EXPECT_EQ(r.solutionExact, model.mesh().numElements());
+      EXPECT_EQ(r.solutionExtended, 0u);
+      EXPECT_NEAR(model.volume(), volume, 1e-12 * volume);
+      EXPECT_NEAR(validate(model.mesh()).volume, volume, 1e-12 * volume);
+      EXPECT_LT(transferError(model, oldBasis, oldU, r.operation.lineage), 1e-12)
+          << "degree " << degree << (split == RefineSplit::Octants ? " octants" : " halves");
+    }
+  }
+}
+
+TEST(ModelRefine, RefinedMeshPassesTheDgChecksAndSolves) {
+  Model model = barModel();
+  RefineRequest request;
+  for (std::uint32_t e = 0; e < 36; e += 3) request.elements.push_back(ElementId(e));
+  const RefineReport r = model.refine(request);
+  ASSERT_TRUE(r.operation.validation.passed) << r.operation.validation.failure;
+  MeshCheckOptions checks;
+  checks.degree = 2;
+  checks.patchTest = GlobalCheck::Always;
+  checks.rigidModes = GlobalCheck::Always;
+  const MeshCheck c = model.check(checks);
+  ASSERT_TRUE(c.passed()) << c.failures().front();
+  // A refined bar bends like the unrefined one: the tip deflection agrees within a few percent
+  // (both are discretizations of the same beam).
+  Model coarse = barModel();
+  const double tipCoarse = coarse.solve(barLoads(2)).maxDisplacement;
+  const double tipFine = model.solve(barLoads(2)).maxDisplacement;
+  EXPECT_NEAR(tipFine, tipCoarse, 0.05 * tipCoarse);
+}
+
+TEST(ModelRefine, RefusesBadRequests) {
+  Model model = barModel();
+  RefineRequest request;
+  request.elements = {ElementId(36)};
+  EXPECT_THROW(model.refine(request), InputError);
+  request.elements = {ElementId(1), ElementId(1)};
+  EXPECT_THROW(model.refine(request), InputError);
+  request.elements = {ElementId(1)};
+  request.split = RefineSplit::Halves;  // no solution, no direction
+  EXPECT_THROW(model.refine(request), InputError);
+  request.directions = {Vec3::Zero()};
+  EXPECT_THROW(model.refine(request), InputError);
+  EXPECT_EQ(model.mesh().numElements(), 36u);  // nothing was touched
+}
+
+TEST(ModelRefine, B11RefinesWhereThePrincipalStressIsLarge) {
+  // Thesis Fig. 4.9: the bar refines at the clamped end, where bending stress is largest, and
+  // 1-to-2 splits make fewer elements than 1-to-8 at the same threshold.
+  std::size_t counts[2] = {0, 0};
+  for (RefineSplit split : {RefineSplit::Octants, RefineSplit::Halves}) {
+    Model model = barModel();
+    SolveOptions o = barLoads(1);
+    AdaptOptions a;
+    a.criterion = AdaptCriterion::Stress;
+    a.split = split;
+    a.stressFraction = 0.5;
+    a.maxRounds = 3;
+    o.adapt = a;
+    const SolveReport r = model.solve(o);
+    ASSERT_GE(r.rounds.size(), 2u);
+    ASSERT_LE(r.rounds.size(), 4u);
+    EXPECT_EQ(r.rounds.front().elements, 36u);
+    EXPECT_FALSE(r.rounds.back().stop.empty());
+    for (std::size_t i = 0; i + 1 < r.rounds.size(); ++i) {
+      EXPECT_GT(r.rounds[i].marked, 0u);
+      EXPECT_EQ(r.rounds[i + 1].elements, r.rounds[i].elementsAfter);
+      EXPECT_EQ(
+          r.rounds[i].elementsAfter,
+          r.rounds[i].elements + r.rounds[i].marked * (split == RefineSplit::Octants ? 7 : 1));
+    }
+    // The clamped half of the bar holds the refinement.
+    std::size_t nearClamp = 0;
+    const Solution& u = *model.solution();
+    for (std::size_t e = 0; e < model.mesh().numElements(); ++e)
+      nearClamp += u.basis->centre(ElementId(e)).x() < 4.5;
+    EXPECT_GT(nearClamp, model.mesh().numElements() - nearClamp);
+    EXPECT_TRUE(validate(model.mesh()).passed);
+    counts[split == RefineSplit::Octants ? 0 : 1] = model.mesh().numElements();
+  }
+  EXPECT_GT(counts[0], counts[1]);
+}
+
+TEST(ModelRefine, OctreeSlicingFillsTheVolumeWithFewerElements) {
+  // A sphere far from the origin and the bundled torus (a real model with a hole): the octree
+  // mesh has the uniform mesh's volume, validates, passes the DG checks, has fewer elements, and
+  // face neighbours differ by at most one level (cell sizes by at most 2x, read from the
+  // hexahedra's boxes).
+  const std::vector<TriangleSurface> surfaces = {
+      icosphere(Vec3(1e4, -2e4, 3e4), 1.0, 4),
+      readSurface(std::string(POLYDG_TESTDATA_DIR) + "/torus.obj")};
+  for (const TriangleSurface& surface : surfaces) {
+    MeshOptions options;
+    options.cells = 24;
+    MeshReport uniform, octree;
+    const Model u = Model::fromSurface(surface, options, uniform);
+    options.adaptive = true;
+    const Model a = Model::fromSurface(surface, options, octree);
+    ASSERT_TRUE(uniform.passed());
+    ASSERT_TRUE(octree.passed()) << octree.failures().front();
+    EXPECT_GE(octree.levels, 2);
+    EXPECT_LT(a.mesh().numElements(), u.mesh().numElements());
+    std::size_t perLevel = 0;
+    for (std::size_t n : octree.elementsPerLevel) perLevel += n;
+    EXPECT_EQ(perLevel, a.mesh().numElements());
+    const double volume = uniform.meshing.outputVolume;
+    EXPECT_NEAR(octree.meshing.outputVolume, volume, 1e-10 * volume);
+    EXPECT_NEAR(octree.meshing.outputVolume, octree.meshing.inputVolume, 1e-10 * volume);
+    // Whole cells of the octree (cubes filled completely): face neighbours' edges within 2x.
+    const PolyMesh& m = a.mesh();
+    auto cube = [&](ElementId e) -> double {
+      const Vec3 s = elementBounds(m, e).sizes();
+      const double v = s.x() * s.y() * s.z();
+      const bool whole = s.maxCoeff() - s.minCoeff() <= 1e-12 * s.maxCoeff() &&
+                         std::abs(signedVolume(m, e) - v) <= 1e-12 * v;
+      return whole ? s.x() : 0.0;
+    };
+    double worst = 1.0;
+    std::size_t checked = 0;
+    for (std::size_t i = 0; i < m.numFaces(); ++i) {
+      const Face& f = m.face(FaceId(i));
+      if (!f.front.valid() || !f.back.valid()) continue;
+      const double a1 = cube(f.front), a2 = cube(f.back);
+      if (a1 == 0.0 || a2 == 0.0) continue;
+      worst = std::max(worst, std::max(a1 / a2, a2 / a1));
+      ++checked;
+    }
+    EXPECT_GT(checked, 0u);
+    EXPECT_LE(worst, 2.0 + 1e-8);  // box sizes 3e4 from the origin: differences of rounded corners
+  }
+}
+
+}  // namespace
+}  // namespace polydg
