@@ -202,4 +202,38 @@ OperationReport MeshEditor::refineInPlace(std::span<const ElementRefinement> ele
   return report;
 }
 
+OperationReport MeshEditor::coarsen(std::span<const std::vector<ElementId>> groups,
+                                    ValidationLevel validation, int validationDegree) {
+  if (!state_) throw std::logic_error("MeshEditor: used after release()");
+  if (validationDegree < 1 || validationDegree > 3)
+    throw std::invalid_argument("the validation degree must be 1, 2 or 3");
+  State& s = *state_;
+  std::unordered_set<std::uint32_t> listed;
+  for (const std::vector<ElementId>& group : groups) {
+    if (group.size() < 2)
+      throw std::invalid_argument("coarsen: a group needs two elements or more");
+    for (ElementId e : group) {
+      if (!e.valid() || e.index() >= s.mesh.numElements())
+        throw std::invalid_argument("coarsen: element id " + std::to_string(e.value) +
+                                    " is not in the mesh");
+      if (!listed.insert(e.value).second)
+        throw std::invalid_argument("coarsen: element " + std::to_string(e.value) +
+                                    " is listed twice");
+    }
+  }
+  const Stopwatch start;
+  OperationReport report;
+  report.op = "coarsen";
+  report.facesReintegrated += raiseMomentDegree(2 * validationDegree);
+  const double volumeBefore = s.volume;
+  Edit edit(s.mesh, *s.moments, s.grid);
+  for (const std::vector<ElementId>& group : groups)
+    for (std::size_t i = 1; i < group.size(); ++i) edit.merge(group[i], group[0]);
+  report.elementsSplit = 0;
+  report.facesReintegrated += edit.updateMoments();
+  finishOperation(s, edit, volumeBefore, validation, validationDegree, 0.0, report);
+  report.seconds = start.seconds();
+  return report;
+}
+
 }  // namespace polydg

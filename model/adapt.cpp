@@ -227,6 +227,42 @@ RefineReport Model::refine(const RefineRequest& request) {
   return report;
 }
 
+CoarsenReport Model::coarsen(const CoarsenRequest& request) {
+  State& s = *state_;
+  s.requireUsable();
+  checkEditOptions(0.0, request.validationDegree);
+  const std::size_t ne = mesh().numElements();
+  std::unordered_set<std::uint32_t> listed;
+  for (const std::vector<ElementId>& group : request.groups) {
+    if (group.size() < 2) throw InputError("a group to coarsen needs two elements or more");
+    for (ElementId e : group) {
+      if (!e.valid() || e.index() >= ne)
+        throw InputError("element " + std::to_string(e.value) + " is not in the mesh (it has " +
+                         std::to_string(ne) + " elements)");
+      if (!listed.insert(e.value).second)
+        throw InputError("element " + std::to_string(e.value) +
+                         " is listed twice; each element joins one group");
+    }
+  }
+  std::optional<Solution> before;
+  if (s.solution) before = std::move(s.solution);
+  CoarsenReport report;
+  report.operation = s.edit().coarsen(request.groups, request.validation, request.validationDegree);
+  s.finishEdit(report.operation, request.validation);
+  if (before && report.operation.validation.passed &&
+      before->basis->kind() == BasisKind::Orthonormal) {
+    const int p = before->basis->degree();
+    const MomentCache& after = this->moments(2 * p);
+    auto basis = std::make_unique<DgBasis>(mesh(), after, BasisOptions{p, BasisKind::Orthonormal});
+    std::vector<Eigen::VectorXd> moved =
+        projectFields(*before->basis, {&before->coefficients}, *basis, report.operation.lineage);
+    for (std::size_t e = 0; e < mesh().numElements(); ++e)
+      report.solutionProjected += report.operation.lineage.sources(ElementId(e)).size() > 1;
+    s.adoptSolution(std::move(basis), std::move(moved[0]), before->material, after);
+  }
+  return report;
+}
+
 SolveReport solveAdaptively(Model& model, const SolveOptions& options) {
   const AdaptOptions& a = *options.adapt;
   if (a.maxRounds < 0 || a.maxRounds > 20)

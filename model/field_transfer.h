@@ -28,6 +28,15 @@ std::vector<Eigen::VectorXd> transferFields(const DgBasis& from,
                                             const DgBasis& to, const ElementLineage& lineage,
                                             TransferCounts* counts = nullptr);
 
+/// `fields` on the mesh after an edit that merged elements, by L2 projection: element e takes
+/// sum over its sources s of Q_s^T u_s, Q_s re-expressing e's basis in s's (both orthonormal:
+/// the mass matrices are identities). Polynomials of the degree survive exactly, and so do the
+/// integrals of the fields against every polynomial of the degree (mass and momentum).
+/// Throws std::invalid_argument unless both bases are orthonormal.
+std::vector<Eigen::VectorXd> projectFields(const DgBasis& from,
+                                           const std::vector<const Eigen::VectorXd*>& fields,
+                                           const DgBasis& to, const ElementLineage& lineage);
+
 /// Refinement levels across an edit: each element after it takes the highest level of its
 /// sources, plus one if a source is in `refined` (split by the edit).
 std::vector<int> levelsAfter(const std::vector<int>& levels, const ElementLineage& lineage,

@@ -427,7 +427,8 @@ json toJson(const Scene& s) {
     j["adapt"] = {{"stress", s.adapt.stress},
                   {"split", nameOf(refineSplitNames(), s.adapt.split)},
                   {"every", s.adapt.every},
-                  {"max_level", s.adapt.maxLevel}};
+                  {"max_level", s.adapt.maxLevel},
+                  {"coarsen", s.adapt.coarsen}};
   if (!s.obstacles.empty()) {
     j["obstacles"] = json::array();
     for (const SceneObstacle& o : s.obstacles) {
@@ -493,6 +494,7 @@ json toJson(const SimulationReport& r) {
   for (const SimulationRefinement& f : r.refinements)
     refinements.push_back({{"time", f.time},
                            {"marked", f.marked},
+                           {"coarsened", f.coarsened},
                            {"elements_before", f.elementsBefore},
                            {"elements_after", f.elementsAfter},
                            {"exact", f.exact},

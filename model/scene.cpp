@@ -154,6 +154,7 @@ Scene parseScene(const json& document, const std::string& file) {
     if (a.has("split")) s.adapt.split = a.choice("split", refineSplitNames());
     if (a.has("every")) s.adapt.every = a.integer("every", 1, 100000000);
     if (a.has("max_level")) s.adapt.maxLevel = a.integer("max_level", 1, 8);
+    if (a.has("coarsen")) s.adapt.coarsen = a.number("coarsen", 0.0, 1.0);
     a.finish();
   }
   if (r.has("contact")) {

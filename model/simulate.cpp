@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <sstream>
+#include <unordered_map>
 #include <unordered_set>
 
 #include "field_transfer.h"
@@ -318,11 +319,15 @@ SimulationReport Model::simulate(const Scene& scene, const SimulateOptions& opti
   bool cutSinceFrame = false;
   // After an edit: the new solver takes the displacement and velocity through the lineage, the
   // embedded surface's weights and the contact points follow the new elements.
+  // A coarsening (`project`) projects the fields onto the merged elements instead (L2: mass and
+  // momentum kept).
   auto afterEdit = [&](const ElementLineage& lineage, const DgBasis& oldBasis,
-                       const Eigen::VectorXd& oldU, const Eigen::VectorXd& oldV, double time) {
+                       const Eigen::VectorXd& oldU, const Eigen::VectorXd& oldV, double time,
+                       bool project = false) {
     TransferCounts counts;
     const std::vector<Eigen::VectorXd> moved =
-        transferFields(oldBasis, {&oldU, &oldV}, solver.basis(), lineage, &counts);
+        project ? projectFields(oldBasis, {&oldU, &oldV}, solver.basis(), lineage)
+                : transferFields(oldBasis, {&oldU, &oldV}, solver.basis(), lineage, &counts);
     solver.setState(time, moved[0], moved[1]);
     if (surface.embedding || contact) {
       const std::size_t elements = mesh().numElements();
@@ -347,6 +352,33 @@ SimulationReport Model::simulate(const Scene& scene, const SimulateOptions& opti
   // Refinement by stress (scene "adapt"): each element's level, and the refinement due after a
   // step.
   std::vector<int> level(mesh().numElements(), 0);
+  // Families: the children of one refined element (coarsening merges a whole family back). Each
+  // element's family (-1: none), each family's parent family and its number of children.
+  std::vector<int> family(mesh().numElements(), -1), familyParent;
+  std::vector<std::size_t> familySize;
+  auto familiesAfter = [&](const ElementLineage& lineage,
+                           const std::unordered_set<std::uint32_t>& refined, bool merged) {
+    std::unordered_map<std::uint32_t, int> made;  // refined element -> its children's family
+    std::vector<int> next(mesh().numElements(), -1);
+    for (std::size_t e = 0; e < next.size(); ++e) {
+      const std::vector<ElementId> sources = lineage.sources(ElementId(e));
+      const ElementId s = sources.front();
+      if (refined.count(s.value)) {
+        auto [it, inserted] = made.try_emplace(s.value, static_cast<int>(familyParent.size()));
+        if (inserted) {
+          familyParent.push_back(family[s.index()]);
+          familySize.push_back(0);
+        }
+        next[e] = it->second;
+        ++familySize[static_cast<std::size_t>(it->second)];
+      } else if (merged && sources.size() > 1 && family[s.index()] >= 0) {
+        next[e] = familyParent[static_cast<std::size_t>(family[s.index()])];
+      } else {
+        next[e] = family[s.index()];
+      }
+    }
+    family = std::move(next);
+  };
   auto refineDue = [&](int k) {
     const SceneAdapt& a = scene.adapt;
     if (!a.enabled || k % a.every != 0) return false;
@@ -361,7 +393,58 @@ SimulationReport Model::simulate(const Scene& scene, const SimulateOptions& opti
         request.elements.push_back(ElementId(e));
         request.directions.push_back(fields.principalDirection[ElementId(e)]);
       }
-    if (request.elements.empty()) return false;
+    // Families whose children are all still there, none refined further, and all below the
+    // coarsening threshold are merged back (none that a refinement marked now).
+    CoarsenRequest coarsenRequest;
+    coarsenRequest.validation = ValidationLevel::None;
+    if (a.coarsen > 0.0) {
+      std::vector<std::vector<ElementId>> members(familySize.size());
+      std::vector<char> keep(familySize.size(), 1);
+      for (std::size_t e = 0; e < family.size(); ++e) {
+        if (family[e] < 0) continue;
+        const std::size_t f = static_cast<std::size_t>(family[e]);
+        members[f].push_back(ElementId(e));
+        if (std::abs(fields.principalStress[ElementId(e)]) >= a.coarsen * a.stress) keep[f] = 0;
+      }
+      for (std::size_t f = 0; f < members.size(); ++f)
+        if (keep[f] && members[f].size() == familySize[f] && members[f].size() >= 2)
+          coarsenRequest.groups.push_back(members[f]);
+    }
+    if (request.elements.empty() && coarsenRequest.groups.empty()) return false;
+    if (request.elements.empty()) {
+      SimulationRefinement record;
+      record.time = solver.time();
+      record.coarsened = coarsenRequest.groups.size();
+      record.elementsBefore = mesh().numElements();
+      const BodyState before = solver.state();
+      const DgBasis oldBasis = solver.basis();
+      const Eigen::VectorXd oldU = solver.displacement(), oldV = solver.velocity();
+      const CoarsenReport c = coarsen(coarsenRequest);
+      if (!c.operation.validation.passed)
+        throw CheckFailure("the coarsening at t = " + std::to_string(record.time) + " failed (" +
+                           c.operation.validation.failure + "); the simulation stops there");
+      std::vector<int> next(mesh().numElements(), 0);
+      for (std::size_t e = 0; e < next.size(); ++e) {
+        const std::vector<ElementId> sources = c.operation.lineage.sources(ElementId(e));
+        next[e] = level[sources.front().index()] - (sources.size() > 1 ? 1 : 0);
+      }
+      level = std::move(next);
+      familiesAfter(c.operation.lineage, {}, true);
+      record.elementsAfter = mesh().numElements();
+      solver = build();
+      afterEdit(c.operation.lineage, oldBasis, oldU, oldV, record.time, true);
+      const BodyState after = solver.state();
+      record.momentumChange =
+          (after.momentum - before.momentum).norm() / std::max(before.momentum.norm(), 1e-300);
+      record.kineticChange =
+          (before.kinetic - after.kinetic) / std::max(std::abs(before.kinetic), 1e-300);
+      record.elasticChange =
+          std::abs(before.elastic - after.elastic) / std::max(std::abs(before.elastic), 1e-300);
+      record.seconds = tr.seconds();
+      report.cutSeconds += record.seconds;
+      report.refinements.push_back(record);
+      return true;
+    }
     if (a.split == RefineSplit::Octants) request.directions.clear();
     SimulationRefinement record;
     record.time = solver.time();
@@ -377,6 +460,7 @@ SimulationReport Model::simulate(const Scene& scene, const SimulateOptions& opti
     std::unordered_set<std::uint32_t> refined;
     for (ElementId e : request.elements) refined.insert(e.value);
     level = levelsAfter(level, r.operation.lineage, mesh().numElements(), refined);
+    familiesAfter(r.operation.lineage, refined, false);
     record.elementsAfter = mesh().numElements();
     solver = build();
     const TransferCounts counts = afterEdit(r.operation.lineage, oldBasis, oldU, oldV, record.time);
@@ -412,6 +496,7 @@ SimulationReport Model::simulate(const Scene& scene, const SimulateOptions& opti
       record.elementsAfter = mesh().numElements();
       report.cutSeconds += tc.seconds();
       level = levelsAfter(level, record.report.lineage, record.elementsAfter, {});
+      familiesAfter(record.report.lineage, {}, false);
       solver = build();
       const Stopwatch tt;
       const TransferCounts counts =

@@ -397,6 +397,36 @@ PYBIND11_MODULE(_polydg, m) {
           },
           py::arg("elements"), py::arg("split") = "octants", py::arg("directions") = py::none(),
           py::arg("merge_slivers") = py::none(), py::arg("validate") = "local")
+      .def(
+          "_coarsen",
+          [](Model& model, const std::vector<std::vector<std::int64_t>>& groups,
+             const std::string& validate) {
+            CoarsenRequest request;
+            const auto level = parseName(validationNames(), validate);
+            if (!level)
+              throw InputError("validate must be one of " + listNames(validationNames()) +
+                               ", not '" + validate + "'");
+            request.validation = *level;
+            for (const auto& group : groups) {
+              request.groups.emplace_back();
+              for (std::int64_t e : group) {
+                if (e < 0 || e > std::numeric_limits<std::uint32_t>::max() - 1)
+                  throw InputError("element " + std::to_string(e) + " is not in the mesh");
+                request.groups.back().push_back(ElementId(static_cast<std::uint32_t>(e)));
+              }
+            }
+            CoarsenReport r;
+            {
+              py::gil_scoped_release release;
+              r = model.coarsen(request);
+            }
+            if (!r.operation.validation.passed)
+              throw CheckFailure("coarsen failed: " + r.operation.validation.failure);
+            nlohmann::json j = toJson(r.operation);
+            j["solution_projected"] = r.solutionProjected;
+            return toPython(j);
+          },
+          py::arg("groups"), py::arg("validate") = "local")
       .def("_check",
            [](Model& model, const py::kwargs& kwargs) {
              return operate<CheckStep>(

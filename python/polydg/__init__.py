@@ -217,6 +217,14 @@ def _refine(self, elements, split="octants", directions=None, merge_slivers=None
                                  validate=validate))
 
 
+def _coarsen(self, groups, validate="local"):
+    """Merges each group of element ids (two or more, face-connected, e.g. the children of a
+    refinement) back into one element; the last solution, if any, is projected onto the merged
+    elements (L2: mass and momentum kept exactly). Validated like a cut. Returns the operation's
+    report (with "solution_projected")."""
+    return self._coarsen([[int(e) for e in g] for g in groups], validate=validate)
+
+
 def _simulate(self, scene, output=None, progress=None):
     """Moves the body in time (``polydg simulate``): dynamic DG elasticity through the steps of
     ``scene``, with its cuts made at their times on this model. Afterwards the model holds the
@@ -292,6 +300,7 @@ Model.merge_slivers = _merge_slivers
 Model.check = _check
 Model.solve = _solve
 Model.refine = _refine
+Model.coarsen = _coarsen
 Model.simulate = _simulate
 Model.embedding_weights = _embedding_weights
 Model.deformed_surface = _deformed_surface

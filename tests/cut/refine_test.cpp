@@ -157,6 +157,34 @@ TEST(Refine, CutPolyhedraRefineIntoTheirPieces) {
   expectValid(editor, volume);
 }
 
+TEST(Refine, CoarseningMergesTheChildrenBack) {
+  MeshEditor editor(hexGridMesh(3, 3, 3, Box3(Vec3(0, 0, 0), Vec3(3, 3, 3))));
+  const std::vector<ElementRefinement> split = {octants(editor.mesh(), ElementId(13))};
+  const OperationReport r = editor.refine(split, fullChecks());
+  ASSERT_TRUE(r.validation.passed) << r.validation.failure;
+  std::vector<ElementId> children;
+  for (std::size_t e = 0; e < editor.mesh().numElements(); ++e)
+    if (r.lineage.sources(ElementId(e)).front() == ElementId(13)) children.push_back(ElementId(e));
+  ASSERT_EQ(children.size(), 8u);
+  const std::vector<std::vector<ElementId>> groups = {children};
+  const OperationReport c = editor.coarsen(groups, ValidationLevel::Full, 2);
+  ASSERT_TRUE(c.validation.passed) << c.validation.failure;
+  EXPECT_EQ(c.op, "coarsen");
+  EXPECT_EQ(editor.mesh().numElements(), 27u);
+  // The merged element is the centre cube again: volume 1, centroid (1.5, 1.5, 1.5).
+  std::size_t merged = 0;
+  for (std::size_t e = 0; e < 27; ++e)
+    if (c.lineage.sources(ElementId(e)).size() == 8) {
+      ++merged;
+      EXPECT_NEAR(editor.moments().volume(ElementId(e)), 1.0, 1e-14);
+      EXPECT_LT((editor.moments().centroid(ElementId(e)) - Vec3(1.5, 1.5, 1.5)).norm(), 1e-14);
+    }
+  EXPECT_EQ(merged, 1u);
+  expectValid(editor, 27.0);
+  EXPECT_THROW(editor.coarsen(std::vector<std::vector<ElementId>>{{ElementId(0)}}),
+               std::invalid_argument);
+}
+
 TEST(Refine, RejectsBadRequests) {
   MeshEditor editor(hexGridMesh(2, 2, 2, Box3(Vec3(0, 0, 0), Vec3(1, 1, 1))));
   const ElementRefinement a = octants(editor.mesh(), ElementId(0));

@@ -2,7 +2,9 @@
 // degree p survives 1-to-8 and 1-to-2 unchanged), refined meshes pass the DG checks and keep
 // their volume, bad requests are refused with InputError, and B11 (thesis Fig. 4.9's bent bar)
 // refines where the principal stress is large, by either split.
+#include <algorithm>
 #include <cmath>
+#include <map>
 
 #include <gtest/gtest.h>
 
@@ -99,6 +101,78 @@ TEST(ModelRefine, RefinedMeshPassesTheDgChecksAndSolves) {
   const double tipCoarse = coarse.solve(barLoads(2)).maxDisplacement;
   const double tipFine = model.solve(barLoads(2)).maxDisplacement;
   EXPECT_NEAR(tipFine, tipCoarse, 0.05 * tipCoarse);
+}
+
+TEST(ModelRefine, CoarseningProjectsTheSolutionKeepingMassAndMomentum) {
+  // Refine, solve on the refined mesh (children differ), coarsen the children back: each merged
+  // element's integral of u equals its children's (the L2 projection keeps every polynomial
+  // moment of degree <= p, the mean among them), and a refine-coarsen round trip of a solution
+  // gives it back exactly.
+  for (int degree : {1, 2}) {
+    Model model = barModel();
+    model.solve(barLoads(degree));
+    const Eigen::VectorXd original = model.solution()->coefficients;
+    RefineRequest request;
+    request.elements = {ElementId(0), ElementId(9), ElementId(20)};
+    const RefineReport r = model.refine(request);
+    ASSERT_TRUE(r.operation.validation.passed);
+    std::map<std::uint32_t, std::vector<ElementId>> families;
+    for (std::size_t e = 0; e < model.mesh().numElements(); ++e) {
+      const ElementId source = r.operation.lineage.sources(ElementId(e)).front();
+      if (source == ElementId(0) || source == ElementId(9) || source == ElementId(20))
+        families[source.value].push_back(ElementId(e));
+    }
+    CoarsenRequest coarsen;
+    for (auto& [id, children] : families) coarsen.groups.push_back(children);
+    {
+      Model roundTrip = barModel();
+      roundTrip.solve(barLoads(degree));
+      ASSERT_TRUE(roundTrip.refine(request).operation.validation.passed);
+      const CoarsenReport c = roundTrip.coarsen(coarsen);
+      ASSERT_TRUE(c.operation.validation.passed) << c.operation.validation.failure;
+      EXPECT_EQ(c.solutionProjected, 3u);
+      EXPECT_EQ(roundTrip.mesh().numElements(), 36u);
+      // Element ids may have moved: compare through each element's mean displacement field.
+      Model reference = barModel();
+      reference.solve(barLoads(degree));
+      double worst = 0.0, scale = 0.0;
+      for (std::size_t e = 0; e < 36; ++e) {
+        const Vec3 c0 = reference.moments(2).centroid(ElementId(e));
+        for (std::size_t f = 0; f < 36; ++f)
+          if ((roundTrip.moments(2).centroid(ElementId(f)) - c0).norm() < 1e-9) {
+            const Vec3 a = reference.solution()->fields.meanDisplacement[ElementId(e)];
+            const Vec3 b = roundTrip.solution()->fields.meanDisplacement[ElementId(f)];
+            worst = std::max(worst, (a - b).norm());
+            scale = std::max(scale, a.norm());
+          }
+      }
+      EXPECT_LT(worst, 1e-12 * scale) << "degree " << degree;
+    }
+    model.solve(barLoads(degree));  // on the refined mesh: the children's fields differ
+    std::map<std::uint32_t, Vec3> integral;
+    const Solution& fine = *model.solution();
+    for (auto& [id, children] : families) {
+      Vec3& sum = integral.try_emplace(id, Vec3::Zero()).first->second;
+      for (ElementId e : children)
+        sum += model.moments(2).volume(e) * fine.fields.meanDisplacement[e];
+    }
+    const CoarsenReport c = model.coarsen(coarsen);
+    ASSERT_TRUE(c.operation.validation.passed) << c.operation.validation.failure;
+    const Solution& coarse = *model.solution();
+    std::size_t checked = 0;
+    for (std::size_t e = 0; e < model.mesh().numElements(); ++e) {
+      const std::vector<ElementId> sources = c.operation.lineage.sources(ElementId(e));
+      if (sources.size() < 2) continue;
+      // The element of the unrefined bar these children came from.
+      const ElementId family = r.operation.lineage.sources(sources.front()).front();
+      const Vec3 mass =
+          model.moments(2).volume(ElementId(e)) * coarse.fields.meanDisplacement[ElementId(e)];
+      EXPECT_LT((mass - integral[family.value]).norm(), 1e-12 * integral[family.value].norm())
+          << "degree " << degree;
+      ++checked;
+    }
+    EXPECT_EQ(checked, 3u);
+  }
 }
 
 TEST(ModelRefine, RefusesBadRequests) {

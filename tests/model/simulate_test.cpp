@@ -159,6 +159,35 @@ TEST(Simulate, RefinesByStressWithoutAPop) {
   }
 }
 
+TEST(Simulate, CoarsensBackWhenTheStressFalls) {
+  // The beam bent by an end load until t = 2, damped: the clamped end refines while loaded and
+  // every family of children merges back once its stresses fall below half the threshold. The
+  // projection keeps momentum exactly and can only lose kinetic energy.
+  Model model = beam();
+  const json scene = json::parse(R"({"material": {"E": 1000, "nu": 0.3, "density": 1},
+      "degree": 1, "dt": 0.1, "duration": 6.0, "damping": {"mass": 5},
+      "fixed": [{"plane": [1, 0, 0, 0]}],
+      "loads": [{"traction": [0, 0, -1], "on": {"plane": [1, 0, 0, 10]}, "until": 2.0}],
+      "adapt": {"stress": 5, "every": 5, "max_level": 1, "coarsen": 0.5}})");
+  const SimulationReport r = model.simulate(parseScene(scene, "coarsen"), {});
+  std::size_t refinements = 0, coarsenings = 0;
+  for (const SimulationRefinement& f : r.refinements) {
+    EXPECT_LT(f.momentumChange, 1e-12);
+    if (f.coarsened > 0) {
+      ++coarsenings;
+      EXPECT_LT(f.elementsAfter, f.elementsBefore);
+      EXPECT_GE(f.kineticChange, -1e-12);  // a projection never adds kinetic energy
+      EXPECT_LT(f.kineticChange, 1e-3);
+    } else {
+      ++refinements;
+    }
+  }
+  EXPECT_GT(refinements, 0u);
+  EXPECT_GT(coarsenings, 0u);
+  EXPECT_EQ(model.mesh().numElements(), r.elements);  // every family merged back
+  EXPECT_TRUE(validate(model.mesh()).passed);
+}
+
 TEST(Simulate, DampedSimulationSettlesToTheStaticSolve) {
   // The static limit: linear, heavily damped backward Euler under gravity against
   // Model::solve with the same clamp, load and discretization.

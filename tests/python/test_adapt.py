@@ -76,3 +76,23 @@ def test_bad_requests_raise():
     with pytest.raises(polydg.Error):
         model.solve(degree=1, adapt={"by": "stress", "bulk": 2}, **LOADS)
     assert model.num_elements == 10
+
+
+def test_coarsen_merges_the_children_back_keeping_the_integral():
+    model = beam()
+    model.solve(degree=1, **LOADS)
+    box_min, box_max = np.array([4, 0, 0]), np.array([5, 1, 1])  # element [4, 5] x [0, 1]^2
+    inside = lambda c: bool(np.all(c > box_min) and np.all(c < box_max))
+    parent = [e for e, c in enumerate(model.element_centroids) if inside(c)]
+    assert len(parent) == 1
+    model.refine(parent)
+    children = [e for e, c in enumerate(model.element_centroids) if inside(c)]
+    assert len(children) == 8
+    model.solve(degree=1, **LOADS)  # on the refined mesh: the children differ
+    total = (model.element_displacements * model.element_volumes[:, None]).sum(axis=0)
+    report = model.coarsen([children], validate="full")
+    assert model.num_elements == 10 and report["solution_projected"] == 1
+    after = (model.element_displacements * model.element_volumes[:, None]).sum(axis=0)
+    assert np.abs(after - total).max() < 1e-12 * np.abs(total).max()
+    with pytest.raises(polydg.Error):
+        model.coarsen([[0]])

@@ -165,6 +165,14 @@ class MeshEditor {
   OperationReport refine(std::span<const ElementRefinement> elements,
                          const RefineOptions& options = {});
 
+  /// Merges each group of elements (at least two, face-connected, no element in two groups)
+  /// into one element: the faces between them disappear, their other faces become the new
+  /// element's (coarsening after refine()). Checked like a cut. Throws std::invalid_argument for
+  /// an invalid id, a group of fewer than two or an element listed twice.
+  OperationReport coarsen(std::span<const std::vector<ElementId>> groups,
+                          ValidationLevel validation = ValidationLevel::Local,
+                          int validationDegree = 1);
+
   /// Merges every element below `fraction` * referenceVolume() into a neighbour, as after a cut.
   OperationReport mergeSlivers(double fraction, ValidationLevel validation = ValidationLevel::Local,
                                int validationDegree = 1);

@@ -155,6 +155,20 @@ struct RefineReport {
   std::size_t solutionExact = 0, solutionExtended = 0;
 };
 
+/// A coarsening: groups of elements merged back into one each (children of a refinement).
+struct CoarsenRequest {
+  std::vector<std::vector<ElementId>> groups;
+  ValidationLevel validation = ValidationLevel::Local;
+  int validationDegree = 1;
+};
+
+/// What a coarsening did: the last solution, if any, went to the merged elements by L2
+/// projection (mass and momentum kept exactly) in `solutionProjected` of them.
+struct CoarsenReport {
+  OperationReport operation;
+  std::size_t solutionProjected = 0;
+};
+
 /// What `solve --adapt` refines by.
 enum class AdaptCriterion {
   Error,   ///< the a posteriori error estimate (physics/error_estimator.h), bulk marking
@@ -323,6 +337,11 @@ class Model {
   /// Throws InputError for an element id not in the mesh, one listed twice, or Halves without
   /// directions or a solution.
   RefineReport refine(const RefineRequest& request);
+  /// Merges groups of elements back into one each (see CoarsenRequest), validated like a cut;
+  /// the last solution, if any, is projected onto the merged elements (L2) and stays the model's
+  /// solution. Throws InputError for an element not in the mesh, one listed twice or a group of
+  /// fewer than two.
+  CoarsenReport coarsen(const CoarsenRequest& request);
 
   /// The checks of `options` (physics/mesh_checks.h) with the model's moments.
   MeshCheck check(const MeshCheckOptions& options);

@@ -67,6 +67,9 @@ struct SceneAdapt {
   RefineSplit split = RefineSplit::Octants;
   int every = 1;
   int maxLevel = 2;
+  /// The children of one refinement whose stresses all fall below coarsen * stress are merged
+  /// back (their fields projected: mass and momentum kept); 0: never.
+  double coarsen = 0.5;
 };
 
 /// Everything a simulation needs besides the mesh.
@@ -132,10 +135,14 @@ struct SimulationCut {
 };
 
 /// A refinement during a simulation (scene "adapt"): the fields went to the children exactly,
-/// so the momenta and energies after it equal those before it to round-off (relative changes).
+/// so momentum and kinetic energy after it equal those before it to round-off (relative
+/// changes); or a coarsening, whose L2 projection keeps momentum exactly and can only lower the
+/// kinetic energy (kineticChange: the relative loss).
 struct SimulationRefinement {
   double time = 0.0;
-  std::size_t marked = 0, elementsBefore = 0, elementsAfter = 0;
+  std::size_t marked = 0;     ///< elements refined (0 for a coarsening)
+  std::size_t coarsened = 0;  ///< families merged back (a coarsening)
+  std::size_t elementsBefore = 0, elementsAfter = 0;
   std::size_t exact = 0, extended = 0;
   double momentumChange = 0.0, kineticChange = 0.0, elasticChange = 0.0;
   double seconds = 0.0;
