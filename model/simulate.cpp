@@ -411,59 +411,45 @@ SimulationReport Model::simulate(const Scene& scene, const SimulateOptions& opti
           coarsenRequest.groups.push_back(members[f]);
     }
     if (request.elements.empty() && coarsenRequest.groups.empty()) return false;
-    if (request.elements.empty()) {
-      SimulationRefinement record;
-      record.time = solver.time();
-      record.coarsened = coarsenRequest.groups.size();
-      record.elementsBefore = mesh().numElements();
-      const BodyState before = solver.state();
-      const DgBasis oldBasis = solver.basis();
-      const Eigen::VectorXd oldU = solver.displacement(), oldV = solver.velocity();
-      const CoarsenReport c = coarsen(coarsenRequest);
-      if (!c.operation.validation.passed)
-        throw CheckFailure("the coarsening at t = " + std::to_string(record.time) + " failed (" +
-                           c.operation.validation.failure + "); the simulation stops there");
-      std::vector<int> next(mesh().numElements(), 0);
-      for (std::size_t e = 0; e < next.size(); ++e) {
-        const std::vector<ElementId> sources = c.operation.lineage.sources(ElementId(e));
-        next[e] = level[sources.front().index()] - (sources.size() > 1 ? 1 : 0);
-      }
-      level = std::move(next);
-      familiesAfter(c.operation.lineage, {}, true);
-      record.elementsAfter = mesh().numElements();
-      solver = build();
-      afterEdit(c.operation.lineage, oldBasis, oldU, oldV, record.time, true);
-      const BodyState after = solver.state();
-      record.momentumChange =
-          (after.momentum - before.momentum).norm() / std::max(before.momentum.norm(), 1e-300);
-      record.kineticChange =
-          (before.kinetic - after.kinetic) / std::max(std::abs(before.kinetic), 1e-300);
-      record.elasticChange =
-          std::abs(before.elastic - after.elastic) / std::max(std::abs(before.elastic), 1e-300);
-      record.seconds = tr.seconds();
-      report.cutSeconds += record.seconds;
-      report.refinements.push_back(record);
-      return true;
-    }
-    if (a.split == RefineSplit::Octants) request.directions.clear();
+    // A refinement if any element is marked, else a coarsening; the same steps around either.
+    const bool coarsening = request.elements.empty();
     SimulationRefinement record;
     record.time = solver.time();
-    record.marked = request.elements.size();
     record.elementsBefore = mesh().numElements();
     const BodyState before = solver.state();
     const DgBasis oldBasis = solver.basis();
     const Eigen::VectorXd oldU = solver.displacement(), oldV = solver.velocity();
-    const RefineReport r = refine(request);
-    if (!r.operation.validation.passed)
-      throw CheckFailure("the refinement at t = " + std::to_string(record.time) + " failed (" +
-                         r.operation.validation.failure + "); the simulation stops there");
-    std::unordered_set<std::uint32_t> refined;
-    for (ElementId e : request.elements) refined.insert(e.value);
-    level = levelsAfter(level, r.operation.lineage, mesh().numElements(), refined);
-    familiesAfter(r.operation.lineage, refined, false);
+    ElementLineage lineage;
+    if (coarsening) {
+      record.coarsened = coarsenRequest.groups.size();
+      const CoarsenReport c = coarsen(coarsenRequest);
+      if (!c.operation.validation.passed)
+        throw CheckFailure("the coarsening at t = " + std::to_string(record.time) + " failed (" +
+                           c.operation.validation.failure + "); the simulation stops there");
+      lineage = c.operation.lineage;
+      std::vector<int> next(mesh().numElements(), 0);
+      for (std::size_t e = 0; e < next.size(); ++e) {
+        const std::vector<ElementId> sources = lineage.sources(ElementId(e));
+        next[e] = level[sources.front().index()] - (sources.size() > 1 ? 1 : 0);
+      }
+      level = std::move(next);
+      familiesAfter(lineage, {}, true);
+    } else {
+      if (a.split == RefineSplit::Octants) request.directions.clear();
+      record.marked = request.elements.size();
+      const RefineReport r = refine(request);
+      if (!r.operation.validation.passed)
+        throw CheckFailure("the refinement at t = " + std::to_string(record.time) + " failed (" +
+                           r.operation.validation.failure + "); the simulation stops there");
+      lineage = r.operation.lineage;
+      std::unordered_set<std::uint32_t> refined;
+      for (ElementId e : request.elements) refined.insert(e.value);
+      level = levelsAfter(level, lineage, mesh().numElements(), refined);
+      familiesAfter(lineage, refined, false);
+    }
     record.elementsAfter = mesh().numElements();
     solver = build();
-    const TransferCounts counts = afterEdit(r.operation.lineage, oldBasis, oldU, oldV, record.time);
+    const TransferCounts counts = afterEdit(lineage, oldBasis, oldU, oldV, record.time, coarsening);
     record.exact = counts.exact;
     record.extended = counts.extended;
     const BodyState after = solver.state();
@@ -472,7 +458,10 @@ SimulationReport Model::simulate(const Scene& scene, const SimulateOptions& opti
     };
     record.momentumChange =
         (after.momentum - before.momentum).norm() / std::max(before.momentum.norm(), 1e-300);
-    record.kineticChange = relative(before.kinetic, after.kinetic);
+    // A coarsening's projection can only lose kinetic energy: its change is the signed loss.
+    record.kineticChange =
+        coarsening ? (before.kinetic - after.kinetic) / std::max(std::abs(before.kinetic), 1e-300)
+                   : relative(before.kinetic, after.kinetic);
     record.elasticChange = relative(before.elastic, after.elastic);
     record.seconds = tr.seconds();
     report.cutSeconds += record.seconds;
