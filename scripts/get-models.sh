@@ -1,0 +1,29 @@
+#!/usr/bin/env bash
+# Fetches the real models the benchmarks use beyond the bundled testdata/, from Debian's
+# packages (the project does not ship them): the Stanford bunny as a closed 75,408-triangle
+# surface (bunny00.off of CGAL's data, package libcgal-demo) and tetgen, the reference mesher
+# `polydg bench --suite meshing` times polydg against.
+# Usage: scripts/get-models.sh [DIR]   (default build/share/polydg/models, where polydg bench
+# looks for them; `polydg bench --models DIR` names another folder).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+dest=${1:-build/share/polydg/models}
+mkdir -p "$dest"
+SUDO=""
+if [[ $(id -u) -ne 0 ]]; then SUDO="sudo"; fi
+export DEBIAN_FRONTEND=noninteractive
+if ! command -v tetgen >/dev/null 2>&1; then
+  $SUDO apt-get update -qq
+  $SUDO apt-get install -y -qq --no-install-recommends tetgen >/dev/null
+fi
+if [[ ! -f "$dest/bunny.off" ]]; then
+  work=$(mktemp -d)
+  trap 'rm -rf "$work"' EXIT
+  (cd "$work" && { apt-get download libcgal-demo >/dev/null 2>&1 ||
+    { $SUDO apt-get update -qq && apt-get download libcgal-demo >/dev/null; }; })
+  dpkg -x "$work"/libcgal-demo_*.deb "$work/x"
+  tar -xzf "$work/x/usr/share/doc/libcgal-dev/data.tar.gz" -C "$work" data/meshes/bunny00.off
+  mv "$work/data/meshes/bunny00.off" "$dest/bunny.off.tmp"
+  mv "$dest/bunny.off.tmp" "$dest/bunny.off"
+fi
+echo "models in $dest: $(ls "$dest" | tr '\n' ' ')"
