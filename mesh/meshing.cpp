@@ -122,10 +122,12 @@ void recordDiagnosis(const TriangleSurface& input, const SurfaceDiagnosis& d, Me
 /// Orients a closed manifold surface, slices it with the grid of `cellSize` and merges slivers
 /// into `result`, timing the phases "orient", "slice" and "merge_slivers".
 void orientAndSlice(const TriangleSurface& closed, double cellSize, const MeshingOptions& options,
-                    MeshingResult& result, PhaseTimer& timer) {
+                    MeshingResult& result, PhaseTimer& timer,
+                    const SurfaceTopology* topology = nullptr) {
   MeshingReport& r = result.report;
   bool reoriented = false;
-  const TriangleSurface surface = orientToBoundVolume(closed, reoriented, &r.shells, &r.cavities);
+  const TriangleSurface surface =
+      orientToBoundVolume(closed, reoriented, &r.shells, &r.cavities, topology);
   if (reoriented) r.repairs.push_back("re-oriented the surface to bound its volume outward");
   r.inputVolume = enclosedVolume(surface);
   if (!(r.inputVolume > 0)) throw InputError("the surface encloses no volume");
@@ -149,7 +151,8 @@ void orientAndSlice(const TriangleSurface& closed, double cellSize, const Meshin
 /// input: the self-intersection test (the costly, serial part of the diagnosis) runs while the
 /// surface is oriented and sliced. The result, if the test finds no defect; otherwise nothing
 /// (the slicing is dropped, and the caller repairs or refuses the surface from `d`).
-std::optional<MeshingResult> meshWhileDiagnosing(const TriangleSurface& input, double cellSize,
+std::optional<MeshingResult> meshWhileDiagnosing(const TriangleSurface& input,
+                                                 const SurfaceTopology& topology, double cellSize,
                                                  const MeshingOptions& options,
                                                  SurfaceDiagnosis& d) {
   MeshingResult result;
@@ -158,12 +161,12 @@ std::optional<MeshingResult> meshWhileDiagnosing(const TriangleSurface& input, d
   tbb::task_group diagnosis;
   diagnosis.run([&] {
     const Stopwatch start;
-    d = diagnose(input);
+    d = diagnose(input, &topology);
     checkSeconds = start.seconds();
   });
   std::exception_ptr failure;  // of the slicing; it matters only if the surface is sound
   try {
-    orientAndSlice(input, cellSize, options, result, timer);
+    orientAndSlice(input, cellSize, options, result, timer, &topology);
   } catch (...) {
     failure = std::current_exception();
   }
@@ -191,7 +194,8 @@ MeshingResult meshSurface(const TriangleSurface& input, const MeshingOptions& op
   const SurfaceTopology topology = analyzeTopology(input);
   if (topology.boundaryEdges == 0 && topology.nonManifoldEdges == 0 &&
       topology.degenerateTriangles == 0) {
-    if (std::optional<MeshingResult> done = meshWhileDiagnosing(input, cellSize, options, d)) {
+    if (std::optional<MeshingResult> done =
+            meshWhileDiagnosing(input, topology, cellSize, options, d)) {
       finish(*done);
       return std::move(*done);
     }

@@ -3,56 +3,81 @@
 #include "polydg/util/union_find.h"
 
 #include <algorithm>
-#include <map>
 #include <numeric>
 
 namespace polydg {
 
 SurfaceTopology analyzeTopology(const TriangleSurface& surface) {
   SurfaceTopology topo;
-  // Undirected edge -> (uses a->b with a<b, uses b->a, first triangle).
+  // Each use of an edge by a triangle, sorted by the undirected edge: uses of one edge are then
+  // adjacent (a sort rather than a map of edges: a third of the time on 75k triangles).
   struct EdgeUse {
-    std::uint32_t forward = 0, backward = 0;
-    std::size_t firstTriangle = 0;
+    std::uint32_t lo, hi;  ///< the edge's vertices, lo < hi
+    std::uint32_t corner;  ///< 3 t + k: the edge runs from triangle t's vertex k to k + 1
+    bool forward;          ///< runs lo -> hi
   };
-  std::map<std::pair<std::uint32_t, std::uint32_t>, EdgeUse> edges;
-  UnionFind components(surface.triangles.size());
-  for (std::size_t t = 0; t < surface.triangles.size(); ++t) {
+  const std::size_t n = surface.triangles.size();
+  std::vector<EdgeUse> uses;
+  uses.reserve(3 * n);
+  std::vector<bool> skipped(n, false);
+  for (std::size_t t = 0; t < n; ++t) {
     const auto& tri = surface.triangles[t];
     if (tri[0] == tri[1] || tri[1] == tri[2] || tri[2] == tri[0]) {
       ++topo.degenerateTriangles;
+      skipped[t] = true;
       continue;
     }
     const Vec3& a = surface.vertices[tri[0]];
     if ((surface.vertices[tri[1]] - a).cross(surface.vertices[tri[2]] - a).squaredNorm() == 0.0)
       ++topo.degenerateTriangles;
-    for (int k = 0; k < 3; ++k) {
+    for (std::uint32_t k = 0; k < 3; ++k) {
       const std::uint32_t u = tri[k], v = tri[(k + 1) % 3];
-      auto [it, inserted] = edges.try_emplace({std::min(u, v), std::max(u, v)});
-      if (inserted)
-        it->second.firstTriangle = t;
-      else
-        components.unite(t, it->second.firstTriangle);
-      (u < v ? it->second.forward : it->second.backward)++;
+      uses.push_back(
+          {std::min(u, v), std::max(u, v), static_cast<std::uint32_t>(3 * t + k), u < v});
     }
   }
-  topo.edges = edges.size();
-  for (const auto& [key, use] : edges) {
-    const std::uint32_t total = use.forward + use.backward;
-    if (total == 1)
-      ++topo.boundaryEdges;
-    else if (total > 2)
-      ++topo.nonManifoldEdges;
-    else if (use.forward != 1)
-      ++topo.misorientedEdges;
-  }
-  std::vector<bool> isRoot(surface.triangles.size(), false);
-  for (std::size_t t = 0; t < surface.triangles.size(); ++t) {
+  std::sort(uses.begin(), uses.end(), [](const EdgeUse& x, const EdgeUse& y) {
+    return x.lo != y.lo ? x.lo < y.lo : x.hi != y.hi ? x.hi < y.hi : x.corner < y.corner;
+  });
+  UnionFind components(n);
+  // Corners (triangle t's vertex k is corner 3 t + k) joined across the edges two triangles
+  // share: the corners of one vertex fall into one set per fan of triangles around it.
+  UnionFind fans(3 * n);
+  auto cornerAt = [&](std::uint32_t corner, std::uint32_t vertex) {
+    const std::uint32_t t = corner / 3;
     const auto& tri = surface.triangles[t];
-    if (tri[0] == tri[1] || tri[1] == tri[2] || tri[2] == tri[0]) continue;
-    isRoot[components.find(t)] = true;
+    return 3 * t + (tri[0] == vertex ? 0u : tri[1] == vertex ? 1u : 2u);
+  };
+  for (std::size_t i = 0; i < uses.size();) {
+    std::size_t j = i + 1;
+    std::uint32_t forward = uses[i].forward;
+    while (j < uses.size() && uses[j].lo == uses[i].lo && uses[j].hi == uses[i].hi) {
+      components.unite(uses[j].corner / 3, uses[i].corner / 3);
+      forward += uses[j].forward;
+      ++j;
+    }
+    ++topo.edges;
+    const std::size_t total = j - i;
+    if (total == 1) {
+      ++topo.boundaryEdges;
+    } else if (total > 2) {
+      ++topo.nonManifoldEdges;
+    } else {
+      if (forward != 1) ++topo.misorientedEdges;
+      for (std::uint32_t vertex : {uses[i].lo, uses[i].hi})
+        fans.unite(cornerAt(uses[i].corner, vertex), cornerAt(uses[i + 1].corner, vertex));
+    }
+    i = j;
   }
-  topo.components = static_cast<std::size_t>(std::count(isRoot.begin(), isRoot.end(), true));
+  std::vector<std::uint32_t> fansAt(surface.vertices.size(), 0);
+  for (std::size_t t = 0; t < n; ++t) {
+    if (skipped[t]) continue;
+    if (components.find(t) == t) ++topo.components;
+    for (std::uint32_t k = 0; k < 3; ++k)
+      if (fans.find(3 * t + k) == 3 * t + k) ++fansAt[surface.triangles[t][k]];
+  }
+  topo.singularVertices = static_cast<std::size_t>(
+      std::count_if(fansAt.begin(), fansAt.end(), [](std::uint32_t f) { return f > 1; }));
   return topo;
 }
 

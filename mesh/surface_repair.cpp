@@ -4,6 +4,7 @@
 #include <vector>
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Interval_nt.h>
 #include <CGAL/Polygon_mesh_processing/border.h>
 #include <CGAL/Polygon_mesh_processing/connected_components.h>
 #include <CGAL/Polygon_mesh_processing/orient_polygon_soup.h>
@@ -59,17 +60,42 @@ TriangleSurface fromMesh(const Mesh& mesh) {
   return s;
 }
 
+/// The sign of the volume a surface closed by consistently oriented triangles encloses, from
+/// the sum of the signed tetrahedra about its bounding box's centre in interval arithmetic
+/// (CGAL's Interval_nt, every rounding directed outward): +1 or -1 when the interval excludes 0,
+/// which makes the sign exact; 0 when the volume is within round-off of zero (then undecided).
+int enclosedVolumeSign(const TriangleSurface& surface) {
+  const CGAL::Protect_FPU_rounding<true> rounding;
+  using Interval = CGAL::Interval_nt<false>;
+  const Box3 box = bounds(surface);
+  const Vec3 centre = 0.5 * (box.min() + box.max());
+  std::vector<std::array<Interval, 3>> p(surface.vertices.size());
+  for (std::size_t v = 0; v < p.size(); ++v)
+    for (int i = 0; i < 3; ++i) p[v][i] = Interval(surface.vertices[v][i]) - Interval(centre[i]);
+  Interval sixVolume(0.0);
+  for (const auto& t : surface.triangles) {
+    const auto &a = p[t[0]], &b = p[t[1]], &c = p[t[2]];
+    sixVolume += a[0] * (b[1] * c[2] - b[2] * c[1]) + a[1] * (b[2] * c[0] - b[0] * c[2]) +
+                 a[2] * (b[0] * c[1] - b[1] * c[0]);
+  }
+  if (sixVolume.inf() > 0) return 1;
+  if (sixVolume.sup() < 0) return -1;
+  return 0;
+}
+
 }  // namespace
 
-SurfaceDiagnosis diagnose(const TriangleSurface& surface) {
+SurfaceDiagnosis diagnose(const TriangleSurface& surface, const SurfaceTopology* topology) {
   SurfaceDiagnosis d;
-  d.topology = analyzeTopology(surface);
+  d.topology = topology ? *topology : analyzeTopology(surface);
   if (surface.triangles.empty()) return d;
   if (d.topology.nonManifoldEdges > 0) return d;
-  // Consistently oriented copy (orientation does not change intersections or nesting).
+  // Consistently oriented copy (orientation does not change intersections or nesting); a
+  // closed surface without singular vertices is one already.
   auto points = toPoints(surface);
   auto polygons = toPolygons(surface);
-  PMP::orient_polygon_soup(points, polygons);
+  if (!d.topology.closed() || d.topology.singularVertices > 0)
+    PMP::orient_polygon_soup(points, polygons);
   Mesh mesh;
   PMP::polygon_soup_to_polygon_mesh(points, polygons, mesh);
   std::vector<std::pair<Mesh::Face_index, Mesh::Face_index>> pairs;
@@ -82,7 +108,23 @@ SurfaceDiagnosis diagnose(const TriangleSurface& surface) {
 }
 
 TriangleSurface orientToBoundVolume(const TriangleSurface& surface, bool& changed,
-                                    std::size_t* shells, std::size_t* cavities) {
+                                    std::size_t* shells, std::size_t* cavities,
+                                    const SurfaceTopology* topology) {
+  // One closed shell, consistently oriented already (the usual input): it bounds a volume
+  // outward when its volume is positive, and inward when negative (then every triangle flips).
+  const SurfaceTopology topo = topology ? *topology : analyzeTopology(surface);
+  if (topo.closed() && topo.components == 1 && topo.singularVertices == 0 &&
+      topo.degenerateTriangles == 0) {
+    if (const int sign = enclosedVolumeSign(surface)) {
+      if (shells) *shells = 1;
+      if (cavities) *cavities = 0;
+      changed = sign < 0;
+      TriangleSurface out = surface;
+      if (changed)
+        for (auto& t : out.triangles) std::swap(t[1], t[2]);
+      return out;
+    }
+  }
   auto points = toPoints(surface);
   auto polygons = toPolygons(surface);
   const auto before = polygons;

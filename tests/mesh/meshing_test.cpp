@@ -16,6 +16,7 @@
 
 #include "polydg/integrate/moment_cache.h"
 #include "polydg/mesh/surface_io.h"
+#include "polydg/mesh/surface_repair.h"
 #include "polydg/mesh/surface_shapes.h"
 #include "tests/support/identical_meshes.h"
 #include "tests/support/shapes.h"
@@ -89,6 +90,41 @@ TEST(Meshing, InwardSurfaceIsReorientedAndKeepsItsVolume) {
   EXPECT_LT(std::abs(inward.report.outputVolume - outward.report.outputVolume) /
                 outward.report.outputVolume,
             kVolumeTolerance);
+}
+
+// One consistently oriented shell takes the shortcut of orientToBoundVolume(): the sign of its
+// volume. It must agree with CGAL's path, which two shells still take (and which reports the
+// inner one as a cavity), also far from the origin, where the volume is a sum of large terms.
+TEST(Meshing, OrientationByTheVolumeSignAgreesWithCgalsOrientation) {
+  for (const Vec3& centre : {Vec3(0.1, 0.2, -0.3), Vec3(1e6, -2e6, 3e6)}) {
+    const TriangleSurface sphere = icosphere(centre, 1.0, 3);
+    for (bool flip : {false, true}) {
+      const TriangleSurface input = flip ? reversedSurface(sphere) : sphere;
+      bool changed = !flip;
+      std::size_t shells = 0, cavities = 1;
+      const TriangleSurface out = orientToBoundVolume(input, changed, &shells, &cavities);
+      EXPECT_EQ(changed, flip);
+      EXPECT_EQ(shells, 1u);
+      EXPECT_EQ(cavities, 0u);
+      EXPECT_GT(enclosedVolume(out), 0.0);
+      EXPECT_EQ(out.triangles, sphere.triangles);
+    }
+    // Two shells, the inner one outward too: CGAL's path turns it inward, a cavity.
+    TriangleSurface shell = sphere;
+    const TriangleSurface inner = icosphere(centre, 0.5, 2);
+    const auto offset = static_cast<std::uint32_t>(shell.vertices.size());
+    shell.vertices.insert(shell.vertices.end(), inner.vertices.begin(), inner.vertices.end());
+    for (auto t : inner.triangles)
+      shell.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+    bool changed = false;
+    std::size_t shells = 0, cavities = 0;
+    const TriangleSurface out = orientToBoundVolume(shell, changed, &shells, &cavities);
+    EXPECT_TRUE(changed);
+    EXPECT_EQ(shells, 2u);
+    EXPECT_EQ(cavities, 1u);
+    const double expected = 4.0 / 3.0 * M_PI * (1.0 - 0.125);
+    EXPECT_NEAR(enclosedVolume(out), expected, 0.05 * expected);  // polyhedral spheres
+  }
 }
 
 TEST(Meshing, ValidationCanBeLeftToTheCaller) {

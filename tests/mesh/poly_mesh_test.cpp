@@ -106,5 +106,26 @@ TEST(SurfaceTopology, CountsBoundaryNonManifoldAndMisorientedEdges) {
   EXPECT_EQ(t.boundaryEdges, 2u);     // 1-3 and 3-2 still open
 }
 
+TEST(SurfaceTopology, CountsVerticesWhereTwoFansTouch) {
+  // Two closed tetrahedra sharing vertex 0 only: every edge is used twice, in opposite
+  // directions, yet the surface is not a manifold at vertex 0 (two fans of triangles there).
+  TriangleSurface s;
+  s.vertices = {Vec3(0, 0, 0),  Vec3(1, 0, 0),  Vec3(0, 1, 0), Vec3(0, 0, 1),
+                Vec3(-1, 0, 0), Vec3(0, -1, 0), Vec3(0, 0, -1)};
+  s.triangles = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3},
+                 {0, 4, 5}, {0, 6, 4}, {0, 5, 6}, {4, 6, 5}};
+  SurfaceTopology t = analyzeTopology(s);
+  EXPECT_TRUE(t.closed());
+  EXPECT_EQ(t.components, 2u);
+  EXPECT_EQ(t.singularVertices, 1u);
+  s.triangles.resize(4);  // one tetrahedron: every vertex has one fan
+  t = analyzeTopology(s);
+  EXPECT_EQ(t.singularVertices, 0u);
+  s.triangles.pop_back();  // open: the fans around the hole's vertices are open, still one each
+  t = analyzeTopology(s);
+  EXPECT_EQ(t.boundaryEdges, 3u);
+  EXPECT_EQ(t.singularVertices, 0u);
+}
+
 }  // namespace
 }  // namespace polydg

@@ -24,6 +24,9 @@ struct SurfaceTopology {
   std::size_t misorientedEdges = 0;     ///< used twice in the same direction
   std::size_t degenerateTriangles = 0;  ///< two equal vertex indices or zero area
   std::size_t components = 0;           ///< connected through shared edges
+  /// Vertices whose triangles form more than one fan through the edges pairs of them share (two
+  /// parts of the surface touching at a point): counted on edges used by exactly two triangles.
+  std::size_t singularVertices = 0;
   /// Closed: every edge used by exactly two triangles in opposite directions.
   bool closed() const {
     return boundaryEdges == 0 && nonManifoldEdges == 0 && misorientedEdges == 0;

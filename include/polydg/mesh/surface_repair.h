@@ -26,15 +26,23 @@ struct SurfaceDiagnosis {
 
 /// Counts the defects of `surface`. Self-intersections are looked for when the surface can be
 /// made a manifold mesh (that is, when every edge has at most two triangles).
-SurfaceDiagnosis diagnose(const TriangleSurface& surface);
+/// `topology` is analyzeTopology()'s result if the caller has it (computed if null).
+SurfaceDiagnosis diagnose(const TriangleSurface& surface,
+                          const SurfaceTopology* topology = nullptr);
 
 /// Orients a closed, manifold, non-self-intersecting surface so that it bounds a volume: outer
 /// shells outward, cavities inward (CGAL's orient_to_bound_a_volume, after making the
 /// orientation consistent). `changed` says whether any triangle was flipped; `shells` and
 /// `cavities` (optional) receive the number of closed components and of those nested at odd
-/// depth (holes in the solid).
+/// depth (holes in the solid). A surface of one shell whose triangles are consistently
+/// oriented already (`topology`, analyzeTopology()'s result, computed if null: closed, one
+/// component, no singular vertex or degenerate triangle) takes a shortcut: the sign of its
+/// enclosed volume, exact through interval arithmetic, says whether to flip every triangle or
+/// none (on a 75k-triangle bunny 2 ms instead of 0.36 s); a volume within round-off of zero
+/// takes CGAL's path.
 TriangleSurface orientToBoundVolume(const TriangleSurface& surface, bool& changed,
-                                    std::size_t* shells = nullptr, std::size_t* cavities = nullptr);
+                                    std::size_t* shells = nullptr, std::size_t* cavities = nullptr,
+                                    const SurfaceTopology* topology = nullptr);
 
 /// Removes triangles with repeated vertices or zero area, welding their edges away (CGAL's
 /// remove_degenerate_faces on the soup made into a mesh). Returns how many were removed.
