@@ -429,7 +429,7 @@ SolveReport Model::solve(const SolveOptions& options) {
   report.facesIntegrated = facesIntegrated() - before;
   if (options.estimate) {
     report.estimate = estimateError(m, solver, options.material, loads, *u);
-    report.energyNorm = std::sqrt(std::max(0.0, u->dot(solver.system().matrix * *u)));
+    report.energyNorm = std::sqrt(std::max(0.0, u->dot(solver.stiffnessTimes(*u))));
   }
 
   if (options.exactDisplacement && options.exactGradient) {

@@ -15,6 +15,7 @@
 #endif
 
 #include "polydg/integrate/quadrature.h"
+#include "polydg/physics/block_rows.h"
 #include "polydg/physics/face_quadrature.h"
 
 namespace polydg {
@@ -193,26 +194,13 @@ ElementData<double> elementPenaltyThresholds(const PolyMesh& mesh, const DgBasis
 
 namespace {
 
-/// localMatrices() with a choice of terms: the element stiffness if `element`, the face terms
-/// `diagonalTerms` (FaceTerms bits) in the diagonal blocks and `couplingTerms` in the coupling
-/// blocks.
-LocalMatrices localMatricesOf(const PolyMesh& mesh, const DgBasis& basis,
-                              const MomentCache& moments, const FaceRoles& roles,
-                              const FormCoefficients& form, bool element, int diagonalTerms,
-                              int couplingTerms, bool dirichletFaces = true) {
-  const std::size_t ne = mesh.numElements();
-  LocalMatrices local;
-  local.functions = basis.size();
-  local.blockSize = 3 * local.functions;
-  local.componentDiagonalCoupling = form.method == Method::BZ;
-  const int bs = local.blockSize;
-  const std::size_t bb = static_cast<std::size_t>(bs) * static_cast<std::size_t>(bs);
-
-  // Neighbours of each element (sorted, with self), through coupled interior faces.
-  local.neighbours.resize(ne);
-  tbb::parallel_for(std::size_t(0), ne, [&](std::size_t i) {
+/// Neighbours of each element (sorted, with self), through coupled interior faces.
+std::vector<std::vector<std::uint32_t>> coupledNeighbours(const PolyMesh& mesh,
+                                                          const FaceRoles& roles) {
+  std::vector<std::vector<std::uint32_t>> neighbours(mesh.numElements());
+  tbb::parallel_for(std::size_t(0), mesh.numElements(), [&](std::size_t i) {
     const ElementId e(i);
-    auto& b = local.neighbours[i];
+    auto& b = neighbours[i];
     b.push_back(e.value);
     for (const FaceUse& use : mesh.element(e).faces) {
       if (roles.kind[use.face] != FaceKind::Interior) continue;
@@ -222,26 +210,32 @@ LocalMatrices localMatricesOf(const PolyMesh& mesh, const DgBasis& basis,
     std::sort(b.begin(), b.end());
     b.erase(std::unique(b.begin(), b.end()), b.end());
   });
-  local.couplingStart.assign(ne + 1, 0);
-  for (std::size_t i = 0; i < ne; ++i) {
-    const auto& b = local.neighbours[i];
-    const std::size_t greater = static_cast<std::size_t>(
-        b.end() - std::upper_bound(b.begin(), b.end(), static_cast<std::uint32_t>(i)));
-    local.couplingStart[i + 1] = local.couplingStart[i] + greater;
-  }
-  local.diagonal.resize(ne * bb);
-  local.coupling.resize(local.couplingStart[ne] * bb);
+  return neighbours;
+}
 
+/// The rows of each element of a form with a choice of terms: the element stiffness if
+/// `element`, the face terms `diagonalTerms` (FaceTerms bits) in the diagonal blocks and
+/// `couplingTerms` in the coupling blocks. For each element e, in parallel,
+/// store(e, diagonal, coupling) receives e's diagonal block (bs x bs, column-major) and its
+/// coupling blocks with its neighbours f > e (in the order of `neighbours`, each bs x bs
+/// row-major: column (e, c) of K reads row c of the block), in a scratch buffer.
+template <class Store>
+void forEachElementRows(const PolyMesh& mesh, const DgBasis& basis, const MomentCache& moments,
+                        const FaceRoles& roles, const FormCoefficients& form,
+                        const std::vector<std::vector<std::uint32_t>>& neighbours, bool element,
+                        int diagonalTerms, int couplingTerms, bool dirichletFaces, Store&& store) {
+  const int bs = 3 * basis.size();
+  const std::size_t bb = static_cast<std::size_t>(bs) * static_cast<std::size_t>(bs);
   tbb::parallel_for(
-      tbb::blocked_range<std::size_t>(0, ne, 16), [&](const tbb::blocked_range<std::size_t>& r) {
+      tbb::blocked_range<std::size_t>(0, mesh.numElements(), 16),
+      [&](const tbb::blocked_range<std::size_t>& r) {
         Eigen::MatrixXd self, faceSelf, faceOther;
+        std::vector<double> coupling;
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
           const ElementId e(i);
-          const auto& b = local.neighbours[i];
+          const auto& b = neighbours[i];
           const auto firstGreater = std::upper_bound(b.begin(), b.end(), e.value);
-          double* coupling = local.coupling.data() + local.couplingStart[i] * bb;
-          std::fill(coupling, coupling + (local.couplingStart[i + 1] - local.couplingStart[i]) * bb,
-                    0.0);
+          coupling.assign(static_cast<std::size_t>(b.end() - firstGreater) * bb, 0.0);
           if (element)
             elementStiffness(basis, moments, e, form.mu, form.lambda, self);
           else
@@ -271,15 +265,118 @@ LocalMatrices localMatricesOf(const PolyMesh& mesh, const DgBasis& basis,
             const auto t = std::lower_bound(firstGreater, b.end(), view.other.value) - firstGreater;
             // Row-major: column (e, c) of K reads row c of the block.
             Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
-                coupling + static_cast<std::size_t>(t) * bb, bs, bs) += faceOther;
+                coupling.data() + static_cast<std::size_t>(t) * bb, bs, bs) += faceOther;
           }
-          Eigen::Map<Eigen::MatrixXd>(local.diagonal.data() + i * bb, bs, bs) = self;
+          store(i, self, coupling.data());
         }
+      });
+}
+
+/// localMatrices() with a choice of terms (forEachElementRows()).
+LocalMatrices localMatricesOf(const PolyMesh& mesh, const DgBasis& basis,
+                              const MomentCache& moments, const FaceRoles& roles,
+                              const FormCoefficients& form, bool element, int diagonalTerms,
+                              int couplingTerms, bool dirichletFaces = true) {
+  const std::size_t ne = mesh.numElements();
+  LocalMatrices local;
+  local.functions = basis.size();
+  local.blockSize = 3 * local.functions;
+  local.componentDiagonalCoupling = form.method == Method::BZ;
+  const std::size_t bb =
+      static_cast<std::size_t>(local.blockSize) * static_cast<std::size_t>(local.blockSize);
+  local.neighbours = coupledNeighbours(mesh, roles);
+  local.couplingStart.assign(ne + 1, 0);
+  for (std::size_t i = 0; i < ne; ++i) {
+    const auto& b = local.neighbours[i];
+    const std::size_t greater = static_cast<std::size_t>(
+        b.end() - std::upper_bound(b.begin(), b.end(), static_cast<std::uint32_t>(i)));
+    local.couplingStart[i + 1] = local.couplingStart[i] + greater;
+  }
+  local.diagonal.resize(ne * bb);
+  local.coupling.resize(local.couplingStart[ne] * bb);
+  forEachElementRows(
+      mesh, basis, moments, roles, form, local.neighbours, element, diagonalTerms, couplingTerms,
+      dirichletFaces, [&](std::size_t i, const Eigen::MatrixXd& self, const double* coupling) {
+        Eigen::Map<Eigen::MatrixXd>(local.diagonal.data() + i * bb, self.rows(), self.cols()) =
+            self;
+        std::copy(coupling, coupling + (local.couplingStart[i + 1] - local.couplingStart[i]) * bb,
+                  local.coupling.data() + local.couplingStart[i] * bb);
       });
   return local;
 }
 
 }  // namespace
+
+BlockRows<double> assembleBlockRows(const PolyMesh& mesh, const DgBasis& basis,
+                                    const MomentCache& moments, const FaceRoles& roles,
+                                    const FormCoefficients& form) {
+  const int n = basis.size(), bs = 3 * n;
+  const bool bz = form.method == Method::BZ;
+  const std::vector<std::vector<std::uint32_t>> neighbours = coupledNeighbours(mesh, roles);
+  const std::size_t ne = neighbours.size();
+  BlockRows<double> rows;
+  rows.n = n;
+  rows.bs = bs;
+  rows.start.assign(ne + 1, 0);
+  for (std::size_t e = 0; e < ne; ++e)
+    rows.start[e + 1] = rows.start[e] + static_cast<int>(neighbours[e].size());
+  const std::size_t slots = static_cast<std::size_t>(rows.start.back());
+  rows.element.resize(slots);
+  rows.diagonal.resize(slots);
+  rows.offset.assign(slots + 1, 0);
+  std::size_t k = 0;
+  for (std::size_t e = 0; e < ne; ++e)
+    for (const std::uint32_t f : neighbours[e]) {
+      rows.element[k] = static_cast<int>(f);
+      // BZ's neighbour blocks couple equal components only: three n x n blocks.
+      rows.diagonal[k] = bz && f != e ? 1 : 0;
+      rows.offset[k + 1] =
+          rows.offset[k] + static_cast<std::size_t>(rows.diagonal[k] ? 3 * n * n : bs * bs);
+      ++k;
+    }
+  rows.values.resize(rows.offset.back());
+  // Element e writes its own row's slots of itself and of each f > e, and row f's slot of e
+  // (the transpose): every slot has one writer.
+  forEachElementRows(
+      mesh, basis, moments, roles, form, neighbours, true, kAllFaceTerms, kAllFaceTerms, true,
+      [&](std::size_t e, const Eigen::MatrixXd& self, const double* coupling) {
+        const auto& b = neighbours[e];
+        const std::size_t first = static_cast<std::size_t>(rows.start[e]);
+        const std::size_t own = static_cast<std::size_t>(
+            std::lower_bound(b.begin(), b.end(), static_cast<std::uint32_t>(e)) - b.begin());
+        Eigen::Map<Eigen::MatrixXd>(rows.values.data() + rows.offset[first + own], bs, bs) = self;
+        for (std::size_t t = own + 1; t < b.size(); ++t) {
+          const std::size_t f = b[t];
+          // K_ef(c, j) = block(c, j), the block row-major.
+          const double* block = coupling + (t - own - 1) * static_cast<std::size_t>(bs * bs);
+          const auto& bf = neighbours[f];
+          const std::size_t back =
+              static_cast<std::size_t>(rows.start[f]) +
+              static_cast<std::size_t>(
+                  std::lower_bound(bf.begin(), bf.end(), static_cast<std::uint32_t>(e)) -
+                  bf.begin());
+          double* ef = rows.values.data() + rows.offset[first + t];
+          double* fe = rows.values.data() + rows.offset[back];
+          if (bz) {  // component d's n x n blocks, column-major; K_fe = K_ef^T
+            for (int d = 0; d < 3; ++d)
+              for (int j = 0; j < n; ++j)
+                for (int c = 0; c < n; ++c) {
+                  const double v = block[(d * n + c) * bs + d * n + j];
+                  ef[d * n * n + j * n + c] = v;
+                  fe[d * n * n + c * n + j] = v;
+                }
+            continue;
+          }
+          for (int j = 0; j < bs; ++j)
+            for (int c = 0; c < bs; ++c) {
+              const double v = block[c * bs + j];
+              ef[j * bs + c] = v;
+              fe[c * bs + j] = v;
+            }
+        }
+      });
+  return rows;
+}
 
 LocalMatrices localMatrices(const PolyMesh& mesh, const DgBasis& basis, const MomentCache& moments,
                             const FaceRoles& roles, const FormCoefficients& form) {

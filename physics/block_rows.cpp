@@ -194,6 +194,52 @@ const T* BlockRows<T>::diagonalBlock(int e) const {
   return values.data() + offset[slot];
 }
 
+template <class T>
+Eigen::SparseMatrix<double, Eigen::ColMajor, int> BlockRows<T>::toSparse() const {
+  const int ne = elements();
+  const Eigen::Index dofs = static_cast<Eigen::Index>(ne) * bs;
+  Eigen::SparseMatrix<double, Eigen::ColMajor, int> a(dofs, dofs);
+  // Column c of element e's rows is row c (symmetric): per slot, n (component-diagonal) or
+  // bs entries.
+  std::vector<int> outer(static_cast<std::size_t>(dofs) + 1, 0);
+  for (int e = 0; e < ne; ++e) {
+    int perColumn = 0;
+    for (int k = start[static_cast<std::size_t>(e)]; k < start[static_cast<std::size_t>(e) + 1];
+         ++k)
+      perColumn += diagonal[static_cast<std::size_t>(k)] ? n : bs;
+    for (int c = 0; c < bs; ++c) outer[static_cast<std::size_t>(e * bs + c) + 1] = perColumn;
+  }
+  for (std::size_t c = 1; c < outer.size(); ++c) outer[c] += outer[c - 1];
+  a.resizeNonZeros(outer.back());
+  std::copy(outer.begin(), outer.end(), a.outerIndexPtr());
+  int* inner = a.innerIndexPtr();
+  double* out = a.valuePtr();
+  tbb::parallel_for(0, ne, [&](int e) {
+    for (int c = 0; c < bs; ++c) {
+      const int d = c / n, cn = c - d * n;
+      int pos = outer[static_cast<std::size_t>(e * bs + c)];
+      for (int k = start[static_cast<std::size_t>(e)]; k < start[static_cast<std::size_t>(e) + 1];
+           ++k) {
+        const std::size_t slot = static_cast<std::size_t>(k);
+        const int base = element[slot] * bs;
+        const T* block = values.data() + offset[slot];
+        if (diagonal[slot]) {  // row c, columns d n .. d n + n - 1 of the block
+          for (int j = 0; j < n; ++j) {
+            inner[pos] = base + d * n + j;
+            out[pos++] = static_cast<double>(block[d * n * n + j * n + cn]);
+          }
+          continue;
+        }
+        for (int j = 0; j < bs; ++j) {  // row c of the block, column-major
+          inner[pos] = base + j;
+          out[pos++] = static_cast<double>(block[j * bs + c]);
+        }
+      }
+    }
+  });
+  return a;
+}
+
 template struct BlockRows<float>;
 template struct BlockRows<double>;
 

@@ -68,11 +68,15 @@ void symmetricProduct(const SpMat& matrix, const Eigen::VectorXd& x, Eigen::Vect
                     });
 }
 
-SolverKind chooseSolver(const SpMat& matrix, const SolverOptions& options) {
+SolverKind chooseSolver(std::size_t dofs, std::size_t nonzeros, const SolverOptions& options) {
   if (options.kind != SolverKind::Auto) return options.kind;
-  const bool small = static_cast<std::size_t>(matrix.rows()) <= options.directLimitDofs &&
-                     static_cast<std::size_t>(matrix.nonZeros()) <= options.directLimitNonzeros;
+  const bool small = dofs <= options.directLimitDofs && nonzeros <= options.directLimitNonzeros;
   return small ? SolverKind::Cholesky : SolverKind::ConjugateGradient;
+}
+
+SolverKind chooseSolver(const SpMat& matrix, const SolverOptions& options) {
+  return chooseSolver(static_cast<std::size_t>(matrix.rows()),
+                      static_cast<std::size_t>(matrix.nonZeros()), options);
 }
 
 struct LinearSolver::Impl {
@@ -90,10 +94,18 @@ struct LinearSolver::Impl {
   /// nonzeros (B2, IP, p = 1: 0.31 -> 0.2 ms per product).
   BlockRows<double> productBlocks;
   bool useProductBlocks = false;
+  /// K given by block rows alone (compute(const BlockRows<double>&)): the caller's, the one
+  /// copy of K, read by the product and the smoother; `matrix` is then null.
+  const BlockRows<double>* rows = nullptr;
+
+  const BlockRows<double>* productRows() const {
+    return rows ? rows : useProductBlocks ? &productBlocks : nullptr;
+  }
 
   /// y = K x; returns x.y. One pass (and one hand-off between threads) with the block rows.
   double productDot(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
-    if (!useProductBlocks) {
+    const BlockRows<double>* blocks = productRows();
+    if (!blocks) {
       symmetricProduct(*matrix, x, y);
       return parallelDot(x, y);
     }
@@ -104,7 +116,7 @@ struct LinearSolver::Impl {
         [&](const tbb::blocked_range<int>& r, double sum) {
           for (int e = r.begin(); e != r.end(); ++e) {
             const Eigen::Index base = static_cast<Eigen::Index>(e) * blockSize;
-            productBlocks.rowProduct(e, x.data(), y.data() + base);
+            blocks->rowProduct(e, x.data(), y.data() + base);
             sum += x.segment(base, blockSize).dot(y.segment(base, blockSize));
           }
           return sum;
@@ -131,16 +143,20 @@ struct LinearSolver::Impl {
   }
 
   bool buildBlockJacobi() {
-    const Eigen::Index nb = matrix->rows() / blockSize;
+    const Eigen::Index nb = rows ? rows->elements() : matrix->rows() / blockSize;
     blockInverses.assign(static_cast<std::size_t>(nb), Eigen::MatrixXd());
     std::atomic<bool> ok{true};
     tbb::parallel_for(Eigen::Index(0), nb, [&](Eigen::Index b) {
       const Eigen::Index base = b * blockSize;
       Eigen::MatrixXd block = Eigen::MatrixXd::Zero(blockSize, blockSize);
-      for (int c = 0; c < blockSize; ++c)
-        for (SpMat::InnerIterator it(*matrix, base + c); it; ++it)
-          if (it.row() >= base && it.row() < base + blockSize)
-            block(it.row() - base, c) = it.value();
+      if (rows)
+        block = Eigen::Map<const Eigen::MatrixXd>(rows->diagonalBlock(static_cast<int>(b)),
+                                                  blockSize, blockSize);
+      else
+        for (int c = 0; c < blockSize; ++c)
+          for (SpMat::InnerIterator it(*matrix, base + c); it; ++it)
+            if (it.row() >= base && it.row() < base + blockSize)
+              block(it.row() - base, c) = it.value();
       Eigen::LLT<Eigen::MatrixXd> llt(block);
       if (llt.info() != Eigen::Success) {
         ok = false;
@@ -222,6 +238,7 @@ SolverKind LinearSolver::kind() const { return impl_->kind; }
 bool LinearSolver::compute(const SpMat& matrix, int blockSize, const ElementFrames* frames) {
   Impl& m = *impl_;
   m.matrix = &matrix;
+  m.rows = nullptr;
   m.blockSize = blockSize;
   m.kind = chooseSolver(matrix, m.options);
   const Stopwatch t0;
@@ -239,9 +256,37 @@ bool LinearSolver::compute(const SpMat& matrix, int blockSize, const ElementFram
   return ok;
 }
 
+bool LinearSolver::compute(const BlockRows<double>& rows, const ElementFrames* frames) {
+  Impl& m = *impl_;
+  if (m.options.kind == SolverKind::Cholesky)
+    throw std::invalid_argument(
+        "LinearSolver::compute: block rows are for conjugate gradients; Cholesky needs the "
+        "CSR matrix");
+  m.matrix = nullptr;
+  m.rows = &rows;
+  m.useProductBlocks = false;
+  m.productBlocks = BlockRows<double>{};
+  m.blockSize = rows.bs;
+  m.kind = SolverKind::ConjugateGradient;
+  m.preconditioner = m.options.preconditioner;
+  const Stopwatch t0;
+  bool ok = true;
+  const int degree = m.degreeOfBlock();
+  if (m.preconditioner == CgPreconditioner::PMultigrid && degree >= 0) {
+    ok = m.multigrid.compute(rows, degree, frames);
+  } else {
+    m.preconditioner = CgPreconditioner::BlockJacobi;
+    ok = m.buildBlockJacobi();
+  }
+  m.factorSeconds = t0.seconds();
+  return ok;
+}
+
 bool LinearSolver::update(const SpMat& matrix, bool refreshPreconditioner,
                           const ElementFrames* frames) {
   Impl& m = *impl_;
+  if (m.rows)
+    throw std::invalid_argument("LinearSolver::update: the solver was computed from block rows");
   if (!m.matrix) return compute(matrix, m.blockSize, frames);
   if (matrix.rows() != m.matrix->rows() || matrix.nonZeros() != m.matrix->nonZeros())
     throw std::invalid_argument("LinearSolver::update: the matrix has another pattern");
@@ -282,7 +327,7 @@ Eigen::VectorXd LinearSolver::solve(const Eigen::VectorXd& rhs, LinearSolveRepor
   }
   report.solveSeconds = t0.seconds();
   Eigen::VectorXd ku;
-  symmetricProduct(*m.matrix, u, ku);
+  m.productDot(u, ku);
   const double fNorm = rhs.norm();
   report.residual = fNorm > 0.0 ? (rhs - ku).norm() / fNorm : (ku).norm();
   return u;

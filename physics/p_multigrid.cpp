@@ -56,6 +56,9 @@ enum class Transfer {
 struct Level {
   const SpMat* matrix = nullptr;
   SpMat owned;
+  /// The top level given by block rows alone (the caller's, double precision; no CSR matrix):
+  /// the smoother reads them as they are.
+  const BlockRows<double>* rows = nullptr;
   int n = 0, bs = 0;
   std::vector<double> inverses;
   /// The smoother's copy of the matrix in single precision (BlockRows): half the bytes of
@@ -80,6 +83,9 @@ struct Level {
   Agglomeration groups;
   // Scratch of apply(): right-hand side and solution of this level.
   mutable Eigen::VectorXd b, x;
+
+  /// Blocks (elements or groups) of the level.
+  Eigen::Index blockCount() const { return rows ? rows->elements() : matrix->cols() / bs; }
 };
 
 /// The principal submatrix of `fine` (n functions per component) on the DOFs of the first
@@ -148,6 +154,11 @@ inline void blockResidual(const Level& level, int e, const Eigen::VectorXd& b,
                           const Eigen::VectorXd& x, double* s) {
   const int bs = level.bs;
   const Eigen::Index base = static_cast<Eigen::Index>(e) * bs;
+  if (level.rows) {
+    for (int c = 0; c < bs; ++c) s[c] = b[base + c];
+    level.rows->subtractRowProduct(e, x.data(), s);
+    return;
+  }
   if (!level.useBlocks) {
     const SpMat& a = *level.matrix;
     const int* outer = a.outerIndexPtr();
@@ -196,21 +207,23 @@ bool invertBlock(int bs, const double* block, double* inverse) {
 
 /// Inverts the element diagonal blocks of `level`; false if one is not positive definite.
 bool invertBlocks(Level& level) {
-  const SpMat& a = *level.matrix;
   const int bs = level.bs;
-  const Eigen::Index ne = a.cols() / bs;
+  const Eigen::Index ne = level.blockCount();
   level.inverses.resize(static_cast<std::size_t>(ne * bs * bs));
   std::atomic<bool> ok{true};
   tbb::parallel_for(Eigen::Index(0), ne, [&](Eigen::Index e) {
     const Eigen::Index base = e * bs;
     double block[kMaxBlock * kMaxBlock];
     std::fill(block, block + bs * bs, 0.0);
-    if (level.useBlocks) {  // invert the block as the smoother sees it (single precision)
+    if (level.rows) {
+      const double* values = level.rows->diagonalBlock(static_cast<int>(e));
+      std::copy(values, values + bs * bs, block);
+    } else if (level.useBlocks) {  // invert the block as the smoother sees it (single precision)
       const float* values = level.blocks.diagonalBlock(static_cast<int>(e));
       std::copy(values, values + bs * bs, block);
     } else {
       for (int c = 0; c < bs; ++c)
-        for (SpMat::InnerIterator it(a, base + c); it; ++it)
+        for (SpMat::InnerIterator it(*level.matrix, base + c); it; ++it)
           if (it.row() >= base && it.row() < base + bs)
             block[c * bs + (it.row() - base)] = it.value();
     }
@@ -242,6 +255,63 @@ std::vector<std::vector<int>> colourElements(const SpMat& a, int bs) {
     classes[static_cast<std::size_t>(c)].push_back(e);
   }
   return classes;
+}
+
+/// colourElements() for a matrix by block rows.
+std::vector<std::vector<int>> colourElements(const BlockRows<double>& a) {
+  const int ne = a.elements();
+  std::vector<int> colour(static_cast<std::size_t>(ne), -1);
+  std::vector<int> seenBy;
+  std::vector<std::vector<int>> classes;
+  for (int e = 0; e < ne; ++e) {
+    for (int k = a.start[static_cast<std::size_t>(e)]; k < a.start[static_cast<std::size_t>(e) + 1];
+         ++k) {
+      const int c = colour[static_cast<std::size_t>(a.element[static_cast<std::size_t>(k)])];
+      if (c >= 0) seenBy[static_cast<std::size_t>(c)] = e;
+    }
+    int c = 0;
+    while (c < static_cast<int>(seenBy.size()) && seenBy[static_cast<std::size_t>(c)] == e) ++c;
+    if (c == static_cast<int>(seenBy.size())) {
+      seenBy.push_back(-1);
+      classes.emplace_back();
+    }
+    colour[static_cast<std::size_t>(e)] = c;
+    classes[static_cast<std::size_t>(c)].push_back(e);
+  }
+  return classes;
+}
+
+/// The principal submatrix of `fine` on the first `nc` functions of each component, as
+/// restrictMatrix() gives it, from block rows.
+SpMat restrictBlocks(const BlockRows<double>& fine, int nc) {
+  BlockRows<double> coarse;
+  const int n = fine.n, bs = fine.bs, bsc = 3 * nc;
+  coarse.n = nc;
+  coarse.bs = bsc;
+  coarse.start = fine.start;
+  coarse.element = fine.element;
+  coarse.diagonal = fine.diagonal;
+  coarse.offset.assign(fine.offset.size(), 0);
+  for (std::size_t k = 0; k + 1 < fine.offset.size(); ++k)
+    coarse.offset[k + 1] =
+        coarse.offset[k] + static_cast<std::size_t>(fine.diagonal[k] ? 3 * nc * nc : bsc * bsc);
+  coarse.values.resize(coarse.offset.back());
+  tbb::parallel_for(std::size_t(0), fine.element.size(), [&](std::size_t k) {
+    const double* from = fine.values.data() + fine.offset[k];
+    double* to = coarse.values.data() + coarse.offset[k];
+    if (fine.diagonal[k]) {
+      for (int d = 0; d < 3; ++d)
+        for (int j = 0; j < nc; ++j)
+          for (int i = 0; i < nc; ++i) to[d * nc * nc + j * nc + i] = from[d * n * n + j * n + i];
+      return;
+    }
+    for (int dj = 0; dj < 3; ++dj)
+      for (int j = 0; j < nc; ++j)
+        for (int di = 0; di < 3; ++di)
+          for (int i = 0; i < nc; ++i)
+            to[(dj * nc + j) * bsc + di * nc + i] = from[(dj * n + j) * bs + di * n + i];
+  });
+  return coarse.toSparse();
 }
 
 /// Functions per component of degree `degree`: numMonomials, checked against the block size.
@@ -313,6 +383,10 @@ struct PMultigrid::Impl {
 
   const Level& coarsest() const { return levels.back(); }
 
+  /// PMultigrid::compute() from the CSR matrix or (matrix null) from block rows.
+  bool build(const SpMat* matrix, const BlockRows<double>* rows, int degree,
+             const BlockRows<double>* matrixBlocks, const ElementFrames* frames);
+
   void coarseSolve(const Eigen::VectorXd& b, Eigen::VectorXd& x) const {
     if (coarseParts.empty()) {
       x = coarse.front()->solve(b);
@@ -371,9 +445,10 @@ struct PMultigrid::Impl {
   /// Colours, smoother blocks and block inverses of a level that is smoothed.
   bool prepareSmoother(Level& level, const BlockRows<double>* matrixBlocks) {
     if (level.colours.empty()) level.colours = colourElements(*level.matrix, level.bs);
-    level.inLastColour.assign(static_cast<std::size_t>(level.matrix->cols() / level.bs), 0);
+    level.inLastColour.assign(static_cast<std::size_t>(level.blockCount()), 0);
     if (!level.colours.empty())
       for (int e : level.colours.back()) level.inLastColour[static_cast<std::size_t>(e)] = 1;
+    if (level.rows) return invertBlocks(level);  // the smoother reads the caller's rows
     if (matrixBlocks == nullptr) matrixBlocks = level.source;
     if (matrixBlocks != nullptr && !matrixBlocks->values.empty()) {
       level.blocks.convertFrom(*matrixBlocks);
@@ -410,7 +485,7 @@ struct PMultigrid::Impl {
   void push(Level&& level) {
     levels.push_back(std::move(level));
     for (std::size_t k = 0; k < levels.size(); ++k) {
-      if (k > 0) levels[k].matrix = &levels[k].owned;
+      if (k > 0 || levels[k].owned.size() > 0) levels[k].matrix = &levels[k].owned;
       if (!levels[k].exact.values.empty()) levels[k].source = &levels[k].exact;
     }
   }
@@ -552,16 +627,38 @@ Eigen::Index PMultigrid::coarseUnknowns() const {
 
 bool PMultigrid::compute(const SpMat& matrix, int degree, const BlockRows<double>* matrixBlocks,
                          const ElementFrames* frames) {
-  Impl& m = *impl_;
+  return impl_->build(&matrix, nullptr, degree, matrixBlocks, frames);
+}
+
+bool PMultigrid::compute(const BlockRows<double>& rows, int degree, const ElementFrames* frames) {
+  return impl_->build(nullptr, &rows, degree, nullptr, frames);
+}
+
+bool PMultigrid::Impl::build(const SpMat* matrix, const BlockRows<double>* rows, int degree,
+                             const BlockRows<double>* matrixBlocks, const ElementFrames* frames) {
+  Impl& m = *this;
   m.levels.clear();
+  // Room for every level: growing the vector would copy the levels (Eigen's sparse matrices
+  // move without noexcept), each matrix twice at once.
+  m.levels.reserve(32);
   m.levels.emplace_back();
   Level& top = m.levels.back();
   top.n = numMonomials(degree);
   top.bs = 3 * top.n;
   functionsOfBlock(top.bs, degree);
-  top.matrix = &matrix;
-  top.colours = colourElements(matrix, top.bs);
-  const Eigen::Index ne = matrix.cols() / top.bs;
+  top.matrix = matrix;
+  top.rows = rows;
+  if (rows) {
+    if (rows->bs != top.bs)
+      throw std::invalid_argument("PMultigrid: block size does not match the degree");
+    top.source = rows;
+    top.colours = colourElements(*rows);
+  } else {
+    top.colours = colourElements(*matrix, top.bs);
+  }
+  const Eigen::Index ne = top.blockCount();
+  const double nonzeros =
+      rows ? static_cast<double>(rows->entries()) : static_cast<double>(matrix->nonZeros());
   const bool agglomerate = frames != nullptr && degree >= 1 &&
                            frames->centres.size() == static_cast<std::size_t>(ne) &&
                            frames->scales.size() == static_cast<std::size_t>(ne) &&
@@ -572,9 +669,16 @@ bool PMultigrid::compute(const SpMat& matrix, int degree, const BlockRows<double
     Level level;
     level.n = numMonomials(q);
     level.bs = 3 * level.n;
-    level.owned = restrictMatrix(*fine.matrix, fine.n, level.n);
+    level.owned = fine.rows ? restrictBlocks(*fine.rows, level.n)
+                            : restrictMatrix(*fine.matrix, fine.n, level.n);
     level.colours = fine.colours;  // the same element graph
     m.push(std::move(level));
+  }
+  if (m.levels.size() == 1 && !agglomerate && top.rows) {
+    // The top level is the coarsest, factorized: it needs the CSR matrix.
+    top.owned = top.rows->toSparse();
+    top.matrix = &top.owned;
+    top.rows = nullptr;
   }
   if (agglomerate) {
     Level& elements = m.levels.back();
@@ -585,8 +689,7 @@ bool PMultigrid::compute(const SpMat& matrix, int degree, const BlockRows<double
     // smoothing is cheap (an eighth of the blocks each), so they sweep twice: a V-cycle with
     // two agglomeration levels then needs about as many iterations as one with an exact
     // first agglomeration level.
-    const double limit = std::max(static_cast<double>(kCoarseUnknowns),
-                                  std::sqrt(static_cast<double>(matrix.nonZeros())));
+    const double limit = std::max(static_cast<double>(kCoarseUnknowns), std::sqrt(nonzeros));
     while (static_cast<double>(m.levels.back().matrix->rows()) > limit) {
       const Eigen::Index before = m.levels.back().matrix->rows();
       m.levels.back().sweeps = 2;

@@ -1,14 +1,19 @@
 #include "polydg/physics/static_solver.h"
 
 #include <algorithm>
+#include <optional>
 #include <stdexcept>
 
+#include <tbb/parallel_for.h>
+
 #include "polydg/physics/agglomeration.h"
+#include "polydg/physics/block_rows.h"
 #include "polydg/util/stopwatch.h"
 
 namespace polydg {
 
 namespace {
+using SpMat = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
 /// Doubling gives up after this many factorizations (eta grows by 2^kMaxDoublings).
 constexpr int kMaxDoublings = 40;
 }  // namespace
@@ -87,11 +92,30 @@ void StaticSolver::assemble(const LoadCase& loads) {
   factorized_ = false;
   report_.penaltyAttempts = 1;
   // The thesis's phases (Table 4.1): "integration" computes the element and face matrices,
-  // "assembly" accumulates them into K and F.
-  LocalMatrices local = localMatrices(*mesh_, *basis_, *moments_, roles_, form_);
-  const Stopwatch tAssemble;
-  const double localSeconds = t0.seconds();
-  assembleInto(local, system_.matrix);
+  // "assembly" accumulates them into K and F. Without a penalty search, each element's rows
+  // go straight into K by block rows (assembleBlockRows()): the two phases are one, timed as
+  // integration, and K is kept once, 8 bytes per nonzero. A system small enough for Cholesky
+  // is then converted to CSR (assembly); a larger one stays in blocks for CG.
+  double localSeconds = 0.0;
+  std::optional<Stopwatch> tAssemble;
+  rows_.reset();
+  system_.matrix = SpMat();
+  if (disc.penalty.rule != PenaltyRule::Doubling) {
+    rows_ = std::make_unique<BlockRows<double>>(
+        assembleBlockRows(*mesh_, *basis_, *moments_, roles_, form_));
+    localSeconds = t0.seconds();
+    tAssemble.emplace();
+    const std::size_t dofs = static_cast<std::size_t>(rows_->elements()) * rows_->bs;
+    if (chooseSolver(dofs, rows_->entries(), options_.solver) == SolverKind::Cholesky) {
+      system_.matrix = rows_->toSparse();
+      rows_.reset();
+    }
+  } else {
+    LocalMatrices local = localMatrices(*mesh_, *basis_, *moments_, roles_, form_);
+    localSeconds = t0.seconds();
+    tAssemble.emplace();
+    assembleInto(local, system_.matrix);
+  }
 
   double searchSeconds = 0.0;
   if (disc.penalty.rule == PenaltyRule::Doubling) {
@@ -119,11 +143,12 @@ void StaticSolver::assemble(const LoadCase& loads) {
   report_.eta = form_.eta;
   system_.rhs =
       assembleLoad(*mesh_, *basis_, *moments_, roles_, form_, material_, loads, quadrature);
-  report_.dofs = static_cast<std::size_t>(system_.matrix.rows());
-  report_.nonzeros = static_cast<std::size_t>(system_.matrix.nonZeros());
+  report_.dofs = rows_ ? static_cast<std::size_t>(rows_->elements()) * rows_->bs
+                       : static_cast<std::size_t>(system_.matrix.rows());
+  report_.nonzeros = rows_ ? rows_->entries() : static_cast<std::size_t>(system_.matrix.nonZeros());
   // Trial factorizations belong to the solve phase; the one that succeeded is reused.
   report_.integrateSeconds = momentsSeconds_ + localSeconds;
-  report_.assembleSeconds = tAssemble.seconds() - searchSeconds;
+  report_.assembleSeconds = tAssemble->seconds() - searchSeconds;
   report_.solveSeconds = searchSeconds;
 }
 
@@ -136,12 +161,13 @@ void StaticSolver::assembleInto(const LocalMatrices& local,
 }
 
 const Eigen::VectorXd& StaticSolver::solve() {
-  if (system_.matrix.rows() == 0 && mesh_->numElements() > 0)
+  if (!rows_ && system_.matrix.rows() == 0 && mesh_->numElements() > 0)
     throw std::logic_error("StaticSolver::solve: call assemble() first");
   const Stopwatch t0;
   if (!factorized_) {
     solver_ = LinearSolver(options_.solver);
-    const bool direct = chooseSolver(system_.matrix, options_.solver) == SolverKind::Cholesky;
+    const bool direct =
+        !rows_ && chooseSolver(system_.matrix, options_.solver) == SolverKind::Cholesky;
     // Cholesky and the p-multigrid's coarsest factorization detect an indefinite K; the
     // block-Jacobi preconditioner falls back to diagonals and lets CG report the failure.
     const bool definiteCheck =
@@ -149,8 +175,10 @@ const Eigen::VectorXd& StaticSolver::solve() {
     // The element frames let the p-multigrid coarsen by agglomerating elements (the linear
     // displacements of groups of elements, rotations included).
     const ElementFrames frames = direct ? ElementFrames{} : elementFrames(*basis_);
-    if (!solver_.compute(system_.matrix, system_.blockSize, direct ? nullptr : &frames) &&
-        definiteCheck)
+    const bool computed =
+        rows_ ? solver_.compute(*rows_, &frames)
+              : solver_.compute(system_.matrix, system_.blockSize, direct ? nullptr : &frames);
+    if (!computed && definiteCheck)
       throw std::runtime_error(
           "the stiffness matrix is not positive definite: is the body held by a Dirichlet "
           "condition (e.g. --clamp)?");
@@ -160,6 +188,25 @@ const Eigen::VectorXd& StaticSolver::solve() {
   report_.solveSeconds += t0.seconds();
   report_.energy = 0.5 * coefficients_.dot(system_.rhs);
   return coefficients_;
+}
+
+const LinearSystem& StaticSolver::system() const {
+  if (rows_ && system_.matrix.rows() == 0) system_.matrix = rows_->toSparse();
+  return system_;
+}
+
+Eigen::VectorXd StaticSolver::stiffnessTimes(const Eigen::VectorXd& u) const {
+  Eigen::VectorXd y;
+  if (!rows_) {
+    symmetricProduct(system_.matrix, u, y);
+    return y;
+  }
+  y.resize(u.size());
+  const int bs = rows_->bs;
+  tbb::parallel_for(0, rows_->elements(), [&](int e) {
+    rows_->rowProduct(e, u.data(), y.data() + static_cast<Eigen::Index>(e) * bs);
+  });
+  return y;
 }
 
 StaticSolution StaticSolver::release() {

@@ -15,6 +15,9 @@
 
 namespace polydg {
 
+template <class T>
+struct BlockRows;
+
 /// The elements using a face: one (boundary) or two (interior), with their orientations.
 struct FaceUses {
   std::array<ElementId, 2> element;
@@ -141,6 +144,14 @@ SplitLocalMatrices splitLocalMatrices(const PolyMesh& mesh, const DgBasis& basis
 /// elements. With BZ, blocks between neighbours couple equal components only and are stored
 /// so (the paper's sparser BZ matrices).
 Eigen::SparseMatrix<double, Eigen::ColMajor, int> assembleStiffness(const LocalMatrices& local);
+
+/// K of `form` (localMatrices()' terms) by element block rows (BlockRows, double precision),
+/// assembled straight from each element's rows: the one copy of K an iterative solve needs,
+/// 8 bytes per nonzero, with neither the local matrices nor a CSR matrix alongside. BZ's
+/// neighbour blocks are stored component-diagonal, as assembleStiffness() stores them.
+BlockRows<double> assembleBlockRows(const PolyMesh& mesh, const DgBasis& basis,
+                                    const MomentCache& moments, const FaceRoles& roles,
+                                    const FormCoefficients& form);
 
 /// Writes K from `local` into `matrix`, which has the pattern assembleStiffness() made for
 /// local matrices of the same layout: new values (a warped stiffness, a time step's system

@@ -82,6 +82,15 @@ struct BlockRows {
   /// The diagonal block of element e, bs x bs column-major (a full slot).
   const T* diagonalBlock(int e) const;
 
+  /// Elements (block rows), and the entries stored: the nonzeros of the CSR matrix with the
+  /// same pattern (assembleStiffness()'s).
+  int elements() const { return start.empty() ? 0 : static_cast<int>(start.size()) - 1; }
+  std::size_t entries() const { return values.size(); }
+
+  /// The same matrix in CSR (both triangles, columns sorted), with assembleStiffness()'s
+  /// pattern: every stored entry, zeros included.
+  Eigen::SparseMatrix<double, Eigen::ColMajor, int> toSparse() const;
+
   /// out = (A x)_e, the rows of element e (bs values).
   void rowProduct(int e, const double* x, double* out) const {
     std::fill(out, out + bs, 0.0);

@@ -11,6 +11,8 @@
 namespace polydg {
 
 struct ElementFrames;
+template <class T>
+struct BlockRows;
 
 enum class SolverKind {
   Auto,               ///< Cholesky up to SolverOptions::directLimitDofs DOFs, else CG
@@ -70,6 +72,7 @@ struct LinearSolveReport {
 /// The solver chosen by `options` for a matrix of this size.
 SolverKind chooseSolver(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix,
                         const SolverOptions& options);
+SolverKind chooseSolver(std::size_t dofs, std::size_t nonzeros, const SolverOptions& options);
 
 /// A solver that keeps its factorization (or preconditioner) for repeated right-hand sides.
 class LinearSolver {
@@ -86,6 +89,12 @@ class LinearSolver {
   /// p-multigrid build its agglomeration levels.
   bool compute(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix, int blockSize,
                const ElementFrames* frames = nullptr);
+  /// Conjugate gradients on K given by block rows alone (assembleBlockRows()), which must
+  /// stay alive while the solver is used: its product and its p-multigrid smoother read them,
+  /// and no other copy of K is made (8 bytes per nonzero in all, against about 24 with the CSR
+  /// matrix and the copies the iteration makes of it). Throws std::invalid_argument if the
+  /// options ask for Cholesky. Returns false as compute() does.
+  bool compute(const BlockRows<double>& rows, const ElementFrames* frames = nullptr);
   /// New values of the matrix (`matrix`, with the pattern of the one given to compute(), must
   /// stay alive): Cholesky factorizes them numerically again, keeping the symbolic analysis;
   /// CG multiplies with them, and rebuilds its preconditioner only if `refreshPreconditioner`

@@ -62,6 +62,12 @@ class PMultigrid {
                const BlockRows<double>* matrixBlocks = nullptr,
                const ElementFrames* frames = nullptr);
 
+  /// The same from K by block rows alone (double precision, e.g. assembleBlockRows()), which
+  /// must stay alive while the preconditioner is used: the top level's smoother reads them as
+  /// they are (no CSR matrix and no single-precision copy), the lower degree levels are their
+  /// principal submatrices. The one copy of K a CG solve then keeps.
+  bool compute(const BlockRows<double>& rows, int degree, const ElementFrames* frames = nullptr);
+
   /// z = M^-1 r: one V-cycle for K z = r from z = 0.
   void apply(const Eigen::VectorXd& r, Eigen::VectorXd& z) const;
 

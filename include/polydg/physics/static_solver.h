@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "polydg/physics/assembly.h"
+#include "polydg/physics/block_rows.h"
 #include "polydg/physics/linear_solver.h"
 
 namespace polydg {
@@ -110,7 +111,12 @@ class StaticSolver {
 
   const MomentCache& moments() const { return *moments_; }
   const DgBasis& basis() const { return *basis_; }
-  const LinearSystem& system() const { return system_; }
+  /// K (CSR) and F. A system solved by CG keeps K by block rows only (assemble()); the CSR
+  /// matrix is then made from them on the first call (a second copy of K, for callers that
+  /// need the matrix itself: condition estimates, zero-mode counts).
+  const LinearSystem& system() const;
+  /// K u, from whichever copy of K the solver keeps.
+  Eigen::VectorXd stiffnessTimes(const Eigen::VectorXd& u) const;
   const FaceRoles& roles() const { return roles_; }
   const FormCoefficients& form() const { return form_; }
   const StaticReport& report() const { return report_; }
@@ -132,7 +138,9 @@ class StaticSolver {
   /// Per-element penalties that form_.elementEta points to (on the heap: stable under moves).
   std::unique_ptr<ElementData<double>> elementEta_;
   FormCoefficients form_;
-  LinearSystem system_;
+  mutable LinearSystem system_;  ///< its matrix made on demand from rows_ (system())
+  /// K by block rows, when the solve is iterative (CG): then the only copy of K.
+  std::unique_ptr<BlockRows<double>> rows_;
   LinearSolver solver_;
   bool factorized_ = false;
   double momentsSeconds_ = 0.0;  ///< integrate()'s share of StaticReport::integrateSeconds
