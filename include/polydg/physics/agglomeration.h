@@ -35,15 +35,16 @@ ElementFrames elementFrames(const DgBasis& basis, const PolyMesh& mesh);
 /// `boxes` (one per element): cell (i, j, k) of element e holds its box centre,
 /// origin + h * (i, j, k) <= centre < origin + h * (i + 1, j + 1, k + 1), indices >= 0.
 /// Why inferred and not recorded: a sliced element is its grid cell clipped by the surface,
-/// and cuts, sliver merges and refinement only make pieces inside it (or, rarely, join two),
-/// so the lattice is in the geometry of every mesh made by slicing, by a hex grid or read
-/// back from a VTU file, with no field to carry through each edit and file. Along each axis
-/// the cell length h is the most common bounding-box extent (within kLatticeTolerance h: a
-/// whole cell, which most elements of a sliced mesh are) and the origin the lattice plane, at
-/// a multiple of h from the lower side of an element of that extent, at or below every box.
+/// and cuts and refinement only make pieces inside it (a sliver merged across a cell face
+/// joins two), so the lattice is in the geometry of every mesh made by slicing, by a hex grid
+/// or read back from a VTU file, with no field to carry through each edit and file. Along each
+/// axis the cell length h is the most common bounding-box extent (within 1e-6 h: a whole cell,
+/// which most elements of a sliced mesh are) and the origin the lattice plane, at a multiple
+/// of h from the lower side of an element of that extent, at or below every box.
 /// Returns no cells (empty) unless at least half the boxes lie each within one cell (within
-/// kLatticeTolerance h; the rest are mostly slivers merged across a cell face, 11-12% at 16
-/// cells): a tetrahedral or Voronoi mesh has no such lattice.
+/// 1e-6 h; the rest are mostly slivers merged across a cell face, 11-12% at 16 cells): a
+/// tetrahedral or Voronoi mesh has no such lattice. An octree mesh is grouped on its most
+/// common cell size, each larger element in the cell of its centre.
 std::vector<Eigen::Vector3i> latticeCells(const std::vector<Eigen::AlignedBox3d>& boxes);
 
 /// Blocks (elements, or groups of a finer agglomeration) grouped, and the linear
