@@ -8,8 +8,10 @@
 #include <tbb/parallel_for.h>
 #include <Eigen/Dense>
 
+#include "polydg/mesh/geometry.h"
 #include "polydg/physics/block_rows.h"
 #include "polydg/physics/dg_basis.h"
+#include "polydg/util/union_find.h"
 
 namespace polydg {
 
@@ -19,6 +21,20 @@ using SpMat = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
 
 /// Functions per component of a group: the linear polynomials.
 constexpr int kLinear = 4;
+
+/// Lattice comparisons (extents, planes) are within this fraction of a cell length: far above
+/// the round-off of slicing (ulps of the model's size per coordinate), far below any feature
+/// a surface or a cut makes on purpose.
+constexpr double kLatticeTolerance = 1e-6;
+
+/// The share of elements that must each lie in one cell for a lattice to be used. Not all:
+/// a sliver merged into its neighbour across a cell face makes one element of two cells, and
+/// slicing merges many (at 16 cells 88% of the bunny's 1,149 elements and 89% of the torus's
+/// 840 lie in one cell); with no lattice few boxes share the one extent and origin found.
+constexpr double kLatticeShare = 0.5;
+
+/// Cells per axis at most (indices fit an int with room for the box arithmetic).
+constexpr double kMaxLatticeCells = 1 << 24;
 
 /// Smallest |cos| of the angle between the axis and the line joining two centres for a pair
 /// to form along that axis (60 degrees).
@@ -87,6 +103,53 @@ std::vector<int> pairAlongAxes(const BlockRows<double>& rows,
     groups = static_cast<int>(centre.size());
   }
   count = groups;
+  return group;
+}
+
+/// floor(c / 2) per component.
+Eigen::Vector3i halved(const Eigen::Vector3i& c) {
+  Eigen::Vector3i h;
+  for (int l = 0; l < 3; ++l) h[l] = c[l] >= 0 ? c[l] / 2 : -((1 - c[l]) / 2);
+  return h;
+}
+
+/// Whether stored slot k of `rows` has a nonzero entry.
+bool coupledSlot(const BlockRows<double>& rows, int k) {
+  const std::size_t slot = static_cast<std::size_t>(k);
+  const std::size_t count = rows.diagonal[slot] ? static_cast<std::size_t>(3 * rows.n * rows.n)
+                                                : static_cast<std::size_t>(rows.bs * rows.bs);
+  const double* v = rows.values.data() + rows.offset[slot];
+  return std::any_of(v, v + count, [](double x) { return x != 0.0; });
+}
+
+/// Groups the blocks by 2 x 2 x 2 boxes of their cells, each box split into the connected
+/// components of the blocks' coupling inside it; groups in the order of their first block.
+/// Returns each block's group; `boxes` gets each group's box (the cells halved).
+std::vector<int> groupByCells(const BlockRows<double>& rows,
+                              const std::vector<Eigen::Vector3i>& cells,
+                              std::vector<Eigen::Vector3i>& boxes) {
+  const int nb = static_cast<int>(rows.start.size()) - 1;
+  std::vector<Eigen::Vector3i> box(static_cast<std::size_t>(nb));
+  for (std::size_t b = 0; b < box.size(); ++b) box[b] = halved(cells[b]);
+  UnionFind components(static_cast<std::size_t>(nb));
+  for (int b = 0; b < nb; ++b)
+    for (int k = rows.start[static_cast<std::size_t>(b)];
+         k < rows.start[static_cast<std::size_t>(b) + 1]; ++k) {
+      const int f = rows.element[static_cast<std::size_t>(k)];
+      if (f < b && box[static_cast<std::size_t>(f)] == box[static_cast<std::size_t>(b)] &&
+          coupledSlot(rows, k))
+        components.unite(static_cast<std::uint32_t>(f), static_cast<std::uint32_t>(b));
+    }
+  std::vector<int> id(static_cast<std::size_t>(nb), -1), group(static_cast<std::size_t>(nb));
+  boxes.clear();
+  for (int b = 0; b < nb; ++b) {
+    int& g = id[components.find(static_cast<std::uint32_t>(b))];
+    if (g < 0) {
+      g = static_cast<int>(boxes.size());
+      boxes.push_back(box[static_cast<std::size_t>(b)]);
+    }
+    group[static_cast<std::size_t>(b)] = g;
+  }
   return group;
 }
 
@@ -211,29 +274,91 @@ SpMat galerkinMatrix(const Agglomeration& fine, const BlockRows<double>& rows) {
   return full;
 }
 
-ElementFrames elementFrames(const DgBasis& basis) {
+std::vector<Eigen::Vector3i> latticeCells(const std::vector<Eigen::AlignedBox3d>& boxes) {
+  const std::size_t ne = boxes.size();
+  if (ne == 0) return {};
+  Eigen::Vector3d h, origin;
+  for (int l = 0; l < 3; ++l) {
+    // The most common extent: the largest run of sorted extents within the tolerance of its
+    // first.
+    std::vector<double> extents(ne);
+    for (std::size_t e = 0; e < ne; ++e) extents[e] = boxes[e].sizes()[l];
+    std::sort(extents.begin(), extents.end());
+    std::size_t best = 0, bestCount = 0;
+    for (std::size_t i = 0, j = 0; i < ne; i = j) {
+      j = i + 1;
+      while (j < ne && extents[j] <= extents[i] * (1.0 + kLatticeTolerance)) ++j;
+      if (j - i > bestCount) {
+        best = i;
+        bestCount = j - i;
+      }
+    }
+    h[l] = extents[best];
+    if (!(h[l] > 0.0) || !std::isfinite(h[l])) return {};
+    double lowest = boxes[0].min()[l], reference = 0.0;
+    bool found = false;
+    for (const Eigen::AlignedBox3d& box : boxes) {
+      lowest = std::min(lowest, box.min()[l]);
+      if (!found && std::abs(box.sizes()[l] - h[l]) <= kLatticeTolerance * h[l]) {
+        reference = box.min()[l];
+        found = true;
+      }
+    }
+    const double below = std::ceil((reference - lowest) / h[l] - kLatticeTolerance);
+    if (below > kMaxLatticeCells) return {};
+    origin[l] = reference - below * h[l];
+  }
+  std::vector<Eigen::Vector3i> cells(ne);
+  std::size_t inOneCell = 0;
+  for (std::size_t e = 0; e < ne; ++e) {
+    const Eigen::Vector3d lo = (boxes[e].min() - origin).cwiseQuotient(h);
+    const Eigen::Vector3d hi = (boxes[e].max() - origin).cwiseQuotient(h);
+    const Eigen::Vector3d centre = 0.5 * (lo + hi);
+    if (!(centre.maxCoeff() < kMaxLatticeCells)) return {};
+    bool one = true;
+    for (int l = 0; l < 3; ++l) {
+      const double cell = std::max(0.0, std::floor(centre[l]));
+      cells[e][l] = static_cast<int>(cell);
+      one = one && lo[l] >= cell - kLatticeTolerance && hi[l] <= cell + 1.0 + kLatticeTolerance;
+    }
+    if (one) ++inOneCell;
+  }
+  if (static_cast<double>(inOneCell) < kLatticeShare * static_cast<double>(ne)) return {};
+  return cells;
+}
+
+ElementFrames elementFrames(const DgBasis& basis, const PolyMesh& mesh) {
   ElementFrames frames;
   const std::size_t ne = basis.numElements();
   frames.centres.resize(ne);
   frames.scales.resize(ne);
   frames.linear.resize(ne);
-  for (std::size_t e = 0; e < ne; ++e) {
+  std::vector<Eigen::AlignedBox3d> boxes(ne);
+  tbb::parallel_for(std::size_t(0), ne, [&](std::size_t e) {
     const ElementId id(e);
     frames.centres[e] = basis.centre(id);
     frames.scales[e] = basis.scale(id);
     frames.linear[e] = basis.coefficients(id).topLeftCorner<4, 4>();
-  }
+    boxes[e] = elementBounds(mesh, id);
+  });
+  frames.cells = latticeCells(boxes);
   return frames;
 }
 
 Agglomeration agglomerate(const BlockRows<double>& rows,
                           const std::vector<Eigen::Vector3d>& centres,
                           const std::vector<double>& scales,
-                          const std::vector<Eigen::Matrix4d>* linear) {
+                          const std::vector<Eigen::Matrix4d>* linear,
+                          const std::vector<Eigen::Vector3i>& cells) {
   const int nb = static_cast<int>(rows.start.size()) - 1;
   Agglomeration a;
   int count = 0;
-  a.parent = pairAlongAxes(rows, centres, count);
+  if (!cells.empty() && cells.size() == static_cast<std::size_t>(nb)) {
+    a.parent = groupByCells(rows, cells, a.cells);
+    count = static_cast<int>(a.cells.size());
+  } else {
+    a.parent = pairAlongAxes(rows, centres, count);
+  }
   a.childStart.assign(static_cast<std::size_t>(count) + 1, 0);
   for (int g : a.parent) ++a.childStart[static_cast<std::size_t>(g) + 1];
   for (std::size_t g = 0; g < static_cast<std::size_t>(count); ++g)

@@ -175,7 +175,7 @@ struct DynamicSolver::Impl {
     for (const TimedTraction& tr : loads.tractions) until.push_back(tr.until);
 
     system = parts.jumps;  // layout; values are written per step
-    frames = elementFrames(*basis);
+    frames = elementFrames(*basis, m);
     activeSolver = options.solver;
     if (options.adaptivePreconditioner) activeSolver.preconditioner = CgPreconditioner::BlockJacobi;
     solver = LinearSolver(activeSolver);

@@ -459,20 +459,21 @@ struct PMultigrid::Impl {
     return invertBlocks(level);
   }
 
-  /// Appends the agglomeration level of levels.back(), whose blocks have the given centres and
-  /// scales (the frames for the element level, then the groups of the level before); `linear`,
-  /// for the element level, the frames' T_e. The centres and scales are read before the levels
-  /// grow (they may belong to a level).
+  /// Appends the agglomeration level of levels.back(), whose blocks have the given centres,
+  /// scales and lattice cells (the frames for the element level, then the groups of the level
+  /// before; no cells: grouped by pairing); `linear`, for the element level, the frames' T_e.
+  /// They are read before the levels grow (they may belong to a level).
   void addAggregateLevel(const std::vector<Eigen::Vector3d>& centres,
                          const std::vector<double>& scales,
-                         const std::vector<Eigen::Matrix4d>* linear) {
+                         const std::vector<Eigen::Matrix4d>* linear,
+                         const std::vector<Eigen::Vector3i>& cells) {
     Level& fine = levels.back();
     fine.transfer = Transfer::Aggregate;
     if (fine.source == nullptr) {
       fine.exact.build(*fine.matrix, kLinear, std::numeric_limits<double>::infinity());
       fine.source = &fine.exact;
     }
-    fine.groups = agglomerate(*fine.source, centres, scales, linear);
+    fine.groups = agglomerate(*fine.source, centres, scales, linear, cells);
     Level level;
     level.n = kLinear;
     level.bs = 3 * kLinear;
@@ -684,7 +685,10 @@ bool PMultigrid::Impl::build(const SpMat* matrix, const BlockRows<double>* rows,
     Level& elements = m.levels.back();
     if (m.levels.size() == 1 && matrixBlocks != nullptr && !matrixBlocks->values.empty())
       elements.source = matrixBlocks;
-    m.addAggregateLevel(frames->centres, frames->scales, &frames->linear);
+    const std::vector<Eigen::Vector3i> noCells;
+    m.addAggregateLevel(
+        frames->centres, frames->scales, &frames->linear,
+        frames->cells.size() == static_cast<std::size_t>(ne) ? frames->cells : noCells);
     // Further levels while the coarsest is large and grouping still shrinks it. Their
     // smoothing is cheap (an eighth of the blocks each), so they sweep twice: a V-cycle with
     // two agglomeration levels then needs about as many iterations as one with an exact
@@ -695,7 +699,7 @@ bool PMultigrid::Impl::build(const SpMat* matrix, const BlockRows<double>* rows,
       m.levels.back().sweeps = 2;
       // The blocks of the last level are the groups of the one before.
       const Agglomeration& blocks = m.levels[m.levels.size() - 2].groups;
-      m.addAggregateLevel(blocks.centres, blocks.scales, nullptr);
+      m.addAggregateLevel(blocks.centres, blocks.scales, nullptr, blocks.cells);
       if (m.levels.back().matrix->rows() * 4 > before * 3) break;  // grouping stalled
     }
   } else if (degree > 0) {

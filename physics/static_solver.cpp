@@ -174,7 +174,7 @@ const Eigen::VectorXd& StaticSolver::solve() {
         direct || options_.solver.preconditioner == CgPreconditioner::PMultigrid;
     // The element frames let the p-multigrid coarsen by agglomerating elements (the linear
     // displacements of groups of elements, rotations included).
-    const ElementFrames frames = direct ? ElementFrames{} : elementFrames(*basis_);
+    const ElementFrames frames = direct ? ElementFrames{} : elementFrames(*basis_, *mesh_);
     const bool computed =
         rows_ ? solver_.compute(*rows_, &frames)
               : solver_.compute(system_.matrix, system_.blockSize, direct ? nullptr : &frames);

@@ -13,6 +13,8 @@
 //                                                   minutes)
 //   polydg bench --suite adaptivity --out bench/   (B11 and B12: refinement by stress and by
 //                                                   the error estimate)
+//   polydg bench --suite multigrid --out bench/    (CG iterations on the bunny and the torus,
+//                                                   sliced and cut, beside the unit cube)
 //   polydg bench --suite meshing --out b/ --data DIR  (torus.obj from DIR instead of the
 //                                                      share/polydg folder beside the binary)
 #include <filesystem>
@@ -63,6 +65,8 @@ void runBench(BenchOptions o, const CommonOptions& common) {
     timed("contact", [&] { return bench::contactSuite(o, common.quiet); });
   if (all || o.suite == "adaptivity")
     timed("adaptivity", [&] { return bench::adaptivitySuite(o, common.quiet); });
+  if (all || o.suite == "multigrid")
+    timed("multigrid", [&] { return bench::multigridSuite(o, common.quiet); });
   if (!common.quiet && all) std::cout << "all suites: " << total.seconds() << " s" << std::endl;
 }
 
@@ -74,13 +78,15 @@ void addBenchCommand(CLI::App& app, const CommonOptions& common, int& exitCode) 
       "bench",
       "Benchmark suites as JSON, CSV and SVG plots: accuracy (B1), table41 (B2), "
       "stability (B4), meshing, cutting, dynamics (B6, B7, time per step), contact (B9, "
-      "embedding and collision speed), adaptivity (B11, B12), or all");
+      "embedding and collision speed), adaptivity (B11, B12), multigrid (CG iterations on real "
+      "models), or all");
   cmd->add_option(
          "--suite", o->suite,
-         "accuracy, table41, stability, meshing, cutting, dynamics, contact, adaptivity or all")
+         "accuracy, table41, stability, meshing, cutting, dynamics, contact, adaptivity, multigrid "
+         "or all")
       ->required()
       ->check(CLI::IsMember({"accuracy", "table41", "stability", "meshing", "cutting", "dynamics",
-                             "contact", "adaptivity", "all"}));
+                             "contact", "adaptivity", "multigrid", "all"}));
   cmd->add_option("--out", o->out, "folder for NAME.json, NAME.csv and NAME*.svg")->required();
   cmd->add_flag("--skip-sliced", o->skipSliced, "accuracy: hex grids only");
   cmd->add_flag("--quick", o->quick,

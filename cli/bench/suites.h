@@ -33,6 +33,12 @@
 //              at tau = 0.25, 0.5, 0.75, beside the thesis's 274 and 77) and B12 (the steep
 //              bump: uniform 8, 16, 32 against solve --adapt from 4; DOFs to each uniform L2
 //              error, effectivity of the estimate on every mesh).
+//   multigrid  CG iterations of the p-multigrid on real models: the Stanford bunny (fetched by
+//              scripts/get-models.sh into DATA/models/bunny.off; skipped with a note if absent)
+//              and the bundled torus, sliced at 16 cells, then also cut by a plane and a finite
+//              polygon, IP at p = 1, 2, clamped at the bottom under gravity (B2's material),
+//              beside B2 on the unit cube of about as many elements: DOFs, iterations and their
+//              ratio to the cube's, setup and solve time.
 // With `quick` each runs reduced sizes (a smoke test of every output, as the tests run it).
 #pragma once
 
@@ -43,7 +49,7 @@
 namespace polydg::bench {
 
 struct BenchOptions {
-  std::string suite;        ///< accuracy, ..., contact, adaptivity or all
+  std::string suite;        ///< accuracy, ..., adaptivity, multigrid or all
   std::string out;          ///< the folder the files go to
   bool skipSliced = false;  ///< accuracy: hex grids only
   bool quick = false;
@@ -61,5 +67,6 @@ SuiteOutput cuttingSuite(const BenchOptions& options, bool quiet);
 SuiteOutput dynamicsSuite(const BenchOptions& options, bool quiet);
 SuiteOutput contactSuite(const BenchOptions& options, bool quiet);
 SuiteOutput adaptivitySuite(const BenchOptions& options, bool quiet);
+SuiteOutput multigridSuite(const BenchOptions& options, bool quiet);
 
 }  // namespace polydg::bench

@@ -1,17 +1,30 @@
-// Agglomeration (physics/agglomeration.h): on a hex grid the groups are 2 x 2 x 2 cubes; the
-// coarse functions are exactly the linear displacements of each group, on non-convex sliced
-// elements too; the Galerkin matrix equals P^T K P formed explicitly and is exactly
-// symmetric, for IP's coupled and BZ's component-diagonal blocks.
+// Agglomeration (physics/agglomeration.h): the lattice of a hex grid (any spacing) and of a
+// sliced mesh is found, and none in boxes of no lattice; on a hex grid the groups are 2 x 2 x 2
+// cubes; on a sliced mesh each group lies in one 2 x 2 x 2 box of grid cells and is
+// face-connected; the pieces a cut separates never share a group; the coarse functions are exactly
+// the linear displacements of each group, on non-convex sliced elements too; the Galerkin matrix
+// equals P^T K P formed explicitly and is exactly symmetric, for IP's coupled and BZ's
+// component-diagonal blocks.
 #include "polydg/physics/agglomeration.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <random>
+#include <set>
 #include <vector>
 
 #include "cli/bench/problems.h"
+#include "polydg/cut/cut.h"
+#include "polydg/mesh/geometry.h"
+#include "polydg/mesh/primitives.h"
 #include "polydg/physics/block_rows.h"
 #include "polydg/physics/dg_basis.h"
+#include "polydg/util/union_find.h"
 #include "tests/support/dg_systems.h"
 
 namespace polydg {
@@ -47,11 +60,65 @@ BlockRows<double> blockRows(const SpMat& k, int n) {
   return rows;
 }
 
+/// The bounding boxes of `mesh`'s elements.
+std::vector<Eigen::AlignedBox3d> elementBoxes(const PolyMesh& mesh) {
+  std::vector<Eigen::AlignedBox3d> boxes;
+  for (std::size_t e = 0; e < mesh.numElements(); ++e)
+    boxes.push_back(elementBounds(mesh, ElementId(e)));
+  return boxes;
+}
+
+/// Whether the elements of each group are connected through the interior faces between them.
+bool groupsFaceConnected(const PolyMesh& mesh, const Agglomeration& groups) {
+  UnionFind joined(mesh.numElements());
+  for (std::size_t f = 0; f < mesh.numFaces(); ++f) {
+    const Face& face = mesh.face(FaceId(f));
+    if (face.isBoundary()) continue;
+    if (groups.parent[face.front.index()] == groups.parent[face.back.index()])
+      joined.unite(static_cast<std::uint32_t>(face.front.index()),
+                   static_cast<std::uint32_t>(face.back.index()));
+  }
+  for (int g = 0; g < groups.groups(); ++g) {
+    const int first = groups.childStart[static_cast<std::size_t>(g)];
+    for (int k = first + 1; k < groups.childStart[static_cast<std::size_t>(g) + 1]; ++k)
+      if (joined.find(static_cast<std::uint32_t>(groups.children[static_cast<std::size_t>(k)])) !=
+          joined.find(static_cast<std::uint32_t>(groups.children[static_cast<std::size_t>(first)])))
+        return false;
+  }
+  return true;
+}
+
+TEST(Agglomeration, FindsTheLatticeOfHexGridsAndNoneInBoxesOfNoLattice) {
+  // A 6 x 3 x 5 grid of cells 0.5 x 1/3 x 0.2 from (-1, 2, 0.5): each element its own cell.
+  const PolyMesh grid = hexGridMesh(6, 3, 5, Box3(Vec3(-1, 2, 0.5), Vec3(2, 3, 1.5)));
+  const std::vector<Eigen::AlignedBox3d> boxes = elementBoxes(grid);
+  const std::vector<Eigen::Vector3i> cells = latticeCells(boxes);
+  ASSERT_EQ(cells.size(), boxes.size());
+  const Eigen::Vector3d h(0.5, 1.0 / 3.0, 0.2);
+  for (std::size_t e = 0; e < boxes.size(); ++e) {
+    const Eigen::Vector3d expected =
+        (boxes[e].center() - Eigen::Vector3d(-1, 2, 0.5)).cwiseQuotient(h).array().floor();
+    EXPECT_EQ(cells[e], expected.cast<int>()) << e;
+  }
+  // Boxes of random corners and sizes (seeded): no lattice holds most of them in one cell.
+  const unsigned seed = 17;
+  std::printf("seed %u\n", seed);
+  std::mt19937 random(seed);
+  std::uniform_real_distribution<double> corner(0.0, 10.0), size(0.5, 1.5);
+  std::vector<Eigen::AlignedBox3d> scattered;
+  for (int k = 0; k < 500; ++k) {
+    const Eigen::Vector3d lo(corner(random), corner(random), corner(random));
+    scattered.emplace_back(lo, lo + Eigen::Vector3d(size(random), size(random), size(random)));
+  }
+  EXPECT_TRUE(latticeCells(scattered).empty());
+}
+
 TEST(Agglomeration, GroupsAHexGridIntoCubesOfEight) {
   const FramedSystem s = b2FramedSystem(Method::BZ, 1);
+  ASSERT_EQ(s.frames.cells.size(), 1000u);  // the grid is its own lattice
   const BlockRows<double> rows = blockRows(s.system.matrix, 4);
   const Agglomeration groups =
-      agglomerate(rows, s.frames.centres, s.frames.scales, &s.frames.linear);
+      agglomerate(rows, s.frames.centres, s.frames.scales, &s.frames.linear, s.frames.cells);
   ASSERT_EQ(groups.groups(), 125);
   for (int g = 0; g < groups.groups(); ++g) {
     const int first = groups.childStart[static_cast<std::size_t>(g)];
@@ -70,8 +137,87 @@ TEST(Agglomeration, GroupsAHexGridIntoCubesOfEight) {
   // Grouping the groups: 5 per axis pair into 3 (two pairs and one left alone).
   const SpMat coarse = galerkinMatrix(groups, rows);
   const Agglomeration next =
-      agglomerate(blockRows(coarse, 4), groups.centres, groups.scales, nullptr);
+      agglomerate(blockRows(coarse, 4), groups.centres, groups.scales, nullptr, groups.cells);
   EXPECT_EQ(next.groups(), 27);
+  // Pairing (no lattice) makes the same cubes on a hex grid.
+  const Agglomeration paired =
+      agglomerate(rows, s.frames.centres, s.frames.scales, &s.frames.linear);
+  EXPECT_EQ(paired.parent, groups.parent);
+}
+
+TEST(Agglomeration, GroupsOfASlicedMeshLieInOneBoxOfTwoByTwoByTwoCells) {
+  // B1's sliced cube: 9 cells of 1/8 per axis centred at (0.5, 0.5, 0.5) + (0.37, 0.29,
+  // 0.23) h.
+  const int n = 8;
+  const double h = 1.0 / n;
+  const Eigen::Vector3d gridOrigin =
+      Eigen::Vector3d::Constant(0.5 - 0.5 * (n + 1) * h) + h * Eigen::Vector3d(0.37, 0.29, 0.23);
+  const PolyMesh mesh = benchmarkB1Mesh(BenchmarkMesh::Sliced, n);
+  const FramedSystem s = b1FramedSystem(mesh, Method::IP, 1);
+  ASSERT_EQ(s.frames.cells.size(), mesh.numElements());
+  const BlockRows<double> rows = blockRows(s.system.matrix, 4);
+  const Agglomeration groups =
+      agglomerate(rows, s.frames.centres, s.frames.scales, &s.frames.linear, s.frames.cells);
+  // Each group's elements span at most 2 grid cells per axis (their box centres' cells).
+  std::set<std::array<int, 3>> boxes;  // of 2 x 2 x 2 cells, from the grid's first
+  for (int g = 0; g < groups.groups(); ++g) {
+    Eigen::Vector3i lo = Eigen::Vector3i::Constant(1 << 20), hi = -lo;
+    for (int k = groups.childStart[static_cast<std::size_t>(g)];
+         k < groups.childStart[static_cast<std::size_t>(g) + 1]; ++k) {
+      const ElementId e(static_cast<std::size_t>(groups.children[static_cast<std::size_t>(k)]));
+      const Eigen::Vector3i cell =
+          ((elementBounds(mesh, e).center() - gridOrigin) / h).array().floor().cast<int>().matrix();
+      lo = lo.cwiseMin(cell);
+      hi = hi.cwiseMax(cell);
+      boxes.insert({cell[0] / 2, cell[1] / 2, cell[2] / 2});
+    }
+    EXPECT_LE((hi - lo).maxCoeff(), 1) << "group " << g;
+  }
+  EXPECT_TRUE(groupsFaceConnected(mesh, groups));
+  // And whole: one group per box of 2 x 2 x 2 cells (the cube is connected in each).
+  EXPECT_EQ(static_cast<std::size_t>(groups.groups()), boxes.size());
+}
+
+TEST(Agglomeration, PiecesACutSeparatesNeverShareAGroup) {
+  // A 6^3 grid cut through by a tilted plane (both sides kept) and slit by a square polygon
+  // inside it: pieces of one cell on either side of a blade are coupled by no face.
+  MeshEditor editor(hexGridMesh(6, 6, 6, Box3(Vec3::Zero(), Vec3::Ones())));
+  const Plane plane = Plane::make(Vec3(1.0, 0.3, 0.2), 0.62);
+  CutOptions keepBoth;
+  keepBoth.sliverFraction = 0.0;
+  ASSERT_TRUE(editor.cut(Blade::plane(plane.normal, plane.offset), keepBoth).validation.passed);
+  ASSERT_TRUE(editor
+                  .cut(Blade::fromPolygon({Vec3(0.12, 0.1, 0.43), Vec3(0.4, 0.1, 0.45),
+                                           Vec3(0.4, 0.55, 0.47), Vec3(0.12, 0.55, 0.45)}),
+                       keepBoth)
+                  .validation.passed);
+  const PolyMesh mesh = editor.release();
+  const FramedSystem s = b1FramedSystem(mesh, Method::IP, 1);
+  ASSERT_EQ(s.frames.cells.size(), mesh.numElements());
+  const BlockRows<double> rows = blockRows(s.system.matrix, 4);
+  const Agglomeration groups =
+      agglomerate(rows, s.frames.centres, s.frames.scales, &s.frames.linear, s.frames.cells);
+  // Never both sides of the plane in one group (an element's side: that of its corner
+  // farthest from the plane; the others lie on its side or in the plane).
+  auto side = [&](ElementId e) {
+    double farthest = 0.0;
+    for (const FaceUse& use : mesh.element(e).faces)
+      for (VertexId v : mesh.face(use.face).vertices) {
+        const double d = plane.normal.dot(mesh.position(v)) - plane.offset;
+        if (std::abs(d) > std::abs(farthest)) farthest = d;
+      }
+    return farthest > 0.0;
+  };
+  for (int g = 0; g < groups.groups(); ++g) {
+    std::map<bool, int> sides;
+    for (int k = groups.childStart[static_cast<std::size_t>(g)];
+         k < groups.childStart[static_cast<std::size_t>(g) + 1]; ++k)
+      ++sides[side(
+          ElementId(static_cast<std::size_t>(groups.children[static_cast<std::size_t>(k)])))];
+    EXPECT_EQ(sides.size(), 1u) << "group " << g;
+  }
+  // Across the slit, only through the elements around its edge inside the group's box.
+  EXPECT_TRUE(groupsFaceConnected(mesh, groups));
 }
 
 TEST(Agglomeration, CoarseFunctionsAreTheLinearDisplacementsOfEachGroup) {
@@ -85,10 +231,10 @@ TEST(Agglomeration, CoarseFunctionsAreTheLinearDisplacementsOfEachGroup) {
   StaticSolver solver(mesh, problem.material, o);
   solver.assemble(bench::benchmarkB1Loads(problem));
   const DgBasis& basis = solver.basis();
-  const ElementFrames frames = elementFrames(basis);
+  const ElementFrames frames = elementFrames(basis, mesh);
   const int n = basis.size();
   const Agglomeration groups = agglomerate(blockRows(solver.system().matrix, n), frames.centres,
-                                           frames.scales, &frames.linear);
+                                           frames.scales, &frames.linear, frames.cells);
   EXPECT_LT(groups.groups(), static_cast<int>(mesh.numElements()) / 3);
   // u(x) = a + B x, as each group's coefficients: u(C) and H grad u.
   const Eigen::Vector3d a(0.3, -1.2, 2.0);
@@ -124,18 +270,21 @@ TEST(Agglomeration, CoarseFunctionsAreTheLinearDisplacementsOfEachGroup) {
   EXPECT_LT(worst, 1e-12);
 }
 
-/// galerkinMatrix against P^T K P of Eigen's sparse products, and its exact symmetry.
+/// galerkinMatrix against P^T K P of Eigen's sparse products, and its exact symmetry, for
+/// groups by lattice cells and by pairing.
 void expectGalerkinProduct(const FramedSystem& s) {
   const SpMat& k = s.system.matrix;
   const BlockRows<double> rows = blockRows(k, 4);
-  const Agglomeration groups =
-      agglomerate(rows, s.frames.centres, s.frames.scales, &s.frames.linear);
-  const SpMat coarse = galerkinMatrix(groups, rows);
-  const SpMat p = prolongation(groups, 4);
-  const SpMat expected = SpMat(p.transpose() * k * p);
-  const double scale = Eigen::MatrixXd(expected).cwiseAbs().maxCoeff();
-  EXPECT_LT(Eigen::MatrixXd(coarse - expected).cwiseAbs().maxCoeff(), 1e-13 * scale);
-  EXPECT_EQ(Eigen::MatrixXd(coarse - SpMat(coarse.transpose())).cwiseAbs().maxCoeff(), 0.0);
+  for (const std::vector<Eigen::Vector3i>& cells : {s.frames.cells, {}}) {
+    const Agglomeration groups =
+        agglomerate(rows, s.frames.centres, s.frames.scales, &s.frames.linear, cells);
+    const SpMat coarse = galerkinMatrix(groups, rows);
+    const SpMat p = prolongation(groups, 4);
+    const SpMat expected = SpMat(p.transpose() * k * p);
+    const double scale = Eigen::MatrixXd(expected).cwiseAbs().maxCoeff();
+    EXPECT_LT(Eigen::MatrixXd(coarse - expected).cwiseAbs().maxCoeff(), 1e-13 * scale);
+    EXPECT_EQ(Eigen::MatrixXd(coarse - SpMat(coarse.transpose())).cwiseAbs().maxCoeff(), 0.0);
+  }
 }
 
 TEST(Agglomeration, GalerkinMatrixIsPTransposeKPForIpOnASlicedMesh) {
@@ -149,7 +298,7 @@ TEST(Agglomeration, GalerkinMatrixIsPTransposeKPForBzWithComponentDiagonalBlocks
   // only their three diagonal 4 x 4 parts.
   const BlockRows<double> rows = blockRows(s.system.matrix, 4);
   const Agglomeration groups =
-      agglomerate(rows, s.frames.centres, s.frames.scales, &s.frames.linear);
+      agglomerate(rows, s.frames.centres, s.frames.scales, &s.frames.linear, s.frames.cells);
   const SpMat coarse = galerkinMatrix(groups, rows);
   std::size_t crossComponent = 0;
   for (int c = 0; c < coarse.cols(); ++c)

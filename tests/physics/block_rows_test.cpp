@@ -113,7 +113,7 @@ TEST(BlockRows, AssembledStraightIntoBlocksEqualTheCsrAssembly) {
 
         SolverOptions cg;
         cg.kind = SolverKind::ConjugateGradient;
-        const ElementFrames frames = elementFrames(solver.basis());
+        const ElementFrames frames = elementFrames(solver.basis(), mesh);
         const Eigen::VectorXd& f = solver.system().rhs;
         LinearSolver fromCsr(cg), fromBlocks(cg);
         ASSERT_TRUE(fromCsr.compute(csr, rows.bs, &frames));

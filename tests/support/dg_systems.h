@@ -22,7 +22,7 @@ inline FramedSystem framedSystem(const PolyMesh& mesh, const Material& material,
   o.discretization.basis.degree = degree;
   StaticSolver solver(mesh, material, o);
   solver.assemble(loads);
-  return {solver.system(), elementFrames(solver.basis())};
+  return {solver.system(), elementFrames(solver.basis(), mesh)};
 }
 
 /// K, F and frames of B1 on `mesh` (Dirichlet on the whole boundary, so K is SPD).

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <Eigen/SparseCore>
 
 namespace polydg {
@@ -12,19 +13,39 @@ namespace polydg {
 template <class T>
 struct BlockRows;
 class DgBasis;
+class PolyMesh;
 
 /// What agglomeration needs of each element e: its basis's centre c_e and length scale h_e,
 /// and how its first four scalar functions (degree <= 1) combine the scaled monomials
 /// 1, (x - c_e) / h_e, (y - c_e) / h_e, (z - c_e) / h_e: phi_i = sum_a T_e(i, a) m_a (the
-/// top-left 4 x 4 block of DgBasis::coefficients).
+/// top-left 4 x 4 block of DgBasis::coefficients); and, if the mesh lies on a lattice of
+/// cells (latticeCells()), the cell of each element, else `cells` is empty.
 struct ElementFrames {
   std::vector<Eigen::Vector3d> centres;
   std::vector<double> scales;
   std::vector<Eigen::Matrix4d> linear;
+  std::vector<Eigen::Vector3i> cells;
 };
 
-/// The frames of `basis`'s elements.
-ElementFrames elementFrames(const DgBasis& basis);
+/// The frames of `basis`'s elements on `mesh` (the mesh the basis was built on), with the
+/// cells of latticeCells() of their bounding boxes.
+ElementFrames elementFrames(const DgBasis& basis, const PolyMesh& mesh);
+
+/// The cells of the lattice the elements were made on, inferred from their bounding boxes
+/// `boxes` (one per element): cell (i, j, k) of element e holds its box centre,
+/// origin + h * (i, j, k) <= centre < origin + h * (i + 1, j + 1, k + 1), indices >= 0.
+/// Why inferred and not recorded: a sliced element is its grid cell clipped by the surface,
+/// and cuts and refinement only make pieces inside it (a sliver merged across a cell face
+/// joins two), so the lattice is in the geometry of every mesh made by slicing, by a hex grid
+/// or read back from a VTU file, with no field to carry through each edit and file. Along each
+/// axis the cell length h is the most common bounding-box extent (within 1e-6 h: a whole cell,
+/// which most elements of a sliced mesh are) and the origin the lattice plane, at a multiple
+/// of h from the lower side of an element of that extent, at or below every box.
+/// Returns no cells (empty) unless at least half the boxes lie each within one cell (within
+/// 1e-6 h; the rest are mostly slivers merged across a cell face, 11-12% at 16 cells): a
+/// tetrahedral or Voronoi mesh has no such lattice. An octree mesh is grouped on its most
+/// common cell size, each larger element in the cell of its centre.
+std::vector<Eigen::Vector3i> latticeCells(const std::vector<Eigen::AlignedBox3d>& boxes);
 
 /// Blocks (elements, or groups of a finer agglomeration) grouped, and the linear
 /// displacements of each group expressed in its blocks' functions.
@@ -40,22 +61,35 @@ struct Agglomeration {
   /// that |x - C_g| <= H_g on each block (given |x - c_b| <= h_b there).
   std::vector<Eigen::Vector3d> centres;
   std::vector<double> scales;
+  /// Grouped by cells: group g's cell on the lattice twice as coarse as its blocks' (their
+  /// cells divided by 2, rounded down), the cells the next agglomeration groups by; empty
+  /// when grouped by pairing.
+  std::vector<Eigen::Vector3i> cells;
 
   int groups() const { return static_cast<int>(centres.size()); }
 };
 
-/// Groups the blocks of a symmetric block matrix, given by block rows (neighbours: blocks that
-/// share a stored block), by three rounds of greedy pairing: blocks, then pairs, then pairs of
-/// pairs, round k pairing each group with its unpaired neighbour best aligned with axis k (the
-/// line between their centres at most 60 degrees from the axis; groups in order). On a hex
-/// grid this gives 2 x 2 x 2 blocks; on a sliced mesh, groups of up to 8 face neighbours.
+/// Groups the blocks of a symmetric block matrix, given by block rows.
+/// With `cells` (one per block: ElementFrames::cells for elements, Agglomeration::cells of the
+/// finer agglomeration for its groups): the blocks of each 2 x 2 x 2 box of cells, split into
+/// the connected components of their coupling within the box (blocks coupled: a stored block
+/// between them with a nonzero entry), so a group never joins pieces
+/// that a cut separates. On a hex grid these are the 2 x 2 x 2 blocks; on a sliced mesh the
+/// elements of 2 x 2 x 2 grid cells (then 4 x 4 x 4, ...), compact however the surface or
+/// the cuts clip them. Groups are numbered in the order of their first block.
+/// Without (empty `cells`: no lattice), three rounds of greedy pairing: blocks, then pairs,
+/// then pairs of pairs, round k pairing each group with its unpaired neighbour (a stored block)
+/// best aligned with axis k (the line between their centres at most 60 degrees from the axis;
+/// groups in order): 2 x 2 x 2 blocks on a hex grid, groups of up to 8 face neighbours of any
+/// shape elsewhere.
 /// `centres` and `scales` are the blocks' frames; `linear` their T (ElementFrames::linear), or
 /// nullptr when the blocks' functions are the scaled monomials themselves (groups of a finer
 /// agglomeration).
 Agglomeration agglomerate(const BlockRows<double>& rows,
                           const std::vector<Eigen::Vector3d>& centres,
                           const std::vector<double>& scales,
-                          const std::vector<Eigen::Matrix4d>* linear);
+                          const std::vector<Eigen::Matrix4d>* linear,
+                          const std::vector<Eigen::Vector3i>& cells = {});
 
 /// The Galerkin matrix P^T A P of the coarse space of `groups` (4 linear functions per
 /// component of each group, unknown (g, d, j) at 12 g + 4 d + j), from A by block rows in

@@ -28,12 +28,13 @@ struct ElementFrames;
 /// Agglomeration levels. Below degree 1, piecewise constants are a poor coarse space for
 /// elasticity: they cannot represent rotations, which cost nothing in K but much in the
 /// penalty between constants, so CG needed 31-38 iterations on B2 (p = 1). Instead, elements
-/// are grouped into agglomerates (three rounds of pairing face neighbours, each round along one
-/// axis: 2 x 2 x 2 blocks on a hex grid) and the coarse space is the linear displacements of
-/// each agglomerate, rigid motions included (12 unknowns per agglomerate, P built from the
-/// frames; the Galerkin matrix P^T K P is formed block by block). Agglomerates are grouped
-/// again until the coarsest level has few unknowns. B2, p = 1: 24 CG iterations instead of 38
-/// (BZ) and 31 (IP); p = 2: 25 and 26.
+/// are grouped into agglomerates (the elements of 2 x 2 x 2 cells of the lattice the mesh was
+/// sliced on, split into face-coupled components; without a lattice, three rounds of pairing
+/// face neighbours, each round along one axis: physics/agglomeration.h) and the coarse space is the
+/// linear displacements of each agglomerate, rigid motions included (12 unknowns per agglomerate, P
+/// built from the frames; the Galerkin matrix P^T K P is formed block by block). Agglomerates are
+/// grouped again until the coarsest level has few unknowns. B2, p = 1: 24 CG iterations instead of
+/// 38 (BZ) and 31 (IP); p = 2: 25 and 26.
 ///
 /// Smoother. Block Gauss-Seidel with one block per element or agglomerate (exact inverse of
 /// its diagonal block), visited colour by colour (a greedy colouring of the level's block

@@ -3,7 +3,8 @@
 // incremental cuts, B6's energy and period, B7's volume with and without corotation, the speed
 // rows, B9's contacts, penetration and energy, the embedding's and the queries' figures),
 // the meshing suite finding its model in share/polydg beside the binary (build tree and an
-// installation's layout) or in --data, and an unknown suite refused with one line.
+// installation's layout) or in --data, the multigrid suite saying in one line how to get the
+// bunny and still running the torus, and an unknown suite refused with one line.
 #include <gtest/gtest.h>
 
 #include <unistd.h>
@@ -321,6 +322,30 @@ TEST_F(BenchData, MeshingSuiteFindsItsModelBesideTheBinaryFromAnyFolder) {
     EXPECT_TRUE(row["valid"].get<bool>()) << row.dump();
     EXPECT_TRUE(row["dg_passed"].get<bool>()) << row.dump();
   }
+}
+
+TEST_F(BenchData, MultigridSuiteSaysHowToGetTheBunnyAndRunsTheTorus) {
+  // testdata/ holds torus.obj but not models/bunny.off.
+  const Result r = run(std::string("bench --suite multigrid --quick --data ") +
+                       POLYDG_TESTDATA_DIR + " --out " + path("out"));
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  const std::size_t note = r.out.find("bunny.off not found: run scripts/get-models.sh");
+  ASSERT_NE(note, std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("bunny", r.out.find('\n', note)), std::string::npos) << r.out;
+  const nlohmann::json j = readJson("out/multigrid.json");
+  EXPECT_TRUE(j.contains("missing"));
+  ASSERT_EQ(j["rows"].size(), 4u);  // the torus sliced and cut, p = 1 and 2
+  for (const nlohmann::json& row : j["rows"]) {
+    EXPECT_EQ(row["model"], "torus");
+    EXPECT_GT(row["iterations"].get<int>(), 0) << row.dump();
+    EXPECT_GT(row["cube_iterations"].get<int>(), 0) << row.dump();
+    EXPECT_GT(row["dofs"].get<std::size_t>(), 0u) << row.dump();
+  }
+  EXPECT_LT(j["rows"][2]["elements"].get<std::size_t>(),
+            j["rows"][0]["elements"].get<std::size_t>())
+      << "the plane cut removes a part";
+  EXPECT_TRUE(fs::exists(dir_ / "out" / "multigrid.csv"));
+  EXPECT_TRUE(fs::exists(dir_ / "out" / "multigrid.svg"));
 }
 
 TEST_F(BenchData, CopiedBinaryLooksInItsOwnShareFolderOrInData) {
