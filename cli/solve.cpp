@@ -141,6 +141,9 @@ void addSolveCommand(CLI::App& app, const CommonOptions& common, int& exitCode) 
   cmd->add_option("-o,--output", o->output, "output mesh with displacement and stress (.vtu)")
       ->required();
   addChoice(*cmd, "--method", s.method, methodNames(), "DG method (interior penalty or BZ)");
+  addChoice(*cmd, "--bz-penalty", s.bzPenalty, bzPenaltyNames(),
+            "--method bz: penalty ~1/h (fixed: cheap, its error stops falling) or the "
+            "superpenalty ~h^-(2p+1) (super: converges at rate >= p, stiffer system)");
   cmd->add_option("--degree", s.degree, "polynomial degree of the basis")
       ->check(CLI::Range(1, 3))
       ->capture_default_str();

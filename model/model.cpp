@@ -13,6 +13,7 @@
 #include "model_state.h"
 #include "polydg/mesh/geometry.h"
 #include "polydg/mesh/surface_io.h"
+#include "polydg/model/names.h"
 #include "polydg/model/provenance.h"
 #include "polydg/util/error.h"
 #include "polydg/util/stopwatch.h"
@@ -381,6 +382,9 @@ SolveReport Model::solve(const SolveOptions& options) {
     throw InputError("nothing holds the body: give at least one clamp (a plane, below or box)");
   if (!options.exactDisplacement != !options.exactGradient)
     throw InputError("an exact solution needs both its displacement and its gradient");
+  if (options.bzPenalty != BzPenalty::Fixed && options.method != Method::BZ)
+    throw InputError("the BZ penalty scaling \"" + toString(options.bzPenalty) +
+                     "\" is for the BZ method; use --method bz");
   if (options.estimate && options.method != Method::IP)
     throw InputError("the error estimate is for the IP method; use --method ip");
   const PolyMesh& m = mesh();
@@ -401,6 +405,7 @@ SolveReport Model::solve(const SolveOptions& options) {
   loads.gravity = options.gravity;
   StaticOptions so;
   so.discretization.method = options.method;
+  so.discretization.bzPenalty = options.bzPenalty;
   so.discretization.basis.degree = options.degree;
   so.discretization.penalty.rule = options.penalty;
   if (options.penalty != PenaltyRule::TraceBound) {

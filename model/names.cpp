@@ -7,6 +7,11 @@ const Names<Method>& methodNames() {
   return names;
 }
 
+const Names<BzPenalty>& bzPenaltyNames() {
+  static const Names<BzPenalty> names{{"fixed", BzPenalty::Fixed}, {"super", BzPenalty::Super}};
+  return names;
+}
+
 const Names<RefineSplit>& refineSplitNames() {
   static const Names<RefineSplit> names{{"octants", RefineSplit::Octants},
                                         {"halves", RefineSplit::Halves}};

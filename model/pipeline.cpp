@@ -145,6 +145,7 @@ SolveStep solveStep(JsonObjectReader& r) {
   SolveStep s;
   SolveOptions& o = s.options;
   if (r.has("method")) o.method = r.choice("method", methodNames());
+  if (r.has("bz_penalty")) o.bzPenalty = r.choice("bz_penalty", bzPenaltyNames());
   if (r.has("degree")) o.degree = r.integer("degree", 1, 3);
   if (r.has("material")) o.material = readMaterial(r, o.material);
   if (r.has("gravity")) o.gravity = r.vec3(r.get("gravity"), r.at("gravity"));

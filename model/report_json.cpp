@@ -299,7 +299,7 @@ json toJson(const SolveReport& report) {
     t["faces"] = i < report.tractionFaces.size() ? report.tractionFaces[i] : 0;
     tractions.push_back(t);
   }
-  return {
+  json j = {
       {"method", toString(o.method)},
       {"degree", o.degree},
       {"material",
@@ -338,8 +338,8 @@ json toJson(const SolveReport& report) {
         {"assemble", r.assembleSeconds},
         {"solve", r.solveSeconds},
         {"factorize", r.solver.factorSeconds}}},
-      {"estimate", report.estimate
-                       ? json{{"total", report.estimate->total},
+      {"estimate",
+       report.estimate ? json{{"total", report.estimate->total},
                               {"energy_norm", report.energyNorm},
                               {"residual", std::sqrt(report.estimate->residual)},
                               {"traction_jump", std::sqrt(report.estimate->tractionJump)},
@@ -347,6 +347,11 @@ json toJson(const SolveReport& report) {
                               {"dirichlet", std::sqrt(report.estimate->dirichlet)}}
                        : json(nullptr)},
       {"adapt", adaptJson(report)}};
+  if (o.method == Method::BZ) {
+    j["bz_penalty"] = toString(o.bzPenalty);
+    j["bz_factor"] = r.bzFactor;
+  }
+  return j;
 }
 
 json toJson(const RefineReport& r) {
@@ -389,6 +394,7 @@ json toJson(const Scene& s) {
                    {"nu", s.material.poissonRatio},
                    {"density", s.material.density}};
   j["method"] = toString(s.method);
+  if (s.method == Method::BZ) j["bz_penalty"] = toString(s.bzPenalty);
   j["degree"] = s.degree;
   j["corotational"] = s.corotational;
   j["integrator"] = nameOf(integratorNames(), s.integrator);

@@ -37,6 +37,11 @@ Scene parseScene(const json& document, const std::string& file) {
     r.fail("material", e.what());
   }
   if (r.has("method")) s.method = r.choice("method", methodNames());
+  if (r.has("bz_penalty")) {
+    s.bzPenalty = r.choice("bz_penalty", bzPenaltyNames());
+    if (s.bzPenalty != BzPenalty::Fixed && s.method != Method::BZ)
+      r.fail("bz_penalty", "is for the BZ method: add \"method\": \"bz\"");
+  }
   if (r.has("degree")) s.degree = r.integer("degree", 1, 3);
   if (r.has("corotational")) s.corotational = r.boolean("corotational");
   if (r.has("integrator")) s.integrator = r.choice("integrator", integratorNames());

@@ -35,6 +35,7 @@ DynamicsOptions dynamicsOptions(const Scene& scene) {
   DynamicsOptions o;
   o.material = scene.material;
   o.discretization.method = scene.method;
+  o.discretization.bzPenalty = scene.bzPenalty;
   o.discretization.basis.degree = scene.degree;
   o.solver.kind = scene.solver;
   o.corotational = scene.corotational;
@@ -56,6 +57,8 @@ void checkScene(const Scene& scene) {
   if (!(scene.dt > 0.0) || !std::isfinite(scene.dt))
     throw InputError("the time step dt must be a positive number");
   if (scene.steps < 1) throw InputError("the scene needs at least one step");
+  if (scene.bzPenalty != BzPenalty::Fixed && scene.method != Method::BZ)
+    throw InputError("the BZ penalty scaling is for the BZ method");
   if (scene.outputEvery < 1) throw InputError("output every must be at least 1");
   if (!(scene.massDamping >= 0.0) || !(scene.stiffnessDamping >= 0.0))
     throw InputError("damping coefficients must not be negative");

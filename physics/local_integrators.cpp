@@ -262,7 +262,8 @@ double facePenalty(const FormCoefficients& form, const MomentCache& moments, Fac
   auto eta = [&](ElementId e) { return form.elementEta ? (*form.elementEta)[e] : form.eta; };
   double sum = eta(self) / moments.volume(self);
   if (other.valid()) sum += eta(other) / moments.volume(other);
-  return moments.area(f) * sum;
+  const double factor = form.method == Method::BZ ? form.bzFactor : 1.0;
+  return moments.area(f) * sum * factor;
 }
 
 void faceRows(const PolyMesh& mesh, const DgBasis& basis, const MomentCache& moments,

@@ -1,10 +1,12 @@
 #include "polydg/physics/static_solver.h"
 
 #include <algorithm>
+#include <cmath>
 #include <optional>
 #include <stdexcept>
 
 #include <tbb/parallel_for.h>
+#include <Eigen/Geometry>
 
 #include "polydg/physics/agglomeration.h"
 #include "polydg/physics/block_rows.h"
@@ -48,6 +50,22 @@ void StaticSolver::integrate() {
   report_.basisFallbacks = basis_->fallbackElements();
 }
 
+double superpenaltyFactor(const PolyMesh& mesh, const DgBasis& basis, double referenceLength) {
+  if (!(referenceLength >= 0.0 && std::isfinite(referenceLength)))
+    throw std::invalid_argument("the BZ reference length must be positive and finite (or 0)");
+  double length = referenceLength;
+  if (length == 0.0) {
+    Eigen::AlignedBox3d box;
+    for (const Vec3& x : mesh.positions()) box.extend(x);
+    length = box.isEmpty() ? 0.0 : box.diagonal().norm();
+  }
+  double h = 0.0;
+  for (std::size_t i = 0; i < mesh.numElements(); ++i)
+    h = std::max(h, 2.0 * basis.scale(ElementId(i)));
+  if (!(h > 0.0 && length > 0.0)) return 1.0;  // no elements: no faces to penalize
+  return std::pow(length / h, 2 * basis.degree());
+}
+
 FormCoefficients formCoefficients(const PolyMesh& mesh, const DgBasis& basis,
                                   const MomentCache& moments, const FaceRoles& roles,
                                   const Material& material, const DiscretizationOptions& disc,
@@ -73,6 +91,8 @@ FormCoefficients formCoefficients(const PolyMesh& mesh, const DgBasis& basis,
     case PenaltyRule::Doubling: form.eta = disc.penalty.eta; break;
   }
   if (!(form.eta > 0.0)) throw std::invalid_argument("the penalty eta must be positive");
+  if (disc.method == Method::BZ && disc.bzPenalty == BzPenalty::Super)
+    form.bzFactor = superpenaltyFactor(mesh, basis, disc.bzReferenceLength);
   return form;
 }
 
@@ -141,6 +161,7 @@ void StaticSolver::assemble(const LoadCase& loads) {
     }
   }
   report_.eta = form_.eta;
+  report_.bzFactor = form_.bzFactor;
   system_.rhs =
       assembleLoad(*mesh_, *basis_, *moments_, roles_, form_, material_, loads, quadrature);
   report_.dofs = rows_ ? static_cast<std::size_t>(rows_->elements()) * rows_->bs

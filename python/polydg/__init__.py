@@ -169,11 +169,14 @@ def _check(self, degree=1):
 
 def _solve(self, method="ip", degree=1, E=None, nu=None, density=None, gravity=None,
            clamp=None, traction=None, solver=None, penalty=None, eta=None, adapt=None,
-           estimate=None):
+           estimate=None, bz_penalty=None):
     """Static linear elasticity with DG (``polydg solve``) on the model; keeps the solution for
     ``write``.
 
     method: "ip" (interior penalty) or "bz" (Babuska-Zlamal); degree: 1-3.
+    bz_penalty: with method="bz", "fixed" (the default: penalty ~1/h, cheap, but the error stops
+    falling under refinement) or "super" (the superpenalty ~h^-(2p+1): converges at rate >= p,
+    with a stiffer system).
     E: Young's modulus (default 1), nu: Poisson's ratio in (-1, 0.5) (default 0.3),
     density: mass density (default 1; with gravity), gravity: [gx, gy, gz] (acceleration).
     clamp: where u = 0 (weakly); a region or a list of regions (at least one). A region is a dict:
@@ -200,7 +203,8 @@ def _solve(self, method="ip", degree=1, E=None, nu=None, density=None, gravity=N
     material = _given(E=E, nu=nu, density=density)
     return self._solve(**_given(method=method, degree=degree, material=material or None,
                                 gravity=gravity, clamp=clamp, traction=traction, solver=solver,
-                                penalty=penalty, eta=eta, adapt=adapt, estimate=estimate))
+                                penalty=penalty, eta=eta, adapt=adapt, estimate=estimate,
+                                bz_penalty=bz_penalty))
 
 
 def _refine(self, elements, split="octants", directions=None, merge_slivers=None,

@@ -170,3 +170,30 @@ def test_faces_and_solution_arrays():
     u = model.element_displacements
     assert u.shape == (model.num_elements, 3) and (u[:, 2] <= 1e-12).all()
     assert model.element_von_mises.shape == (model.num_elements,)
+
+
+def test_bz_superpenalty_is_chosen_by_name_and_does_not_depend_on_the_models_scale():
+    # The superpenalty's factor (L/h)^(2p) is dimensionless: the same surface scaled by 1e-6
+    # (at the origin) and by 1e6 (moved 3e6 away) gives the same factor.
+    surface = polydg.read_surface(TORUS)
+    factors = []
+    for scale, offset in ((1.0, 0.0), (1e-6, 0.0), (1e6, 3e6)):
+        s = polydg.Surface(surface.V * scale + offset, surface.F)
+        model = polydg.mesh(s, cells=4)
+        lowest = float(np.min(s.V[:, 2]))
+        height = float(np.ptp(s.V[:, 2]))
+        report = model.solve(method="bz", bz_penalty="super", degree=2, gravity=[0, 0, -1],
+                             clamp={"below": [0, 0, 1, lowest + 0.2 * height]})
+        assert report["bz_penalty"] == "super"
+        factors.append(report["bz_factor"])
+    assert factors[0] > 1.0
+    assert factors[1] == pytest.approx(factors[0], rel=1e-9)
+    assert factors[2] == pytest.approx(factors[0], rel=1e-9)
+
+    model = polydg.mesh(surface, cells=4)
+    clamp = {"below": [0, 0, 1, float(np.min(surface.V[:, 2])) + 0.2]}
+    with pytest.raises(polydg.Error, match="'huge'") as caught:
+        model.solve(method="bz", bz_penalty="huge", clamp=clamp)
+    assert "\n" not in str(caught.value)
+    with pytest.raises(polydg.Error, match="for the BZ method"):
+        model.solve(bz_penalty="super", clamp=clamp)

@@ -201,6 +201,8 @@ struct TractionLoad {
 /// A static solve (`polydg solve`, pipeline solve steps, Model.solve in Python).
 struct SolveOptions {
   Method method = Method::IP;
+  /// Method::BZ: its penalty's scaling (DiscretizationOptions::bzPenalty); Super needs BZ.
+  BzPenalty bzPenalty = BzPenalty::Fixed;
   int degree = 1;
   Material material;
   Vec3 gravity = Vec3::Zero();

@@ -20,6 +20,7 @@ template <class E>
 using Names = std::vector<std::pair<std::string, E>>;
 
 const Names<Method>& methodNames();                    ///< ip, bz
+const Names<BzPenalty>& bzPenaltyNames();              ///< fixed, super
 const Names<SolverKind>& solverNames();                ///< auto, cholesky, cg
 const Names<PenaltyRule>& penaltyNames();              ///< bound, doubling, fixed
 const Names<RepairMode>& repairNames();                ///< none, fill, wrap
@@ -62,6 +63,7 @@ std::string listNames(const Names<E>& names) {
 }
 
 inline std::string toString(Method m) { return nameOf(methodNames(), m); }
+inline std::string toString(BzPenalty b) { return nameOf(bzPenaltyNames(), b); }
 inline std::string toString(SolverKind k) { return nameOf(solverNames(), k); }
 inline std::string toString(PenaltyRule r) { return nameOf(penaltyNames(), r); }
 inline std::string toString(RepairMode r) { return nameOf(repairNames(), r); }

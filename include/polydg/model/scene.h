@@ -76,6 +76,7 @@ struct SceneAdapt {
 struct Scene {
   Material material;
   Method method = Method::IP;
+  BzPenalty bzPenalty = BzPenalty::Fixed;  ///< Method::BZ: its penalty's scaling; Super needs BZ
   int degree = 1;
   bool corotational = true;
   TimeIntegrator integrator = TimeIntegrator::BackwardEuler;

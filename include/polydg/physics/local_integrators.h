@@ -21,6 +21,20 @@ enum class Method {
   BZ,  ///< Babuska-Zlamal penalty, eq. (6): only the jump penalty; inconsistent
 };
 
+/// How the jump penalty of the BZ method scales with the mesh (Method::BZ only).
+enum class BzPenalty {
+  /// eta_F = facePenalty() as for IP, ~ 1/h. Cheap and as well conditioned as IP, but BZ is
+  /// inconsistent: the error stops decreasing under refinement (B1: L2 ~ 3e-3 for p = 1).
+  Fixed,
+  /// Babuska and Zlamal's superpenalty, eta_F (L/h)^(2p) ~ h^-(2p+1): the consistency error,
+  /// ~ |sigma n|_F / sqrt(eta_F), then falls as h^p, and the L2 error with it, at the price
+  /// of a stiffer jump term (condition numbers ~ h^-(2p+2) instead of h^-2). The factor is
+  /// FormCoefficients::bzFactor, from superpenaltyFactor() (physics/static_solver.h).
+  /// p >= 2 only: for p = 1 on hex grids the jumps are forced towards continuous complete
+  /// linears, i.e. global linears, and the error locks (B1: L2 ~ 2e-3 at every n).
+  Super,
+};
+
 /// How an element sees one of its faces.
 enum class FaceKind {
   Interior,   ///< shared with another element
@@ -40,9 +54,14 @@ struct FormCoefficients {
   /// argument (penaltyThreshold() in physics/assembly.h) with each element's own bound, so a
   /// badly shaped sliced element raises the penalty only on its own faces.
   const ElementData<double>* elementEta = nullptr;
+  /// BZ only: eta_F is multiplied by this dimensionless factor, (L/h)^(2p) for
+  /// BzPenalty::Super, 1 for BzPenalty::Fixed. IP ignores it.
+  double bzFactor = 1.0;
 };
 
-/// eta_F of face `f` between `self` and `other` (invalid on the boundary) under `form`.
+/// eta_F of face `f` between `self` and `other` (invalid on the boundary) under `form`:
+/// area(F) (eta_K / vol(K) + eta_L / vol(L)) (eta_K = eta without per-element penalties),
+/// times FormCoefficients::bzFactor for the BZ method.
 double facePenalty(const FormCoefficients& form, const MomentCache& moments, FaceId f,
                    ElementId self, ElementId other);
 
@@ -91,6 +110,7 @@ void elementMass(const DgBasis& basis, const MomentCache& moments, ElementId e,
 /// (physics/assembly.h).
 ///
 /// BZ (paper eq. 6): only mu eta_F int_F [u] . [v]; positive definite for every eta > 0.
+/// eta_F includes FormCoefficients::bzFactor (the superpenalty, BzPenalty::Super).
 ///
 /// Dirichlet faces (u_L = g, v_L = 0, sigma_L = sigma_K) give the same terms with one side;
 /// their right-hand side is dirichletLoad().

@@ -36,6 +36,11 @@ struct PenaltyOptions {
 
 struct DiscretizationOptions {
   Method method = Method::IP;
+  /// Method::BZ: how its penalty scales with the mesh (the superpenalty converges).
+  BzPenalty bzPenalty = BzPenalty::Fixed;
+  /// BzPenalty::Super: the reference length L of superpenaltyFactor(); 0 picks the mesh's
+  /// bounding-box diagonal. In the model's length unit.
+  double bzReferenceLength = 0.0;
   BasisOptions basis;
   PenaltyOptions penalty;
   /// Degree of exactness of the quadrature for non-polynomial loads (body force function,
@@ -55,6 +60,7 @@ struct StaticReport {
   std::size_t nonzeros = 0;   ///< stored entries of K (both triangles)
   double eta = 0.0;           ///< the global penalty used (local: the largest eta_K)
   double etaThreshold = 0.0;  ///< penaltyThreshold() (the IP coercivity bound)
+  double bzFactor = 1.0;      ///< FormCoefficients::bzFactor (BZ superpenalty: (L/h)^(2p))
   int penaltyAttempts = 1;    ///< factorizations tried by PenaltyRule::Doubling
   std::size_t dirichletFaces = 0, tractionFaces = 0;
   std::size_t basisFallbacks = 0;  ///< DgBasis::fallbackElements()
@@ -79,10 +85,22 @@ struct StaticSolution {
   StaticReport report;
 };
 
+/// The factor (L/h)^(2p) of the BZ superpenalty (BzPenalty::Super), p = basis.degree(): L is
+/// `referenceLength`, or the diagonal of the mesh's bounding box if it is 0; h is the largest
+/// element length, the bounding-box diagonal of an element (2 DgBasis::scale(), the length the
+/// basis is scaled by). Dimensionless, so invariant to the model's unit and position; 1 on a
+/// mesh of one element, n^(2p) on an n x n x n grid of a cube (L/h = n). One h for the whole
+/// mesh: eta_F already grows as 1/h locally (area(F)/vol(K)), and a small cut piece does not
+/// raise the factor (and the condition number) everywhere. Under uniform refinement eta_F then
+/// scales as h^-(2p+1), Babuska and Zlamal's rate. Throws std::invalid_argument for a negative
+/// or non-finite `referenceLength`.
+double superpenaltyFactor(const PolyMesh& mesh, const DgBasis& basis, double referenceLength = 0.0);
+
 /// The coefficients of the form of `disc` for `material`: the penalty by its rule (TraceBound:
 /// the coercivity bounds of penaltyThreshold(), per element into `elementEta`, which the form
-/// then points to and which must outlive it; Fixed and Doubling: the given eta). `threshold` is
-/// the largest bound. Throws std::invalid_argument for a non-positive eta.
+/// then points to and which must outlive it; Fixed and Doubling: the given eta), and the BZ
+/// penalty's factor (`disc.bzPenalty`, superpenaltyFactor()). `threshold` is the largest bound.
+/// Throws std::invalid_argument for a non-positive eta.
 FormCoefficients formCoefficients(const PolyMesh& mesh, const DgBasis& basis,
                                   const MomentCache& moments, const FaceRoles& roles,
                                   const Material& material, const DiscretizationOptions& disc,
