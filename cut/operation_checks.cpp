@@ -63,10 +63,10 @@ void validateOperation(const PolyMesh& mesh, const MomentCache& moments,
     v.regionElements = dg.elements;
     v.regionComponents = dg.components;
     v.zeroModes = dg.zeroModes;
-    v.patchTestError = dg.patchTestError;
+    v.patchTestError = dg.patchTestResidual;
     if (!dg.passed()) {
       std::ostringstream msg;
-      msg << "DG region check: patch test error " << dg.patchTestError << ", " << dg.zeroModes
+      msg << "DG region check: patch test residual " << dg.patchTestResidual << ", " << dg.zeroModes
           << " zero modes for " << dg.components << " components (expected " << 6 * dg.components
           << ")";
       fail(msg.str());

@@ -88,6 +88,15 @@ void MomentCache::reverseFace(FaceId f) {
   if (f.index() < faceNormals_.size()) faceNormals_[f] = -faceNormals_[f];
 }
 
+void MomentCache::assignFace(FaceId f, std::span<const double> values, const Vec3& normal) {
+  if (values.size() != static_cast<std::size_t>(stride_))
+    throw std::invalid_argument("MomentCache::assignFace: moments of another degree");
+  std::copy(values.begin(), values.end(), faceMoments_.begin() + f.index() * stride_);
+  faceNormals_[f] = normal;
+  invalidateFace(f);
+  faceDirty_[f.index()] = 0;  // a stale entry in dirtyFaces_ is skipped by update()
+}
+
 void MomentCache::invalidateAll() {
   for (std::size_t f = 0; f < faceDirty_.size(); ++f) invalidateFace(FaceId(f));
 }

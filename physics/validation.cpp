@@ -275,6 +275,17 @@ Eigen::MatrixXd rigidMotionCoefficients(const DgBasis& basis, ElementId e, const
   return out;
 }
 
+Eigen::VectorXd linearFieldCoefficients(const DgBasis& basis, ElementId e, const Vec3& b,
+                                        const Eigen::Matrix3d& a, const Vec3& x0) {
+  LinearField field;
+  field.a = a;
+  field.b = b;
+  field.x0 = x0;
+  Eigen::VectorXd out(3 * basis.size());
+  linearFieldCoefficients(basis, e, field, {out.data(), static_cast<std::size_t>(out.size())});
+  return out;
+}
+
 Eigen::VectorXd zeroModeScaling(const Eigen::VectorXd& diagonal, int blockSize) {
   Eigen::VectorXd scale(diagonal.size());
   for (Eigen::Index b = 0; b < diagonal.size() / blockSize; ++b) {
@@ -585,6 +596,15 @@ struct CheckTotals {
 };
 
 }  // namespace
+
+std::size_t elementZeroModes(const Eigen::MatrixXd& stiffness, int degree) {
+  return detail::dispatchBasisDegree(degree, [&](auto p) -> std::size_t {
+    using Kernel = LocalCheckKernel<p()>;
+    if (stiffness.rows() != Kernel::B || stiffness.cols() != Kernel::B)
+      throw std::invalid_argument("elementZeroModes: the stiffness is not 3n x 3n for the degree");
+    return static_cast<std::size_t>(Kernel::zeroModes(typename Kernel::Mat(stiffness)));
+  });
+}
 
 LocalDgCheck localDgChecks(const PolyMesh& mesh, const MomentCache& moments,
                            const LocalDgCheckOptions& options) {

@@ -65,7 +65,7 @@ struct OperationValidation {
   bool passed = true;
   std::size_t elementsChecked = 0;  ///< geometric checks
   std::size_t regionElements = 0;   ///< DG region (touched elements plus one ring)
-  double patchTestError = 0.0;      ///< relative, over the region (or the mesh, Full)
+  double patchTestError = 0.0;  ///< Local: the region's patch-test residual; Full: relative error
   /// Local: components of the region's coupling graph, its elements joined through the faces
   /// that hold them together (RegionCoupling::HoldingFaces); Full: of the mesh.
   std::size_t regionComponents = 0;

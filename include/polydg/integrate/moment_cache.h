@@ -55,6 +55,12 @@ class MomentCache {
   /// Face f was reversed with its first vertex kept: same moments, opposite normal.
   void reverseFace(FaceId f);
 
+  /// Face f takes the moments `values` (this cache's stride) and unit `normal` computed for it
+  /// elsewhere: by another cache, for a face with the same vertices and loops in another mesh
+  /// (a copy of part of a mesh). The face is no longer dirty and nothing is integrated for it;
+  /// its elements are marked, so update() sums their moments from their faces.
+  void assignFace(FaceId f, std::span<const double> values, const Vec3& normal);
+
   std::span<const double> face(FaceId f) const {
     return {faceMoments_.data() + f.index() * stride_, static_cast<std::size_t>(stride_)};
   }

@@ -80,6 +80,11 @@ ZeroModeReport zeroModes(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>
 Eigen::MatrixXd rigidMotionCoefficients(const DgBasis& basis, ElementId e, const Vec3& centre,
                                         double length);
 
+/// Element e's coefficients (3n values, LinearSystem's order d n + i) of the linear field
+/// u(x) = b + a (x - x0), exact (every basis spans the linear functions; no quadrature).
+Eigen::VectorXd linearFieldCoefficients(const DgBasis& basis, ElementId e, const Vec3& b,
+                                        const Eigen::Matrix3d& a, const Vec3& x0);
+
 /// The Jacobi scaling of zeroModes(), D^(-1/2), for a matrix with diagonal `diagonal` in blocks
 /// of `blockSize`: 1 / sqrt(d_i), where an entry that is not positive (the constant functions
 /// of an element without coupled faces) takes its block's mean diagonal (negative entries
@@ -120,6 +125,13 @@ DefinitenessReport definiteness(const PolyMesh& mesh, const PhysicsCheckOptions&
 /// round-off and 37 times below that sliver (1e-10 would flag slivers thinner than 1e-5 at
 /// degree 2, which the solver handles: see kZeroModeThreshold).
 inline constexpr double kElementZeroModeThreshold = 1e-13;
+
+/// The zero modes of one element's stiffness K_K (elementStiffness(), 3n x 3n) by the rule of
+/// localDgChecks()' rigid-mode check: the eigenvalues of its Jacobi-scaled form below
+/// kElementZeroModeThreshold times its largest absolute row sum, negative ones included, counted
+/// by Sylvester's law of inertia (pivoted LDL^T). 6 on a valid element; an inverted element has
+/// more. `degree` is the basis degree p (K_K has 3 numMonomials(p) rows).
+std::size_t elementZeroModes(const Eigen::MatrixXd& stiffness, int degree);
 
 /// An element passes the local patch test when its error (LocalDgCheck::maxPatchTestError) is
 /// below this, the global patch test's tolerance. Valid meshes give 1e-17 .. 1e-14 (a sliced
