@@ -4,7 +4,7 @@
 # surface (bunny00.off of CGAL's data, package libcgal-demo) and tetgen, the reference mesher
 # `polydg bench --suite meshing` times polydg against.
 # Usage: scripts/get-models.sh [DIR]   (default build/share/polydg/models, where polydg bench
-# looks for them; `polydg bench --models DIR` names another folder).
+# looks for them; `polydg bench --data DIR` reads DIR/models instead).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 dest=${1:-build/share/polydg/models}

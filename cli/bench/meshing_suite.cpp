@@ -1,6 +1,10 @@
 #include "cli/bench/suites.h"
 
+#include <unistd.h>
+
 #include <algorithm>
+#include <chrono>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <limits>
@@ -15,6 +19,67 @@
 namespace polydg::bench {
 
 namespace fs = std::filesystem;
+
+namespace {
+
+/// Wall time of a shell command, or -1 if it failed.
+double commandSeconds(const std::string& command) {
+  const auto start = std::chrono::steady_clock::now();
+  const int status = std::system(command.c_str());
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return status == 0 ? seconds : -1.0;
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+/// polydg's whole `polydg mesh` command (read, checks, slicing, validation, DG checks, the
+/// VTU written) against Debian's `tetgen -pQ` on the same closed 75k-triangle surface (the
+/// bunny of scripts/get-models.sh), run alternately `rounds` times in one run. The project
+/// does not link tetgen; the comparison is skipped, with one line saying why, when the bunny
+/// or the tetgen command is missing.
+nlohmann::json againstTetgen(const BenchOptions& o, int rounds, bool quiet) {
+  const fs::path bunny = fs::path(o.dataDir) / "models" / "bunny.off";
+  auto skipped = [&](const std::string& why) {
+    if (!quiet) std::cout << "meshing against tetgen skipped: " << why << std::endl;
+    return nlohmann::json{{"comparison", "tetgen -pQ"}, {"skipped", why}};
+  };
+  if (!fs::exists(bunny))
+    return skipped(bunny.string() + " not found; scripts/get-models.sh fetches it");
+  if (std::system("command -v tetgen > /dev/null 2>&1") != 0)
+    return skipped("tetgen not installed; scripts/get-models.sh installs it (Debian's tetgen)");
+  std::error_code ec;
+  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
+  if (ec) return skipped("cannot find the polydg executable through /proc/self/exe");
+  const fs::path dir = fs::temp_directory_path() / ("polydg-tetgen-" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  fs::copy_file(bunny, dir / "bunny.off", fs::copy_options::overwrite_existing);
+  const std::string polydg = "'" + self.string() + "' mesh '" + (dir / "bunny.off").string() +
+                             "' --cells 64 -o '" + (dir / "bunny.vtu").string() + "' --quiet";
+  const std::string tetgen = "tetgen -pQ '" + (dir / "bunny.off").string() + "' > /dev/null";
+  std::vector<double> ours, theirs;
+  for (int r = 0; r < rounds; ++r) {
+    ours.push_back(commandSeconds(polydg));
+    theirs.push_back(commandSeconds(tetgen));
+    if (ours.back() < 0 || theirs.back() < 0) {
+      fs::remove_all(dir);
+      return skipped(std::string(ours.back() < 0 ? "polydg mesh" : "tetgen") + " failed");
+    }
+  }
+  fs::remove_all(dir);
+  const double a = median(ours), b = median(theirs);
+  if (!quiet)
+    std::cout << "bunny (75,408 triangles), 64 cells: polydg mesh " << a << " s, tetgen -pQ " << b
+              << " s (medians of " << rounds << ", run alternately)" << std::endl;
+  return {{"comparison", "tetgen -pQ"}, {"model", "bunny.off"},   {"cells", 64},
+          {"rounds", rounds},           {"polydg_seconds", ours}, {"tetgen_seconds", theirs},
+          {"polydg_median", a},         {"tetgen_median", b},     {"ratio", a / b}};
+}
+
+}  // namespace
 
 SuiteOutput meshingSuite(const BenchOptions& o, bool quiet) {
   SuiteOutput s{"meshing", nlohmann::json::array(), nlohmann::json::array(), {}};
@@ -73,6 +138,7 @@ SuiteOutput meshingSuite(const BenchOptions& o, bool quiet) {
                   << run.geometricValidationSeconds << " s + DG checks " << run.dgCheckSeconds
                   << " s" << std::endl;
     }
+  if (!o.quick) s.json.push_back(againstTetgen(o, 7, quiet));
   s.plots.push_back({"meshing_time.svg",
                      {"Meshing: wall time against grid resolution (2 cores)",
                       {"cells along the longest side", AxisScale::Log},
