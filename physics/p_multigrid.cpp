@@ -232,19 +232,19 @@ bool invertBlocks(Level& level) {
   return ok;
 }
 
-/// Greedy colouring of the element graph of `a` (elements sharing a nonzero block are
-/// neighbours): the elements of each colour, in increasing order.
-std::vector<std::vector<int>> colourElements(const SpMat& a, int bs) {
-  const int ne = static_cast<int>(a.cols() / bs);
+/// Greedy colouring of `ne` elements, in order, each taking the first colour none of its
+/// neighbours has: forEachNeighbour(e, visit) calls visit(f) for each neighbour f of e. The
+/// elements of each colour, in increasing order.
+template <class ForEachNeighbour>
+std::vector<std::vector<int>> colourGreedily(int ne, ForEachNeighbour&& forEachNeighbour) {
   std::vector<int> colour(static_cast<std::size_t>(ne), -1);
   std::vector<int> seenBy;  // seenBy[c] == e: colour c is taken by a neighbour of e
   std::vector<std::vector<int>> classes;
   for (int e = 0; e < ne; ++e) {
-    // Column e bs holds a row of every neighbour block (BZ blocks included: component 0).
-    for (SpMat::InnerIterator it(a, static_cast<Eigen::Index>(e) * bs); it; ++it) {
-      const int c = colour[static_cast<std::size_t>(it.row() / bs)];
+    forEachNeighbour(e, [&](int f) {
+      const int c = colour[static_cast<std::size_t>(f)];
       if (c >= 0) seenBy[static_cast<std::size_t>(c)] = e;
-    }
+    });
     int c = 0;
     while (c < static_cast<int>(seenBy.size()) && seenBy[static_cast<std::size_t>(c)] == e) ++c;
     if (c == static_cast<int>(seenBy.size())) {
@@ -257,28 +257,23 @@ std::vector<std::vector<int>> colourElements(const SpMat& a, int bs) {
   return classes;
 }
 
-/// colourElements() for a matrix by block rows.
+/// The colouring of the element graph of `a` (elements sharing a nonzero block are
+/// neighbours).
+std::vector<std::vector<int>> colourElements(const SpMat& a, int bs) {
+  return colourGreedily(static_cast<int>(a.cols() / bs), [&](int e, auto&& visit) {
+    // Column e bs holds a row of every neighbour block (BZ blocks included: component 0).
+    for (SpMat::InnerIterator it(a, static_cast<Eigen::Index>(e) * bs); it; ++it)
+      visit(static_cast<int>(it.row() / bs));
+  });
+}
+
+/// The same for a matrix by block rows: an element's neighbours are its slots' elements.
 std::vector<std::vector<int>> colourElements(const BlockRows<double>& a) {
-  const int ne = a.elements();
-  std::vector<int> colour(static_cast<std::size_t>(ne), -1);
-  std::vector<int> seenBy;
-  std::vector<std::vector<int>> classes;
-  for (int e = 0; e < ne; ++e) {
+  return colourGreedily(a.elements(), [&](int e, auto&& visit) {
     for (int k = a.start[static_cast<std::size_t>(e)]; k < a.start[static_cast<std::size_t>(e) + 1];
-         ++k) {
-      const int c = colour[static_cast<std::size_t>(a.element[static_cast<std::size_t>(k)])];
-      if (c >= 0) seenBy[static_cast<std::size_t>(c)] = e;
-    }
-    int c = 0;
-    while (c < static_cast<int>(seenBy.size()) && seenBy[static_cast<std::size_t>(c)] == e) ++c;
-    if (c == static_cast<int>(seenBy.size())) {
-      seenBy.push_back(-1);
-      classes.emplace_back();
-    }
-    colour[static_cast<std::size_t>(e)] = c;
-    classes[static_cast<std::size_t>(c)].push_back(e);
-  }
-  return classes;
+         ++k)
+      visit(a.element[static_cast<std::size_t>(k)]);
+  });
 }
 
 /// The principal submatrix of `fine` on the first `nc` functions of each component, as
