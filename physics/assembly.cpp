@@ -604,6 +604,7 @@ Eigen::VectorXd assembleLoad(const PolyMesh& mesh, const DgBasis& basis, const M
       if (!g) continue;  // an empty field means g = 0: no right-hand side
       const Vec3 normal = use.reversed ? Vec3(-moments.faceNormal(fid)) : moments.faceNormal(fid);
       const double etaF = facePenalty(form, moments, fid, e, ElementId());
+      const double etaMean = faceMeanPenalty(form, moments, fid, e, ElementId());
       const double mu = form.mu, lambda = form.lambda;
       const double cK = roles.coupledFaces[e];
       const auto rule = faceQuadrature(mesh, fid, quadratureDegree);
@@ -611,11 +612,18 @@ Eigen::VectorXd assembleLoad(const PolyMesh& mesh, const DgBasis& basis, const M
       Eigen::VectorXd bg = Eigen::VectorXd::Zero(n1);
       Eigen::MatrixXd mpsi = Eigen::MatrixXd::Zero(n1, n);
       const auto o = basis.liftingCoefficients(e);
+      // The face mean's extra penalty (faceMeanPenalty()): |F|^-1 int_F g . int_F phi.
+      Vec3 gMean = Vec3::Zero();
+      Eigen::VectorXd phiMean = Eigen::VectorXd::Zero(n);
       for (const QuadraturePoint& q : rule) {
         const Vec3 gx = g(q.point);
         basis.values(e, q.point, phi);
         for (int d = 0; d < 3; ++d)
           for (int r = 0; r < n; ++r) fe[d * n + r] += q.weight * mu * etaF * gx[d] * phi[r];
+        if (etaMean != 0.0) {
+          gMean += q.weight * gx;
+          for (int r = 0; r < n; ++r) phiMean[r] += q.weight * phi[r];
+        }
         if (!ip) continue;
         basis.gradients(e, q.point, grad);
         const double gn = gx.dot(normal);
@@ -639,6 +647,11 @@ Eigen::VectorXd assembleLoad(const PolyMesh& mesh, const DgBasis& basis, const M
           bg[a] += q.weight * psi[a] * gn;
           for (int r = 0; r < n; ++r) mpsi(a, r) += q.weight * psi[a] * phi[r];
         }
+      }
+      if (etaMean != 0.0) {
+        const double c = mu * etaMean / moments.area(fid);
+        for (int d = 0; d < 3; ++d)
+          for (int r = 0; r < n; ++r) fe[d * n + r] += c * gMean[d] * phiMean[r];
       }
       if (ip && lambda != 0.0) {
         const Eigen::VectorXd lift = mpsi.transpose() * bg;  // sum_q b_q(g) int psi_q phi_r

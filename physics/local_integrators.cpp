@@ -157,8 +157,11 @@ struct Kernel {
     const FaceFrame fr = frame(mesh, moments, view.face);
     const Vec3 n =
         view.selfIsFront ? moments.faceNormal(view.face) : Vec3(-moments.faceNormal(view.face));
-    const double etaF =
-        facePenalty(form, moments, view.face, view.self, interior ? view.other : ElementId());
+    const ElementId other = interior ? view.other : ElementId();
+    const double etaF = facePenalty(form, moments, view.face, view.self, other);
+    // The face mean's extra penalty over |F|.
+    const double etaMean =
+        faceMeanPenalty(form, moments, view.face, view.self, other) / moments.area(view.face);
     const double w = interior ? 0.5 : 1.0;
     const double mu = form.mu, lambda = form.lambda;
     const bool ip = form.method == Method::IP;
@@ -188,7 +191,10 @@ struct Kernel {
                      Eigen::MatrixXd& out) {
       out.setZero(3 * N, 3 * N);
       if (jump) {
-        const Mat m = sk.p.lazyProduct(cb);
+        Mat m = sk.p.lazyProduct(cb);
+        // The face mean's extra penalty: int_F phi^K_i int_F phi^B_j (cb's row 0 holds
+        // int_F y^0 phi^B_j).
+        if (etaMean != 0.0) m += (etaMean / etaF) * (sk.p.lazyProduct(fr.gram.col(0))) * cb.row(0);
         for (int d = 0; d < 3; ++d) out.template block<N, N>(d * N, d * N) += (mu * etaF * sb) * m;
       }
       if (!ip) return;
@@ -262,8 +268,14 @@ double facePenalty(const FormCoefficients& form, const MomentCache& moments, Fac
   auto eta = [&](ElementId e) { return form.elementEta ? (*form.elementEta)[e] : form.eta; };
   double sum = eta(self) / moments.volume(self);
   if (other.valid()) sum += eta(other) / moments.volume(other);
-  const double factor = form.method == Method::BZ ? form.bzFactor : 1.0;
-  return moments.area(f) * sum * factor;
+  const bool factored = form.method == Method::BZ && !form.bzFactorOnMean;
+  return moments.area(f) * sum * (factored ? form.bzFactor : 1.0);
+}
+
+double faceMeanPenalty(const FormCoefficients& form, const MomentCache& moments, FaceId f,
+                       ElementId self, ElementId other) {
+  if (form.method != Method::BZ || !form.bzFactorOnMean) return 0.0;
+  return (form.bzFactor - 1.0) * facePenalty(form, moments, f, self, other);
 }
 
 void faceRows(const PolyMesh& mesh, const DgBasis& basis, const MomentCache& moments,

@@ -91,8 +91,10 @@ FormCoefficients formCoefficients(const PolyMesh& mesh, const DgBasis& basis,
     case PenaltyRule::Doubling: form.eta = disc.penalty.eta; break;
   }
   if (!(form.eta > 0.0)) throw std::invalid_argument("the penalty eta must be positive");
-  if (disc.method == Method::BZ && disc.bzPenalty == BzPenalty::Super)
+  if (disc.method == Method::BZ && disc.bzPenalty == BzPenalty::Super) {
     form.bzFactor = superpenaltyFactor(mesh, basis, disc.bzReferenceLength);
+    form.bzFactorOnMean = basis.degree() == 1;  // see BzPenalty::Super
+  }
   return form;
 }
 

@@ -30,8 +30,13 @@ enum class BzPenalty {
   /// ~ |sigma n|_F / sqrt(eta_F), then falls as h^p, and the L2 error with it, at the price
   /// of a stiffer jump term (condition numbers ~ h^-(2p+2) instead of h^-2). The factor is
   /// FormCoefficients::bzFactor, from superpenaltyFactor() (physics/static_solver.h).
-  /// p >= 2 only: for p = 1 on hex grids the jumps are forced towards continuous complete
-  /// linears, i.e. global linears, and the error locks (B1: L2 ~ 2e-3 at every n).
+  /// For p >= 2 it multiplies the penalty of the whole jump. For p = 1 it multiplies only the
+  /// penalty of the jump's mean over each face (the rest of the jump keeps eta_F): on the whole
+  /// jump it would force the solution towards continuous complete linears, which on a hex grid
+  /// are only the global linears, and the error locked (B1, n = 4 -> 8: L2 2.2e-3 -> 2.0e-3).
+  /// With continuous face means instead, the limit is a nonconforming P1 method (face-mean
+  /// continuity, as Crouzeix-Raviart's), which passes the patch test: for a constant stress
+  /// the missing flux term sigma n . int_F [v] vanishes. FormCoefficients::bzFactorOnMean.
   Super,
 };
 
@@ -57,13 +62,24 @@ struct FormCoefficients {
   /// BZ only: eta_F is multiplied by this dimensionless factor, (L/h)^(2p) for
   /// BzPenalty::Super, 1 for BzPenalty::Fixed. IP ignores it.
   double bzFactor = 1.0;
+  /// BZ only: the factor multiplies only the penalty of the jump's face mean (BzPenalty::Super
+  /// at p = 1): the jump term is eta_F int_F [u].[v] + (factor - 1) eta_F |F|^-1 int_F [u] .
+  /// int_F [v] (facePenalty() and faceMeanPenalty()).
+  bool bzFactorOnMean = false;
 };
 
-/// eta_F of face `f` between `self` and `other` (invalid on the boundary) under `form`:
-/// area(F) (eta_K / vol(K) + eta_L / vol(L)) (eta_K = eta without per-element penalties),
-/// times FormCoefficients::bzFactor for the BZ method.
+/// eta_F of face `f` between `self` and `other` (invalid on the boundary) under `form`, the
+/// penalty of the whole jump: area(F) (eta_K / vol(K) + eta_L / vol(L)) (eta_K = eta without
+/// per-element penalties), times FormCoefficients::bzFactor for the BZ method unless the factor
+/// is on the face mean only (FormCoefficients::bzFactorOnMean).
 double facePenalty(const FormCoefficients& form, const MomentCache& moments, FaceId f,
                    ElementId self, ElementId other);
+
+/// The penalty the jump's face mean gets on top of facePenalty(): (bzFactor - 1) eta_F with
+/// FormCoefficients::bzFactorOnMean (BZ superpenalty at p = 1), else 0. The jump term is then
+/// facePenalty() int_F [u].[v] + faceMeanPenalty() |F|^-1 int_F [u] . int_F [v].
+double faceMeanPenalty(const FormCoefficients& form, const MomentCache& moments, FaceId f,
+                       ElementId self, ElementId other);
 
 /// One face as seen from one of its elements (`self`), with what the face integrators need
 /// about both sides.
