@@ -139,7 +139,23 @@ std::uint32_t PlaneSplitter::edgePoint(std::uint32_t u, std::uint32_t v, const S
   } else {
     const double dp = plane.normal.dot(p) - plane.offset;
     const double dq = plane.normal.dot(q) - plane.offset;
-    r = p + (dp / (dp - dq)) * (q - p);
+    if (dp != dq) {
+      // Rounded distances on one side (the ends within round-off of the plane) give t outside
+      // [0, 1]: the clamp below puts the point on the nearer end, where it welds.
+      r = p + (dp / (dp - dq)) * (q - p);
+    } else {
+      // The exact sides differ but the rounded distances are equal (both ends within round-off
+      // of the plane, e.g. points that two mirror-image planes made on one edge): the
+      // interpolation would divide by zero. The exact intersection, rounded, instead.
+      using Q = CGAL::Exact_rational;
+      Q np(0), nq(0);
+      for (int i = 0; i < 3; ++i) {
+        np += Q(plane.normal[i]) * Q(p[i]);
+        nq += Q(plane.normal[i]) * Q(q[i]);
+      }
+      const Q t = (Q(plane.offset) - np) / (nq - np);
+      for (int i = 0; i < 3; ++i) r[i] = CGAL::to_double(Q(p[i]) + t * (Q(q[i]) - Q(p[i])));
+    }
   }
   // Stay inside the edge's box, so later side tests against other planes keep the order of
   // the edge's endpoints.

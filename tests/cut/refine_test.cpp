@@ -137,6 +137,35 @@ TEST(Refine, HalvesAcrossAnObliqueDirection) {
   expectValid(editor, 1.0);
 }
 
+TEST(Refine, MirrorPlanesMeetingOnASharedEdgeWithinRoundOff) {
+  // Three of B11's bar elements (36 unit hexahedra) halved across their principal stress
+  // directions: 4 and 13 share the face y = 1, 13 and 31 the face z = 1, all three the edge
+  // y = z = 1. The planes of 13 and 31 are mirror images across z = 1, so they meet that edge at
+  // one point; rounded, the points they make there are one ulp apart. The split once stopped
+  // with "traceLoops: open chain of edges" (found when a rounding change in a solve picked these
+  // planes in B11's first round of 1-to-2 refinement).
+  struct Split {
+    std::uint32_t element;
+    Vec3 normal;
+    double offset;
+  };
+  const Split splits[] = {
+      {4, {-0.9943215426362888, -0.0025450323757824681, -0.10638699478600366}, -4.5289129554441923},
+      {13,
+       {-0.99432154263628958, 0.0025450323757857463, -0.10638699478599668},
+       -4.5238228906926228},
+      {31, {-0.99432154263628958, 0.0025450323757853074, 0.10638699478599653}, -4.311048901120631},
+  };
+  MeshEditor editor(hexGridMesh(9, 2, 2, Box3(Vec3(0, 0, 0), Vec3(9, 2, 2))));
+  std::vector<ElementRefinement> split;
+  for (const Split& s : splits)
+    split.push_back({ElementId(s.element), {Plane::make(s.normal, s.offset)}});
+  const OperationReport r = editor.refine(split, fullChecks());
+  ASSERT_TRUE(r.validation.passed) << r.validation.failure;
+  EXPECT_EQ(r.elementsSplit, 3u);
+  expectValid(editor, 36.0);
+}
+
 TEST(Refine, CutPolyhedraRefineIntoTheirPieces) {
   // A cut leaves polyhedra with a Cut face; their octants are their connected pieces, and the
   // cut faces stay boundary faces (split, never coupled).
