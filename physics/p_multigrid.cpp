@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <numeric>
 #include <stdexcept>
 
 #include <tbb/parallel_for.h>
@@ -15,6 +16,7 @@
 #include "polydg/integrate/monomials.h"
 #include "polydg/physics/agglomeration.h"
 #include "polydg/physics/block_rows.h"
+#include "polydg/physics/strong_coupling.h"
 
 namespace polydg {
 
@@ -29,6 +31,20 @@ constexpr Eigen::Index kSimplicialAggregateLimit = 1000;
 
 /// Largest element block handled (3 numMonomials(3)).
 constexpr int kMaxBlock = 60;
+
+/// Smoother groups join blocks whose coupling strength gamma (couplingStrengths(), the cosine of
+/// the angle between their unknowns in the energy inner product) is at least
+/// kSmootherStrongCoupling = sqrt(3)/2 (physics/strong_coupling.h). On hex grids no pair is that
+/// strong (gamma <= 0.72 for p = 1 and 0.80 for p = 2 on the unit cubes of `bench --suite
+/// multigrid`), so their smoother is unchanged; across the faces of clipped elements, whose
+/// penalties eta_K reach 200 times a cube's, gamma reaches 0.99. Joining pairs down to
+/// 1/sqrt(2) helped the bunny more (p = 1: 58 instead of 64 iterations) but joined cube
+/// elements too and cost the cube 1-2 iterations at p = 2.
+/// Most blocks in one smoother group, and so most unknowns. Strong couplings chain along a
+/// clipped surface layer; groups of up to 16 took the bunny at p = 2 from 82 (up to 8) to 74
+/// iterations, and larger caps gave no more. Most groups are pairs.
+constexpr int kMaxGroupBlocks = 16;
+constexpr int kMaxGroupUnknowns = kMaxGroupBlocks * kMaxBlock;
 
 /// When agglomeration stops. The coarsest level is factorized once and solved once per
 /// V-cycle; its factorization should cost about one V-cycle on K. A coarse matrix with 12 x 12
@@ -50,9 +66,9 @@ enum class Transfer {
   Aggregate,  ///< linear functions of groups of blocks (weights per block)
 };
 
-/// One level: its matrix (the top level borrows K), functions per component, the inverses of
-/// its diagonal blocks (bs x bs each, column-major), its colouring and its transfer to the
-/// next coarser level.
+/// One level: its matrix (the top level borrows K), functions per component, its smoother's
+/// groups of blocks with the inverses of their diagonal blocks, its colouring and its
+/// transfer to the next coarser level.
 struct Level {
   const SpMat* matrix = nullptr;
   SpMat owned;
@@ -60,6 +76,12 @@ struct Level {
   /// the smoother reads them as they are.
   const BlockRows<double>* rows = nullptr;
   int n = 0, bs = 0;
+  /// The smoother's blocks: groups of the level's blocks (elements or agglomerates) joined
+  /// along strong couplings (groupStrongCouplings()), most of them single blocks. Group g's
+  /// diagonal block inverted, (m bs) x (m bs) for its m blocks, column-major, at
+  /// inverses[inverseOffset[g]].
+  BlockGroups smootherGroups;
+  std::vector<std::size_t> inverseOffset;
   std::vector<double> inverses;
   /// The smoother's copy of the matrix in single precision (BlockRows): half the bytes of
   /// the CSR values (a sixth for BZ's component-diagonal neighbour blocks) and no index per
@@ -73,7 +95,8 @@ struct Level {
   /// is the caller's, `source`).
   BlockRows<double> exact;
   const BlockRows<double>* source = nullptr;
-  /// Blocks of each colour, in increasing order; inLastColour[b] = 1 for the last colour's.
+  /// Smoother groups of each colour, in increasing order (groups of one colour share no
+  /// entry); inLastColour[b] = 1 for the blocks of the last colour's groups.
   std::vector<std::vector<int>> colours;
   std::vector<std::uint8_t> inLastColour;
   /// Gauss-Seidel sweeps before (and, reversed, after) the coarse correction.
@@ -205,29 +228,70 @@ bool invertBlock(int bs, const double* block, double* inverse) {
   }
 }
 
-/// Inverts the element diagonal blocks of `level`; false if one is not positive definite.
-bool invertBlocks(Level& level) {
+/// Writes the diagonal block of `level`'s smoother group g into `block` ((m bs) x (m bs),
+/// column-major, zeroed by the caller), from the matrix as the smoother reads it.
+void groupBlock(const Level& level, int g, double* block) {
   const int bs = level.bs;
-  const Eigen::Index ne = level.blockCount();
-  level.inverses.resize(static_cast<std::size_t>(ne * bs * bs));
-  std::atomic<bool> ok{true};
-  tbb::parallel_for(Eigen::Index(0), ne, [&](Eigen::Index e) {
-    const Eigen::Index base = e * bs;
-    double block[kMaxBlock * kMaxBlock];
-    std::fill(block, block + bs * bs, 0.0);
-    if (level.rows) {
-      const double* values = level.rows->diagonalBlock(static_cast<int>(e));
-      std::copy(values, values + bs * bs, block);
-    } else if (level.useBlocks) {  // invert the block as the smoother sees it (single precision)
-      const float* values = level.blocks.diagonalBlock(static_cast<int>(e));
-      std::copy(values, values + bs * bs, block);
-    } else {
+  const BlockGroups& groups = level.smootherGroups;
+  const int first = groups.start[static_cast<std::size_t>(g)];
+  const int m = groups.size(g), size = m * bs;
+  const int* members = groups.members.data() + first;
+  // The position of block f in the group, or -1.
+  auto local = [&](int f) {
+    const int* it = std::lower_bound(members, members + m, f);
+    return it != members + m && *it == f ? static_cast<int>(it - members) : -1;
+  };
+  auto copyRows = [&](const auto& rows) {
+    for (int i = 0; i < m; ++i)
+      for (int k = rows.start[static_cast<std::size_t>(members[i])];
+           k < rows.start[static_cast<std::size_t>(members[i]) + 1]; ++k)
+        if (const int j = local(rows.element[static_cast<std::size_t>(k)]); j >= 0)
+          rows.copySlot(static_cast<std::size_t>(k),
+                        block + static_cast<std::ptrdiff_t>(j) * bs * size + i * bs, size);
+  };
+  if (level.rows) {
+    copyRows(*level.rows);
+  } else if (level.useBlocks) {  // invert the block as the smoother sees it (single precision)
+    copyRows(level.blocks);
+  } else {
+    // Column c of block i is row c of it (symmetric storage).
+    for (int i = 0; i < m; ++i)
       for (int c = 0; c < bs; ++c)
-        for (SpMat::InnerIterator it(*level.matrix, base + c); it; ++it)
-          if (it.row() >= base && it.row() < base + bs)
-            block[c * bs + (it.row() - base)] = it.value();
+        for (SpMat::InnerIterator it(*level.matrix, static_cast<Eigen::Index>(members[i]) * bs + c);
+             it; ++it)
+          if (const int j = local(static_cast<int>(it.row() / bs)); j >= 0)
+            block[static_cast<std::ptrdiff_t>(i * bs + c) * size + j * bs + it.row() % bs] =
+                it.value();
+  }
+}
+
+/// Inverts the diagonal blocks of `level`'s smoother groups; false if one is not positive
+/// definite.
+bool invertGroups(Level& level) {
+  const int bs = level.bs;
+  const BlockGroups& groups = level.smootherGroups;
+  const int ng = groups.groups();
+  level.inverseOffset.assign(static_cast<std::size_t>(ng) + 1, 0);
+  for (int g = 0; g < ng; ++g)
+    level.inverseOffset[static_cast<std::size_t>(g) + 1] =
+        level.inverseOffset[static_cast<std::size_t>(g)] +
+        static_cast<std::size_t>(groups.size(g) * bs) *
+            static_cast<std::size_t>(groups.size(g) * bs);
+  level.inverses.resize(level.inverseOffset.back());
+  std::atomic<bool> ok{true};
+  tbb::parallel_for(0, ng, [&](int g) {
+    const int size = groups.size(g) * bs;
+    double* inverse = level.inverses.data() + level.inverseOffset[static_cast<std::size_t>(g)];
+    if (size == bs) {
+      double block[kMaxBlock * kMaxBlock];
+      std::fill(block, block + bs * bs, 0.0);
+      groupBlock(level, g, block);
+      if (!invertBlock(bs, block, inverse)) ok = false;
+      return;
     }
-    if (!invertBlock(bs, block, level.inverses.data() + e * bs * bs)) ok = false;
+    Eigen::MatrixXd block = Eigen::MatrixXd::Zero(size, size);
+    groupBlock(level, g, block.data());
+    if (!invertBlock(size, block.data(), inverse)) ok = false;
   });
   return ok;
 }
@@ -257,23 +321,47 @@ std::vector<std::vector<int>> colourGreedily(int ne, ForEachNeighbour&& forEachN
   return classes;
 }
 
-/// The colouring of the element graph of `a` (elements sharing a nonzero block are
-/// neighbours).
-std::vector<std::vector<int>> colourElements(const SpMat& a, int bs) {
-  return colourGreedily(static_cast<int>(a.cols() / bs), [&](int e, auto&& visit) {
-    // Column e bs holds a row of every neighbour block (BZ blocks included: component 0).
-    for (SpMat::InnerIterator it(a, static_cast<Eigen::Index>(e) * bs); it; ++it)
-      visit(static_cast<int>(it.row() / bs));
+/// Calls visit(f) for each block f that shares a stored block with block e of `level` (e
+/// itself included), from the matrix as the smoother reads it.
+template <class Visit>
+void forEachNeighbour(const Level& level, int e, Visit&& visit) {
+  auto fromRows = [&](const auto& rows) {
+    for (int k = rows.start[static_cast<std::size_t>(e)];
+         k < rows.start[static_cast<std::size_t>(e) + 1]; ++k)
+      visit(rows.element[static_cast<std::size_t>(k)]);
+  };
+  if (level.rows) return fromRows(*level.rows);
+  if (level.useBlocks) return fromRows(level.blocks);
+  // Column e bs holds a row of every neighbour block (BZ blocks included: component 0).
+  for (SpMat::InnerIterator it(*level.matrix, static_cast<Eigen::Index>(e) * level.bs); it; ++it)
+    visit(static_cast<int>(it.row() / level.bs));
+}
+
+/// The colouring of `level`'s smoother groups (two groups are neighbours if a stored block
+/// couples one of each).
+std::vector<std::vector<int>> colourGroups(const Level& level) {
+  const BlockGroups& groups = level.smootherGroups;
+  std::vector<int> groupOf(groups.members.size());
+  for (int g = 0; g < groups.groups(); ++g)
+    for (int k = groups.start[static_cast<std::size_t>(g)];
+         k < groups.start[static_cast<std::size_t>(g) + 1]; ++k)
+      groupOf[static_cast<std::size_t>(groups.members[static_cast<std::size_t>(k)])] = g;
+  return colourGreedily(groups.groups(), [&](int g, auto&& visit) {
+    for (int k = groups.start[static_cast<std::size_t>(g)];
+         k < groups.start[static_cast<std::size_t>(g) + 1]; ++k)
+      forEachNeighbour(level, groups.members[static_cast<std::size_t>(k)],
+                       [&](int f) { visit(groupOf[static_cast<std::size_t>(f)]); });
   });
 }
 
-/// The same for a matrix by block rows: an element's neighbours are its slots' elements.
-std::vector<std::vector<int>> colourElements(const BlockRows<double>& a) {
-  return colourGreedily(a.elements(), [&](int e, auto&& visit) {
-    for (int k = a.start[static_cast<std::size_t>(e)]; k < a.start[static_cast<std::size_t>(e) + 1];
-         ++k)
-      visit(a.element[static_cast<std::size_t>(k)]);
-  });
+/// Every block of `level` a group of its own.
+BlockGroups singleBlocks(int blocks) {
+  BlockGroups groups;
+  groups.start.resize(static_cast<std::size_t>(blocks) + 1);
+  groups.members.resize(static_cast<std::size_t>(blocks));
+  std::iota(groups.start.begin(), groups.start.end(), 0);
+  std::iota(groups.members.begin(), groups.members.end(), 0);
+  return groups;
 }
 
 /// The principal submatrix of `fine` on the first `nc` functions of each component, as
@@ -437,21 +525,34 @@ struct PMultigrid::Impl {
     return ok;
   }
 
-  /// Colours, smoother blocks and block inverses of a level that is smoothed.
+  /// Colours, smoother groups and their inverses of a level that is smoothed.
   bool prepareSmoother(Level& level, const BlockRows<double>* matrixBlocks) {
-    if (level.colours.empty()) level.colours = colourElements(*level.matrix, level.bs);
+    if (!level.rows) {  // the top level given by rows: the smoother reads the caller's rows
+      if (matrixBlocks == nullptr) matrixBlocks = level.source;
+      if (matrixBlocks != nullptr && !matrixBlocks->values.empty()) {
+        level.blocks.convertFrom(*matrixBlocks);
+        level.useBlocks = true;
+      } else {
+        level.useBlocks = level.blocks.build(*level.matrix, level.n, 2.0);
+      }
+    }
+    if (level.rows)
+      level.smootherGroups =
+          groupStrongCouplings(*level.rows, kSmootherStrongCoupling, kMaxGroupBlocks);
+    else if (level.useBlocks)
+      level.smootherGroups =
+          groupStrongCouplings(level.blocks, kSmootherStrongCoupling, kMaxGroupBlocks);
+    else  // a pattern too sparse for blocks (BlockRows::build)
+      level.smootherGroups = singleBlocks(static_cast<int>(level.blockCount()));
+    level.colours = colourGroups(level);
     level.inLastColour.assign(static_cast<std::size_t>(level.blockCount()), 0);
     if (!level.colours.empty())
-      for (int e : level.colours.back()) level.inLastColour[static_cast<std::size_t>(e)] = 1;
-    if (level.rows) return invertBlocks(level);  // the smoother reads the caller's rows
-    if (matrixBlocks == nullptr) matrixBlocks = level.source;
-    if (matrixBlocks != nullptr && !matrixBlocks->values.empty()) {
-      level.blocks.convertFrom(*matrixBlocks);
-      level.useBlocks = true;
-    } else {
-      level.useBlocks = level.blocks.build(*level.matrix, level.n, 2.0);
-    }
-    return invertBlocks(level);
+      for (int g : level.colours.back())
+        for (int k = level.smootherGroups.start[static_cast<std::size_t>(g)];
+             k < level.smootherGroups.start[static_cast<std::size_t>(g) + 1]; ++k)
+          level.inLastColour[static_cast<std::size_t>(
+              level.smootherGroups.members[static_cast<std::size_t>(k)])] = 1;
+    return invertGroups(level);
   }
 
   /// Appends the agglomeration level of levels.back(), whose blocks have the given centres,
@@ -486,32 +587,55 @@ struct PMultigrid::Impl {
     }
   }
 
-  /// One block Gauss-Seidel sweep on `level` for A x = b, colours in order or reversed. With
-  /// `fromZero` (x = 0 on entry, forward sweep) the first colour's residual is b itself and
-  /// is not computed: a sixth less smoother work per V-cycle with two colours.
+  /// One block Gauss-Seidel sweep on `level` for A x = b, colours in order or reversed, one
+  /// smoother group at a time. With `fromZero` (x = 0 on entry, forward sweep) the first
+  /// colour's residual is b itself and is not computed: a sixth less smoother work per
+  /// V-cycle with two colours.
   void sweep(const Level& level, const Eigen::VectorXd& b, Eigen::VectorXd& x, bool reverse,
              bool fromZero = false) const {
     const int bs = level.bs;
+    const BlockGroups& groups = level.smootherGroups;
     const std::vector<std::vector<int>>& colours = level.colours;
     const std::size_t nc = colours.size();
     for (std::size_t t = 0; t < nc; ++t) {
       const std::vector<int>& cls = colours[reverse ? nc - 1 - t : t];
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cls.size(), 8),
-                        [&](const tbb::blocked_range<std::size_t>& range) {
-                          double s[kMaxBlock];
-                          for (std::size_t j = range.begin(); j != range.end(); ++j) {
-                            const int e = cls[j];
-                            const Eigen::Index base = static_cast<Eigen::Index>(e) * bs;
-                            if (fromZero && t == 0)
-                              std::copy(b.data() + base, b.data() + base + bs, s);
-                            else
-                              blockResidual(level, e, b, x, s);
-                            // x_e += D_e^-1 s (D_e^-1 column-major): a plain loop, where
-                            // Eigen's dynamic-size GEMV call cost a tenth of the CG time on B2.
-                            addDenseProduct(bs, level.inverses.data() + base * bs, s,
-                                            x.data() + base);
-                          }
-                        });
+      tbb::parallel_for(
+          tbb::blocked_range<std::size_t>(0, cls.size(), 8),
+          [&](const tbb::blocked_range<std::size_t>& range) {
+            double s[kMaxGroupUnknowns], y[kMaxGroupUnknowns];
+            for (std::size_t j = range.begin(); j != range.end(); ++j) {
+              const int g = cls[j];
+              const int first = groups.start[static_cast<std::size_t>(g)];
+              const int m = groups.size(g), size = m * bs;
+              // s = the residual of the group's rows.
+              for (int i = 0; i < m; ++i) {
+                const int e = groups.members[static_cast<std::size_t>(first + i)];
+                const Eigen::Index base = static_cast<Eigen::Index>(e) * bs;
+                if (fromZero && t == 0)
+                  std::copy(b.data() + base, b.data() + base + bs, s + i * bs);
+                else
+                  blockResidual(level, e, b, x, s + i * bs);
+              }
+              // x_g += D_g^-1 s (D_g^-1 column-major): a plain loop, where Eigen's
+              // dynamic-size GEMV call cost a tenth of the CG time on B2.
+              const double* inverse =
+                  level.inverses.data() + level.inverseOffset[static_cast<std::size_t>(g)];
+              if (m == 1) {
+                const Eigen::Index base =
+                    static_cast<Eigen::Index>(groups.members[static_cast<std::size_t>(first)]) * bs;
+                addDenseProduct(bs, inverse, s, x.data() + base);
+                continue;
+              }
+              std::fill(y, y + size, 0.0);
+              addDenseProduct(size, inverse, s, y);
+              for (int i = 0; i < m; ++i) {
+                double* xe = x.data() + static_cast<Eigen::Index>(
+                                            groups.members[static_cast<std::size_t>(first + i)]) *
+                                            bs;
+                for (int c = 0; c < bs; ++c) xe[c] += y[i * bs + c];
+              }
+            }
+          });
     }
   }
 
@@ -614,6 +738,14 @@ PMultigrid::PMultigrid(PMultigrid&&) noexcept = default;
 PMultigrid& PMultigrid::operator=(PMultigrid&&) noexcept = default;
 
 int PMultigrid::levels() const { return static_cast<int>(impl_->levels.size()); }
+int PMultigrid::groupedBlocks() const {
+  if (impl_->levels.empty()) return 0;
+  const BlockGroups& groups = impl_->levels.front().smootherGroups;
+  int count = 0;
+  for (int g = 0; g < groups.groups(); ++g)
+    if (groups.size(g) > 1) count += groups.size(g);
+  return count;
+}
 int PMultigrid::colours() const {
   return impl_->levels.empty() ? 0 : static_cast<int>(impl_->levels.front().colours.size());
 }
@@ -648,9 +780,6 @@ bool PMultigrid::Impl::build(const SpMat* matrix, const BlockRows<double>* rows,
     if (rows->bs != top.bs)
       throw std::invalid_argument("PMultigrid: block size does not match the degree");
     top.source = rows;
-    top.colours = colourElements(*rows);
-  } else {
-    top.colours = colourElements(*matrix, top.bs);
   }
   const Eigen::Index ne = top.blockCount();
   const double nonzeros =
@@ -667,7 +796,6 @@ bool PMultigrid::Impl::build(const SpMat* matrix, const BlockRows<double>* rows,
     level.bs = 3 * level.n;
     level.owned = fine.rows ? restrictBlocks(*fine.rows, level.n)
                             : restrictMatrix(*fine.matrix, fine.n, level.n);
-    level.colours = fine.colours;  // the same element graph
     m.push(std::move(level));
   }
   if (m.levels.size() == 1 && !agglomerate && top.rows) {

@@ -82,6 +82,24 @@ struct BlockRows {
   /// The diagonal block of element e, bs x bs column-major (a full slot).
   const T* diagonalBlock(int e) const;
 
+  /// Writes slot k's block (rows: the row element's DOFs, columns: element[k]'s) into `out`,
+  /// column-major with leading dimension `ld` >= bs. A component-diagonal slot writes its three
+  /// n x n diagonal blocks only; the entries between them are left as they are.
+  void copySlot(std::size_t k, double* out, int ld) const {
+    const T* block = values.data() + offset[k];
+    if (diagonal[k]) {
+      for (int d = 0; d < 3; ++d)
+        for (int j = 0; j < n; ++j)
+          for (int i = 0; i < n; ++i)
+            out[static_cast<std::ptrdiff_t>(d * n + j) * ld + d * n + i] =
+                static_cast<double>(block[d * n * n + j * n + i]);
+      return;
+    }
+    for (int j = 0; j < bs; ++j)
+      for (int i = 0; i < bs; ++i)
+        out[static_cast<std::ptrdiff_t>(j) * ld + i] = static_cast<double>(block[j * bs + i]);
+  }
+
   /// Elements (block rows), and the entries stored: the nonzeros of the CSR matrix with the
   /// same pattern (assembleStiffness()'s).
   int elements() const { return start.empty() ? 0 : static_cast<int>(start.size()) - 1; }

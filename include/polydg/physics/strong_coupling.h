@@ -1,0 +1,50 @@
+// Groups of the blocks of a symmetric positive definite block matrix that are coupled more
+// strongly than block Gauss-Seidel can smooth: the smoother blocks of the p-multigrid
+// (physics/p_multigrid.h).
+#pragma once
+
+#include <vector>
+
+namespace polydg {
+
+template <class T>
+struct BlockRows;
+
+/// The strength of the coupling of blocks e and f of an SPD matrix A with diagonal blocks
+/// D_e, D_f and off-diagonal block A_ef: gamma_ef = || D_e^-1/2 A_ef D_f^-1/2 ||_2, the
+/// cosine of the angle between the subspaces of e's and f's unknowns in the A inner product
+/// (the strengthened Cauchy-Schwarz constant). Dimensionless, in [0, 1) for SPD A, the same
+/// under any scaling of A or change of basis within a block. Block Gauss-Seidel on the two
+/// blocks alone contracts the error by gamma^2 per sweep: the mode in which e and f move
+/// together costs 1 - gamma of what the blocks see.
+/// The strengths of `a`'s stored slots, in slot order: strength[k] for slot k of row e
+/// against element[k] (0 for the diagonal slots and for zero blocks). Symmetric
+/// (gamma_ef = gamma_fe).
+template <class T>
+std::vector<double> couplingStrengths(const BlockRows<T>& a);
+
+/// Blocks joined into groups: group g is blocks members[start[g] .. start[g + 1] - 1], in
+/// increasing order; groups in the order of their smallest block.
+struct BlockGroups {
+  std::vector<int> start, members;
+
+  int groups() const { return start.empty() ? 0 : static_cast<int>(start.size()) - 1; }
+  int size(int g) const {
+    return start[static_cast<std::size_t>(g) + 1] - start[static_cast<std::size_t>(g)];
+  }
+  /// Every group a single block.
+  bool singletons() const { return members.size() + 1 == start.size(); }
+};
+
+/// The blocks of `a` joined along their strong couplings: pairs with gamma_ef >= `threshold`
+/// (couplingStrengths()), strongest first, unless the union would exceed `maxBlocks` blocks.
+/// A matrix with no strong coupling gives singletons.
+template <class T>
+BlockGroups groupStrongCouplings(const BlockRows<T>& a, double threshold, int maxBlocks);
+
+/// The threshold the p-multigrid's smoother joins blocks at: gamma >= sqrt(3)/2, where block
+/// Gauss-Seidel on the pair alone would remove less than a quarter (1 - gamma^2) of its error
+/// per sweep. Dimensionless and the same for every degree.
+inline constexpr double kSmootherStrongCoupling = 0.86602540378443865;  // sqrt(3) / 2
+
+}  // namespace polydg
