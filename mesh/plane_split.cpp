@@ -17,6 +17,19 @@ namespace {
 
 using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 using Point2 = Kernel::Point_2;
+using Exact = CGAL::Exact_rational;
+
+/// Where segment p q meets `plane`, exactly: the point's coordinate k (p and q on opposite
+/// exact sides of the plane, so the denominator is not zero).
+Exact exactCrossing(const Plane& plane, const Vec3& p, const Vec3& q, int k) {
+  Exact np(0), nq(0);
+  for (int i = 0; i < 3; ++i) {
+    np += Exact(plane.normal[i]) * Exact(p[i]);
+    nq += Exact(plane.normal[i]) * Exact(q[i]);
+  }
+  const Exact t = (Exact(plane.offset) - np) / (nq - np);
+  return Exact(p[k]) + t * (Exact(q[k]) - Exact(p[k]));
+}
 
 /// Projection of a plane with normal n onto the coordinate plane that drops n's largest
 /// component; `sign` is +1 when the projection keeps orientation (counter-clockwise about n
@@ -90,24 +103,14 @@ std::vector<Vec3> PlaneSplitter::points() const {
 }
 
 int PlaneSplitter::compareExactly(std::uint32_t v, std::uint32_t w, int k) const {
-  using Q = CGAL::Exact_rational;
-  auto exact = [&](std::uint32_t id) -> Q {
+  auto exact = [&](std::uint32_t id) -> Exact {
     const PointRecord& r = records_[id];
-    if (r.a == r.b) return Q(r.position[k]);  // a given point: exactly where it is
+    if (r.a == r.b) return Exact(r.position[k]);  // a given point: exactly where it is
     decltype(planes_)::const_accessor found;
     if (!planes_.find(found, r.onPlane)) throw std::logic_error("compareExactly: unknown plane");
-    const SplitPlane& plane = found->second;
-    const Vec3& p = records_[r.a].position;
-    const Vec3& q = records_[r.b].position;
-    Q np(0), nq(0);
-    for (int i = 0; i < 3; ++i) {
-      np += Q(plane.normal[i]) * Q(p[i]);
-      nq += Q(plane.normal[i]) * Q(q[i]);
-    }
-    const Q t = (Q(plane.offset) - np) / (nq - np);
-    return Q(p[k]) + t * (Q(q[k]) - Q(p[k]));
+    return exactCrossing(found->second, records_[r.a].position, records_[r.b].position, k);
   };
-  const Q a = exact(v), b = exact(w);
+  const Exact a = exact(v), b = exact(w);
   return a < b ? -1 : (b < a ? 1 : 0);
 }
 
@@ -147,14 +150,7 @@ std::uint32_t PlaneSplitter::edgePoint(std::uint32_t u, std::uint32_t v, const S
       // The exact sides differ but the rounded distances are equal (both ends within round-off
       // of the plane, e.g. points that two mirror-image planes made on one edge): the
       // interpolation would divide by zero. The exact intersection, rounded, instead.
-      using Q = CGAL::Exact_rational;
-      Q np(0), nq(0);
-      for (int i = 0; i < 3; ++i) {
-        np += Q(plane.normal[i]) * Q(p[i]);
-        nq += Q(plane.normal[i]) * Q(q[i]);
-      }
-      const Q t = (Q(plane.offset) - np) / (nq - np);
-      for (int i = 0; i < 3; ++i) r[i] = CGAL::to_double(Q(p[i]) + t * (Q(q[i]) - Q(p[i])));
+      for (int i = 0; i < 3; ++i) r[i] = CGAL::to_double(exactCrossing(plane, p, q, i));
     }
   }
   // Stay inside the edge's box, so later side tests against other planes keep the order of
