@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <limits>
 #include <numeric>
+#include <span>
 #include <stdexcept>
 
 #include <tbb/parallel_for.h>
@@ -232,10 +233,9 @@ bool invertBlock(int bs, const double* block, double* inverse) {
 /// column-major, zeroed by the caller), from the matrix as the smoother reads it.
 void groupBlock(const Level& level, int g, double* block) {
   const int bs = level.bs;
-  const BlockGroups& groups = level.smootherGroups;
-  const int first = groups.start[static_cast<std::size_t>(g)];
-  const int m = groups.size(g), size = m * bs;
-  const int* members = groups.members.data() + first;
+  const std::span<const int> group = level.smootherGroups.of(g);
+  const int m = static_cast<int>(group.size()), size = m * bs;
+  const int* members = group.data();
   // The position of block f in the group, or -1.
   auto local = [&](int f) {
     const int* it = std::lower_bound(members, members + m, f);
@@ -343,14 +343,10 @@ std::vector<std::vector<int>> colourGroups(const Level& level) {
   const BlockGroups& groups = level.smootherGroups;
   std::vector<int> groupOf(groups.members.size());
   for (int g = 0; g < groups.groups(); ++g)
-    for (int k = groups.start[static_cast<std::size_t>(g)];
-         k < groups.start[static_cast<std::size_t>(g) + 1]; ++k)
-      groupOf[static_cast<std::size_t>(groups.members[static_cast<std::size_t>(k)])] = g;
+    for (int e : groups.of(g)) groupOf[static_cast<std::size_t>(e)] = g;
   return colourGreedily(groups.groups(), [&](int g, auto&& visit) {
-    for (int k = groups.start[static_cast<std::size_t>(g)];
-         k < groups.start[static_cast<std::size_t>(g) + 1]; ++k)
-      forEachNeighbour(level, groups.members[static_cast<std::size_t>(k)],
-                       [&](int f) { visit(groupOf[static_cast<std::size_t>(f)]); });
+    for (int e : groups.of(g))
+      forEachNeighbour(level, e, [&](int f) { visit(groupOf[static_cast<std::size_t>(f)]); });
   });
 }
 
@@ -548,10 +544,8 @@ struct PMultigrid::Impl {
     level.inLastColour.assign(static_cast<std::size_t>(level.blockCount()), 0);
     if (!level.colours.empty())
       for (int g : level.colours.back())
-        for (int k = level.smootherGroups.start[static_cast<std::size_t>(g)];
-             k < level.smootherGroups.start[static_cast<std::size_t>(g) + 1]; ++k)
-          level.inLastColour[static_cast<std::size_t>(
-              level.smootherGroups.members[static_cast<std::size_t>(k)])] = 1;
+        for (int e : level.smootherGroups.of(g))
+          level.inLastColour[static_cast<std::size_t>(e)] = 1;
     return invertGroups(level);
   }
 
@@ -599,43 +593,39 @@ struct PMultigrid::Impl {
     const std::size_t nc = colours.size();
     for (std::size_t t = 0; t < nc; ++t) {
       const std::vector<int>& cls = colours[reverse ? nc - 1 - t : t];
-      tbb::parallel_for(
-          tbb::blocked_range<std::size_t>(0, cls.size(), 8),
-          [&](const tbb::blocked_range<std::size_t>& range) {
-            double s[kMaxGroupUnknowns], y[kMaxGroupUnknowns];
-            for (std::size_t j = range.begin(); j != range.end(); ++j) {
-              const int g = cls[j];
-              const int first = groups.start[static_cast<std::size_t>(g)];
-              const int m = groups.size(g), size = m * bs;
-              // s = the residual of the group's rows.
-              for (int i = 0; i < m; ++i) {
-                const int e = groups.members[static_cast<std::size_t>(first + i)];
-                const Eigen::Index base = static_cast<Eigen::Index>(e) * bs;
-                if (fromZero && t == 0)
-                  std::copy(b.data() + base, b.data() + base + bs, s + i * bs);
-                else
-                  blockResidual(level, e, b, x, s + i * bs);
-              }
-              // x_g += D_g^-1 s (D_g^-1 column-major): a plain loop, where Eigen's
-              // dynamic-size GEMV call cost a tenth of the CG time on B2.
-              const double* inverse =
-                  level.inverses.data() + level.inverseOffset[static_cast<std::size_t>(g)];
-              if (m == 1) {
-                const Eigen::Index base =
-                    static_cast<Eigen::Index>(groups.members[static_cast<std::size_t>(first)]) * bs;
-                addDenseProduct(bs, inverse, s, x.data() + base);
-                continue;
-              }
-              std::fill(y, y + size, 0.0);
-              addDenseProduct(size, inverse, s, y);
-              for (int i = 0; i < m; ++i) {
-                double* xe = x.data() + static_cast<Eigen::Index>(
-                                            groups.members[static_cast<std::size_t>(first + i)]) *
-                                            bs;
-                for (int c = 0; c < bs; ++c) xe[c] += y[i * bs + c];
-              }
-            }
-          });
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cls.size(), 8),
+                        [&](const tbb::blocked_range<std::size_t>& range) {
+                          double s[kMaxGroupUnknowns], y[kMaxGroupUnknowns];
+                          for (std::size_t j = range.begin(); j != range.end(); ++j) {
+                            const int g = cls[j];
+                            const std::span<const int> group = groups.of(g);
+                            const int m = static_cast<int>(group.size()), size = m * bs;
+                            // s = the residual of the group's rows.
+                            for (int i = 0; i < m; ++i) {
+                              const Eigen::Index base = static_cast<Eigen::Index>(group[i]) * bs;
+                              if (fromZero && t == 0)
+                                std::copy(b.data() + base, b.data() + base + bs, s + i * bs);
+                              else
+                                blockResidual(level, group[i], b, x, s + i * bs);
+                            }
+                            // x_g += D_g^-1 s (D_g^-1 column-major): a plain loop, where Eigen's
+                            // dynamic-size GEMV call cost a tenth of the CG time on B2.
+                            const double* inverse =
+                                level.inverses.data() +
+                                level.inverseOffset[static_cast<std::size_t>(g)];
+                            if (m == 1) {
+                              addDenseProduct(bs, inverse, s,
+                                              x.data() + static_cast<Eigen::Index>(group[0]) * bs);
+                              continue;
+                            }
+                            std::fill(y, y + size, 0.0);
+                            addDenseProduct(size, inverse, s, y);
+                            for (int i = 0; i < m; ++i) {
+                              double* xe = x.data() + static_cast<Eigen::Index>(group[i]) * bs;
+                              for (int c = 0; c < bs; ++c) xe[c] += y[i * bs + c];
+                            }
+                          }
+                        });
     }
   }
 

@@ -148,6 +148,26 @@ TEST(PMultigrid, AgglomerationLevelsOfTheHexCube) {
 
 class VCycle : public ::testing::TestWithParam<bool> {};
 
+/// The V-cycle M^-1 of `mg` (n unknowns) on pairs of random vectors (seeded, printed):
+/// <x, M^-1 y> = <y, M^-1 x> and <x, M^-1 x> > 0, `trials` times.
+void expectSymmetricPositive(const PMultigrid& mg, Eigen::Index n, unsigned seed, int trials) {
+  std::printf("seed %u\n", seed);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  for (int trial = 0; trial < trials; ++trial) {
+    Eigen::VectorXd x(n), y(n), mx, my;
+    for (Eigen::Index i = 0; i < n; ++i) {
+      x[i] = uniform(rng);
+      y[i] = uniform(rng);
+    }
+    mg.apply(x, mx);
+    mg.apply(y, my);
+    const double xy = x.dot(my), yx = y.dot(mx);
+    EXPECT_NEAR(xy, yx, kSymmetryTolerance * (std::abs(xy) + x.norm() * my.norm()));
+    EXPECT_GT(x.dot(mx), 0.0);
+  }
+}
+
 TEST_P(VCycle, IsSymmetricPositiveDefinite) {
   // Constants: degrees 2, 1, 0. Agglomerates: the elements (degree 1), their groups and the
   // groups of groups (factorized), the middle level smoothed by its own colouring.
@@ -160,23 +180,7 @@ TEST_P(VCycle, IsSymmetricPositiveDefinite) {
   ASSERT_TRUE(mg.compute(system.matrix, degree, nullptr, agglomerate ? &framed.frames : nullptr));
   EXPECT_EQ(mg.levels(), 3);
   EXPECT_GE(mg.colours(), 2);
-  const unsigned seed = 20261123;
-  std::printf("seed %u\n", seed);
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
-  const Eigen::Index n = system.matrix.rows();
-  for (int trial = 0; trial < 3; ++trial) {
-    Eigen::VectorXd x(n), y(n), mx, my;
-    for (Eigen::Index i = 0; i < n; ++i) {
-      x[i] = uniform(rng);
-      y[i] = uniform(rng);
-    }
-    mg.apply(x, mx);
-    mg.apply(y, my);
-    const double xy = x.dot(my), yx = y.dot(mx);
-    EXPECT_NEAR(xy, yx, kSymmetryTolerance * (std::abs(xy) + x.norm() * my.norm()));
-    EXPECT_GT(x.dot(mx), 0.0);
-  }
+  expectSymmetricPositive(mg, system.matrix.rows(), 20261123, 3);
 }
 
 INSTANTIATE_TEST_SUITE_P(ConstantsOrAgglomerates, VCycle, ::testing::Bool());
@@ -197,21 +201,7 @@ TEST(PMultigrid, GroupedSmootherOnASlicedTorus) {
   std::printf("%d of %zu elements in smoother groups\n", mg.groupedBlocks(),
               meshed.mesh.numElements());
   EXPECT_GT(mg.groupedBlocks(), 0);
-  const unsigned seed = 20261202;
-  std::printf("seed %u\n", seed);
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
-  const Eigen::Index n = system.matrix.rows();
-  Eigen::VectorXd x(n), y(n), mx, my;
-  for (Eigen::Index i = 0; i < n; ++i) {
-    x[i] = uniform(rng);
-    y[i] = uniform(rng);
-  }
-  mg.apply(x, mx);
-  mg.apply(y, my);
-  const double xy = x.dot(my), yx = y.dot(mx);
-  EXPECT_NEAR(xy, yx, kSymmetryTolerance * (std::abs(xy) + x.norm() * my.norm()));
-  EXPECT_GT(x.dot(mx), 0.0);
+  expectSymmetricPositive(mg, system.matrix.rows(), 20261202, 1);
 
   SolverOptions cg;
   cg.kind = SolverKind::ConjugateGradient;

@@ -3,6 +3,7 @@
 // (physics/p_multigrid.h).
 #pragma once
 
+#include <span>
 #include <vector>
 
 namespace polydg {
@@ -31,6 +32,10 @@ struct BlockGroups {
   int groups() const { return start.empty() ? 0 : static_cast<int>(start.size()) - 1; }
   int size(int g) const {
     return start[static_cast<std::size_t>(g) + 1] - start[static_cast<std::size_t>(g)];
+  }
+  /// Group g's blocks, in increasing order.
+  std::span<const int> of(int g) const {
+    return {members.data() + start[static_cast<std::size_t>(g)], static_cast<std::size_t>(size(g))};
   }
   /// Every group a single block.
   bool singletons() const { return members.size() + 1 == start.size(); }
