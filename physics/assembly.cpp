@@ -150,9 +150,29 @@ double penaltyThreshold(const PolyMesh& mesh, const DgBasis& basis, const Moment
   return required.size() == 0 ? 0.0 : *std::max_element(required.begin(), required.end());
 }
 
+ElementData<double> meanCoupledFaceAreas(const PolyMesh& mesh, const MomentCache& moments,
+                                         const FaceRoles& roles) {
+  ElementData<double> mean(mesh.numElements(), 0.0);
+  for (std::size_t i = 0; i < mesh.numElements(); ++i) {
+    const ElementId e(i);
+    double sum = 0.0;
+    int count = 0;
+    for (const FaceUse& use : mesh.element(e).faces) {
+      if (roles.kind[use.face] == FaceKind::Free) continue;
+      const double area = moments.area(use.face);
+      if (!(area > 0.0)) continue;
+      sum += area;
+      ++count;
+    }
+    if (count > 0) mean[e] = sum / count;
+  }
+  return mean;
+}
+
 ElementData<double> elementPenaltyThresholds(const PolyMesh& mesh, const DgBasis& basis,
                                              const MomentCache& moments, const FaceRoles& roles) {
   const std::size_t ne = mesh.numElements();
+  const ElementData<double> meanArea = meanCoupledFaceAreas(mesh, moments, roles);
   const int n1 = basis.liftingSize();
   const int dim = 6 * n1;
   // Strain vector (e11, e22, e33, e12, e13, e23): |eps|^2 = e11^2 + e22^2 + e33^2 +
@@ -181,7 +201,7 @@ ElementData<double> elementPenaltyThresholds(const PolyMesh& mesh, const DgBasis
       for (int c = 0; c < 6; ++c) nmap.col(c) *= invSqrtW[c];
       const Eigen::Matrix<double, 6, 6> sn = nmap.transpose() * nmap;
       const Eigen::MatrixXd g = liftingFaceGram(basis, moments, mesh, use.face, e);
-      const double weight = w2 * volume / area;
+      const double weight = w2 * volume / meanArea[e];
       for (int q = 0; q < n1; ++q)
         for (int r = 0; r < n1; ++r) form.block<6, 6>(6 * q, 6 * r) += (weight * g(q, r)) * sn;
     }

@@ -84,7 +84,7 @@ struct DynamicSolver::Impl {
   DynamicsOptions options;
   std::unique_ptr<DgBasis> basis;
   FaceRoles roles;
-  ElementData<double> elementEta;
+  ElementPenalties penalties;
   FormCoefficients form;
   SplitLocalMatrices parts;
   int n = 0, bs = 0;
@@ -152,7 +152,7 @@ struct DynamicSolver::Impl {
       if (roles.traction[id] >= 0) ++tractionFaces[static_cast<std::size_t>(roles.traction[id])];
     }
     double threshold = 0.0;
-    form = formCoefficients(m, *basis, mc, roles, options.material, o.discretization, elementEta,
+    form = formCoefficients(m, *basis, mc, roles, options.material, o.discretization, penalties,
                             threshold);
     parts = splitLocalMatrices(m, *basis, mc, roles, form);
     buildSlots();

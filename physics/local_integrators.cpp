@@ -266,10 +266,13 @@ void elementMass(const DgBasis& basis, const MomentCache& moments, ElementId e,
 double facePenalty(const FormCoefficients& form, const MomentCache& moments, FaceId f,
                    ElementId self, ElementId other) {
   auto eta = [&](ElementId e) { return form.elementEta ? (*form.elementEta)[e] : form.eta; };
-  double sum = eta(self) / moments.volume(self);
-  if (other.valid()) sum += eta(other) / moments.volume(other);
+  auto area = [&](ElementId e) {
+    return form.elementFaceArea ? (*form.elementFaceArea)[e] : moments.area(f);
+  };
+  double sum = eta(self) * area(self) / moments.volume(self);
+  if (other.valid()) sum += eta(other) * area(other) / moments.volume(other);
   const bool factored = form.method == Method::BZ && !form.bzFactorOnMean;
-  return moments.area(f) * sum * (factored ? form.bzFactor : 1.0);
+  return sum * (factored ? form.bzFactor : 1.0);
 }
 
 double faceMeanPenalty(const FormCoefficients& form, const MomentCache& moments, FaceId f,

@@ -69,11 +69,12 @@ double superpenaltyFactor(const PolyMesh& mesh, const DgBasis& basis, double ref
 FormCoefficients formCoefficients(const PolyMesh& mesh, const DgBasis& basis,
                                   const MomentCache& moments, const FaceRoles& roles,
                                   const Material& material, const DiscretizationOptions& disc,
-                                  ElementData<double>& elementEta, double& threshold) {
+                                  ElementPenalties& penalties, double& threshold) {
   FormCoefficients form;
   form.method = disc.method;
   form.mu = material.mu();
   form.lambda = material.lambda();
+  ElementData<double>& elementEta = penalties.eta;
   elementEta = elementPenaltyThresholds(mesh, basis, moments, roles);
   threshold =
       elementEta.size() == 0 ? 0.0 : *std::max_element(elementEta.begin(), elementEta.end());
@@ -81,6 +82,8 @@ FormCoefficients formCoefficients(const PolyMesh& mesh, const DgBasis& basis,
     case PenaltyRule::TraceBound:
       form.eta = disc.penalty.safety * threshold;
       if (form.eta <= 0.0) form.eta = 1.0;  // no coupled faces: any positive value
+      penalties.faceArea = meanCoupledFaceAreas(mesh, moments, roles);
+      form.elementFaceArea = &penalties.faceArea;
       if (disc.penalty.local) {
         // Elements without coupled faces have no penalty terms; any positive value does.
         for (double& eta : elementEta) eta = eta > 0.0 ? disc.penalty.safety * eta : form.eta;
@@ -105,8 +108,8 @@ void StaticSolver::assemble(const LoadCase& loads) {
   roles_ = classifyFaces(*mesh_, loads);
   report_.dirichletFaces = roles_.dirichletFaces;
   report_.tractionFaces = roles_.tractionFaces;
-  elementEta_ = std::make_unique<ElementData<double>>();
-  form_ = formCoefficients(*mesh_, *basis_, *moments_, roles_, material_, disc, *elementEta_,
+  penalties_ = std::make_unique<ElementPenalties>();
+  form_ = formCoefficients(*mesh_, *basis_, *moments_, roles_, material_, disc, *penalties_,
                            report_.etaThreshold);
   const int quadrature =
       disc.quadratureDegree >= 0 ? disc.quadratureDegree : 2 * basis_->degree() + 2;

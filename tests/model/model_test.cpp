@@ -2,8 +2,10 @@
 // (each face integrated once), region selections, and operations that refuse to leave nothing.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <filesystem>
 #include <fstream>
+#include <map>
 
 #include "polydg/mesh/primitives.h"
 #include "polydg/mesh/surface_shapes.h"
@@ -208,6 +210,73 @@ TEST_F(ModelTest, SolveReportsAndWritesTheSolution) {
   cut.blade = Blade::plane(Vec3::UnitX(), 0.55);
   model.cut(cut);
   EXPECT_EQ(model.solution(), nullptr);
+}
+
+/// The surface of `box` with each side an m x m grid of squares, two triangles each (outward).
+TriangleSurface finelyTriangulatedBox(const Box3& box, int m) {
+  TriangleSurface s;
+  std::map<std::array<int, 3>, std::uint32_t> index;  // lattice point -> vertex
+  auto vertex = [&](const std::array<int, 3>& q) {
+    const auto [it, added] = index.try_emplace(q, static_cast<std::uint32_t>(s.vertices.size()));
+    if (added) {
+      Vec3 x;
+      for (int l = 0; l < 3; ++l) x[l] = box.min()[l] + box.sizes()[l] * q[l] / m;
+      s.vertices.push_back(x);
+    }
+    return it->second;
+  };
+  for (int axis = 0; axis < 3; ++axis)
+    for (int side = 0; side < 2; ++side) {
+      // (u, v, axis) right-handed: u x v is +axis; swapped on the low side, so normals point out.
+      int u = (axis + 1) % 3, v = (axis + 2) % 3;
+      if (side == 0) std::swap(u, v);
+      auto at = [&](int i, int j) {
+        std::array<int, 3> q{};
+        q[axis] = side * m;
+        q[u] = i;
+        q[v] = j;
+        return vertex(q);
+      };
+      for (int i = 0; i < m; ++i)
+        for (int j = 0; j < m; ++j) {
+          s.triangles.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+          s.triangles.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+        }
+    }
+  return s;
+}
+
+TEST_F(ModelTest, SplittingTheClampedFacesIntoManyTrianglesLeavesTheSolutionAlone) {
+  // The same body, its sides as 2 or as 2 x 12^2 triangles: under the clamp each element then
+  // has up to 60 Dirichlet faces instead of 1 or 2. The penalty bound spreads the penalty by
+  // the element's mean coupled face area (penaltyThreshold()), so the penalty per unit area of
+  // every face is the same in both meshes; with each face's own area (eq. 7) the bound grew
+  // with the face count and stiffened the clamp (the energies differed by 3.5% at p = 1).
+  // With nu = 0 the lambda term drops out (its lifting weight c_K counts faces): the form, and
+  // the solution, are then the same to round-off.
+  const Box3 box(Vec3(0.05, 0.1, 0.15), Vec3(0.95, 0.8, 0.85));
+  MeshOptions mo;
+  mo.cells = 3;
+  mo.dgChecks = false;
+  SolveOptions so;
+  so.material.poissonRatio = 0.0;
+  so.clamps = {FaceSelector::inPlane(2, 0.15)};
+  so.gravity = Vec3(0.0, 0.0, -1.0);
+  for (int degree = 1; degree <= 2; ++degree) {
+    so.degree = degree;
+    std::array<SolveReport, 2> r;
+    for (int k = 0; k < 2; ++k) {
+      MeshReport report;
+      Model model = Model::fromSurface(finelyTriangulatedBox(box, k == 0 ? 1 : 12), mo, report);
+      ASSERT_TRUE(report.passed());
+      r[k] = model.solve(so);
+    }
+    EXPECT_GE(r[1].clampFaces[0], 20 * r[0].clampFaces[0]) << "degree " << degree;
+    EXPECT_NEAR(r[1].solve.energy, r[0].solve.energy, 1e-10 * std::abs(r[0].solve.energy))
+        << "degree " << degree;
+    EXPECT_NEAR(r[1].maxDisplacement, r[0].maxDisplacement, 1e-10 * r[0].maxDisplacement)
+        << "degree " << degree;
+  }
 }
 
 }  // namespace

@@ -52,25 +52,37 @@ inline constexpr double kConsistencyEnergyShare = 0.9;
 /// The smallest global eta for which the IP form is guaranteed coercive, so that the stiffness
 /// matrix with Dirichlet conditions is SPD:  eta_min = max_K 2 tau_K / theta, where
 ///   tau_K = max over strains eps in Sym(3) (x) P_{p-1}(K) of
-///           sum_{F of K with face terms} w_F^2 (vol(K) / area(F)) |eps n_F|^2_F / |eps|^2_K
-/// (a generalized eigenvalue of size 6 numMonomials(p-1), from liftingFaceGram()), w_F = 1/2
-/// on interior and 1 on Dirichlet faces, theta = kConsistencyEnergyShare. Derivation: the
-/// consistency terms are bounded by sum_K sum_F 4 mu w_F |eps(u_K) n|_F |[u]|_F; Young's
-/// inequality with weights mu s_K area(F)/vol(K), s_K = 2 tau_K / theta, bounds them by
-/// theta 2 mu |eps(u)|^2 + sum_F mu (sum_K s_K / vol(K)) area(F) |[u]|^2_F, which the penalty
-/// mu eta_F |[u]|^2_F of eq. (7) covers when eta >= max_K s_K. The lambda part is positive
-/// semi-definite by itself (faceRows()). Dimensionless: independent of the material, the mesh
-/// scale and position. For unit cubes and p = 1, 2, 3 it gives 2.8, 9.6, 20.7 (set by the
-/// elements next to Dirichlet faces); Cholesky already succeeds at about half of these.
-/// Returns 0 for a mesh without coupled faces.
+///           sum_{F of K with face terms} w_F^2 (vol(K) / a_K) |eps n_F|^2_F / |eps|^2_K
+/// (a generalized eigenvalue of size 6 numMonomials(p-1), from liftingFaceGram()), a_K the mean
+/// area of K's faces with face terms (meanCoupledFaceAreas()), w_F = 1/2 on interior and 1 on
+/// Dirichlet faces, theta = kConsistencyEnergyShare. Derivation: the consistency terms are
+/// bounded by sum_K sum_F 4 mu w_F |eps(u_K) n|_F |[u]|_F; Young's inequality with weights
+/// mu s_K a_K / vol(K), s_K = 2 tau_K / theta, bounds them by theta 2 mu |eps(u)|^2 +
+/// sum_F mu (sum_K s_K a_K / vol(K)) |[u]|^2_F, which the penalty mu eta_F |[u]|^2_F covers
+/// when eta >= max_K s_K (facePenalty() with FormCoefficients::elementFaceArea).
+/// Why a_K and not each face's own area (the weight area(F) / vol(K) of eq. 7): with it, each
+/// face's term above is about |eps n_F|^2 / |eps|^2 whatever the face's size, so tau_K grew
+/// with the number of faces: an element under a clamp with 500 surface triangles as Dirichlet
+/// faces got s_K = 580 against a cube's 2.8 at p = 1, and with it the penalty on all its faces.
+/// With a_K the sum is an area-weighted mean, bounded by the shape and not the face count; on
+/// a hex grid, where every face of an element has the same area, nothing changes. The lambda
+/// part is positive semi-definite by itself (faceRows()). Dimensionless: independent of the
+/// material, the mesh scale and position. For unit cubes and p = 1, 2, 3 it gives 2.8, 9.6,
+/// 20.7 (set by the elements next to Dirichlet faces); Cholesky already succeeds at about half
+/// of these. Returns 0 for a mesh without coupled faces.
 double penaltyThreshold(const PolyMesh& mesh, const DgBasis& basis, const MomentCache& moments,
                         const FaceRoles& roles);
 
+/// The mean area a_K of each element's faces with face terms (Interior or Dirichlet, of
+/// positive area); 0 for an element without them.
+ElementData<double> meanCoupledFaceAreas(const PolyMesh& mesh, const MomentCache& moments,
+                                         const FaceRoles& roles);
+
 /// The per-element bounds s_K = 2 tau_K / theta of penaltyThreshold() (0 for an element
 /// without coupled faces). The derivation there needs, face by face, only
-/// eta_F >= area(F) sum_{K of F} s_K / vol(K): with FormCoefficients::elementEta = s_K the IP
+/// eta_F >= sum_{K of F} s_K a_K / vol(K): with FormCoefficients::elementEta = s_K the IP
 /// form is coercive while each face's penalty follows its own two elements, not the worst
-/// element of the mesh (a sliced sphere's worst is ~800 against ~10 for a cube).
+/// element of the mesh.
 ElementData<double> elementPenaltyThresholds(const PolyMesh& mesh, const DgBasis& basis,
                                              const MomentCache& moments, const FaceRoles& roles);
 

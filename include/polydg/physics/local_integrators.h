@@ -59,6 +59,14 @@ struct FormCoefficients {
   /// argument (penaltyThreshold() in physics/assembly.h) with each element's own bound, so a
   /// badly shaped sliced element raises the penalty only on its own faces.
   const ElementData<double>* elementEta = nullptr;
+  /// Per-element face areas a_K, the mean area of K's coupled faces (meanCoupledFaceAreas()),
+  /// or null. With them the penalty does not grow with the number of faces an element's
+  /// boundary is split into (the surface triangles under a clamp, say): eta_F = eta_K a_K /
+  /// vol(K) + eta_L a_L / vol(L) instead of eq. 7's area(F) (eta_K / vol(K) + ...), as the
+  /// penalty bound assumes (penaltyThreshold()). On faces of equal area (hex grids) the two
+  /// agree. Null: eq. 7, for a given eta (PenaltyRule::Fixed, Doubling). The lambda term's
+  /// lifting weight c_K still counts faces (faceRows()).
+  const ElementData<double>* elementFaceArea = nullptr;
   /// BZ only: eta_F is multiplied by this dimensionless factor, (L/h)^(2p) for
   /// BzPenalty::Super, 1 for BzPenalty::Fixed. IP ignores it.
   double bzFactor = 1.0;
@@ -69,9 +77,10 @@ struct FormCoefficients {
 };
 
 /// eta_F of face `f` between `self` and `other` (invalid on the boundary) under `form`, the
-/// penalty of the whole jump: area(F) (eta_K / vol(K) + eta_L / vol(L)) (eta_K = eta without
-/// per-element penalties), times FormCoefficients::bzFactor for the BZ method unless the factor
-/// is on the face mean only (FormCoefficients::bzFactorOnMean).
+/// penalty of the whole jump: eta_K a_K / vol(K) + eta_L a_L / vol(L) (eta_K = eta without
+/// per-element penalties, a_K = area(F) without per-element face areas), times
+/// FormCoefficients::bzFactor for the BZ method unless the factor is on the face mean only
+/// (FormCoefficients::bzFactorOnMean).
 double facePenalty(const FormCoefficients& form, const MomentCache& moments, FaceId f,
                    ElementId self, ElementId other);
 
@@ -113,7 +122,7 @@ void elementMass(const DgBasis& basis, const MomentCache& moments, ElementId e,
 ///   + mu eta_F int_F [u] . [v]              stability, eq. (13) with eta_F of eq. (7)
 ///   + lambda sum_{E in {K,L}} c_E (R_E[u.n], R_E[v.n])_E                     (lambda term)
 /// eta_F = facePenalty(): eta area(F) (1/vol(K) + 1/vol(L)) (one side on the boundary), or
-/// with per-element eta_K (FormCoefficients::elementEta). The penalty scales
+/// with per-element eta_K and face areas a_K (FormCoefficients). The penalty scales
 /// with mu only: the lambda part of the consistency terms, -int {lambda div u}[v.n], is
 /// controlled instead by the local lifting R_E: P_{p-1}(E) <- face, (R_E w, q)_E =
 /// w_F int_F q w (w_F = 1/2 inside, 1 on the boundary), weighted by c_E = the number of faces

@@ -96,15 +96,22 @@ struct StaticSolution {
 /// or non-finite `referenceLength`.
 double superpenaltyFactor(const PolyMesh& mesh, const DgBasis& basis, double referenceLength = 0.0);
 
+/// What a FormCoefficients of the TraceBound rule points to: each element's bound eta_K and the
+/// face area a_K its penalty is spread by (FormCoefficients::elementEta, elementFaceArea).
+struct ElementPenalties {
+  ElementData<double> eta;
+  ElementData<double> faceArea;
+};
+
 /// The coefficients of the form of `disc` for `material`: the penalty by its rule (TraceBound:
-/// the coercivity bounds of penaltyThreshold(), per element into `elementEta`, which the form
-/// then points to and which must outlive it; Fixed and Doubling: the given eta), and the BZ
-/// penalty's factor (`disc.bzPenalty`, superpenaltyFactor()). `threshold` is the largest bound.
-/// Throws std::invalid_argument for a non-positive eta.
+/// the coercivity bounds of penaltyThreshold(), per element into `penalties`, which the form
+/// then points to and which must outlive it; Fixed and Doubling: the given eta, on eq. 7's
+/// face areas), and the BZ penalty's factor (`disc.bzPenalty`, superpenaltyFactor()).
+/// `threshold` is the largest bound. Throws std::invalid_argument for a non-positive eta.
 FormCoefficients formCoefficients(const PolyMesh& mesh, const DgBasis& basis,
                                   const MomentCache& moments, const FaceRoles& roles,
                                   const Material& material, const DiscretizationOptions& disc,
-                                  ElementData<double>& elementEta, double& threshold);
+                                  ElementPenalties& penalties, double& threshold);
 
 /// The stages of a static solve, each callable again (e.g. assemble() with new loads reuses
 /// the moments and bases; solve() reuses the factorization when only F changed).
@@ -153,8 +160,8 @@ class StaticSolver {
   std::unique_ptr<MomentCache> ownMoments_;
   std::unique_ptr<DgBasis> basis_;
   FaceRoles roles_;
-  /// Per-element penalties that form_.elementEta points to (on the heap: stable under moves).
-  std::unique_ptr<ElementData<double>> elementEta_;
+  /// Per-element penalties that form_ points to (on the heap: stable under moves).
+  std::unique_ptr<ElementPenalties> penalties_;
   FormCoefficients form_;
   mutable LinearSystem system_;  ///< its matrix made on demand from rows_ (system())
   /// K by block rows, when the solve is iterative (CG): then the only copy of K.
