@@ -146,7 +146,8 @@ int sideOf(const FaceRoles& roles, FaceId f, ElementId e) {
 
 double penaltyThreshold(const PolyMesh& mesh, const DgBasis& basis, const MomentCache& moments,
                         const FaceRoles& roles) {
-  const ElementData<double> required = elementPenaltyThresholds(mesh, basis, moments, roles);
+  const ElementData<double> required = elementPenaltyThresholds(
+      mesh, basis, moments, roles, meanCoupledFaceAreas(mesh, moments, roles));
   return required.size() == 0 ? 0.0 : *std::max_element(required.begin(), required.end());
 }
 
@@ -170,9 +171,9 @@ ElementData<double> meanCoupledFaceAreas(const PolyMesh& mesh, const MomentCache
 }
 
 ElementData<double> elementPenaltyThresholds(const PolyMesh& mesh, const DgBasis& basis,
-                                             const MomentCache& moments, const FaceRoles& roles) {
+                                             const MomentCache& moments, const FaceRoles& roles,
+                                             const ElementData<double>& meanArea) {
   const std::size_t ne = mesh.numElements();
-  const ElementData<double> meanArea = meanCoupledFaceAreas(mesh, moments, roles);
   const int n1 = basis.liftingSize();
   const int dim = 6 * n1;
   // Strain vector (e11, e22, e33, e12, e13, e23): |eps|^2 = e11^2 + e22^2 + e33^2 +

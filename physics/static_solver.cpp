@@ -74,15 +74,15 @@ FormCoefficients formCoefficients(const PolyMesh& mesh, const DgBasis& basis,
   form.method = disc.method;
   form.mu = material.mu();
   form.lambda = material.lambda();
+  penalties.faceArea = meanCoupledFaceAreas(mesh, moments, roles);
   ElementData<double>& elementEta = penalties.eta;
-  elementEta = elementPenaltyThresholds(mesh, basis, moments, roles);
+  elementEta = elementPenaltyThresholds(mesh, basis, moments, roles, penalties.faceArea);
   threshold =
       elementEta.size() == 0 ? 0.0 : *std::max_element(elementEta.begin(), elementEta.end());
   switch (disc.penalty.rule) {
     case PenaltyRule::TraceBound:
       form.eta = disc.penalty.safety * threshold;
       if (form.eta <= 0.0) form.eta = 1.0;  // no coupled faces: any positive value
-      penalties.faceArea = meanCoupledFaceAreas(mesh, moments, roles);
       form.elementFaceArea = &penalties.faceArea;
       if (disc.penalty.local) {
         // Elements without coupled faces have no penalty terms; any positive value does.

@@ -82,9 +82,10 @@ ElementData<double> meanCoupledFaceAreas(const PolyMesh& mesh, const MomentCache
 /// without coupled faces). The derivation there needs, face by face, only
 /// eta_F >= sum_{K of F} s_K a_K / vol(K): with FormCoefficients::elementEta = s_K the IP
 /// form is coercive while each face's penalty follows its own two elements, not the worst
-/// element of the mesh.
+/// element of the mesh. `meanArea`: meanCoupledFaceAreas() of the same mesh and roles.
 ElementData<double> elementPenaltyThresholds(const PolyMesh& mesh, const DgBasis& basis,
-                                             const MomentCache& moments, const FaceRoles& roles);
+                                             const MomentCache& moments, const FaceRoles& roles,
+                                             const ElementData<double>& meanArea);
 
 /// A symmetric sparse system K U = F. Element e's DOFs are the contiguous range
 /// [e * blockSize, (e + 1) * blockSize), in the order d * n + i (component d, function i).
