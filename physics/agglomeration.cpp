@@ -3,11 +3,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <stdexcept>
 
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <Eigen/Dense>
 
+#include "polydg/integrate/monomials.h"
 #include "polydg/mesh/geometry.h"
 #include "polydg/physics/block_rows.h"
 #include "polydg/physics/dg_basis.h"
@@ -18,9 +20,6 @@ namespace polydg {
 namespace {
 
 using SpMat = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
-
-/// Functions per component of a group: the linear polynomials.
-constexpr int kLinear = 4;
 
 /// Lattice comparisons (extents, planes) are within this fraction of a cell length: far above
 /// the round-off of slicing (ulps of the model's size per coordinate), far below any feature
@@ -153,43 +152,63 @@ std::vector<int> groupByCells(const BlockRows<double>& rows,
   return group;
 }
 
-/// Column j of the result: the coarse monomial j of a group centred at C with scale H
-/// (1, (x - C) / H, ...) in the scaled monomials of a block centred at c with scale h.
-Eigen::Matrix4d linearChange(const Eigen::Vector3d& c, double h, const Eigen::Vector3d& C,
-                             double H) {
-  Eigen::Matrix4d m = Eigen::Matrix4d::Zero();
-  m(0, 0) = 1.0;
-  for (int l = 0; l < 3; ++l) {
-    m(0, 1 + l) = (c[l] - C[l]) / H;
-    m(1 + l, 1 + l) = h / H;
+/// Column j of the result: the coarse monomial j of degree <= q (1 or 2) of a group centred at
+/// C with scale H, ((x - C) / H)^a, in the scaled monomials of a block centred at c with
+/// scale h: with x = c + h y, (x - C) / H = s y + t (s = h / H, t = (c - C) / H), expanded
+/// binomially per axis.
+Eigen::MatrixXd monomialChange(const Eigen::Vector3d& c, double h, const Eigen::Vector3d& C,
+                               double H, int q) {
+  const int n = numMonomials(q);
+  const double s = h / H;
+  const Eigen::Vector3d t = (c - C) / H;
+  // The y^i term of (s y + t)^k along axis l, k <= 2.
+  auto term = [&](int k, int i, int l) {
+    const double binomial = k == 2 && i == 1 ? 2.0 : 1.0;
+    return binomial * std::pow(s, i) * std::pow(t[l], k - i);
+  };
+  Eigen::MatrixXd m = Eigen::MatrixXd::Zero(n, n);
+  for (int j = 0; j < n; ++j) {
+    const Exponents ej = monomialExponents(j);
+    const int pj[3] = {ej.a, ej.b, ej.c};
+    for (int i = 0; i <= j; ++i) {  // graded order: a term's degree is at most its monomial's
+      const Exponents ei = monomialExponents(i);
+      const int pi[3] = {ei.a, ei.b, ei.c};
+      double v = 1.0;
+      for (int l = 0; l < 3 && v != 0.0; ++l) v = pi[l] > pj[l] ? 0.0 : v * term(pj[l], pi[l], l);
+      m(i, j) = v;
+    }
   }
   return m;
 }
 
-}  // namespace
+/// Per coarse row block C: its coarse column blocks B <= C (in order met) and P_CB.
+struct Panels {
+  std::vector<int> columns;
+  std::vector<double> panel;  // block k at (3 n)^2 k, column-major
+};
 
-SpMat galerkinMatrix(const Agglomeration& fine, const BlockRows<double>& rows) {
+/// The panels of P^T A P for N functions per component (a fixed size: these products are the
+/// agglomeration levels' setup cost).
+template <int N>
+void galerkinPanels(const Agglomeration& fine, const BlockRows<double>& rows,
+                    std::vector<Panels>& panels) {
   const int coarseBlocks = fine.groups();
-  constexpr int n = kLinear, bs = 3 * n, bs2 = bs * bs;
-  using Mat4 = Eigen::Matrix4d;
+  constexpr int bs = 3 * N, bs2 = bs * bs;
+  constexpr std::size_t weights = N * N;
+  using Weights = Eigen::Matrix<double, N, N>;
   using Block = Eigen::Matrix<double, bs, bs>;
-  // Per coarse row block C: its coarse column blocks B <= C (in order met) and P_CB.
-  struct Row {
-    std::vector<int> columns;
-    std::vector<double> panel;  // block k at 144 k, column-major
-  };
-  std::vector<Row> panels(static_cast<std::size_t>(coarseBlocks));
   tbb::enumerable_thread_specific<std::vector<int>> slots(
       std::vector<int>(static_cast<std::size_t>(coarseBlocks), -1));
   tbb::parallel_for(0, coarseBlocks, [&](int cc) {
     std::vector<int>& slot = slots.local();
-    Row& row = panels[static_cast<std::size_t>(cc)];
+    Panels& row = panels[static_cast<std::size_t>(cc)];
     row.columns.reserve(8);
     row.panel.reserve(8 * bs2);
     for (int k = fine.childStart[static_cast<std::size_t>(cc)];
          k < fine.childStart[static_cast<std::size_t>(cc) + 1]; ++k) {
       const int e = fine.children[static_cast<std::size_t>(k)];
-      const Eigen::Map<const Mat4> we(fine.weights.data() + 16 * static_cast<std::size_t>(e));
+      const Eigen::Map<const Weights> we(fine.weights.data() +
+                                         weights * static_cast<std::size_t>(e));
       for (int t = rows.start[static_cast<std::size_t>(e)];
            t < rows.start[static_cast<std::size_t>(e) + 1]; ++t) {
         const std::size_t sl = static_cast<std::size_t>(t);
@@ -203,31 +222,46 @@ SpMat galerkinMatrix(const Agglomeration& fine, const BlockRows<double>& rows) {
           row.columns.push_back(cb);
           row.panel.resize(row.panel.size() + bs2, 0.0);
         }
-        const Eigen::Map<const Mat4> wf(fine.weights.data() + 16 * static_cast<std::size_t>(f));
+        const Eigen::Map<const Weights> wf(fine.weights.data() +
+                                           weights * static_cast<std::size_t>(f));
         Eigen::Map<Block> target(row.panel.data() + static_cast<std::size_t>(s) * bs2);
         const double* values = rows.values.data() + rows.offset[sl];
         if (rows.diagonal[sl]) {
           for (int d = 0; d < 3; ++d)
-            target.block<n, n>(d * n, d * n).noalias() +=
-                we.transpose() * (Eigen::Map<const Mat4>(values + d * n * n) * wf);
+            target.template block<N, N>(d * N, d * N).noalias() +=
+                we.transpose() * (Eigen::Map<const Weights>(values + d * N * N) * wf);
           continue;
         }
         const Eigen::Map<const Block> block(values);
         for (int dr = 0; dr < 3; ++dr)
           for (int dc = 0; dc < 3; ++dc)
-            target.block<n, n>(dr * n, dc * n).noalias() +=
-                we.transpose() * (block.block<n, n>(dr * n, dc * n) * wf);
+            target.template block<N, N>(dr * N, dc * N).noalias() +=
+                we.transpose() * (block.template block<N, N>(dr * N, dc * N) * wf);
       }
     }
     for (int c : row.columns) slot[static_cast<std::size_t>(c)] = -1;
   });
+}
+
+}  // namespace
+
+SpMat galerkinMatrix(const Agglomeration& fine, const BlockRows<double>& rows) {
+  if (rows.n != fine.functions)
+    throw std::invalid_argument("galerkinMatrix: the rows' functions do not match the groups'");
+  const int coarseBlocks = fine.groups();
+  const int n = fine.functions, bs = 3 * n, bs2 = bs * bs;
+  std::vector<Panels> panels(static_cast<std::size_t>(coarseBlocks));
+  if (n == 4)
+    galerkinPanels<4>(fine, rows, panels);
+  else
+    galerkinPanels<10>(fine, rows, panels);
   // The upper triangle by columns: column block C holds (B, C) = P_CB^T for B <= C, in order;
   // coupled or component-diagonal blocks.
   const Eigen::Index size = static_cast<Eigen::Index>(coarseBlocks) * bs;
   std::vector<int> counts(static_cast<std::size_t>(size) + 1, 0);
   std::vector<std::vector<std::pair<int, int>>> order(static_cast<std::size_t>(coarseBlocks));
   tbb::parallel_for(0, coarseBlocks, [&](int cc) {
-    const Row& row = panels[static_cast<std::size_t>(cc)];
+    const Panels& row = panels[static_cast<std::size_t>(cc)];
     // (coarse block B, slot), sorted; the slot coded -1 - slot if component-diagonal.
     std::vector<std::pair<int, int>>& blocks = order[static_cast<std::size_t>(cc)];
     for (std::size_t s = 0; s < row.columns.size(); ++s) {
@@ -253,7 +287,7 @@ SpMat galerkinMatrix(const Agglomeration& fine, const BlockRows<double>& rows) {
   int* rowIndex = upper.innerIndexPtr();
   double* entry = upper.valuePtr();
   tbb::parallel_for(0, coarseBlocks, [&](int cc) {
-    const Row& row = panels[static_cast<std::size_t>(cc)];
+    const Panels& row = panels[static_cast<std::size_t>(cc)];
     for (int c = 0; c < bs; ++c) {
       int pos = counts[static_cast<std::size_t>(cc * bs + c)];
       for (const auto& [cb, code] : order[static_cast<std::size_t>(cc)]) {
@@ -332,13 +366,14 @@ ElementFrames elementFrames(const DgBasis& basis, const PolyMesh& mesh) {
   const std::size_t ne = basis.numElements();
   frames.centres.resize(ne);
   frames.scales.resize(ne);
-  frames.linear.resize(ne);
+  frames.bases.resize(ne);
+  const int n = numMonomials(std::min(basis.degree(), 2));
   std::vector<Eigen::AlignedBox3d> boxes(ne);
   tbb::parallel_for(std::size_t(0), ne, [&](std::size_t e) {
     const ElementId id(e);
     frames.centres[e] = basis.centre(id);
     frames.scales[e] = basis.scale(id);
-    frames.linear[e] = basis.coefficients(id).topLeftCorner<4, 4>();
+    frames.bases[e] = basis.coefficients(id).topLeftCorner(n, n);
     boxes[e] = elementBounds(mesh, id);
   });
   frames.cells = latticeCells(boxes);
@@ -348,10 +383,12 @@ ElementFrames elementFrames(const DgBasis& basis, const PolyMesh& mesh) {
 Agglomeration agglomerate(const BlockRows<double>& rows,
                           const std::vector<Eigen::Vector3d>& centres,
                           const std::vector<double>& scales,
-                          const std::vector<Eigen::Matrix4d>* linear,
-                          const std::vector<Eigen::Vector3i>& cells) {
+                          const std::vector<Eigen::MatrixXd>* bases,
+                          const std::vector<Eigen::Vector3i>& cells, int degree) {
+  if (degree < 1 || degree > 2) throw std::invalid_argument("agglomerate: degree must be 1 or 2");
   const int nb = static_cast<int>(rows.start.size()) - 1;
   Agglomeration a;
+  a.functions = numMonomials(degree);
   int count = 0;
   if (!cells.empty() && cells.size() == static_cast<std::size_t>(nb)) {
     a.parent = groupByCells(rows, cells, a.cells);
@@ -381,16 +418,19 @@ Agglomeration agglomerate(const BlockRows<double>& rows,
       a.scales[g] = std::max(a.scales[g], (centres[b] - a.centres[g]).norm() + scales[b]);
     }
   }
-  a.weights.resize(16 * static_cast<std::size_t>(nb));
+  const int n = a.functions;
+  const std::size_t size = static_cast<std::size_t>(n * n);
+  a.weights.resize(size * static_cast<std::size_t>(nb));
   tbb::parallel_for(0, nb, [&](int b) {
     const std::size_t i = static_cast<std::size_t>(b);
     const std::size_t g = static_cast<std::size_t>(a.parent[i]);
-    const Eigen::Matrix4d change = linearChange(centres[i], scales[i], a.centres[g], a.scales[g]);
+    const Eigen::MatrixXd change =
+        monomialChange(centres[i], scales[i], a.centres[g], a.scales[g], degree);
     // phi = T m: the group function sum_a change(a, j) m_a is sum_i W(i, j) phi_i with
     // T^T W = change (T lower triangular).
-    Eigen::Map<Eigen::Matrix4d> w(a.weights.data() + 16 * i);
-    if (linear != nullptr)
-      w = (*linear)[i].transpose().triangularView<Eigen::Upper>().solve(change);
+    Eigen::Map<Eigen::MatrixXd> w(a.weights.data() + size * i, n, n);
+    if (bases != nullptr)
+      w = (*bases)[i].topLeftCorner(n, n).transpose().triangularView<Eigen::Upper>().solve(change);
     else
       w = change;
   });

@@ -26,7 +26,8 @@ namespace {
 using SpMat = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
 
 /// Unknowns up to which CHOLMOD factorizes the coarsest level simplicially (see
-/// factorizeCoarse()): a degree-0 level, and an agglomeration level (denser: 12 x 12 blocks).
+/// factorizeCoarse()): a degree-0 level, and an agglomeration level (denser: 12 x 12 or 30 x 30
+/// blocks).
 constexpr Eigen::Index kSimplicialCoarseLimit = 30000;
 constexpr Eigen::Index kSimplicialAggregateLimit = 1000;
 
@@ -53,19 +54,18 @@ constexpr int kMaxGroupUnknowns = kMaxGroupBlocks * kMaxBlock;
 /// blocks on a 3D mesh factorizes in about 13 N^2 flops for N unknowns (B2: 28.7 MFlop at
 /// 1,500 unknowns, 0.9 at 324), about what a V-cycle costs at 13 flops per nonzero of K when
 /// N^2 = nnz(K). So agglomeration continues while N^2 > nnz(K), and at least down to
-/// kCoarseUnknowns. On B2 this keeps the 1,500 unknowns of the first agglomeration level
-/// exact for p = 2 (nnz(K) = 2.5e6 for BZ: 25 instead of 34 iterations, 94 instead of 120 ms)
-/// and agglomerates once more for p = 1 (nnz(K) = 4.0e5 for BZ: 24 instead of 21 iterations,
-/// but 0.7 instead of 10-13 ms of factorization).
+/// kCoarseUnknowns. On B2 this agglomerates once more for p = 1 (nnz(K) = 4.0e5 for BZ: 24
+/// instead of 21 iterations, but 0.7 instead of 10-13 ms of factorization), and for p = 2,
+/// whose first groups carry quadratic displacements (nnz(K) = 2.5e6 for BZ, 125 groups of 30
+/// unknowns, then 27: 26 iterations; the 1,500 unknowns of linear groups, when p = 2 went
+/// through degree 1, were kept exact: 25). Denser 30 x 30 blocks cost more flops per N^2; the
+/// rule is not tuned to them.
 constexpr Eigen::Index kCoarseUnknowns = 600;
-
-/// Functions per component of an agglomeration level: the linear polynomials.
-constexpr int kLinear = 4;
 
 /// How a level's unknowns reach the next coarser level.
 enum class Transfer {
   Degree,     ///< the first numMonomials(q) functions of each element (index maps)
-  Aggregate,  ///< linear functions of groups of blocks (weights per block)
+  Aggregate,  ///< polynomials of groups of blocks (weights per block)
 };
 
 /// One level: its matrix (the top level borrows K), functions per component, its smoother's
@@ -506,7 +506,8 @@ struct PMultigrid::Impl {
       // Small coarse levels: simplicial. The supernodal solve calls the threaded BLAS twice
       // per V-cycle and its thread hand-offs cost more than the solve (B2, 3000 unknowns of
       // degree 0: 42 instead of 70 ms of CG iterations for p = 1, factorization 4 ms slower).
-      // Agglomeration levels have dense 12 x 12 blocks, where the supernodal factorization
+      // Agglomeration levels have dense 12 x 12 (or 30 x 30) blocks, where the supernodal
+      // factorization
       // wins sooner (B2: 324 unknowns 0.7 ms simplicial, 1.2 supernodal; 1,500 unknowns 13.7
       // and 9.5-11 ms, the solves equally fast).
       const Eigen::Index simplicialLimit =
@@ -552,22 +553,23 @@ struct PMultigrid::Impl {
 
   /// Appends the agglomeration level of levels.back(), whose blocks have the given centres,
   /// scales and lattice cells (the frames for the element level, then the groups of the level
-  /// before; no cells: grouped by pairing); `linear`, for the element level, the frames' T_e.
+  /// before; no cells: grouped by pairing); `bases`, for the element level, the frames' T_e;
+  /// `degree` that of the groups' functions, the degree of the level's own blocks.
   /// They are read before the levels grow (they may belong to a level).
   void addAggregateLevel(const std::vector<Eigen::Vector3d>& centres,
                          const std::vector<double>& scales,
-                         const std::vector<Eigen::Matrix4d>* linear,
-                         const std::vector<Eigen::Vector3i>& cells) {
+                         const std::vector<Eigen::MatrixXd>* bases,
+                         const std::vector<Eigen::Vector3i>& cells, int degree) {
     Level& fine = levels.back();
     fine.transfer = Transfer::Aggregate;
     if (fine.source == nullptr) {
-      fine.exact.build(*fine.matrix, kLinear, std::numeric_limits<double>::infinity());
+      fine.exact.build(*fine.matrix, fine.n, std::numeric_limits<double>::infinity());
       fine.source = &fine.exact;
     }
-    fine.groups = agglomerate(*fine.source, centres, scales, linear, cells);
+    fine.groups = agglomerate(*fine.source, centres, scales, bases, cells, degree);
     Level level;
-    level.n = kLinear;
-    level.bs = 3 * kLinear;
+    level.n = numMonomials(degree);
+    level.bs = 3 * level.n;
     level.owned = galerkinMatrix(fine.groups, *fine.source);
     push(std::move(level));
   }
@@ -669,13 +671,13 @@ struct PMultigrid::Impl {
                             if (fine.inLastColour[static_cast<std::size_t>(e)]) continue;
                             blockResidual(fine, e, b, x, s);
                             const double* w =
-                                groups.weights.data() + 16 * static_cast<std::size_t>(e);
+                                groups.weights.data() +
+                                static_cast<std::size_t>(n * nc) * static_cast<std::size_t>(e);
                             for (int d = 0; d < 3; ++d)
-                              for (int j = 0; j < kLinear; ++j) {
+                              for (int j = 0; j < nc; ++j) {
                                 double sum = 0.0;
-                                for (int i = 0; i < kLinear; ++i)
-                                  sum += w[i + 4 * j] * s[d * kLinear + i];
-                                coarse[d * kLinear + j] += sum;
+                                for (int i = 0; i < n; ++i) sum += w[i + n * j] * s[d * n + i];
+                                coarse[d * nc + j] += sum;
                               }
                           }
                         }
@@ -697,11 +699,11 @@ struct PMultigrid::Impl {
       const double* xc =
           next.x.data() +
           static_cast<Eigen::Index>(fine.groups.parent[static_cast<std::size_t>(e)]) * next.bs;
-      const double* w = fine.groups.weights.data() + 16 * e;
+      const double* w = fine.groups.weights.data() + static_cast<Eigen::Index>(n * nc) * e;
       for (int d = 0; d < 3; ++d)
-        for (int j = 0; j < kLinear; ++j) {
-          const double v = xc[d * kLinear + j];
-          for (int i = 0; i < kLinear; ++i) xe[d * kLinear + i] += w[i + 4 * j] * v;
+        for (int j = 0; j < nc; ++j) {
+          const double v = xc[d * nc + j];
+          for (int i = 0; i < n; ++i) xe[d * n + i] += w[i + n * j] * v;
         }
     });
   }
@@ -778,9 +780,11 @@ bool PMultigrid::Impl::build(const SpMat* matrix, const BlockRows<double>* rows,
   const bool agglomerate = frames != nullptr && degree >= 1 &&
                            frames->centres.size() == static_cast<std::size_t>(ne) &&
                            frames->scales.size() == static_cast<std::size_t>(ne) &&
-                           frames->linear.size() == static_cast<std::size_t>(ne);
-  // Degree levels down to 1 with frames (then agglomerates), else down to 0.
-  for (int q = degree - 1; q >= (agglomerate ? 1 : 0); --q) {
+                           frames->bases.size() == static_cast<std::size_t>(ne);
+  // Degree levels down to min(p, 2) with frames (then agglomerates of that degree), else down
+  // to 0.
+  const int groupDegree = std::min(degree, 2);
+  for (int q = degree - 1; q >= (agglomerate ? groupDegree : 0); --q) {
     Level& fine = m.levels.back();
     Level level;
     level.n = numMonomials(q);
@@ -801,19 +805,21 @@ bool PMultigrid::Impl::build(const SpMat* matrix, const BlockRows<double>* rows,
       elements.source = matrixBlocks;
     const std::vector<Eigen::Vector3i> noCells;
     m.addAggregateLevel(
-        frames->centres, frames->scales, &frames->linear,
-        frames->cells.size() == static_cast<std::size_t>(ne) ? frames->cells : noCells);
+        frames->centres, frames->scales, &frames->bases,
+        frames->cells.size() == static_cast<std::size_t>(ne) ? frames->cells : noCells,
+        groupDegree);
     // Further levels while the coarsest is large and grouping still shrinks it. Their
     // smoothing is cheap (an eighth of the blocks each), so they sweep twice: a V-cycle with
     // two agglomeration levels then needs about as many iterations as one with an exact
-    // first agglomeration level.
+    // first agglomeration level on B2 (not on the bunny at 16 cells, p = 2: 44-52 against
+    // 35-38; README, "Speed").
     const double limit = std::max(static_cast<double>(kCoarseUnknowns), std::sqrt(nonzeros));
     while (static_cast<double>(m.levels.back().matrix->rows()) > limit) {
       const Eigen::Index before = m.levels.back().matrix->rows();
       m.levels.back().sweeps = 2;
       // The blocks of the last level are the groups of the one before.
       const Agglomeration& blocks = m.levels[m.levels.size() - 2].groups;
-      m.addAggregateLevel(blocks.centres, blocks.scales, nullptr, blocks.cells);
+      m.addAggregateLevel(blocks.centres, blocks.scales, nullptr, blocks.cells, groupDegree);
       if (m.levels.back().matrix->rows() * 4 > before * 3) break;  // grouping stalled
     }
   } else if (degree > 0) {

@@ -198,8 +198,8 @@ const Eigen::VectorXd& StaticSolver::solve() {
     // block-Jacobi preconditioner falls back to diagonals and lets CG report the failure.
     const bool definiteCheck =
         direct || options_.solver.preconditioner == CgPreconditioner::PMultigrid;
-    // The element frames let the p-multigrid coarsen by agglomerating elements (the linear
-    // displacements of groups of elements, rotations included).
+    // The element frames let the p-multigrid coarsen by agglomerating elements (the linear or
+    // quadratic displacements of groups of elements, rotations included).
     const ElementFrames frames = direct ? ElementFrames{} : elementFrames(*basis_, *mesh_);
     const bool computed =
         rows_ ? solver_.compute(*rows_, &frames)

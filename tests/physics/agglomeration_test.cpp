@@ -2,9 +2,10 @@
 // sliced mesh is found, and none in boxes of no lattice; on a hex grid the groups are 2 x 2 x 2
 // cubes; on a sliced mesh each group lies in one 2 x 2 x 2 box of grid cells and is
 // face-connected; the pieces a cut separates never share a group; the coarse functions are exactly
-// the linear displacements of each group, on non-convex sliced elements too; the Galerkin matrix
-// equals P^T K P formed explicitly and is exactly symmetric, for IP's coupled and BZ's
-// component-diagonal blocks.
+// the linear or quadratic displacements of each group, and of each group of groups, on
+// non-convex sliced elements too; the Galerkin matrix equals P^T K P formed explicitly and is
+// exactly symmetric, for linear and quadratic groups, IP's coupled and BZ's component-diagonal
+// blocks.
 #include "polydg/physics/agglomeration.h"
 
 #include <gtest/gtest.h>
@@ -16,10 +17,13 @@
 #include <map>
 #include <random>
 #include <set>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "cli/bench/problems.h"
 #include "polydg/cut/cut.h"
+#include "polydg/integrate/monomials.h"
 #include "polydg/mesh/geometry.h"
 #include "polydg/mesh/primitives.h"
 #include "polydg/physics/block_rows.h"
@@ -35,21 +39,38 @@ using bench::BenchmarkMesh;
 
 using SpMat = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
 
-/// P of `groups` for a matrix with n functions per component (the first 4 take part).
+/// P of `groups` for a matrix with n functions per component (the first groups.functions
+/// take part).
 SpMat prolongation(const Agglomeration& groups, int n) {
-  const int nb = static_cast<int>(groups.parent.size());
+  const int nb = static_cast<int>(groups.parent.size()), m = groups.functions;
+  const std::size_t size = static_cast<std::size_t>(m * m);
   std::vector<Eigen::Triplet<double>> entries;
   for (int b = 0; b < nb; ++b) {
     const int g = groups.parent[static_cast<std::size_t>(b)];
     for (int d = 0; d < 3; ++d)
-      for (int i = 0; i < 4; ++i)
-        for (int j = 0; j < 4; ++j)
-          entries.emplace_back(3 * n * b + n * d + i, 12 * g + 4 * d + j,
-                               groups.weights[16 * static_cast<std::size_t>(b) + i + 4 * j]);
+      for (int i = 0; i < m; ++i)
+        for (int j = 0; j < m; ++j)
+          entries.emplace_back(3 * n * b + n * d + i, 3 * m * g + m * d + j,
+                               groups.weights[size * static_cast<std::size_t>(b) +
+                                              static_cast<std::size_t>(i + m * j)]);
   }
-  SpMat p(3 * n * nb, 12 * groups.groups());
+  SpMat p(3 * n * nb, 3 * m * groups.groups());
   p.setFromTriplets(entries.begin(), entries.end());
   return p;
+}
+
+/// The principal submatrix of `k` (n functions per component) on each component's first m.
+SpMat restrictToDegree(const SpMat& k, int n, int m) {
+  const Eigen::Index blocks = k.cols() / (3 * n);
+  std::vector<Eigen::Triplet<double>> entries;
+  for (Eigen::Index b = 0; b < blocks; ++b)
+    for (int d = 0; d < 3; ++d)
+      for (int i = 0; i < m; ++i)
+        entries.emplace_back(static_cast<int>(3 * n * b + n * d + i),
+                             static_cast<int>(3 * m * b + m * d + i), 1.0);
+  SpMat s(k.rows(), blocks * 3 * m);
+  s.setFromTriplets(entries.begin(), entries.end());
+  return SpMat(s.transpose() * k * s);
 }
 
 /// `k` (n functions per component) by block rows in double precision, as the p-multigrid
@@ -118,7 +139,7 @@ TEST(Agglomeration, GroupsAHexGridIntoCubesOfEight) {
   ASSERT_EQ(s.frames.cells.size(), 1000u);  // the grid is its own lattice
   const BlockRows<double> rows = blockRows(s.system.matrix, 4);
   const Agglomeration groups =
-      agglomerate(rows, s.frames.centres, s.frames.scales, &s.frames.linear, s.frames.cells);
+      agglomerate(rows, s.frames.centres, s.frames.scales, &s.frames.bases, s.frames.cells);
   ASSERT_EQ(groups.groups(), 125);
   for (int g = 0; g < groups.groups(); ++g) {
     const int first = groups.childStart[static_cast<std::size_t>(g)];
@@ -141,7 +162,7 @@ TEST(Agglomeration, GroupsAHexGridIntoCubesOfEight) {
   EXPECT_EQ(next.groups(), 27);
   // Pairing (no lattice) makes the same cubes on a hex grid.
   const Agglomeration paired =
-      agglomerate(rows, s.frames.centres, s.frames.scales, &s.frames.linear);
+      agglomerate(rows, s.frames.centres, s.frames.scales, &s.frames.bases);
   EXPECT_EQ(paired.parent, groups.parent);
 }
 
@@ -157,7 +178,7 @@ TEST(Agglomeration, GroupsOfASlicedMeshLieInOneBoxOfTwoByTwoByTwoCells) {
   ASSERT_EQ(s.frames.cells.size(), mesh.numElements());
   const BlockRows<double> rows = blockRows(s.system.matrix, 4);
   const Agglomeration groups =
-      agglomerate(rows, s.frames.centres, s.frames.scales, &s.frames.linear, s.frames.cells);
+      agglomerate(rows, s.frames.centres, s.frames.scales, &s.frames.bases, s.frames.cells);
   // Each group's elements span at most 2 grid cells per axis (their box centres' cells).
   std::set<std::array<int, 3>> boxes;  // of 2 x 2 x 2 cells, from the grid's first
   for (int g = 0; g < groups.groups(); ++g) {
@@ -196,7 +217,7 @@ TEST(Agglomeration, PiecesACutSeparatesNeverShareAGroup) {
   ASSERT_EQ(s.frames.cells.size(), mesh.numElements());
   const BlockRows<double> rows = blockRows(s.system.matrix, 4);
   const Agglomeration groups =
-      agglomerate(rows, s.frames.centres, s.frames.scales, &s.frames.linear, s.frames.cells);
+      agglomerate(rows, s.frames.centres, s.frames.scales, &s.frames.bases, s.frames.cells);
   // Never both sides of the plane in one group (an element's side: that of its corner
   // farthest from the plane; the others lie on its side or in the plane).
   auto side = [&](ElementId e) {
@@ -220,10 +241,61 @@ TEST(Agglomeration, PiecesACutSeparatesNeverShareAGroup) {
   EXPECT_TRUE(groupsFaceConnected(mesh, groups));
 }
 
-TEST(Agglomeration, CoarseFunctionsAreTheLinearDisplacementsOfEachGroup) {
-  // Degree 2 on non-convex sliced elements: W maps each group's linear functions onto the
-  // elements' first four basis functions (the degree-1 part of the hierarchical basis).
-  const PolyMesh mesh = benchmarkB1Mesh(BenchmarkMesh::Sliced, 4);
+/// A polynomial displacement u_d(x) = a_d + g_d . x + x^T S_d x (S_d = 0 for degree 1).
+struct PolynomialField {
+  int degree;
+  Eigen::Vector3d a{0.3, -1.2, 2.0};
+  Eigen::Matrix3d g;
+  std::array<Eigen::Matrix3d, 3> s;
+
+  explicit PolynomialField(int q) : degree(q) {
+    g << 1.0, -2.0, 0.5, 0.25, 3.0, -1.5, -0.75, 1.25, 2.0;
+    for (int d = 0; d < 3; ++d) {
+      Eigen::Matrix3d m;
+      m << 0.5 + d, -0.25, 0.75, 0.1, -1.0, 0.3 * d, 0.2, -0.6, 1.5 - d;
+      s[static_cast<std::size_t>(d)] =
+          q == 2 ? Eigen::Matrix3d(0.5 * (m + m.transpose())) : Eigen::Matrix3d::Zero();
+    }
+  }
+  Eigen::Vector3d operator()(const Eigen::Vector3d& x) const {
+    Eigen::Vector3d v = a + g * x;
+    for (int d = 0; d < 3; ++d) v[d] += x.dot(s[static_cast<std::size_t>(d)] * x);
+    return v;
+  }
+  /// Component d's coefficients in the scaled monomials ((x - C) / H)^alpha of degree <=
+  /// `degree`: H^|alpha| d^alpha u_d(C) / alpha!.
+  Eigen::VectorXd coefficients(int d, const Eigen::Vector3d& c, double h) const {
+    const Eigen::Matrix3d& sd = s[static_cast<std::size_t>(d)];
+    const Eigen::Vector3d gradient = g.row(d).transpose() + 2.0 * sd * c;
+    Eigen::VectorXd out(numMonomials(degree));
+    for (int j = 0; j < out.size(); ++j) {
+      const Exponents e = monomialExponents(j);
+      const int p[3] = {e.a, e.b, e.c};
+      const int order = p[0] + p[1] + p[2];
+      if (order == 0) {
+        out[j] = (*this)(c)[d];
+      } else if (order == 1) {
+        out[j] = h * gradient[p[1] == 1 ? 1 : p[2] == 1 ? 2 : 0];
+      } else {  // x_l x_m: the Hessian 2 S over alpha!: S_ll, or 2 S_lm for l != m
+        int l = -1, m = -1;
+        for (int k = 0; k < 3; ++k)
+          for (int r = 0; r < p[k]; ++r) (l < 0 ? l : m) = k;
+        out[j] = h * h * (l == m ? sd(l, l) : 2.0 * sd(l, m));
+      }
+    }
+    return out;
+  }
+};
+
+class CoarseFunctions : public ::testing::TestWithParam<int> {};
+
+/// On non-convex sliced elements of degree 2: W maps each group's polynomials of the degree
+/// (1 or 2) onto the elements' first basis functions (the hierarchical basis's part of that
+/// degree), exactly, and so do the groups of groups (monomials of the groups of the first
+/// agglomeration, nullptr bases) composed with them.
+TEST_P(CoarseFunctions, AreThePolynomialDisplacementsOfEachGroup) {
+  const int degree = GetParam();
+  const PolyMesh mesh = benchmarkB1Mesh(BenchmarkMesh::Sliced, 6);
   const bench::ManufacturedProblem problem = bench::benchmarkB1Problem();
   StaticOptions o;
   o.discretization.method = Method::IP;
@@ -232,54 +304,74 @@ TEST(Agglomeration, CoarseFunctionsAreTheLinearDisplacementsOfEachGroup) {
   solver.assemble(bench::benchmarkB1Loads(problem));
   const DgBasis& basis = solver.basis();
   const ElementFrames frames = elementFrames(basis, mesh);
-  const int n = basis.size();
-  const Agglomeration groups = agglomerate(blockRows(solver.system().matrix, n), frames.centres,
-                                           frames.scales, &frames.linear, frames.cells);
+  const int n = basis.size(), m = numMonomials(degree);
+  const BlockRows<double> rows = blockRows(solver.system().matrix, n);
+  const Agglomeration groups =
+      agglomerate(rows, frames.centres, frames.scales, &frames.bases, frames.cells, degree);
+  ASSERT_EQ(groups.functions, m);
   EXPECT_LT(groups.groups(), static_cast<int>(mesh.numElements()) / 3);
-  // u(x) = a + B x, as each group's coefficients: u(C) and H grad u.
-  const Eigen::Vector3d a(0.3, -1.2, 2.0);
-  Eigen::Matrix3d grad;
-  grad << 1.0, -2.0, 0.5, 0.25, 3.0, -1.5, -0.75, 1.25, 2.0;
-  auto u = [&](const Eigen::Vector3d& x) -> Eigen::Vector3d { return a + grad * x; };
+  // The second agglomeration reads the block graph of the first's Galerkin matrix (of the
+  // degree-`degree` part of K).
+  const BlockRows<double> part = blockRows(restrictToDegree(solver.system().matrix, n, m), m);
+  const Agglomeration second =
+      agglomerate(blockRows(galerkinMatrix(groups, part), m), groups.centres, groups.scales,
+                  nullptr, groups.cells, degree);
+  EXPECT_LT(second.groups(), groups.groups() / 3);
+  const PolynomialField u(degree);
   std::vector<double> phi(static_cast<std::size_t>(n));
+  const std::size_t size = static_cast<std::size_t>(m * m);
   double worst = 0.0;
-  for (std::size_t e = 0; e < mesh.numElements(); ++e) {
-    const int g = groups.parent[e];
-    const Eigen::Vector3d& centre = groups.centres[static_cast<std::size_t>(g)];
-    const double scale = groups.scales[static_cast<std::size_t>(g)];
-    const Eigen::Map<const Eigen::Matrix4d> w(groups.weights.data() + 16 * e);
-    // Element e's coefficients of u, component by component: W (u(C), H du_d/dx).
-    Eigen::Matrix<double, 4, 3> coefficients;
-    for (int d = 0; d < 3; ++d) {
-      Eigen::Vector4d coarse;
-      coarse << u(centre)[d], scale * grad(d, 0), scale * grad(d, 1), scale * grad(d, 2);
-      coefficients.col(d) = w * coarse;
+  for (int level = 1; level <= 2; ++level)
+    for (std::size_t e = 0; e < mesh.numElements(); ++e) {
+      const int g = groups.parent[e];
+      const Eigen::Map<const Eigen::MatrixXd> w(groups.weights.data() + size * e, m, m);
+      Eigen::MatrixXd coefficients(m, 3);  // element e's, component by component
+      for (int d = 0; d < 3; ++d) {
+        if (level == 1) {
+          coefficients.col(d) = w * u.coefficients(d, groups.centres[static_cast<std::size_t>(g)],
+                                                   groups.scales[static_cast<std::size_t>(g)]);
+          continue;
+        }
+        const int top = second.parent[static_cast<std::size_t>(g)];
+        const Eigen::Map<const Eigen::MatrixXd> wg(
+            second.weights.data() + size * static_cast<std::size_t>(g), m, m);
+        coefficients.col(d) =
+            w * (wg * u.coefficients(d, second.centres[static_cast<std::size_t>(top)],
+                                     second.scales[static_cast<std::size_t>(top)]));
+      }
+      const ElementId id(e);
+      for (const Eigen::Vector3d& offset :
+           {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0.4, -0.3, 0.2),
+            Eigen::Vector3d(-0.5, 0.5, -0.5)}) {
+        const Eigen::Vector3d x = basis.centre(id) + basis.scale(id) * offset;
+        basis.values(id, x, phi);
+        Eigen::Vector3d value = Eigen::Vector3d::Zero();
+        for (int d = 0; d < 3; ++d)
+          for (int i = 0; i < m; ++i)
+            value[d] += coefficients(i, d) * phi[static_cast<std::size_t>(i)];
+        worst = std::max(worst, (value - u(x)).norm() / u(x).norm());
+      }
     }
-    const ElementId id(e);
-    for (const Eigen::Vector3d& offset : {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0.4, -0.3, 0.2),
-                                          Eigen::Vector3d(-0.5, 0.5, -0.5)}) {
-      const Eigen::Vector3d x = basis.centre(id) + basis.scale(id) * offset;
-      basis.values(id, x, phi);
-      Eigen::Vector3d value = Eigen::Vector3d::Zero();
-      for (int d = 0; d < 3; ++d)
-        for (int i = 0; i < 4; ++i)
-          value[d] += coefficients(i, d) * phi[static_cast<std::size_t>(i)];
-      worst = std::max(worst, (value - u(x)).norm() / u(x).norm());
-    }
-  }
   EXPECT_LT(worst, 1e-12);
 }
 
+INSTANTIATE_TEST_SUITE_P(Agglomeration, CoarseFunctions, ::testing::Values(1, 2),
+                         [](const ::testing::TestParamInfo<int>& info) {
+                           return info.param == 1 ? std::string("Linear")
+                                                  : std::string("Quadratic");
+                         });
+
 /// galerkinMatrix against P^T K P of Eigen's sparse products, and its exact symmetry, for
-/// groups by lattice cells and by pairing.
-void expectGalerkinProduct(const FramedSystem& s) {
+/// groups by lattice cells and by pairing, of the degree of `s` (1 or 2).
+void expectGalerkinProduct(const FramedSystem& s, int degree) {
   const SpMat& k = s.system.matrix;
-  const BlockRows<double> rows = blockRows(k, 4);
+  const int n = numMonomials(degree);
+  const BlockRows<double> rows = blockRows(k, n);
   for (const std::vector<Eigen::Vector3i>& cells : {s.frames.cells, {}}) {
     const Agglomeration groups =
-        agglomerate(rows, s.frames.centres, s.frames.scales, &s.frames.linear, cells);
+        agglomerate(rows, s.frames.centres, s.frames.scales, &s.frames.bases, cells, degree);
     const SpMat coarse = galerkinMatrix(groups, rows);
-    const SpMat p = prolongation(groups, 4);
+    const SpMat p = prolongation(groups, n);
     const SpMat expected = SpMat(p.transpose() * k * p);
     const double scale = Eigen::MatrixXd(expected).cwiseAbs().maxCoeff();
     EXPECT_LT(Eigen::MatrixXd(coarse - expected).cwiseAbs().maxCoeff(), 1e-13 * scale);
@@ -288,17 +380,28 @@ void expectGalerkinProduct(const FramedSystem& s) {
 }
 
 TEST(Agglomeration, GalerkinMatrixIsPTransposeKPForIpOnASlicedMesh) {
-  expectGalerkinProduct(b1FramedSystem(benchmarkB1Mesh(BenchmarkMesh::Sliced, 4), Method::IP, 1));
+  expectGalerkinProduct(b1FramedSystem(benchmarkB1Mesh(BenchmarkMesh::Sliced, 4), Method::IP, 1),
+                        1);
+}
+
+TEST(Agglomeration, GalerkinMatrixOfQuadraticGroupsIsPTransposeKPOnASlicedMesh) {
+  const FramedSystem s = b1FramedSystem(benchmarkB1Mesh(BenchmarkMesh::Sliced, 4), Method::IP, 2);
+  expectGalerkinProduct(s, 2);
+  // Quadratic groups need the rows of the quadratic functions, not of the linear ones.
+  const BlockRows<double> linear = blockRows(restrictToDegree(s.system.matrix, 10, 4), 4);
+  const Agglomeration groups =
+      agglomerate(linear, s.frames.centres, s.frames.scales, &s.frames.bases, s.frames.cells, 2);
+  EXPECT_THROW(galerkinMatrix(groups, linear), std::invalid_argument);
 }
 
 TEST(Agglomeration, GalerkinMatrixIsPTransposeKPForBzWithComponentDiagonalBlocks) {
   const FramedSystem s = b2FramedSystem(Method::BZ, 1);
-  expectGalerkinProduct(s);
+  expectGalerkinProduct(s, 1);
   // BZ couples components only inside elements: the coarse blocks between two groups keep
   // only their three diagonal 4 x 4 parts.
   const BlockRows<double> rows = blockRows(s.system.matrix, 4);
   const Agglomeration groups =
-      agglomerate(rows, s.frames.centres, s.frames.scales, &s.frames.linear, s.frames.cells);
+      agglomerate(rows, s.frames.centres, s.frames.scales, &s.frames.bases, s.frames.cells);
   const SpMat coarse = galerkinMatrix(groups, rows);
   std::size_t crossComponent = 0;
   for (int c = 0; c < coarse.cols(); ++c)

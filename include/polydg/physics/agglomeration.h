@@ -1,5 +1,6 @@
-// Agglomeration of DG elements into groups of neighbours, and the linear displacements of each
-// group as a coarse space: the coarse levels of the p-multigrid (physics/p_multigrid.h).
+// Agglomeration of DG elements into groups of neighbours, and the linear or quadratic
+// displacements of each group as a coarse space: the coarse levels of the p-multigrid
+// (physics/p_multigrid.h).
 #pragma once
 
 #include <vector>
@@ -16,14 +17,15 @@ class DgBasis;
 class PolyMesh;
 
 /// What agglomeration needs of each element e: its basis's centre c_e and length scale h_e,
-/// and how its first four scalar functions (degree <= 1) combine the scaled monomials
-/// 1, (x - c_e) / h_e, (y - c_e) / h_e, (z - c_e) / h_e: phi_i = sum_a T_e(i, a) m_a (the
-/// top-left 4 x 4 block of DgBasis::coefficients); and, if the mesh lies on a lattice of
-/// cells (latticeCells()), the cell of each element, else `cells` is empty.
+/// and how its first scalar functions, those of degree <= min(p, 2), combine the scaled
+/// monomials m_a = ((x - c_e) / h_e)^a (order of integrate/monomials.h): phi_i = sum_a
+/// T_e(i, a) m_a, `bases[e]` the top-left 4 x 4 (p = 1) or 10 x 10 block of
+/// DgBasis::coefficients; and, if the mesh lies on a lattice of cells (latticeCells()), the
+/// cell of each element, else `cells` is empty.
 struct ElementFrames {
   std::vector<Eigen::Vector3d> centres;
   std::vector<double> scales;
-  std::vector<Eigen::Matrix4d> linear;
+  std::vector<Eigen::MatrixXd> bases;
   std::vector<Eigen::Vector3i> cells;
 };
 
@@ -47,15 +49,19 @@ ElementFrames elementFrames(const DgBasis& basis, const PolyMesh& mesh);
 /// common cell size, each larger element in the cell of its centre.
 std::vector<Eigen::Vector3i> latticeCells(const std::vector<Eigen::AlignedBox3d>& boxes);
 
-/// Blocks (elements, or groups of a finer agglomeration) grouped, and the linear
-/// displacements of each group expressed in its blocks' functions.
+/// Blocks (elements, or groups of a finer agglomeration) grouped, and the polynomial
+/// displacements of each group (degree 1 or 2) expressed in its blocks' functions.
 struct Agglomeration {
   /// Block b belongs to group parent[b]; group g's blocks are
   /// children[childStart[g] .. childStart[g + 1] - 1], in increasing order.
   std::vector<int> parent, childStart, children;
-  /// Group g's linear functions M_j: 1, (x - C_g) / H_g, (y - C_g) / H_g, (z - C_g) / H_g. On
-  /// its block b, M_j = sum_i W_b(i, j) phi_i over the block's first four functions, W_b
-  /// column-major at weights[16 b]; the same for each displacement component.
+  /// Functions per displacement component, of each group and of each block that take part
+  /// (the block's first ones): numMonomials(degree), 4 (linear) or 10 (quadratic).
+  int functions = 4;
+  /// Group g's functions M_j, the scaled monomials ((x - C_g) / H_g)^a of degree <= the
+  /// degree. On its block b, M_j = sum_i W_b(i, j) phi_i over the block's first `functions`
+  /// functions phi_i (which span the polynomials of that degree: exact), W_b column-major at
+  /// weights[functions^2 b]; the same for each displacement component.
   std::vector<double> weights;
   /// Each group's centre C_g (the mean of its blocks' centres) and scale H_g, large enough
   /// that |x - C_g| <= H_g on each block (given |x - c_b| <= h_b there).
@@ -82,19 +88,22 @@ struct Agglomeration {
 /// best aligned with axis k (the line between their centres at most 60 degrees from the axis;
 /// groups in order): 2 x 2 x 2 blocks on a hex grid, groups of up to 8 face neighbours of any
 /// shape elsewhere.
-/// `centres` and `scales` are the blocks' frames; `linear` their T (ElementFrames::linear), or
-/// nullptr when the blocks' functions are the scaled monomials themselves (groups of a finer
-/// agglomeration).
+/// `centres` and `scales` are the blocks' frames; `bases` their T (ElementFrames::bases, of
+/// which the top-left numMonomials(degree) block is used), or nullptr when the blocks'
+/// functions are the scaled monomials themselves (groups of a finer agglomeration of the
+/// same degree). `degree` (1 or 2) is that of the groups' functions; the blocks' first
+/// functions must span the polynomials of that degree.
 Agglomeration agglomerate(const BlockRows<double>& rows,
                           const std::vector<Eigen::Vector3d>& centres,
                           const std::vector<double>& scales,
-                          const std::vector<Eigen::Matrix4d>* linear,
-                          const std::vector<Eigen::Vector3i>& cells = {});
+                          const std::vector<Eigen::MatrixXd>* bases,
+                          const std::vector<Eigen::Vector3i>& cells = {}, int degree = 1);
 
-/// The Galerkin matrix P^T A P of the coarse space of `groups` (4 linear functions per
-/// component of each group, unknown (g, d, j) at 12 g + 4 d + j), from A by block rows in
-/// double precision (n = 4 functions per component). A coarse block whose displacement
-/// components are uncoupled (BZ's) stores only its three diagonal 4 x 4 parts. Exactly
+/// The Galerkin matrix P^T A P of the coarse space of `groups` (n = groups.functions per
+/// component of each group, unknown (g, d, j) at 3 n g + n d + j), from A by block rows in
+/// double precision with the same n functions per component (else std::invalid_argument). A
+/// coarse block whose displacement components are uncoupled (BZ's) stores only its three
+/// diagonal n x n parts. Exactly
 /// symmetric, both triangles stored.
 Eigen::SparseMatrix<double, Eigen::ColMajor, int> galerkinMatrix(const Agglomeration& groups,
                                                                  const BlockRows<double>& rows);

@@ -22,8 +22,9 @@ enum class SolverKind {
 
 /// Preconditioner of SolverKind::ConjugateGradient.
 enum class CgPreconditioner {
-  /// One symmetric V-cycle over the degrees p, ..., 1 and agglomerates of elements (or over
-  /// p, ..., 0 without element frames; PMultigrid). Needs the hierarchical DG basis layout;
+  /// One symmetric V-cycle over the degrees p, ..., min(p, 2) and agglomerates of elements
+  /// (or over p, ..., 0 without element frames; PMultigrid). Needs the hierarchical DG basis
+  /// layout;
   /// other block sizes use BlockJacobi.
   PMultigrid,
   BlockJacobi,  ///< inverses of the per-element diagonal blocks
