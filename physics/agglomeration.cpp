@@ -152,35 +152,6 @@ std::vector<int> groupByCells(const BlockRows<double>& rows,
   return group;
 }
 
-/// Column j of the result: the coarse monomial j of degree <= q (1 or 2) of a group centred at
-/// C with scale H, ((x - C) / H)^a, in the scaled monomials of a block centred at c with
-/// scale h: with x = c + h y, (x - C) / H = s y + t (s = h / H, t = (c - C) / H), expanded
-/// binomially per axis.
-Eigen::MatrixXd monomialChange(const Eigen::Vector3d& c, double h, const Eigen::Vector3d& C,
-                               double H, int q) {
-  const int n = numMonomials(q);
-  const double s = h / H;
-  const Eigen::Vector3d t = (c - C) / H;
-  // The y^i term of (s y + t)^k along axis l, k <= 2.
-  auto term = [&](int k, int i, int l) {
-    const double binomial = k == 2 && i == 1 ? 2.0 : 1.0;
-    return binomial * std::pow(s, i) * std::pow(t[l], k - i);
-  };
-  Eigen::MatrixXd m = Eigen::MatrixXd::Zero(n, n);
-  for (int j = 0; j < n; ++j) {
-    const Exponents ej = monomialExponents(j);
-    const int pj[3] = {ej.a, ej.b, ej.c};
-    for (int i = 0; i <= j; ++i) {  // graded order: a term's degree is at most its monomial's
-      const Exponents ei = monomialExponents(i);
-      const int pi[3] = {ei.a, ei.b, ei.c};
-      double v = 1.0;
-      for (int l = 0; l < 3 && v != 0.0; ++l) v = pi[l] > pj[l] ? 0.0 : v * term(pj[l], pi[l], l);
-      m(i, j) = v;
-    }
-  }
-  return m;
-}
-
 /// Per coarse row block C: its coarse column blocks B <= C (in order met) and P_CB.
 struct Panels {
   std::vector<int> columns;
@@ -424,8 +395,11 @@ Agglomeration agglomerate(const BlockRows<double>& rows,
   tbb::parallel_for(0, nb, [&](int b) {
     const std::size_t i = static_cast<std::size_t>(b);
     const std::size_t g = static_cast<std::size_t>(a.parent[i]);
+    // Column j: the group's monomial j, ((x - C) / H)^a, in the block's scaled monomials
+    // ((x - c) / h)^b (x = c + h y: sigma = h / H, d = (c - C) / H).
     const Eigen::MatrixXd change =
-        monomialChange(centres[i], scales[i], a.centres[g], a.scales[g], degree);
+        monomialShift(degree, scales[i] / a.scales[g], (centres[i] - a.centres[g]) / a.scales[g])
+            .transpose();
     // phi = T m: the group function sum_a change(a, j) m_a is sum_i W(i, j) phi_i with
     // T^T W = change (T lower triangular).
     Eigen::Map<Eigen::MatrixXd> w(a.weights.data() + size * i, n, n);

@@ -178,20 +178,13 @@ Eigen::VectorXd affineCoefficients(const DgBasis& basis, ElementId e, double val
   return basis.coefficients(e).transpose().triangularView<Eigen::Upper>().solve(a);
 }
 
-Eigen::MatrixXd transferMatrix(const DgBasis& source, ElementId from, const DgBasis& target,
-                               ElementId to) {
-  if (source.degree() != target.degree())
-    throw std::invalid_argument("transferMatrix: the bases have different degrees");
-  const int p = source.degree(), n = source.size();
-  // m_a((x - c) / h) = sum_b S(a, b) m'_b((x - c') / h'): with x = c' + h' y,
-  // (x - c) / h = sigma y + d, sigma = h' / h, d = (c' - c) / h; binomial expansion per axis.
-  const double h = source.scale(from);
-  const double sigma = target.scale(to) / h;
-  const Vec3 d = (target.centre(to) - source.centre(from)) / h;
-  double sp[4], dp[3][4];
+Eigen::MatrixXd monomialShift(int degree, double sigma, const Vec3& d) {
+  const int n = numMonomials(degree);
+  // m_a(sigma y + d) per axis: (sigma y + d)^k = sum_i binomial(k, i) sigma^i d^(k - i) y^i.
+  double sp[detail::kMaxBasisDegree + 1], dp[3][detail::kMaxBasisDegree + 1];
   sp[0] = 1.0;
   for (int k = 0; k < 3; ++k) dp[k][0] = 1.0;
-  for (int m = 1; m <= p; ++m) {
+  for (int m = 1; m <= degree; ++m) {
     sp[m] = sp[m - 1] * sigma;
     for (int k = 0; k < 3; ++k) dp[k][m] = dp[k][m - 1] * d[k];
   }
@@ -199,7 +192,7 @@ Eigen::MatrixXd transferMatrix(const DgBasis& source, ElementId from, const DgBa
   for (int a = 0; a < n; ++a) {
     const Exponents ea = monomialExponents(a);
     const int pa[3] = {ea.a, ea.b, ea.c};
-    for (int b = 0; b < n; ++b) {
+    for (int b = 0; b <= a; ++b) {  // graded order: a term's degree is at most its monomial's
       const Exponents eb = monomialExponents(b);
       const int pb[3] = {eb.a, eb.b, eb.c};
       double v = 1.0;
@@ -208,6 +201,16 @@ Eigen::MatrixXd transferMatrix(const DgBasis& source, ElementId from, const DgBa
       shift(a, b) = v;
     }
   }
+  return shift;
+}
+
+Eigen::MatrixXd transferMatrix(const DgBasis& source, ElementId from, const DgBasis& target,
+                               ElementId to) {
+  if (source.degree() != target.degree())
+    throw std::invalid_argument("transferMatrix: the bases have different degrees");
+  const double h = source.scale(from);
+  const Eigen::MatrixXd shift = monomialShift(source.degree(), target.scale(to) / h,
+                                              (target.centre(to) - source.centre(from)) / h);
   // f = c^T T m = c^T T S m' = c^T T S T'^-1 phi': Q = T'^-T S^T T^T.
   const Eigen::MatrixXd rhs = shift.transpose() * source.coefficients(from).transpose();
   return target.coefficients(to).transpose().triangularView<Eigen::Upper>().solve(rhs);

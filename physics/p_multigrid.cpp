@@ -507,9 +507,8 @@ struct PMultigrid::Impl {
       // per V-cycle and its thread hand-offs cost more than the solve (B2, 3000 unknowns of
       // degree 0: 42 instead of 70 ms of CG iterations for p = 1, factorization 4 ms slower).
       // Agglomeration levels have dense 12 x 12 (or 30 x 30) blocks, where the supernodal
-      // factorization
-      // wins sooner (B2: 324 unknowns 0.7 ms simplicial, 1.2 supernodal; 1,500 unknowns 13.7
-      // and 9.5-11 ms, the solves equally fast).
+      // factorization wins sooner (B2: 324 unknowns 0.7 ms simplicial, 1.2 supernodal; 1,500
+      // unknowns 13.7 and 9.5-11 ms, the solves equally fast).
       const Eigen::Index simplicialLimit =
           level.bs == 3 ? kSimplicialCoarseLimit : kSimplicialAggregateLimit;
       if (factored.rows() <= simplicialLimit) c.setMode(Eigen::CholmodSimplicialLLt);

@@ -105,4 +105,10 @@ Eigen::MatrixXd transferMatrix(const DgBasis& source, ElementId from, const DgBa
 /// Scaled monomials m_a(y) for |a| <= degree at y (already centred and scaled).
 void scaledMonomials(int degree, const Vec3& y, std::span<double> out);
 
+/// The change of scaled monomials of degree <= `degree` (1..3) to another centre and scale:
+/// S with m_a(sigma y + d) = sum_b S(a, b) m_b(y), lower triangular (graded order). For
+/// monomials about c with scale h re-expressed about c' with scale h' (x = c' + h' y):
+/// sigma = h' / h, d = (c' - c) / h.
+Eigen::MatrixXd monomialShift(int degree, double sigma, const Vec3& d);
+
 }  // namespace polydg
