@@ -32,6 +32,14 @@ constexpr double kLatticeTolerance = 1e-6;
 /// 840 lie in one cell); with no lattice few boxes share the one extent and origin found.
 constexpr double kLatticeShare = 0.5;
 
+/// Monomial combinations of a group whose Gram eigenvalue over its blocks' weights
+/// (Agglomeration::spans) is below this fraction of the largest are not kept: on the blocks
+/// they are under 1e-4 of the best-represented combination, which a coarse correction cannot
+/// use and which would make the coarse matrix nearly singular. Where the blocks tell a
+/// combination apart at all, on a sliced mesh, its eigenvalue is far larger; where they do
+/// not (blocks on a line), it is round-off, about 1e-16 of the largest.
+constexpr double kSpanTolerance = 1e-8;
+
 /// Cells per axis at most (indices fit an int with room for the box arithmetic).
 constexpr double kMaxLatticeCells = 1 << 24;
 
@@ -158,15 +166,17 @@ struct Panels {
   std::vector<double> panel;  // block k at (3 n)^2 k, column-major
 };
 
-/// The panels of P^T A P for N functions per component (a fixed size: these products are the
-/// agglomeration levels' setup cost).
-template <int N>
+/// The panels of P^T A P for NF functions per component of the blocks and N of the groups (a
+/// fixed size: these products are the agglomeration levels' setup cost).
+template <int NF, int N>
 void galerkinPanels(const Agglomeration& fine, const BlockRows<double>& rows,
                     std::vector<Panels>& panels) {
   const int coarseBlocks = fine.groups();
   constexpr int bs = 3 * N, bs2 = bs * bs;
-  constexpr std::size_t weights = N * N;
-  using Weights = Eigen::Matrix<double, N, N>;
+  constexpr std::size_t weights = NF * N;
+  using Weights = Eigen::Matrix<double, NF, N>;
+  using FineBlock = Eigen::Matrix<double, 3 * NF, 3 * NF>;
+  using FineDiagonal = Eigen::Matrix<double, NF, NF>;
   using Block = Eigen::Matrix<double, bs, bs>;
   tbb::enumerable_thread_specific<std::vector<int>> slots(
       std::vector<int>(static_cast<std::size_t>(coarseBlocks), -1));
@@ -200,14 +210,14 @@ void galerkinPanels(const Agglomeration& fine, const BlockRows<double>& rows,
         if (rows.diagonal[sl]) {
           for (int d = 0; d < 3; ++d)
             target.template block<N, N>(d * N, d * N).noalias() +=
-                we.transpose() * (Eigen::Map<const Weights>(values + d * N * N) * wf);
+                we.transpose() * (Eigen::Map<const FineDiagonal>(values + d * NF * NF) * wf);
           continue;
         }
-        const Eigen::Map<const Block> block(values);
+        const Eigen::Map<const FineBlock> block(values);
         for (int dr = 0; dr < 3; ++dr)
           for (int dc = 0; dc < 3; ++dc)
             target.template block<N, N>(dr * N, dc * N).noalias() +=
-                we.transpose() * (block.template block<N, N>(dr * N, dc * N) * wf);
+                we.transpose() * (block.template block<NF, NF>(dr * NF, dc * NF) * wf);
       }
     }
     for (int c : row.columns) slot[static_cast<std::size_t>(c)] = -1;
@@ -217,15 +227,17 @@ void galerkinPanels(const Agglomeration& fine, const BlockRows<double>& rows,
 }  // namespace
 
 SpMat galerkinMatrix(const Agglomeration& fine, const BlockRows<double>& rows) {
-  if (rows.n != fine.functions)
+  if (rows.n != fine.blockFunctions)
     throw std::invalid_argument("galerkinMatrix: the rows' functions do not match the groups'");
   const int coarseBlocks = fine.groups();
   const int n = fine.functions, bs = 3 * n, bs2 = bs * bs;
   std::vector<Panels> panels(static_cast<std::size_t>(coarseBlocks));
   if (n == 4)
-    galerkinPanels<4>(fine, rows, panels);
+    galerkinPanels<4, 4>(fine, rows, panels);
+  else if (fine.blockFunctions == 4)
+    galerkinPanels<4, 10>(fine, rows, panels);
   else
-    galerkinPanels<10>(fine, rows, panels);
+    galerkinPanels<10, 10>(fine, rows, panels);
   // The upper triangle by columns: column block C holds (B, C) = P_CB^T for B <= C, in order;
   // coupled or component-diagonal blocks.
   const Eigen::Index size = static_cast<Eigen::Index>(coarseBlocks) * bs;
@@ -275,7 +287,16 @@ SpMat galerkinMatrix(const Agglomeration& fine, const BlockRows<double>& rows) {
       }
     }
   });
+  std::vector<Panels>().swap(panels);  // before the full matrix is formed
   SpMat full = upper.selfadjointView<Eigen::Upper>();
+  // Unknowns that prolong to nothing (zero columns of a group's span): decoupled, unit
+  // diagonal.
+  for (int g = 0; g < coarseBlocks; ++g)
+    for (int j = fine.ranks.empty() ? n : fine.ranks[static_cast<std::size_t>(g)]; j < n; ++j)
+      for (int d = 0; d < 3; ++d) {
+        const Eigen::Index u = static_cast<Eigen::Index>(g) * bs + d * n + j;
+        full.coeffRef(u, u) = 1.0;
+      }
   return full;
 }
 
@@ -351,21 +372,36 @@ ElementFrames elementFrames(const DgBasis& basis, const PolyMesh& mesh) {
   return frames;
 }
 
-Agglomeration agglomerate(const BlockRows<double>& rows,
-                          const std::vector<Eigen::Vector3d>& centres,
-                          const std::vector<double>& scales,
-                          const std::vector<Eigen::MatrixXd>* bases,
+namespace {
+
+/// The functions of the blocks being grouped: each block's centre c_b and scale h_b, its
+/// functions per component that take part, and how they combine the block's scaled monomials
+/// m_a = ((x - c_b) / h_b)^a: elements phi = T_b m (`triangular`, ElementFrames::bases),
+/// groups of a finer agglomeration F = S_b^T m (`spans`, Agglomeration::spans), else the
+/// monomials themselves.
+struct BlockFunctions {
+  const std::vector<Eigen::Vector3d>& centres;
+  const std::vector<double>& scales;
+  const std::vector<Eigen::MatrixXd>* triangular = nullptr;
+  const std::vector<double>* spans = nullptr;
+  int functions = 4;
+};
+
+Agglomeration groupBlocks(const BlockRows<double>& rows, const BlockFunctions& blocks,
                           const std::vector<Eigen::Vector3i>& cells, int degree) {
   if (degree < 1 || degree > 2) throw std::invalid_argument("agglomerate: degree must be 1 or 2");
   const int nb = static_cast<int>(rows.start.size()) - 1;
   Agglomeration a;
   a.functions = numMonomials(degree);
+  a.blockFunctions = blocks.functions;
+  if (a.blockFunctions > a.functions)
+    throw std::invalid_argument("agglomerate: the groups' degree is below their blocks'");
   int count = 0;
   if (!cells.empty() && cells.size() == static_cast<std::size_t>(nb)) {
     a.parent = groupByCells(rows, cells, a.cells);
     count = static_cast<int>(a.cells.size());
   } else {
-    a.parent = pairAlongAxes(rows, centres, count);
+    a.parent = pairAlongAxes(rows, blocks.centres, count);
   }
   a.childStart.assign(static_cast<std::size_t>(count) + 1, 0);
   for (int g : a.parent) ++a.childStart[static_cast<std::size_t>(g) + 1];
@@ -382,33 +418,90 @@ Agglomeration agglomerate(const BlockRows<double>& rows,
     const int first = a.childStart[g], last = a.childStart[g + 1];
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     for (int k = first; k < last; ++k)
-      sum += centres[static_cast<std::size_t>(a.children[static_cast<std::size_t>(k)])];
+      sum += blocks.centres[static_cast<std::size_t>(a.children[static_cast<std::size_t>(k)])];
     a.centres[g] = sum / (last - first);
     for (int k = first; k < last; ++k) {
       const std::size_t b = static_cast<std::size_t>(a.children[static_cast<std::size_t>(k)]);
-      a.scales[g] = std::max(a.scales[g], (centres[b] - a.centres[g]).norm() + scales[b]);
+      a.scales[g] =
+          std::max(a.scales[g], (blocks.centres[b] - a.centres[g]).norm() + blocks.scales[b]);
     }
   }
-  const int n = a.functions;
-  const std::size_t size = static_cast<std::size_t>(n * n);
+  const int n = a.functions, nf = a.blockFunctions;
+  const std::size_t size = static_cast<std::size_t>(nf * n),
+                    spanSize = static_cast<std::size_t>(n * n);
   a.weights.resize(size * static_cast<std::size_t>(nb));
-  tbb::parallel_for(0, nb, [&](int b) {
-    const std::size_t i = static_cast<std::size_t>(b);
-    const std::size_t g = static_cast<std::size_t>(a.parent[i]);
-    // Column j: the group's monomial j, ((x - C) / H)^a, in the block's scaled monomials
-    // ((x - c) / h)^b (x = c + h y: sigma = h / H, d = (c - C) / H).
-    const Eigen::MatrixXd change =
-        monomialShift(degree, scales[i] / a.scales[g], (centres[i] - a.centres[g]) / a.scales[g])
-            .transpose();
-    // phi = T m: the group function sum_a change(a, j) m_a is sum_i W(i, j) phi_i with
-    // T^T W = change (T lower triangular).
-    Eigen::Map<Eigen::MatrixXd> w(a.weights.data() + size * i, n, n);
-    if (bases != nullptr)
-      w = (*bases)[i].topLeftCorner(n, n).transpose().triangularView<Eigen::Upper>().solve(change);
-    else
-      w = change;
+  a.spans.resize(spanSize * static_cast<std::size_t>(count));
+  a.ranks.assign(static_cast<std::size_t>(count), n);
+  tbb::parallel_for(0, count, [&](int g) {
+    const std::size_t gi = static_cast<std::size_t>(g);
+    Eigen::MatrixXd gram = Eigen::MatrixXd::Zero(n, n);
+    for (int k = a.childStart[gi]; k < a.childStart[gi + 1]; ++k) {
+      const std::size_t i = static_cast<std::size_t>(a.children[static_cast<std::size_t>(k)]);
+      // Column j: the group's monomial j, ((x - C) / H)^a, in the block's scaled monomials
+      // ((x - c) / h)^b (x = c + h y: sigma = h / H, d = (c - C) / H), of degree <= the
+      // block's: all of it, or its Taylor part at c.
+      const Eigen::MatrixXd change =
+          monomialShift(degree, blocks.scales[i] / a.scales[gi],
+                        (blocks.centres[i] - a.centres[gi]) / a.scales[gi])
+              .transpose()
+              .topRows(nf);
+      // In the block's functions: phi = T m, so T^T W = change (T lower triangular); F = S^T m
+      // with orthonormal (or zero) columns, so W = S^T change.
+      Eigen::Map<Eigen::MatrixXd> w(a.weights.data() + size * i, nf, n);
+      if (blocks.triangular != nullptr)
+        w = (*blocks.triangular)[i]
+                .topLeftCorner(nf, nf)
+                .transpose()
+                .triangularView<Eigen::Upper>()
+                .solve(change);
+      else if (blocks.spans != nullptr)
+        w = Eigen::Map<const Eigen::MatrixXd>(
+                blocks.spans->data() + static_cast<std::size_t>(nf * nf) * i, nf, nf)
+                .transpose() *
+            change;
+      else
+        w = change;
+      gram.noalias() += w.transpose() * w;
+    }
+    Eigen::Map<Eigen::MatrixXd> span(a.spans.data() + spanSize * gi, n, n);
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(gram);
+    const Eigen::VectorXd& lambda = eigen.eigenvalues();  // increasing
+    int rank = 0;
+    while (rank < n && lambda[n - 1 - rank] > kSpanTolerance * lambda[n - 1]) ++rank;
+    if (rank == n) {
+      span.setIdentity();
+      return;
+    }
+    a.ranks[gi] = rank;
+    span.setZero();
+    span.leftCols(rank) = eigen.eigenvectors().rightCols(rank).rowwise().reverse();
+    for (int k = a.childStart[gi]; k < a.childStart[gi + 1]; ++k) {
+      const std::size_t i = static_cast<std::size_t>(a.children[static_cast<std::size_t>(k)]);
+      Eigen::Map<Eigen::MatrixXd> w(a.weights.data() + size * i, nf, n);
+      w = (w * span).eval();
+    }
   });
   return a;
+}
+
+}  // namespace
+
+Agglomeration agglomerate(const BlockRows<double>& rows,
+                          const std::vector<Eigen::Vector3d>& centres,
+                          const std::vector<double>& scales,
+                          const std::vector<Eigen::MatrixXd>* bases,
+                          const std::vector<Eigen::Vector3i>& cells, int degree) {
+  BlockFunctions blocks{centres, scales};
+  blocks.triangular = bases;
+  blocks.functions = numMonomials(std::clamp(degree, 1, 2));
+  return groupBlocks(rows, blocks, cells, degree);
+}
+
+Agglomeration agglomerate(const BlockRows<double>& rows, const Agglomeration& finer, int degree) {
+  BlockFunctions blocks{finer.centres, finer.scales};
+  blocks.spans = &finer.spans;
+  blocks.functions = finer.functions;
+  return groupBlocks(rows, blocks, finer.cells, degree);
 }
 
 }  // namespace polydg

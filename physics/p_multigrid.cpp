@@ -53,13 +53,16 @@ constexpr int kMaxGroupUnknowns = kMaxGroupBlocks * kMaxBlock;
 /// V-cycle; its factorization should cost about one V-cycle on K. A coarse matrix with 12 x 12
 /// blocks on a 3D mesh factorizes in about 13 N^2 flops for N unknowns (B2: 28.7 MFlop at
 /// 1,500 unknowns, 0.9 at 324), about what a V-cycle costs at 13 flops per nonzero of K when
-/// N^2 = nnz(K). So agglomeration continues while N^2 > nnz(K), and at least down to
-/// kCoarseUnknowns. On B2 this agglomerates once more for p = 1 (nnz(K) = 4.0e5 for BZ: 24
-/// instead of 21 iterations, but 0.7 instead of 10-13 ms of factorization), and for p = 2,
-/// whose first groups carry quadratic displacements (nnz(K) = 2.5e6 for BZ, 125 groups of 30
-/// unknowns, then 27: 26 iterations; the 1,500 unknowns of linear groups, when p = 2 went
-/// through degree 1, were kept exact: 25). Denser 30 x 30 blocks cost more flops per N^2; the
-/// rule is not tuned to them.
+/// N^2 = nnz(K). With b x b blocks a factorization costs about b^3 per pair of the N / b block
+/// unknowns, b N^2: for 3 n x 3 n blocks (n functions per component) agglomeration continues
+/// while N^2 > 4 nnz(K) / n (nnz(K) for linear groups, 0.4 nnz(K) for quadratic ones), and
+/// at least down to kCoarseUnknowns. On B2 (nnz(K) = 4.0e5 for BZ, p = 1) that is 125 linear
+/// groups (1,500 unknowns), 27 quadratic ones (810) and 8 (240): 21 iterations (with linear
+/// groups of groups, 324 unknowns: 24; with the 1,500 exact: 21, but 10-13 ms of
+/// factorization instead of 0.7). For p = 2 (nnz(K) = 2.5e6) 125 quadratic groups (3,750)
+/// and 27 (810): 26 iterations (the 1,500 unknowns of linear groups, when p = 2 went through
+/// degree 1, were kept exact: 25). At 1.3 million DOFs (48^3 cells, p = 1, IP) the bound for
+/// quadratic groups factorizes 810 unknowns instead of 6,480.
 constexpr Eigen::Index kCoarseUnknowns = 600;
 
 /// How a level's unknowns reach the next coarser level.
@@ -110,7 +113,9 @@ struct Level {
   mutable Eigen::VectorXd b, x;
 
   /// Blocks (elements or groups) of the level.
-  Eigen::Index blockCount() const { return rows ? rows->elements() : matrix->cols() / bs; }
+  Eigen::Index blockCount() const {
+    return rows ? rows->elements() : useBlocks ? blocks.elements() : matrix->cols() / bs;
+  }
 };
 
 /// The principal submatrix of `fine` (n functions per component) on the DOFs of the first
@@ -524,7 +529,9 @@ struct PMultigrid::Impl {
 
   /// Colours, smoother groups and their inverses of a level that is smoothed.
   bool prepareSmoother(Level& level, const BlockRows<double>* matrixBlocks) {
-    if (!level.rows) {  // the top level given by rows: the smoother reads the caller's rows
+    // The top level given by rows: the smoother reads the caller's rows; a level converted
+    // already: keepSmootherCopyOnly().
+    if (!level.rows && !level.useBlocks) {
       if (matrixBlocks == nullptr) matrixBlocks = level.source;
       if (matrixBlocks != nullptr && !matrixBlocks->values.empty()) {
         level.blocks.convertFrom(*matrixBlocks);
@@ -550,27 +557,45 @@ struct PMultigrid::Impl {
     return invertGroups(level);
   }
 
-  /// Appends the agglomeration level of levels.back(), whose blocks have the given centres,
-  /// scales and lattice cells (the frames for the element level, then the groups of the level
-  /// before; no cells: grouped by pairing); `bases`, for the element level, the frames' T_e;
-  /// `degree` that of the groups' functions, the degree of the level's own blocks.
-  /// They are read before the levels grow (they may belong to a level).
-  void addAggregateLevel(const std::vector<Eigen::Vector3d>& centres,
-                         const std::vector<double>& scales,
-                         const std::vector<Eigen::MatrixXd>* bases,
-                         const std::vector<Eigen::Vector3i>& cells, int degree) {
+  /// Appends the agglomeration level of levels.back() with functions of `degree`: groups of
+  /// its elements (`frames`) or, without frames, of the groups of the level before.
+  void addAggregateLevel(const ElementFrames* frames, int degree) {
     Level& fine = levels.back();
     fine.transfer = Transfer::Aggregate;
     if (fine.source == nullptr) {
       fine.exact.build(*fine.matrix, fine.n, std::numeric_limits<double>::infinity());
       fine.source = &fine.exact;
+      // A level of our own is smoothed from block rows (converted from these), unless it
+      // ends up the coarsest (then rebuilt from them): its CSR matrix is not needed meanwhile.
+      if (&fine != &levels.front()) fine.owned = SpMat();
     }
-    fine.groups = agglomerate(*fine.source, centres, scales, bases, cells, degree);
+    if (frames != nullptr) {
+      const std::vector<Eigen::Vector3i> noCells;
+      const bool lattice = frames->cells.size() == frames->centres.size();
+      fine.groups = agglomerate(*fine.source, frames->centres, frames->scales, &frames->bases,
+                                lattice ? frames->cells : noCells, degree);
+    } else {
+      // The groups of the level before are read before the levels grow.
+      fine.groups = agglomerate(*fine.source, levels[levels.size() - 2].groups, degree);
+    }
     Level level;
     level.n = numMonomials(degree);
     level.bs = 3 * level.n;
     level.owned = galerkinMatrix(fine.groups, *fine.source);
     push(std::move(level));
+  }
+
+  /// Keeps of a coarse level that is smoothed (not the top, not the coarsest) only what its
+  /// smoother reads: its matrix by block rows in single precision, converted from the double
+  /// ones that served the grouping and the Galerkin product of the next level (its CSR matrix
+  /// is gone already, addAggregateLevel()). Holding both copies of levels 1 and 2 took the
+  /// peak memory of `polydg solve` on the 48^3 cube (p = 1, IP, 1.3 million DOFs) from 1.85 to
+  /// 2.04 GB.
+  void keepSmootherCopyOnly(Level& level) {
+    level.blocks.convertFrom(level.exact);
+    level.useBlocks = true;
+    level.exact = BlockRows<double>();
+    level.source = nullptr;
   }
 
   /// Appends a coarser level that owns its matrix. Re-points every owned matrix: the vector
@@ -637,7 +662,7 @@ struct PMultigrid::Impl {
   void restrictedResidual(const Level& fine, const Level& next, const Eigen::VectorXd& b,
                           const Eigen::VectorXd& x) const {
     const int n = fine.n, nc = next.n;
-    const Eigen::Index coarseBlocks = next.matrix->cols() / next.bs;
+    const Eigen::Index coarseBlocks = next.blockCount();
     next.b.resize(coarseBlocks * next.bs);
     if (fine.transfer == Transfer::Degree) {
       tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, coarseBlocks, 16),
@@ -802,24 +827,33 @@ bool PMultigrid::Impl::build(const SpMat* matrix, const BlockRows<double>* rows,
     Level& elements = m.levels.back();
     if (m.levels.size() == 1 && matrixBlocks != nullptr && !matrixBlocks->values.empty())
       elements.source = matrixBlocks;
-    const std::vector<Eigen::Vector3i> noCells;
-    m.addAggregateLevel(
-        frames->centres, frames->scales, &frames->bases,
-        frames->cells.size() == static_cast<std::size_t>(ne) ? frames->cells : noCells,
-        groupDegree);
-    // Further levels while the coarsest is large and grouping still shrinks it. Their
-    // smoothing is cheap (an eighth of the blocks each), so they sweep twice: a V-cycle with
-    // two agglomeration levels then needs about as many iterations as one with an exact
-    // first agglomeration level on B2 (not on the bunny at 16 cells, p = 2: 44-52 against
-    // 35-38; README, "Speed").
-    const double limit = std::max(static_cast<double>(kCoarseUnknowns), std::sqrt(nonzeros));
-    while (static_cast<double>(m.levels.back().matrix->rows()) > limit) {
+    m.addAggregateLevel(frames, groupDegree);
+    // Further levels while the coarsest is large and grouping still shrinks it, all with
+    // quadratic functions: groups of 4 x 4 x 4 cells and more span the thin parts of a real
+    // model (the bunny's ears), which bend within a group (for p = 1, linear groups take the
+    // Taylor parts of their parent's quadratics). Their smoothing is cheap (an eighth of the
+    // blocks each), so they sweep twice: a V-cycle with two agglomeration levels then needs
+    // about as many iterations as one with an exact first agglomeration level on B2 (not on
+    // the bunny at 16 cells, p = 2: 44-52 against 35-38; README, "Speed").
+    auto large = [&](const Level& level) {
+      return static_cast<double>(level.matrix->rows()) >
+             std::max(static_cast<double>(kCoarseUnknowns), std::sqrt(nonzeros));
+    };
+    while (large(m.levels.back())) {
       const Eigen::Index before = m.levels.back().matrix->rows();
       m.levels.back().sweeps = 2;
       // The blocks of the last level are the groups of the one before.
-      const Agglomeration& blocks = m.levels[m.levels.size() - 2].groups;
-      m.addAggregateLevel(blocks.centres, blocks.scales, nullptr, blocks.cells, groupDegree);
-      if (m.levels.back().matrix->rows() * 4 > before * 3) break;  // grouping stalled
+      m.addAggregateLevel(nullptr, 2);
+      const Eigen::Index after = m.levels.back().matrix->rows();
+      if (after >= before) {  // quadratic groups of groups on a line: no fewer unknowns
+        m.levels.pop_back();
+        Level& coarsest = m.levels.back();  // factorized: its CSR matrix again
+        coarsest.owned = coarsest.exact.toSparse();
+        coarsest.matrix = &coarsest.owned;
+        break;
+      }
+      m.keepSmootherCopyOnly(m.levels[m.levels.size() - 2]);
+      if (after * 4 > before * 3) break;  // grouping stalled
     }
   } else if (degree > 0) {
     // Level 0 couples elements through the penalty, mu eta_F [u].[v], which couples equal

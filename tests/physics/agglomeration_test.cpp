@@ -10,6 +10,8 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/SparseCholesky>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -39,20 +41,21 @@ using bench::BenchmarkMesh;
 
 using SpMat = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
 
-/// P of `groups` for a matrix with n functions per component (the first groups.functions
-/// take part).
+/// P of `groups` for a matrix with n functions per component (the first
+/// groups.blockFunctions take part).
 SpMat prolongation(const Agglomeration& groups, int n) {
-  const int nb = static_cast<int>(groups.parent.size()), m = groups.functions;
-  const std::size_t size = static_cast<std::size_t>(m * m);
+  const int nb = static_cast<int>(groups.parent.size()), m = groups.functions,
+            mf = groups.blockFunctions;
+  const std::size_t size = static_cast<std::size_t>(mf * m);
   std::vector<Eigen::Triplet<double>> entries;
   for (int b = 0; b < nb; ++b) {
     const int g = groups.parent[static_cast<std::size_t>(b)];
     for (int d = 0; d < 3; ++d)
-      for (int i = 0; i < m; ++i)
+      for (int i = 0; i < mf; ++i)
         for (int j = 0; j < m; ++j)
           entries.emplace_back(3 * n * b + n * d + i, 3 * m * g + m * d + j,
                                groups.weights[size * static_cast<std::size_t>(b) +
-                                              static_cast<std::size_t>(i + m * j)]);
+                                              static_cast<std::size_t>(i + mf * j)]);
   }
   SpMat p(3 * n * nb, 3 * m * groups.groups());
   p.setFromTriplets(entries.begin(), entries.end());
@@ -314,9 +317,10 @@ TEST_P(CoarseFunctions, AreThePolynomialDisplacementsOfEachGroup) {
   // degree-`degree` part of K).
   const BlockRows<double> part = blockRows(restrictToDegree(solver.system().matrix, n, m), m);
   const Agglomeration second =
-      agglomerate(blockRows(galerkinMatrix(groups, part), m), groups.centres, groups.scales,
-                  nullptr, groups.cells, degree);
+      agglomerate(blockRows(galerkinMatrix(groups, part), m), groups, degree);
   EXPECT_LT(second.groups(), groups.groups() / 3);
+  // Blocks of the full degree tell every polynomial apart: no group drops a combination.
+  EXPECT_EQ(std::count(second.ranks.begin(), second.ranks.end(), m), second.groups());
   const PolynomialField u(degree);
   std::vector<double> phi(static_cast<std::size_t>(n));
   const std::size_t size = static_cast<std::size_t>(m * m);
@@ -360,6 +364,103 @@ INSTANTIATE_TEST_SUITE_P(Agglomeration, CoarseFunctions, ::testing::Values(1, 2)
                            return info.param == 1 ? std::string("Linear")
                                                   : std::string("Quadratic");
                          });
+
+/// Linear groups (of linear elements, B1's sliced mesh, p = 1) grouped with quadratic
+/// functions: on each linear group, a quadratic displacement of its group becomes its value and
+/// gradient at the linear group's centre (the Taylor part), exactly; the Galerkin matrix of
+/// these 4 -> 10 weights is P^T K P formed explicitly, exactly symmetric.
+TEST(Agglomeration, QuadraticGroupsOfLinearGroupsTakeTheirTaylorParts) {
+  const FramedSystem s = b1FramedSystem(benchmarkB1Mesh(BenchmarkMesh::Sliced, 6), Method::IP, 1);
+  const BlockRows<double> rows = blockRows(s.system.matrix, 4);
+  const Agglomeration groups =
+      agglomerate(rows, s.frames.centres, s.frames.scales, &s.frames.bases, s.frames.cells, 1);
+  const SpMat coarse = galerkinMatrix(groups, rows);
+  const BlockRows<double> coarseRows = blockRows(coarse, 4);
+  const Agglomeration second = agglomerate(coarseRows, groups, 2);
+  ASSERT_EQ(second.functions, 10);
+  ASSERT_EQ(second.blockFunctions, 4);
+  EXPECT_LT(second.groups(), groups.groups() / 3);
+  const PolynomialField u(2);
+  double worst = 0.0;
+  int checked = 0;
+  for (int g = 0; g < groups.groups(); ++g) {
+    const std::size_t top = static_cast<std::size_t>(second.parent[static_cast<std::size_t>(g)]);
+    if (second.ranks[top] < 10) continue;  // its blocks cannot tell every quadratic apart
+    ++checked;
+    const Eigen::Map<const Eigen::MatrixXd> w(
+        second.weights.data() + 40 * static_cast<std::size_t>(g), 4, 10);
+    for (int d = 0; d < 3; ++d) {
+      const Eigen::VectorXd taylor = u.coefficients(d, groups.centres[static_cast<std::size_t>(g)],
+                                                    groups.scales[static_cast<std::size_t>(g)])
+                                         .head(4);
+      const Eigen::VectorXd got = w * u.coefficients(d, second.centres[top], second.scales[top]);
+      worst = std::max(worst, (got - taylor).norm() / taylor.norm());
+    }
+  }
+  EXPECT_GT(checked, groups.groups() / 2);
+  EXPECT_LT(worst, 1e-12);
+  const SpMat p = prolongation(second, 4);
+  const SpMat expected = SpMat(p.transpose() * coarse * p);
+  const SpMat got = galerkinMatrix(second, coarseRows);
+  const double scale = Eigen::MatrixXd(expected).cwiseAbs().maxCoeff();
+  Eigen::MatrixXd difference = Eigen::MatrixXd(got - expected);
+  // Unknowns that prolong to nothing get a unit diagonal (none are expected here, but the
+  // comparison allows for them).
+  for (int g = 0; g < second.groups(); ++g)
+    for (int j = second.ranks[static_cast<std::size_t>(g)]; j < 10; ++j)
+      for (int d = 0; d < 3; ++d) difference(30 * g + 10 * d + j, 30 * g + 10 * d + j) -= 1.0;
+  EXPECT_LT(difference.cwiseAbs().maxCoeff(), 1e-13 * scale);
+  EXPECT_EQ(Eigen::MatrixXd(got - SpMat(got.transpose())).cwiseAbs().maxCoeff(), 0.0);
+}
+
+/// A bar one cell thick (16 x 1 x 1 hexahedra, p = 1), far from the origin: linear groups of
+/// 2 x 1 x 1 cells lie on a line (up to the round-off of their centres), so their Taylor parts
+/// cannot tell y^2, z^2 and y z from zero. Each quadratic group of two keeps the other 7
+/// combinations (orthonormal), the 3 dropped ones become decoupled unknowns with a unit
+/// diagonal, and the Galerkin matrix stays positive definite.
+TEST(Agglomeration, GroupsOnALineKeepTheCombinationsTheirBlocksTellApart) {
+  const PolyMesh bar =
+      hexGridMesh(16, 1, 1, Box3(Vec3(1000.1, -200.3, 50.7), Vec3(1004.1, -200.05, 50.95)));
+  const FramedSystem s = b1FramedSystem(bar, Method::IP, 1);
+  const BlockRows<double> rows = blockRows(s.system.matrix, 4);
+  const Agglomeration groups =
+      agglomerate(rows, s.frames.centres, s.frames.scales, &s.frames.bases, s.frames.cells, 1);
+  ASSERT_EQ(groups.groups(), 8);
+  const SpMat coarse = galerkinMatrix(groups, rows);
+  const BlockRows<double> coarseRows = blockRows(coarse, 4);
+  const Agglomeration second = agglomerate(coarseRows, groups, 2);
+  ASSERT_EQ(second.groups(), 4);
+  for (int g = 0; g < 4; ++g) {
+    EXPECT_EQ(second.ranks[static_cast<std::size_t>(g)], 7) << g;
+    const Eigen::Map<const Eigen::MatrixXd> span(
+        second.spans.data() + 100 * static_cast<std::size_t>(g), 10, 10);
+    const Eigen::MatrixXd kept = span.leftCols(7);
+    EXPECT_LT((kept.transpose() * kept - Eigen::MatrixXd::Identity(7, 7)).norm(), 1e-12);
+    EXPECT_EQ(span.rightCols(3).norm(), 0.0);
+    // No kept combination is one of the dropped monomials y^2, y z, z^2.
+    for (const int dropped :
+         {monomialIndex(0, 2, 0), monomialIndex(0, 1, 1), monomialIndex(0, 0, 2)})
+      EXPECT_LT(kept.row(dropped).norm(), 1e-12) << dropped;
+  }
+  // Centres off the line by 1e-6 of a group's size (a round-off of slicing): their Taylor
+  // parts tell y^2 apart from zero by 1e-12 of the rest, which a coarse correction cannot
+  // use: still dropped.
+  Agglomeration bent = groups;
+  for (std::size_t g = 0; g < bent.centres.size(); g += 2)
+    bent.centres[g].y() += 1e-6 * bent.scales[g];
+  const Agglomeration nearly = agglomerate(coarseRows, bent, 2);
+  for (int g = 0; g < 4; ++g) EXPECT_EQ(nearly.ranks[static_cast<std::size_t>(g)], 7) << g;
+  const SpMat a = galerkinMatrix(second, coarseRows);
+  for (int g = 0; g < 4; ++g)
+    for (int d = 0; d < 3; ++d)
+      for (int j = 7; j < 10; ++j) {
+        const int u = 30 * g + 10 * d + j;
+        EXPECT_EQ(a.coeff(u, u), 1.0);
+        EXPECT_EQ(Eigen::VectorXd(a.col(u)).cwiseAbs().sum(), 1.0);  // decoupled
+      }
+  const Eigen::SimplicialLLT<SpMat> llt(a);
+  EXPECT_EQ(llt.info(), Eigen::Success);
+}
 
 /// galerkinMatrix against P^T K P of Eigen's sparse products, and its exact symmetry, for
 /// groups by lattice cells and by pairing, of the degree of `s` (1 or 2).

@@ -109,21 +109,17 @@ TEST(PMultigrid, AgglomeratesNeedFewerIterationsThanConstantsOnTheBentCube) {
   }
 }
 
-TEST(PMultigrid, AgglomeratesOfTwoSeparateBodies) {
-  // Two bodies (two elements and one): groups never join them; the lone element is a group of
-  // its own. CG still reproduces Cholesky's solution.
-  const FramedSystem s = b1FramedSystem(testing::twoSeparateBlocks(), Method::IP, 2);
+/// CG with the p-multigrid of `s`'s frames reproduces Cholesky's solution of `s`.
+void expectCgMatchesCholesky(const FramedSystem& s) {
   SolverOptions direct;
   direct.kind = SolverKind::Cholesky;
   LinearSolveReport directReport;
   const Eigen::VectorXd reference =
       solveLinearSystem(s.system.matrix, s.system.rhs, s.system.blockSize, direct, directReport);
   ASSERT_TRUE(directReport.success);
-  PMultigrid mg;
-  ASSERT_TRUE(mg.compute(s.system.matrix, 2, nullptr, &s.frames));
-  EXPECT_EQ(mg.coarseUnknowns(), 2 * 30);  // quadratic displacements of each group
   SolverOptions cg;
   cg.kind = SolverKind::ConjugateGradient;
+  cg.tolerance = kCgTolerance;
   LinearSolver solver(cg);
   ASSERT_TRUE(solver.compute(s.system.matrix, s.system.blockSize, &s.frames));
   LinearSolveReport report;
@@ -132,14 +128,25 @@ TEST(PMultigrid, AgglomeratesOfTwoSeparateBodies) {
   EXPECT_LE((u - reference).norm(), kSolutionAgreement * reference.norm());
 }
 
+TEST(PMultigrid, AgglomeratesOfTwoSeparateBodies) {
+  // Two bodies (two elements and one): groups never join them; the lone element is a group of
+  // its own. CG still reproduces Cholesky's solution.
+  const FramedSystem s = b1FramedSystem(testing::twoSeparateBlocks(), Method::IP, 2);
+  PMultigrid mg;
+  ASSERT_TRUE(mg.compute(s.system.matrix, 2, nullptr, &s.frames));
+  EXPECT_EQ(mg.coarseUnknowns(), 2 * 30);  // quadratic displacements of each group
+  expectCgMatchesCholesky(s);
+}
+
 TEST(PMultigrid, AgglomerationLevelsOfTheHexCube) {
-  // 1000 elements of degree 1: 125 groups of 2 x 2 x 2 (1,500 unknowns), then 27 groups
-  // (324), small enough to factorize (324^2 <= nnz(K)).
+  // 1000 elements of degree 1: 125 groups of 2 x 2 x 2 with linear displacements (1,500
+  // unknowns), then 27 groups with quadratic ones (810, more than sqrt(nnz(K)) = 632 with
+  // nnz(K) = 4.0e5), then 8 (240), small enough to factorize.
   const FramedSystem s = b2FramedSystem(Method::BZ, 1);
   PMultigrid mg;
   ASSERT_TRUE(mg.compute(s.system.matrix, 1, nullptr, &s.frames));
-  EXPECT_EQ(mg.levels(), 3);
-  EXPECT_EQ(mg.coarseUnknowns(), 324);
+  EXPECT_EQ(mg.levels(), 4);
+  EXPECT_EQ(mg.coarseUnknowns(), 240);
   // Degree 2: straight to groups with quadratic displacements (30 unknowns each), 125 of them
   // (3,750 unknowns, more than sqrt(nnz(K)) = 1,581 with nnz(K) = 2.5e6), then 27 (810).
   const FramedSystem q = b2FramedSystem(Method::BZ, 2);
@@ -215,6 +222,20 @@ TEST(PMultigrid, GroupedSmootherOnASlicedTorus) {
   std::printf("sliced torus, p = 2: %d iterations\n", report.iterations);
   EXPECT_TRUE(report.success);
   EXPECT_LE(report.iterations, kTorusIterations);
+}
+
+TEST(PMultigrid, QuadraticGroupsThatWouldNotShrinkTheLevelAreNotAdded) {
+  // A bar of 256 x 1 x 1 elements of degree 1: 128 linear groups of two (1,536 unknowns, more
+  // than kCoarseUnknowns), whose quadratic groups of two would be 64 x 30 = 1,920 unknowns:
+  // the linear level stays the coarsest. CG still reproduces Cholesky's solution.
+  const FramedSystem s =
+      framedSystem(hexGridMesh(256, 1, 1, Box3(Vec3::Zero(), Vec3(25.6, 0.1, 0.1))),
+                   bench::benchmarkB2Material(), bench::benchmarkB2Loads(), Method::IP, 1);
+  PMultigrid mg;
+  ASSERT_TRUE(mg.compute(s.system.matrix, 1, nullptr, &s.frames));
+  EXPECT_EQ(mg.levels(), 2);
+  EXPECT_EQ(mg.coarseUnknowns(), 1536);
+  expectCgMatchesCholesky(s);
 }
 
 TEST(PMultigrid, PlateOneElementThickNeedsAboutTheCubesIterations) {

@@ -55,14 +55,27 @@ struct Agglomeration {
   /// Block b belongs to group parent[b]; group g's blocks are
   /// children[childStart[g] .. childStart[g + 1] - 1], in increasing order.
   std::vector<int> parent, childStart, children;
-  /// Functions per displacement component, of each group and of each block that take part
-  /// (the block's first ones): numMonomials(degree), 4 (linear) or 10 (quadratic).
+  /// Functions per displacement component of each group, numMonomials(degree): 4 (linear)
+  /// or 10 (quadratic); and of each block, those that take part (the block's first ones):
+  /// `functions`, or 4 when linear groups are grouped with quadratic functions.
   int functions = 4;
-  /// Group g's functions M_j, the scaled monomials ((x - C_g) / H_g)^a of degree <= the
-  /// degree. On its block b, M_j = sum_i W_b(i, j) phi_i over the block's first `functions`
-  /// functions phi_i (which span the polynomials of that degree: exact), W_b column-major at
-  /// weights[functions^2 b]; the same for each displacement component.
+  int blockFunctions = 4;
+  /// Group g's functions F_j = sum_a S_g(a, j) M_a, combinations of the scaled monomials
+  /// M_a = ((x - C_g) / H_g)^a of degree <= the degree. On its block b, F_j = sum_i W_b(i, j)
+  /// phi_i over the block's first `blockFunctions` functions phi_i, W_b column-major at
+  /// weights[functions blockFunctions b]; the same for each displacement component. Exact
+  /// when the blocks' functions span the groups' polynomials; linear blocks of quadratic
+  /// groups take each monomial's Taylor part at their centre (value and gradient).
   std::vector<double> weights;
+  /// S_g (functions x functions, column-major at spans[functions^2 g]): the identity, unless
+  /// the group's blocks cannot tell some monomial combinations apart (linear blocks on a line
+  /// or a plane: their Taylor parts vanish together). Then S_g's first ranks[g] columns are an
+  /// orthonormal basis of the combinations they do tell apart (the eigenvectors of
+  /// sum_b W_b^T W_b above kSpanTolerance of its largest eigenvalue) and the rest zero:
+  /// unknowns that prolong to nothing, with a unit diagonal in galerkinMatrix() and zero
+  /// right-hand side, so the coarse correction is exact on the rest.
+  std::vector<double> spans;
+  std::vector<int> ranks;
   /// Each group's centre C_g (the mean of its blocks' centres) and scale H_g, large enough
   /// that |x - C_g| <= H_g on each block (given |x - c_b| <= h_b there).
   std::vector<Eigen::Vector3d> centres;
@@ -99,9 +112,15 @@ Agglomeration agglomerate(const BlockRows<double>& rows,
                           const std::vector<Eigen::MatrixXd>* bases,
                           const std::vector<Eigen::Vector3i>& cells = {}, int degree = 1);
 
+/// The groups of the groups of `finer` (whose Galerkin matrix `rows` has finer.functions per
+/// component), by finer.cells if any, with functions of `degree` >= finer's degree: their
+/// blocks' functions are finer's F_j (the spans S_g included).
+Agglomeration agglomerate(const BlockRows<double>& rows, const Agglomeration& finer, int degree);
+
 /// The Galerkin matrix P^T A P of the coarse space of `groups` (n = groups.functions per
 /// component of each group, unknown (g, d, j) at 3 n g + n d + j), from A by block rows in
-/// double precision with the same n functions per component (else std::invalid_argument). A
+/// double precision with groups.blockFunctions per component (else std::invalid_argument),
+/// with a unit diagonal for the unknowns that prolong to nothing (Agglomeration::spans). A
 /// coarse block whose displacement components are uncoupled (BZ's) stores only its three
 /// diagonal n x n parts. Exactly
 /// symmetric, both triangles stored.
