@@ -53,16 +53,16 @@ constexpr int kMaxGroupUnknowns = kMaxGroupBlocks * kMaxBlock;
 /// V-cycle; its factorization should cost about one V-cycle on K. A coarse matrix with 12 x 12
 /// blocks on a 3D mesh factorizes in about 13 N^2 flops for N unknowns (B2: 28.7 MFlop at
 /// 1,500 unknowns, 0.9 at 324), about what a V-cycle costs at 13 flops per nonzero of K when
-/// N^2 = nnz(K). With b x b blocks a factorization costs about b^3 per pair of the N / b block
-/// unknowns, b N^2: for 3 n x 3 n blocks (n functions per component) agglomeration continues
-/// while N^2 > 4 nnz(K) / n (nnz(K) for linear groups, 0.4 nnz(K) for quadratic ones), and
-/// at least down to kCoarseUnknowns. On B2 (nnz(K) = 4.0e5 for BZ, p = 1) that is 125 linear
-/// groups (1,500 unknowns), 27 quadratic ones (810) and 8 (240): 21 iterations (with linear
-/// groups of groups, 324 unknowns: 24; with the 1,500 exact: 21, but 10-13 ms of
-/// factorization instead of 0.7). For p = 2 (nnz(K) = 2.5e6) 125 quadratic groups (3,750)
-/// and 27 (810): 26 iterations (the 1,500 unknowns of linear groups, when p = 2 went through
-/// degree 1, were kept exact: 25). At 1.3 million DOFs (48^3 cells, p = 1, IP) the bound for
-/// quadratic groups factorizes 810 unknowns instead of 6,480.
+/// N^2 = nnz(K). So agglomeration continues while N^2 > nnz(K), and at least down to
+/// kCoarseUnknowns. On B2 (nnz(K) = 4.0e5 for BZ, p = 1) that is 125 linear groups (1,500
+/// unknowns), 27 quadratic ones (810) and 8 (240): 21 iterations (with linear groups of
+/// groups, 324 unknowns: 24; with the 1,500 exact: 21, but 10-13 ms of factorization instead
+/// of 0.7). For p = 2 (nnz(K) = 2.5e6) 125 quadratic groups (3,750) and 27 (810): 26
+/// iterations (the 1,500 unknowns of linear groups, when p = 2 went through degree 1, were
+/// kept exact: 25). Denser 30 x 30 blocks cost more flops per N^2 (about 2.5 times), but a
+/// bound scaled to them (N^2 <= 0.4 nnz(K)) cost iterations (a 24 x 24 x 1 plate, p = 2: 45
+/// instead of 36; the 48^3 cube, p = 1, BZ: 26 instead of 22) and saved neither memory nor
+/// time there (IP: 810 coarse unknowns instead of 6,480), so the rule stays.
 constexpr Eigen::Index kCoarseUnknowns = 600;
 
 /// How a level's unknowns reach the next coarser level.
@@ -589,8 +589,8 @@ struct PMultigrid::Impl {
   /// smoother reads: its matrix by block rows in single precision, converted from the double
   /// ones that served the grouping and the Galerkin product of the next level (its CSR matrix
   /// is gone already, addAggregateLevel()). Holding both copies of levels 1 and 2 took the
-  /// peak memory of `polydg solve` on the 48^3 cube (p = 1, IP, 1.3 million DOFs) from 1.85 to
-  /// 2.04 GB.
+  /// peak memory of `polydg solve` on the 48^3 cube (p = 1, IP, 1.3 million DOFs) from 1.77 to
+  /// 1.94 GB.
   void keepSmootherCopyOnly(Level& level) {
     level.blocks.convertFrom(level.exact);
     level.useBlocks = true;
@@ -831,15 +831,14 @@ bool PMultigrid::Impl::build(const SpMat* matrix, const BlockRows<double>* rows,
     // Further levels while the coarsest is large and grouping still shrinks it, all with
     // quadratic functions: groups of 4 x 4 x 4 cells and more span the thin parts of a real
     // model (the bunny's ears), which bend within a group (for p = 1, linear groups take the
-    // Taylor parts of their parent's quadratics). Their smoothing is cheap (an eighth of the
-    // blocks each), so they sweep twice: a V-cycle with two agglomeration levels then needs
-    // about as many iterations as one with an exact first agglomeration level on B2 (not on
-    // the bunny at 16 cells, p = 2: 44-52 against 35-38; README, "Speed").
-    auto large = [&](const Level& level) {
-      return static_cast<double>(level.matrix->rows()) >
-             std::max(static_cast<double>(kCoarseUnknowns), std::sqrt(nonzeros));
-    };
-    while (large(m.levels.back())) {
+    // Taylor parts of their parent's quadratics). They have an eighth of the blocks of the
+    // level before each (at p = 1 the first quadratic level, with 30 x 30 blocks, has 0.8 of
+    // the nonzeros of the linear level above it), so they sweep twice: a V-cycle with two
+    // agglomeration levels then needs about as many iterations as one with an exact first
+    // agglomeration level on B2 (not on the bunny at 16 cells: p = 1 34-37 against 31, p = 2
+    // 38-44 against 36-37; README, "Speed").
+    const double limit = std::max(static_cast<double>(kCoarseUnknowns), std::sqrt(nonzeros));
+    while (static_cast<double>(m.levels.back().matrix->rows()) > limit) {
       const Eigen::Index before = m.levels.back().matrix->rows();
       m.levels.back().sweeps = 2;
       // The blocks of the last level are the groups of the one before.
