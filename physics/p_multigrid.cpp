@@ -565,9 +565,6 @@ struct PMultigrid::Impl {
     if (fine.source == nullptr) {
       fine.exact.build(*fine.matrix, fine.n, std::numeric_limits<double>::infinity());
       fine.source = &fine.exact;
-      // A level of our own is smoothed from block rows (converted from these), unless it
-      // ends up the coarsest (then rebuilt from them): its CSR matrix is not needed meanwhile.
-      if (&fine != &levels.front()) fine.owned = SpMat();
     }
     if (frames != nullptr) {
       const std::vector<Eigen::Vector3i> noCells;
@@ -587,15 +584,15 @@ struct PMultigrid::Impl {
 
   /// Keeps of a coarse level that is smoothed (not the top, not the coarsest) only what its
   /// smoother reads: its matrix by block rows in single precision, converted from the double
-  /// ones that served the grouping and the Galerkin product of the next level (its CSR matrix
-  /// is gone already, addAggregateLevel()). Holding both copies of levels 1 and 2 took the
-  /// peak memory of `polydg solve` on the 48^3 cube (p = 1, IP, 1.3 million DOFs) from 1.77 to
-  /// 1.94 GB.
+  /// ones that served the grouping and the Galerkin product of the next level; those and its
+  /// CSR matrix are freed. Holding them at levels 1 and 2 took the peak memory of `polydg
+  /// solve` on the 48^3 cube (p = 1, IP, 1.3 million DOFs) from 1.77 to 1.94 GB.
   void keepSmootherCopyOnly(Level& level) {
     level.blocks.convertFrom(level.exact);
     level.useBlocks = true;
     level.exact = BlockRows<double>();
     level.source = nullptr;
+    level.owned = SpMat();
   }
 
   /// Appends a coarser level that owns its matrix. Re-points every owned matrix: the vector
@@ -846,9 +843,6 @@ bool PMultigrid::Impl::build(const SpMat* matrix, const BlockRows<double>* rows,
       const Eigen::Index after = m.levels.back().matrix->rows();
       if (after >= before) {  // quadratic groups of groups on a line: no fewer unknowns
         m.levels.pop_back();
-        Level& coarsest = m.levels.back();  // factorized: its CSR matrix again
-        coarsest.owned = coarsest.exact.toSparse();
-        coarsest.matrix = &coarsest.owned;
         break;
       }
       m.keepSmootherCopyOnly(m.levels[m.levels.size() - 2]);
