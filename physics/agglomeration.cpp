@@ -376,9 +376,8 @@ namespace {
 
 /// The functions of the blocks being grouped: each block's centre c_b and scale h_b, its
 /// functions per component that take part, and how they combine the block's scaled monomials
-/// m_a = ((x - c_b) / h_b)^a: elements phi = T_b m (`triangular`, ElementFrames::bases),
-/// groups of a finer agglomeration F = S_b^T m (`spans`, Agglomeration::spans), else the
-/// monomials themselves.
+/// m_a = ((x - c_b) / h_b)^a: elements phi = T_b m (`triangular`, ElementFrames::bases), or
+/// groups of a finer agglomeration F = S_b^T m (`spans`, Agglomeration::spans).
 struct BlockFunctions {
   const std::vector<Eigen::Vector3d>& centres;
   const std::vector<double>& scales;
@@ -454,13 +453,11 @@ Agglomeration groupBlocks(const BlockRows<double>& rows, const BlockFunctions& b
                 .transpose()
                 .triangularView<Eigen::Upper>()
                 .solve(change);
-      else if (blocks.spans != nullptr)
+      else
         w = Eigen::Map<const Eigen::MatrixXd>(
                 blocks.spans->data() + static_cast<std::size_t>(nf * nf) * i, nf, nf)
                 .transpose() *
             change;
-      else
-        w = change;
       gram.noalias() += w.transpose() * w;
     }
     Eigen::Map<Eigen::MatrixXd> span(a.spans.data() + spanSize * gi, n, n);
@@ -489,10 +486,10 @@ Agglomeration groupBlocks(const BlockRows<double>& rows, const BlockFunctions& b
 Agglomeration agglomerate(const BlockRows<double>& rows,
                           const std::vector<Eigen::Vector3d>& centres,
                           const std::vector<double>& scales,
-                          const std::vector<Eigen::MatrixXd>* bases,
+                          const std::vector<Eigen::MatrixXd>& bases,
                           const std::vector<Eigen::Vector3i>& cells, int degree) {
   BlockFunctions blocks{centres, scales};
-  blocks.triangular = bases;
+  blocks.triangular = &bases;
   blocks.functions = numMonomials(std::clamp(degree, 1, 2));
   return groupBlocks(rows, blocks, cells, degree);
 }

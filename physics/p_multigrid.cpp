@@ -569,7 +569,7 @@ struct PMultigrid::Impl {
     if (frames != nullptr) {
       const std::vector<Eigen::Vector3i> noCells;
       const bool lattice = frames->cells.size() == frames->centres.size();
-      fine.groups = agglomerate(*fine.source, frames->centres, frames->scales, &frames->bases,
+      fine.groups = agglomerate(*fine.source, frames->centres, frames->scales, frames->bases,
                                 lattice ? frames->cells : noCells, degree);
     } else {
       // The groups of the level before are read before the levels grow.

@@ -142,7 +142,7 @@ TEST(Agglomeration, GroupsAHexGridIntoCubesOfEight) {
   ASSERT_EQ(s.frames.cells.size(), 1000u);  // the grid is its own lattice
   const BlockRows<double> rows = blockRows(s.system.matrix, 4);
   const Agglomeration groups =
-      agglomerate(rows, s.frames.centres, s.frames.scales, &s.frames.bases, s.frames.cells);
+      agglomerate(rows, s.frames.centres, s.frames.scales, s.frames.bases, s.frames.cells);
   ASSERT_EQ(groups.groups(), 125);
   for (int g = 0; g < groups.groups(); ++g) {
     const int first = groups.childStart[static_cast<std::size_t>(g)];
@@ -160,12 +160,10 @@ TEST(Agglomeration, GroupsAHexGridIntoCubesOfEight) {
   }
   // Grouping the groups: 5 per axis pair into 3 (two pairs and one left alone).
   const SpMat coarse = galerkinMatrix(groups, rows);
-  const Agglomeration next =
-      agglomerate(blockRows(coarse, 4), groups.centres, groups.scales, nullptr, groups.cells);
+  const Agglomeration next = agglomerate(blockRows(coarse, 4), groups, 1);
   EXPECT_EQ(next.groups(), 27);
   // Pairing (no lattice) makes the same cubes on a hex grid.
-  const Agglomeration paired =
-      agglomerate(rows, s.frames.centres, s.frames.scales, &s.frames.bases);
+  const Agglomeration paired = agglomerate(rows, s.frames.centres, s.frames.scales, s.frames.bases);
   EXPECT_EQ(paired.parent, groups.parent);
 }
 
@@ -181,7 +179,7 @@ TEST(Agglomeration, GroupsOfASlicedMeshLieInOneBoxOfTwoByTwoByTwoCells) {
   ASSERT_EQ(s.frames.cells.size(), mesh.numElements());
   const BlockRows<double> rows = blockRows(s.system.matrix, 4);
   const Agglomeration groups =
-      agglomerate(rows, s.frames.centres, s.frames.scales, &s.frames.bases, s.frames.cells);
+      agglomerate(rows, s.frames.centres, s.frames.scales, s.frames.bases, s.frames.cells);
   // Each group's elements span at most 2 grid cells per axis (their box centres' cells).
   std::set<std::array<int, 3>> boxes;  // of 2 x 2 x 2 cells, from the grid's first
   for (int g = 0; g < groups.groups(); ++g) {
@@ -220,7 +218,7 @@ TEST(Agglomeration, PiecesACutSeparatesNeverShareAGroup) {
   ASSERT_EQ(s.frames.cells.size(), mesh.numElements());
   const BlockRows<double> rows = blockRows(s.system.matrix, 4);
   const Agglomeration groups =
-      agglomerate(rows, s.frames.centres, s.frames.scales, &s.frames.bases, s.frames.cells);
+      agglomerate(rows, s.frames.centres, s.frames.scales, s.frames.bases, s.frames.cells);
   // Never both sides of the plane in one group (an element's side: that of its corner
   // farthest from the plane; the others lie on its side or in the plane).
   auto side = [&](ElementId e) {
@@ -294,8 +292,8 @@ class CoarseFunctions : public ::testing::TestWithParam<int> {};
 
 /// On non-convex sliced elements of degree 2: W maps each group's polynomials of the degree
 /// (1 or 2) onto the elements' first basis functions (the hierarchical basis's part of that
-/// degree), exactly, and so do the groups of groups (monomials of the groups of the first
-/// agglomeration, nullptr bases) composed with them.
+/// degree), exactly, and so do the groups of groups (agglomerate(rows, finer, degree))
+/// composed with them.
 TEST_P(CoarseFunctions, AreThePolynomialDisplacementsOfEachGroup) {
   const int degree = GetParam();
   const PolyMesh mesh = benchmarkB1Mesh(BenchmarkMesh::Sliced, 6);
@@ -310,7 +308,7 @@ TEST_P(CoarseFunctions, AreThePolynomialDisplacementsOfEachGroup) {
   const int n = basis.size(), m = numMonomials(degree);
   const BlockRows<double> rows = blockRows(solver.system().matrix, n);
   const Agglomeration groups =
-      agglomerate(rows, frames.centres, frames.scales, &frames.bases, frames.cells, degree);
+      agglomerate(rows, frames.centres, frames.scales, frames.bases, frames.cells, degree);
   ASSERT_EQ(groups.functions, m);
   EXPECT_LT(groups.groups(), static_cast<int>(mesh.numElements()) / 3);
   // The second agglomeration reads the block graph of the first's Galerkin matrix (of the
@@ -373,7 +371,7 @@ TEST(Agglomeration, QuadraticGroupsOfLinearGroupsTakeTheirTaylorParts) {
   const FramedSystem s = b1FramedSystem(benchmarkB1Mesh(BenchmarkMesh::Sliced, 6), Method::IP, 1);
   const BlockRows<double> rows = blockRows(s.system.matrix, 4);
   const Agglomeration groups =
-      agglomerate(rows, s.frames.centres, s.frames.scales, &s.frames.bases, s.frames.cells, 1);
+      agglomerate(rows, s.frames.centres, s.frames.scales, s.frames.bases, s.frames.cells, 1);
   const SpMat coarse = galerkinMatrix(groups, rows);
   const BlockRows<double> coarseRows = blockRows(coarse, 4);
   const Agglomeration second = agglomerate(coarseRows, groups, 2);
@@ -424,7 +422,7 @@ TEST(Agglomeration, GroupsOnALineKeepTheCombinationsTheirBlocksTellApart) {
   const FramedSystem s = b1FramedSystem(bar, Method::IP, 1);
   const BlockRows<double> rows = blockRows(s.system.matrix, 4);
   const Agglomeration groups =
-      agglomerate(rows, s.frames.centres, s.frames.scales, &s.frames.bases, s.frames.cells, 1);
+      agglomerate(rows, s.frames.centres, s.frames.scales, s.frames.bases, s.frames.cells, 1);
   ASSERT_EQ(groups.groups(), 8);
   const SpMat coarse = galerkinMatrix(groups, rows);
   const BlockRows<double> coarseRows = blockRows(coarse, 4);
@@ -470,7 +468,7 @@ void expectGalerkinProduct(const FramedSystem& s, int degree) {
   const BlockRows<double> rows = blockRows(k, n);
   for (const std::vector<Eigen::Vector3i>& cells : {s.frames.cells, {}}) {
     const Agglomeration groups =
-        agglomerate(rows, s.frames.centres, s.frames.scales, &s.frames.bases, cells, degree);
+        agglomerate(rows, s.frames.centres, s.frames.scales, s.frames.bases, cells, degree);
     const SpMat coarse = galerkinMatrix(groups, rows);
     const SpMat p = prolongation(groups, n);
     const SpMat expected = SpMat(p.transpose() * k * p);
@@ -491,7 +489,7 @@ TEST(Agglomeration, GalerkinMatrixOfQuadraticGroupsIsPTransposeKPOnASlicedMesh) 
   // Quadratic groups need the rows of the quadratic functions, not of the linear ones.
   const BlockRows<double> linear = blockRows(restrictToDegree(s.system.matrix, 10, 4), 4);
   const Agglomeration groups =
-      agglomerate(linear, s.frames.centres, s.frames.scales, &s.frames.bases, s.frames.cells, 2);
+      agglomerate(linear, s.frames.centres, s.frames.scales, s.frames.bases, s.frames.cells, 2);
   EXPECT_THROW(galerkinMatrix(groups, linear), std::invalid_argument);
 }
 
@@ -502,7 +500,7 @@ TEST(Agglomeration, GalerkinMatrixIsPTransposeKPForBzWithComponentDiagonalBlocks
   // only their three diagonal 4 x 4 parts.
   const BlockRows<double> rows = blockRows(s.system.matrix, 4);
   const Agglomeration groups =
-      agglomerate(rows, s.frames.centres, s.frames.scales, &s.frames.bases, s.frames.cells);
+      agglomerate(rows, s.frames.centres, s.frames.scales, s.frames.bases, s.frames.cells);
   const SpMat coarse = galerkinMatrix(groups, rows);
   std::size_t crossComponent = 0;
   for (int c = 0; c < coarse.cols(); ++c)

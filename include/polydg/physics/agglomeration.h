@@ -101,15 +101,14 @@ struct Agglomeration {
 /// best aligned with axis k (the line between their centres at most 60 degrees from the axis;
 /// groups in order): 2 x 2 x 2 blocks on a hex grid, groups of up to 8 face neighbours of any
 /// shape elsewhere.
-/// `centres` and `scales` are the blocks' frames; `bases` their T (ElementFrames::bases, of
-/// which the top-left numMonomials(degree) block is used), or nullptr when the blocks'
-/// functions are the scaled monomials themselves (groups of a finer agglomeration of the
-/// same degree). `degree` (1 or 2) is that of the groups' functions; the blocks' first
-/// functions must span the polynomials of that degree.
+/// `centres` and `scales` are the elements' frames; `bases` their T (ElementFrames::bases, of
+/// which the top-left numMonomials(degree) block is used). `degree` (1 or 2) is that of the
+/// groups' functions; the elements' first functions must span the polynomials of that degree.
+/// Groups of groups: the overload below.
 Agglomeration agglomerate(const BlockRows<double>& rows,
                           const std::vector<Eigen::Vector3d>& centres,
                           const std::vector<double>& scales,
-                          const std::vector<Eigen::MatrixXd>* bases,
+                          const std::vector<Eigen::MatrixXd>& bases,
                           const std::vector<Eigen::Vector3i>& cells = {}, int degree = 1);
 
 /// The groups of the groups of `finer` (whose Galerkin matrix `rows` has finer.functions per
