@@ -238,57 +238,78 @@ SpMat galerkinMatrix(const Agglomeration& fine, const BlockRows<double>& rows) {
     galerkinPanels<4, 10>(fine, rows, panels);
   else
     galerkinPanels<10, 10>(fine, rows, panels);
-  // The upper triangle by columns: column block C holds (B, C) = P_CB^T for B <= C, in order;
-  // coupled or component-diagonal blocks.
-  const Eigen::Index size = static_cast<Eigen::Index>(coarseBlocks) * bs;
-  std::vector<int> counts(static_cast<std::size_t>(size) + 1, 0);
-  std::vector<std::vector<std::pair<int, int>>> order(static_cast<std::size_t>(coarseBlocks));
+  // Each stored block (B, C) of the full matrix, by column block C: P_CB^T from C's panels for
+  // B <= C, P_BC from B's panels for B > C. A block coupled between displacement components
+  // (every diagonal block, and IP's off-diagonal ones) is stored whole, an uncoupled one (BZ's)
+  // as its three diagonal n x n parts. Formed directly, both triangles: an upper triangle
+  // made full by Eigen's selfadjointView cost as much again as the panels (48^3 cube, p = 1).
+  struct Source {
+    int block;  // B
+    int owner;  // the coarse row block whose panel holds it: C (B <= C) or B
+    int slot;   // its slot there
+    bool coupled;
+  };
+  std::vector<std::vector<Source>> sources(static_cast<std::size_t>(coarseBlocks));
+  std::vector<std::vector<std::uint8_t>> coupledSlots(static_cast<std::size_t>(coarseBlocks));
   tbb::parallel_for(0, coarseBlocks, [&](int cc) {
     const Panels& row = panels[static_cast<std::size_t>(cc)];
-    // (coarse block B, slot), sorted; the slot coded -1 - slot if component-diagonal.
-    std::vector<std::pair<int, int>>& blocks = order[static_cast<std::size_t>(cc)];
+    std::vector<std::uint8_t>& coupled = coupledSlots[static_cast<std::size_t>(cc)];
+    coupled.assign(row.columns.size(), 0);
     for (std::size_t s = 0; s < row.columns.size(); ++s) {
       const double* block = row.panel.data() + s * bs2;
-      bool coupled = row.columns[s] == cc;
-      for (int c = 0; c < bs && !coupled; ++c)
+      bool c = row.columns[s] == cc;
+      for (int j = 0; j < bs && !c; ++j)
         for (int r = 0; r < bs; ++r)
-          if (r / n != c / n && block[c * bs + r] != 0.0) coupled = true;
-      blocks.emplace_back(row.columns[s], coupled ? static_cast<int>(s) : -1 - static_cast<int>(s));
-    }
-    std::sort(blocks.begin(), blocks.end());
-    for (int c = 0; c < bs; ++c) {
-      int count = 0;
-      for (const auto& [cb, code] : blocks)
-        count += cb == cc ? c + 1 : code >= 0 ? bs : n;  // diagonal block: rows <= c
-      counts[static_cast<std::size_t>(cc * bs + c) + 1] = count;
+          if (r / n != j / n && block[j * bs + r] != 0.0) c = true;
+      coupled[s] = c ? 1 : 0;
     }
   });
-  for (std::size_t c = 1; c < counts.size(); ++c) counts[c] += counts[c - 1];
-  SpMat upper(size, size);
-  upper.resizeNonZeros(counts.back());
-  std::copy(counts.begin(), counts.end(), upper.outerIndexPtr());
-  int* rowIndex = upper.innerIndexPtr();
-  double* entry = upper.valuePtr();
-  tbb::parallel_for(0, coarseBlocks, [&](int cc) {
+  for (int cc = 0; cc < coarseBlocks; ++cc) {
     const Panels& row = panels[static_cast<std::size_t>(cc)];
+    for (std::size_t s = 0; s < row.columns.size(); ++s) {
+      const int cb = row.columns[s];
+      const bool c = coupledSlots[static_cast<std::size_t>(cc)][s] != 0;
+      sources[static_cast<std::size_t>(cc)].push_back({cb, cc, static_cast<int>(s), c});
+      if (cb != cc)
+        sources[static_cast<std::size_t>(cb)].push_back({cc, cc, static_cast<int>(s), c});
+    }
+  }
+  const Eigen::Index size = static_cast<Eigen::Index>(coarseBlocks) * bs;
+  std::vector<int> counts(static_cast<std::size_t>(size) + 1, 0);
+  tbb::parallel_for(0, coarseBlocks, [&](int cc) {
+    std::vector<Source>& blocks = sources[static_cast<std::size_t>(cc)];
+    std::sort(blocks.begin(), blocks.end(),
+              [](const Source& a, const Source& b) { return a.block < b.block; });
+    int count = 0;
+    for (const Source& b : blocks) count += b.coupled ? bs : n;
+    for (int c = 0; c < bs; ++c) counts[static_cast<std::size_t>(cc * bs + c) + 1] = count;
+  });
+  for (std::size_t c = 1; c < counts.size(); ++c) counts[c] += counts[c - 1];
+  SpMat full(size, size);
+  full.resizeNonZeros(counts.back());
+  std::copy(counts.begin(), counts.end(), full.outerIndexPtr());
+  int* rowIndex = full.innerIndexPtr();
+  double* entry = full.valuePtr();
+  tbb::parallel_for(0, coarseBlocks, [&](int cc) {
     for (int c = 0; c < bs; ++c) {
       int pos = counts[static_cast<std::size_t>(cc * bs + c)];
-      for (const auto& [cb, code] : order[static_cast<std::size_t>(cc)]) {
-        const bool coupled = code >= 0;
-        const std::size_t s = static_cast<std::size_t>(coupled ? code : -1 - code);
-        // Entry (r, c) of block (B, C) is entry (c, r) of P_CB.
-        const double* block = row.panel.data() + s * bs2;
-        const int first = coupled || cb == cc ? 0 : (c / n) * n;
-        const int last = cb == cc ? c + 1 : coupled ? bs : first + n;
+      for (const Source& b : sources[static_cast<std::size_t>(cc)]) {
+        const double* block = panels[static_cast<std::size_t>(b.owner)].panel.data() +
+                              static_cast<std::size_t>(b.slot) * bs2;
+        const int first = b.coupled ? 0 : (c / n) * n, last = b.coupled ? bs : first + n;
+        // Entry (r, c) of block (B, C): P_CB(c, r) if B < C, P_BC(r, c) if B > C, and on the
+        // diagonal block P_CC's upper triangle mirrored (sums in another order make P_CC
+        // symmetric only to round-off; the matrix is exactly symmetric).
         for (int r = first; r < last; ++r) {
-          rowIndex[pos] = cb * bs + r;
-          entry[pos++] = block[r * bs + c];
+          rowIndex[pos] = b.block * bs + r;
+          entry[pos++] = b.block < cc   ? block[r * bs + c]
+                         : b.block > cc ? block[c * bs + r]
+                                        : block[std::min(r, c) * bs + std::max(r, c)];
         }
       }
     }
   });
-  std::vector<Panels>().swap(panels);  // before the full matrix is formed
-  SpMat full = upper.selfadjointView<Eigen::Upper>();
+  std::vector<Panels>().swap(panels);
   // Unknowns that prolong to nothing (zero columns of a group's span): decoupled, unit
   // diagonal.
   for (int g = 0; g < coarseBlocks; ++g)

@@ -132,7 +132,8 @@ void StaticSolver::assemble(const LoadCase& loads) {
     tAssemble.emplace();
     const std::size_t dofs = static_cast<std::size_t>(rows_->elements()) * rows_->bs;
     if (chooseSolver(dofs, rows_->entries(), options_.solver) == SolverKind::Cholesky) {
-      system_.matrix = rows_->toSparse();
+      SpMat matrix = rows_->toSparse();  // swapped in: Eigen 3.4's SpMat has no move assignment
+      system_.matrix.swap(matrix);
       rows_.reset();
     }
   } else {
@@ -217,7 +218,10 @@ const Eigen::VectorXd& StaticSolver::solve() {
 }
 
 const LinearSystem& StaticSolver::system() const {
-  if (rows_ && system_.matrix.rows() == 0) system_.matrix = rows_->toSparse();
+  if (rows_ && system_.matrix.rows() == 0) {
+    SpMat matrix = rows_->toSparse();
+    system_.matrix.swap(matrix);
+  }
   return system_;
 }
 
