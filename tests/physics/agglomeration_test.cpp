@@ -240,6 +240,32 @@ TEST(Agglomeration, PiecesACutSeparatesNeverShareAGroup) {
   }
   // Across the slit, only through the elements around its edge inside the group's box.
   EXPECT_TRUE(groupsFaceConnected(mesh, groups));
+  // But never two pieces of one cell, which the blades separate in it; a group joining them
+  // around the slit's edge could not open the slit. The same for the groups of groups and the
+  // boxes of the groups.
+  auto oneOfEachCell = [](const Agglomeration& a, const std::vector<Eigen::Vector3i>& cells) {
+    int pieces = 0;
+    for (int g = 0; g < a.groups(); ++g) {
+      std::set<std::array<int, 3>> seen;
+      for (int k = a.childStart[static_cast<std::size_t>(g)];
+           k < a.childStart[static_cast<std::size_t>(g) + 1]; ++k) {
+        const Eigen::Vector3i& c =
+            cells[static_cast<std::size_t>(a.children[static_cast<std::size_t>(k)])];
+        if (!seen.insert({c[0], c[1], c[2]}).second) ++pieces;
+      }
+    }
+    return pieces;
+  };
+  EXPECT_EQ(oneOfEachCell(groups, s.frames.cells), 0);
+  // The blades split cells into pieces (more elements than cells) and groups hold them apart.
+  std::set<std::array<int, 3>> cells;
+  for (const Eigen::Vector3i& c : s.frames.cells) cells.insert({c[0], c[1], c[2]});
+  EXPECT_GT(mesh.numElements(), cells.size());
+  const Agglomeration next = agglomerate(blockRows(galerkinMatrix(groups, rows), 4), groups, 2);
+  EXPECT_EQ(oneOfEachCell(next, groups.cells), 0);
+  std::set<std::array<int, 3>> boxes;
+  for (const Eigen::Vector3i& c : groups.cells) boxes.insert({c[0], c[1], c[2]});
+  EXPECT_GT(static_cast<std::size_t>(groups.groups()), boxes.size());
 }
 
 /// A polynomial displacement u_d(x) = a_d + g_d . x + x^T S_d x (S_d = 0 for degree 1).

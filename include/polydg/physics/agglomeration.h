@@ -92,8 +92,10 @@ struct Agglomeration {
 /// With `cells` (one per block: ElementFrames::cells for elements, Agglomeration::cells of the
 /// finer agglomeration for its groups): the blocks of each 2 x 2 x 2 box of cells, split into
 /// the connected components of their coupling within the box (blocks coupled: a stored block
-/// between them with a nonzero entry), so a group never joins pieces
-/// that a cut separates. On a hex grid these are the 2 x 2 x 2 blocks; on a sliced mesh the
+/// between them with a nonzero entry), so a group never joins pieces that a cut separates;
+/// nor two blocks of one cell, which a component can join around the edge of a finite cut
+/// inside the box (pairs joined in block order, each unless it would put two blocks of one
+/// cell in a group). On a hex grid these are the 2 x 2 x 2 blocks; on a sliced mesh the
 /// elements of 2 x 2 x 2 grid cells (then 4 x 4 x 4, ...), compact however the surface or
 /// the cuts clip them. Groups are numbered in the order of their first block.
 /// Without (empty `cells`: no lattice), three rounds of greedy pairing: blocks, then pairs,
