@@ -36,16 +36,15 @@ constexpr int kMaxBlock = 60;
 
 /// Smoother groups join blocks whose coupling strength gamma (couplingStrengths(), the cosine of
 /// the angle between their unknowns in the energy inner product) is at least
-/// kSmootherStrongCoupling = sqrt(3)/2 (physics/strong_coupling.h). On hex grids no pair is that
-/// strong (gamma <= 0.72 for p = 1 and 0.80 for p = 2 on the unit cubes of `bench --suite
-/// multigrid`), so their smoother is unchanged; across faces of elements clipped by the
-/// surface gamma comes close to 1. Measured when the penalty still grew with an element's face
-/// count (eq. 7's area(F), penaltyThreshold()): joining pairs down to 1/sqrt(2) helped the
-/// bunny more (p = 1: 58 instead of 64 iterations) but joined cube elements too and cost the
-/// cube 1-2 iterations at p = 2.
-/// Most blocks in one smoother group, and so most unknowns. Strong couplings chain along a
-/// clipped surface layer; groups of up to 16 took the bunny at p = 2 from 82 (up to 8) to 74
-/// iterations (with that penalty), and larger caps gave no more. Most groups are pairs.
+/// smootherStrongCoupling(p) = sqrt(3)/2, or 3/4 for p = 1 (physics/strong_coupling.h). On hex
+/// grids no pair is that strong, so their smoother is unchanged; across faces of elements
+/// clipped by the surface gamma comes close to 1. Measured when the penalty still grew with an
+/// element's face count (eq. 7's area(F), penaltyThreshold()): joining pairs down to 1/sqrt(2)
+/// helped the bunny more (p = 1: 58 instead of 64 iterations) but joined cube elements too and cost
+/// the cube 1-2 iterations at p = 2. Most blocks in one smoother group, and so most unknowns.
+/// Strong couplings chain along a clipped surface layer; groups of up to 16 took the bunny at p = 2
+/// from 82 (up to 8) to 74 iterations (with that penalty), and larger caps gave no more. Most
+/// groups are pairs.
 constexpr int kMaxGroupBlocks = 16;
 constexpr int kMaxGroupUnknowns = kMaxGroupBlocks * kMaxBlock;
 
@@ -457,6 +456,8 @@ bool splitComponents(const SpMat& a, std::vector<SpMat>& parts) {
 
 struct PMultigrid::Impl {
   std::vector<Level> levels;  ///< levels[0] is K (degree p), each next one coarser
+  /// The coupling strength from which the smoothers join blocks (smootherStrongCoupling(p)).
+  double strongCoupling = kSmootherStrongCoupling;
   /// The coarsest level's factorization: of the whole matrix, or, for a degree-0 level whose
   /// displacement components are uncoupled (splitComponents()), of each component's matrix,
   /// factorized side by side, or of the one matrix S of all three (a = I_3 (x) S: three
@@ -541,11 +542,9 @@ struct PMultigrid::Impl {
       }
     }
     if (level.rows)
-      level.smootherGroups =
-          groupStrongCouplings(*level.rows, kSmootherStrongCoupling, kMaxGroupBlocks);
+      level.smootherGroups = groupStrongCouplings(*level.rows, strongCoupling, kMaxGroupBlocks);
     else if (level.useBlocks)
-      level.smootherGroups =
-          groupStrongCouplings(level.blocks, kSmootherStrongCoupling, kMaxGroupBlocks);
+      level.smootherGroups = groupStrongCouplings(level.blocks, strongCoupling, kMaxGroupBlocks);
     else  // a pattern too sparse for blocks (BlockRows::build)
       level.smootherGroups = singleBlocks(static_cast<int>(level.blockCount()));
     level.colours = colourGroups(level);
@@ -781,6 +780,7 @@ bool PMultigrid::compute(const BlockRows<double>& rows, int degree, const Elemen
 bool PMultigrid::Impl::build(const SpMat* matrix, const BlockRows<double>* rows, int degree,
                              const BlockRows<double>* matrixBlocks, const ElementFrames* frames) {
   Impl& m = *this;
+  m.strongCoupling = smootherStrongCoupling(degree);
   m.levels.clear();
   // Room for every level: growing the vector would copy the levels (Eigen's sparse matrices
   // move without noexcept), each matrix twice at once.
@@ -835,7 +835,8 @@ bool PMultigrid::Impl::build(const SpMat* matrix, const BlockRows<double>* rows,
     // the nonzeros of the linear level above it), so they sweep twice: a V-cycle with two
     // agglomeration levels then needs about as many iterations as one with an exact first
     // agglomeration level on B2 (not on the bunny at 16 cells: p = 1 34-37 against 31, p = 2
-    // 38-44 against 36-37; README, "Speed").
+    // 38-44 against 36-37, measured before groups kept the pieces of a cell apart and the p = 1
+    // smoother joined blocks from 3/4, which took it to 32-33 and 38-39; README, "Speed").
     const double limit = std::max(static_cast<double>(kCoarseUnknowns), std::sqrt(nonzeros));
     while (static_cast<double>(m.levels.back().matrix->rows()) > limit) {
       const Eigen::Index before = m.levels.back().matrix->rows();

@@ -110,7 +110,8 @@ TEST(PMultigrid, AgglomeratesNeedFewerIterationsThanConstantsOnTheBentCube) {
 }
 
 /// CG with the p-multigrid of `s`'s frames reproduces Cholesky's solution of `s`.
-void expectCgMatchesCholesky(const FramedSystem& s) {
+/// `agreement`: the largest difference from Cholesky's solution, relative to it.
+void expectCgMatchesCholesky(const FramedSystem& s, double agreement = kSolutionAgreement) {
   SolverOptions direct;
   direct.kind = SolverKind::Cholesky;
   LinearSolveReport directReport;
@@ -125,7 +126,7 @@ void expectCgMatchesCholesky(const FramedSystem& s) {
   LinearSolveReport report;
   const Eigen::VectorXd u = solver.solve(s.system.rhs, report);
   EXPECT_TRUE(report.success);
-  EXPECT_LE((u - reference).norm(), kSolutionAgreement * reference.norm());
+  EXPECT_LE((u - reference).norm(), agreement * reference.norm());
 }
 
 TEST(PMultigrid, AgglomeratesOfTwoSeparateBodies) {
@@ -227,7 +228,10 @@ TEST(PMultigrid, GroupedSmootherOnASlicedTorus) {
 TEST(PMultigrid, QuadraticGroupsThatWouldNotShrinkTheLevelAreNotAdded) {
   // A bar of 256 x 1 x 1 elements of degree 1: 128 linear groups of two (1,536 unknowns, more
   // than kCoarseUnknowns), whose quadratic groups of two would be 64 x 30 = 1,920 unknowns:
-  // the linear level stays the coarsest. CG still reproduces Cholesky's solution.
+  // the linear level stays the coarsest. CG still reproduces Cholesky's solution, to the
+  // accuracy the slender bar (256 : 1, cond(K) = 1.6e11) allows: with all its elements in smoother
+  // groups (p = 1) CG stalls 1.1e-7 of the solution away from Cholesky's at a residual
+  // tolerance of 1e-10, 1e-12 or 1e-14 alike, the rounding floor of the two solutions.
   const FramedSystem s =
       framedSystem(hexGridMesh(256, 1, 1, Box3(Vec3::Zero(), Vec3(25.6, 0.1, 0.1))),
                    bench::benchmarkB2Material(), bench::benchmarkB2Loads(), Method::IP, 1);
@@ -235,7 +239,7 @@ TEST(PMultigrid, QuadraticGroupsThatWouldNotShrinkTheLevelAreNotAdded) {
   ASSERT_TRUE(mg.compute(s.system.matrix, 1, nullptr, &s.frames));
   EXPECT_EQ(mg.levels(), 2);
   EXPECT_EQ(mg.coarseUnknowns(), 1536);
-  expectCgMatchesCholesky(s);
+  expectCgMatchesCholesky(s, 10.0 * kSolutionAgreement);
 }
 
 TEST(PMultigrid, PlateOneElementThickNeedsAboutTheCubesIterations) {

@@ -101,20 +101,21 @@ TEST(StrongCoupling, GroupsFollowStrongPairsUpToTheCap) {
 }
 
 TEST(StrongCoupling, NoGroupsOnHexGrids) {
-  // The smoother of the p-multigrid stays per element on hex grids, at every degree: B2's
-  // cube (clamped on one side) and B1's (held on the whole boundary), IP and BZ.
+  // The smoother of the p-multigrid stays per element on hex grids, at every degree (with its
+  // threshold, 3/4 for p = 1): B2's cube (clamped on one side) and B1's (held on the whole
+  // boundary), IP and BZ.
   for (int degree : {1, 2, 3})
     for (Method method : {Method::IP, Method::BZ}) {
       const LinearSystem b1 =
           b1System(bench::benchmarkB1Mesh(bench::BenchmarkMesh::Hex, 4), method, degree);
       BlockRows<double> rows;
       ASSERT_TRUE(rows.build(b1.matrix, numMonomials(degree), 2.0));
-      EXPECT_TRUE(groupStrongCouplings(rows, kSmootherStrongCoupling, 16).singletons())
+      EXPECT_TRUE(groupStrongCouplings(rows, smootherStrongCoupling(degree), 16).singletons())
           << "B1, degree " << degree;
       if (degree == 3) continue;  // B2 at p = 3 is large for a unit test
       const FramedSystem b2 = b2FramedSystem(method, degree);
       ASSERT_TRUE(rows.build(b2.system.matrix, numMonomials(degree), 2.0));
-      EXPECT_TRUE(groupStrongCouplings(rows, kSmootherStrongCoupling, 16).singletons())
+      EXPECT_TRUE(groupStrongCouplings(rows, smootherStrongCoupling(degree), 16).singletons())
           << "B2, degree " << degree;
     }
 }

@@ -53,15 +53,15 @@ struct ElementFrames;
 /// Smoother. Block Gauss-Seidel with one block per element or agglomerate, except where blocks
 /// are strongly coupled: blocks whose coupling strength gamma (the cosine of the angle between
 /// their unknowns in the energy inner product, physics/strong_coupling.h) is at least
-/// sqrt(3)/2 are solved together, in groups of up to 16 (union-find, strongest pairs first),
-/// each with the exact inverse of its diagonal block. Such pairs are found across faces of
-/// elements clipped by the surface; on hex grids none reaches the threshold and every group is one
-/// block. Groups are visited colour by colour (a greedy colouring of the level's group graph, so
-/// that groups of one colour share no entry and are updated in parallel): colours in order before
-/// the coarse correction and in reverse order after it, which makes the V-cycle a symmetric
-/// positive definite operator (a valid CG preconditioner) whenever K is SPD. Bunny at 16 cells, p =
-/// 2: 65 CG iterations instead of 73 without groups (torus cut: 39 instead of 49); the cube's 26
-/// unchanged.
+/// sqrt(3)/2 (3/4 for p = 1) are solved together, in groups of up to 16 (union-find, strongest
+/// pairs first), each with the exact inverse of its diagonal block. Such pairs are found across
+/// faces of elements clipped by the surface; on hex grids none reaches the threshold and every
+/// group is one block. Groups are visited colour by colour (a greedy colouring of the level's group
+/// graph, so that groups of one colour share no entry and are updated in parallel): colours in
+/// order before the coarse correction and in reverse order after it, which makes the V-cycle a
+/// symmetric positive definite operator (a valid CG preconditioner) whenever K is SPD. Bunny at 16
+/// cells, p = 2: 65 CG iterations instead of 73 without groups (torus cut: 39 instead of 49); the
+/// cube's 26 unchanged.
 ///
 /// Not thread-safe: apply() uses scratch vectors of the object.
 class PMultigrid {
