@@ -248,9 +248,9 @@ void galerkinPanels(const Agglomeration& fine, const BlockRows<double>& rows,
 
 }  // namespace
 
-SpMat galerkinMatrix(const Agglomeration& fine, const BlockRows<double>& rows) {
+BlockRows<double> galerkinBlocks(const Agglomeration& fine, const BlockRows<double>& rows) {
   if (rows.n != fine.blockFunctions)
-    throw std::invalid_argument("galerkinMatrix: the rows' functions do not match the groups'");
+    throw std::invalid_argument("galerkinBlocks: the rows' functions do not match the groups'");
   const int coarseBlocks = fine.groups();
   const int n = fine.functions, bs = 3 * n, bs2 = bs * bs;
   std::vector<Panels> panels(static_cast<std::size_t>(coarseBlocks));
@@ -260,11 +260,12 @@ SpMat galerkinMatrix(const Agglomeration& fine, const BlockRows<double>& rows) {
     galerkinPanels<4, 10>(fine, rows, panels);
   else
     galerkinPanels<10, 10>(fine, rows, panels);
-  // Each stored block (B, C) of the full matrix, by column block C: P_CB^T from C's panels for
-  // B <= C, P_BC from B's panels for B > C. A block coupled between displacement components
-  // (every diagonal block, and IP's off-diagonal ones) is stored whole, an uncoupled one (BZ's)
-  // as its three diagonal n x n parts. Formed directly, both triangles: an upper triangle
-  // made full by Eigen's selfadjointView cost as much again as the panels (48^3 cube, p = 1).
+  // Each stored block (C, B) of coarse row block C: P_CB from C's panels for B <= C, P_BC^T
+  // from B's panels for B > C. A block coupled between displacement components (every
+  // diagonal block, and IP's off-diagonal ones) is stored whole, an uncoupled one (BZ's) as
+  // its three diagonal n x n parts. Written straight from the panels: a CSR matrix (made
+  // full by Eigen's selfadjointView) and the block rows converted from it cost as much
+  // again as the panels, and the CSR matrix was the peak of the setup on the 48^3 cube.
   struct Source {
     int block;  // B
     int owner;  // the coarse row block whose panel holds it: C (B <= C) or B
@@ -296,51 +297,70 @@ SpMat galerkinMatrix(const Agglomeration& fine, const BlockRows<double>& rows) {
         sources[static_cast<std::size_t>(cb)].push_back({cc, cc, static_cast<int>(s), c});
     }
   }
-  const Eigen::Index size = static_cast<Eigen::Index>(coarseBlocks) * bs;
-  std::vector<int> counts(static_cast<std::size_t>(size) + 1, 0);
+  BlockRows<double> coarse;
+  coarse.n = n;
+  coarse.bs = bs;
+  coarse.start.assign(static_cast<std::size_t>(coarseBlocks) + 1, 0);
   tbb::parallel_for(0, coarseBlocks, [&](int cc) {
     std::vector<Source>& blocks = sources[static_cast<std::size_t>(cc)];
     std::sort(blocks.begin(), blocks.end(),
               [](const Source& a, const Source& b) { return a.block < b.block; });
-    int count = 0;
-    for (const Source& b : blocks) count += b.coupled ? bs : n;
-    for (int c = 0; c < bs; ++c) counts[static_cast<std::size_t>(cc * bs + c) + 1] = count;
+    coarse.start[static_cast<std::size_t>(cc) + 1] = static_cast<int>(blocks.size());
   });
-  for (std::size_t c = 1; c < counts.size(); ++c) counts[c] += counts[c - 1];
-  SpMat full(size, size);
-  full.resizeNonZeros(counts.back());
-  std::copy(counts.begin(), counts.end(), full.outerIndexPtr());
-  int* rowIndex = full.innerIndexPtr();
-  double* entry = full.valuePtr();
+  for (std::size_t c = 1; c < coarse.start.size(); ++c) coarse.start[c] += coarse.start[c - 1];
+  const std::size_t slots = static_cast<std::size_t>(coarse.start.back());
+  coarse.element.resize(slots);
+  coarse.diagonal.resize(slots);
+  coarse.offset.assign(slots + 1, 0);
+  for (int cc = 0; cc < coarseBlocks; ++cc) {
+    std::size_t k = static_cast<std::size_t>(coarse.start[static_cast<std::size_t>(cc)]);
+    for (const Source& b : sources[static_cast<std::size_t>(cc)]) {
+      coarse.element[k] = b.block;
+      coarse.diagonal[k] = b.coupled ? 0 : 1;
+      coarse.offset[k + 1] =
+          coarse.offset[k] + static_cast<std::size_t>(b.coupled ? bs2 : 3 * n * n);
+      ++k;
+    }
+  }
+  coarse.values.resize(coarse.offset.back());
   tbb::parallel_for(0, coarseBlocks, [&](int cc) {
-    for (int c = 0; c < bs; ++c) {
-      int pos = counts[static_cast<std::size_t>(cc * bs + c)];
-      for (const Source& b : sources[static_cast<std::size_t>(cc)]) {
-        const double* block = panels[static_cast<std::size_t>(b.owner)].panel.data() +
-                              static_cast<std::size_t>(b.slot) * bs2;
-        const int first = b.coupled ? 0 : (c / n) * n, last = b.coupled ? bs : first + n;
-        // Entry (r, c) of block (B, C): P_CB(c, r) if B < C, P_BC(r, c) if B > C, and on the
-        // diagonal block P_CC's upper triangle mirrored (sums in another order make P_CC
-        // symmetric only to round-off; the matrix is exactly symmetric).
-        for (int r = first; r < last; ++r) {
-          rowIndex[pos] = b.block * bs + r;
-          entry[pos++] = b.block < cc   ? block[r * bs + c]
-                         : b.block > cc ? block[c * bs + r]
-                                        : block[std::min(r, c) * bs + std::max(r, c)];
-        }
+    std::size_t k = static_cast<std::size_t>(coarse.start[static_cast<std::size_t>(cc)]);
+    for (const Source& b : sources[static_cast<std::size_t>(cc)]) {
+      const double* block = panels[static_cast<std::size_t>(b.owner)].panel.data() +
+                            static_cast<std::size_t>(b.slot) * bs2;
+      double* to = coarse.values.data() + coarse.offset[k++];
+      // Entry (i, j) of block (C, B): P_CB(i, j) if B < C, P_BC(j, i) if B > C, and on the
+      // diagonal block P_CC's upper triangle mirrored (sums in another order make P_CC
+      // symmetric only to round-off; the matrix is exactly symmetric).
+      auto entry = [&](int i, int j) {
+        return b.block < cc   ? block[j * bs + i]
+               : b.block > cc ? block[i * bs + j]
+                              : block[std::min(i, j) * bs + std::max(i, j)];
+      };
+      if (b.coupled) {
+        for (int j = 0; j < bs; ++j)
+          for (int i = 0; i < bs; ++i) to[j * bs + i] = entry(i, j);
+        continue;
       }
+      for (int d = 0; d < 3; ++d)
+        for (int j = 0; j < n; ++j)
+          for (int i = 0; i < n; ++i) to[d * n * n + j * n + i] = entry(d * n + i, d * n + j);
     }
   });
   std::vector<Panels>().swap(panels);
   // Unknowns that prolong to nothing (zero columns of a group's span): decoupled, unit
   // diagonal.
-  for (int g = 0; g < coarseBlocks; ++g)
-    for (int j = fine.ranks.empty() ? n : fine.ranks[static_cast<std::size_t>(g)]; j < n; ++j)
-      for (int d = 0; d < 3; ++d) {
-        const Eigen::Index u = static_cast<Eigen::Index>(g) * bs + d * n + j;
-        full.coeffRef(u, u) = 1.0;
-      }
-  return full;
+  if (!fine.ranks.empty())
+    for (int g = 0; g < coarseBlocks; ++g) {
+      double* diagonalBlock = const_cast<double*>(coarse.diagonalBlock(g));
+      for (int j = fine.ranks[static_cast<std::size_t>(g)]; j < n; ++j)
+        for (int d = 0; d < 3; ++d) diagonalBlock[(d * n + j) * bs + d * n + j] = 1.0;
+    }
+  return coarse;
+}
+
+SpMat galerkinMatrix(const Agglomeration& fine, const BlockRows<double>& rows) {
+  return galerkinBlocks(fine, rows).toSparse();
 }
 
 std::vector<Eigen::Vector3i> latticeCells(const std::vector<Eigen::AlignedBox3d>& boxes) {

@@ -96,7 +96,8 @@ struct Level {
   BlockRows<float> blocks;
   /// The matrix by block rows in double precision, for a level that is agglomerated: the
   /// grouping reads its block graph and the Galerkin product its values (the top level's copy
-  /// is the caller's, `source`).
+  /// is the caller's, `source`). An agglomeration level's Galerkin matrix is formed this way,
+  /// with no CSR matrix unless it is the coarsest.
   BlockRows<double> exact;
   const BlockRows<double>* source = nullptr;
   /// Smoother groups of each colour, in increasing order (groups of one colour share no
@@ -111,10 +112,14 @@ struct Level {
   // Scratch of apply(): right-hand side and solution of this level.
   mutable Eigen::VectorXd b, x;
 
-  /// Blocks (elements or groups) of the level.
+  /// Blocks (elements or groups) of the level, and its unknowns.
   Eigen::Index blockCount() const {
-    return rows ? rows->elements() : useBlocks ? blocks.elements() : matrix->cols() / bs;
+    return rows                   ? rows->elements()
+           : useBlocks            ? blocks.elements()
+           : !exact.start.empty() ? exact.elements()
+                                  : matrix->cols() / bs;
   }
+  Eigen::Index unknowns() const { return blockCount() * bs; }
 };
 
 /// The principal submatrix of `fine` (n functions per component) on the DOFs of the first
@@ -577,7 +582,22 @@ struct PMultigrid::Impl {
     Level level;
     level.n = numMonomials(degree);
     level.bs = 3 * level.n;
-    push(std::move(level), galerkinMatrix(fine.groups, *fine.source));
+    // By block rows: what the next grouping, the next Galerkin product and the smoother read;
+    // the coarsest level alone is converted to CSR, for CHOLMOD (finishAggregation()).
+    level.exact = galerkinBlocks(fine.groups, *fine.source);
+    push(std::move(level));
+  }
+
+  /// The coarsest level's matrix in CSR, for its factorization, from its block rows (an
+  /// agglomeration level), which are then freed.
+  void finishAggregation() {
+    Level& last = levels.back();
+    if (last.exact.start.empty() || last.owned.size() > 0) return;
+    SpMat matrix = last.exact.toSparse();
+    last.owned.swap(matrix);
+    last.matrix = &last.owned;
+    last.exact = BlockRows<double>();
+    last.source = nullptr;
   }
 
   /// Keeps of a coarse level that is smoothed (not the top, not the coarsest) only what its
@@ -597,7 +617,7 @@ struct PMultigrid::Impl {
   /// may have moved the levels. Eigen 3.4's SparseMatrix has no move constructor or
   /// assignment: a Level moved with its matrix, or a returned matrix assigned, copies every
   /// nonzero (0.25 s of the 1.9 s setup on the 48^3 cube, p = 1); the matrix is swapped in.
-  void push(Level&& level, SpMat matrix) {
+  void push(Level&& level, SpMat matrix = SpMat()) {
     levels.push_back(std::move(level));
     levels.back().owned.swap(matrix);
     for (std::size_t k = 0; k < levels.size(); ++k) {
@@ -838,12 +858,12 @@ bool PMultigrid::Impl::build(const SpMat* matrix, const BlockRows<double>* rows,
     // 38-44 against 36-37, measured before groups kept the pieces of a cell apart and the p = 1
     // smoother joined blocks from 3/4, which took it to 32-33 and 38-39; README, "Speed").
     const double limit = std::max(static_cast<double>(kCoarseUnknowns), std::sqrt(nonzeros));
-    while (static_cast<double>(m.levels.back().matrix->rows()) > limit) {
-      const Eigen::Index before = m.levels.back().matrix->rows();
+    while (static_cast<double>(m.levels.back().unknowns()) > limit) {
+      const Eigen::Index before = m.levels.back().unknowns();
       m.levels.back().sweeps = 2;
       // The blocks of the last level are the groups of the one before.
       m.addAggregateLevel(nullptr, 2);
-      const Eigen::Index after = m.levels.back().matrix->rows();
+      const Eigen::Index after = m.levels.back().unknowns();
       if (after >= before) {  // quadratic groups of groups on a line: no fewer unknowns
         m.levels.pop_back();
         break;
@@ -851,6 +871,7 @@ bool PMultigrid::Impl::build(const SpMat* matrix, const BlockRows<double>* rows,
       m.keepSmootherCopyOnly(m.levels[m.levels.size() - 2]);
       if (after * 4 > before * 3) break;  // grouping stalled
     }
+    m.finishAggregation();
   } else if (degree > 0) {
     // Level 0 couples elements through the penalty, mu eta_F [u].[v], which couples equal
     // components only, and (IP) the lifting of the normal jump, which couples components

@@ -119,12 +119,15 @@ Agglomeration agglomerate(const BlockRows<double>& rows,
 Agglomeration agglomerate(const BlockRows<double>& rows, const Agglomeration& finer, int degree);
 
 /// The Galerkin matrix P^T A P of the coarse space of `groups` (n = groups.functions per
-/// component of each group, unknown (g, d, j) at 3 n g + n d + j), from A by block rows in
-/// double precision with groups.blockFunctions per component (else std::invalid_argument),
-/// with a unit diagonal for the unknowns that prolong to nothing (Agglomeration::spans). A
-/// coarse block whose displacement components are uncoupled (BZ's) stores only its three
-/// diagonal n x n parts. Exactly
-/// symmetric, both triangles stored.
+/// component of each group, unknown (g, d, j) at 3 n g + n d + j) by block rows (one per
+/// group, its blocks in increasing order), from A by block rows in double precision with
+/// groups.blockFunctions per component (else std::invalid_argument), with a unit diagonal
+/// for the unknowns that prolong to nothing (Agglomeration::spans). A coarse block whose
+/// displacement components are uncoupled (BZ's) is stored component-diagonal (its three
+/// diagonal n x n parts). Exactly symmetric.
+BlockRows<double> galerkinBlocks(const Agglomeration& groups, const BlockRows<double>& rows);
+
+/// The same in CSR (BlockRows::toSparse()), both triangles stored.
 Eigen::SparseMatrix<double, Eigen::ColMajor, int> galerkinMatrix(const Agglomeration& groups,
                                                                  const BlockRows<double>& rows);
 
