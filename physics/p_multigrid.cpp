@@ -41,10 +41,11 @@ constexpr int kMaxBlock = 60;
 /// clipped by the surface gamma comes close to 1. Measured when the penalty still grew with an
 /// element's face count (eq. 7's area(F), penaltyThreshold()): joining pairs down to 1/sqrt(2)
 /// helped the bunny more (p = 1: 58 instead of 64 iterations) but joined cube elements too and cost
-/// the cube 1-2 iterations at p = 2. Most blocks in one smoother group, and so most unknowns.
-/// Strong couplings chain along a clipped surface layer; groups of up to 16 took the bunny at p = 2
-/// from 82 (up to 8) to 74 iterations (with that penalty), and larger caps gave no more. Most
-/// groups are pairs.
+/// the cube 1-2 iterations at p = 2.
+///
+/// Most blocks in one smoother group, and so most unknowns. Strong couplings chain along a
+/// clipped surface layer; groups of up to 16 took the bunny at p = 2 from 82 (up to 8) to 74
+/// iterations (with that penalty), and larger caps gave no more. Most groups are pairs.
 constexpr int kMaxGroupBlocks = 16;
 constexpr int kMaxGroupUnknowns = kMaxGroupBlocks * kMaxBlock;
 
