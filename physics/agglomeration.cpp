@@ -268,8 +268,7 @@ BlockRows<double> galerkinBlocks(const Agglomeration& fine, const BlockRows<doub
   // again as the panels, and the CSR matrix was the peak of the setup on the 48^3 cube.
   struct Source {
     int block;  // B
-    int owner;  // the coarse row block whose panel holds it: C (B <= C) or B
-    int slot;   // its slot there
+    int slot;   // its slot in the panels of C (B <= C) or of B (B > C)
     bool coupled;
   };
   std::vector<std::vector<Source>> sources(static_cast<std::size_t>(coarseBlocks));
@@ -292,9 +291,8 @@ BlockRows<double> galerkinBlocks(const Agglomeration& fine, const BlockRows<doub
     for (std::size_t s = 0; s < row.columns.size(); ++s) {
       const int cb = row.columns[s];
       const bool c = coupledSlots[static_cast<std::size_t>(cc)][s] != 0;
-      sources[static_cast<std::size_t>(cc)].push_back({cb, cc, static_cast<int>(s), c});
-      if (cb != cc)
-        sources[static_cast<std::size_t>(cb)].push_back({cc, cc, static_cast<int>(s), c});
+      sources[static_cast<std::size_t>(cc)].push_back({cb, static_cast<int>(s), c});
+      if (cb != cc) sources[static_cast<std::size_t>(cb)].push_back({cc, static_cast<int>(s), c});
     }
   }
   BlockRows<double> coarse;
@@ -326,7 +324,8 @@ BlockRows<double> galerkinBlocks(const Agglomeration& fine, const BlockRows<doub
   tbb::parallel_for(0, coarseBlocks, [&](int cc) {
     std::size_t k = static_cast<std::size_t>(coarse.start[static_cast<std::size_t>(cc)]);
     for (const Source& b : sources[static_cast<std::size_t>(cc)]) {
-      const double* block = panels[static_cast<std::size_t>(b.owner)].panel.data() +
+      const int owner = std::max(b.block, cc);  // the row block whose panel holds it
+      const double* block = panels[static_cast<std::size_t>(owner)].panel.data() +
                             static_cast<std::size_t>(b.slot) * bs2;
       double* to = coarse.values.data() + coarse.offset[k++];
       // Entry (i, j) of block (C, B): P_CB(i, j) if B < C, P_BC(j, i) if B > C, and on the

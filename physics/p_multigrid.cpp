@@ -601,17 +601,16 @@ struct PMultigrid::Impl {
     last.source = nullptr;
   }
 
-  /// Keeps of a coarse level that is smoothed (not the top, not the coarsest) only what its
+  /// Keeps of an agglomeration level that is smoothed (not the coarsest) only what its
   /// smoother reads: its matrix by block rows in single precision, converted from the double
-  /// ones that served the grouping and the Galerkin product of the next level; those and its
-  /// CSR matrix are freed. Holding them at levels 1 and 2 took the peak memory of `polydg
-  /// solve` on the 48^3 cube (p = 1, IP, 1.3 million DOFs) from 1.77 to 1.94 GB.
+  /// ones that served the grouping and the Galerkin product of the next level, which are
+  /// freed. Holding them (and, then, a CSR matrix) at levels 1 and 2 took the peak memory of
+  /// `polydg solve` on the 48^3 cube (p = 1, IP, 1.3 million DOFs) from 1.77 to 1.94 GB.
   void keepSmootherCopyOnly(Level& level) {
     level.blocks.convertFrom(level.exact);
     level.useBlocks = true;
     level.exact = BlockRows<double>();
     level.source = nullptr;
-    level.owned = SpMat();
   }
 
   /// Appends a coarser level that owns `matrix`. Re-points every owned matrix: the vector

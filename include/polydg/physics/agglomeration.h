@@ -72,7 +72,7 @@ struct Agglomeration {
   /// or a plane: their Taylor parts vanish together). Then S_g's first ranks[g] columns are an
   /// orthonormal basis of the combinations they do tell apart (the eigenvectors of
   /// sum_b W_b^T W_b above kSpanTolerance of its largest eigenvalue) and the rest zero:
-  /// unknowns that prolong to nothing, with a unit diagonal in galerkinMatrix() and zero
+  /// unknowns that prolong to nothing, with a unit diagonal in galerkinBlocks() and zero
   /// right-hand side, so the coarse correction is exact on the rest.
   std::vector<double> spans;
   std::vector<int> ranks;
