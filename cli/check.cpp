@@ -20,7 +20,7 @@ struct CheckCommandOptions {
 };
 
 void print(const std::string& input, const MeshCheck& c) {
-  const ValidationReport& r = *c.geometry;
+  const GeometryCheck& r = *c.geometry;
   std::cout << input << ": " << (c.passed() ? "valid" : "INVALID") << ", " << r.elements
             << " elements, " << r.faces << " faces (" << r.interiorFaces << " interior), "
             << r.components << " component(s), volume " << r.volume << '\n';

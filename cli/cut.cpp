@@ -23,7 +23,7 @@ struct CutCommandOptions {
   std::optional<Blade> polygon;
   int removeSide = 0;
   std::optional<double> sliverFraction;
-  ValidationLevel validation = ValidationLevel::Local;
+  CheckLevel checks = CheckLevel::Local;
 };
 
 std::string describe(const Blade& blade) {
@@ -69,14 +69,13 @@ void run(const CutCommandOptions& o, bool quiet, int& exitCode) {
     request.blade = blades[i];
     request.removeSide = o.removeSide;
     request.sliverFraction = o.sliverFraction;
-    request.validation = o.validation;
+    request.checks = o.checks;
     const OperationReport r = model.cut(request);
     report["operations"].push_back(toJson(r));
     progress.update(double(i + 1) / double(blades.size()));
-    if (!r.validation.passed) {
+    if (!r.check.passed) {
       failure = "operation " + std::to_string(i + 1) + " (" + r.op + ", " + describe(blades[i]) +
-                ") failed its " + toString(r.validation.level) +
-                " validation: " + r.validation.failure;
+                ") failed its " + toString(r.check.level) + " validation: " + r.check.failure;
       break;
     }
   }
@@ -138,7 +137,7 @@ void addCutCommand(CLI::App& app, const CommonOptions& common, int& exitCode) {
          "below (TAU V)^(1/3); 0: never; default: the mesh's sliver rule, 0.01 unless meshed "
          "otherwise")
       ->check(finiteRange(0.0, 1.0));
-  addChoice(*cmd, "--validate", o->validation, validationNames(), "checks after each operation");
+  addChoice(*cmd, "--validate", o->checks, checkLevelNames(), "checks after each operation");
   cmd->add_option("--report", o->report, "write a JSON report to this file");
   cmd->callback([o, &common, &exitCode] { run(*o, common.quiet, exitCode); });
 }

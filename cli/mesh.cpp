@@ -29,7 +29,7 @@ void printSummary(const MeshReport& report) {
             << r.grid.cellSize << "\n"
             << "  volume " << r.outputVolume << " (input " << r.inputVolume << ", relative error "
             << r.volumeRelError << "), slivers merged " << r.slivers.merged << ", validation "
-            << (r.validation.passed ? "passed" : "FAILED") << "\n";
+            << (r.geometry.passed ? "passed" : "FAILED") << "\n";
   for (const std::string& repair : r.repairs) std::cout << "  repair: " << repair << "\n";
   if (report.coarseCellSize > 0.0) {
     std::cout << "  octree: " << report.levels << " levels below cells of " << report.coarseCellSize

@@ -61,7 +61,7 @@ void run(const SolveCommandOptions& o, const CommonOptions& common) {
   if (o.adapt) options.adapt = o.adaptOptions;
   const SolveReport r = model.solve(options);
   const WriteReport written = model.write(o.output);
-  // The deformed embedded surface (physics/embedding.h), written atomically.
+  // The deformed embedded surface (physics/contact/embedding.h), written atomically.
   nlohmann::json surfaceJson;
   if (!o.surfaceOutput.empty()) {
     const Stopwatch watch;

@@ -1,5 +1,5 @@
 // MeshEditor: cuts and sliver merges in place. Each operation is an Edit (edit.h) whose crossed
-// elements a Splitter (piece_splitter.h) splits, checked by validateOperation()
+// elements a Splitter (piece_splitter.h) splits, checked by checkOperation()
 // (operation_checks.h).
 #include "polydg/cut/cut.h"
 
@@ -14,10 +14,10 @@
 
 #include "edit.h"
 #include "editor_state.h"
-#include "operation_checks.h"
 #include "piece_splitter.h"
 #include "polydg/cut/element_grid.h"
 #include "polydg/mesh/plane_split.h"
+#include "polydg/physics/checks/operation_checks.h"
 #include "polydg/util/stopwatch.h"
 #include "polygon_test.h"
 
@@ -107,7 +107,7 @@ void checkOptions(const CutOptions& options) {
     throw std::invalid_argument("removeSide must be -1, 0 or +1");
   if (!(options.sliverFraction >= 0.0) || !std::isfinite(options.sliverFraction))
     throw std::invalid_argument("the sliver fraction must be finite and not negative");
-  if (options.validationDegree < 1 || options.validationDegree > 3)
+  if (options.checkDegree < 1 || options.checkDegree > 3)
     throw std::invalid_argument("the validation degree must be 1, 2 or 3");
 }
 
@@ -124,9 +124,9 @@ OperationReport MeshEditor::cut(const Blade& blade, const CutOptions& options) {
     // fails like a failed check, and the part-edited mesh must not be used further.
     OperationReport report;
     report.op = blade.finite() ? "cut_polygon" : "cut";
-    report.validation.level = options.validation;
-    report.validation.passed = false;
-    report.validation.failure = std::string("split: ") + e.what();
+    report.check.level = options.checks;
+    report.check.passed = false;
+    report.check.failure = std::string("split: ") + e.what();
     report.seconds = start.seconds();
     return report;
   }
@@ -137,7 +137,7 @@ OperationReport MeshEditor::cutInPlace(const Blade& blade, const CutOptions& opt
   State& s = *state_;
   OperationReport report;
   report.op = blade.finite() ? "cut_polygon" : "cut";
-  report.facesReintegrated += raiseMomentDegree(2 * options.validationDegree);
+  report.facesReintegrated += raiseMomentDegree(2 * options.checkDegree);
   const double volumeBefore = s.volume;
   Edit edit(s.mesh, *s.moments, s.grid);
   const std::uint32_t planeId = planeIdOf(s, blade);
@@ -245,7 +245,7 @@ OperationReport MeshEditor::cutInPlace(const Blade& blade, const CutOptions& opt
 
   // 6. Compaction, the grid, the volume, and 7. the checks.
   report.facesReintegrated += edit.updateMoments();
-  finishOperation(s, edit, volumeBefore, options.validation, options.validationDegree,
+  finishOperation(s, edit, volumeBefore, options.checks, options.checkDegree,
                   options.sliverFraction * s.referenceVolume, report);
   report.seconds = start.seconds();
   return report;
@@ -320,7 +320,7 @@ void insertEdgePoints(Edit& edit, const std::vector<ElementId>& elements,
   }
 }
 
-void finishOperation(MeshEditor::State& s, Edit& edit, double volumeBefore, ValidationLevel level,
+void finishOperation(MeshEditor::State& s, Edit& edit, double volumeBefore, CheckLevel level,
                      int degree, double sliverThreshold, OperationReport& report) {
   const double oldVolume = edit.oldVolume();
   edit.compact();
@@ -336,8 +336,8 @@ void finishOperation(MeshEditor::State& s, Edit& edit, double volumeBefore, Vali
   report.leftWhole = edit.leftWhole().sorted();
   report.lineage = edit.lineage();
   report.facesTotal = s.mesh.numFaces();
-  OperationValidation& v = report.validation;
-  validateOperation(s.mesh, *s.moments, touched, s.region, level, degree, sliverThreshold, v);
+  OperationCheck& v = report.check;
+  checkOperation(s.mesh, *s.moments, touched, s.region, level, degree, sliverThreshold, v);
   v.volumeRelError =
       std::abs(volumeBefore - report.volumeRemoved - s.volume) / std::abs(volumeBefore);
   if (!(v.volumeRelError <= kVolumeBalanceTolerance)) {
@@ -350,26 +350,24 @@ void finishOperation(MeshEditor::State& s, Edit& edit, double volumeBefore, Vali
 
 }  // namespace cut_detail
 
-OperationReport MeshEditor::mergeSlivers(double fraction, ValidationLevel validation,
-                                         int validationDegree) {
+OperationReport MeshEditor::mergeSlivers(double fraction, CheckLevel checks, int checkDegree) {
   CutOptions options;
   options.sliverFraction = fraction;
-  options.validationDegree = validationDegree;
+  options.checkDegree = checkDegree;
   checkOptions(options);
   if (!state_) throw std::logic_error("MeshEditor: used after release()");
   const Stopwatch start;
   State& s = *state_;
   OperationReport report;
   report.op = "merge";
-  report.facesReintegrated += raiseMomentDegree(2 * validationDegree);
+  report.facesReintegrated += raiseMomentDegree(2 * checkDegree);
   const double volumeBefore = s.volume;
   Edit edit(s.mesh, *s.moments, s.grid);
   std::vector<ElementId> all(s.mesh.numElements());
   for (std::size_t e = 0; e < all.size(); ++e) all[e] = ElementId(e);
   if (fraction > 0.0) mergeSliverPieces(edit, std::move(all), fraction * s.referenceVolume, report);
   report.facesReintegrated += edit.updateMoments();
-  finishOperation(s, edit, volumeBefore, validation, validationDegree, fraction * s.referenceVolume,
-                  report);
+  finishOperation(s, edit, volumeBefore, checks, checkDegree, fraction * s.referenceVolume, report);
   report.seconds = start.seconds();
   return report;
 }

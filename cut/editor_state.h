@@ -55,7 +55,7 @@ void insertEdgePoints(Edit& edit, const std::vector<ElementId>& elements, const 
 
 /// The end of an operation: compaction, the grid and the volume brought up to date, lineage,
 /// checks and volume balance. `volumeBefore` is the volume before it.
-void finishOperation(MeshEditor::State& s, Edit& edit, double volumeBefore, ValidationLevel level,
+void finishOperation(MeshEditor::State& s, Edit& edit, double volumeBefore, CheckLevel level,
                      int degree, double sliverThreshold, OperationReport& report);
 
 }  // namespace cut_detail

@@ -14,9 +14,9 @@
 
 #include "edit.h"
 #include "editor_state.h"
-#include "operation_checks.h"
 #include "piece_splitter.h"
 #include "polydg/cut/cut.h"
+#include "polydg/physics/checks/operation_checks.h"
 #include "polydg/util/stopwatch.h"
 
 namespace polydg {
@@ -75,7 +75,7 @@ OperationReport MeshEditor::refine(std::span<const ElementRefinement> elements,
   if (!state_) throw std::logic_error("MeshEditor: used after release()");
   if (!(options.sliverFraction >= 0.0) || !std::isfinite(options.sliverFraction))
     throw std::invalid_argument("the sliver fraction must be finite and not negative");
-  if (options.validationDegree < 1 || options.validationDegree > 3)
+  if (options.checkDegree < 1 || options.checkDegree > 3)
     throw std::invalid_argument("the validation degree must be 1, 2 or 3");
   std::unordered_set<std::uint32_t> listed;
   for (const ElementRefinement& r : elements) {
@@ -94,9 +94,9 @@ OperationReport MeshEditor::refine(std::span<const ElementRefinement> elements,
   } catch (const std::exception& e) {
     OperationReport report;
     report.op = "refine";
-    report.validation.level = options.validation;
-    report.validation.passed = false;
-    report.validation.failure = std::string("split: ") + e.what();
+    report.check.level = options.checks;
+    report.check.passed = false;
+    report.check.failure = std::string("split: ") + e.what();
     report.seconds = start.seconds();
     return report;
   }
@@ -108,7 +108,7 @@ OperationReport MeshEditor::refineInPlace(std::span<const ElementRefinement> ele
   State& s = *state_;
   OperationReport report;
   report.op = "refine";
-  report.facesReintegrated += raiseMomentDegree(2 * options.validationDegree);
+  report.facesReintegrated += raiseMomentDegree(2 * options.checkDegree);
   const double volumeBefore = s.volume;
   Edit edit(s.mesh, *s.moments, s.grid);
 
@@ -196,16 +196,15 @@ OperationReport MeshEditor::refineInPlace(std::span<const ElementRefinement> ele
   }
   report.sliverThreshold = threshold;
   report.facesReintegrated += edit.updateMoments();
-  finishOperation(s, edit, volumeBefore, options.validation, options.validationDegree, threshold,
-                  report);
+  finishOperation(s, edit, volumeBefore, options.checks, options.checkDegree, threshold, report);
   report.seconds = start.seconds();
   return report;
 }
 
 OperationReport MeshEditor::coarsen(std::span<const std::vector<ElementId>> groups,
-                                    ValidationLevel validation, int validationDegree) {
+                                    CheckLevel checks, int checkDegree) {
   if (!state_) throw std::logic_error("MeshEditor: used after release()");
-  if (validationDegree < 1 || validationDegree > 3)
+  if (checkDegree < 1 || checkDegree > 3)
     throw std::invalid_argument("the validation degree must be 1, 2 or 3");
   State& s = *state_;
   std::unordered_set<std::uint32_t> listed;
@@ -224,14 +223,14 @@ OperationReport MeshEditor::coarsen(std::span<const std::vector<ElementId>> grou
   const Stopwatch start;
   OperationReport report;
   report.op = "coarsen";
-  report.facesReintegrated += raiseMomentDegree(2 * validationDegree);
+  report.facesReintegrated += raiseMomentDegree(2 * checkDegree);
   const double volumeBefore = s.volume;
   Edit edit(s.mesh, *s.moments, s.grid);
   for (const std::vector<ElementId>& group : groups)
     for (std::size_t i = 1; i < group.size(); ++i) edit.merge(group[i], group[0]);
   report.elementsSplit = 0;
   report.facesReintegrated += edit.updateMoments();
-  finishOperation(s, edit, volumeBefore, validation, validationDegree, 0.0, report);
+  finishOperation(s, edit, volumeBefore, checks, checkDegree, 0.0, report);
   report.seconds = start.seconds();
   return report;
 }

@@ -53,8 +53,8 @@ int main(int argc, char** argv) {
     cut.blade = polydg::Blade::plane(polydg::Vec3::Unit(longest), box.center()[longest]);
     cut.removeSide = +1;
     const polydg::OperationReport op = model.cut(cut);
-    if (!op.validation.passed) {
-      std::cerr << "the cut failed its validation: " << op.validation.failure << '\n';
+    if (!op.check.passed) {
+      std::cerr << "the cut failed its validation: " << op.check.failure << '\n';
       return 1;
     }
     std::cout << "cut: " << op.elementsSplit << " elements split, " << op.elementsRemoved

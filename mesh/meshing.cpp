@@ -185,7 +185,7 @@ MeshingResult meshSurface(const TriangleSurface& input, const MeshingOptions& op
   const Stopwatch start;
   auto finish = [&](MeshingResult& result) {
     result.report.seconds = start.seconds();
-    if (options.validate) validateMeshing(result);
+    if (options.checkGeometry) checkMeshing(result);
   };
   if (input.triangles.empty()) throw InputError("the surface has no triangles");
   const double cellSize = checkedCellSize(input, options);
@@ -264,16 +264,16 @@ MeshingResult meshSurface(const TriangleSurface& input, const MeshingOptions& op
   return result;
 }
 
-void validateMeshing(MeshingResult& result) { validateMeshing(result.mesh, result.report); }
+void checkMeshing(MeshingResult& result) { checkMeshing(result.mesh, result.report); }
 
-void validateMeshing(const PolyMesh& mesh, MeshingReport& r) {
+void checkMeshing(const PolyMesh& mesh, MeshingReport& r) {
   const Stopwatch start;
-  r.validation = validate(mesh);
+  r.geometry = checkGeometry(mesh);
   r.elements = mesh.numElements();
-  r.faces = r.validation.faces;
-  r.interiorFaces = r.validation.interiorFaces;
-  r.boundaryFaces = r.validation.boundaryFaces;
-  r.outputVolume = r.validation.volume;
+  r.faces = r.geometry.faces;
+  r.interiorFaces = r.geometry.interiorFaces;
+  r.boundaryFaces = r.geometry.boundaryFaces;
+  r.outputVolume = r.geometry.volume;
   r.volumeRelError = std::abs(r.outputVolume - r.inputVolume) / r.inputVolume;
   // Shape counts in parallel: (hexahedra, non-convex).
   using Counts = std::pair<std::size_t, std::size_t>;

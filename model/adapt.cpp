@@ -83,7 +83,7 @@ void refineAtSurface(Model& model, const Grid& coarse, int levels, double sliver
   auto split = [&](const std::vector<ElementId>& marked, int round) {
     RefineRequest request;
     request.sliverFraction = 0.0;  // slivers are merged once, at the finest cell's scale
-    request.validation = ValidationLevel::None;
+    request.checks = CheckLevel::None;
     std::unordered_set<std::uint32_t> refined;
     for (ElementId e : marked) {
       const Grid grid = finerGrid(coarse, level[e.index()] + 1);
@@ -104,9 +104,9 @@ void refineAtSurface(Model& model, const Grid& coarse, int levels, double sliver
       return;
     }
     const RefineReport r = model.refine(request);
-    if (!r.operation.validation.passed)
+    if (!r.operation.check.passed)
       throw CheckFailure("octree round " + std::to_string(round) + " failed (" +
-                         r.operation.validation.failure + ")");
+                         r.operation.check.failure + ")");
     level = levelsAfter(level, r.operation.lineage, model.mesh().numElements(), refined);
   };
   for (int round = 1; round <= levels; ++round) {
@@ -140,7 +140,7 @@ void refineAtSurface(Model& model, const Grid& coarse, int levels, double sliver
   if (sliverFraction > 0.0) {
     MergeRequest merge;
     merge.fraction = sliverFraction;
-    merge.validation = ValidationLevel::None;
+    merge.checks = CheckLevel::None;
     const OperationReport r = model.mergeSlivers(merge);
     report.meshing.slivers.slivers += r.slivers;
     report.meshing.slivers.merged += r.sliversMerged;
@@ -158,7 +158,7 @@ RefineReport Model::refine(const RefineRequest& request) {
   State& s = *state_;
   s.requireUsable();
   const double fraction = request.sliverFraction.value_or(s.provenance.sliverFraction);
-  checkEditOptions(fraction, request.validationDegree);
+  checkEditOptions(fraction, request.checkDegree);
   const std::size_t ne = mesh().numElements();
   std::unordered_set<std::uint32_t> listed;
   for (ElementId e : request.elements) {
@@ -208,12 +208,12 @@ RefineReport Model::refine(const RefineRequest& request) {
 
   RefineOptions options;
   options.sliverFraction = fraction;
-  options.validation = request.validation;
-  options.validationDegree = request.validationDegree;
+  options.checks = request.checks;
+  options.checkDegree = request.checkDegree;
   RefineReport report;
   report.operation = s.edit().refine(split, options);
-  s.finishEdit(report.operation, request.validation);
-  if (before && report.operation.validation.passed) {
+  s.finishEdit(report.operation, request.checks);
+  if (before && report.operation.check.passed) {
     const int p = before->basis->degree();
     const MomentCache& after = this->moments(2 * p);
     auto basis = std::make_unique<DgBasis>(mesh(), after, BasisOptions{p, before->basis->kind()});
@@ -230,7 +230,7 @@ RefineReport Model::refine(const RefineRequest& request) {
 CoarsenReport Model::coarsen(const CoarsenRequest& request) {
   State& s = *state_;
   s.requireUsable();
-  checkEditOptions(0.0, request.validationDegree);
+  checkEditOptions(0.0, request.checkDegree);
   const std::size_t ne = mesh().numElements();
   std::unordered_set<std::uint32_t> listed;
   for (const std::vector<ElementId>& group : request.groups) {
@@ -247,10 +247,9 @@ CoarsenReport Model::coarsen(const CoarsenRequest& request) {
   std::optional<Solution> before;
   if (s.solution) before = std::move(s.solution);
   CoarsenReport report;
-  report.operation = s.edit().coarsen(request.groups, request.validation, request.validationDegree);
-  s.finishEdit(report.operation, request.validation);
-  if (before && report.operation.validation.passed &&
-      before->basis->kind() == BasisKind::Orthonormal) {
+  report.operation = s.edit().coarsen(request.groups, request.checks, request.checkDegree);
+  s.finishEdit(report.operation, request.checks);
+  if (before && report.operation.check.passed && before->basis->kind() == BasisKind::Orthonormal) {
     const int p = before->basis->degree();
     const MomentCache& after = this->moments(2 * p);
     auto basis = std::make_unique<DgBasis>(mesh(), after, BasisOptions{p, BasisKind::Orthonormal});
@@ -326,11 +325,11 @@ SolveReport solveAdaptively(Model& model, const SolveOptions& options) {
     // The next round's solve validates the whole mesh's geometry (the edit leaves its validity
     // unknown) and its factorization fails on a singular stiffness: the region DG checks would
     // factorize the refined region once more (issue 17 measures them at 100x a cut).
-    request.validation = ValidationLevel::None;
+    request.checks = CheckLevel::None;
     const RefineReport refined = model.refine(request);
-    if (!refined.operation.validation.passed)
+    if (!refined.operation.check.passed)
       throw CheckFailure("refinement round " + std::to_string(round + 1) + " failed its checks (" +
-                         refined.operation.validation.failure + ")");
+                         refined.operation.check.failure + ")");
     r.refineSeconds = refineWatch.seconds();
     r.elementsAfter = model.mesh().numElements();
     rounds.push_back(r);

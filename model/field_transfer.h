@@ -1,6 +1,6 @@
 // What travels across an edit of the mesh: DG fields and refinement levels. Fields: each element
 // after it takes the polynomial of its first source before it, re-expressed in its own basis
-// (physics/dg_basis.h, transferMatrix): exact for a piece of one element, an extension for an
+// (physics/dg/dg_basis.h, transferMatrix): exact for a piece of one element, an extension for an
 // element that merged pieces of several. Private to model/.
 #pragma once
 
@@ -12,7 +12,7 @@
 #include <Eigen/Core>
 
 #include "polydg/cut/cut.h"
-#include "polydg/physics/dg_basis.h"
+#include "polydg/physics/dg/dg_basis.h"
 
 namespace polydg {
 

@@ -1,8 +1,8 @@
 #include "polydg/model/info.h"
 
+#include "polydg/mesh/geometry_checks.h"
 #include "polydg/mesh/surface.h"
 #include "polydg/mesh/surface_io.h"
-#include "polydg/mesh/validate.h"
 #include "polydg/model/model.h"
 #include "polydg/model/report_json.h"
 
@@ -42,7 +42,7 @@ VolumeMeshInfo inspectVolumeMesh(const std::string& path) {
   ReadReport read;
   const Model model = Model::read(path, &read);
   const PolyMesh& mesh = model.mesh();
-  const ValidationReport v = validate(mesh);
+  const GeometryCheck v = checkGeometry(mesh);
   VolumeMeshInfo i;
   i.vertices = mesh.numVertices();
   i.faces = mesh.numFaces();

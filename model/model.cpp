@@ -89,9 +89,9 @@ std::size_t Model::facesIntegrated() const {
 
 std::vector<std::string> MeshReport::failures() const {
   std::vector<std::string> out;
-  if (!meshing.validation.passed) {
-    if (meshing.validation.messages.empty()) out.push_back("geometry: the new mesh is invalid");
-    for (const std::string& m : meshing.validation.messages) out.push_back("geometry: " + m);
+  if (!meshing.geometry.passed) {
+    if (meshing.geometry.messages.empty()) out.push_back("geometry: the new mesh is invalid");
+    for (const std::string& m : meshing.geometry.messages) out.push_back("geometry: " + m);
   }
   for (std::string& m : dg.failures()) out.push_back(std::move(m));
   return out;
@@ -151,7 +151,7 @@ Model Model::fromSurface(const TriangleSurface& surface, const MeshOptions& opti
     meshing.sliverTau = 0.0;
   }
   meshing.progress = options.progress;
-  meshing.validate = false;  // below, beside the checks and the writing
+  meshing.checkGeometry = false;  // below, beside the checks and the writing
   MeshingResult meshed = meshSurface(surface, meshing);
   report.meshing = std::move(meshed.report);
   const Grid& grid = report.meshing.grid;
@@ -175,7 +175,7 @@ Model Model::fromSurface(const TriangleSurface& surface, const MeshOptions& opti
   std::exception_ptr writeFailure, dgFailure;
   MeshCheck dg;
   tbb::parallel_invoke(
-      [&] { validateMeshing(mesh, report.meshing); },
+      [&] { checkMeshing(mesh, report.meshing); },
       [&] {
         if (!options.dgChecks) return;
         try {
@@ -202,7 +202,7 @@ Model Model::fromSurface(const TriangleSurface& surface, const MeshOptions& opti
         }
       });
   if (options.momentDegree > 0 && !options.dgChecks) model.moments(options.momentDegree);
-  if (!report.meshing.validation.passed) {
+  if (!report.meshing.geometry.passed) {
     dg = MeshCheck();
     dg.notes.push_back("DG checks skipped: the mesh failed the geometric validation");
   } else if (dgFailure) {
@@ -211,7 +211,7 @@ Model Model::fromSurface(const TriangleSurface& surface, const MeshOptions& opti
   if (!options.dgChecks) dg.notes.push_back("DG checks skipped (not asked for)");
   report.dg = std::move(dg);
   if (writeFailure) std::rethrow_exception(writeFailure);
-  model.state_->valid = report.meshing.validation.passed;
+  model.state_->valid = report.meshing.geometry.passed;
   if (file && report.passed()) {
     file->commit();
     report.output = options.output;
@@ -260,13 +260,13 @@ OperationReport Model::cut(const CutRequest& request) {
   CutOptions options;
   options.removeSide = request.removeSide;
   options.sliverFraction = request.sliverFraction.value_or(s.provenance.sliverFraction);
-  options.validation = request.validation;
-  options.validationDegree = request.validationDegree;
+  options.checks = request.checks;
+  options.checkDegree = request.checkDegree;
   if (request.removeSide < -1 || request.removeSide > 1)
     throw InputError("the side to remove must be +, - or none");
-  checkEditOptions(options.sliverFraction, options.validationDegree);
+  checkEditOptions(options.sliverFraction, options.checkDegree);
   OperationReport report = s.edit().cut(request.blade, options);
-  s.finishEdit(report, request.validation);
+  s.finishEdit(report, request.checks);
   return report;
 }
 
@@ -274,10 +274,9 @@ OperationReport Model::mergeSlivers(const MergeRequest& request) {
   State& s = *state_;
   s.requireUsable();
   const double fraction = request.fraction.value_or(s.provenance.sliverFraction);
-  checkEditOptions(fraction, request.validationDegree);
-  OperationReport report =
-      s.edit().mergeSlivers(fraction, request.validation, request.validationDegree);
-  s.finishEdit(report, request.validation);
+  checkEditOptions(fraction, request.checkDegree);
+  OperationReport report = s.edit().mergeSlivers(fraction, request.checks, request.checkDegree);
+  s.finishEdit(report, request.checks);
   return report;
 }
 
@@ -323,9 +322,9 @@ std::string boxText(const Box3& box) {
 
 void Model::State::requireValid() {
   const PolyMesh& m = currentMesh();
-  if (!valid.has_value()) valid = validate(m).passed;
+  if (!valid.has_value()) valid = checkGeometry(m).passed;
   if (*valid) return;
-  const ValidationReport v = validate(m);
+  const GeometryCheck v = checkGeometry(m);
   throw CheckFailure("the mesh is invalid (" +
                      (v.messages.empty() ? std::string("see 'polydg check'") : v.messages.front()) +
                      "); run 'polydg check' for details");

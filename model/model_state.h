@@ -20,7 +20,7 @@ struct Model::State {
   std::unique_ptr<MomentCache> moments;  ///< until the first edit (null until needed)
   std::unique_ptr<MeshEditor> editor;    ///< from the first edit
   std::size_t retiredIntegrations = 0;   ///< faces integrated by caches replaced before it
-  /// Whether the mesh is known to pass validate(): set by a passed validation, kept by edits
+  /// Whether the mesh is known to pass checkGeometry(): set by a passed validation, kept by edits
   /// whose own validation passed, unknown (nullopt) after an unvalidated edit.
   std::optional<bool> valid;
   /// Set by an operation that failed part-way: the mesh must not be used further.
@@ -61,25 +61,25 @@ struct Model::State {
   /// What follows every edit (cut or merge): the solution no longer fits the mesh; an edit that
   /// left no element fails; a failed one breaks the model; an unvalidated one leaves its
   /// validity unknown.
-  void finishEdit(OperationReport& report, ValidationLevel validation) {
+  void finishEdit(OperationReport& report, CheckLevel checks) {
     solution.reset();
-    if (currentMesh().numElements() == 0 && report.validation.passed) {
-      report.validation.passed = false;
-      report.validation.failure =
+    if (currentMesh().numElements() == 0 && report.check.passed) {
+      report.check.passed = false;
+      report.check.failure =
           "the " + report.op + " left no element (everything was removed); nothing to write";
     }
-    if (!report.validation.passed)
-      broken = report.op + " failed: " + report.validation.failure;
-    else if (validation == ValidationLevel::None)
+    if (!report.check.passed)
+      broken = report.op + " failed: " + report.check.failure;
+    else if (checks == CheckLevel::None)
       valid.reset();
   }
 };
 
 /// The options cuts and merges share, checked before the mesh is touched.
-inline void checkEditOptions(double sliverFraction, int validationDegree) {
+inline void checkEditOptions(double sliverFraction, int checkDegree) {
   if (!(sliverFraction >= 0.0 && sliverFraction <= 1.0))
     throw InputError("the sliver fraction must be a number in [0, 1]");
-  if (validationDegree < 1 || validationDegree > 3)
+  if (checkDegree < 1 || checkDegree > 3)
     throw InputError("the validation degree must be 1, 2 or 3");
 }
 

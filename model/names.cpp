@@ -44,10 +44,9 @@ const Names<RepairMode>& repairNames() {
   return names;
 }
 
-const Names<ValidationLevel>& validationNames() {
-  static const Names<ValidationLevel> names{{"none", ValidationLevel::None},
-                                            {"local", ValidationLevel::Local},
-                                            {"full", ValidationLevel::Full}};
+const Names<CheckLevel>& checkLevelNames() {
+  static const Names<CheckLevel> names{
+      {"none", CheckLevel::None}, {"local", CheckLevel::Local}, {"full", CheckLevel::Full}};
   return names;
 }
 

@@ -31,8 +31,8 @@ int Pipeline::momentDegree() const {
   for (const PipelineStep& step : steps) {
     int need = 0;
     if (const auto* s = std::get_if<MeshStep>(&step)) need = s->options.dgChecks ? 2 : 0;
-    if (const auto* s = std::get_if<CutStep>(&step)) need = 2 * s->request.validationDegree;
-    if (const auto* s = std::get_if<MergeStep>(&step)) need = 2 * s->request.validationDegree;
+    if (const auto* s = std::get_if<CutStep>(&step)) need = 2 * s->request.checkDegree;
+    if (const auto* s = std::get_if<MergeStep>(&step)) need = 2 * s->request.checkDegree;
     if (const auto* s = std::get_if<CheckStep>(&step)) need = 2 * s->options.degree;
     if (const auto* s = std::get_if<SolveStep>(&step)) need = 2 * s->options.degree;
     degree = std::max(degree, need);
@@ -61,7 +61,7 @@ CutRequest readCutRequest(JsonObjectReader& r) {
     r.fail(r.at(plane ? "plane" : "polygon"), e.what());
   }
   if (r.has("remove_side")) s.request.removeSide = r.choice("remove_side", removeSideNames());
-  if (r.has("validate")) s.request.validation = r.choice("validate", validationNames());
+  if (r.has("validate")) s.request.checks = r.choice("validate", checkLevelNames());
   if (r.has("sliver_fraction")) s.request.sliverFraction = r.number("sliver_fraction", 0.0, 1.0);
   return s.request;
 }
@@ -112,7 +112,7 @@ CutStep cutStep(JsonObjectReader& r) { return {readCutRequest(r)}; }
 MergeStep mergeStep(JsonObjectReader& r) {
   MergeStep s;
   if (r.has("fraction")) s.request.fraction = r.number("fraction", 0.0, 1.0);
-  if (r.has("validate")) s.request.validation = r.choice("validate", validationNames());
+  if (r.has("validate")) s.request.checks = r.choice("validate", checkLevelNames());
   return s;
 }
 
@@ -357,9 +357,8 @@ class InputRun {
     result["operations"] = json::array({toJson(r)});
     result["output"] = {{"elements", current().mesh().numElements()},
                         {"volume", current().volume()}};
-    if (!r.validation.passed)
-      throw StepFailure(std::string("the ") + what +
-                        " failed its validation: " + r.validation.failure);
+    if (!r.check.passed)
+      throw StepFailure(std::string("the ") + what + " failed its validation: " + r.check.failure);
     log(std::string(what) + ": " + std::to_string(r.elementsSplit) + " elements split, " +
         std::to_string(r.elementsRemoved) + " removed, " + std::to_string(r.sliversMerged) +
         " slivers merged, " + std::to_string(current().mesh().numElements()) + " elements");

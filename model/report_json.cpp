@@ -65,7 +65,7 @@ json toJson(const Provenance& p) {
       {"sliver_threshold", p.sliverFraction * p.referenceVolume}};
 }
 
-json toJson(const ValidationReport& r) {
+json toJson(const GeometryCheck& r) {
   return {{"passed", r.passed},
           {"elements", r.elements},
           {"faces", r.faces},
@@ -156,16 +156,15 @@ json toJson(const MeshReport& report) {
   timings["slice_split"] = r.slice.secondsSplitting;
   timings["slice_build"] = r.slice.secondsBuilding;
 
-  json validation = toJson(r.validation);
-  validation["geometry_passed"] = r.validation.passed;
-  validation["passed"] = report.passed();
-  validation["dg_checked"] = report.dg.local.has_value();
+  json checks = toJson(r.geometry);
+  checks["geometry_passed"] = r.geometry.passed;
+  checks["passed"] = report.passed();
+  checks["dg_checked"] = report.dg.local.has_value();
   if (report.dg.local) {
-    validation.update(toJson(*report.dg.local, report.dg.localSeconds));
-    for (const std::string& m : failureMessages(*report.dg.local))
-      validation["messages"].push_back(m);
+    checks.update(toJson(*report.dg.local, report.dg.localSeconds));
+    for (const std::string& m : failureMessages(*report.dg.local)) checks["messages"].push_back(m);
   } else {
-    nullLocalKeys(validation);
+    nullLocalKeys(checks);
   }
   return {
       {"input",
@@ -208,13 +207,13 @@ json toJson(const MeshReport& report) {
         {"sliver_threshold", r.slivers.threshold},
         {"cells_with_several_pieces", r.slice.multiPieceCells}}},
       {"volume_rel_error", r.volumeRelError},
-      {"validation", validation},
+      {"validation", checks},
       {"faces_integrated", report.dg.facesIntegrated},
       {"timings_s", timings}};
 }
 
 json toJson(const OperationReport& r) {
-  const OperationValidation& v = r.validation;
+  const OperationCheck& v = r.check;
   constexpr std::size_t kListedIds = 20;
   std::vector<std::uint32_t> firstIds;
   for (std::size_t i = 0; i < r.leftWhole.size() && i < kListedIds; ++i)

@@ -15,8 +15,8 @@
 #include "polydg/model/files.h"
 #include "polydg/model/names.h"
 #include "polydg/model/scene.h"
-#include "polydg/physics/contact.h"
-#include "polydg/physics/post_process.h"
+#include "polydg/physics/contact/contact.h"
+#include "polydg/physics/dg/post_process.h"
 #include "polydg/util/stopwatch.h"
 
 namespace polydg {
@@ -390,7 +390,7 @@ SimulationReport Model::simulate(const Scene& scene, const SimulateOptions& opti
                                                solver.displacement(), scene.material);
     RefineRequest request;
     request.split = a.split;
-    request.validation = ValidationLevel::None;
+    request.checks = CheckLevel::None;
     for (std::size_t e = 0; e < level.size(); ++e)
       if (level[e] < a.maxLevel && std::abs(fields.principalStress[ElementId(e)]) > a.stress) {
         request.elements.push_back(ElementId(e));
@@ -399,7 +399,7 @@ SimulationReport Model::simulate(const Scene& scene, const SimulateOptions& opti
     // Families whose children are all still there, none refined further, and all below the
     // coarsening threshold are merged back (none that a refinement marked now).
     CoarsenRequest coarsenRequest;
-    coarsenRequest.validation = ValidationLevel::None;
+    coarsenRequest.checks = CheckLevel::None;
     if (a.coarsen > 0.0) {
       std::vector<std::vector<ElementId>> members(familySize.size());
       std::vector<char> keep(familySize.size(), 1);
@@ -426,9 +426,9 @@ SimulationReport Model::simulate(const Scene& scene, const SimulateOptions& opti
     if (coarsening) {
       record.coarsened = coarsenRequest.groups.size();
       const CoarsenReport c = coarsen(coarsenRequest);
-      if (!c.operation.validation.passed)
+      if (!c.operation.check.passed)
         throw CheckFailure("the coarsening at t = " + std::to_string(record.time) + " failed (" +
-                           c.operation.validation.failure + "); the simulation stops there");
+                           c.operation.check.failure + "); the simulation stops there");
       lineage = c.operation.lineage;
       std::vector<int> next(mesh().numElements(), 0);
       for (std::size_t e = 0; e < next.size(); ++e) {
@@ -441,9 +441,9 @@ SimulationReport Model::simulate(const Scene& scene, const SimulateOptions& opti
       if (a.split == RefineSplit::Octants) request.directions.clear();
       record.marked = request.elements.size();
       const RefineReport r = refine(request);
-      if (!r.operation.validation.passed)
+      if (!r.operation.check.passed)
         throw CheckFailure("the refinement at t = " + std::to_string(record.time) + " failed (" +
-                           r.operation.validation.failure + "); the simulation stops there");
+                           r.operation.check.failure + "); the simulation stops there");
       lineage = r.operation.lineage;
       std::unordered_set<std::uint32_t> refined;
       for (ElementId e : request.elements) refined.insert(e.value);
@@ -482,9 +482,9 @@ SimulationReport Model::simulate(const Scene& scene, const SimulateOptions& opti
       const DgBasis oldBasis = solver.basis();
       const Eigen::VectorXd oldU = solver.displacement(), oldV = solver.velocity();
       record.report = cut(timed.request);
-      if (!record.report.validation.passed)
+      if (!record.report.check.passed)
         throw CheckFailure("the cut at t = " + std::to_string(record.time) + " failed (" +
-                           record.report.validation.failure + "); the simulation stops there");
+                           record.report.check.failure + "); the simulation stops there");
       record.elementsAfter = mesh().numElements();
       report.cutSeconds += tc.seconds();
       level = levelsAfter(level, record.report.lineage, record.elementsAfter, {});

@@ -82,7 +82,7 @@ py::object operate(Model& model, const char* step, const char* caller, const py:
 /// The report of a cut or merge; one that failed its validation (or left nothing) raises
 /// CheckFailure naming it, as `polydg cut` exits 1.
 nlohmann::json editReport(const OperationReport& r) {
-  if (!r.validation.passed) throw CheckFailure(r.op + " failed: " + r.validation.failure);
+  if (!r.check.passed) throw CheckFailure(r.op + " failed: " + r.check.failure);
   return toJson(r);
 }
 
@@ -372,11 +372,11 @@ PYBIND11_MODULE(_polydg, m) {
               throw InputError("split must be one of " + listNames(refineSplitNames()) + ", not '" +
                                split + "'");
             request.split = *kind;
-            const auto level = parseName(validationNames(), validate);
+            const auto level = parseName(checkLevelNames(), validate);
             if (!level)
-              throw InputError("validate must be one of " + listNames(validationNames()) +
+              throw InputError("validate must be one of " + listNames(checkLevelNames()) +
                                ", not '" + validate + "'");
-            request.validation = *level;
+            request.checks = *level;
             for (std::int64_t e : elements) {
               if (e < 0 || e > std::numeric_limits<std::uint32_t>::max() - 1)
                 throw InputError("element " + std::to_string(e) + " is not in the mesh");
@@ -391,8 +391,8 @@ PYBIND11_MODULE(_polydg, m) {
               py::gil_scoped_release release;
               r = model.refine(request);
             }
-            if (!r.operation.validation.passed)
-              throw CheckFailure("refine failed: " + r.operation.validation.failure);
+            if (!r.operation.check.passed)
+              throw CheckFailure("refine failed: " + r.operation.check.failure);
             return toPython(toJson(r));
           },
           py::arg("elements"), py::arg("split") = "octants", py::arg("directions") = py::none(),
@@ -402,11 +402,11 @@ PYBIND11_MODULE(_polydg, m) {
           [](Model& model, const std::vector<std::vector<std::int64_t>>& groups,
              const std::string& validate) {
             CoarsenRequest request;
-            const auto level = parseName(validationNames(), validate);
+            const auto level = parseName(checkLevelNames(), validate);
             if (!level)
-              throw InputError("validate must be one of " + listNames(validationNames()) +
+              throw InputError("validate must be one of " + listNames(checkLevelNames()) +
                                ", not '" + validate + "'");
-            request.validation = *level;
+            request.checks = *level;
             for (const auto& group : groups) {
               request.groups.emplace_back();
               for (std::int64_t e : group) {
@@ -420,8 +420,8 @@ PYBIND11_MODULE(_polydg, m) {
               py::gil_scoped_release release;
               r = model.coarsen(request);
             }
-            if (!r.operation.validation.passed)
-              throw CheckFailure("coarsen failed: " + r.operation.validation.failure);
+            if (!r.operation.check.passed)
+              throw CheckFailure("coarsen failed: " + r.operation.check.failure);
             nlohmann::json j = toJson(r.operation);
             j["solution_projected"] = r.solutionProjected;
             return toPython(j);

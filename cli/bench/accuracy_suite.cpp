@@ -9,7 +9,7 @@
 
 #include "cli/bench/problems.h"
 #include "polydg/model/names.h"
-#include "polydg/physics/condition_estimate.h"
+#include "polydg/physics/solvers/condition_estimate.h"
 
 namespace polydg::bench {
 

@@ -19,8 +19,8 @@
 #include "polydg/mesh/geometry.h"
 #include "polydg/mesh/surface_shapes.h"
 #include "polydg/model/scene.h"
-#include "polydg/physics/embedding.h"
-#include "polydg/physics/obstacles.h"
+#include "polydg/physics/contact/embedding.h"
+#include "polydg/physics/contact/obstacles.h"
 #include "polydg/util/error.h"
 #include "polydg/util/stopwatch.h"
 

@@ -49,16 +49,16 @@ SuiteOutput cuttingSuite(const BenchOptions& o, bool quiet) {
   SuiteOutput s{"cutting", nlohmann::json::object(), nlohmann::json::array(), {}};
   SeriesSet time;
   nlohmann::json runs = nlohmann::json::array();
-  for (ValidationLevel level : {ValidationLevel::None, ValidationLevel::Local}) {
-    const std::string levelName = level == ValidationLevel::None ? "none" : "local";
+  for (CheckLevel level : {CheckLevel::None, CheckLevel::Local}) {
+    const std::string levelName = level == CheckLevel::None ? "none" : "local";
     MeshEditor editor(hexGridMesh(n, n, n, Box3(Vec3(0, 0, 0), Vec3(1, 1, 1))));
     const std::size_t elements0 = editor.mesh().numElements();
     CutOptions options;
-    options.validation = level;
+    options.checks = level;
     for (const CutRow& row : cuttingRows(o.quick)) {
       const OperationReport r = editor.cut(Blade::plane(row.normal, row.offset), options);
-      if (!r.validation.passed)
-        throw std::runtime_error("cutting suite: " + row.name + ": " + r.validation.failure);
+      if (!r.check.passed)
+        throw std::runtime_error("cutting suite: " + row.name + ": " + r.check.failure);
       const Stopwatch rebuildTime;
       MomentCache fresh(editor.mesh(), editor.moments().degree());
       fresh.update();
@@ -74,12 +74,12 @@ SuiteOutput cuttingSuite(const BenchOptions& o, bool quiet) {
                        {"faces_total", r.facesTotal},
                        {"t_cut", r.seconds},
                        {"t_full_rebuild", rebuild},
-                       {"validation_passed", r.validation.passed}};
+                       {"validation_passed", r.check.passed}};
       runs.push_back(j);
       s.rows.push_back(j);
       const double split = static_cast<double>(std::max<std::size_t>(r.elementsSplit, 1));
       time.add("cut, validation " + levelName, split, r.seconds);
-      if (level == ValidationLevel::None) time.add("full moment rebuild (2 cores)", split, rebuild);
+      if (level == CheckLevel::None) time.add("full moment rebuild (2 cores)", split, rebuild);
       if (!quiet)
         std::cout << "cut " << row.name << " (validation " << levelName << "): " << r.elementsSplit
                   << " split, " << r.facesReintegrated << " of " << r.facesTotal

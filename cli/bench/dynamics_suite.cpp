@@ -13,8 +13,8 @@
 #include "polydg/mesh/primitives.h"
 #include "polydg/model/names.h"
 #include "polydg/model/scene.h"
-#include "polydg/physics/dynamics.h"
-#include "polydg/physics/post_process.h"
+#include "polydg/physics/dg/post_process.h"
+#include "polydg/physics/dynamics/dynamics.h"
 #include "polydg/util/stopwatch.h"
 
 namespace polydg::bench {

@@ -4,7 +4,7 @@
 
 #include "polydg/integrate/moment_cache.h"
 #include "polydg/mesh/surface_shapes.h"
-#include "polydg/physics/validation.h"
+#include "polydg/physics/checks/dg_checks.h"
 #include "polydg/util/stopwatch.h"
 
 namespace polydg::bench {
@@ -26,7 +26,7 @@ MeshingBenchmarkRun meshingBenchmarkRun(const std::string& model, const Triangle
   run.polyhedra = report.polyhedra;
   run.slivers_merged = report.slivers.merged;
   run.volumeRelError = report.volumeRelError;
-  run.valid = report.validation.passed;
+  run.valid = report.geometry.passed;
   run.phases = report.timings;
   run.secondsTotal = report.seconds;
   return run;
@@ -40,7 +40,7 @@ MeshingCostRun runMeshingCostCase(const std::string& model, const TriangleSurfac
   MeshingCostRun run;
   run.meshing = meshingBenchmarkRun(model, surface, cells, result.report);
   for (const auto& [phase, seconds] : result.report.timings)
-    if (phase == "validate") run.geometricValidationSeconds += seconds;
+    if (phase == "validate") run.geometryCheckSeconds += seconds;
   const Stopwatch t0;
   LocalDgCheckOptions checks;
   MomentCache moments(result.mesh, 2 * checks.basis.degree);

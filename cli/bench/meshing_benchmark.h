@@ -37,8 +37,8 @@ MeshingBenchmarkRun meshingBenchmarkRun(const std::string& model, const Triangle
 /// moments they need.
 struct MeshingCostRun {
   MeshingBenchmarkRun meshing;
-  double geometricValidationSeconds = 0.0;  ///< the "validate" phase of meshing
-  double dgCheckSeconds = 0.0;              ///< moments + localDgChecks(), wall
+  double geometryCheckSeconds = 0.0;  ///< the "validate" phase of meshing
+  double dgCheckSeconds = 0.0;        ///< moments + localDgChecks(), wall
   std::size_t dgElements = 0;
   bool dgPassed = false;
 };

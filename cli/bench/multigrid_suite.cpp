@@ -139,9 +139,9 @@ SuiteOutput multigridSuite(const BenchOptions& o, bool quiet) {
         Model model = Model::fromSurface(surface, mo, meshed, path);
         if (std::string(variant) == "cut")
           for (const CutRequest& cut : cutsThrough(box))
-            if (const OperationReport cr = model.cut(cut); !cr.validation.passed)
+            if (const OperationReport cr = model.cut(cut); !cr.check.passed)
               throw std::runtime_error(name + ": the " + cr.op +
-                                       " failed its validation: " + cr.validation.failure);
+                                       " failed its validation: " + cr.check.failure);
         const std::size_t elements = model.mesh().numElements();
         const StaticReport r = model.solve(clampedUnderGravity(box, up, p)).solve;
         // The unit cube of about as many elements.

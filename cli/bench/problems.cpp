@@ -8,7 +8,7 @@
 #include "polydg/mesh/primitives.h"
 #include "polydg/mesh/slice.h"
 #include "polydg/mesh/surface_shapes.h"
-#include "polydg/physics/face_quadrature.h"
+#include "polydg/physics/dg/face_quadrature.h"
 
 namespace polydg::bench {
 

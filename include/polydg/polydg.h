@@ -14,24 +14,24 @@
 #include "polydg/version.h"
 
 #include "polydg/mesh/geometry.h"
+#include "polydg/mesh/geometry_checks.h"
 #include "polydg/mesh/meshing.h"
 #include "polydg/mesh/plane.h"
 #include "polydg/mesh/poly_mesh.h"
 #include "polydg/mesh/surface.h"
 #include "polydg/mesh/surface_io.h"
 #include "polydg/mesh/surface_shapes.h"
-#include "polydg/mesh/validate.h"
 #include "polydg/mesh/vtu_io.h"
 
 #include "polydg/integrate/moment_cache.h"
 #include "polydg/integrate/moments.h"
 
-#include "polydg/physics/loads.h"
-#include "polydg/physics/material.h"
-#include "polydg/physics/mesh_checks.h"
-#include "polydg/physics/post_process.h"
-#include "polydg/physics/static_solver.h"
-#include "polydg/physics/validation.h"
+#include "polydg/physics/checks/dg_checks.h"
+#include "polydg/physics/checks/mesh_checks.h"
+#include "polydg/physics/dg/loads.h"
+#include "polydg/physics/dg/material.h"
+#include "polydg/physics/dg/post_process.h"
+#include "polydg/physics/solvers/static_solver.h"
 
 #include "polydg/cut/cut.h"
 

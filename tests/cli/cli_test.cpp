@@ -139,7 +139,8 @@ TEST_F(Cli, MeshWritesAValidMeshAndReport) {
   // (Overwrite guards: Commands.NoCommandOverwritesItsInput, with each guard reached alone.)
 }
 
-/// Tolerance of the DG patch test in reports (physics/validation.h's kLocalPatchTestTolerance).
+/// Tolerance of the DG patch test in reports (physics/checks/dg_checks.h's
+/// kLocalPatchTestTolerance).
 constexpr double kPatchTolerance = 1e-9;
 
 TEST_F(Cli, CheckReportsTheDgValidation) {

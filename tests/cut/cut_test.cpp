@@ -8,9 +8,9 @@
 
 #include <gtest/gtest.h>
 
+#include "polydg/mesh/geometry_checks.h"
 #include "polydg/mesh/primitives.h"
-#include "polydg/mesh/validate.h"
-#include "polydg/physics/validation.h"
+#include "polydg/physics/checks/dg_checks.h"
 
 namespace polydg {
 namespace {
@@ -24,7 +24,7 @@ PolyMesh unitGrid(int n) { return hexGridMesh(n, n, n, Box3(Vec3(0, 0, 0), Vec3(
 /// The mesh is valid, its volume is `volume`, and the editor's moments equal fresh ones.
 void expectConsistent(const MeshEditor& editor, double volume) {
   const PolyMesh& mesh = editor.mesh();
-  const ValidationReport report = validate(mesh);
+  const GeometryCheck report = checkGeometry(mesh);
   ASSERT_TRUE(report.passed) << (report.messages.empty() ? "" : report.messages.front());
   EXPECT_NEAR(report.volume, volume, kVolumeTolerance * volume);
   EXPECT_NEAR(editor.volume(), volume, kVolumeTolerance * volume);
@@ -51,7 +51,7 @@ TEST(Cut, ObliquePlaneSplitsCrossedElements) {
   CutOptions options;
   options.sliverFraction = 0.0;
   const auto r = editor.cut(Blade::plane(Vec3(1, 2, 3), 2.9), options);
-  EXPECT_TRUE(r.validation.passed) << r.validation.failure;
+  EXPECT_TRUE(r.check.passed) << r.check.failure;
   EXPECT_GT(r.elementsSplit, 0u);
   EXPECT_GE(r.piecesCreated, 2 * r.elementsSplit);
   EXPECT_EQ(editor.mesh().numElements(), 64 - r.elementsSplit + r.piecesCreated);
@@ -77,7 +77,7 @@ TEST(Cut, LineageNamesEachElementsSources) {
       options.sliverFraction = sliver;
       options.removeSide = removeSide;
       const auto r = editor.cut(Blade::plane(Vec3(1, 2, 3), 2.9), options);
-      ASSERT_TRUE(r.validation.passed) << r.validation.failure;
+      ASSERT_TRUE(r.check.passed) << r.check.failure;
       EXPECT_FALSE(r.lineage.changed.empty());
       std::vector<double> covered(before.numElements(), 0.0);
       std::size_t merged = 0;
@@ -119,7 +119,7 @@ TEST(Cut, PlaneThroughVerticesMakesNoDegenerateFace) {
   // x + y + z = 1.5 on a 2^3 grid passes through grid vertices such as (0.5, 0.5, 0.5).
   MeshEditor editor(unitGrid(2));
   const auto r = editor.cut(Blade::plane(Vec3(1, 1, 1), 1.5), noMerging());
-  EXPECT_TRUE(r.validation.passed) << r.validation.failure;
+  EXPECT_TRUE(r.check.passed) << r.check.failure;
   EXPECT_GT(r.elementsSplit, 0u);
   expectConsistent(editor, 1.0);
 }
@@ -128,7 +128,7 @@ TEST(Cut, PlaneAlongEdgesMakesNoDegenerateFace) {
   // x = y contains the grid edges on the diagonal of every xy layer.
   MeshEditor editor(unitGrid(3));
   const auto r = editor.cut(Blade::plane(Vec3(1, -1, 0), 0.0), noMerging());
-  EXPECT_TRUE(r.validation.passed) << r.validation.failure;
+  EXPECT_TRUE(r.check.passed) << r.check.failure;
   EXPECT_EQ(r.elementsSplit, 9u);   // the three diagonal cells of each layer
   EXPECT_EQ(r.piecesCreated, 18u);  // two prisms each
   expectConsistent(editor, 1.0);
@@ -149,7 +149,7 @@ TEST(Cut, PlaneThroughRoundedVerticesWeldsThem) {
   for (const Case& c : {Case{12, Vec3(1, 0.3, 0.1), 0.7}, Case{3, Vec3(1, 1, 0), 1.0}}) {
     MeshEditor editor(unitGrid(c.n));
     const auto r = editor.cut(Blade::plane(c.normal, c.offset), noMerging());
-    EXPECT_TRUE(r.validation.passed) << c.n << ": " << r.validation.failure;
+    EXPECT_TRUE(r.check.passed) << c.n << ": " << r.check.failure;
     EXPECT_GT(r.elementsSplit, 0u);
     expectConsistent(editor, 1.0);
   }
@@ -159,7 +159,7 @@ TEST(Cut, GridPlaneDecouplesWithoutSplitting) {
   MeshEditor editor(unitGrid(4));
   const std::size_t faces = editor.mesh().numFaces();
   const auto r = editor.cut(Blade::plane(Vec3(0, 0, 1), 0.5), noMerging());
-  EXPECT_TRUE(r.validation.passed) << r.validation.failure;
+  EXPECT_TRUE(r.check.passed) << r.check.failure;
   EXPECT_EQ(r.elementsSplit, 0u);
   EXPECT_EQ(r.piecesCreated, 0u);
   EXPECT_EQ(editor.mesh().numElements(), 64u);
@@ -177,10 +177,10 @@ TEST(Cut, PlaneThroughExistingFacesOfSplitPieces) {
   MeshEditor editor(unitGrid(4));
   editor.cut(Blade::plane(Vec3(0, 0, 1), 0.4), noMerging());
   const auto first = editor.cut(Blade::plane(Vec3(1, 1, 0), 1.0), noMerging());
-  ASSERT_TRUE(first.validation.passed) << first.validation.failure;
+  ASSERT_TRUE(first.check.passed) << first.check.failure;
   const std::size_t elements = editor.mesh().numElements();
   const auto again = editor.cut(Blade::plane(Vec3(2, 2, 0), 2.0), noMerging());
-  EXPECT_TRUE(again.validation.passed) << again.validation.failure;
+  EXPECT_TRUE(again.check.passed) << again.check.failure;
   EXPECT_EQ(again.elementsSplit, 0u);
   EXPECT_EQ(again.facesReintegrated, 0u);
   EXPECT_EQ(editor.mesh().numElements(), elements);
@@ -191,7 +191,7 @@ TEST(Cut, PlaneGrazingOneVertexChangesNothing) {
   MeshEditor editor(unitGrid(2));
   const std::size_t faces = editor.mesh().numFaces();
   const auto r = editor.cut(Blade::plane(Vec3(1, 1, 1), 3.0), noMerging());  // touches (1,1,1)
-  EXPECT_TRUE(r.validation.passed) << r.validation.failure;
+  EXPECT_TRUE(r.check.passed) << r.check.failure;
   EXPECT_EQ(r.elementsSplit, 0u);
   EXPECT_EQ(r.facesReintegrated, 0u);
   EXPECT_EQ(editor.mesh().numFaces(), faces);
@@ -203,11 +203,11 @@ TEST(Cut, SameCutTwiceIsANoOp) {
   MeshEditor editor(unitGrid(4));
   const Blade blade = Blade::plane(Vec3(0.3, -0.7, 1.1), 0.37);
   const auto first = editor.cut(blade);
-  ASSERT_TRUE(first.validation.passed) << first.validation.failure;
+  ASSERT_TRUE(first.check.passed) << first.check.failure;
   ASSERT_GT(first.elementsSplit, 0u);
   const std::size_t elements = editor.mesh().numElements(), faces = editor.mesh().numFaces();
   const auto second = editor.cut(blade);
-  EXPECT_TRUE(second.validation.passed) << second.validation.failure;
+  EXPECT_TRUE(second.check.passed) << second.check.failure;
   EXPECT_EQ(second.elementsSplit, 0u);
   EXPECT_EQ(second.facesReintegrated, 0u);
   EXPECT_EQ(editor.mesh().numElements(), elements);
@@ -224,12 +224,12 @@ TEST(Cut, RepeatedPlanesInAnyOrderSplitNothing) {
   const std::vector<Blade> blades{Blade::plane(Vec3(1, 0.3125, 0.1875), 0.5625),
                                   Blade::plane(Vec3(-0.1875, 1, 0.6875), 0.4375),
                                   Blade::plane(Vec3(0.125, 0.625, -1), -0.1875)};
-  for (const Blade& b : blades) ASSERT_TRUE(editor.cut(b, noMerging()).validation.passed);
+  for (const Blade& b : blades) ASSERT_TRUE(editor.cut(b, noMerging()).check.passed);
   const std::size_t elements = editor.mesh().numElements();
   for (int round = 0; round < 2; ++round)
     for (const std::size_t i : {2, 0, 1}) {
       const auto r = editor.cut(blades[i], noMerging());
-      EXPECT_TRUE(r.validation.passed) << r.validation.failure;
+      EXPECT_TRUE(r.check.passed) << r.check.failure;
       EXPECT_EQ(r.elementsSplit, 0u) << "plane " << i;
       EXPECT_EQ(r.facesReintegrated, 0u) << "plane " << i;
     }
@@ -247,17 +247,17 @@ TEST(Cut, ParallelCutsOneTrillionthApart) {
     options.sliverFraction = fraction;
     const Vec3 n(0.2, 0.3, 1.0);
     const auto a = editor.cut(Blade::plane(n, 0.61), options);
-    ASSERT_TRUE(a.validation.passed) << a.validation.failure;
+    ASSERT_TRUE(a.check.passed) << a.check.failure;
     const auto b = editor.cut(Blade::plane(n, 0.61 + 1e-12), options);
     EXPECT_GT(b.elementsSplit, 0u);
     expectConsistent(editor, 1.0);
     if (fraction > 0) {
-      EXPECT_TRUE(b.validation.passed) << b.validation.failure;
+      EXPECT_TRUE(b.check.passed) << b.check.failure;
       EXPECT_EQ(b.sliversMerged + 1, b.slivers);
       EXPECT_EQ(b.isolatedSlivers, 1u);
     } else {
-      EXPECT_FALSE(b.validation.passed);
-      EXPECT_EQ(b.validation.failure.rfind("DG region check", 0), 0u) << b.validation.failure;
+      EXPECT_FALSE(b.check.passed);
+      EXPECT_EQ(b.check.failure.rfind("DG region check", 0), 0u) << b.check.failure;
     }
   }
 }
@@ -270,7 +270,7 @@ TEST(Cut, RemovingEachSideLeavesComplementaryVolumes) {
     CutOptions options;
     options.removeSide = side;
     const auto r = editor.cut(blade, options);
-    EXPECT_TRUE(r.validation.passed) << r.validation.failure;
+    EXPECT_TRUE(r.check.passed) << r.check.failure;
     EXPECT_GT(r.elementsRemoved, 0u);
     EXPECT_NEAR(r.volumeRemoved + editor.volume(), 1.0, kVolumeTolerance);
     kept[side < 0 ? 0 : 1] = editor.volume();
@@ -288,12 +288,12 @@ TEST(Cut, ManyCutsKeepIncrementalMomentsExact) {
   std::mt19937_64 rng(20261123);
   std::uniform_real_distribution<double> coordinate(0.0, 1.0), component(-1.0, 1.0);
   CutOptions options;
-  options.validation = ValidationLevel::None;
+  options.checks = CheckLevel::None;
   for (int i = 0; i < 40; ++i) {
     const Vec3 p(coordinate(rng), coordinate(rng), coordinate(rng));
     const Vec3 n(component(rng), component(rng), component(rng));
     const auto r = editor.cut(Blade::plane(n, n.dot(p)), options);
-    ASSERT_TRUE(r.validation.passed) << "cut " << i << ": " << r.validation.failure;
+    ASSERT_TRUE(r.check.passed) << "cut " << i << ": " << r.check.failure;
   }
   expectConsistent(editor, 1.0);
 }
@@ -303,7 +303,7 @@ TEST(Cut, PolygonBladeSplitsOnlyInside) {
   const Blade blade = Blade::fromPolygon(
       {Vec3(0.1, 0.1, 0.4), Vec3(0.6, 0.1, 0.4), Vec3(0.6, 0.6, 0.55), Vec3(0.1, 0.6, 0.55)});
   const auto r = editor.cut(blade, noMerging());
-  EXPECT_TRUE(r.validation.passed) << r.validation.failure;
+  EXPECT_TRUE(r.check.passed) << r.check.failure;
   EXPECT_GT(r.elementsSplit, 0u);
   EXPECT_FALSE(r.leftWhole.empty());
   expectConsistent(editor, 1.0);
@@ -322,7 +322,7 @@ TEST(Cut, PlaneThroughPointsAnEarlierPolygonCutMadeOnIt) {
   const Blade polygon = Blade::fromPolygon({Vec3(0.13, 0.11, 0.433), Vec3(0.71, 0.17, 0.271),
                                             Vec3(0.67, 0.69, 0.387), Vec3(0.09, 0.63, 0.549)});
   const auto first = editor.cut(polygon, noMerging());
-  ASSERT_TRUE(first.validation.passed) << first.validation.failure;
+  ASSERT_TRUE(first.check.passed) << first.check.failure;
   ASSERT_FALSE(first.leftWhole.empty());
   // The case at hand: points the polygon cut made that round off its plane.
   const Plane plane = Plane::make(polygon.normal, polygon.offset);
@@ -334,7 +334,7 @@ TEST(Cut, PlaneThroughPointsAnEarlierPolygonCutMadeOnIt) {
   ASSERT_GT(rounded, 0u);
 
   const auto whole = editor.cut(Blade::plane(polygon.normal, polygon.offset), noMerging());
-  EXPECT_TRUE(whole.validation.passed) << whole.validation.failure;
+  EXPECT_TRUE(whole.check.passed) << whole.check.failure;
   EXPECT_GT(whole.elementsSplit, 0u);
   expectConsistent(editor, 1.0);
   double shortest = 1.0;
@@ -364,15 +364,15 @@ TEST(Blade, RejectsBadInput) {
 TEST(Cut, FullValidationChecksTheWholeMesh) {
   MeshEditor editor(unitGrid(3));
   CutOptions options;
-  options.validation = ValidationLevel::Full;
-  options.validationDegree = 2;
+  options.checks = CheckLevel::Full;
+  options.checkDegree = 2;
   const auto r = editor.cut(Blade::plane(Vec3(0.4, 1, -0.3), 0.45), options);
-  EXPECT_TRUE(r.validation.passed) << r.validation.failure;
-  EXPECT_EQ(r.validation.level, ValidationLevel::Full);
-  EXPECT_EQ(r.validation.elementsChecked, editor.mesh().numElements());
-  EXPECT_EQ(r.validation.regionComponents, 2u);
-  EXPECT_EQ(r.validation.zeroModes, 12u);
-  EXPECT_LT(r.validation.patchTestError, kLocalPatchTestTolerance);
+  EXPECT_TRUE(r.check.passed) << r.check.failure;
+  EXPECT_EQ(r.check.level, CheckLevel::Full);
+  EXPECT_EQ(r.check.elementsChecked, editor.mesh().numElements());
+  EXPECT_EQ(r.check.regionComponents, 2u);
+  EXPECT_EQ(r.check.zeroModes, 12u);
+  EXPECT_LT(r.check.patchTestError, kLocalPatchTestTolerance);
   EXPECT_GE(editor.moments().degree(), 4);
   expectConsistent(editor, 1.0);
 }
@@ -380,13 +380,13 @@ TEST(Cut, FullValidationChecksTheWholeMesh) {
 TEST(Cut, LocalValidationCoversTheTouchedRegion) {
   MeshEditor editor(unitGrid(4));
   const auto r = editor.cut(Blade::plane(Vec3(0, 1, 0), 0.6), noMerging());
-  ASSERT_TRUE(r.validation.passed) << r.validation.failure;
+  ASSERT_TRUE(r.check.passed) << r.check.failure;
   EXPECT_EQ(r.elementsSplit, 16u);
-  EXPECT_EQ(r.validation.elementsChecked, 32u);             // the pieces
-  EXPECT_EQ(r.validation.regionElements, 32u + 16u + 16u);  // and one ring on each side
-  EXPECT_EQ(r.validation.regionComponents, 2u);
-  EXPECT_EQ(r.validation.zeroModes, 12u);
-  EXPECT_LE(r.validation.volumeRelError, 1e-15);
+  EXPECT_EQ(r.check.elementsChecked, 32u);             // the pieces
+  EXPECT_EQ(r.check.regionElements, 32u + 16u + 16u);  // and one ring on each side
+  EXPECT_EQ(r.check.regionComponents, 2u);
+  EXPECT_EQ(r.check.zeroModes, 12u);
+  EXPECT_LE(r.check.volumeRelError, 1e-15);
 }
 
 TEST(MergeSlivers, MergesSmallPiecesIntoNeighbours) {
@@ -396,7 +396,7 @@ TEST(MergeSlivers, MergesSmallPiecesIntoNeighbours) {
   editor.cut(Blade::plane(Vec3(1, 0, 0), 0.25 - 1e-4), noMerging());
   const std::size_t before = editor.mesh().numElements();
   const auto r = editor.mergeSlivers(kDefaultSliverFraction);
-  EXPECT_TRUE(r.validation.passed) << r.validation.failure;
+  EXPECT_TRUE(r.check.passed) << r.check.failure;
   EXPECT_EQ(r.op, "merge");
   EXPECT_GT(r.sliversMerged, 0u);
   EXPECT_EQ(r.facesReintegrated, 0u);  // merging integrates no face

@@ -4,8 +4,8 @@
 #include <gtest/gtest.h>
 
 #include "polydg/integrate/moment_cache.h"
+#include "polydg/mesh/geometry_checks.h"
 #include "polydg/mesh/primitives.h"
-#include "polydg/mesh/validate.h"
 
 namespace polydg {
 namespace {
@@ -50,7 +50,7 @@ TEST(MeshEditing, RemovingAnElementMovesTheLastIntoItsSlot) {
   EXPECT_EQ(cache.update(), 0u);  // nothing new to integrate
   EXPECT_EQ(mesh.numElements(), 2u);
   EXPECT_EQ(mesh.numFaces(), 16u - 4u);
-  const ValidationReport report = validate(mesh);
+  const GeometryCheck report = checkGeometry(mesh);
   EXPECT_TRUE(report.passed) << report.messages.front();
   EXPECT_EQ(report.components, 2u);
   EXPECT_NEAR(report.volume, 2.0, kTolerance);
@@ -73,7 +73,7 @@ TEST(MeshEditing, SplitEdgeKeepsTheFaceAndItsMoments) {
     }
   EXPECT_EQ(changed, 2u);
   EXPECT_EQ(cache.update(), 2u);
-  EXPECT_TRUE(validate(mesh).passed);
+  EXPECT_TRUE(checkGeometry(mesh).passed);
   expectMomentsFresh(mesh, cache);
 }
 

@@ -12,9 +12,9 @@
 #include <gtest/gtest.h>
 
 #include "polydg/cut/cut.h"
+#include "polydg/mesh/geometry_checks.h"
 #include "polydg/mesh/meshing.h"
 #include "polydg/mesh/surface_shapes.h"
-#include "polydg/mesh/validate.h"
 #include "polydg/util/union_find.h"
 
 namespace polydg {
@@ -29,7 +29,7 @@ constexpr int kCutsPerSphere = 10;
 constexpr double kVolumeTolerance = 1e-10;
 
 /// Components as unions of elements that list the same face (element face lists only, not the
-/// faces' front/back links that validate() and the editor use).
+/// faces' front/back links that checkGeometry() and the editor use).
 std::size_t componentsFromFaceLists(const PolyMesh& mesh) {
   UnionFind sets(mesh.numElements());
   std::unordered_map<std::uint32_t, std::size_t> firstUser;
@@ -85,14 +85,14 @@ TEST(RandomCuts, ThousandCutsThroughSlicedSpheres) {
       const Blade blade = Blade::plane(n, n.dot(p));
       planes.emplace_back(blade.normal, blade.offset);
       const OperationReport r = editor.cut(blade);
-      ASSERT_TRUE(r.validation.passed) << where << ": " << r.validation.failure;
+      ASSERT_TRUE(r.check.passed) << where << ": " << r.check.failure;
       split += r.elementsSplit;
       merged += r.sliversMerged;
       isolated += r.isolatedSlivers;
       reintegrated += r.facesReintegrated;
       total += r.facesTotal;
 
-      const ValidationReport check = validate(editor.mesh());
+      const GeometryCheck check = checkGeometry(editor.mesh());
       ASSERT_TRUE(check.passed) << where << ": " << check.messages.front();
       ASSERT_NEAR(check.volume, volume, kVolumeTolerance * volume) << where;
       ASSERT_NEAR(editor.volume(), volume, kVolumeTolerance * volume) << where;

@@ -8,8 +8,8 @@
 
 #include "polydg/cut/cut.h"
 #include "polydg/mesh/geometry.h"
+#include "polydg/mesh/geometry_checks.h"
 #include "polydg/mesh/primitives.h"
-#include "polydg/mesh/validate.h"
 
 namespace polydg {
 namespace {
@@ -27,8 +27,8 @@ ElementRefinement octants(const PolyMesh& mesh, ElementId e) {
 
 RefineOptions fullChecks(int degree = 1) {
   RefineOptions options;
-  options.validation = ValidationLevel::Full;
-  options.validationDegree = degree;
+  options.checks = CheckLevel::Full;
+  options.checkDegree = degree;
   return options;
 }
 
@@ -39,7 +39,7 @@ std::size_t countOrigin(const PolyMesh& mesh, FaceOrigin origin) {
 }
 
 void expectValid(const MeshEditor& editor, double volume) {
-  const ValidationReport report = validate(editor.mesh());
+  const GeometryCheck report = checkGeometry(editor.mesh());
   ASSERT_TRUE(report.passed) << (report.messages.empty() ? "" : report.messages.front());
   EXPECT_NEAR(report.volume, volume, kVolumeTolerance * volume);
   EXPECT_NEAR(editor.volume(), volume, kVolumeTolerance * volume);
@@ -58,7 +58,7 @@ TEST(Refine, OctantsOfTheCentreHexahedron) {
                                      countOrigin(editor.mesh(), FaceOrigin::Box);
   const std::vector<ElementRefinement> split = {octants(editor.mesh(), ElementId(13))};
   const OperationReport r = editor.refine(split, fullChecks(2));
-  ASSERT_TRUE(r.validation.passed) << r.validation.failure;
+  ASSERT_TRUE(r.check.passed) << r.check.failure;
   EXPECT_EQ(r.op, "refine");
   EXPECT_EQ(r.elementsSplit, 1u);
   EXPECT_EQ(editor.mesh().numElements(), 26u + 8u);
@@ -76,8 +76,8 @@ TEST(Refine, OctantsOfTheCentreHexahedron) {
   }
   EXPECT_EQ(children, 8u);
   EXPECT_EQ(neighboursWithFourFaces, 6u);  // 5 whole faces + 4 parts of the shared one
-  EXPECT_EQ(r.validation.zeroModes, 6u);
-  EXPECT_LT(r.validation.patchTestError, 1e-9);
+  EXPECT_EQ(r.check.zeroModes, 6u);
+  EXPECT_LT(r.check.patchTestError, 1e-9);
   // Each child comes from element 13 (one of them may have taken its id).
   std::size_t fromCentre = 0;
   for (std::size_t e = 0; e < editor.mesh().numElements(); ++e) {
@@ -94,7 +94,7 @@ TEST(Refine, EveryHexahedronGivesTheFinerGrid) {
   std::vector<ElementRefinement> split;
   for (std::size_t e = 0; e < 27; ++e) split.push_back(octants(editor.mesh(), ElementId(e)));
   const OperationReport r = editor.refine(split, fullChecks());
-  ASSERT_TRUE(r.validation.passed) << r.validation.failure;
+  ASSERT_TRUE(r.check.passed) << r.check.failure;
   const PolyMesh fine = hexGridMesh(6, 6, 6, Box3(Vec3(0, 0, 0), Vec3(1, 1, 1)));
   EXPECT_EQ(editor.mesh().numElements(), fine.numElements());
   EXPECT_EQ(editor.mesh().numFaces(), fine.numFaces());
@@ -113,7 +113,7 @@ TEST(Refine, NestedLevelsAtACornerStayClosed) {
       if (elementBounds(editor.mesh(), ElementId(e)).min().norm() == 0.0) corner = ElementId(e);
     const std::vector<ElementRefinement> split = {octants(editor.mesh(), corner)};
     const OperationReport r = editor.refine(split, fullChecks());
-    ASSERT_TRUE(r.validation.passed) << "level " << level << ": " << r.validation.failure;
+    ASSERT_TRUE(r.check.passed) << "level " << level << ": " << r.check.failure;
   }
   EXPECT_EQ(editor.mesh().numElements(), 8u + 3u * 7u);
   expectValid(editor, 1.0);
@@ -130,7 +130,7 @@ TEST(Refine, HalvesAcrossAnObliqueDirection) {
   RefineOptions options = fullChecks(2);
   options.sliverFraction = 0.0;
   const OperationReport r = editor.refine(split, options);
-  ASSERT_TRUE(r.validation.passed) << r.validation.failure;
+  ASSERT_TRUE(r.check.passed) << r.check.failure;
   EXPECT_EQ(r.elementsSplit, 3u);
   EXPECT_EQ(editor.mesh().numElements(), 27u + 3u);
   EXPECT_EQ(countOrigin(editor.mesh(), FaceOrigin::Cut), 0u);
@@ -161,7 +161,7 @@ TEST(Refine, MirrorPlanesMeetingOnASharedEdgeWithinRoundOff) {
   for (const Split& s : splits)
     split.push_back({ElementId(s.element), {Plane::make(s.normal, s.offset)}});
   const OperationReport r = editor.refine(split, fullChecks());
-  ASSERT_TRUE(r.validation.passed) << r.validation.failure;
+  ASSERT_TRUE(r.check.passed) << r.check.failure;
   EXPECT_EQ(r.elementsSplit, 3u);
   expectValid(editor, 36.0);
 }
@@ -173,14 +173,14 @@ TEST(Refine, CutPolyhedraRefineIntoTheirPieces) {
   CutOptions cut;
   cut.removeSide = 1;
   const OperationReport c = editor.cut(Blade::plane(Vec3(1, 1, 1), 1.6), cut);
-  ASSERT_TRUE(c.validation.passed) << c.validation.failure;
+  ASSERT_TRUE(c.check.passed) << c.check.failure;
   const double volume = editor.volume();
   const std::size_t cutFacesBefore = countOrigin(editor.mesh(), FaceOrigin::Cut);
   std::vector<ElementRefinement> split;
   for (std::size_t e = 0; e < editor.mesh().numElements(); ++e)
     split.push_back(octants(editor.mesh(), ElementId(e)));
   const OperationReport r = editor.refine(split, fullChecks());
-  ASSERT_TRUE(r.validation.passed) << r.validation.failure;
+  ASSERT_TRUE(r.check.passed) << r.check.failure;
   EXPECT_GT(countOrigin(editor.mesh(), FaceOrigin::Cut), cutFacesBefore);
   EXPECT_GT(editor.mesh().numElements(), 4 * split.size());
   expectValid(editor, volume);
@@ -190,14 +190,14 @@ TEST(Refine, CoarseningMergesTheChildrenBack) {
   MeshEditor editor(hexGridMesh(3, 3, 3, Box3(Vec3(0, 0, 0), Vec3(3, 3, 3))));
   const std::vector<ElementRefinement> split = {octants(editor.mesh(), ElementId(13))};
   const OperationReport r = editor.refine(split, fullChecks());
-  ASSERT_TRUE(r.validation.passed) << r.validation.failure;
+  ASSERT_TRUE(r.check.passed) << r.check.failure;
   std::vector<ElementId> children;
   for (std::size_t e = 0; e < editor.mesh().numElements(); ++e)
     if (r.lineage.sources(ElementId(e)).front() == ElementId(13)) children.push_back(ElementId(e));
   ASSERT_EQ(children.size(), 8u);
   const std::vector<std::vector<ElementId>> groups = {children};
-  const OperationReport c = editor.coarsen(groups, ValidationLevel::Full, 2);
-  ASSERT_TRUE(c.validation.passed) << c.validation.failure;
+  const OperationReport c = editor.coarsen(groups, CheckLevel::Full, 2);
+  ASSERT_TRUE(c.check.passed) << c.check.failure;
   EXPECT_EQ(c.op, "coarsen");
   EXPECT_EQ(editor.mesh().numElements(), 27u);
   // The merged element is the centre cube again: volume 1, centroid (1.5, 1.5, 1.5).
@@ -225,7 +225,7 @@ TEST(Refine, RejectsBadRequests) {
   // A plane that misses the element leaves it whole.
   const OperationReport r = editor.refine(
       std::vector<ElementRefinement>{{ElementId(0), {Plane::make(Vec3::UnitX(), 5.0)}}});
-  ASSERT_TRUE(r.validation.passed) << r.validation.failure;
+  ASSERT_TRUE(r.check.passed) << r.check.failure;
   EXPECT_EQ(r.elementsSplit, 0u);
   EXPECT_EQ(editor.mesh().numElements(), 8u);
 }

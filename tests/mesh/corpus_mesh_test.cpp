@@ -154,7 +154,7 @@ Result meshModel(const std::string& path, Classes& classes) {
   options.cellsAlongLongest = kCells;
   try {
     const MeshingResult r = meshSurface(surface, options);
-    EXPECT_TRUE(r.report.validation.passed) << path;
+    EXPECT_TRUE(r.report.geometry.passed) << path;
     EXPECT_EQ(f.boundaryEdges, 0u) << path << ": an open surface was meshed";
     EXPECT_EQ(f.nonManifoldEdges, 0u) << path << ": a non-manifold surface was meshed";
     EXPECT_FALSE(f.checked && f.selfIntersecting)
@@ -192,7 +192,7 @@ Result meshModel(const std::string& path, Classes& classes) {
     options.repair = RepairMode::Wrap;
     try {
       const MeshingResult r = meshSurface(surface, options);
-      EXPECT_TRUE(r.report.validation.passed) << path << " (wrapped)";
+      EXPECT_TRUE(r.report.geometry.passed) << path << " (wrapped)";
       return {Outcome::Wrapped, why, r.report.elements};
     } catch (const InputError& e) {
       return {Outcome::Refused, e.what()};

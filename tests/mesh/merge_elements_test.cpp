@@ -10,10 +10,10 @@
 #include <vector>
 
 #include "polydg/mesh/geometry.h"
+#include "polydg/mesh/geometry_checks.h"
 #include "polydg/mesh/primitives.h"
 #include "polydg/mesh/slice.h"
 #include "polydg/mesh/surface_shapes.h"
-#include "polydg/mesh/validate.h"
 #include "tests/support/identical_meshes.h"
 
 namespace polydg {
@@ -56,12 +56,12 @@ TEST(MergeElements, SliverMergingKeepsASlicedSphereValid) {
   const TriangleSurface sphere = icosphere(Vec3(0.013, -0.021, 0.007), 1.0, 4);
   const Grid grid = Grid::withCellsAlongLongest(bounds(sphere), 10);
   const PolyMesh sliced = sliceSurface(sphere, grid);
-  const ValidationReport before = validate(sliced);
+  const GeometryCheck before = checkGeometry(sliced);
   ASSERT_TRUE(before.passed);
   const double threshold = 0.05 * grid.cellVolume();
   SliverMergeReport report;
   const PolyMesh merged = mergeSlivers(sliced, threshold, &report);
-  const ValidationReport after = validate(merged);
+  const GeometryCheck after = checkGeometry(merged);
   EXPECT_TRUE(after.passed);
   EXPECT_GT(report.merged, 0u);
   EXPECT_LE(report.merged + report.isolated, report.slivers);

@@ -42,7 +42,7 @@ TEST(Meshing, ClosedSurfaceReportsItsDiagnosisAndEveryPhase) {
   const TriangleSurface sphere = icosphere(Vec3(0.1, 0.2, -0.3), 1.0, 3);
   const MeshingResult m = meshSurface(sphere, cells(8));
   const MeshingReport& r = m.report;
-  EXPECT_TRUE(r.validation.passed);
+  EXPECT_TRUE(r.geometry.passed);
   EXPECT_EQ(r.inputTriangles, sphere.triangles.size());
   EXPECT_EQ(r.inputVertices, sphere.vertices.size());
   EXPECT_TRUE(r.inputClosed);
@@ -72,7 +72,7 @@ TEST(Meshing, SelfIntersectingClosedSurfaceIsRefusedOrWrapped) {
   MeshingOptions wrap = cells(8);
   wrap.repair = RepairMode::Wrap;
   const MeshingResult m = meshSurface(overlapping, wrap);
-  EXPECT_TRUE(m.report.validation.passed);
+  EXPECT_TRUE(m.report.geometry.passed);
   EXPECT_GT(m.report.selfIntersections, 0u);
   ASSERT_FALSE(m.report.repairs.empty());
   EXPECT_NE(m.report.repairs[0].find("alpha-wrapped"), std::string::npos);
@@ -83,7 +83,7 @@ TEST(Meshing, InwardSurfaceIsReorientedAndKeepsItsVolume) {
   const TriangleSurface sphere = icosphere(Vec3(0.1, 0.2, -0.3), 1.0, 3);
   const MeshingResult outward = meshSurface(sphere, cells(8));
   const MeshingResult inward = meshSurface(reversedSurface(sphere), cells(8));
-  EXPECT_TRUE(inward.report.validation.passed);
+  EXPECT_TRUE(inward.report.geometry.passed);
   ASSERT_EQ(inward.report.repairs.size(), 1u);
   EXPECT_NE(inward.report.repairs[0].find("re-oriented"), std::string::npos);
   EXPECT_EQ(inward.report.elements, outward.report.elements);
@@ -130,13 +130,13 @@ TEST(Meshing, OrientationByTheVolumeSignAgreesWithCgalsOrientation) {
 TEST(Meshing, ValidationCanBeLeftToTheCaller) {
   const TriangleSurface sphere = icosphere(Vec3::Zero(), 1.0, 2);
   MeshingOptions later = cells(6);
-  later.validate = false;
+  later.checkGeometry = false;
   MeshingResult m = meshSurface(sphere, later);
   EXPECT_FALSE(hasPhase(m.report, "validate"));
   EXPECT_EQ(m.report.elements, 0u);
-  validateMeshing(m);
+  checkMeshing(m);
   EXPECT_TRUE(hasPhase(m.report, "validate"));
-  EXPECT_TRUE(m.report.validation.passed);
+  EXPECT_TRUE(m.report.geometry.passed);
   EXPECT_EQ(m.report.elements, m.mesh.numElements());
   EXPECT_EQ(m.report.hexahedra + m.report.polyhedra, m.report.elements);
   EXPECT_LT(m.report.volumeRelError, kVolumeTolerance);
@@ -163,7 +163,7 @@ std::string refusal(const TriangleSurface& surface, const MeshingOptions& option
 void expectMeshesExactly(const TriangleSurface& surface, const MeshingOptions& options,
                          double volume, std::size_t elements) {
   const MeshingResult m = meshSurface(surface, options);
-  EXPECT_TRUE(m.report.validation.passed);
+  EXPECT_TRUE(m.report.geometry.passed);
   EXPECT_EQ(m.report.elements, elements);
   EXPECT_LT(std::abs(m.report.outputVolume - volume) / volume, kVolumeTolerance)
       << m.report.outputVolume << " vs " << volume;
@@ -272,7 +272,7 @@ TEST(Meshing, SwissCheeseBlockMeshesToItsKnownVolume) {
 
   const MeshingResult m = meshSurface(cheese, cells(16));
   const MeshingReport& r = m.report;
-  EXPECT_TRUE(r.validation.passed);
+  EXPECT_TRUE(r.geometry.passed);
   EXPECT_TRUE(r.inputClosed);
   EXPECT_TRUE(r.inputManifold);
   EXPECT_TRUE(r.selfIntersectionsChecked);
@@ -280,7 +280,7 @@ TEST(Meshing, SwissCheeseBlockMeshesToItsKnownVolume) {
   EXPECT_EQ(r.shells, 1u);
   EXPECT_EQ(r.cavities, 0u);
   EXPECT_TRUE(r.repairs.empty());
-  EXPECT_EQ(r.validation.components, 1u);
+  EXPECT_EQ(r.geometry.components, 1u);
   EXPECT_LT(std::abs(r.outputVolume - volume) / volume, kVolumeTolerance);
 }
 
@@ -289,7 +289,7 @@ TEST(Meshing, SwissCheeseWithWallsJustOffTheGridPlanes) {
   // thickness between each wall and its plane, merged, and faces that thin between elements.
   const CheeseWalls walls = testing::cheeseWallsOffGrid(Box3(Vec3::Zero(), Vec3(11, 10, 9)), 16);
   const MeshingResult m = meshSurface(swissCheeseBlock(walls), cells(16));
-  EXPECT_TRUE(m.report.validation.passed);
+  EXPECT_TRUE(m.report.geometry.passed);
   EXPECT_EQ(m.report.selfIntersections, 0u);
   EXPECT_GT(m.report.slivers.merged, 0u);
   const double volume = swissCheeseVolume(walls);
@@ -306,8 +306,8 @@ TEST(Meshing, TorusObjAtCellCountsPuttingAVertexOnOneGridPlaneAndNearAnother) {
   for (const int n : {14, 28}) {
     SCOPED_TRACE("cells " + std::to_string(n));
     const MeshingResult m = meshSurface(torus, cells(n));
-    EXPECT_TRUE(m.report.validation.passed);
-    EXPECT_EQ(m.report.validation.components, 1u);
+    EXPECT_TRUE(m.report.geometry.passed);
+    EXPECT_EQ(m.report.geometry.components, 1u);
     EXPECT_LT(std::abs(m.report.outputVolume - m.report.inputVolume) / m.report.inputVolume,
               kVolumeTolerance);
   }

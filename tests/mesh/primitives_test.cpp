@@ -8,7 +8,7 @@
 #include <stdexcept>
 
 #include "polydg/mesh/geometry.h"
-#include "polydg/mesh/validate.h"
+#include "polydg/mesh/geometry_checks.h"
 
 namespace polydg {
 namespace {
@@ -23,7 +23,7 @@ TEST(BoxCellsMesh, BoxBesideTwoHalfBoxesIsValidWithExactVolumes) {
                                 Box3(Vec3(1, 0, 0.5), Vec3(2, 1, 1))};
   const PolyMesh mesh = boxCellsMesh(boxes);
   ASSERT_EQ(mesh.numElements(), 3u);
-  const ValidationReport report = validate(mesh);
+  const GeometryCheck report = checkGeometry(mesh);
   EXPECT_TRUE(report.passed) << (report.messages.empty() ? "" : report.messages.front());
   EXPECT_EQ(report.interiorFaces, 3u);  // the big box's side split in two, and z = 0.5
   EXPECT_EQ(report.components, 1u);

@@ -6,8 +6,8 @@
 #include <gtest/gtest.h>
 
 #include "polydg/integrate/moment_cache.h"
+#include "polydg/mesh/geometry_checks.h"
 #include "polydg/mesh/surface_shapes.h"
-#include "polydg/mesh/validate.h"
 
 namespace polydg {
 namespace {
@@ -17,7 +17,7 @@ constexpr double kVolumeTolerance = 1e-10;
 
 struct Sliced {
   PolyMesh mesh;
-  ValidationReport validation;
+  GeometryCheck geometry;
   double volume = 0.0;
   std::size_t hexahedra = 0;
   std::vector<double> elementVolumes;
@@ -26,7 +26,7 @@ struct Sliced {
 Sliced slice(const TriangleSurface& surface, const Grid& grid) {
   Sliced s;
   s.mesh = sliceSurface(surface, grid);
-  s.validation = validate(s.mesh);
+  s.geometry = checkGeometry(s.mesh);
   MomentCache moments(s.mesh, 0);
   moments.update();
   for (std::size_t e = 0; e < s.mesh.numElements(); ++e) {
@@ -43,11 +43,11 @@ Sliced slice(const TriangleSurface& surface, const Grid& grid) {
 }
 
 void expectGood(const Sliced& s, double exactVolume, std::size_t components) {
-  EXPECT_TRUE(s.validation.passed);
-  for (const std::string& m : s.validation.messages) ADD_FAILURE() << m;
+  EXPECT_TRUE(s.geometry.passed);
+  for (const std::string& m : s.geometry.messages) ADD_FAILURE() << m;
   EXPECT_NEAR(s.volume, exactVolume, kVolumeTolerance * std::abs(exactVolume));
-  EXPECT_NEAR(s.validation.volume, exactVolume, kVolumeTolerance * std::abs(exactVolume));
-  EXPECT_EQ(s.validation.components, components);
+  EXPECT_NEAR(s.geometry.volume, exactVolume, kVolumeTolerance * std::abs(exactVolume));
+  EXPECT_EQ(s.geometry.components, components);
 }
 
 TEST(Slice, SphereFillsItsVolume) {
@@ -92,7 +92,7 @@ TEST(Slice, TwoSpheresInOneCellAreTwoElements) {
   const Sliced s = slice(two, grid);
   expectGood(s, enclosedVolume(two), 2);
   EXPECT_EQ(s.mesh.numElements(), 2u);
-  EXPECT_EQ(s.validation.interiorFaces, 0u);
+  EXPECT_EQ(s.geometry.interiorFaces, 0u);
   // Finer: still two components, never coupled.
   const Sliced fine = slice(two, Grid::covering(bounds(two), 0.1));
   expectGood(fine, enclosedVolume(two), 2);

@@ -86,7 +86,7 @@ TEST_F(ModelTest, EveryFaceIsIntegratedOnceAcrossCutCheckAndSolve) {
   CutRequest cut;
   cut.blade = Blade::plane(Vec3(1.0, 0.3, 0.2), 0.55);
   const OperationReport op = model.cut(cut);
-  ASSERT_TRUE(op.validation.passed) << op.validation.failure;
+  ASSERT_TRUE(op.check.passed) << op.check.failure;
   EXPECT_GT(op.facesReintegrated, 0u);
   EXPECT_EQ(model.facesIntegrated(), meshed + op.facesReintegrated);
 
@@ -164,9 +164,8 @@ TEST_F(ModelTest, ACutThatRemovesEverythingFails) {
   cut.blade = Blade::plane(Vec3::UnitZ(), 2.0);  // everything is below z = 2
   cut.removeSide = -1;
   const OperationReport r = model.cut(cut);
-  EXPECT_FALSE(r.validation.passed);
-  EXPECT_NE(r.validation.failure.find("left no element"), std::string::npos)
-      << r.validation.failure;
+  EXPECT_FALSE(r.check.passed);
+  EXPECT_NE(r.check.failure.find("left no element"), std::string::npos) << r.check.failure;
   EXPECT_EQ(model.mesh().numElements(), 0u);
   // The model refuses further use rather than writing an empty mesh.
   EXPECT_THROW(model.write((dir_ / "empty.vtu").string()), CheckFailure);

@@ -10,10 +10,10 @@
 
 #include "polydg/integrate/quadrature.h"
 #include "polydg/mesh/geometry.h"
+#include "polydg/mesh/geometry_checks.h"
 #include "polydg/mesh/primitives.h"
 #include "polydg/mesh/surface_io.h"
 #include "polydg/mesh/surface_shapes.h"
-#include "polydg/mesh/validate.h"
 #include "polydg/model/model.h"
 #include "polydg/util/error.h"
 
@@ -67,16 +67,16 @@ TEST(ModelRefine, SolutionSurvivesOctantsAndHalvesExactly) {
       RefineRequest request;
       request.split = split;
       request.sliverFraction = 0.0;
-      request.validation = ValidationLevel::Full;
+      request.checks = CheckLevel::Full;
       for (std::uint32_t e : {0u, 5u, 17u, 35u}) request.elements.push_back(ElementId(e));
       const double volume = model.volume();
       const RefineReport r = model.refine(request);
-      ASSERT_TRUE(r.operation.validation.passed) << r.operation.validation.failure;
+      ASSERT_TRUE(r.operation.check.passed) << r.operation.check.failure;
       EXPECT_EQ(model.mesh().numElements(), 36u + 4u * (split == RefineSplit::Octants ? 7 : 1));
       EXPECT_EQ(r.solutionExact, model.mesh().numElements());
       EXPECT_EQ(r.solutionExtended, 0u);
       EXPECT_NEAR(model.volume(), volume, 1e-12 * volume);
-      EXPECT_NEAR(validate(model.mesh()).volume, volume, 1e-12 * volume);
+      EXPECT_NEAR(checkGeometry(model.mesh()).volume, volume, 1e-12 * volume);
       EXPECT_LT(transferError(model, oldBasis, oldU, r.operation.lineage), 1e-12)
           << "degree " << degree << (split == RefineSplit::Octants ? " octants" : " halves");
     }
@@ -88,7 +88,7 @@ TEST(ModelRefine, RefinedMeshPassesTheDgChecksAndSolves) {
   RefineRequest request;
   for (std::uint32_t e = 0; e < 36; e += 3) request.elements.push_back(ElementId(e));
   const RefineReport r = model.refine(request);
-  ASSERT_TRUE(r.operation.validation.passed) << r.operation.validation.failure;
+  ASSERT_TRUE(r.operation.check.passed) << r.operation.check.failure;
   MeshCheckOptions checks;
   checks.degree = 2;
   checks.patchTest = GlobalCheck::Always;
@@ -115,7 +115,7 @@ TEST(ModelRefine, CoarseningProjectsTheSolutionKeepingMassAndMomentum) {
     RefineRequest request;
     request.elements = {ElementId(0), ElementId(9), ElementId(20)};
     const RefineReport r = model.refine(request);
-    ASSERT_TRUE(r.operation.validation.passed);
+    ASSERT_TRUE(r.operation.check.passed);
     std::map<std::uint32_t, std::vector<ElementId>> families;
     for (std::size_t e = 0; e < model.mesh().numElements(); ++e) {
       const ElementId source = r.operation.lineage.sources(ElementId(e)).front();
@@ -127,9 +127,9 @@ TEST(ModelRefine, CoarseningProjectsTheSolutionKeepingMassAndMomentum) {
     {
       Model roundTrip = barModel();
       roundTrip.solve(barLoads(degree));
-      ASSERT_TRUE(roundTrip.refine(request).operation.validation.passed);
+      ASSERT_TRUE(roundTrip.refine(request).operation.check.passed);
       const CoarsenReport c = roundTrip.coarsen(coarsen);
-      ASSERT_TRUE(c.operation.validation.passed) << c.operation.validation.failure;
+      ASSERT_TRUE(c.operation.check.passed) << c.operation.check.failure;
       EXPECT_EQ(c.solutionProjected, 3u);
       EXPECT_EQ(roundTrip.mesh().numElements(), 36u);
       // Element ids may have moved: compare through each element's mean displacement field.
@@ -157,7 +157,7 @@ TEST(ModelRefine, CoarseningProjectsTheSolutionKeepingMassAndMomentum) {
         sum += model.moments(2).volume(e) * fine.fields.meanDisplacement[e];
     }
     const CoarsenReport c = model.coarsen(coarsen);
-    ASSERT_TRUE(c.operation.validation.passed) << c.operation.validation.failure;
+    ASSERT_TRUE(c.operation.check.passed) << c.operation.check.failure;
     const Solution& coarse = *model.solution();
     std::size_t checked = 0;
     for (std::size_t e = 0; e < model.mesh().numElements(); ++e) {
@@ -221,7 +221,7 @@ TEST(ModelRefine, B11RefinesWhereThePrincipalStressIsLarge) {
     for (std::size_t e = 0; e < model.mesh().numElements(); ++e)
       nearClamp += u.basis->centre(ElementId(e)).x() < 4.5;
     EXPECT_GT(nearClamp, model.mesh().numElements() - nearClamp);
-    EXPECT_TRUE(validate(model.mesh()).passed);
+    EXPECT_TRUE(checkGeometry(model.mesh()).passed);
     counts[split == RefineSplit::Octants ? 0 : 1] = model.mesh().numElements();
   }
   EXPECT_GT(counts[0], counts[1]);

@@ -8,12 +8,12 @@
 #include <numbers>
 #include <regex>
 
+#include "polydg/mesh/geometry_checks.h"
 #include "polydg/mesh/surface_io.h"
 #include "polydg/mesh/surface_shapes.h"
-#include "polydg/mesh/validate.h"
 #include "polydg/model/report_json.h"
 #include "polydg/model/scene.h"
-#include "polydg/physics/dynamics.h"
+#include "polydg/physics/dynamics/dynamics.h"
 #include "polydg/util/error.h"
 
 namespace polydg {
@@ -82,8 +82,8 @@ TEST(Simulate, CutWhileMovingFreesAHalfThatFallsWithGravity) {
     const SimulationReport r = model.simulate(parseScene(b10Scene(1.0 + k * m * dt), "b10"), {});
     ASSERT_EQ(r.cuts.size(), 1u);
     const SimulationCut& cut = r.cuts[0];
-    EXPECT_TRUE(cut.report.validation.passed) << cut.report.validation.failure;
-    EXPECT_LT(cut.report.validation.volumeRelError, 1e-10);
+    EXPECT_TRUE(cut.report.check.passed) << cut.report.check.failure;
+    EXPECT_LT(cut.report.check.volumeRelError, 1e-10);
     EXPECT_NEAR(model.volume(), 10.0, 1e-10 * 10);
     EXPECT_GT(cut.elementsAfter, cut.elementsBefore);
     EXPECT_EQ(cut.exact, cut.elementsAfter);  // no sliver here: every element took its parent's
@@ -155,7 +155,7 @@ TEST(Simulate, RefinesByStressWithoutAPop) {
     // At most max_level = 2 refinements of each element: 8^2 (or 2^2) children per cell.
     const std::size_t perCell = std::string(split) == "octants" ? 64 : 4;
     EXPECT_LE(model.mesh().numElements(), r.elements * perCell);
-    EXPECT_TRUE(validate(model.mesh()).passed);
+    EXPECT_TRUE(checkGeometry(model.mesh()).passed);
   }
 }
 
@@ -185,7 +185,7 @@ TEST(Simulate, CoarsensBackWhenTheStressFalls) {
   EXPECT_GT(refinements, 0u);
   EXPECT_GT(coarsenings, 0u);
   EXPECT_EQ(model.mesh().numElements(), r.elements);  // every family merged back
-  EXPECT_TRUE(validate(model.mesh()).passed);
+  EXPECT_TRUE(checkGeometry(model.mesh()).passed);
 }
 
 TEST(Simulate, DampedSimulationSettlesToTheStaticSolve) {

@@ -3,12 +3,12 @@
 #pragma once
 
 #include "cli/bench/problems.h"
-#include "polydg/physics/agglomeration.h"
-#include "polydg/physics/static_solver.h"
+#include "polydg/physics/solvers/agglomeration.h"
+#include "polydg/physics/solvers/static_solver.h"
 
 namespace polydg {
 
-/// K, F and the frames of the basis (physics/agglomeration.h).
+/// K, F and the frames of the basis (physics/solvers/agglomeration.h).
 struct FramedSystem {
   LinearSystem system;
   ElementFrames frames;

@@ -17,6 +17,7 @@
 #include "polydg/integrate/moment_cache.h"
 #include "polydg/mesh/plane.h"
 #include "polydg/mesh/poly_mesh.h"
+#include "polydg/physics/checks/operation_checks.h"
 
 namespace polydg {
 
@@ -34,15 +35,6 @@ struct Blade : Plane {
   bool finite() const { return !polygon.empty(); }
 };
 
-/// How much checking follows each operation.
-enum class ValidationLevel {
-  None,   ///< volume bookkeeping only
-  Local,  ///< geometric checks of the touched elements; DG patch test and rigid-mode count on
-          ///< the touched elements plus one ring of neighbours (regionDgChecks() with
-          ///< RegionCoupling::HoldingFaces); global volume balance
-  Full,   ///< geometric validation of the whole mesh; global patch test and rigid modes
-};
-
 /// Default sliver fraction, shared with meshing (MeshingOptions::sliverTau).
 inline constexpr double kDefaultSliverFraction = 0.01;
 
@@ -54,24 +46,9 @@ struct CutOptions {
   /// reference volume: volume below T or 6 volume / area below T^(1/3)) are merged into the
   /// neighbour across their largest shared face (0: no merging).
   double sliverFraction = kDefaultSliverFraction;
-  ValidationLevel validation = ValidationLevel::Local;
+  CheckLevel checks = CheckLevel::Local;
   /// Degree of the DG basis used by the DG checks.
-  int validationDegree = 1;
-};
-
-/// The outcome of the checks after one operation.
-struct OperationValidation {
-  ValidationLevel level = ValidationLevel::None;
-  bool passed = true;
-  std::size_t elementsChecked = 0;  ///< geometric checks
-  std::size_t regionElements = 0;   ///< DG region (touched elements plus one ring)
-  double patchTestError = 0.0;  ///< Local: the region's patch-test residual; Full: relative error
-  /// Local: components of the region's coupling graph, its elements joined through the faces
-  /// that hold them together (RegionCoupling::HoldingFaces); Full: of the mesh.
-  std::size_t regionComponents = 0;
-  std::size_t zeroModes = 0;    ///< expected: 6 * regionComponents
-  double volumeRelError = 0.0;  ///< |V_before - V_removed - V_after| / V_before
-  std::string failure;          ///< first failed check, one line; empty when passed
+  int checkDegree = 1;
 };
 
 /// Where the elements after an operation come from: element e of the result covers all or part
@@ -97,8 +74,8 @@ struct RefineOptions {
   /// A piece below this fraction of its element's volume / 2^planes is merged into the
   /// neighbour it shares most area with (0: never).
   double sliverFraction = kDefaultSliverFraction;
-  ValidationLevel validation = ValidationLevel::Local;
-  int validationDegree = 1;
+  CheckLevel checks = CheckLevel::Local;
+  int checkDegree = 1;
 };
 
 /// What one operation did.
@@ -116,7 +93,7 @@ struct OperationReport {
   std::size_t facesTotal = 0;         ///< faces of the mesh after it
   /// Finite blade: elements the blade's plane crosses at the polygon's edge, left whole.
   std::vector<ElementId> leftWhole;
-  OperationValidation validation;
+  OperationCheck check;
   ElementLineage lineage;
   double seconds = 0.0;
 };
@@ -170,12 +147,11 @@ class MeshEditor {
   /// element's (coarsening after refine()). Checked like a cut. Throws std::invalid_argument for
   /// an invalid id, a group of fewer than two or an element listed twice.
   OperationReport coarsen(std::span<const std::vector<ElementId>> groups,
-                          ValidationLevel validation = ValidationLevel::Local,
-                          int validationDegree = 1);
+                          CheckLevel checks = CheckLevel::Local, int checkDegree = 1);
 
   /// Merges every element below `fraction` * referenceVolume() into a neighbour, as after a cut.
-  OperationReport mergeSlivers(double fraction, ValidationLevel validation = ValidationLevel::Local,
-                               int validationDegree = 1);
+  OperationReport mergeSlivers(double fraction, CheckLevel checks = CheckLevel::Local,
+                               int checkDegree = 1);
 
   /// Gives the mesh back (the editor is empty afterwards).
   PolyMesh release();

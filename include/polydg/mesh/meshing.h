@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
+#include "polydg/mesh/geometry_checks.h"
 #include "polydg/mesh/merge_elements.h"
 #include "polydg/mesh/slice.h"
-#include "polydg/mesh/validate.h"
 #include "polydg/util/error.h"
 
 namespace polydg {
@@ -26,7 +26,7 @@ enum class RepairMode { None, Fill, Wrap };
 /// with a grid plane, a face's first vertex and an element's reference point for moments);
 /// absolute coordinates are only added to and compared (grid planes, exact rational
 /// comparisons). The highest power of a length is in the element moments a degree-p DG basis
-/// needs (p <= 3, physics/dg_basis.h): int_K (x - o)^alpha dV with |alpha| = 2p = 6, at most
+/// needs (p <= 3, physics/dg/dg_basis.h): int_K (x - o)^alpha dV with |alpha| = 2p = 6, at most
 /// vol(K) diam(K)^6 <= diam(K)^9; below come face moments (diam^8), squared norms of area vectors
 /// (diam^4) and volumes (diam^3). (The bases divide moments by diam^|alpha| before any other
 /// product, so nothing of higher degree follows.) An element lies in the bounding box and in one
@@ -60,8 +60,8 @@ struct MeshingOptions {
   ProgressFn progress;
   /// Validate the result and count its shapes at the end of meshSurface(). A caller that
   /// overlaps that work with something else (writing the mesh) turns this off and calls
-  /// validateMeshing() itself.
-  bool validate = true;
+  /// checkMeshing() itself.
+  bool checkGeometry = true;
 };
 
 struct MeshingReport {
@@ -85,12 +85,12 @@ struct MeshingReport {
   std::size_t faces = 0, interiorFaces = 0, boundaryFaces = 0;
   double outputVolume = 0.0;
   double volumeRelError = 0.0;
-  ValidationReport validation;
+  GeometryCheck geometry;
 
   // Wall time per phase, seconds. Phases may overlap (the check runs beside the slicing of a
   // closed surface), so they can add up to more than `seconds`.
   std::vector<std::pair<std::string, double>> timings;
-  /// Wall time of meshSurface() and validateMeshing() together, seconds.
+  /// Wall time of meshSurface() and checkMeshing() together, seconds.
   double seconds = 0.0;
 };
 
@@ -108,8 +108,8 @@ MeshingResult meshSurface(const TriangleSurface& surface, const MeshingOptions& 
 /// The geometric validation of `result.mesh` and the output part of its report (elements,
 /// faces, volume and its error, hexahedra, polyhedra, non-convex), timed as phase "validate".
 /// meshSurface() ends with it unless MeshingOptions::validate is false.
-void validateMeshing(MeshingResult& result);
+void checkMeshing(MeshingResult& result);
 /// The same for a mesh kept apart from its report (moved into a model before validation).
-void validateMeshing(const PolyMesh& mesh, MeshingReport& report);
+void checkMeshing(const PolyMesh& mesh, MeshingReport& report);
 
 }  // namespace polydg

@@ -89,7 +89,7 @@ class PolyMesh {
   }
   /// Replaces the whole mesh with prebuilt arrays, for builders that assemble a large mesh in
   /// parallel. The caller guarantees consistency: face ids in elements in range, each face's
-  /// front/back the elements that use it unreversed/reversed (validate() checks a finished
+  /// front/back the elements that use it unreversed/reversed (checkGeometry() checks a finished
   /// mesh).
   void assign(VertexData<Vec3> positions, FaceData<Face> faces, ElementData<Element> elements) {
     positions_ = std::move(positions);
@@ -116,7 +116,7 @@ class PolyMesh {
   /// loops equal, reversed, those of an existing face with a free back side is shared with that
   /// face's element (it becomes an interior face); otherwise a new face is created with tag
   /// `boundaryOrigin` — also when the polygon would be used a third time or twice with the same
-  /// orientation, so that such (invalid) input is kept and reported by validate() as duplicate
+  /// orientation, so that such (invalid) input is kept and reported by checkGeometry() as duplicate
   /// faces rather than rejected here. Returns the new element's id.
   ElementId addElement(const std::vector<std::vector<Loop>>& boundary,
                        FaceOrigin boundaryOrigin = FaceOrigin::Imported);

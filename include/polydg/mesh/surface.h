@@ -46,7 +46,7 @@ double enclosedVolume(const TriangleSurface& surface);
 double surfaceArea(const TriangleSurface& surface);
 
 /// A mesh of one element bounded by the surface's triangles, each a face tagged `Surface`.
-/// The surface should be closed and oriented outward (not checked here; see validate()).
+/// The surface should be closed and oriented outward (not checked here; see checkGeometry()).
 PolyMesh singleElementMesh(const TriangleSurface& surface);
 
 }  // namespace polydg

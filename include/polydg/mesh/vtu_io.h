@@ -133,7 +133,7 @@ void writeVtu(const PolyMesh& mesh, const std::string& path, const VtuWriteOptio
 /// Points become vertices and cells elements, both in file order. Faces of two different cells
 /// with the same vertices in opposite cyclic order become one shared face, whose front is the
 /// earlier cell; any other face (used a third time, or twice in the same orientation) stays a
-/// separate face, so that validate() reports the problem instead of the reader failing.
+/// separate face, so that checkGeometry() reports the problem instead of the reader failing.
 /// Boundary faces are tagged FaceOrigin::Imported. If the file carries writeVtu's field data
 /// and it is consistent, the mesh is restored instead exactly as written: the copies of a
 /// vertex become that vertex again (same vertex ids), same face ids, the

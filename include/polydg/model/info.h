@@ -30,7 +30,7 @@ struct VolumeMeshInfo {
   std::size_t vertices = 0, faces = 0, facesWithHoles = 0, interiorFaces = 0, boundaryFaces = 0;
   std::size_t elements = 0, components = 0;
   bool closed = false;  ///< every element closed
-  bool valid = false;   ///< validate() passed
+  bool valid = false;   ///< checkGeometry() passed
   Box3 bounds;
   double volume = 0.0;
   /// The provenance (model/model.h): as stored in the file's field data if polydg wrote it,

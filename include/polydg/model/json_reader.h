@@ -11,7 +11,7 @@
 
 #include "polydg/mesh/poly_mesh.h"
 #include "polydg/model/names.h"
-#include "polydg/physics/loads.h"
+#include "polydg/physics/dg/loads.h"
 #include "polydg/util/error.h"
 
 namespace polydg {

@@ -15,12 +15,12 @@
 #include "polydg/mesh/meshing.h"
 #include "polydg/mesh/surface.h"
 #include "polydg/mesh/vtu_io.h"
-#include "polydg/physics/embedding.h"
-#include "polydg/physics/error_estimator.h"
-#include "polydg/physics/loads.h"
-#include "polydg/physics/mesh_checks.h"
-#include "polydg/physics/post_process.h"
-#include "polydg/physics/static_solver.h"
+#include "polydg/physics/checks/mesh_checks.h"
+#include "polydg/physics/contact/embedding.h"
+#include "polydg/physics/dg/loads.h"
+#include "polydg/physics/dg/post_process.h"
+#include "polydg/physics/solvers/error_estimator.h"
+#include "polydg/physics/solvers/static_solver.h"
 
 namespace polydg {
 
@@ -89,7 +89,7 @@ struct MeshReport {
   double writeSeconds = 0.0;  ///< overlapped with the checks
   double wallSeconds = 0.0;   ///< the whole operation, read to write
 
-  bool passed() const { return meshing.validation.passed && dg.passed(); }
+  bool passed() const { return meshing.geometry.passed && dg.passed(); }
   /// One line per failed check (empty when passed).
   std::vector<std::string> failures() const;
 };
@@ -112,15 +112,15 @@ struct CutRequest {
   /// Pieces below this fraction of the reference volume are merged (0: never); unset: the
   /// mesh's sliver rule (Provenance::sliverFraction).
   std::optional<double> sliverFraction;
-  ValidationLevel validation = ValidationLevel::Local;
-  int validationDegree = 1;
+  CheckLevel checks = CheckLevel::Local;
+  int checkDegree = 1;
 };
 
 /// A sliver merge (`merge` pipeline steps).
 struct MergeRequest {
   std::optional<double> fraction;  ///< unset: the mesh's sliver rule
-  ValidationLevel validation = ValidationLevel::Local;
-  int validationDegree = 1;
+  CheckLevel checks = CheckLevel::Local;
+  int checkDegree = 1;
 };
 
 /// How refinement splits an element (paper section 10, thesis Fig. 4.9).
@@ -142,8 +142,8 @@ struct RefineRequest {
   /// A piece below this fraction of its element's volume / number of children is merged into
   /// a neighbour; unset: the mesh's sliver rule (Provenance::sliverFraction).
   std::optional<double> sliverFraction;
-  ValidationLevel validation = ValidationLevel::Local;
-  int validationDegree = 1;
+  CheckLevel checks = CheckLevel::Local;
+  int checkDegree = 1;
 };
 
 /// What a refinement did, with the fate of the last solution.
@@ -158,8 +158,8 @@ struct RefineReport {
 /// A coarsening: groups of elements merged back into one each (children of a refinement).
 struct CoarsenRequest {
   std::vector<std::vector<ElementId>> groups;
-  ValidationLevel validation = ValidationLevel::Local;
-  int validationDegree = 1;
+  CheckLevel checks = CheckLevel::Local;
+  int checkDegree = 1;
 };
 
 /// What a coarsening did: the last solution, if any, went to the merged elements by L2
@@ -171,7 +171,7 @@ struct CoarsenReport {
 
 /// What `solve --adapt` refines by.
 enum class AdaptCriterion {
-  Error,   ///< the a posteriori error estimate (physics/error_estimator.h), bulk marking
+  Error,   ///< the a posteriori error estimate (physics/solvers/error_estimator.h), bulk marking
   Stress,  ///< the largest absolute principal stress above a threshold (the paper's)
 };
 
@@ -215,7 +215,7 @@ struct SolveOptions {
   VectorField bodyForce;
   /// u = value (weakly) on each selection, besides the clamps (library and Python).
   std::vector<DirichletCondition> displacements;
-  /// Estimate the solution's error (physics/error_estimator.h; IP only).
+  /// Estimate the solution's error (physics/solvers/error_estimator.h; IP only).
   bool estimate = false;
   /// A known solution to measure the error against (verification, library and Python): the
   /// report's error and energyError, and each adaptive round's. Both or neither.
@@ -275,7 +275,7 @@ struct WriteOptions {
   bool solution = true;
 };
 
-/// A surface carried by the model's displacement (physics/embedding.h).
+/// A surface carried by the model's displacement (physics/contact/embedding.h).
 struct EmbeddedSurface {
   std::string file;  ///< the surface's file
   TriangleSurface surface;
@@ -345,7 +345,7 @@ class Model {
   /// fewer than two.
   CoarsenReport coarsen(const CoarsenRequest& request);
 
-  /// The checks of `options` (physics/mesh_checks.h) with the model's moments.
+  /// The checks of `options` (physics/checks/mesh_checks.h) with the model's moments.
   MeshCheck check(const MeshCheckOptions& options);
 
   /// Static linear elasticity: validates the mesh, selects the clamped and loaded faces

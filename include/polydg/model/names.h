@@ -11,7 +11,7 @@
 #include "polydg/cut/cut.h"
 #include "polydg/mesh/meshing.h"
 #include "polydg/model/model.h"
-#include "polydg/physics/static_solver.h"
+#include "polydg/physics/solvers/static_solver.h"
 
 namespace polydg {
 
@@ -24,7 +24,7 @@ const Names<BzPenalty>& bzPenaltyNames();              ///< fixed, super
 const Names<SolverKind>& solverNames();                ///< auto, cholesky, cg
 const Names<PenaltyRule>& penaltyNames();              ///< bound, doubling, fixed
 const Names<RepairMode>& repairNames();                ///< none, fill, wrap
-const Names<ValidationLevel>& validationNames();       ///< none, local, full
+const Names<CheckLevel>& checkLevelNames();            ///< none, local, full
 const Names<CgPreconditioner>& preconditionerNames();  ///< p-multigrid, block-jacobi
 const Names<RefineSplit>& refineSplitNames();          ///< octants, halves
 const Names<AdaptCriterion>& adaptCriterionNames();    ///< error, stress
@@ -67,7 +67,7 @@ inline std::string toString(BzPenalty b) { return nameOf(bzPenaltyNames(), b); }
 inline std::string toString(SolverKind k) { return nameOf(solverNames(), k); }
 inline std::string toString(PenaltyRule r) { return nameOf(penaltyNames(), r); }
 inline std::string toString(RepairMode r) { return nameOf(repairNames(), r); }
-inline std::string toString(ValidationLevel l) { return nameOf(validationNames(), l); }
+inline std::string toString(CheckLevel l) { return nameOf(checkLevelNames(), l); }
 inline std::string toString(CgPreconditioner p) { return nameOf(preconditionerNames(), p); }
 
 }  // namespace polydg

@@ -13,7 +13,7 @@ namespace polydg {
 nlohmann::json toJson(const Box3& box);  ///< {min, max}, null for an empty box
 nlohmann::json toJson(const Provenance& p);
 /// The geometric validation: passed, counts, volume range, problems {...}, messages.
-nlohmann::json toJson(const ValidationReport& r);
+nlohmann::json toJson(const GeometryCheck& r);
 /// The element-local DG checks as keys of a report's `validation` section: dg_degree,
 /// patch_test_error (max over elements), patch_test_tolerance, patch_test_failures,
 /// worst_patch_test_element, rigid_mode_failures (elements whose stiffness has not exactly six

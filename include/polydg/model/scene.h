@@ -12,7 +12,7 @@
 
 #include "polydg/model/model.h"
 #include "polydg/model/names.h"
-#include "polydg/physics/dynamics.h"
+#include "polydg/physics/dynamics/dynamics.h"
 
 namespace polydg {
 
@@ -112,7 +112,7 @@ struct SimulateOptions {
 };
 
 /// One step of a simulation. Energies and momenta are those of the state at the step's end
-/// (physics/dynamics.h, BodyState).
+/// (physics/dynamics/dynamics.h, BodyState).
 struct SimulationStep {
   StepReport step;
   BodyState state;

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "polydg/integrate/moment_cache.h"
-#include "polydg/mesh/validate.h"
+#include "polydg/mesh/geometry_checks.h"
 #include "tests/cli/bench/b4_measurements.h"
 
 namespace polydg::bench {
@@ -42,7 +42,7 @@ TEST(StabilityMeshes, SliverMeshIsValidWithExactVolumes) {
   for (double r : {1.0, 1e-1, 1e-6, 1e-12}) {
     const PolyMesh mesh = sliverMesh(r);
     EXPECT_EQ(mesh.numElements(), r < 1.0 ? 28u : 27u);
-    EXPECT_TRUE(validate(mesh).passed) << r;
+    EXPECT_TRUE(checkGeometry(mesh).passed) << r;
     EXPECT_NEAR(totalVolume(mesh), 27.0, 1e-12);
     const std::vector<double> v = volumes(mesh);
     EXPECT_NEAR(*std::min_element(v.begin(), v.end()), r, 1e-15) << r;
@@ -53,7 +53,7 @@ TEST(StabilityMeshes, ThinNeckIsOneValidElement) {
   for (double eps : {1e-1, 1e-9}) {
     const PolyMesh mesh = thinNeckMesh(eps);
     EXPECT_EQ(mesh.numElements(), 1u);
-    EXPECT_TRUE(validate(mesh).passed) << eps;
+    EXPECT_TRUE(checkGeometry(mesh).passed) << eps;
     EXPECT_NEAR(totalVolume(mesh), 2.0 + eps, 1e-14);
   }
 }

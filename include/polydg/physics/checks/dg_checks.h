@@ -1,0 +1,224 @@
+// Invariant checks of the DG discretization on any valid mesh: the patch test (a linear field
+// is reproduced exactly), the rigid-motion kernel of the stiffness without boundary conditions
+// (six zero modes per connected component), and positive definiteness with them; and their
+// cheap element-local forms, run on every mesh polydg makes (localDgChecks()).
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "polydg/physics/solvers/static_solver.h"
+
+namespace polydg {
+
+/// A mode is zero when its eigenvalue of the Jacobi-scaled stiffness D^(-1/2) K D^(-1/2)
+/// (unit diagonal, so its largest eigenvalue is at most the largest row count) is below this.
+/// Rigid motions give round-off, 1e-18 .. 1e-15 on the test corpus; the smallest elastic
+/// mode is above 1e-2 on regular meshes and above 5e-8 with a sliver of relative thickness
+/// 1e-6 (degree 3), so the threshold sits about four orders from both.
+inline constexpr double kZeroModeThreshold = 1e-11;
+
+/// The discretization checked (material and penalty as in a solve).
+struct PhysicsCheckOptions {
+  Method method = Method::IP;
+  BasisOptions basis{.degree = 1, .kind = BasisKind::Orthonormal};
+  PenaltyOptions penalty;
+  Material material;
+};
+
+struct PatchTestResult {
+  double relativeError = 0.0;    ///< |u_h - u|_L2 / |u|_L2 over the mesh
+  double maxElementError = 0.0;  ///< max over elements of |u_h - u|_L2(K) / |u|_L2(K)
+  double eta = 0.0;
+  double residual = 0.0;  ///< of the linear solve
+};
+
+/// The patch test: u(x) = L b + A (x - x0) (a fixed general matrix A with |A| ~ 1, x0 and L
+/// the centre and diagonal of the mesh's bounding box) imposed weakly on every boundary face,
+/// no body force. A consistent method (IP) reproduces u up to round-off: ~1e-14 on good
+/// meshes, ~1e-10 with slivers of relative thickness 1e-6, and ~3e-10 for a unit mesh
+/// translated by 1e6 (quadrature points and g are evaluated in absolute coordinates, whose
+/// spacing there is 1e6 * 2^-52 ~ 1e-10). Errors are exact (element mass matrices).
+/// `moments`, if given, is the mesh's cache of degree >= 2p (else the mesh is integrated here).
+PatchTestResult patchTest(const PolyMesh& mesh, const PhysicsCheckOptions& options,
+                          const MomentCache* moments = nullptr);
+
+struct ZeroModeReport {
+  std::size_t components = 0;                      ///< connected through shared faces
+  std::vector<std::size_t> zeroModesPerComponent;  ///< eigenvalues below kZeroModeThreshold
+  std::size_t zeroModes = 0;                       ///< their sum
+  double largestZeroEigenvalue = 0.0;              ///< largest of those (Jacobi-scaled)
+  double smallestNonzeroEigenvalue = 0.0;  ///< smallest eigenvalue above the threshold found
+  /// max over the 6 rigid motions r of each component of |S r| / |r|, S the scaled matrix.
+  double rigidMotionResidual = 0.0;
+};
+
+/// Zero modes of a symmetric positive semi-definite `matrix` (DOFs in element blocks of
+/// `blockSize`, as LinearSystem), per connected component of `mesh` (components are decoupled
+/// blocks of K): the smallest eigenvalues of each component's Jacobi-scaled block, all of them
+/// by a dense eigensolver up to 1500 DOFs, else the 12 smallest by subspace iteration with a
+/// CHOLMOD factorization of S + 1e-10 I. Also checks that the rigid motions are in the kernel.
+/// Throws std::invalid_argument if `matrix` couples elements of two components.
+ZeroModeReport zeroModes(const PolyMesh& mesh, const DgBasis& basis, const MomentCache& moments,
+                         const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix);
+
+/// The same count per component of a coupling graph the caller built along with `matrix`:
+/// block b (DOFs b * blockSize .. (b + 1) * blockSize - 1) belongs to component[b], in
+/// 0 .. components - 1. The components must be decoupled blocks of `matrix`, so that each zero
+/// mode belongs to one of them: throws std::invalid_argument if `matrix` has an entry between
+/// two components. Rigid motions are not checked (rigidMotionResidual is 0). If `kernels` is
+/// not null, (*kernels)[c] holds component c's zero modes as columns (eigenvectors of the scaled
+/// matrix, unscaled to coefficients), its rows the component's DOFs in increasing order.
+ZeroModeReport zeroModes(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix,
+                         int blockSize, std::span<const std::uint32_t> component,
+                         std::size_t components, std::vector<Eigen::MatrixXd>* kernels = nullptr);
+
+/// Element e's coefficients (3n x 6, LinearSystem's order) of the rigid motions zeroModes()
+/// checks: the translations along x, y and z, then the rotations about x, y and z through
+/// `centre`, divided by `length` (so that all six have the size of a translation).
+Eigen::MatrixXd rigidMotionCoefficients(const DgBasis& basis, ElementId e, const Vec3& centre,
+                                        double length);
+
+/// Element e's coefficients (3n values, LinearSystem's order d n + i) of the linear field
+/// u(x) = b + a (x - x0), exact (every basis spans the linear functions; no quadrature).
+Eigen::VectorXd linearFieldCoefficients(const DgBasis& basis, ElementId e, const Vec3& b,
+                                        const Eigen::Matrix3d& a, const Vec3& x0);
+
+/// The Jacobi scaling of zeroModes(), D^(-1/2), for a matrix with diagonal `diagonal` in blocks
+/// of `blockSize`: 1 / sqrt(d_i), where an entry that is not positive (the constant functions
+/// of an element without coupled faces) takes its block's mean diagonal (negative entries
+/// counted as 0), which keeps the scaling scale-free.
+Eigen::VectorXd zeroModeScaling(const Eigen::VectorXd& diagonal, int blockSize);
+
+/// The zero modes of a small dense symmetric `matrix` under the scaling `scale` (as
+/// zeroModeScaling()): the eigenvalues of diag(scale) matrix diag(scale) below
+/// kZeroModeThreshold, counted by Sylvester's law of inertia as the negative pivots of the
+/// pivoted LDL^T of that matrix minus kZeroModeThreshold I (a NaN pivot counts too).
+std::size_t countZeroModes(const Eigen::MatrixXd& matrix, const Eigen::VectorXd& scale);
+
+/// The stiffness matrix without boundary conditions (every boundary face free): expected
+/// exactly 6 zero modes per component. `moments` as for patchTest().
+ZeroModeReport rigidModes(const PolyMesh& mesh, const PhysicsCheckOptions& options,
+                          const MomentCache* moments = nullptr);
+
+struct DefinitenessReport {
+  double asymmetry = 0.0;          ///< max |K_ij - K_ji| / max |K_ij|
+  bool choleskySucceeded = false;  ///< CHOLMOD's LL^T factorization
+  ZeroModeReport modes;            ///< with the Dirichlet conditions: 0 zero modes expected
+};
+
+/// The stiffness matrix with u = 0 weakly on every boundary face: symmetric positive definite.
+/// `moments` as for patchTest().
+DefinitenessReport definiteness(const PolyMesh& mesh, const PhysicsCheckOptions& options,
+                                const MomentCache* moments = nullptr);
+
+/// A mode of one element's stiffness is zero when its eigenvalue, for the Jacobi-scaled matrix
+/// D^(-1/2) K_K D^(-1/2) (unit diagonal where the diagonal is positive; the constant functions
+/// have zero rows and keep scale 1), is below this times the matrix's largest absolute row sum
+/// (a bound on its largest eigenvalue). Negative eigenvalues count as zero modes too (an
+/// inverted element has more than six). Rigid motions give at most 6e-16 of that bound on the
+/// test corpus and a sliced sphere of 145k elements. Elastic modes stay above 2e-2 at degree 1
+/// whatever the shape (the scaling equalizes thin and long directions), but from degree 2 on
+/// an element of relative thickness t has bending modes at about 3.7 t^2: 3.7e-12 for the
+/// corpus' sliver with t = 1e-6. The threshold sits between the two, 200 times above the
+/// round-off and 37 times below that sliver (1e-10 would flag slivers thinner than 1e-5 at
+/// degree 2, which the solver handles: see kZeroModeThreshold).
+inline constexpr double kElementZeroModeThreshold = 1e-13;
+
+/// The zero modes of one element's stiffness K_K (elementStiffness(), 3n x 3n) by the rule of
+/// localDgChecks()' rigid-mode check: the eigenvalues of its Jacobi-scaled form below
+/// kElementZeroModeThreshold times its largest absolute row sum, negative ones included, counted
+/// by Sylvester's law of inertia (pivoted LDL^T). 6 on a valid element; an inverted element has
+/// more. `degree` is the basis degree p (K_K has 3 numMonomials(p) rows).
+std::size_t elementZeroModes(const Eigen::MatrixXd& stiffness, int degree);
+
+/// An element passes the local patch test when its error (LocalDgCheck::maxPatchTestError) is
+/// below this, the global patch test's tolerance. Valid meshes give 1e-17 .. 1e-14 (a sliced
+/// sphere, meshes scaled by 1e+-6 or translated by 1e6), up to 2.3e-10 on the corpus' sliver of
+/// relative thickness 1e-6 at degree 3 (its local system is ill-conditioned). A vertex moved off
+/// its faces' planes by 1e-3 of the element size gives ~1e-5 (so a mesh whose faces are planar
+/// only to single precision, which the geometric check accepts, fails it: such a mesh reproduces
+/// linear fields only to about its planarity), a reversed face ~1e-2. An inverted element
+/// passes (it is consistent with the opposite orientation) but fails the other two checks.
+inline constexpr double kLocalPatchTestTolerance = 1e-9;
+
+/// The discretization of the local checks: the IP method (BZ is inconsistent and fails any
+/// patch test), with the basis and material as in a solve.
+struct LocalDgCheckOptions {
+  BasisOptions basis{.degree = 1, .kind = BasisKind::Orthonormal};
+  Material material;
+  /// If not empty (one entry per element), only elements with a non-zero entry are checked;
+  /// the others still give their neighbours the exact linear trace.
+  std::vector<char> only;
+};
+
+/// Result of localDgChecks(). Element ids refer to the mesh checked.
+struct LocalDgCheck {
+  int degree = 0;
+  std::size_t elements = 0;  ///< elements checked (all, or those selected by `only`)
+  /// Max over elements of the local patch-test error (see localDgChecks()); +inf when a local
+  /// solve produced a non-finite value.
+  double maxPatchTestError = 0.0;
+  ElementId worstPatchTestElement;              ///< where the maximum is (invalid if none)
+  std::size_t patchTestFailures = 0;            ///< elements above kLocalPatchTestTolerance
+  std::size_t elementsWithWrongRigidModes = 0;  ///< stiffness without exactly 6 zero modes
+  ElementId firstWrongRigidModeElement;         ///< lowest such id (invalid if none)
+  /// Elements whose local IP matrix was not positive definite (a pivot of its LDL^T was not
+  /// positive; the error is then computed with a full-pivoting LU solve). The local penalty
+  /// makes it SPD on every valid element.
+  std::size_t nonDefiniteElements = 0;
+  double seconds = 0.0;  ///< wall time, face roles and bases included (moments excluded)
+  /// Faces whose moments the checks integrated (localDgChecksOfSelection(); 0 when the caller
+  /// gave the moments).
+  std::size_t facesIntegrated = 0;
+
+  bool passed() const {
+    return maxPatchTestError < kLocalPatchTestTolerance && elementsWithWrongRigidModes == 0 &&
+           nonDefiniteElements == 0;
+  }
+};
+
+/// Element-local DG checks of every element K, in parallel, with small dense matrices only
+/// (no global assembly or solve). Degree 1 costs about 7.5 us of CPU per element, 60% of it in
+/// faceRows(): 0.57 s on two cores for the 145k elements of a sphere sliced at 64 cells (plus
+/// 0.075 s for the degree 2 moments), about half the time of the slicing itself.
+///
+/// 1. Rigid modes: the element stiffness K_K (elementStiffness(), the volume term) has exactly
+///    6 zero modes, counted as the eigenvalues of its Jacobi-scaled form below
+///    kElementZeroModeThreshold times its largest absolute row sum. They are counted exactly by
+///    Sylvester's law of inertia, as the negative pivots of the LDL^T factorization (diagonal
+///    pivoting) of the shifted matrix, which costs a tenth of the eigenvalues.
+/// 2. Local patch test: u(x) = L b + A (x - x0), with x0 and L the centre and diagonal of the
+///    mesh's bounding box, b = (0.5, -0.6, 0.7) and
+///        A = [ 0.31 -0.17  0.23;  0.13  0.27 -0.19;  -0.29  0.11  0.21 ]
+///    (entries distinct, not symmetric: stretch, shear and rotation; |A (x - x0)| <= 0.34 L, so
+///    |u| >= 0.7 L on the whole box). K's rows of the IP system with every boundary face a
+///    Dirichlet face with g = u: the element term and all face terms of K (faceRows()), the
+///    neighbours' coefficients set to u's and the Dirichlet load of g = u, are solved for K's
+///    coefficients alone (3n x 3n LDL^T). IP is consistent, so the solution is u up to
+///    round-off; the element's error is max |u_h - u| / max |u| over K's vertices. The check
+///    therefore tests the discrete divergence theorem between K's element and face moments:
+///    a leaky or non-planar element, a reversed face or a wrong face moment gives a large
+///    error. The penalty is local, eta_K = (2 / theta) sum_F w_F^2 (vol(K) / area(F))
+///    trace(liftingFaceGram(F, K)) (= (2 / theta) sum_F w_F^2 for degree 1) with theta and w_F
+///    as in penaltyThreshold(): an upper bound of K's term 2 tau_K / theta of that threshold
+///    (the error does not depend on eta).
+/// 3. Definiteness: with that penalty K's local matrix is positive definite on a valid element;
+///    an inverted one (which passes 2, being consistent with the opposite orientation) is not.
+///
+/// `moments` must be up to date and hold degree 2p moments. Throws std::invalid_argument if a
+/// face is used more than twice or twice with the same orientation (see faceUses()).
+LocalDgCheck localDgChecks(const PolyMesh& mesh, const MomentCache& moments,
+                           const LocalDgCheckOptions& options = {});
+
+/// localDgChecks() of the elements selected by `options.only` (one entry per element, not
+/// empty), with moments computed here for those elements and their face neighbours only: the
+/// checks read nothing else. The same checks and the same numbers as localDgChecks() on the
+/// whole mesh (the patch field uses the whole mesh's bounding box; the neighbours keep every
+/// face, so their coupling counts are unchanged), at a cost that grows with the selection, not
+/// the mesh: `polydg mesh` selects the 12% of a sliced sphere's elements that are not whole
+/// grid cells. Element ids in the result refer to `mesh`.
+LocalDgCheck localDgChecksOfSelection(const PolyMesh& mesh, const LocalDgCheckOptions& options);
+
+}  // namespace polydg

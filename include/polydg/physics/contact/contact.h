@@ -1,0 +1,123 @@
+// Collision response with penalty forces on embedded points (Kaufmann et al. 2008, section 9;
+// Kaufmann 2013, section 4.6): points of an embedding (surface vertices, or the mesh's boundary
+// nodes) against obstacles (physics/contact/obstacles.h), the force linearized into the implicit
+// step.
+//
+// Penalty. A point c with the signed distance phi_c < 0 to an obstacle gets the force
+//   f_c = k a_c (-phi_c) n_c
+// (k the stiffness: pressure per unit penetration; a_c the point's share of the surface area;
+// n_c the obstacle's outward normal), energy E_c = k a_c phi_c^2 / 2. Linearized about the
+// point's position predicted for the step's end, q = x + u~_n + dt v~_n, with
+// phi(y) ~ phi(q) + n . (y - q):
+//   f_c(U) = -k a_c (phi(q) + n . (u~(U) - u~_q)) n = A u~(U) + b,  A = -k a_c n n^T,
+// which eq. (20)'s update turns into K += W^T (k a_c n n^T) W and F += W^T b (u~ = W U, eq. 19).
+// A contact whose linearized force would pull (the point leaves the obstacle within the step)
+// is dropped and the step solved again; a point that ends a step inside an obstacle it was
+// not in contact with joins, likewise (at most ContactOptions::maxPasses solves).
+//
+// Friction (optional): regularized Coulomb friction, a tangential force opposing the slip
+// velocity relative to the obstacle with magnitude mu |f_c| above the slip speed v_s, and
+// proportional to it below (viscous): damping c_t = mu |f_c| / max(|v_t|, v_s) on the tangential
+// velocity, taken implicitly (D += W^T c_t (I - n n^T) W), so it only dissipates.
+#pragma once
+
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+
+#include "polydg/physics/contact/embedding.h"
+#include "polydg/physics/contact/obstacles.h"
+
+namespace polydg {
+
+struct ContactOptions {
+  /// Penalty stiffness: pressure per unit penetration (force / length^3), > 0.
+  double stiffness = 0.0;
+  double friction = 0.0;   ///< Coulomb coefficient mu (0: frictionless)
+  double slipSpeed = 0.0;  ///< v_s of the regularization, > 0 when friction is on
+  int maxPasses = 3;       ///< solves per step for the active set
+};
+
+/// The contact terms of one step: the stiffness K_c, damping C_t and the force at U_n.
+struct ContactLinearization {
+  Eigen::SparseMatrix<double, Eigen::ColMajor, int> stiffness;  ///< W^T (k a n n^T) W
+  Eigen::SparseMatrix<double, Eigen::ColMajor, int> damping;    ///< friction, or empty
+  Eigen::VectorXd force;     ///< f(U_n) + C_t v_obstacle: contact forces at the step's start
+  std::size_t contacts = 0;  ///< active points
+  bool empty() const { return contacts == 0; }
+};
+
+/// Contacts at a state, measured (not linearized).
+struct ContactMeasure {
+  std::size_t contacts = 0;  ///< points inside an obstacle
+  double deepest = 0.0;      ///< largest penetration -phi (0 if none)
+  double energy = 0.0;       ///< sum k a phi^2 / 2 over penetrating points
+};
+
+/// The embedded points, their areas and the obstacles; linearizes the contact forces for a
+/// step. Holds a reference to the embedding, which must outlive it (and may be updated in
+/// place between steps: call refresh()).
+class ContactModel {
+ public:
+  /// Throws std::invalid_argument for bad options or one area per point missing.
+  ContactModel(const SurfaceEmbedding& points, std::vector<double> areas,
+               std::vector<Obstacle> obstacles, const ContactOptions& options);
+
+  /// After the embedding changed (a cut): rebuilds the sample matrix.
+  void refresh();
+
+  /// The active contacts for a step from state (u, v) to time tNext with step dt (predicted
+  /// positions, see above), and their linearization. Times the queries (querySeconds()).
+  ContactLinearization linearize(const Eigen::VectorXd& u, const Eigen::VectorXd& v, double tNext,
+                                 double dt);
+  /// After a solve giving uNew: drops active contacts whose linearized force pulls and adds
+  /// points that penetrate uNew but were not active; true if the active set changed (then
+  /// call relinearize()).
+  bool adjust(const Eigen::VectorXd& uNew);
+  /// The linearization of the current active set (after adjust()).
+  ContactLinearization relinearize();
+
+  /// Contacts, deepest penetration and penalty energy at displacement u, time t.
+  ContactMeasure measure(const Eigen::VectorXd& u, double t);
+
+  const ContactOptions& options() const { return options_; }
+  std::size_t numPoints() const { return embedding_->numPoints(); }
+  /// Wall seconds spent in obstacle queries (and point positions) since the last call.
+  double takeQuerySeconds();
+
+ private:
+  struct Active {
+    std::uint32_t point = 0;
+    std::uint32_t obstacle = 0;
+    double distance = 0.0;  ///< phi at the linearization point q
+    Vec3 normal = Vec3::Zero();
+    Vec3 position = Vec3::Zero();  ///< q
+    Vec3 slip = Vec3::Zero();      ///< tangential velocity relative to the obstacle at start
+  };
+  /// Deepest obstacle at each of the given positions (distance >= 0 where none).
+  void queryAll(const Eigen::Matrix<double, Eigen::Dynamic, 3>& positions, double t,
+                std::vector<ObstacleQuery>& out, std::vector<std::uint32_t>& which);
+  ContactLinearization build() const;
+  /// Undeformed points plus `displacement`.
+  Eigen::Matrix<double, Eigen::Dynamic, 3> positionsOf(
+      const Eigen::Matrix<double, Eigen::Dynamic, 3>& displacement) const;
+  /// A contact of `point` with `obstacle`, linearized about its position in `at`.
+  static Active contact(std::size_t point, std::uint32_t obstacle, const ObstacleQuery& q,
+                        const Eigen::Matrix<double, Eigen::Dynamic, 3>& at);
+  /// The points' displacements for coefficients u (the last result kept: see contact.cpp).
+  const Eigen::Matrix<double, Eigen::Dynamic, 3>& displacementsOf(const Eigen::VectorXd& u);
+
+  const SurfaceEmbedding* embedding_;
+  std::vector<double> areas_;
+  std::vector<Obstacle> obstacles_;
+  ContactOptions options_;
+  std::vector<Active> active_;
+  Eigen::Matrix<double, Eigen::Dynamic, 3> startDisplacement_;  ///< u~_n of every point
+  Eigen::VectorXd cachedCoefficients_;
+  Eigen::Matrix<double, Eigen::Dynamic, 3> cachedDisplacement_;
+  double tNext_ = 0.0, querySeconds_ = 0.0;
+  std::size_t dofs_ = 0;
+};
+
+}  // namespace polydg

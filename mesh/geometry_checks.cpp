@@ -1,0 +1,340 @@
+#include "polydg/mesh/geometry_checks.h"
+
+#include <algorithm>
+#include <unordered_map>
+
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
+#include <boost/container/small_vector.hpp>
+#include <cstdio>
+#include <limits>
+#include <map>
+#include <numeric>
+#include <set>
+#include <sstream>
+
+#include "polydg/mesh/geometry.h"
+#include "polydg/util/union_find.h"
+
+namespace polydg {
+
+namespace {
+
+class Problems {
+ public:
+  Problems(GeometryCheck& report, std::size_t maxMessages)
+      : report_(report), maxMessages_(maxMessages) {}
+
+  void add(std::size_t& counter, const std::string& message) {
+    ++counter;
+    if (report_.messages.size() < maxMessages_) report_.messages.push_back(message);
+  }
+
+ private:
+  GeometryCheck& report_;
+  std::size_t maxMessages_;
+};
+
+std::string describe(const char* what, std::size_t index) {
+  return std::string(what) + " " + std::to_string(index);
+}
+
+/// Checks a face's loops: each has >= 3 vertices and no vertex appears twice in the face; and
+/// its area vector (`area`, areaVector()) is not zero.
+bool isDegenerate(const PolyMesh& mesh, FaceId f, const Vec3& area) {
+  const Face& face = mesh.face(f);
+  for (std::size_t k = 0; k < face.numLoops(); ++k)
+    if (face.loop(k).size() < 3) return true;
+  boost::container::small_vector<VertexId, 8> sorted(face.vertices.begin(), face.vertices.end());
+  std::sort(sorted.begin(), sorted.end());
+  if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) return true;
+  return area.squaredNorm() == 0.0;
+}
+
+bool isDegenerate(const PolyMesh& mesh, FaceId f) {
+  return isDegenerate(mesh, f, areaVector(mesh, f));
+}
+
+/// True if every directed edge of the element's oriented faces is matched by its reverse:
+/// each undirected edge's uses in the two directions balance.
+bool isClosed(const PolyMesh& mesh, ElementId e) {
+  boost::container::small_vector<std::pair<std::uint64_t, int>, 64> uses;
+  for (const FaceUse& use : mesh.element(e).faces) {
+    const Face& face = mesh.face(use.face);
+    for (std::size_t k = 0; k < face.numLoops(); ++k) {
+      const auto loop = face.loop(k);
+      for (std::size_t i = 0; i < loop.size(); ++i) {
+        std::uint32_t a = loop[i].value, b = loop[(i + 1) % loop.size()].value;
+        if (use.reversed) std::swap(a, b);
+        uses.emplace_back(std::uint64_t(std::min(a, b)) << 32 | std::max(a, b), a < b ? 1 : -1);
+      }
+    }
+  }
+  std::sort(uses.begin(), uses.end());
+  for (std::size_t i = 0; i < uses.size();) {
+    int balance = 0;
+    std::size_t j = i;
+    for (; j < uses.size() && uses[j].first == uses[i].first; ++j) balance += uses[j].second;
+    if (balance != 0) return false;
+    i = j;
+  }
+  return true;
+}
+
+/// True for the two sides of a cut: boundary faces tagged Cut with the same loops, reversed.
+/// They are one polygon, but deliberately not shared (the sides are not coupled).
+bool areCutSides(const PolyMesh& mesh, FaceId a, FaceId b) {
+  const Face& x = mesh.face(a);
+  const Face& y = mesh.face(b);
+  return x.origin == FaceOrigin::Cut && y.origin == FaceOrigin::Cut && x.isBoundary() &&
+         y.isBoundary() &&
+         isReverseOf(x, {y.vertices.data(), y.vertices.size()},
+                     {y.loopEnd.data(), y.loopEnd.size()});
+}
+
+/// Relative planarity error of a face beyond the tolerance, or 0 when it is planar enough.
+double planarityExcess(const PolyMesh& mesh, FaceId f, const GeometryCheckOptions& options) {
+  const Box3 box = faceBounds(mesh, f);
+  const double deviation = planarityDeviation(mesh, f);
+  const double resolution =
+      16.0 * std::numeric_limits<double>::epsilon() *
+      std::max(box.min().cwiseAbs().maxCoeff(), box.max().cwiseAbs().maxCoeff());
+  const double diameter = box.diagonal().norm();
+  return deviation > options.planarityTolerance * diameter + resolution ? deviation / diameter
+                                                                        : 0.0;
+}
+
+}  // namespace
+
+GeometryCheck checkGeometryOf(const PolyMesh& mesh, std::span<const ElementId> elements,
+                              const GeometryCheckOptions& options) {
+  GeometryCheck report;
+  Problems problems(report, options.maxMessages);
+  report.elements = elements.size();
+  std::vector<FaceId> faces;
+  for (ElementId e : elements) {
+    const Element& element = mesh.element(e);
+    if (element.faces.empty()) {
+      problems.add(report.emptyElements, describe("element without faces:", e.index()));
+      continue;
+    }
+    for (const FaceUse& use : element.faces) {
+      faces.push_back(use.face);
+      const Face& face = mesh.face(use.face);
+      if ((use.reversed ? face.back : face.front) != e)
+        problems.add(report.inconsistentFaces, "element " + std::to_string(e.index()) +
+                                                   " uses face " + std::to_string(use.face.value) +
+                                                   " but the face does not list it");
+    }
+    if (!isClosed(mesh, e))
+      problems.add(report.openElements, describe("element", e.index()) +
+                                            " is not closed (an edge of its faces is "
+                                            "not matched by the reverse edge of another)");
+    const double v = signedVolume(mesh, e);
+    report.volume += v;
+    if (!(v > 0.0)) {
+      std::ostringstream msg;
+      msg << "element " << e.index() << " has non-positive volume " << v;
+      problems.add(report.nonPositiveElements, msg.str());
+    }
+  }
+  std::sort(faces.begin(), faces.end());
+  faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+  report.faces = faces.size();
+  std::vector<std::pair<std::uint64_t, FaceId>> keys;
+  for (FaceId f : faces) {
+    const Face& face = mesh.face(f);
+    if (face.front.valid() && face.back.valid())
+      ++report.interiorFaces;
+    else
+      ++report.boundaryFaces;
+    if (!face.front.valid())
+      problems.add(report.inconsistentFaces, describe("face used only from its back:", f.index()));
+    for (ElementId side : {face.front, face.back}) {
+      if (!side.valid()) continue;
+      const auto& uses = mesh.element(side).faces;
+      if (std::none_of(uses.begin(), uses.end(), [&](const FaceUse& u) { return u.face == f; }))
+        problems.add(report.inconsistentFaces,
+                     "face " + std::to_string(f.index()) + " lists element " +
+                         std::to_string(side.index()) + " which does not use it");
+    }
+    if (isDegenerate(mesh, f)) {
+      problems.add(report.degenerateFaces, describe("degenerate face", f.index()));
+    } else if (const double excess = planarityExcess(mesh, f, options); excess > 0) {
+      std::ostringstream msg;
+      msg << "face " << f.index() << " is not planar (relative error " << excess << ")";
+      problems.add(report.nonPlanarFaces, msg.str());
+    }
+    keys.emplace_back(vertexSetKey({face.vertices.data(), face.vertices.size()}), f);
+  }
+  std::sort(keys.begin(), keys.end());
+  auto sortedIds = [&](FaceId f) {
+    boost::container::small_vector<VertexId, 8> ids(mesh.face(f).vertices.begin(),
+                                                    mesh.face(f).vertices.end());
+    std::sort(ids.begin(), ids.end());
+    return ids;
+  };
+  for (std::size_t a = 0; a < keys.size(); ++a)
+    for (std::size_t b = a + 1; b < keys.size() && keys[b].first == keys[a].first; ++b)
+      if (sortedIds(keys[a].second) == sortedIds(keys[b].second) &&
+          !areCutSides(mesh, keys[a].second, keys[b].second))
+        problems.add(report.duplicateFaces, "faces " + std::to_string(keys[a].second.index()) +
+                                                " and " + std::to_string(keys[b].second.index()) +
+                                                " are the same polygon but not shared");
+  report.passed = report.openElements == 0 && report.nonPositiveElements == 0 &&
+                  report.nonPlanarFaces == 0 && report.degenerateFaces == 0 &&
+                  report.duplicateFaces == 0 && report.inconsistentFaces == 0 &&
+                  report.emptyElements == 0;
+  return report;
+}
+
+ElementData<std::uint32_t> connectedComponents(const PolyMesh& mesh, std::size_t& count) {
+  UnionFind sets(mesh.numElements());
+  for (const Face& face : mesh.faces())
+    if (face.front.valid() && face.back.valid()) sets.unite(face.front.value, face.back.value);
+  ElementData<std::uint32_t> component;
+  count = sets.labels(component.raw());
+  return component;
+}
+
+GeometryCheck checkGeometry(const PolyMesh& mesh, const GeometryCheckOptions& options) {
+  GeometryCheck report;
+  Problems problems(report, options.maxMessages);
+  report.elements = mesh.numElements();
+  report.faces = mesh.numFaces();
+
+  // Faces: shape and planarity in parallel (the costly part), then links, duplicates and the
+  // report in order.
+  struct FaceCheck {
+    bool degenerate = false;
+    double planarity = 0.0;  ///< relative deviation, if beyond the tolerance; else 0
+    std::uint64_t key = 0;   ///< hash of the sorted vertex ids
+  };
+  std::vector<FaceCheck> checks(mesh.numFaces());
+  // Each face's area vector and bounds, once: the elements' volumes below reuse them.
+  FaceData<Vec3> areaVectors(mesh.numFaces(), Vec3::Zero());
+  FaceData<Box3> faceBoxes(mesh.numFaces());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.numFaces(), 1024),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                        const FaceId f(i);
+                        FaceCheck& c = checks[i];
+                        const Face& face = mesh.face(f);
+                        c.key = vertexSetKey({face.vertices.data(), face.vertices.size()});
+                        areaVectors[f] = areaVector(mesh, f);
+                        faceBoxes[f] = faceBounds(mesh, f);
+                        c.degenerate = isDegenerate(mesh, f, areaVectors[f]);
+                        if (c.degenerate) continue;
+                        const Box3& box = faceBoxes[f];
+                        const double deviation = planarityDeviation(mesh, f, areaVectors[f]);
+                        const double resolution = 16.0 * std::numeric_limits<double>::epsilon() *
+                                                  std::max(box.min().cwiseAbs().maxCoeff(),
+                                                           box.max().cwiseAbs().maxCoeff());
+                        const double diameter = box.diagonal().norm();
+                        if (deviation > options.planarityTolerance * diameter + resolution)
+                          c.planarity = deviation / diameter;
+                      }
+                    });
+  for (std::size_t i = 0; i < mesh.numFaces(); ++i) {
+    const Face& face = mesh.face(FaceId(i));
+    if (face.front.valid() && face.back.valid())
+      ++report.interiorFaces;
+    else if (face.front.valid() || face.back.valid())
+      ++report.boundaryFaces;
+    if (checks[i].degenerate) {
+      problems.add(report.degenerateFaces, describe("degenerate face", i));
+    } else if (checks[i].planarity > 0) {
+      std::ostringstream msg;
+      msg << "face " << i << " is not planar (relative error " << checks[i].planarity << ")";
+      problems.add(report.nonPlanarFaces, msg.str());
+    }
+    if (!face.front.valid() && !face.back.valid()) {
+      problems.add(report.inconsistentFaces, describe("face not used by any element:", i));
+    } else if (!face.front.valid()) {
+      // A face used only from its back is legal in principle, but polydg always attaches the
+      // first element to the front; treat it as a link error.
+      problems.add(report.inconsistentFaces, describe("face used only from its back:", i));
+    }
+  }
+  // Duplicates: faces with equal vertex-set hashes, confirmed by comparing the sets.
+  // (key, face) pairs sorted in parallel: faces with equal keys end up adjacent, by id.
+  std::vector<std::pair<std::uint64_t, std::size_t>> keyed(mesh.numFaces());
+  tbb::parallel_for(std::size_t(0), mesh.numFaces(), [&](std::size_t i) {
+    keyed[i] = {checks[i].key, i};
+  });
+  tbb::parallel_sort(keyed.begin(), keyed.end());
+  auto sortedIds = [&](std::size_t f) {
+    boost::container::small_vector<VertexId, 8> ids(mesh.face(FaceId(f)).vertices.begin(),
+                                                    mesh.face(FaceId(f)).vertices.end());
+    std::sort(ids.begin(), ids.end());
+    return ids;
+  };
+  for (std::size_t a = 0; a < keyed.size();) {
+    std::size_t b = a + 1;
+    while (b < keyed.size() && keyed[b].first == keyed[a].first) ++b;
+    for (std::size_t x = a; x < b; ++x)
+      for (std::size_t y = x + 1; y < b; ++y)
+        if (sortedIds(keyed[x].second) == sortedIds(keyed[y].second) &&
+            !areCutSides(mesh, FaceId(keyed[x].second), FaceId(keyed[y].second)))
+          problems.add(report.duplicateFaces,
+                       "faces " + std::to_string(keyed[x].second) + " and " +
+                           std::to_string(keyed[y].second) +
+                           " are the same polygon but not shared (a face used by more than two "
+                           "elements, or twice with the same orientation)");
+    a = b;
+  }
+
+  // Elements: closure and volume in parallel (they are the costly part), then links back to
+  // faces and the report in order.
+  std::vector<char> closed(mesh.numElements());
+  std::vector<double> volumes(mesh.numElements());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.numElements(), 512),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                        closed[i] = isClosed(mesh, ElementId(i));
+                        volumes[i] = signedVolume(mesh, ElementId(i), areaVectors, faceBoxes);
+                      }
+                    });
+  bool first = true;
+  for (std::size_t i = 0; i < mesh.numElements(); ++i) {
+    const ElementId e(i);
+    const Element& element = mesh.element(e);
+    if (element.faces.empty()) {
+      problems.add(report.emptyElements, describe("element without faces:", i));
+      continue;
+    }
+    for (const FaceUse& use : element.faces) {
+      const Face& face = mesh.face(use.face);
+      if ((use.reversed ? face.back : face.front) != e)
+        problems.add(report.inconsistentFaces, "element " + std::to_string(i) + " uses face " +
+                                                   std::to_string(use.face.value) +
+                                                   " but the face does not list it");
+    }
+    if (!closed[i])
+      problems.add(report.openElements, describe("element", i) +
+                                            " is not closed (an edge of its faces is not "
+                                            "matched by the reverse edge of another)");
+    const double v = volumes[i];
+    report.volume += v;
+    report.minElementVolume = first ? v : std::min(report.minElementVolume, v);
+    report.maxElementVolume = first ? v : std::max(report.maxElementVolume, v);
+    first = false;
+    if (!(v > 0.0)) {
+      std::ostringstream msg;
+      msg << "element " << i << " has non-positive volume " << v
+          << (v < 0 ? " (inverted: faces oriented inward)" : "");
+      problems.add(report.nonPositiveElements, msg.str());
+    }
+  }
+
+  connectedComponents(mesh, report.components);
+  report.passed = report.openElements == 0 && report.nonPositiveElements == 0 &&
+                  report.nonPlanarFaces == 0 && report.degenerateFaces == 0 &&
+                  report.duplicateFaces == 0 && report.inconsistentFaces == 0 &&
+                  report.emptyElements == 0 && mesh.numElements() > 0;
+  if (mesh.numElements() == 0 && report.messages.size() < options.maxMessages)
+    report.messages.push_back("the mesh has no elements");
+  return report;
+}
+
+}  // namespace polydg

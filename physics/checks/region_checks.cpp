@@ -1,0 +1,358 @@
+#include "polydg/physics/checks/region_checks.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <unordered_map>
+
+#include <Eigen/Dense>
+
+#include "polydg/integrate/moments.h"
+#include "polydg/integrate/monomials.h"
+#include "polydg/mesh/geometry.h"
+#include "polydg/physics/checks/dg_checks.h"
+#include "polydg/physics/dg/assembly.h"
+#include "polydg/physics/dg/face_quadrature.h"
+#include "polydg/physics/dg/post_process.h"
+#include "polydg/util/stopwatch.h"
+#include "polydg/util/union_find.h"
+
+namespace polydg {
+
+bool RegionDgCheck::passed() const {
+  if (!(patchTestResidual < kRegionPatchResidualTolerance)) return false;
+  if (!(momentMismatch <= kRegionMomentTolerance)) return false;
+  return std::all_of(zeroModesPerComponent.begin(), zeroModesPerComponent.end(),
+                     [](std::size_t m) { return m == 6; });
+}
+
+namespace {
+
+/// A copy of some elements of a mesh with their faces and vertices, local ids dense in the
+/// order elements were added. Faces shared by two copied elements stay shared; faces, loops
+/// and vertex orders are copied as they are, so moments computed on the copy equal the
+/// original's.
+class SubMesh {
+ public:
+  explicit SubMesh(const PolyMesh& source) : source_(source) {}
+
+  PolyMesh& mesh() { return mesh_; }
+  const PolyMesh& mesh() const { return mesh_; }
+  std::size_t size() const { return global_.size(); }
+  ElementId global(ElementId local) const { return global_[local.index()]; }
+  FaceId face(FaceId global) const { return FaceId(faces_.at(global.value)); }
+  FaceId globalFace(FaceId local) const { return globalFaces_[local.index()]; }
+  bool contains(ElementId global) const { return elements_.count(global.value) != 0; }
+
+  /// Copies element `e` of the source (its faces and vertices if not copied yet).
+  ElementId add(ElementId e) {
+    FaceList uses;
+    for (const FaceUse& use : source_.element(e).faces)
+      uses.push_back({copyFace(use.face), use.reversed});
+    const ElementId local = mesh_.addElementFromFaces(uses);
+    global_.push_back(e);
+    elements_.emplace(e.value, local.value);
+    return local;
+  }
+
+ private:
+  FaceId copyFace(FaceId f) {
+    const auto found = faces_.find(f.value);
+    if (found != faces_.end()) return FaceId(found->second);
+    const Face& face = source_.face(f);
+    boost::container::small_vector<VertexId, 6> vertices;
+    for (VertexId v : face.vertices) vertices.push_back(copyVertex(v));
+    const FaceId local = mesh_.addFace({vertices.data(), vertices.size()},
+                                       {face.loopEnd.data(), face.loopEnd.size()}, face.origin);
+    faces_.emplace(f.value, local.value);
+    globalFaces_.push_back(f);
+    return local;
+  }
+
+  VertexId copyVertex(VertexId v) {
+    const auto [it, inserted] = vertices_.emplace(v.value, 0);
+    if (inserted) it->second = mesh_.addVertex(source_.position(v)).value;
+    return VertexId(it->second);
+  }
+
+  const PolyMesh& source_;
+  PolyMesh mesh_;
+  std::vector<ElementId> global_;
+  std::vector<FaceId> globalFaces_;
+  std::unordered_map<std::uint32_t, std::uint32_t> vertices_, faces_, elements_;
+};
+
+/// The element on the other side of face f from e in `mesh` (invalid on a boundary face).
+ElementId across(const PolyMesh& mesh, FaceId f, ElementId e) {
+  const Face& face = mesh.face(f);
+  return face.front == e ? face.back : face.front;
+}
+
+/// The region's moments recomputed from its geometry against the caller's: max over the region's
+/// elements (local ids 0 .. regionSize-1 of `sub`) of |m_a - m'_a| / (|m'_0| h^|a|), m the
+/// caller's element moments, m' those summed from the element's faces integrated afresh (the
+/// stride of `scratch`, degree `degree`), h half the element's bounding-box diagonal (the size
+/// of the monomials over the element). A face shared by two region elements is integrated once.
+double momentMismatch(const SubMesh& sub, std::size_t regionSize, const MomentCache& caller,
+                      int degree) {
+  const PolyMesh& mesh = sub.mesh();
+  const auto stride = static_cast<std::size_t>(numMonomials(degree));
+  std::vector<double> faceValues(mesh.numFaces() * stride);
+  FaceData<Vec3> normals(mesh.numFaces(), Vec3::Zero());
+  FaceData<char> done(mesh.numFaces(), 0);
+  std::vector<double> fresh(stride), scratch(stride);
+  double worst = 0.0;
+  for (std::size_t i = 0; i < regionSize; ++i) {
+    const ElementId local(i);
+    const Vec3 origin = elementReferencePoint(mesh, local);
+    std::fill(fresh.begin(), fresh.end(), 0.0);
+    for (const FaceUse& use : mesh.element(local).faces) {
+      const std::span<double> values{faceValues.data() + use.face.index() * stride, stride};
+      if (!done[use.face]) {
+        faceMoments(mesh, use.face, degree, values, normals[use.face]);
+        done[use.face] = 1;
+      }
+      accumulateElementMoments(degree, values, faceReferencePoint(mesh, use.face),
+                               normals[use.face], use.reversed, origin, scratch, fresh);
+    }
+    const auto a = caller.element(sub.global(local));
+    const double h = 0.5 * elementBounds(mesh, local).diagonal().norm();
+    const double volume = std::abs(fresh[0]);
+    if (!(volume > 0.0) || !(h > 0.0)) {
+      if (a[0] != fresh[0]) worst = std::numeric_limits<double>::infinity();
+      continue;
+    }
+    for (std::size_t k = 0; k < stride; ++k) {
+      const double scale = volume * std::pow(h, monomialExponents(static_cast<int>(k)).degree());
+      worst = std::max(worst, std::abs(a[k] - fresh[k]) / scale);
+    }
+    if (!std::isfinite(a[0])) worst = std::numeric_limits<double>::infinity();
+  }
+  return worst;
+}
+
+/// The penalty of the region's rows: the largest local penalty eta_K of localDgChecks() over
+/// the region's elements (local ids 0 .. regionSize-1 of `sub`), each face weighted as in the
+/// full problem (w_F^2 = 1/4 on a face with an element on both sides in the whole mesh, 1 on a
+/// boundary face). Bounds 2 tau_K / theta of penaltyThreshold() for every region element, so
+/// each region element's block of the IP matrix, and the region's, is SPD.
+double regionPenalty(const SubMesh& sub, std::size_t regionSize, const DgBasis& basis,
+                     const MomentCache& moments) {
+  const PolyMesh& mesh = sub.mesh();
+  double eta = 0.0;
+  for (std::size_t i = 0; i < regionSize; ++i) {
+    const ElementId e(i);
+    double sum = 0.0;
+    for (const FaceUse& use : mesh.element(e).faces) {
+      const double area = moments.area(use.face);
+      if (!(area > 0.0)) continue;
+      const double w2 = across(mesh, use.face, e).valid() ? 0.25 : 1.0;
+      sum += w2 * moments.volume(e) / area *
+             liftingFaceGram(basis, moments, mesh, use.face, e).trace();
+    }
+    eta = std::max(eta, 2.0 * sum / kConsistencyEnergyShare);
+  }
+  return eta;
+}
+
+/// int_F phi_i for element e's functions, by face quadrature exact to the basis degree.
+Eigen::VectorXd faceIntegrals(const PolyMesh& mesh, const DgBasis& basis, FaceId f, ElementId e) {
+  Eigen::VectorXd out = Eigen::VectorXd::Zero(basis.size());
+  Eigen::VectorXd values(basis.size());
+  for (const QuadraturePoint& q : faceQuadrature(mesh, f, basis.degree())) {
+    basis.values(e, q.point, {values.data(), static_cast<std::size_t>(values.size())});
+    out += q.weight * values;
+  }
+  return out;
+}
+
+/// The face terms of a face between two region elements from each side (faceRows()' self and
+/// other blocks S_F and O_F, by side: 0 the face's front element, 1 its back).
+struct FaceBlocks {
+  Eigen::MatrixXd self[2], other[2];
+};
+
+}  // namespace
+
+RegionDgCheck regionDgChecks(const PolyMesh& mesh, const MomentCache& moments,
+                             std::span<const char> region, const LocalDgCheckOptions& options,
+                             RegionCoupling coupling) {
+  const Stopwatch start;
+  options.material.check();
+  if (region.size() != mesh.numElements())
+    throw std::invalid_argument("regionDgChecks: `region` needs one entry per element");
+  const int degree = options.basis.degree;
+  if (moments.degree() < 2 * degree)
+    throw std::invalid_argument("regionDgChecks: the moment cache must hold degree 2p moments");
+
+  RegionDgCheck c;
+  c.degree = degree;
+  // The region (local ids 0 .. regionSize-1), then its neighbours outside it.
+  SubMesh sub(mesh);
+  try {
+    for (std::size_t i = 0; i < region.size(); ++i)
+      if (region[i]) sub.add(ElementId(i));
+  } catch (const std::exception& e) {
+    throw std::invalid_argument(std::string("regionDgChecks: the region's faces are not used "
+                                            "consistently (") +
+                                e.what() + ")");
+  }
+  const std::size_t regionSize = sub.size();
+  c.elements = regionSize;
+  if (regionSize == 0) return c;
+  Box3 box;
+  for (std::size_t i = 0; i < regionSize; ++i) {
+    const ElementId e = sub.global(ElementId(i));
+    box.extend(elementBounds(mesh, e));
+    for (const FaceUse& use : mesh.element(e).faces) {
+      const ElementId other = across(mesh, use.face, e);
+      if (other.valid() && !sub.contains(other)) sub.add(other);
+    }
+  }
+  const PolyMesh& local = sub.mesh();
+
+  // 1. Moments: the caller's, copied to the sub-mesh (nothing integrated), and the region's
+  //    recomputed from its geometry to compare.
+  const int momentDegree = 2 * degree;
+  MomentCache given(local, momentDegree);
+  for (std::size_t f = 0; f < local.numFaces(); ++f) {
+    const FaceId theirs = sub.globalFace(FaceId(f));
+    given.assignFace(FaceId(f),
+                     moments.face(theirs).first(static_cast<std::size_t>(given.stride())),
+                     moments.faceNormal(theirs));
+  }
+  given.update();
+  c.momentMismatch = momentMismatch(sub, regionSize, moments, momentDegree);
+
+  // 2. The region's rows of the IP system at the linear field's coefficients, element by element.
+  const DgBasis basis(local, given, options.basis);
+  const int n = basis.size(), bs = 3 * n;
+  const FormCoefficients form{Method::IP, options.material.mu(), options.material.lambda(),
+                              regionPenalty(sub, regionSize, basis, given)};
+  Eigen::Matrix3d gradient;
+  gradient << 0.31, -0.17, 0.23, 0.13, 0.27, -0.19, -0.29, 0.11, 0.21;
+  const Vec3 b = box.diagonal().norm() * Vec3(0.5, -0.6, 0.7), x0 = box.center();
+  Eigen::VectorXd exact(static_cast<Eigen::Index>(local.numElements()) * bs);
+  for (std::size_t i = 0; i < local.numElements(); ++i)
+    exact.segment(static_cast<Eigen::Index>(i) * bs, bs) =
+        linearFieldCoefficients(basis, ElementId(i), b, gradient, x0);
+  const Eigen::Matrix3d strain = 0.5 * (gradient + gradient.transpose());
+  const Eigen::Matrix3d stress =
+      2.0 * form.mu * strain + form.lambda * strain.trace() * Eigen::Matrix3d::Identity();
+  const auto coefficients = [&](ElementId e) {
+    return exact.segment(static_cast<Eigen::Index>(e.index()) * bs, bs);
+  };
+  // Every face of the full problem has face terms: c_K is the element's face count.
+  const auto coupled = [&](ElementId e) { return static_cast<int>(local.element(e).faces.size()); };
+
+  std::vector<Eigen::MatrixXd> stiffnesses(regionSize);
+  std::vector<Eigen::VectorXd> scales(regionSize);
+  std::unordered_map<std::uint32_t, FaceBlocks> faceBlocks;  // by local face
+  std::vector<long long> surplus(regionSize, 0);             // element zero modes beyond 6
+  double worstResidual = 0.0;
+  bool definite = true;
+  Eigen::MatrixXd stiffness, a, selfBlock, otherBlock;
+  Eigen::VectorXd r, size, diagonal;
+  for (std::size_t i = 0; i < regionSize; ++i) {
+    const ElementId e(i);
+    const auto ue = coefficients(e);
+    elementStiffness(basis, given, e, form.mu, form.lambda, stiffness);
+    surplus[i] = static_cast<long long>(elementZeroModes(stiffness, degree)) - 6;
+    // r = A U - F over K's rows and, entry by entry, the size of the terms summed into it.
+    a = stiffness;
+    r = stiffness * ue;
+    size = stiffness.cwiseAbs() * ue.cwiseAbs();
+    diagonal = stiffness.diagonal();
+    for (const FaceUse& use : local.element(e).faces) {
+      const ElementId other = across(local, use.face, e);
+      FaceView view;
+      view.face = use.face;
+      view.kind = other.valid() ? FaceKind::Interior : FaceKind::Dirichlet;
+      view.self = e;
+      view.other = other;
+      view.selfIsFront = !use.reversed;
+      view.selfCoupledFaces = coupled(e);
+      view.otherCoupledFaces = other.valid() ? coupled(other) : 0;
+      faceRows(local, basis, given, view, form, selfBlock, otherBlock);
+      a += selfBlock;
+      if (other.valid()) {
+        // A Dirichlet face's S_F U_K is on both sides of A U = F: only its t_F is left below.
+        const auto uo = coefficients(other);
+        r.noalias() += selfBlock * ue + otherBlock * uo;
+        size.noalias() +=
+            selfBlock.cwiseAbs() * ue.cwiseAbs() + otherBlock.cwiseAbs() * uo.cwiseAbs();
+        if (other.index() < regionSize) {
+          diagonal += selfBlock.diagonal();
+          FaceBlocks& t = faceBlocks[use.face.value];
+          const int side = use.reversed ? 1 : 0;
+          t.self[side] = selfBlock;
+          t.other[side] = otherBlock;
+        }
+      } else {
+        const Vec3 normal =
+            use.reversed ? Vec3(-given.faceNormal(use.face)) : given.faceNormal(use.face);
+        const Vec3 traction = stress * normal;
+        const Eigen::VectorXd integrals = faceIntegrals(local, basis, use.face, e);
+        for (int d = 0; d < 3; ++d) {
+          r.segment(d * n, n) -= traction[d] * integrals;
+          size.segment(d * n, n) += std::abs(traction[d]) * integrals.cwiseAbs();
+        }
+      }
+    }
+    // Relative to the largest term in K's rows: round-off in the sum stays below a few
+    // machine epsilons of it, times the relative round-off of the matrices' entries.
+    const double largest = size.maxCoeff();
+    const double relative = largest > 0.0   ? r.cwiseAbs().maxCoeff() / largest
+                            : r.isZero(0.0) ? 0.0
+                                            : std::numeric_limits<double>::infinity();
+    worstResidual =
+        std::max(worstResidual,
+                 std::isfinite(relative) ? relative : std::numeric_limits<double>::infinity());
+    // K's block of the IP matrix (every face with its terms) is SPD on a valid element.
+    const Eigen::LDLT<Eigen::MatrixXd> ldlt(a);
+    for (const double d : ldlt.vectorD()) definite = definite && d > 0.0;
+    scales[i] = zeroModeScaling(diagonal, bs);
+    stiffnesses[i] = stiffness;
+  }
+  c.patchTestResidual = definite ? worstResidual : std::numeric_limits<double>::infinity();
+
+  // 3. Zero modes: 6 per element (its own stiffness), and per face between region elements the
+  //    rigid motions it leaves free; components by union-find over the faces that join.
+  UnionFind sets(regionSize);
+  std::vector<long long> faceSurplus;
+  std::vector<std::uint32_t> faceFront;
+  Eigen::MatrixXd pair(2 * bs, 2 * bs);
+  Eigen::VectorXd pairScale(2 * bs);
+  for (const auto& [f, t] : faceBlocks) {
+    const Face& face = local.face(FaceId(std::size_t(f)));
+    const std::size_t front = face.front.index(), back = face.back.index();
+    pair << stiffnesses[front] + t.self[0], t.other[0], t.other[1], stiffnesses[back] + t.self[1];
+    pairScale << scales[front], scales[back];
+    const std::size_t modes = countZeroModes(pair, pairScale);
+    if (coupling == RegionCoupling::HoldingFaces && modes > 6) {
+      ++c.looseFaces;
+      continue;
+    }
+    sets.unite(face.front.value, face.back.value);
+    // A face whose terms do not vanish on the rigid motions common to its two elements (fewer
+    // than 6) takes zero modes from its component. AllFaces joins hinges too, without counting
+    // their soft modes: a count over a component's cycles would take its global eigen-solve.
+    faceSurplus.push_back(std::min(static_cast<long long>(modes) - 6, 0LL));
+    faceFront.push_back(face.front.value);
+  }
+  std::vector<std::uint32_t> component;
+  c.components = sets.labels(component);
+  std::vector<long long> perComponent(c.components, 6);
+  for (std::size_t i = 0; i < regionSize; ++i) perComponent[component[i]] += surplus[i];
+  for (std::size_t k = 0; k < faceSurplus.size(); ++k)
+    perComponent[component[faceFront[k]]] += faceSurplus[k];
+  for (const long long m : perComponent) {
+    c.zeroModesPerComponent.push_back(static_cast<std::size_t>(std::max(m, 0LL)));
+    c.zeroModes += c.zeroModesPerComponent.back();
+  }
+  c.seconds = start.seconds();
+  return c;
+}
+
+}  // namespace polydg

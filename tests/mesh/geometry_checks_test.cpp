@@ -1,0 +1,137 @@
+// Geometric validation accepts valid meshes (hex grids, non-convex elements, faces with holes)
+// and names each kind of defect: open, inverted, non-planar, duplicated, disconnected.
+#include "polydg/mesh/geometry_checks.h"
+
+#include <gtest/gtest.h>
+
+#include "polydg/mesh/geometry.h"
+#include "polydg/mesh/primitives.h"
+#include "polydg/mesh/surface.h"
+
+namespace polydg {
+namespace {
+
+/// Rebuilds `mesh` through addElement with every face of every element described by
+/// `describe(element, face, loops)`; lets a test drop, flip or move faces.
+template <class F>
+PolyMesh rebuild(const PolyMesh& mesh, F&& describe) {
+  PolyMesh out;
+  for (const Vec3& p : mesh.positions()) out.addVertex(p);
+  for (std::size_t e = 0; e < mesh.numElements(); ++e) {
+    std::vector<std::vector<Loop>> boundary;
+    for (const FaceUse& use : mesh.element(ElementId(e)).faces) {
+      const Face& face = mesh.face(use.face);
+      std::vector<Loop> loops;
+      for (std::size_t k = 0; k < face.numLoops(); ++k) {
+        auto l = face.loop(k);
+        Loop loop(l.begin(), l.end());
+        if (use.reversed) std::reverse(loop.begin(), loop.end());
+        loops.push_back(loop);
+      }
+      if (describe(e, use.face, loops)) boundary.push_back(loops);
+    }
+    out.addElement(boundary, FaceOrigin::Box);
+  }
+  return out;
+}
+
+TEST(Validate, AcceptsHexGrid) {
+  const PolyMesh mesh = hexGridMesh(3, 2, 2, Box3(Vec3(0, 0, 0), Vec3(3, 2, 2)));
+  const GeometryCheck r = checkGeometry(mesh);
+  EXPECT_TRUE(r.passed) << (r.messages.empty() ? "" : r.messages[0]);
+  EXPECT_EQ(r.elements, 12u);
+  EXPECT_EQ(r.components, 1u);
+  EXPECT_DOUBLE_EQ(r.volume, 12.0);
+  EXPECT_EQ(r.interiorFaces + r.boundaryFaces, r.faces);
+  EXPECT_EQ(r.boundaryFaces, 2u * (3 * 2 + 3 * 2 + 2 * 2));
+}
+
+TEST(Validate, AcceptsNonConvexElementsAndFacesWithHoles) {
+  Polygon2 p;
+  p.outer = {{0, 0}, {3, 0}, {3, 3}, {0, 3}};
+  p.holes = {{{1, 1}, {1, 2}, {2, 2}, {2, 1}}};
+  const GeometryCheck tunnel = checkGeometry(prismMesh(p, 0.0, 1.0, Vec2(0.5, 0.5)));
+  EXPECT_TRUE(tunnel.passed) << (tunnel.messages.empty() ? "" : tunnel.messages[0]);
+  Polygon2 l;
+  l.outer = {{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}};
+  EXPECT_TRUE(checkGeometry(prismMesh(l, 0.0, 1.0)).passed);
+}
+
+TEST(Validate, CountsComponents) {
+  PolyMesh mesh = hexGridMesh(2, 1, 1, Box3(Vec3(0, 0, 0), Vec3(2, 1, 1)));
+  const PolyMesh other = boxMesh(Box3(Vec3(5, 0, 0), Vec3(6, 1, 1)));
+  const std::size_t first = mesh.numVertices();
+  for (const Vec3& p : other.positions()) mesh.addVertex(p);
+  std::vector<std::vector<Loop>> boundary;
+  for (const Face& face : other.faces()) {
+    Loop loop;
+    for (VertexId v : face.vertices) loop.push_back(VertexId(v.index() + first));
+    boundary.push_back({loop});
+  }
+  mesh.addElement(boundary, FaceOrigin::Box);
+  const GeometryCheck r = checkGeometry(mesh);
+  EXPECT_TRUE(r.passed);
+  EXPECT_EQ(r.components, 2u);
+}
+
+TEST(Validate, RejectsLeakyElement) {
+  const PolyMesh grid = hexGridMesh(2, 1, 1, Box3(Vec3(0, 0, 0), Vec3(2, 1, 1)));
+  const FaceId dropped = grid.element(ElementId(1)).faces[3].face;
+  const PolyMesh leaky = rebuild(
+      grid, [dropped](std::size_t e, FaceId f, auto&) { return !(e == 1 && f == dropped); });
+  const GeometryCheck r = checkGeometry(leaky);
+  EXPECT_FALSE(r.passed);
+  EXPECT_EQ(r.openElements, 1u);
+}
+
+TEST(Validate, RejectsInvertedElement) {
+  const PolyMesh grid = hexGridMesh(1, 1, 2, Box3(Vec3(0, 0, 0), Vec3(1, 1, 2)));
+  // Element 0 with every face reversed: closed, but oriented inward.
+  const PolyMesh inverted = rebuild(grid, [](std::size_t e, FaceId, std::vector<Loop>& loops) {
+    if (e == 0)
+      for (Loop& loop : loops) std::reverse(loop.begin(), loop.end());
+    return true;
+  });
+  const GeometryCheck r = checkGeometry(inverted);
+  EXPECT_FALSE(r.passed);
+  EXPECT_EQ(r.nonPositiveElements, 1u);
+  EXPECT_EQ(r.openElements, 0u);
+  // The shared face now has the same orientation in both: it is duplicated, not shared.
+  EXPECT_EQ(r.duplicateFaces, 1u);
+  EXPECT_EQ(r.components, 2u);
+}
+
+TEST(Validate, RejectsNonPlanarFace) {
+  PolyMesh mesh = boxMesh(Box3(Vec3(0, 0, 0), Vec3(1, 1, 1)));
+  mesh.positions()[VertexId(7)] += Vec3(0.01, 0.01, 0.01);
+  const GeometryCheck r = checkGeometry(mesh);
+  EXPECT_FALSE(r.passed);
+  EXPECT_EQ(r.nonPlanarFaces, 3u);  // the three faces meeting at the moved corner
+  ASSERT_FALSE(r.messages.empty());
+  EXPECT_NE(r.messages[0].find("not planar"), std::string::npos);
+}
+
+TEST(Validate, RejectsDegenerateFaceAndEmptyMesh) {
+  PolyMesh mesh;
+  for (int i = 0; i < 3; ++i) mesh.addVertex(Vec3(i, 0, 0));  // collinear
+  const FaceId f = mesh.addFace({Loop{VertexId(0), VertexId(1), VertexId(2)}}, FaceOrigin::Surface);
+  mesh.addElementFromFaces(std::vector<FaceUse>{{f, false}});
+  const GeometryCheck r = checkGeometry(mesh);
+  EXPECT_FALSE(r.passed);
+  EXPECT_EQ(r.degenerateFaces, 1u);
+  EXPECT_FALSE(checkGeometry(PolyMesh()).passed);
+}
+
+TEST(Validate, AcceptsTranslatedAndScaledMeshes) {
+  for (double scale : {1e-6, 1.0, 1e6}) {
+    PolyMesh mesh = hexGridMesh(2, 2, 2, Box3(Vec3(0, 0, 0), Vec3(1, 1, 1)));
+    // Offsets of 1e6 element sizes: coordinates keep ~1e-10 relative resolution.
+    transform(mesh, scale, scale * Vec3(1e6, -1e6, 1e6));
+    const GeometryCheck r = checkGeometry(mesh);
+    EXPECT_TRUE(r.passed) << "scale " << scale;
+    EXPECT_NEAR(r.volume, scale * scale * scale, 1e-9 * scale * scale * scale);
+  }
+}
+
+}  // namespace
+}  // namespace polydg

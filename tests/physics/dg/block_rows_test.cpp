@@ -1,0 +1,144 @@
+// BlockRows (physics/dg/block_rows.h): the element block rows of a DG matrix give the same
+// product as the CSR matrix, store BZ's neighbour blocks component-diagonal and IP's whole,
+// and refuse a pattern too sparse for blocks.
+#include "polydg/physics/dg/block_rows.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <random>
+
+#include "cli/bench/problems.h"
+#include "polydg/physics/dg/assembly.h"
+#include "polydg/physics/solvers/agglomeration.h"
+#include "polydg/physics/solvers/linear_solver.h"
+#include "polydg/physics/solvers/static_solver.h"
+#include "tests/support/dg_systems.h"
+
+namespace polydg {
+namespace {
+
+using bench::benchmarkB1Mesh;
+using bench::BenchmarkMesh;
+
+Eigen::VectorXd randomVector(Eigen::Index size) {
+  std::mt19937 rng(20261123);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Eigen::VectorXd x(size);
+  for (Eigen::Index i = 0; i < size; ++i) x[i] = u(rng);
+  return x;
+}
+
+/// Stored values over matrix nonzeros, and the relative difference of the products.
+struct Comparison {
+  double storedRatio = 0.0;
+  std::size_t diagonalSlots = 0, slots = 0;
+  double productError = 0.0;
+};
+
+Comparison compare(const PolyMesh& mesh, Method method, int degree) {
+  const auto k = b1System(mesh, method, degree).matrix;
+  const int n = static_cast<int>(k.rows() / mesh.numElements()) / 3;
+  BlockRows<double> rows;
+  EXPECT_TRUE(rows.build(k, n, 1.0));
+  const Eigen::VectorXd x = randomVector(k.cols());
+  Eigen::VectorXd expected, actual(k.rows());
+  symmetricProduct(k, x, expected);
+  for (int e = 0; e < static_cast<int>(mesh.numElements()); ++e)
+    rows.rowProduct(e, x.data(), actual.data() + static_cast<Eigen::Index>(e) * 3 * n);
+  Comparison c;
+  c.storedRatio = static_cast<double>(rows.values.size()) / static_cast<double>(k.nonZeros());
+  c.slots = rows.element.size();
+  for (std::uint8_t d : rows.diagonal) c.diagonalSlots += d;
+  c.productError = (actual - expected).norm() / expected.norm();
+  return c;
+}
+
+TEST(BlockRows, IpProductEqualsCsrOnHexAndSlicedMeshes) {
+  for (BenchmarkMesh kind : {BenchmarkMesh::Hex, BenchmarkMesh::Sliced})
+    for (int degree : {1, 2, 3}) {  // every compile-time block size (n = 4, 10, 20)
+      const Comparison c = compare(benchmarkB1Mesh(kind, 3), Method::IP, degree);
+      EXPECT_LT(c.productError, 1e-14) << "degree " << degree;
+      EXPECT_EQ(c.diagonalSlots, 0u);  // IP couples all components
+      EXPECT_DOUBLE_EQ(c.storedRatio, 1.0);
+    }
+}
+
+TEST(BlockRows, BzNeighbourBlocksAreComponentDiagonal) {
+  const PolyMesh mesh = benchmarkB1Mesh(BenchmarkMesh::Sliced, 3);
+  for (int degree : {1, 2, 3}) {
+    const Comparison c = compare(mesh, Method::BZ, degree);
+    EXPECT_LT(c.productError, 1e-14) << "degree " << degree;
+    // Every slot but the elements' own blocks couples equal components only.
+    EXPECT_EQ(c.diagonalSlots, c.slots - mesh.numElements());
+    EXPECT_DOUBLE_EQ(c.storedRatio, 1.0);
+  }
+}
+
+// assembleBlockRows() writes each element's rows straight into the blocks; assembleStiffness()
+// goes through the local matrices into CSR. Both add the same terms in the same order, so the
+// matrices agree bit for bit, and CG from the blocks alone (no CSR, a double-precision
+// smoother) takes the CSR path's iterations to the same solution.
+TEST(BlockRows, AssembledStraightIntoBlocksEqualTheCsrAssembly) {
+  const bench::ManufacturedProblem problem = bench::benchmarkB1Problem();
+  const LoadCase loads = bench::benchmarkB1Loads(problem);
+  for (BenchmarkMesh kind : {BenchmarkMesh::Hex, BenchmarkMesh::Sliced})
+    for (Method method : {Method::IP, Method::BZ})
+      for (int degree : {1, 2, 3}) {
+        const PolyMesh mesh = benchmarkB1Mesh(kind, 3);
+        StaticOptions o;
+        o.discretization.method = method;
+        o.discretization.basis.degree = degree;
+        StaticSolver solver(mesh, problem.material, o);
+        solver.assemble(loads);
+        const auto csr = assembleStiffness(mesh, solver.basis(), solver.moments(), solver.roles(),
+                                           solver.form());
+        const BlockRows<double> rows = assembleBlockRows(mesh, solver.basis(), solver.moments(),
+                                                         solver.roles(), solver.form());
+        const auto fromRows = rows.toSparse();
+        ASSERT_EQ(fromRows.nonZeros(), csr.nonZeros());
+        ASSERT_EQ(rows.entries(), static_cast<std::size_t>(csr.nonZeros()));
+        // The same terms: coupling blocks bit for bit; the CSR assembly reads each element's
+        // own block by rows (assembleStiffness()), the blocks keep it by columns, so there one
+        // is the other's transpose, bit for bit (they differ by the block's round-off
+        // asymmetry, up to 1e-14 of |K| at p = 3).
+        std::size_t mismatches = 0;
+        const int bs = rows.bs;
+        for (int j = 0; j < csr.outerSize(); ++j)
+          for (decltype(csr)::InnerIterator it(fromRows, j); it; ++it) {
+            const bool own = it.row() / bs == j / bs;
+            mismatches += it.value() != (own ? csr.coeff(j, it.row()) : csr.coeff(it.row(), j));
+          }
+        EXPECT_EQ(mismatches, 0u) << "degree " << degree;
+
+        SolverOptions cg;
+        cg.kind = SolverKind::ConjugateGradient;
+        const ElementFrames frames = elementFrames(solver.basis(), mesh);
+        const Eigen::VectorXd& f = solver.system().rhs;
+        LinearSolver fromCsr(cg), fromBlocks(cg);
+        ASSERT_TRUE(fromCsr.compute(csr, rows.bs, &frames));
+        ASSERT_TRUE(fromBlocks.compute(rows, &frames));
+        LinearSolveReport a, b;
+        const Eigen::VectorXd ua = fromCsr.solve(f, a), ub = fromBlocks.solve(f, b);
+        EXPECT_TRUE(a.success && b.success);
+        EXPECT_NEAR(b.iterations, a.iterations, 1) << "degree " << degree;
+        EXPECT_LT((ua - ub).norm(), 1e-8 * ua.norm());
+        EXPECT_LT(b.residual, 1e-9);
+      }
+}
+
+TEST(BlockRows, RefusesAPatternTooSparseForBlocks) {
+  // The identity of a 2-element, bs = 3 matrix: the elements' own blocks are stored whole,
+  // 9 values for 3 nonzeros each.
+  Eigen::SparseMatrix<double, Eigen::ColMajor, int> a(6, 6);
+  for (int i = 0; i < 6; ++i) a.insert(i, i) = 1.0;
+  a.makeCompressed();
+  BlockRows<float> rows;
+  EXPECT_FALSE(rows.build(a, 1, 2.0));
+  EXPECT_TRUE(rows.values.empty());
+  EXPECT_TRUE(rows.build(a, 1, 3.0));
+  EXPECT_EQ(rows.values.size(), 18u);
+}
+
+}  // namespace
+}  // namespace polydg

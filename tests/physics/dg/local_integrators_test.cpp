@@ -1,0 +1,152 @@
+// The DG basis and local integrators: orthonormal bases, element stiffness with the rigid
+// motions in its kernel and the energy of a known strain, face matrices that fit together
+// symmetrically, exact face quadrature on non-convex faces with holes, and the penalty
+// threshold's independence of scale and material.
+#include "polydg/physics/dg/local_integrators.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "polydg/mesh/primitives.h"
+#include "polydg/physics/dg/assembly.h"
+#include "polydg/physics/dg/face_quadrature.h"
+
+namespace polydg {
+namespace {
+
+constexpr double kTolerance = 1e-12;
+
+PolyMesh lPrism() {
+  Polygon2 l;
+  l.outer = {{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}};
+  return prismMesh(l, 0.0, 0.5, Vec2(0.5, 0.25));
+}
+
+class LocalIntegrators : public ::testing::TestWithParam<int> {};
+
+TEST_P(LocalIntegrators, OrthonormalBasisHasIdentityMass) {
+  const PolyMesh mesh = lPrism();
+  MomentCache moments(mesh, 2 * GetParam());
+  moments.update();
+  const DgBasis basis(mesh, moments, {.degree = GetParam()});
+  Eigen::MatrixXd mass;
+  elementMass(basis, moments, ElementId(0), mass);
+  EXPECT_LT((mass - Eigen::MatrixXd::Identity(basis.size(), basis.size())).norm(), kTolerance);
+  EXPECT_EQ(basis.fallbackElements(), 0u);
+}
+
+TEST_P(LocalIntegrators, StiffnessAnnihilatesRigidMotionsAndMeasuresStrainEnergy) {
+  const PolyMesh mesh = lPrism();
+  const int p = GetParam();
+  MomentCache moments(mesh, 2 * p);
+  moments.update();
+  const DgBasis basis(mesh, moments, {.degree = p, .kind = BasisKind::ScaledMonomial});
+  const double mu = 0.7, lambda = 1.3;
+  Eigen::MatrixXd k;
+  elementStiffness(basis, moments, ElementId(0), mu, lambda, k);
+  const int n = basis.size();
+  const double h = basis.scale(ElementId(0));
+  // With the scaled monomial basis phi_1..3 = (x - c)/h: u = h * e_d x_k has coefficient h.
+  auto linear = [&](int d, int axis) {
+    Eigen::VectorXd u = Eigen::VectorXd::Zero(3 * n);
+    u[d * n + 1 + axis] = h;  // u_d = x_axis - c_axis
+    return u;
+  };
+  for (int d = 0; d < 3; ++d) {
+    Eigen::VectorXd t = Eigen::VectorXd::Zero(3 * n);
+    t[d * n] = 1.0;
+    EXPECT_LT((k * t).norm(), kTolerance * k.norm()) << "translation " << d;
+  }
+  // Rotations about each axis: u = e_a x_b - e_b x_a.
+  for (auto [a, b] : {std::pair{0, 1}, std::pair{0, 2}, std::pair{1, 2}}) {
+    const Eigen::VectorXd r = linear(a, b) - linear(b, a);
+    EXPECT_LT((k * r).norm(), kTolerance * k.norm());
+  }
+  // u = (x, 0, 0): eps = e1 e1^T, energy int sigma:eps = (2 mu + lambda) vol.
+  const Eigen::VectorXd stretch = linear(0, 0);
+  EXPECT_NEAR(stretch.dot(k * stretch), (2 * mu + lambda) * 1.5, 1e-12);
+  // u = (y, x, 0): eps_12 = 1, energy 4 mu vol... sigma:eps = 2 mu * 2 = 4 mu.
+  const Eigen::VectorXd shear = linear(0, 1) + linear(1, 0);
+  EXPECT_NEAR(shear.dot(k * shear), 4 * mu * 1.5, 1e-12);
+}
+
+TEST_P(LocalIntegrators, FaceBlocksOfBothSidesAreTransposes) {
+  const int p = GetParam();
+  const PolyMesh mesh = hexGridMesh(2, 1, 1, Box3(Vec3::Zero(), Vec3(2.0, 1.0, 0.5)));
+  MomentCache moments(mesh, 2 * p);
+  moments.update();
+  const DgBasis basis(mesh, moments, {.degree = p});
+  const FaceRoles roles = classifyFaces(mesh, {});
+  FaceId shared;
+  for (std::size_t f = 0; f < mesh.numFaces(); ++f)
+    if (roles.kind[FaceId(f)] == FaceKind::Interior) shared = FaceId(f);
+  ASSERT_TRUE(shared.valid());
+  const FaceUses& u = roles.uses[shared];
+  const FormCoefficients form{Method::IP, 0.5, 2.0, 10.0};
+  auto view = [&](int s) {
+    FaceView v;
+    v.face = shared;
+    v.self = u.element[s];
+    v.other = u.element[1 - s];
+    v.selfIsFront = !u.reversed[s];
+    v.selfCoupledFaces = v.otherCoupledFaces = 1;
+    return v;
+  };
+  Eigen::MatrixXd s0, o0, s1, o1;
+  faceRows(mesh, basis, moments, view(0), form, s0, o0);
+  faceRows(mesh, basis, moments, view(1), form, s1, o1);
+  EXPECT_LT((s0 - s0.transpose()).norm(), kTolerance * s0.norm());
+  EXPECT_LT((s1 - s1.transpose()).norm(), kTolerance * s1.norm());
+  EXPECT_LT((o0 - o1.transpose()).norm(), kTolerance * o0.norm());
+}
+
+TEST_P(LocalIntegrators, PenaltyThresholdIsScaleAndPositionInvariant) {
+  const int p = GetParam();
+  PolyMesh mesh = lPrism();
+  LoadCase clamp;
+  clamp.dirichlet.push_back({FaceSelector::allBoundary(), {}});
+  auto threshold = [&](const PolyMesh& m) {
+    MomentCache moments(m, 2 * p);
+    moments.update();
+    const DgBasis basis(m, moments, {.degree = p});
+    return penaltyThreshold(m, basis, moments, classifyFaces(m, clamp));
+  };
+  const double reference = threshold(mesh);
+  EXPECT_GT(reference, 0.0);
+  transform(mesh, 1e-6, Vec3(1.0, -2.0, 3.0));
+  EXPECT_NEAR(threshold(mesh), reference, 1e-9 * reference);
+}
+
+INSTANTIATE_TEST_SUITE_P(Degrees, LocalIntegrators, ::testing::Values(1, 2, 3),
+                         [](const auto& info) { return "p" + std::to_string(info.param); });
+
+TEST(FaceQuadrature, IntegratesMonomialsOverANonConvexFaceWithAHole) {
+  Polygon2 h;
+  h.outer = {{0, 0}, {3, 0}, {3, 1}, {1, 1}, {1, 3}, {0, 3}};  // an L
+  h.holes = {{{0.25, 0.25}, {0.25, 0.75}, {0.75, 0.75}, {0.75, 0.25}}};
+  const PolyMesh mesh = prismMesh(h, 0.0, 1.0);
+  // The bottom face (z = 0) of the prism: find it by its normal.
+  for (std::size_t f = 0; f < mesh.numFaces(); ++f) {
+    const FaceId id(f);
+    if (std::abs(unitNormal(mesh, id).z()) < 0.5) continue;
+    const int degree = 6;
+    std::vector<double> exact(numMonomials(degree));
+    Vec3 normal;
+    faceMoments(mesh, id, degree, exact, normal);
+    const Vec3& c = faceReferencePoint(mesh, id);
+    const auto rule = faceQuadrature(mesh, id, degree);
+    for (int a = 0; a < numMonomials(degree); ++a) {
+      const Exponents e = monomialExponents(a);
+      double s = 0.0;
+      for (const QuadraturePoint& q : rule) {
+        const Vec3 d = q.point - c;
+        s += q.weight * std::pow(d.x(), e.a) * std::pow(d.y(), e.b) * std::pow(d.z(), e.c);
+      }
+      EXPECT_NEAR(s, exact[a], 1e-12 * std::max(1.0, std::abs(exact[a]))) << "monomial " << a;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace polydg
