@@ -4,7 +4,7 @@
 
 #include "cli/commands.h"
 #include "cli/options.h"
-#include "polydg/model/files.h"
+#include "model/files.h"
 #include "polydg/model/info.h"
 
 namespace polydg::cli {

@@ -5,10 +5,10 @@
 #include "cli/commands.h"
 #include "cli/options.h"
 #include "cli/progress.h"
+#include "model/files.h"
 #include "polydg/mesh/surface_io.h"
-#include "polydg/model/files.h"
 #include "polydg/model/report_json.h"
-#include "polydg/util/stopwatch.h"
+#include "util/stopwatch.h"
 
 namespace polydg::cli {
 

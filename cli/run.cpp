@@ -12,7 +12,7 @@
 
 #include "cli/commands.h"
 #include "cli/progress.h"
-#include "polydg/model/files.h"
+#include "model/files.h"
 #include "polydg/model/pipeline.h"
 
 namespace polydg::cli {

@@ -10,7 +10,7 @@
 #include "cli/commands.h"
 #include "cli/options.h"
 #include "cli/progress.h"
-#include "polydg/model/files.h"
+#include "model/files.h"
 #include "polydg/model/report_json.h"
 #include "polydg/model/scene.h"
 

@@ -15,10 +15,10 @@
 
 #include "cli/commands.h"
 #include "cli/options.h"
-#include "polydg/mesh/vtp_io.h"
-#include "polydg/model/files.h"
+#include "mesh/vtp_io.h"
+#include "model/files.h"
 #include "polydg/model/report_json.h"
-#include "polydg/util/stopwatch.h"
+#include "util/stopwatch.h"
 
 namespace polydg::cli {
 

@@ -12,14 +12,15 @@
 #include <unordered_map>
 #include <unordered_set>
 
+#include "cut/element_grid.h"
+#include "cut/mesh_editor.h"
 #include "edit.h"
 #include "editor_state.h"
+#include "mesh/plane_split.h"
+#include "physics/checks/operation_checks.h"
 #include "piece_splitter.h"
-#include "polydg/cut/element_grid.h"
-#include "polydg/mesh/plane_split.h"
-#include "polydg/physics/checks/operation_checks.h"
-#include "polydg/util/stopwatch.h"
 #include "polygon_test.h"
+#include "util/stopwatch.h"
 
 namespace polydg {
 

@@ -12,10 +12,11 @@
 
 #include <boost/container/small_vector.hpp>
 
+#include "cut/element_grid.h"
+#include "cut/mesh_editor.h"
+#include "mesh/plane_split.h"
 #include "polydg/cut/cut.h"
-#include "polydg/cut/element_grid.h"
 #include "polydg/integrate/moment_cache.h"
-#include "polydg/mesh/plane_split.h"
 #include "polydg/mesh/poly_mesh.h"
 
 namespace polydg::cut_detail {

@@ -8,10 +8,10 @@
 #include <utility>
 #include <vector>
 
+#include "cut/element_grid.h"
 #include "edit.h"
 #include "piece_splitter.h"
 #include "polydg/cut/cut.h"
-#include "polydg/cut/element_grid.h"
 #include "polydg/integrate/moment_cache.h"
 #include "polydg/mesh/plane.h"
 #include "polydg/mesh/poly_mesh.h"

@@ -1,4 +1,4 @@
-#include "polydg/cut/element_grid.h"
+#include "cut/element_grid.h"
 
 #include <algorithm>
 #include <cmath>

@@ -13,9 +13,9 @@
 #include <vector>
 
 #include "edit.h"
+#include "mesh/plane_split.h"
 #include "polydg/cut/cut.h"
-#include "polydg/mesh/plane_split.h"
-#include "polydg/util/union_find.h"
+#include "util/union_find.h"
 
 namespace polydg::cut_detail {
 

@@ -12,12 +12,13 @@
 #include <unordered_map>
 #include <unordered_set>
 
+#include "cut/mesh_editor.h"
 #include "edit.h"
 #include "editor_state.h"
+#include "physics/checks/operation_checks.h"
 #include "piece_splitter.h"
 #include "polydg/cut/cut.h"
-#include "polydg/physics/checks/operation_checks.h"
-#include "polydg/util/stopwatch.h"
+#include "util/stopwatch.h"
 
 namespace polydg {
 

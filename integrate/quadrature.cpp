@@ -1,4 +1,4 @@
-#include "polydg/integrate/quadrature.h"
+#include "integrate/quadrature.h"
 
 #include <cmath>
 #include <numbers>

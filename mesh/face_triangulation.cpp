@@ -1,4 +1,4 @@
-#include "polydg/mesh/face_triangulation.h"
+#include "mesh/face_triangulation.h"
 
 #include <cmath>
 #include <stdexcept>

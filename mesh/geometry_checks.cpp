@@ -14,7 +14,7 @@
 #include <sstream>
 
 #include "polydg/mesh/geometry.h"
-#include "polydg/util/union_find.h"
+#include "util/union_find.h"
 
 namespace polydg {
 

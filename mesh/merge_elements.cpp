@@ -7,7 +7,7 @@
 #include <stdexcept>
 
 #include "polydg/mesh/geometry.h"
-#include "polydg/util/union_find.h"
+#include "util/union_find.h"
 
 #include <tbb/parallel_for.h>
 

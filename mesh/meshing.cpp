@@ -10,8 +10,8 @@
 #include <sstream>
 #include <string>
 
-#include "polydg/mesh/surface_repair.h"
-#include "polydg/util/stopwatch.h"
+#include "mesh/surface_repair.h"
+#include "util/stopwatch.h"
 
 namespace polydg {
 

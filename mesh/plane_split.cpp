@@ -1,4 +1,4 @@
-#include "polydg/mesh/plane_split.h"
+#include "mesh/plane_split.h"
 
 #include <algorithm>
 #include <cmath>
@@ -9,7 +9,7 @@
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Exact_rational.h>
 
-#include "polydg/util/union_find.h"
+#include "util/union_find.h"
 
 namespace polydg {
 

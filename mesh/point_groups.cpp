@@ -1,6 +1,6 @@
-#include "polydg/mesh/point_groups.h"
+#include "mesh/point_groups.h"
 
-#include "polydg/util/union_find.h"
+#include "util/union_find.h"
 
 namespace polydg {
 

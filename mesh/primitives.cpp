@@ -1,4 +1,4 @@
-#include "polydg/mesh/primitives.h"
+#include "mesh/primitives.h"
 
 #include <algorithm>
 #include <array>

@@ -11,8 +11,8 @@
 #include <stdexcept>
 #include <tuple>
 
-#include "polydg/mesh/plane_split.h"
-#include "polydg/util/stopwatch.h"
+#include "mesh/plane_split.h"
+#include "util/stopwatch.h"
 
 #include <tbb/concurrent_vector.h>
 #include <tbb/enumerable_thread_specific.h>

@@ -1,6 +1,6 @@
 #include "polydg/mesh/surface.h"
 
-#include "polydg/util/union_find.h"
+#include "util/union_find.h"
 
 #include <algorithm>
 #include <numeric>

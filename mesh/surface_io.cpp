@@ -39,8 +39,8 @@
 #include <variant>
 #include <vector>
 
-#include "polydg/mesh/face_triangulation.h"
-#include "polydg/mesh/surface_text_check.h"
+#include "mesh/face_triangulation.h"
+#include "mesh/surface_text_check.h"
 
 namespace polydg {
 

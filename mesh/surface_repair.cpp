@@ -1,4 +1,4 @@
-#include "polydg/mesh/surface_repair.h"
+#include "mesh/surface_repair.h"
 
 #include <stdexcept>
 #include <vector>

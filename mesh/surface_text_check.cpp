@@ -1,6 +1,6 @@
 // Checks of surface file text before CGAL parses it: warnings for lines that are skipped, errors
 // for lines that would be misread or whose loss would change the geometry.
-#include "polydg/mesh/surface_text_check.h"
+#include "mesh/surface_text_check.h"
 
 #include <algorithm>
 #include <cctype>

@@ -1,4 +1,4 @@
-#include "polydg/mesh/vtk_cell_types.h"
+#include "mesh/vtk_cell_types.h"
 
 namespace polydg::vtk_format {
 

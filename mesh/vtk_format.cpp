@@ -1,4 +1,4 @@
-#include "polydg/mesh/vtk_format.h"
+#include "mesh/vtk_format.h"
 
 #include <algorithm>
 #include <array>
@@ -17,7 +17,7 @@
 #include <zlib.h>
 #include <pugixml.hpp>
 
-#include "polydg/mesh/xml_escape.h"
+#include "mesh/xml_escape.h"
 
 namespace polydg::vtk_format {
 

@@ -2,8 +2,8 @@
 #include <stdexcept>
 #include <unordered_set>
 
-#include "polydg/mesh/vtk_format.h"
-#include "polydg/mesh/vtp_io.h"
+#include "mesh/vtk_format.h"
+#include "mesh/vtp_io.h"
 
 namespace polydg {
 

@@ -19,10 +19,10 @@
 
 #include <pugixml.hpp>
 
-#include "polydg/mesh/vtk_cell_types.h"
-#include "polydg/mesh/vtk_format.h"
+#include "mesh/vtk_cell_types.h"
+#include "mesh/vtk_format.h"
+#include "mesh/vtu_restore_arrays.h"
 #include "polydg/mesh/vtu_io.h"
-#include "polydg/mesh/vtu_restore_arrays.h"
 
 namespace polydg {
 

@@ -19,13 +19,13 @@
 #include <tbb/parallel_for.h>
 #include <boost/container/small_vector.hpp>
 
-#include "polydg/mesh/face_triangulation.h"
+#include "mesh/face_triangulation.h"
+#include "mesh/point_groups.h"
+#include "mesh/vtk_cell_types.h"
+#include "mesh/vtk_format.h"
+#include "mesh/vtu_restore_arrays.h"
 #include "polydg/mesh/geometry.h"
-#include "polydg/mesh/point_groups.h"
-#include "polydg/mesh/vtk_cell_types.h"
-#include "polydg/mesh/vtk_format.h"
 #include "polydg/mesh/vtu_io.h"
-#include "polydg/mesh/vtu_restore_arrays.h"
 
 namespace polydg {
 

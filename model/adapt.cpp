@@ -10,11 +10,13 @@
 
 #include "field_transfer.h"
 #include "model_state.h"
+#include "physics/solvers/error_estimator.h"
+#include "physics/solvers/static_solver.h"
 #include "polydg/mesh/geometry.h"
 #include "polydg/mesh/slice.h"
 #include "polydg/model/model.h"
 #include "polydg/util/error.h"
-#include "polydg/util/stopwatch.h"
+#include "util/stopwatch.h"
 
 namespace polydg {
 

@@ -1,4 +1,4 @@
-#include "polydg/model/files.h"
+#include "model/files.h"
 
 #include <cerrno>
 #include <cstring>

@@ -1,4 +1,4 @@
-#include "polydg/model/json_reader.h"
+#include "model/json_reader.h"
 
 #include <cmath>
 #include <fstream>

@@ -11,12 +11,15 @@
 #include <unistd.h>
 
 #include "model_state.h"
+#include "physics/checks/mesh_checks.h"
+#include "physics/solvers/error_estimator.h"
+#include "physics/solvers/static_solver.h"
 #include "polydg/mesh/geometry.h"
 #include "polydg/mesh/surface_io.h"
 #include "polydg/model/names.h"
 #include "polydg/model/provenance.h"
 #include "polydg/util/error.h"
-#include "polydg/util/stopwatch.h"
+#include "util/stopwatch.h"
 
 namespace polydg {
 

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "cut/mesh_editor.h"
 #include "polydg/model/model.h"
 #include "polydg/util/error.h"
 

@@ -10,11 +10,11 @@
 
 #include <unistd.h>
 
+#include "model/files.h"
+#include "model/json_reader.h"
 #include "polydg/mesh/surface_io.h"
-#include "polydg/model/files.h"
-#include "polydg/model/json_reader.h"
 #include "polydg/model/report_json.h"
-#include "polydg/util/stopwatch.h"
+#include "util/stopwatch.h"
 
 namespace polydg {
 

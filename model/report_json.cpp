@@ -2,6 +2,7 @@
 
 #include "polydg/model/scene.h"
 
+#include "physics/checks/mesh_checks.h"
 #include "polydg/model/names.h"
 
 namespace polydg {

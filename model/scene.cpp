@@ -4,7 +4,7 @@
 #include <cmath>
 #include <filesystem>
 
-#include "polydg/model/json_reader.h"
+#include "model/json_reader.h"
 #include "polydg/model/names.h"
 #include "polydg/model/pipeline.h"
 #include "polydg/util/error.h"

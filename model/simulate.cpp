@@ -8,16 +8,17 @@
 #include <unordered_set>
 
 #include "field_transfer.h"
+#include "mesh/vtp_io.h"
+#include "model/files.h"
 #include "model_state.h"
+#include "physics/contact/contact.h"
+#include "physics/dynamics/dynamics.h"
 #include "polydg/mesh/geometry.h"
 #include "polydg/mesh/surface_io.h"
-#include "polydg/mesh/vtp_io.h"
-#include "polydg/model/files.h"
 #include "polydg/model/names.h"
 #include "polydg/model/scene.h"
-#include "polydg/physics/contact/contact.h"
 #include "polydg/physics/dg/post_process.h"
-#include "polydg/util/stopwatch.h"
+#include "util/stopwatch.h"
 
 namespace polydg {
 

@@ -8,8 +8,8 @@
 #include <vector>
 
 #include "cli/bench/problems.h"
+#include "physics/solvers/condition_estimate.h"
 #include "polydg/model/names.h"
-#include "polydg/physics/solvers/condition_estimate.h"
 
 namespace polydg::bench {
 

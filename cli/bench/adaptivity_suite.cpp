@@ -9,11 +9,11 @@
 #include <vector>
 
 #include "cli/bench/suites.h"
-#include "polydg/mesh/primitives.h"
+#include "mesh/primitives.h"
 #include "polydg/mesh/surface_shapes.h"
 #include "polydg/model/model.h"
 #include "polydg/model/names.h"
-#include "polydg/util/stopwatch.h"
+#include "util/stopwatch.h"
 
 namespace polydg::bench {
 

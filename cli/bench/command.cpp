@@ -26,9 +26,9 @@
 #include "cli/bench/data_files.h"
 #include "cli/bench/suites.h"
 #include "cli/commands.h"
-#include "polydg/model/files.h"
+#include "model/files.h"
 #include "polydg/util/error.h"
-#include "polydg/util/stopwatch.h"
+#include "util/stopwatch.h"
 
 namespace polydg::cli {
 

@@ -16,13 +16,13 @@
 #include <system_error>
 #include <vector>
 
+#include "physics/contact/obstacles.h"
 #include "polydg/mesh/geometry.h"
 #include "polydg/mesh/surface_shapes.h"
 #include "polydg/model/scene.h"
 #include "polydg/physics/contact/embedding.h"
-#include "polydg/physics/contact/obstacles.h"
 #include "polydg/util/error.h"
-#include "polydg/util/stopwatch.h"
+#include "util/stopwatch.h"
 
 namespace polydg::bench {
 

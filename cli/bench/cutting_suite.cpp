@@ -6,9 +6,10 @@
 #include <string>
 #include <vector>
 
+#include "cut/mesh_editor.h"
+#include "mesh/primitives.h"
 #include "polydg/cut/cut.h"
-#include "polydg/mesh/primitives.h"
-#include "polydg/util/stopwatch.h"
+#include "util/stopwatch.h"
 
 namespace polydg::bench {
 

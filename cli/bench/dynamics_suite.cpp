@@ -10,12 +10,12 @@
 #include <string>
 #include <vector>
 
-#include "polydg/mesh/primitives.h"
+#include "mesh/primitives.h"
+#include "physics/dynamics/dynamics.h"
 #include "polydg/model/names.h"
 #include "polydg/model/scene.h"
 #include "polydg/physics/dg/post_process.h"
-#include "polydg/physics/dynamics/dynamics.h"
-#include "polydg/util/stopwatch.h"
+#include "util/stopwatch.h"
 
 namespace polydg::bench {
 

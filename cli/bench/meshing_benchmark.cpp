@@ -2,10 +2,10 @@
 
 #include <stdexcept>
 
+#include "physics/checks/dg_checks.h"
 #include "polydg/integrate/moment_cache.h"
 #include "polydg/mesh/surface_shapes.h"
-#include "polydg/physics/checks/dg_checks.h"
-#include "polydg/util/stopwatch.h"
+#include "util/stopwatch.h"
 
 namespace polydg::bench {
 

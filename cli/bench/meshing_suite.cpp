@@ -13,8 +13,8 @@
 #include <vector>
 
 #include "cli/bench/meshing_benchmark.h"
+#include "model/files.h"
 #include "polydg/mesh/surface_io.h"
-#include "polydg/model/files.h"
 
 namespace polydg::bench {
 

@@ -9,7 +9,7 @@
 #include <utility>
 #include <vector>
 
-#include "polydg/mesh/primitives.h"
+#include "mesh/primitives.h"
 #include "polydg/mesh/surface.h"
 #include "polydg/mesh/surface_io.h"
 #include "polydg/model/model.h"

@@ -7,7 +7,7 @@
 #include <limits>
 #include <sstream>
 
-#include "polydg/mesh/xml_escape.h"
+#include "mesh/xml_escape.h"
 
 namespace polydg::bench {
 

@@ -4,11 +4,11 @@
 #include <cmath>
 #include <numbers>
 
+#include "mesh/primitives.h"
+#include "physics/dg/face_quadrature.h"
 #include "polydg/mesh/merge_elements.h"
-#include "polydg/mesh/primitives.h"
 #include "polydg/mesh/slice.h"
 #include "polydg/mesh/surface_shapes.h"
-#include "polydg/physics/dg/face_quadrature.h"
 
 namespace polydg::bench {
 

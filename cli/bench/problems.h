@@ -3,8 +3,8 @@
 // meshes, materials and loads, and one run of each, for `polydg bench` and the tests.
 #pragma once
 
+#include "physics/solvers/static_solver.h"
 #include "polydg/physics/dg/post_process.h"
-#include "polydg/physics/solvers/static_solver.h"
 
 namespace polydg::bench {
 

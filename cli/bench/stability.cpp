@@ -4,8 +4,8 @@
 #include <stdexcept>
 #include <vector>
 
+#include "mesh/primitives.h"
 #include "polydg/mesh/merge_elements.h"
-#include "polydg/mesh/primitives.h"
 
 namespace polydg::bench {
 

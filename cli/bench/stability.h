@@ -5,7 +5,7 @@
 #pragma once
 
 #include "cli/bench/problems.h"
-#include "polydg/physics/solvers/condition_estimate.h"
+#include "physics/solvers/condition_estimate.h"
 
 namespace polydg::bench {
 

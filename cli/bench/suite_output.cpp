@@ -5,7 +5,7 @@
 #include <iostream>
 
 #include "cli/bench/csv.h"
-#include "polydg/model/files.h"
+#include "model/files.h"
 #include "polydg/model/names.h"
 
 namespace polydg::bench {

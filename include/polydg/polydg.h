@@ -1,6 +1,7 @@
 // polydg: surface meshes in, polyhedral discontinuous Galerkin simulation meshes out, cut,
-// checked and solved. One header for library users: the model and its operations, and the
-// layers below it (mesh, exact integration, DG physics, cutting).
+// checked, solved and simulated. One header for library users: the model, its operations,
+// their requests and reports, and the mesh and surface types they take and return. The
+// headers below are the whole installed API; solver internals are not installed.
 //
 //   #include <polydg/polydg.h>
 //   polydg::MeshReport report;
@@ -13,34 +14,18 @@
 
 #include "polydg/version.h"
 
+#include "polydg/util/error.h"
+#include "polydg/util/process.h"
+
 #include "polydg/mesh/geometry.h"
-#include "polydg/mesh/geometry_checks.h"
-#include "polydg/mesh/meshing.h"
-#include "polydg/mesh/plane.h"
-#include "polydg/mesh/poly_mesh.h"
-#include "polydg/mesh/surface.h"
 #include "polydg/mesh/surface_io.h"
 #include "polydg/mesh/surface_shapes.h"
 #include "polydg/mesh/vtu_io.h"
 
-#include "polydg/integrate/moment_cache.h"
-#include "polydg/integrate/moments.h"
-
-#include "polydg/physics/checks/dg_checks.h"
-#include "polydg/physics/checks/mesh_checks.h"
-#include "polydg/physics/dg/loads.h"
-#include "polydg/physics/dg/material.h"
-#include "polydg/physics/dg/post_process.h"
-#include "polydg/physics/solvers/static_solver.h"
-
-#include "polydg/cut/cut.h"
-
-#include "polydg/model/files.h"
 #include "polydg/model/info.h"
 #include "polydg/model/model.h"
 #include "polydg/model/names.h"
 #include "polydg/model/pipeline.h"
 #include "polydg/model/provenance.h"
 #include "polydg/model/report_json.h"
-
-#include "polydg/util/error.h"
+#include "polydg/model/scene.h"

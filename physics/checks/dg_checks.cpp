@@ -1,4 +1,4 @@
-#include "polydg/physics/checks/dg_checks.h"
+#include "physics/checks/dg_checks.h"
 
 #include <algorithm>
 #include <array>
@@ -15,11 +15,11 @@
 #include <Eigen/CholmodSupport>
 #include <Eigen/Dense>
 
+#include "physics/dg/polynomial_tables.h"
 #include "polydg/integrate/moments.h"
 #include "polydg/mesh/geometry_checks.h"
-#include "polydg/physics/dg/polynomial_tables.h"
 #include "polydg/physics/dg/post_process.h"
-#include "polydg/util/stopwatch.h"
+#include "util/stopwatch.h"
 
 namespace polydg {
 

@@ -1,4 +1,4 @@
-#include "polydg/physics/checks/mesh_checks.h"
+#include "physics/checks/mesh_checks.h"
 
 #include <memory>
 #include <sstream>
@@ -8,7 +8,7 @@
 
 #include "polydg/integrate/monomials.h"
 #include "polydg/mesh/geometry.h"
-#include "polydg/util/stopwatch.h"
+#include "util/stopwatch.h"
 
 namespace polydg {
 

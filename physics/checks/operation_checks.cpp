@@ -1,12 +1,12 @@
-#include "polydg/physics/checks/operation_checks.h"
+#include "physics/checks/operation_checks.h"
 
 #include <algorithm>
 #include <sstream>
 #include <string>
 
+#include "physics/checks/mesh_checks.h"
+#include "physics/checks/region_checks.h"
 #include "polydg/mesh/geometry_checks.h"
-#include "polydg/physics/checks/mesh_checks.h"
-#include "polydg/physics/checks/region_checks.h"
 
 namespace polydg {
 

@@ -1,4 +1,4 @@
-#include "polydg/physics/checks/region_checks.h"
+#include "physics/checks/region_checks.h"
 
 #include <algorithm>
 #include <cmath>
@@ -8,15 +8,15 @@
 
 #include <Eigen/Dense>
 
+#include "physics/checks/dg_checks.h"
+#include "physics/dg/assembly.h"
+#include "physics/dg/face_quadrature.h"
 #include "polydg/integrate/moments.h"
 #include "polydg/integrate/monomials.h"
 #include "polydg/mesh/geometry.h"
-#include "polydg/physics/checks/dg_checks.h"
-#include "polydg/physics/dg/assembly.h"
-#include "polydg/physics/dg/face_quadrature.h"
 #include "polydg/physics/dg/post_process.h"
-#include "polydg/util/stopwatch.h"
-#include "polydg/util/union_find.h"
+#include "util/stopwatch.h"
+#include "util/union_find.h"
 
 namespace polydg {
 

@@ -1,12 +1,12 @@
 // Penalty contact on embedded points (physics/contact/contact.h).
-#include "polydg/physics/contact/contact.h"
+#include "physics/contact/contact.h"
 
 #include <cmath>
 #include <stdexcept>
 #include <string>
 #include <unordered_map>
 
-#include "polydg/util/stopwatch.h"
+#include "util/stopwatch.h"
 
 namespace polydg {
 

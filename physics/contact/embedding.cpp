@@ -16,10 +16,10 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 
-#include "polydg/mesh/face_triangulation.h"
+#include "mesh/face_triangulation.h"
 #include "polydg/mesh/geometry.h"
-#include "polydg/util/stopwatch.h"
-#include "polydg/util/union_find.h"
+#include "util/stopwatch.h"
+#include "util/union_find.h"
 
 namespace polydg {
 

@@ -1,4 +1,4 @@
-#include "polydg/physics/contact/obstacles.h"
+#include "physics/contact/obstacles.h"
 
 #include <algorithm>
 #include <array>
@@ -21,7 +21,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include "polydg/util/stopwatch.h"
+#include "util/stopwatch.h"
 
 namespace polydg {
 

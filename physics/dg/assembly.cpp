@@ -1,4 +1,4 @@
-#include "polydg/physics/dg/assembly.h"
+#include "physics/dg/assembly.h"
 
 #include <algorithm>
 #include <cmath>
@@ -14,9 +14,9 @@
 #include <sys/mman.h>
 #endif
 
-#include "polydg/integrate/quadrature.h"
-#include "polydg/physics/dg/block_rows.h"
-#include "polydg/physics/dg/face_quadrature.h"
+#include "integrate/quadrature.h"
+#include "physics/dg/block_rows.h"
+#include "physics/dg/face_quadrature.h"
 
 namespace polydg {
 

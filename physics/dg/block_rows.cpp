@@ -1,4 +1,4 @@
-#include "polydg/physics/dg/block_rows.h"
+#include "physics/dg/block_rows.h"
 
 #include <algorithm>
 

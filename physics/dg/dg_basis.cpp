@@ -6,7 +6,7 @@
 #include <tbb/parallel_for.h>
 #include <Eigen/Cholesky>
 
-#include "polydg/physics/dg/polynomial_tables.h"
+#include "physics/dg/polynomial_tables.h"
 
 namespace polydg {
 

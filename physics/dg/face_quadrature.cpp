@@ -1,4 +1,4 @@
-#include "polydg/physics/dg/face_quadrature.h"
+#include "physics/dg/face_quadrature.h"
 
 namespace polydg {
 

@@ -1,8 +1,8 @@
-#include "polydg/physics/dg/local_integrators.h"
+#include "physics/dg/local_integrators.h"
 
 #include <cmath>
 
-#include "polydg/physics/dg/polynomial_tables.h"
+#include "physics/dg/polynomial_tables.h"
 
 namespace polydg {
 

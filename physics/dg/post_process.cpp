@@ -9,9 +9,9 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 
-#include "polydg/integrate/quadrature.h"
+#include "integrate/quadrature.h"
+#include "physics/dg/local_integrators.h"
 #include "polydg/mesh/geometry.h"
-#include "polydg/physics/dg/local_integrators.h"
 
 namespace polydg {
 

@@ -1,4 +1,4 @@
-#include "polydg/physics/dynamics/dynamics.h"
+#include "physics/dynamics/dynamics.h"
 
 #include <algorithm>
 #include <cmath>
@@ -11,13 +11,13 @@
 #include <Eigen/Cholesky>
 #include <Eigen/SVD>
 
-#include "polydg/integrate/quadrature.h"
-#include "polydg/physics/dg/assembly.h"
-#include "polydg/physics/dg/local_integrators.h"
-#include "polydg/physics/dg/polynomial_tables.h"
+#include "integrate/quadrature.h"
+#include "physics/dg/assembly.h"
+#include "physics/dg/local_integrators.h"
+#include "physics/dg/polynomial_tables.h"
+#include "physics/solvers/agglomeration.h"
 #include "polydg/physics/dg/post_process.h"
-#include "polydg/physics/solvers/agglomeration.h"
-#include "polydg/util/stopwatch.h"
+#include "util/stopwatch.h"
 
 namespace polydg {
 

@@ -1,4 +1,4 @@
-#include "polydg/physics/solvers/agglomeration.h"
+#include "physics/solvers/agglomeration.h"
 
 #include <algorithm>
 #include <cmath>
@@ -9,11 +9,11 @@
 #include <tbb/parallel_for.h>
 #include <Eigen/Dense>
 
+#include "physics/dg/block_rows.h"
 #include "polydg/integrate/monomials.h"
 #include "polydg/mesh/geometry.h"
-#include "polydg/physics/dg/block_rows.h"
 #include "polydg/physics/dg/dg_basis.h"
-#include "polydg/util/union_find.h"
+#include "util/union_find.h"
 
 namespace polydg {
 

@@ -1,4 +1,4 @@
-#include "polydg/physics/solvers/condition_estimate.h"
+#include "physics/solvers/condition_estimate.h"
 
 #include <algorithm>
 #include <limits>
@@ -7,7 +7,7 @@
 #include <Spectra/MatOp/SparseSymMatProd.h>
 #include <Spectra/SymEigsSolver.h>
 
-#include "polydg/physics/solvers/linear_solver.h"
+#include "physics/solvers/linear_solver.h"
 
 namespace polydg {
 

@@ -1,4 +1,4 @@
-#include "polydg/physics/solvers/error_estimator.h"
+#include "physics/solvers/error_estimator.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,9 +7,9 @@
 
 #include <tbb/parallel_for.h>
 
-#include "polydg/integrate/quadrature.h"
-#include "polydg/physics/dg/face_quadrature.h"
-#include "polydg/physics/dg/polynomial_tables.h"
+#include "integrate/quadrature.h"
+#include "physics/dg/face_quadrature.h"
+#include "physics/dg/polynomial_tables.h"
 
 namespace polydg {
 

@@ -1,4 +1,4 @@
-#include "polydg/physics/solvers/linear_solver.h"
+#include "physics/solvers/linear_solver.h"
 
 #include <cmath>
 
@@ -7,10 +7,10 @@
 #include <Eigen/CholmodSupport>
 #include <Eigen/Dense>
 
+#include "physics/dg/block_rows.h"
+#include "physics/solvers/p_multigrid.h"
 #include "polydg/integrate/monomials.h"
-#include "polydg/physics/dg/block_rows.h"
-#include "polydg/physics/solvers/p_multigrid.h"
-#include "polydg/util/stopwatch.h"
+#include "util/stopwatch.h"
 
 namespace polydg {
 

@@ -1,4 +1,4 @@
-#include "polydg/physics/solvers/p_multigrid.h"
+#include "physics/solvers/p_multigrid.h"
 
 #include <algorithm>
 #include <atomic>
@@ -14,10 +14,10 @@
 #include <Eigen/CholmodSupport>
 #include <Eigen/Dense>
 
+#include "physics/dg/block_rows.h"
+#include "physics/solvers/agglomeration.h"
+#include "physics/solvers/strong_coupling.h"
 #include "polydg/integrate/monomials.h"
-#include "polydg/physics/dg/block_rows.h"
-#include "polydg/physics/solvers/agglomeration.h"
-#include "polydg/physics/solvers/strong_coupling.h"
 
 namespace polydg {
 

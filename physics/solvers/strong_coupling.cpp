@@ -1,4 +1,4 @@
-#include "polydg/physics/solvers/strong_coupling.h"
+#include "physics/solvers/strong_coupling.h"
 
 #include <algorithm>
 #include <cmath>
@@ -9,8 +9,8 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
 
-#include "polydg/physics/dg/block_rows.h"
-#include "polydg/util/union_find.h"
+#include "physics/dg/block_rows.h"
+#include "util/union_find.h"
 
 namespace polydg {
 

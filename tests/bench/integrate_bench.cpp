@@ -11,8 +11,8 @@
 
 #include <tbb/global_control.h>
 
+#include "mesh/primitives.h"
 #include "polydg/integrate/moment_cache.h"
-#include "polydg/mesh/primitives.h"
 #include "tests/support/shapes.h"
 
 namespace polydg {

@@ -143,7 +143,7 @@ TEST_F(Cli, MeshWritesAValidMeshAndReport) {
 /// kLocalPatchTestTolerance).
 constexpr double kPatchTolerance = 1e-9;
 
-TEST_F(Cli, CheckReportsTheDgValidation) {
+TEST_F(Cli, CheckReportsTheDgChecks) {
   ASSERT_EQ(
       run("mesh " + data("torus.obj") + " --cells 8 -o " + path("t.vtu") + " --quiet").exitCode, 0);
   const Result r = run("check " + path("t.vtu") + " --report " + path("c.json"));

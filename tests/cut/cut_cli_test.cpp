@@ -103,7 +103,7 @@ TEST_F(CutCli, BadArgumentsExitTwoWithOneLineAndNoOutput) {
   EXPECT_EQ(fs::file_size(input()), size);
 }
 
-TEST_F(CutCli, FailedValidationExitsOneAndWritesNoMesh) {
+TEST_F(CutCli, FailedCheckExitsOneAndWritesNoMesh) {
   // Without sliver merging, the 1e-12 sheet between these planes is split into pieces far too
   // thin for the DG patch test: the second operation fails and is named.
   const Result r = run("cut " + input() + " -o " + path("out.vtu") +

@@ -8,9 +8,10 @@
 
 #include <gtest/gtest.h>
 
+#include "cut/mesh_editor.h"
+#include "mesh/primitives.h"
+#include "physics/checks/dg_checks.h"
 #include "polydg/mesh/geometry_checks.h"
-#include "polydg/mesh/primitives.h"
-#include "polydg/physics/checks/dg_checks.h"
 
 namespace polydg {
 namespace {
@@ -361,7 +362,7 @@ TEST(Blade, RejectsBadInput) {
                std::invalid_argument);  // not convex
 }
 
-TEST(Cut, FullValidationChecksTheWholeMesh) {
+TEST(Cut, FullChecksCoverTheWholeMesh) {
   MeshEditor editor(unitGrid(3));
   CutOptions options;
   options.checks = CheckLevel::Full;
@@ -377,7 +378,7 @@ TEST(Cut, FullValidationChecksTheWholeMesh) {
   expectConsistent(editor, 1.0);
 }
 
-TEST(Cut, LocalValidationCoversTheTouchedRegion) {
+TEST(Cut, LocalChecksCoverTheTouchedRegion) {
   MeshEditor editor(unitGrid(4));
   const auto r = editor.cut(Blade::plane(Vec3(0, 1, 0), 0.6), noMerging());
   ASSERT_TRUE(r.check.passed) << r.check.failure;

@@ -11,12 +11,13 @@
 
 #include <gtest/gtest.h>
 
+#include "cut/mesh_editor.h"
 #include "polydg/cut/cut.h"
 #include "polydg/mesh/geometry.h"
 #include "polydg/mesh/meshing.h"
 #include "polydg/mesh/surface_shapes.h"
-#include "polydg/util/stopwatch.h"
 #include "tests/support/shapes.h"
+#include "util/stopwatch.h"
 
 namespace polydg {
 namespace {

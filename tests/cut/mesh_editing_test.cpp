@@ -3,9 +3,9 @@
 // changed is integrated again.
 #include <gtest/gtest.h>
 
+#include "mesh/primitives.h"
 #include "polydg/integrate/moment_cache.h"
 #include "polydg/mesh/geometry_checks.h"
-#include "polydg/mesh/primitives.h"
 
 namespace polydg {
 namespace {

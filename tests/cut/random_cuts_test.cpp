@@ -11,11 +11,12 @@
 
 #include <gtest/gtest.h>
 
+#include "cut/mesh_editor.h"
 #include "polydg/cut/cut.h"
 #include "polydg/mesh/geometry_checks.h"
 #include "polydg/mesh/meshing.h"
 #include "polydg/mesh/surface_shapes.h"
-#include "polydg/util/union_find.h"
+#include "util/union_find.h"
 
 namespace polydg {
 namespace {

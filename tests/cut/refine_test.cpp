@@ -6,10 +6,11 @@
 
 #include <gtest/gtest.h>
 
+#include "cut/mesh_editor.h"
+#include "mesh/primitives.h"
 #include "polydg/cut/cut.h"
 #include "polydg/mesh/geometry.h"
 #include "polydg/mesh/geometry_checks.h"
-#include "polydg/mesh/primitives.h"
 
 namespace polydg {
 namespace {

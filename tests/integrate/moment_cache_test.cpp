@@ -4,7 +4,7 @@
 
 #include <gtest/gtest.h>
 
-#include "polydg/mesh/primitives.h"
+#include "mesh/primitives.h"
 
 namespace polydg {
 namespace {

@@ -9,8 +9,8 @@
 #include <map>
 #include <random>
 
-#include "polydg/integrate/quadrature.h"
-#include "polydg/mesh/primitives.h"
+#include "integrate/quadrature.h"
+#include "mesh/primitives.h"
 #include "polydg/mesh/surface.h"
 #include "tests/support/shapes.h"
 

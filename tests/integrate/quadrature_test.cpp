@@ -1,12 +1,12 @@
 // Quadrature rules: exactness of Gauss-Legendre and of the tetrahedron rule, and the signed
 // cone decomposition of a non-convex element.
-#include "polydg/integrate/quadrature.h"
+#include "integrate/quadrature.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "polydg/mesh/primitives.h"
+#include "mesh/primitives.h"
 
 namespace polydg {
 namespace {

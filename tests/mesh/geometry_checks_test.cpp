@@ -4,8 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include "mesh/primitives.h"
 #include "polydg/mesh/geometry.h"
-#include "polydg/mesh/primitives.h"
 #include "polydg/mesh/surface.h"
 
 namespace polydg {
@@ -35,7 +35,7 @@ PolyMesh rebuild(const PolyMesh& mesh, F&& describe) {
   return out;
 }
 
-TEST(Validate, AcceptsHexGrid) {
+TEST(GeometryChecks, AcceptsHexGrid) {
   const PolyMesh mesh = hexGridMesh(3, 2, 2, Box3(Vec3(0, 0, 0), Vec3(3, 2, 2)));
   const GeometryCheck r = checkGeometry(mesh);
   EXPECT_TRUE(r.passed) << (r.messages.empty() ? "" : r.messages[0]);
@@ -46,7 +46,7 @@ TEST(Validate, AcceptsHexGrid) {
   EXPECT_EQ(r.boundaryFaces, 2u * (3 * 2 + 3 * 2 + 2 * 2));
 }
 
-TEST(Validate, AcceptsNonConvexElementsAndFacesWithHoles) {
+TEST(GeometryChecks, AcceptsNonConvexElementsAndFacesWithHoles) {
   Polygon2 p;
   p.outer = {{0, 0}, {3, 0}, {3, 3}, {0, 3}};
   p.holes = {{{1, 1}, {1, 2}, {2, 2}, {2, 1}}};
@@ -57,7 +57,7 @@ TEST(Validate, AcceptsNonConvexElementsAndFacesWithHoles) {
   EXPECT_TRUE(checkGeometry(prismMesh(l, 0.0, 1.0)).passed);
 }
 
-TEST(Validate, CountsComponents) {
+TEST(GeometryChecks, CountsComponents) {
   PolyMesh mesh = hexGridMesh(2, 1, 1, Box3(Vec3(0, 0, 0), Vec3(2, 1, 1)));
   const PolyMesh other = boxMesh(Box3(Vec3(5, 0, 0), Vec3(6, 1, 1)));
   const std::size_t first = mesh.numVertices();
@@ -74,7 +74,7 @@ TEST(Validate, CountsComponents) {
   EXPECT_EQ(r.components, 2u);
 }
 
-TEST(Validate, RejectsLeakyElement) {
+TEST(GeometryChecks, RejectsLeakyElement) {
   const PolyMesh grid = hexGridMesh(2, 1, 1, Box3(Vec3(0, 0, 0), Vec3(2, 1, 1)));
   const FaceId dropped = grid.element(ElementId(1)).faces[3].face;
   const PolyMesh leaky = rebuild(
@@ -84,7 +84,7 @@ TEST(Validate, RejectsLeakyElement) {
   EXPECT_EQ(r.openElements, 1u);
 }
 
-TEST(Validate, RejectsInvertedElement) {
+TEST(GeometryChecks, RejectsInvertedElement) {
   const PolyMesh grid = hexGridMesh(1, 1, 2, Box3(Vec3(0, 0, 0), Vec3(1, 1, 2)));
   // Element 0 with every face reversed: closed, but oriented inward.
   const PolyMesh inverted = rebuild(grid, [](std::size_t e, FaceId, std::vector<Loop>& loops) {
@@ -101,7 +101,7 @@ TEST(Validate, RejectsInvertedElement) {
   EXPECT_EQ(r.components, 2u);
 }
 
-TEST(Validate, RejectsNonPlanarFace) {
+TEST(GeometryChecks, RejectsNonPlanarFace) {
   PolyMesh mesh = boxMesh(Box3(Vec3(0, 0, 0), Vec3(1, 1, 1)));
   mesh.positions()[VertexId(7)] += Vec3(0.01, 0.01, 0.01);
   const GeometryCheck r = checkGeometry(mesh);
@@ -111,7 +111,7 @@ TEST(Validate, RejectsNonPlanarFace) {
   EXPECT_NE(r.messages[0].find("not planar"), std::string::npos);
 }
 
-TEST(Validate, RejectsDegenerateFaceAndEmptyMesh) {
+TEST(GeometryChecks, RejectsDegenerateFaceAndEmptyMesh) {
   PolyMesh mesh;
   for (int i = 0; i < 3; ++i) mesh.addVertex(Vec3(i, 0, 0));  // collinear
   const FaceId f = mesh.addFace({Loop{VertexId(0), VertexId(1), VertexId(2)}}, FaceOrigin::Surface);
@@ -122,7 +122,7 @@ TEST(Validate, RejectsDegenerateFaceAndEmptyMesh) {
   EXPECT_FALSE(checkGeometry(PolyMesh()).passed);
 }
 
-TEST(Validate, AcceptsTranslatedAndScaledMeshes) {
+TEST(GeometryChecks, AcceptsTranslatedAndScaledMeshes) {
   for (double scale : {1e-6, 1.0, 1e6}) {
     PolyMesh mesh = hexGridMesh(2, 2, 2, Box3(Vec3(0, 0, 0), Vec3(1, 1, 1)));
     // Offsets of 1e6 element sizes: coordinates keep ~1e-10 relative resolution.

@@ -9,9 +9,9 @@
 #include <cmath>
 #include <vector>
 
+#include "mesh/primitives.h"
 #include "polydg/mesh/geometry.h"
 #include "polydg/mesh/geometry_checks.h"
-#include "polydg/mesh/primitives.h"
 #include "polydg/mesh/slice.h"
 #include "polydg/mesh/surface_shapes.h"
 #include "tests/support/identical_meshes.h"

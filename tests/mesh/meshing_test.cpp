@@ -14,9 +14,9 @@
 #include <limits>
 #include <string>
 
+#include "mesh/surface_repair.h"
 #include "polydg/integrate/moment_cache.h"
 #include "polydg/mesh/surface_io.h"
-#include "polydg/mesh/surface_repair.h"
 #include "polydg/mesh/surface_shapes.h"
 #include "tests/support/identical_meshes.h"
 #include "tests/support/shapes.h"
@@ -127,7 +127,7 @@ TEST(Meshing, OrientationByTheVolumeSignAgreesWithCgalsOrientation) {
   }
 }
 
-TEST(Meshing, ValidationCanBeLeftToTheCaller) {
+TEST(Meshing, GeometryChecksCanBeLeftToTheCaller) {
   const TriangleSurface sphere = icosphere(Vec3::Zero(), 1.0, 2);
   MeshingOptions later = cells(6);
   later.checkGeometry = false;

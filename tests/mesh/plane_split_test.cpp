@@ -1,14 +1,14 @@
 // Splitting closed pieces by planes in the degenerate cases that are normal cases here: planes
 // through vertices, along edges, containing faces, touching a single vertex; non-convex faces,
 // faces with holes, and pieces falling apart into several components.
-#include "polydg/mesh/plane_split.h"
+#include "mesh/plane_split.h"
 
 #include <gtest/gtest.h>
 
 #include <array>
 #include <map>
 
-#include "polydg/mesh/primitives.h"
+#include "mesh/primitives.h"
 #include "polydg/mesh/surface_shapes.h"
 
 namespace polydg {

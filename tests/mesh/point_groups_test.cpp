@@ -1,6 +1,6 @@
 // Tests of mesh/point_groups.h: one point per vertex and group of elements joined through
 // interior faces at that vertex.
-#include "polydg/mesh/point_groups.h"
+#include "mesh/point_groups.h"
 
 #include <algorithm>
 #include <array>
@@ -10,7 +10,7 @@
 
 #include <gtest/gtest.h>
 
-#include "polydg/mesh/primitives.h"
+#include "mesh/primitives.h"
 
 namespace polydg {
 namespace {

@@ -3,7 +3,7 @@
 
 #include <gtest/gtest.h>
 
-#include "polydg/mesh/primitives.h"
+#include "mesh/primitives.h"
 #include "polydg/mesh/surface.h"
 
 namespace polydg {

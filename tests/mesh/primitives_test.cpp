@@ -1,7 +1,7 @@
 // Tests of boxCellsMesh (mesh/primitives.h): boxes of different sizes meeting face to face make
 // a valid mesh whose elements are the boxes (exact volumes, shared faces tiled by the overlaps,
 // hanging vertices inserted), and a side that is only partly covered is refused.
-#include "polydg/mesh/primitives.h"
+#include "mesh/primitives.h"
 
 #include <gtest/gtest.h>
 

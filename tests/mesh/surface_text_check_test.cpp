@@ -3,7 +3,7 @@
 // and line (the file still reads, with the geometry of its well-formed lines) or a one-line error
 // "FILE:LINE: what is wrong; what to do"; blank lines, comments, CR LF line ends and attributes
 // are neither. Every file is a tetrahedron with legs 2, 3 and 4 (volume 4) with one line changed.
-#include "polydg/mesh/surface_text_check.h"
+#include "mesh/surface_text_check.h"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
 // Tests of mesh/vtk_format.h (base64 and DataArray reading and writing) and
 // mesh/vtk_cell_types.h (the faces of VTK's linear cells).
-#include "polydg/mesh/vtk_format.h"
+#include "mesh/vtk_format.h"
 
 #include <bit>
 #include <cstdint>
@@ -14,7 +14,7 @@
 #include <gtest/gtest.h>
 #include <pugixml.hpp>
 
-#include "polydg/mesh/vtk_cell_types.h"
+#include "mesh/vtk_cell_types.h"
 
 namespace polydg::vtk_format {
 namespace {

@@ -26,9 +26,9 @@
 
 #include <gtest/gtest.h>
 
-#include "polydg/mesh/face_triangulation.h"
+#include "mesh/face_triangulation.h"
+#include "mesh/primitives.h"
 #include "polydg/mesh/geometry.h"
-#include "polydg/mesh/primitives.h"
 
 namespace polydg {
 namespace {

@@ -7,7 +7,7 @@
 #include <fstream>
 #include <map>
 
-#include "polydg/mesh/primitives.h"
+#include "mesh/primitives.h"
 #include "polydg/mesh/surface_shapes.h"
 #include "polydg/model/model.h"
 #include "polydg/model/report_json.h"

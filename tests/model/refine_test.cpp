@@ -8,10 +8,10 @@
 
 #include <gtest/gtest.h>
 
-#include "polydg/integrate/quadrature.h"
+#include "integrate/quadrature.h"
+#include "mesh/primitives.h"
 #include "polydg/mesh/geometry.h"
 #include "polydg/mesh/geometry_checks.h"
-#include "polydg/mesh/primitives.h"
 #include "polydg/mesh/surface_io.h"
 #include "polydg/mesh/surface_shapes.h"
 #include "polydg/model/model.h"

@@ -8,12 +8,12 @@
 #include <numbers>
 #include <regex>
 
+#include "physics/dynamics/dynamics.h"
 #include "polydg/mesh/geometry_checks.h"
 #include "polydg/mesh/surface_io.h"
 #include "polydg/mesh/surface_shapes.h"
 #include "polydg/model/report_json.h"
 #include "polydg/model/scene.h"
-#include "polydg/physics/dynamics/dynamics.h"
 #include "polydg/util/error.h"
 
 namespace polydg {

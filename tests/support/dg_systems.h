@@ -3,8 +3,8 @@
 #pragma once
 
 #include "cli/bench/problems.h"
-#include "polydg/physics/solvers/agglomeration.h"
-#include "polydg/physics/solvers/static_solver.h"
+#include "physics/solvers/agglomeration.h"
+#include "physics/solvers/static_solver.h"
 
 namespace polydg {
 

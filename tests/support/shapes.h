@@ -9,7 +9,7 @@
 #include <random>
 #include <vector>
 
-#include "polydg/mesh/primitives.h"
+#include "mesh/primitives.h"
 #include "polydg/mesh/slice.h"
 #include "polydg/mesh/surface.h"
 #include "polydg/mesh/surface_shapes.h"

@@ -15,12 +15,12 @@
 #include "polydg/mesh/meshing.h"
 #include "polydg/mesh/surface.h"
 #include "polydg/mesh/vtu_io.h"
-#include "polydg/physics/checks/mesh_checks.h"
+#include "polydg/physics/checks/check_reports.h"
 #include "polydg/physics/contact/embedding.h"
 #include "polydg/physics/dg/loads.h"
 #include "polydg/physics/dg/post_process.h"
-#include "polydg/physics/solvers/error_estimator.h"
-#include "polydg/physics/solvers/static_solver.h"
+#include "polydg/physics/solvers/error_estimate.h"
+#include "polydg/physics/solvers/static_report.h"
 
 namespace polydg {
 

@@ -11,7 +11,8 @@
 #include "polydg/cut/cut.h"
 #include "polydg/mesh/meshing.h"
 #include "polydg/model/model.h"
-#include "polydg/physics/solvers/static_solver.h"
+#include "polydg/physics/dg/discretization.h"
+#include "polydg/physics/solvers/solver_options.h"
 
 namespace polydg {
 

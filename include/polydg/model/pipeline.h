@@ -14,7 +14,6 @@
 
 #include <nlohmann/json.hpp>
 
-#include "polydg/model/json_reader.h"
 #include "polydg/model/model.h"
 
 namespace polydg {
@@ -88,13 +87,6 @@ struct InputOutcome {
 /// into the outcome; throws (InputError) only if the folder cannot be written.
 InputOutcome runPipelineInput(const Pipeline& pipeline, const std::string& input,
                               const std::string& stem, const std::filesystem::path& out);
-
-/// Readers shared by pipeline steps and simulation scenes. A cut from the keys of `r`: "plane"
-/// [a, b, c, d] or "polygon" [[x, y, z], ...], and optional "remove_side", "validate",
-/// "sliver_fraction".
-CutRequest readCutRequest(JsonObjectReader& r);
-/// The object under "material" of `r` ("E", "nu", "density"), over `defaults`.
-Material readMaterial(JsonObjectReader& r, Material defaults);
 
 /// Output folder names: the inputs' stems, made unique with _2, _3, ... in input order.
 std::vector<std::string> uniqueStems(const std::vector<std::string>& inputs);

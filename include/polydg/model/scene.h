@@ -12,7 +12,8 @@
 
 #include "polydg/model/model.h"
 #include "polydg/model/names.h"
-#include "polydg/physics/dynamics/dynamics.h"
+#include "polydg/physics/contact/contact_measure.h"
+#include "polydg/physics/dynamics/motion.h"
 
 namespace polydg {
 

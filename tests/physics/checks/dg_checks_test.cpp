@@ -4,7 +4,7 @@
 // non-convex prisms (an L and a square with a hole), a grid with a sliver element, and meshes
 // translated by 1e6 or scaled by 1e-6 and 1e6. Degrees 1 to 3. The element-local checks pass on
 // the same corpus and a sliced sphere, and fail on meshes with a corrupted face or element.
-#include "polydg/physics/checks/dg_checks.h"
+#include "physics/checks/dg_checks.h"
 
 #include <gtest/gtest.h>
 
@@ -13,8 +13,8 @@
 #include <string>
 #include <vector>
 
+#include "mesh/primitives.h"
 #include "polydg/mesh/geometry_checks.h"
-#include "polydg/mesh/primitives.h"
 #include "polydg/mesh/slice.h"
 #include "polydg/mesh/surface_shapes.h"
 #include "tests/support/shapes.h"

@@ -6,7 +6,7 @@
 // RegionCoupling::HoldingFaces: slivers hanging by thin faces and elements touching through
 // strips a round-off wide (a Swiss cheese whose walls lie just off the grid planes) are bodies
 // of their own, every ring of the cheese passes as the whole mesh does, and defects still fail.
-#include "polydg/physics/checks/region_checks.h"
+#include "physics/checks/region_checks.h"
 
 #include <gtest/gtest.h>
 
@@ -16,10 +16,10 @@
 #include <string>
 #include <vector>
 
+#include "mesh/primitives.h"
 #include "polydg/mesh/geometry.h"
 #include "polydg/mesh/geometry_checks.h"
 #include "polydg/mesh/meshing.h"
-#include "polydg/mesh/primitives.h"
 #include "polydg/mesh/slice.h"
 #include "polydg/mesh/surface_shapes.h"
 #include "tests/support/shapes.h"

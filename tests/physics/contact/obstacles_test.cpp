@@ -4,7 +4,7 @@
 // a degree, near the origin and 3.7e4 from it, inside, outside and beyond the band; the bowl of the
 // B9 drop (mesh/surface_shapes.h) is a closed shell of the right volume whose hollow is free space;
 // bad input is refused by name.
-#include "polydg/physics/contact/obstacles.h"
+#include "physics/contact/obstacles.h"
 
 #include <gtest/gtest.h>
 

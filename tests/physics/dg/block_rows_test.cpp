@@ -1,7 +1,7 @@
 // BlockRows (physics/dg/block_rows.h): the element block rows of a DG matrix give the same
 // product as the CSR matrix, store BZ's neighbour blocks component-diagonal and IP's whole,
 // and refuse a pattern too sparse for blocks.
-#include "polydg/physics/dg/block_rows.h"
+#include "physics/dg/block_rows.h"
 
 #include <gtest/gtest.h>
 
@@ -9,10 +9,10 @@
 #include <random>
 
 #include "cli/bench/problems.h"
-#include "polydg/physics/dg/assembly.h"
-#include "polydg/physics/solvers/agglomeration.h"
-#include "polydg/physics/solvers/linear_solver.h"
-#include "polydg/physics/solvers/static_solver.h"
+#include "physics/dg/assembly.h"
+#include "physics/solvers/agglomeration.h"
+#include "physics/solvers/linear_solver.h"
+#include "physics/solvers/static_solver.h"
 #include "tests/support/dg_systems.h"
 
 namespace polydg {

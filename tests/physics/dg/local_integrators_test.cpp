@@ -2,15 +2,15 @@
 // motions in its kernel and the energy of a known strain, face matrices that fit together
 // symmetrically, exact face quadrature on non-convex faces with holes, and the penalty
 // threshold's independence of scale and material.
-#include "polydg/physics/dg/local_integrators.h"
+#include "physics/dg/local_integrators.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "polydg/mesh/primitives.h"
-#include "polydg/physics/dg/assembly.h"
-#include "polydg/physics/dg/face_quadrature.h"
+#include "mesh/primitives.h"
+#include "physics/dg/assembly.h"
+#include "physics/dg/face_quadrature.h"
 
 namespace polydg {
 namespace {

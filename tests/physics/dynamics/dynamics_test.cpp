@@ -10,10 +10,10 @@
 #include <Eigen/Geometry>
 
 #include "cli/bench/problems.h"
-#include "polydg/mesh/primitives.h"
+#include "mesh/primitives.h"
+#include "physics/dynamics/dynamics.h"
+#include "physics/solvers/linear_solver.h"
 #include "polydg/physics/dg/post_process.h"
-#include "polydg/physics/dynamics/dynamics.h"
-#include "polydg/physics/solvers/linear_solver.h"
 
 namespace polydg {
 namespace {

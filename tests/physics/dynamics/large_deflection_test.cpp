@@ -25,9 +25,9 @@
 #include <gtest/gtest.h>
 
 #include "cli/bench/problems.h"
-#include "polydg/mesh/primitives.h"
+#include "mesh/primitives.h"
+#include "physics/dynamics/dynamics.h"
 #include "polydg/physics/dg/post_process.h"
-#include "polydg/physics/dynamics/dynamics.h"
 
 namespace polydg {
 namespace {

@@ -6,7 +6,7 @@
 // non-convex sliced elements too; the Galerkin matrix equals P^T K P formed explicitly and is
 // exactly symmetric, for linear and quadratic groups, IP's coupled and BZ's component-diagonal
 // blocks.
-#include "polydg/physics/solvers/agglomeration.h"
+#include "physics/solvers/agglomeration.h"
 
 #include <gtest/gtest.h>
 
@@ -24,14 +24,15 @@
 #include <vector>
 
 #include "cli/bench/problems.h"
+#include "cut/mesh_editor.h"
+#include "mesh/primitives.h"
+#include "physics/dg/block_rows.h"
 #include "polydg/cut/cut.h"
 #include "polydg/integrate/monomials.h"
 #include "polydg/mesh/geometry.h"
-#include "polydg/mesh/primitives.h"
-#include "polydg/physics/dg/block_rows.h"
 #include "polydg/physics/dg/dg_basis.h"
-#include "polydg/util/union_find.h"
 #include "tests/support/dg_systems.h"
+#include "util/union_find.h"
 
 namespace polydg {
 namespace {

@@ -1,7 +1,7 @@
 // Tests of physics/solvers/condition_estimate.h on the IP stiffness of a row of three boxes whose
 // middle one is a sliver (1% of its neighbours' volume): the Lanczos estimates against dense
 // eigenvalues, a free body reported not positive definite, and the Jacobi-scaled matrix.
-#include "polydg/physics/solvers/condition_estimate.h"
+#include "physics/solvers/condition_estimate.h"
 
 #include <gtest/gtest.h>
 
@@ -10,8 +10,8 @@
 
 #include <Eigen/Eigenvalues>
 
-#include "polydg/mesh/primitives.h"
-#include "polydg/physics/solvers/static_solver.h"
+#include "mesh/primitives.h"
+#include "physics/solvers/static_solver.h"
 
 namespace polydg {
 namespace {

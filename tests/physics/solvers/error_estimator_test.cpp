@@ -13,9 +13,9 @@
 #include <gtest/gtest.h>
 
 #include "cli/bench/problems.h"
+#include "mesh/primitives.h"
+#include "physics/solvers/error_estimator.h"
 #include "polydg/integrate/moment_cache.h"
-#include "polydg/mesh/primitives.h"
-#include "polydg/physics/solvers/error_estimator.h"
 
 namespace polydg {
 namespace {

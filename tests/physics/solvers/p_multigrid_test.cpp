@@ -3,7 +3,7 @@
 // meshes for IP and BZ, with piecewise constants or agglomerates as coarse levels, the
 // agglomerates need fewer iterations where the body bends (B2), and it reports a body held by
 // no Dirichlet condition.
-#include "polydg/physics/solvers/p_multigrid.h"
+#include "physics/solvers/p_multigrid.h"
 
 #include <gtest/gtest.h>
 
@@ -11,11 +11,11 @@
 #include <random>
 
 #include "cli/bench/problems.h"
+#include "mesh/primitives.h"
+#include "physics/solvers/linear_solver.h"
+#include "physics/solvers/static_solver.h"
 #include "polydg/mesh/meshing.h"
-#include "polydg/mesh/primitives.h"
 #include "polydg/mesh/surface_io.h"
-#include "polydg/physics/solvers/linear_solver.h"
-#include "polydg/physics/solvers/static_solver.h"
 #include "tests/support/dg_systems.h"
 #include "tests/support/shapes.h"
 

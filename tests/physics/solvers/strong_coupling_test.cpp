@@ -1,15 +1,15 @@
 // Strong couplings (physics/solvers/strong_coupling.h): the strength of a known pair, its symmetry
 // and its invariance under scaling, the cap on a group's size, and no group on a hex grid, where
 // the p-multigrid's smoother must stay per element.
-#include "polydg/physics/solvers/strong_coupling.h"
+#include "physics/solvers/strong_coupling.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <vector>
 
+#include "physics/dg/block_rows.h"
 #include "polydg/integrate/monomials.h"
-#include "polydg/physics/dg/block_rows.h"
 #include "tests/support/dg_systems.h"
 
 namespace polydg {

@@ -7,7 +7,7 @@
 #include <span>
 #include <vector>
 
-#include "polydg/physics/checks/dg_checks.h"
+#include "physics/checks/dg_checks.h"
 
 namespace polydg {
 

@@ -9,8 +9,8 @@
 
 #include <Eigen/SparseCore>
 
+#include "physics/dg/local_integrators.h"
 #include "polydg/physics/dg/loads.h"
-#include "polydg/physics/dg/local_integrators.h"
 #include "polydg/physics/dg/material.h"
 
 namespace polydg {

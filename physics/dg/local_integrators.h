@@ -12,33 +12,9 @@
 #include <Eigen/Core>
 
 #include "polydg/physics/dg/dg_basis.h"
+#include "polydg/physics/dg/discretization.h"
 
 namespace polydg {
-
-/// The DG method (paper section 4).
-enum class Method {
-  IP,  ///< symmetric interior penalty, eq. (8): consistent, converges at the optimal rate
-  BZ,  ///< Babuska-Zlamal penalty, eq. (6): only the jump penalty; inconsistent
-};
-
-/// How the jump penalty of the BZ method scales with the mesh (Method::BZ only).
-enum class BzPenalty {
-  /// eta_F = facePenalty() as for IP, ~ 1/h. Cheap and as well conditioned as IP, but BZ is
-  /// inconsistent: the error stops decreasing under refinement (B1: L2 ~ 3e-3 for p = 1).
-  Fixed,
-  /// Babuska and Zlamal's superpenalty, eta_F (L/h)^(2p) ~ h^-(2p+1): the consistency error,
-  /// ~ |sigma n|_F / sqrt(eta_F), then falls as h^p, and the L2 error with it, at the price
-  /// of a stiffer jump term (condition numbers ~ h^-(2p+2) instead of h^-2). The factor is
-  /// FormCoefficients::bzFactor, from superpenaltyFactor() (physics/solvers/static_solver.h).
-  /// For p >= 2 it multiplies the penalty of the whole jump. For p = 1 it multiplies only the
-  /// penalty of the jump's mean over each face (the rest of the jump keeps eta_F): on the whole
-  /// jump it would force the solution towards continuous complete linears, which on a hex grid
-  /// are only the global linears, and the error locked (B1, n = 4 -> 8: L2 2.2e-3 -> 2.0e-3).
-  /// With continuous face means instead, the limit is a nonconforming P1 method (face-mean
-  /// continuity, as Crouzeix-Raviart's), which passes the patch test: for a constant stress
-  /// the missing flux term sigma n . int_F [v] vanishes. FormCoefficients::bzFactorOnMean.
-  Super,
-};
 
 /// How an element sees one of its faces.
 enum class FaceKind {

@@ -1,15 +1,8 @@
-// A posteriori error estimation for static IP-DG elasticity solves: the residual estimator
-// (element residual, traction jumps and displacement jumps) per element, the true error in the
-// same norm for problems with a known solution, and the marking of elements for refinement.
+// What the a posteriori error estimate of a static IP-DG solution reports, and the true
+// error in the same norm (physics/solvers/error_estimator.h computes both).
 #pragma once
 
-#include <cstddef>
-#include <vector>
-
-#include <Eigen/Core>
-
-#include "polydg/physics/dg/post_process.h"
-#include "polydg/physics/solvers/static_solver.h"
+#include "polydg/mesh/poly_mesh.h"
 
 namespace polydg {
 
@@ -53,22 +46,6 @@ struct ErrorEstimate {
   double dirichlet = 0.0;         ///< Dirichlet faces
 };
 
-/// The estimate for the solution `coefficients` (layout of LinearSystem) of the static problem
-/// assembled with `roles`, `form` and `loads` (as by StaticSolver::assemble(): the same face
-/// roles, penalty and loads; `material` gives the density of the gravity load). IP only: throws
-/// std::invalid_argument for another method. Runs in parallel over faces and elements.
-ErrorEstimate estimateError(const PolyMesh& mesh, const DgBasis& basis, const MomentCache& moments,
-                            const FaceRoles& roles, const FormCoefficients& form,
-                            const Material& material, const LoadCase& loads,
-                            const Eigen::VectorXd& coefficients,
-                            const EstimatorOptions& options = {});
-
-/// The same for a solver after assemble(loads) and solve() (`coefficients` its solution).
-ErrorEstimate estimateError(const PolyMesh& mesh, const StaticSolver& solver,
-                            const Material& material, const LoadCase& loads,
-                            const Eigen::VectorXd& coefficients,
-                            const EstimatorOptions& options = {});
-
 /// The error of a solution against a known exact solution u in the DG energy norm
 ///   |e|_DG^2 = sum_K int_K sigma(e) : eps(e) + sum_F mu eta_F |[e]|^2_F,
 /// e = u - u_h, over interior faces ([e] = -[u_h]) and Dirichlet faces (u - u_h), the norm that
@@ -78,24 +55,5 @@ struct EnergyError {
   double jump = 0.0;    ///< sqrt(sum_F mu eta_F |[e]|^2_F)
   double total() const;
 };
-
-/// |u - u_h| by element quadrature (integrate/quadrature.h, as errorNorms()) and face quadrature
-/// exact to `quadratureDegree` (use >= p + 4 for smooth u, more for steep ones on coarse meshes).
-EnergyError energyError(const PolyMesh& mesh, const DgBasis& basis, const MomentCache& moments,
-                        const FaceRoles& roles, const FormCoefficients& form,
-                        const Eigen::VectorXd& coefficients, const VectorField& exact,
-                        const GradientField& exactGradient, int quadratureDegree);
-
-/// Doerfler's bulk marking: the fewest elements whose indicators sum to at least
-/// theta * sum_K indicators[K] (0 < theta <= 1), largest first (ties by element id). Empty when
-/// every indicator is 0. Throws std::invalid_argument for theta outside (0, 1].
-std::vector<ElementId> markBulk(const ElementData<double>& indicators, double theta);
-
-/// The first elements of `marked` (largest first, as markBulk() orders them) that fit in a DOF
-/// budget: a mesh of `dofs` DOFs in which refining one element adds `dofsPerRefinement` (8
-/// children of 3 numMonomials(p) DOFs replacing one: 7 * 3 numMonomials(p)) stays within
-/// `dofBudget` DOFs. Empty when the mesh is at or over the budget.
-std::vector<ElementId> limitToDofBudget(std::vector<ElementId> marked, std::size_t dofs,
-                                        std::size_t dofsPerRefinement, std::size_t dofBudget);
 
 }  // namespace polydg

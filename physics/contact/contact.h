@@ -26,8 +26,9 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 
+#include "physics/contact/obstacles.h"
+#include "polydg/physics/contact/contact_measure.h"
 #include "polydg/physics/contact/embedding.h"
-#include "polydg/physics/contact/obstacles.h"
 
 namespace polydg {
 
@@ -46,13 +47,6 @@ struct ContactLinearization {
   Eigen::VectorXd force;     ///< f(U_n) + C_t v_obstacle: contact forces at the step's start
   std::size_t contacts = 0;  ///< active points
   bool empty() const { return contacts == 0; }
-};
-
-/// Contacts at a state, measured (not linearized).
-struct ContactMeasure {
-  std::size_t contacts = 0;  ///< points inside an obstacle
-  double deepest = 0.0;      ///< largest penetration -phi (0 if none)
-  double energy = 0.0;       ///< sum k a phi^2 / 2 over penetrating points
 };
 
 /// The embedded points, their areas and the obstacles; linearizes the contact forces for a

@@ -8,7 +8,8 @@
 #include <span>
 #include <vector>
 
-#include "polydg/physics/solvers/static_solver.h"
+#include "physics/solvers/static_solver.h"
+#include "polydg/physics/checks/check_reports.h"
 
 namespace polydg {
 
@@ -19,21 +20,6 @@ namespace polydg {
 /// 1e-6 (degree 3), so the threshold sits about four orders from both.
 inline constexpr double kZeroModeThreshold = 1e-11;
 
-/// The discretization checked (material and penalty as in a solve).
-struct PhysicsCheckOptions {
-  Method method = Method::IP;
-  BasisOptions basis{.degree = 1, .kind = BasisKind::Orthonormal};
-  PenaltyOptions penalty;
-  Material material;
-};
-
-struct PatchTestResult {
-  double relativeError = 0.0;    ///< |u_h - u|_L2 / |u|_L2 over the mesh
-  double maxElementError = 0.0;  ///< max over elements of |u_h - u|_L2(K) / |u|_L2(K)
-  double eta = 0.0;
-  double residual = 0.0;  ///< of the linear solve
-};
-
 /// The patch test: u(x) = L b + A (x - x0) (a fixed general matrix A with |A| ~ 1, x0 and L
 /// the centre and diagonal of the mesh's bounding box) imposed weakly on every boundary face,
 /// no body force. A consistent method (IP) reproduces u up to round-off: ~1e-14 on good
@@ -43,16 +29,6 @@ struct PatchTestResult {
 /// `moments`, if given, is the mesh's cache of degree >= 2p (else the mesh is integrated here).
 PatchTestResult patchTest(const PolyMesh& mesh, const PhysicsCheckOptions& options,
                           const MomentCache* moments = nullptr);
-
-struct ZeroModeReport {
-  std::size_t components = 0;                      ///< connected through shared faces
-  std::vector<std::size_t> zeroModesPerComponent;  ///< eigenvalues below kZeroModeThreshold
-  std::size_t zeroModes = 0;                       ///< their sum
-  double largestZeroEigenvalue = 0.0;              ///< largest of those (Jacobi-scaled)
-  double smallestNonzeroEigenvalue = 0.0;  ///< smallest eigenvalue above the threshold found
-  /// max over the 6 rigid motions r of each component of |S r| / |r|, S the scaled matrix.
-  double rigidMotionResidual = 0.0;
-};
 
 /// Zero modes of a symmetric positive semi-definite `matrix` (DOFs in element blocks of
 /// `blockSize`, as LinearSystem), per connected component of `mesh` (components are decoupled
@@ -132,52 +108,6 @@ inline constexpr double kElementZeroModeThreshold = 1e-13;
 /// by Sylvester's law of inertia (pivoted LDL^T). 6 on a valid element; an inverted element has
 /// more. `degree` is the basis degree p (K_K has 3 numMonomials(p) rows).
 std::size_t elementZeroModes(const Eigen::MatrixXd& stiffness, int degree);
-
-/// An element passes the local patch test when its error (LocalDgCheck::maxPatchTestError) is
-/// below this, the global patch test's tolerance. Valid meshes give 1e-17 .. 1e-14 (a sliced
-/// sphere, meshes scaled by 1e+-6 or translated by 1e6), up to 2.3e-10 on the corpus' sliver of
-/// relative thickness 1e-6 at degree 3 (its local system is ill-conditioned). A vertex moved off
-/// its faces' planes by 1e-3 of the element size gives ~1e-5 (so a mesh whose faces are planar
-/// only to single precision, which the geometric check accepts, fails it: such a mesh reproduces
-/// linear fields only to about its planarity), a reversed face ~1e-2. An inverted element
-/// passes (it is consistent with the opposite orientation) but fails the other two checks.
-inline constexpr double kLocalPatchTestTolerance = 1e-9;
-
-/// The discretization of the local checks: the IP method (BZ is inconsistent and fails any
-/// patch test), with the basis and material as in a solve.
-struct LocalDgCheckOptions {
-  BasisOptions basis{.degree = 1, .kind = BasisKind::Orthonormal};
-  Material material;
-  /// If not empty (one entry per element), only elements with a non-zero entry are checked;
-  /// the others still give their neighbours the exact linear trace.
-  std::vector<char> only;
-};
-
-/// Result of localDgChecks(). Element ids refer to the mesh checked.
-struct LocalDgCheck {
-  int degree = 0;
-  std::size_t elements = 0;  ///< elements checked (all, or those selected by `only`)
-  /// Max over elements of the local patch-test error (see localDgChecks()); +inf when a local
-  /// solve produced a non-finite value.
-  double maxPatchTestError = 0.0;
-  ElementId worstPatchTestElement;              ///< where the maximum is (invalid if none)
-  std::size_t patchTestFailures = 0;            ///< elements above kLocalPatchTestTolerance
-  std::size_t elementsWithWrongRigidModes = 0;  ///< stiffness without exactly 6 zero modes
-  ElementId firstWrongRigidModeElement;         ///< lowest such id (invalid if none)
-  /// Elements whose local IP matrix was not positive definite (a pivot of its LDL^T was not
-  /// positive; the error is then computed with a full-pivoting LU solve). The local penalty
-  /// makes it SPD on every valid element.
-  std::size_t nonDefiniteElements = 0;
-  double seconds = 0.0;  ///< wall time, face roles and bases included (moments excluded)
-  /// Faces whose moments the checks integrated (localDgChecksOfSelection(); 0 when the caller
-  /// gave the moments).
-  std::size_t facesIntegrated = 0;
-
-  bool passed() const {
-    return maxPatchTestError < kLocalPatchTestTolerance && elementsWithWrongRigidModes == 0 &&
-           nonDefiniteElements == 0;
-  }
-};
 
 /// Element-local DG checks of every element K, in parallel, with small dense matrices only
 /// (no global assembly or solve). Degree 1 costs about 7.5 us of CPU per element, 60% of it in

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "polydg/mesh/poly_mesh.h"
+#include "polydg/model/model.h"
 #include "polydg/model/names.h"
 #include "polydg/physics/dg/loads.h"
 #include "polydg/util/error.h"
@@ -74,5 +75,12 @@ class JsonObjectReader {
 /// The JSON document in `file` (a `what` file: "pipeline", "scene"). Throws InputError
 /// ("FILE: cannot open the WHAT file", "FILE: not valid JSON (...)").
 nlohmann::json readJsonDocument(const std::string& file, const std::string& what);
+
+/// Readers shared by pipeline steps and simulation scenes. A cut from the keys of `r`: "plane"
+/// [a, b, c, d] or "polygon" [[x, y, z], ...], and optional "remove_side", "validate",
+/// "sliver_fraction".
+CutRequest readCutRequest(JsonObjectReader& r);
+/// The object under "material" of `r` ("E", "nu", "density"), over `defaults`.
+Material readMaterial(JsonObjectReader& r, Material defaults);
 
 }  // namespace polydg

@@ -8,71 +8,13 @@
 
 #include <Eigen/SparseCore>
 
+#include "polydg/physics/solvers/solver_options.h"
+
 namespace polydg {
 
 struct ElementFrames;
 template <class T>
 struct BlockRows;
-
-enum class SolverKind {
-  Auto,               ///< Cholesky up to SolverOptions::directLimitDofs DOFs, else CG
-  Cholesky,           ///< CHOLMOD supernodal LL^T
-  ConjugateGradient,  ///< preconditioned CG (SolverOptions::preconditioner)
-};
-
-/// Preconditioner of SolverKind::ConjugateGradient.
-enum class CgPreconditioner {
-  /// One symmetric V-cycle over the degrees p, ..., min(p, 2) and agglomerates of elements
-  /// (or over p, ..., 0 without element frames; PMultigrid). Needs the hierarchical DG basis
-  /// layout;
-  /// other block sizes use BlockJacobi.
-  PMultigrid,
-  BlockJacobi,  ///< inverses of the per-element diagonal blocks
-};
-
-/// Fill-reducing ordering of the Cholesky factorization.
-enum class CholeskyOrdering {
-  Cholmod,  ///< CHOLMOD's default strategy (AMD, METIS if AMD's fill is poor)
-  Amd,      ///< approximate minimum degree
-  Metis,    ///< METIS nested dissection
-};
-
-struct SolverOptions {
-  SolverKind kind = SolverKind::Auto;
-  /// METIS: 1.5-2x faster factorizations than CHOLMOD's default on the 3D DG matrices of B1/B2.
-  CholeskyOrdering ordering = CholeskyOrdering::Metis;
-  /// Auto picks Cholesky up to this many unknowns and this many matrix nonzeros, else CG with
-  /// the p-multigrid preconditioner. Measured on B2 (quiet machine): p-multigrid CG beats
-  /// CHOLMOD already at 12,000 DOFs (the factor of a 3D DG matrix grows much faster than the
-  /// matrix: 2.9 GFlop for p = 1, 45 GFlop for p = 2 at 1000 elements); below a few
-  /// thousand DOFs the factorization is as fast and exact.
-  std::size_t directLimitDofs = 3000;
-  std::size_t directLimitNonzeros = 40000000;
-  CgPreconditioner preconditioner = CgPreconditioner::PMultigrid;
-  /// CG stops when its recursively updated residual r (r -= alpha K p) has |r| <= tolerance |F|.
-  /// LinearSolveReport::residual is the true |F - K U| / |F|, which round-off can hold above
-  /// the tolerance on stiff systems: the bunny of `bench --suite multigrid` at p = 2 stops at
-  /// 2.6e-8, and restarting CG from the true residual five times (164 iterations instead of 65)
-  /// left it at 1.7e-8: a round-off floor of this system, not drift that CG could remove. Measured
-  /// on B2 against CHOLMOD's solution (p-multigrid CG, p = 1 and 2): at 1e-10 the algebraic error
-  /// is 1e-12 (l2) and 3e-12 (energy norm) relative, at 1e-8 2e-11 / 2e-10; discretization errors
-  /// of these problems are 1e-2 .. 1e-6 relative (B1), so the algebraic error stays 6+ orders below
-  /// them. Each decade costs 2-4 p-multigrid iterations (B2, p = 1, with the piecewise constants as
-  /// coarse level: 27 iterations at 1e-8, 31 at 1e-10).
-  double tolerance = 1e-10;
-  int maxIterations = 20000;
-};
-
-/// What a solve did. Times are wall seconds.
-struct LinearSolveReport {
-  SolverKind used = SolverKind::Auto;
-  CgPreconditioner preconditioner = CgPreconditioner::PMultigrid;  ///< CG only
-  bool success = false;        ///< factorization succeeded (SPD) / CG converged
-  double factorSeconds = 0.0;  ///< symbolic + numeric factorization, or preconditioner setup
-  double solveSeconds = 0.0;   ///< triangular solves, or CG iterations
-  int iterations = 0;          ///< CG iterations (0 for Cholesky)
-  double residual = 0.0;       ///< |F - K U| / |F| (0 if F = 0)
-};
 
 /// The solver chosen by `options` for a matrix of this size.
 SolverKind chooseSolver(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix,

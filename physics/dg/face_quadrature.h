@@ -5,7 +5,7 @@
 
 #include <vector>
 
-#include "polydg/integrate/quadrature.h"
+#include "integrate/quadrature.h"
 
 namespace polydg {
 
