@@ -20,10 +20,10 @@ constexpr double kHuge = 1e300;
 
 }  // namespace
 
-const Names<TimeIntegrator>& integratorNames() {
-  static const Names<TimeIntegrator> names{{"euler", TimeIntegrator::BackwardEuler},
-                                           {"bdf2", TimeIntegrator::Bdf2},
-                                           {"newmark", TimeIntegrator::Newmark}};
+const Names<Integrator>& integratorNames() {
+  static const Names<Integrator> names{{"euler", Integrator::BackwardEuler},
+                                       {"bdf2", Integrator::Bdf2},
+                                       {"newmark", Integrator::Newmark}};
   return names;
 }
 

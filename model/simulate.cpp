@@ -41,7 +41,6 @@ DynamicsOptions dynamicsOptions(const Scene& scene) {
   o.solver.kind = scene.solver;
   o.corotational = scene.corotational;
   o.integrator = scene.integrator;
-  o.dt = scene.dt;
   o.massDamping = scene.massDamping;
   o.stiffnessDamping = scene.stiffnessDamping;
   return o;
@@ -511,7 +510,7 @@ SimulationReport Model::simulate(const Scene& scene, const SimulateOptions& opti
     const Stopwatch ts;
     SimulationStep step;
     try {
-      step.step = solver.step();
+      step.step = solver.step(scene.dt);
     } catch (const std::runtime_error& e) {
       throw CheckFailure("step " + std::to_string(k) + " (t = " + std::to_string(solver.time()) +
                          "): " + e.what() + "; try a smaller dt");

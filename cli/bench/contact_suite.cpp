@@ -172,7 +172,7 @@ Scene dropScene(double duration, const SceneObstacle& obstacle) {
   Scene scene;
   scene.material = kMaterial;
   scene.degree = 1;
-  scene.integrator = TimeIntegrator::BackwardEuler;
+  scene.integrator = Integrator::BackwardEuler;
   scene.dt = kDt;
   scene.steps = static_cast<int>(std::lround(duration / kDt));
   scene.gravity = kGravity;

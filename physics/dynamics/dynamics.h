@@ -1,29 +1,12 @@
-// Time integration of DG elasticity (Kaufmann et al. 2008, sections 5 and 7; Kaufmann 2013,
-// sections 4.2.2 and 4.4): M U'' + D U' + f(U) = F(t) with the consistent mass matrix from the
-// exact moments, Rayleigh damping D = alpha M + beta K, and the elastic force f either linear,
-// f = K U, or corotated (stiffness warping generalized to DG, section 7).
-//
-// Corotation. Every element K gets the rotation R_K of the polar decomposition of its mean
-// deformation gradient I + (1/|K|) int_K grad u (for the non-nodal bases the linear part of the
-// displacement). The stiffness is split by the element whose strain each term holds
-// (splitLocalMatrices(): K_K and K_f1, K_f2 split by side, the penalty K_f3 apart); a block B of
-// rows A, columns C with strain of element S acts as R_S B (R_S^T X_C - X0_C), the penalty as
-// B (X_C - X0_C), where X = X0 + U are the coefficients of the deformed positions and X0 those of
-// the undeformed ones (x - o, o the body's reference point: the identity map, exact in every
-// element's linear functions). A rigid motion of the whole body thus gives no elastic force.
-//
-// Time stepping, one linear solve per step (the paper's semi-implicit scheme: rotations and the
-// warped stiffness K_w of the step's start, f(U_{n+1}) ~ f(U_n) + K_w (U_{n+1} - U_n)):
-//   backward Euler, eq. (4.12) of the thesis:
-//     (M + dt D + dt^2 K_w) V_{n+1} = M V_n + dt (F_{n+1} - f(U_n)),  U_{n+1} = U_n + dt V_{n+1};
-//   BDF2, c = 2 dt / 3:
-//     (M + c D + c^2 K_w) V_{n+1} = M (4 V_n - V_{n-1}) / 3
-//                                   + c (F_{n+1} - f(U_n) - K_w (U_n - U_{n-1}) / 3),
-//     U_{n+1} = (4 U_n - U_{n-1}) / 3 + c V_{n+1};
-//   Newmark, beta = 1/4, gamma = 1/2 (the trapezoidal rule: second order, no numerical damping,
-//   energy conserving for the linear model):
-//     (M + dt/2 D + dt^2/4 K_w) A_{n+1} = F_{n+1} - f(U_n) - D (V_n + dt/2 A_n)
-//                                        - K_w (dt V_n + dt^2/4 A_n).
+// A moving elastic body: M U'' + D U' + f(U) = F(t) for DG elasticity (Kaufmann et al. 2008,
+// sections 5 and 7; Kaufmann 2013, sections 4.2.2 and 4.4), with the consistent mass matrix
+// from the exact moments (mass_matrix.h), Rayleigh damping D = alpha M + beta K, and the elastic
+// force either linear, f = K U, or corotated (stiffness warping generalized to DG:
+// corotation.h). DynamicSolver holds the mechanics and the state; a TimeIntegrator
+// (time_integrators.h: backward Euler, BDF2, Newmark) advances it. Each step is the paper's
+// semi-implicit step: rotations and the warped stiffness K_w of the step's start,
+// f(U_{n+1}) ~ f(U_n) + K_w (U_{n+1} - U_n), one linear solve (further ones correct the force
+// for the second-order integrators), with the contact terms of physics/contact/ if any.
 #pragma once
 
 #include <limits>
@@ -33,7 +16,8 @@
 #include <Eigen/Core>
 
 #include "physics/contact/contact.h"
-#include "physics/solvers/static_solver.h"
+#include "physics/dg/assembly.h"
+#include "polydg/physics/dg/discretization.h"
 #include "polydg/physics/dg/loads.h"
 #include "polydg/physics/dynamics/motion.h"
 
@@ -61,8 +45,7 @@ struct DynamicsOptions {
   /// p-multigrid once a solve needs more than 80 iterations; false: solver.preconditioner.
   bool adaptivePreconditioner = true;
   bool corotational = true;
-  TimeIntegrator integrator = TimeIntegrator::BackwardEuler;
-  double dt = 0.01;
+  Integrator integrator = Integrator::BackwardEuler;
   double massDamping = 0.0;       ///< Rayleigh alpha: D = alpha M + beta K
   double stiffnessDamping = 0.0;  ///< Rayleigh beta
   /// CG with corotation: the step's matrix changes with the rotations; the preconditioner of
@@ -118,9 +101,10 @@ class DynamicSolver {
   /// outlive its use and have this solver's DOF layout (make it again after a cut).
   void setContact(ContactModel* contact);
 
-  /// Advances one step of options().dt. Throws std::runtime_error if the step's system is not
-  /// positive definite or CG does not converge.
-  StepReport step();
+  /// Advances one step of length dt (positive: the caller's to check, where it reads it) with
+  /// the options' integrator. Throws std::runtime_error if the step's system is not positive
+  /// definite or CG does not converge.
+  StepReport step(double dt);
 
   /// Energies, momenta and centre of mass of the current state.
   BodyState state() const;
@@ -143,9 +127,5 @@ class DynamicSolver {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
-
-/// The rotation of the polar decomposition F = R S (det R = +1; for det F <= 0 the closest
-/// rotation, flipping the direction of the smallest singular value).
-Eigen::Matrix3d polarRotation(const Eigen::Matrix3d& f);
 
 }  // namespace polydg

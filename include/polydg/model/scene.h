@@ -80,7 +80,7 @@ struct Scene {
   BzPenalty bzPenalty = BzPenalty::Fixed;  ///< Method::BZ: its penalty's scaling; Super needs BZ
   int degree = 1;
   bool corotational = true;
-  TimeIntegrator integrator = TimeIntegrator::BackwardEuler;
+  Integrator integrator = Integrator::BackwardEuler;
   double dt = 0.0;
   int steps = 0;  ///< "steps", or "duration" / dt rounded to the nearest whole step
   Vec3 gravity = Vec3::Zero();
@@ -200,7 +200,7 @@ Scene parseScene(const nlohmann::json& document, const std::string& file);
 /// The same from a file.
 Scene readScene(const std::string& file);
 
-const Names<TimeIntegrator>& integratorNames();   ///< euler, bdf2, newmark
+const Names<Integrator>& integratorNames();       ///< euler, bdf2, newmark
 const Names<ContactPoints>& contactPointNames();  ///< surface, nodes
 
 }  // namespace polydg

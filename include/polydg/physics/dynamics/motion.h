@@ -10,7 +10,8 @@
 
 namespace polydg {
 
-enum class TimeIntegrator {
+/// The time integrator of a moving body (physics/dynamics/time_integrators.h has the classes).
+enum class Integrator {
   BackwardEuler,  ///< first order, dissipative: the paper's semi-implicit Euler
   /// Second-order backward differences (the first step is backward Euler): damps only the
   /// highest frequencies, so stays stable with the once-linearized corotated forces.

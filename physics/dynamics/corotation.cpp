@@ -1,0 +1,330 @@
+#include "physics/dynamics/corotation.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+#include <Eigen/SVD>
+
+#include "physics/dg/polynomial_tables.h"
+
+namespace polydg {
+
+namespace {
+
+/// out += s (R (x) I_N) B (R (x) I_N)^T for a 3N x 3N column-major block B, into the
+/// column-major out: N x N blocks, B'_dc = sum_ab R(d, a) B_ab R(c, b).
+template <int N>
+void addWarped(const Eigen::Matrix3d& r, const double* b, double s, double* out) {
+  constexpr int BS = 3 * N;
+  const Eigen::Map<const Eigen::Matrix<double, BS, BS>> in(b);
+  Eigen::Map<Eigen::Matrix<double, BS, BS>> o(out);
+  Eigen::Matrix<double, BS, BS> t;  // (R (x) I) B
+  for (int d = 0; d < 3; ++d)
+    for (int c = 0; c < 3; ++c)
+      t.template block<N, N>(d * N, c * N).noalias() =
+          r(d, 0) * in.template block<N, N>(0, c * N) +
+          r(d, 1) * in.template block<N, N>(N, c * N) +
+          r(d, 2) * in.template block<N, N>(2 * N, c * N);
+  for (int d = 0; d < 3; ++d)
+    for (int c = 0; c < 3; ++c)
+      o.template block<N, N>(d * N, c * N) += (s * r(c, 0)) * t.template block<N, N>(d * N, 0) +
+                                              (s * r(c, 1)) * t.template block<N, N>(d * N, N) +
+                                              (s * r(c, 2)) * t.template block<N, N>(d * N, 2 * N);
+}
+
+}  // namespace
+
+Eigen::Matrix3d polarRotation(const Eigen::Matrix3d& f) {
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(f, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d u = svd.matrixU();
+  const Eigen::Matrix3d v = svd.matrixV();
+  if ((u * v.transpose()).determinant() < 0.0) u.col(2) = -u.col(2);  // smallest singular value
+  return u * v.transpose();
+}
+
+CorotatedStiffness::CorotatedStiffness(const DgBasis& basis, const MomentCache& moments,
+                                       SplitLocalMatrices parts, const Vec3& origin,
+                                       bool corotational)
+    : parts_(std::move(parts)),
+      corotational_(corotational),
+      degree_(basis.degree()),
+      n_(basis.size()),
+      bs_(3 * basis.size()),
+      ne_(parts_.jumps.neighbours.size()) {
+  buildSlots();
+  elementTerms(basis, moments, origin);
+}
+
+void CorotatedStiffness::buildSlots() {
+  const LocalMatrices& l = parts_.jumps;
+  rowStart_.assign(ne_ + 1, 0);
+  slots_.clear();
+  for (std::size_t i = 0; i < ne_; ++i) {
+    const auto& b = l.neighbours[i];
+    const auto firstGreater = std::upper_bound(b.begin(), b.end(), static_cast<std::uint32_t>(i));
+    for (std::uint32_t f : b) {
+      RowSlot s;
+      s.other = f;
+      if (f == i) {
+        s.diagonal = true;
+        s.block = i;
+      } else if (f > i) {
+        s.block =
+            l.couplingStart[i] +
+            static_cast<std::size_t>(std::lower_bound(firstGreater, b.end(), f) - firstGreater);
+      } else {
+        const auto& bf = l.neighbours[f];
+        const auto fg = std::upper_bound(bf.begin(), bf.end(), f);
+        s.block = l.couplingStart[f] +
+                  static_cast<std::size_t>(
+                      std::lower_bound(fg, bf.end(), static_cast<std::uint32_t>(i)) - fg);
+        s.transposed = true;
+      }
+      slots_.push_back(s);
+    }
+    rowStart_[i + 1] = slots_.size();
+  }
+}
+
+void CorotatedStiffness::elementTerms(const DgBasis& basis, const MomentCache& moments,
+                                      const Vec3& origin) {
+  const int n = n_;
+  gradients_.assign(ne_ * 3 * static_cast<std::size_t>(n), 0.0);
+  x0_.resize(static_cast<Eigen::Index>(ne_) * bs_);
+  tbb::parallel_for(std::size_t(0), ne_, [&](std::size_t i) {
+    const ElementId e(i);
+    for (int d = 0; d < 3; ++d)
+      x0_.segment(static_cast<Eigen::Index>(i) * bs_ + d * n, n) =
+          affineCoefficients(basis, e, 0.0, Vec3::Unit(d), origin);
+    // Mean gradients: (1/|K|) int d_k phi_i = (1/|K|) sum_a T(i, a) int d_k m_a.
+    const auto t = basis.coefficients(e);
+    const auto em = moments.element(e);
+    const double h = basis.scale(e), vol = moments.volume(e);
+    for (int k = 0; k < 3; ++k)
+      for (int aIdx = 0; aIdx < n; ++aIdx) {
+        const Exponents ex = monomialExponents(aIdx);
+        int pw[3] = {ex.a, ex.b, ex.c};
+        if (pw[k] == 0) continue;
+        const double factor = pw[k] / h;
+        --pw[k];
+        const int b = monomialIndex(pw[0], pw[1], pw[2]);
+        const double integral = factor * em[b] / std::pow(h, pw[0] + pw[1] + pw[2]);
+        for (int fn = 0; fn < n; ++fn)
+          gradients_[i * 3 * n + k * n + fn] += t(fn, aIdx) * integral / vol;
+      }
+  });
+}
+
+Eigen::Matrix3d CorotatedStiffness::deformationGradient(std::size_t i,
+                                                        const Eigen::VectorXd& u) const {
+  Eigen::Matrix3d f = Eigen::Matrix3d::Identity();
+  const double* g = gradients_.data() + i * 3 * n_;
+  const double* ue = u.data() + i * bs_;
+  for (int d = 0; d < 3; ++d)
+    for (int k = 0; k < 3; ++k) {
+      double sum = 0.0;
+      for (int fn = 0; fn < n_; ++fn) sum += g[k * n_ + fn] * ue[d * n_ + fn];
+      f(d, k) += sum;
+    }
+  return f;
+}
+
+std::vector<Eigen::Matrix3d> CorotatedStiffness::rotations(const Eigen::VectorXd& u) const {
+  std::vector<Eigen::Matrix3d> r(ne_, Eigen::Matrix3d::Identity());
+  if (!corotational_) return r;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ne_, 256),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t i = range.begin(); i != range.end(); ++i)
+                        r[i] = polarRotation(deformationGradient(i, u));
+                    });
+  return r;
+}
+
+int CorotatedStiffness::partsOf(std::size_t i, const RowSlot& s, Part out[3]) const {
+  const std::size_t bb = static_cast<std::size_t>(bs_) * bs_;
+  if (s.diagonal) {
+    out[0] = {parts_.rowStrain.diagonal.data() + i * bb, true, static_cast<std::int64_t>(i)};
+    out[1] = {parts_.jumps.diagonal.data() + i * bb, true, -1};
+    return 2;
+  }
+  const std::size_t off = s.block * bb;
+  const auto self = static_cast<std::int64_t>(i), other = static_cast<std::int64_t>(s.other);
+  if (!s.transposed) {  // row-major, stored by i
+    out[0] = {parts_.rowStrain.coupling.data() + off, false, self};
+    out[1] = {parts_.columnStrain.coupling.data() + off, false, other};
+    out[2] = {parts_.jumps.coupling.data() + off, false, -1};
+  } else {  // stored by `other` as its rows: read transposed
+    out[0] = {parts_.rowStrain.coupling.data() + off, true, other};
+    out[1] = {parts_.columnStrain.coupling.data() + off, true, self};
+    out[2] = {parts_.jumps.coupling.data() + off, true, -1};
+  }
+  return 3;
+}
+
+void CorotatedStiffness::product(const std::vector<Eigen::Matrix3d>& r, const Eigen::VectorXd& x,
+                                 const Eigen::VectorXd* z, Eigen::VectorXd& out,
+                                 double* energy) const {
+  detail::dispatchBasisDegree(
+      degree_, [&](auto p) { productOf<numMonomials(p())>(r, x, z, out, energy); });
+}
+
+template <int N>
+void CorotatedStiffness::productOf(const std::vector<Eigen::Matrix3d>& r,
+                                   const Eigen::VectorXd& x, const Eigen::VectorXd* z,
+                                   Eigen::VectorXd& out, double* energy) const {
+  constexpr int BS = 3 * N;
+  using Vec = Eigen::Matrix<double, BS, 1>;
+  using Components = Eigen::Matrix<double, N, 3>;  // column d: component d
+  using Block = Eigen::Matrix<double, BS, BS>;
+  using RowBlock = Eigen::Matrix<double, BS, BS, Eigen::RowMajor>;
+  out.setZero(x.size());
+  const bool bz = parts_.jumps.componentDiagonalCoupling;
+  const std::size_t bb = static_cast<std::size_t>(BS) * BS;
+  const double e = tbb::parallel_deterministic_reduce(
+      tbb::blocked_range<std::size_t>(0, ne_, 64), 0.0,
+      [&](const tbb::blocked_range<std::size_t>& range, double sum) {
+        Vec w, y, wa, v;
+        for (std::size_t i = range.begin(); i != range.end(); ++i) {
+          Eigen::Map<Vec> oa(out.data() + i * BS);
+          // The vector a side of a block reads: R^T x - z (positions against the undeformed
+          // state: the strain side and interior jumps) or R^T (x - z) (the displacement: the
+          // jump against a Dirichlet face's fixed outside). (R (x) I)^T acts on the
+          // components as V R.
+          auto side = [&](const Eigen::Matrix3d* rot, std::size_t el, bool difference, Vec& o) {
+            v = Eigen::Map<const Vec>(x.data() + el * BS);
+            if (z && difference) v -= Eigen::Map<const Vec>(z->data() + el * BS);
+            if (rot)
+              Eigen::Map<Components>(o.data()).noalias() =
+                  Eigen::Map<const Components>(v.data()) * (*rot);
+            else
+              o = v;
+            if (z && !difference) o -= Eigen::Map<const Vec>(z->data() + el * BS);
+          };
+          // Row i's block B against column element `col`, warped with element `source`'s
+          // rotation (-1: not warped); B column-major or row-major.
+          auto apply = [&](const double* b, bool columnMajor, std::int64_t source,
+                           std::size_t col, bool rowDifference = false,
+                           bool columnDifference = false) {
+            const bool warp = source >= 0 && corotational_;
+            const Eigen::Matrix3d* rot = warp ? &r[static_cast<std::size_t>(source)] : nullptr;
+            side(rot, col, columnDifference, w);
+            if (columnMajor)
+              y.noalias() = Eigen::Map<const Block>(b) * w;
+            else
+              y.noalias() = Eigen::Map<const RowBlock>(b) * w;
+            if (rot)
+              Eigen::Map<Components>(oa.data()).noalias() +=
+                  Eigen::Map<const Components>(y.data()) * rot->transpose();
+            else
+              oa += y;
+            if (energy) {
+              side(rot, i, rowDifference, wa);
+              sum += 0.5 * wa.dot(y);
+            }
+          };
+          if (!bz) {  // the Dirichlet faces' strain terms
+            const auto self = static_cast<std::int64_t>(i);
+            apply(parts_.dirichletTrial.data() + i * bb, true, self, i, true, false);
+            apply(parts_.dirichletTest.data() + i * bb, true, self, i, false, true);
+          }
+          std::size_t neighbour = 0;
+          for (std::size_t k = rowStart_[i]; k < rowStart_[i + 1]; ++k) {
+            const RowSlot& s = slots_[k];
+            if (!s.diagonal && !bz)  // the neighbour's lifting terms in i's diagonal block
+              apply(parts_.neighbourLifting.data() + (parts_.neighbourStart[i] + neighbour++) * bb,
+                    true, s.other, i);
+            Part ps[3];
+            const int np = partsOf(i, s, ps);
+            for (int q = 0; q < np; ++q) {
+              if (ps[q].source >= 0 && !s.diagonal && bz) continue;  // BZ: no coupling strain
+              apply(ps[q].b, ps[q].columnMajor, ps[q].source, s.other);
+            }
+          }
+        }
+        return sum;
+      },
+      std::plus<double>());
+  if (energy) *energy = e;
+}
+
+void CorotatedStiffness::assemble(const std::vector<Eigen::Matrix3d>& r,
+                                  const std::vector<double>& mass, double cM, double cK,
+                                  LocalMatrices& system) const {
+  detail::dispatchBasisDegree(
+      degree_, [&](auto p) { assembleOf<numMonomials(p())>(r, mass, cM, cK, system); });
+}
+
+template <int N>
+void CorotatedStiffness::assembleOf(const std::vector<Eigen::Matrix3d>& r,
+                                    const std::vector<double>& mass, double cM, double cK,
+                                    LocalMatrices& system) const {
+  const int n = n_, bs = bs_;
+  const std::size_t bb = static_cast<std::size_t>(bs) * bs;
+  const bool bz = parts_.jumps.componentDiagonalCoupling;
+  const bool warp = corotational_;
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, ne_, 32),
+      [&](const tbb::blocked_range<std::size_t>& range) {
+        for (std::size_t i = range.begin(); i != range.end(); ++i) {
+          double* d = system.diagonal.data() + i * bb;
+          const double* js = parts_.jumps.diagonal.data() + i * bb;
+          const double* ss = parts_.rowStrain.diagonal.data() + i * bb;
+          for (std::size_t k = 0; k < bb; ++k) d[k] = cK * js[k];
+          if (warp)
+            addWarped<N>(r[i], ss, cK, d);
+          else
+            for (std::size_t k = 0; k < bb; ++k) d[k] += cK * ss[k];
+          if (!bz) {
+            for (const std::vector<double>* dir : {&parts_.dirichletTrial, &parts_.dirichletTest}) {
+              if (warp)
+                addWarped<N>(r[i], dir->data() + i * bb, cK, d);
+              else
+                for (std::size_t q = 0; q < bb; ++q) d[q] += cK * (*dir)[i * bb + q];
+            }
+            const std::size_t first = parts_.neighbourStart[i];
+            std::size_t k = 0;
+            for (std::uint32_t f : parts_.jumps.neighbours[i]) {
+              if (f == i) continue;
+              const double* nl = parts_.neighbourLifting.data() + (first + k++) * bb;
+              if (warp)
+                addWarped<N>(r[f], nl, cK, d);
+              else
+                for (std::size_t q = 0; q < bb; ++q) d[q] += cK * nl[q];
+            }
+          }
+          const double* me = mass.data() + i * n * n;
+          for (int c = 0; c < 3; ++c)
+            for (int fi = 0; fi < n; ++fi)
+              for (int fj = 0; fj < n; ++fj)
+                d[static_cast<std::size_t>(c * n + fj) * bs + c * n + fi] += cM * me[fj * n + fi];
+          const auto& nb = parts_.jumps.neighbours[i];
+          const auto firstGreater =
+              std::upper_bound(nb.begin(), nb.end(), static_cast<std::uint32_t>(i));
+          std::size_t slot = parts_.jumps.couplingStart[i];
+          for (auto it = firstGreater; it != nb.end(); ++it, ++slot) {
+            // Coupling blocks are row-major: as column-major they are the transposed block,
+            // (R1 B R2^T)^T = R2 B^T R1^T.
+            double* c = system.coupling.data() + slot * bb;
+            const double* jc = parts_.jumps.coupling.data() + slot * bb;
+            for (std::size_t k = 0; k < bb; ++k) c[k] = cK * jc[k];
+            if (bz) continue;
+            const double* rc = parts_.rowStrain.coupling.data() + slot * bb;
+            const double* oc = parts_.columnStrain.coupling.data() + slot * bb;
+            if (warp) {
+              const Eigen::Matrix3d& rf = r[*it];
+              // Read each row-major block column-major (its transpose) and write the
+              // transpose of the warped block: R_f B^T R_f^T etc. with the roles swapped.
+              addWarped<N>(r[i], rc, cK, c);
+              addWarped<N>(rf, oc, cK, c);
+            } else {
+              for (std::size_t k = 0; k < bb; ++k) c[k] += cK * (rc[k] + oc[k]);
+            }
+          }
+        }
+      });
+}
+
+}  // namespace polydg

@@ -1,0 +1,98 @@
+// The corotated DG stiffness (Kaufmann et al. 2008, section 7): each element's rotation from
+// the polar decomposition of its mean deformation gradient, and the stiffness warped by those
+// rotations, applied to a vector or assembled with the mass into a time step's matrix.
+//
+// The stiffness is split by the element whose strain each term holds (splitLocalMatrices():
+// K_K and K_f1, K_f2 split by side, the penalty K_f3 apart); a block B of rows A, columns C with
+// strain of element S acts as R_S B (R_S^T X_C - X0_C), the penalty as B (X_C - X0_C), where
+// X = X0 + U are the coefficients of the deformed positions and X0 those of the undeformed ones
+// (x - o, o the body's reference point: the identity map, exact in every element's linear
+// functions). A rigid motion of the whole body thus gives no elastic force.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "physics/dg/assembly.h"
+
+namespace polydg {
+
+/// The rotation of the polar decomposition F = R S (det R = +1; for det F <= 0 the closest
+/// rotation, flipping the direction of the smallest singular value).
+Eigen::Matrix3d polarRotation(const Eigen::Matrix3d& f);
+
+/// The split element and face blocks of a mesh's DG stiffness, warped by element rotations.
+/// Vectors are in LinearSystem's layout (element blocks of 3n, component-major).
+class CorotatedStiffness {
+ public:
+  /// `parts` from splitLocalMatrices() of `basis`; `origin` is o of X0 (the body's undeformed
+  /// centre of mass keeps the coordinates bounded far from the world's origin). Without
+  /// `corotational` every rotation is the identity: the linear stiffness.
+  CorotatedStiffness(const DgBasis& basis, const MomentCache& moments, SplitLocalMatrices parts,
+                     const Vec3& origin, bool corotational);
+
+  bool corotational() const { return corotational_; }
+  /// X0: the coefficients of x - origin.
+  const Eigen::VectorXd& undeformed() const { return x0_; }
+  /// The layout of the assembled blocks (the penalty's: every coupled pair of elements).
+  const LocalMatrices& layout() const { return parts_.jumps; }
+
+  /// Element i's mean deformation gradient I + (1/|K|) int_K grad u for the displacement `u`.
+  Eigen::Matrix3d deformationGradient(std::size_t i, const Eigen::VectorXd& u) const;
+  /// Every element's rotation for the displacement `u` (identities without corotation).
+  std::vector<Eigen::Matrix3d> rotations(const Eigen::VectorXd& u) const;
+
+  /// out = sum over blocks of R_S B (R_S^T x_C - z_C) (z null: 0), and if `energy`, the form's
+  /// energy 1/2 sum (R_S^T x_A - z_A) . B (R_S^T x_C - z_C). With x = X0 + U and z = X0 this is
+  /// the elastic force f(U); with z null, K_w x.
+  void product(const std::vector<Eigen::Matrix3d>& r, const Eigen::VectorXd& x,
+               const Eigen::VectorXd* z, Eigen::VectorXd& out, double* energy) const;
+
+  /// The blocks of cM M + cK K_w into `system` (which has layout()'s pattern): `mass` holds each
+  /// element's n x n scalar mass block, column-major.
+  void assemble(const std::vector<Eigen::Matrix3d>& r, const std::vector<double>& mass, double cM,
+                double cK, LocalMatrices& system) const;
+
+ private:
+  /// One block of an element's rows: against element `other`, read from `block` of the split
+  /// matrices (diagonal: the element's own; else a coupling block, transposed when stored by
+  /// the other element).
+  struct RowSlot {
+    std::uint32_t other = 0;
+    std::size_t block = 0;  ///< diagonal: the element; coupling: the coupling block's index
+    bool diagonal = false;
+    bool transposed = false;
+  };
+  /// The parts of a block of row element i: pointers, layouts and the element whose rotation
+  /// warps it (-1: none).
+  struct Part {
+    const double* b;
+    bool columnMajor;  ///< else row-major (read transposed: the other layout)
+    std::int64_t source;
+  };
+
+  void buildSlots();
+  void elementTerms(const DgBasis& basis, const MomentCache& moments, const Vec3& origin);
+  int partsOf(std::size_t i, const RowSlot& s, Part out[3]) const;
+  template <int N>
+  void productOf(const std::vector<Eigen::Matrix3d>& r, const Eigen::VectorXd& x,
+                 const Eigen::VectorXd* z, Eigen::VectorXd& out, double* energy) const;
+  template <int N>
+  void assembleOf(const std::vector<Eigen::Matrix3d>& r, const std::vector<double>& mass,
+                  double cM, double cK, LocalMatrices& system) const;
+
+  SplitLocalMatrices parts_;
+  bool corotational_ = true;
+  int degree_ = 1;
+  int n_ = 0, bs_ = 0;
+  std::size_t ne_ = 0;
+  std::vector<std::size_t> rowStart_;
+  std::vector<RowSlot> slots_;
+  std::vector<double> gradients_;  ///< (1/|K|) int d_k phi_i at k * n + i, 3n per element
+  Eigen::VectorXd x0_;
+};
+
+}  // namespace polydg

@@ -1,0 +1,92 @@
+#include "physics/dynamics/step_solver.h"
+
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+
+namespace polydg {
+
+namespace {
+
+/// Block-Jacobi CG until a solve needs more than this many iterations, then the p-multigrid:
+/// a block-Jacobi iteration costs a seventh of a V-cycle, and B10's beam needs 45 of the one
+/// against 14 of the other at dt = 0.01.
+constexpr int kBlockJacobiLimit = 80;
+
+}  // namespace
+
+StepSolver::StepSolver(const StepSolverOptions& options, const ElementFrames& frames,
+                       int blockSize)
+    : options_(options), frames_(&frames), blockSize_(blockSize), active_(options.solver) {
+  if (options_.adaptivePreconditioner) active_.preconditioner = CgPreconditioner::BlockJacobi;
+  solver_ = LinearSolver(active_);
+}
+
+void StepSolver::beginStep() {
+  if (!switchToMultigrid_) return;
+  active_.preconditioner = CgPreconditioner::PMultigrid;
+  solver_ = LinearSolver(active_);
+  ready_ = false;
+  switchToMultigrid_ = false;
+}
+
+void StepSolver::prepare(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix,
+                         bool changed, StepReport& report) {
+  if (!ready_) {
+    const bool direct = chooseSolver(matrix, active_) == SolverKind::Cholesky;
+    if (!solver_.compute(matrix, blockSize_, direct ? nullptr : frames_) && direct)
+      throw std::runtime_error(
+          "the time step's system matrix is not positive definite (a corotated element "
+          "turned inside out?)");
+    report.refactorized = direct;
+    report.preconditionerRebuilt = !direct;
+    ready_ = true;
+    baselineIterations_ = -1;
+  } else if (changed) {
+    const bool direct = solver_.kind() == SolverKind::Cholesky;
+    const bool refresh = !direct && baselineIterations_ >= 0 &&
+                         lastIterations_ > options_.refreshRatio * std::max(baselineIterations_, 1);
+    if (!solver_.update(matrix, refresh, frames_) && direct)
+      throw std::runtime_error(
+          "the time step's system matrix is not positive definite (a corotated element "
+          "turned inside out?)");
+    report.refactorized = direct;
+    report.preconditionerRebuilt = refresh;
+    if (refresh) baselineIterations_ = -1;
+  }
+}
+
+void StepSolver::prepareWithContact(
+    const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix, StepReport& report) {
+  const bool direct = chooseSolver(matrix, active_) == SolverKind::Cholesky;
+  if (!solver_.compute(matrix, blockSize_, direct ? nullptr : frames_) && direct)
+    throw std::runtime_error("the time step's system matrix with contacts is not positive definite");
+  report.refactorized = direct;
+  report.preconditionerRebuilt = !direct;
+  ready_ = false;
+  baselineIterations_ = -1;
+}
+
+Eigen::VectorXd StepSolver::solve(const Eigen::VectorXd& rhs, const Eigen::VectorXd& guess,
+                                  StepReport& report) {
+  LinearSolveReport lr;
+  Eigen::VectorXd x = solver_.solve(rhs, lr, &guess);
+  if (!lr.success)
+    throw std::runtime_error("the time step's solve failed (CG did not converge, residual " +
+                             std::to_string(lr.residual) + ")");
+  report.iterations += lr.iterations;
+  report.residual = lr.residual;
+  return x;
+}
+
+void StepSolver::endStep(StepReport& report) {
+  lastIterations_ = report.iterations;
+  if (baselineIterations_ < 0) baselineIterations_ = report.iterations;
+  report.preconditioner = active_.preconditioner;
+  if (solver_.kind() == SolverKind::ConjugateGradient && options_.adaptivePreconditioner &&
+      active_.preconditioner == CgPreconditioner::BlockJacobi &&
+      report.iterations > kBlockJacobiLimit * report.solves)
+    switchToMultigrid_ = true;
+}
+
+}  // namespace polydg

@@ -1,0 +1,62 @@
+// The linear solver of a moving body's steps and its policy: when the step's matrix is
+// factorized again (Cholesky) or its preconditioner rebuilt (CG), and when CG moves from
+// block-Jacobi to the p-multigrid.
+#pragma once
+
+#include <Eigen/SparseCore>
+
+#include "physics/solvers/agglomeration.h"
+#include "physics/solvers/linear_solver.h"
+#include "polydg/physics/dynamics/motion.h"
+
+namespace polydg {
+
+struct StepSolverOptions {
+  SolverOptions solver;
+  /// CG: start with block-Jacobi and switch to the p-multigrid once a solve needs more than
+  /// kBlockJacobiLimit iterations; false: solver.preconditioner throughout.
+  bool adaptivePreconditioner = true;
+  /// CG: the preconditioner of an earlier matrix is kept until a step needs more than this
+  /// many times the iterations of the first step after it was built.
+  double refreshRatio = 1.5;
+};
+
+class StepSolver {
+ public:
+  /// `frames`: the elements' frames (the p-multigrid's agglomerates), kept by the caller.
+  StepSolver(const StepSolverOptions& options, const ElementFrames& frames, int blockSize);
+
+  /// A step begins: a switch to the p-multigrid decided by the last step takes effect.
+  void beginStep();
+  /// Ready to solve with `matrix` (the step's matrix without contact terms): factorized or its
+  /// preconditioner built the first time, and after prepareWithContact(); else, if `changed`,
+  /// refactorized, or the preconditioner kept or rebuilt by the refresh rule. Throws
+  /// std::runtime_error if Cholesky finds the matrix not positive definite.
+  void prepare(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix, bool changed,
+               StepReport& report);
+  /// The same for a matrix with contact terms (another pattern): factorized or its
+  /// preconditioner built anew, and again for the next step's matrix.
+  void prepareWithContact(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix,
+                          StepReport& report);
+  /// The solution of the prepared matrix for `rhs`, starting from `guess`; its iterations and
+  /// residual go to `report`. Throws std::runtime_error if CG does not converge.
+  Eigen::VectorXd solve(const Eigen::VectorXd& rhs, const Eigen::VectorXd& guess,
+                        StepReport& report);
+  /// A step ended: the refresh rule's counts and the preconditioner switch.
+  void endStep(StepReport& report);
+  /// The next prepare() starts over (the system changed: contact set or removed).
+  void reset() { ready_ = false; }
+  SolverKind kind() const { return solver_.kind(); }
+
+ private:
+  StepSolverOptions options_;
+  const ElementFrames* frames_;
+  int blockSize_;
+  SolverOptions active_;  ///< options_.solver with the preconditioner in use
+  LinearSolver solver_;
+  bool ready_ = false;  ///< factorized, or preconditioner built, for the matrix without contacts
+  bool switchToMultigrid_ = false;
+  int baselineIterations_ = -1, lastIterations_ = 0;
+};
+
+}  // namespace polydg
