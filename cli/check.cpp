@@ -75,8 +75,9 @@ void addCheckCommand(CLI::App& app, const CommonOptions& common, int& exitCode) 
                   "largest vertex distance from a face's plane, relative to the face size")
       ->check(kPositive)
       ->capture_default_str();
-  cmd->add_option("--degree", o->check.degree, "polynomial degree of the DG checks")
-      ->check(CLI::Range(1, 3))
+  cmd->add_option("--degree", o->check.physics.discretization.basis.degree,
+                  "polynomial degree of the DG checks")
+      ->check(kDegree)
       ->capture_default_str();
   cmd->add_flag("--no-dg", o->skipDg, "geometric validation only, no DG checks");
   cmd->callback([o, &common, &exitCode] { run(*o, common, exitCode); });

@@ -43,6 +43,47 @@ const CLI::Validator kPositive = numberCheck(
 const CLI::Validator kNonNegative = numberCheck(
     "NONNEGATIVE", [](double x) { return x >= 0.0; }, "a finite number >= 0");
 
+CLI::Validator libraryRule(std::function<void(double)> rule) {
+  return CLI::Validator(
+      [rule](std::string& text) -> std::string {
+        const auto v = finiteNumber(text);
+        if (!v) return "'" + text + "' is not a finite number";
+        try {
+          rule(*v);
+        } catch (const InvalidOption& e) {
+          return e.problem;
+        }
+        return {};
+      },
+      "", "NUMBER");
+}
+
+const CLI::Validator kYoungsModulus = libraryRule([](double e) {
+  Material m;
+  m.youngsModulus = e;
+  m.check();
+});
+const CLI::Validator kPoissonRatio = libraryRule([](double nu) {
+  Material m;
+  m.poissonRatio = nu;
+  m.check();
+});
+const CLI::Validator kDensity = libraryRule([](double rho) {
+  Material m;
+  m.density = rho;
+  m.check();
+});
+const CLI::Validator kDegree = libraryRule([](double p) {
+  DiscretizationOptions d;
+  d.basis.degree = p >= 0 && p <= 1e6 ? static_cast<int>(p) : -1;
+  d.check();
+});
+const CLI::Validator kPenalty = libraryRule([](double eta) {
+  DiscretizationOptions d;
+  d.penalty.eta = eta;
+  d.check();
+});
+
 CLI::Validator finiteRange(double lo, double hi) {
   std::ostringstream s;
   s << "a finite number in [" << lo << ", " << hi << "]";

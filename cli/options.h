@@ -21,6 +21,13 @@ extern const CLI::Validator kPositive;
 extern const CLI::Validator kNonNegative;
 /// Finite in [lo, hi].
 CLI::Validator finiteRange(double lo, double hi);
+/// A finite number that the library's own check of the option accepts: `rule` sets the value
+/// on the option's struct and calls its check() (which throws InvalidOption), so the command
+/// line refuses exactly what the library refuses, in the library's words.
+CLI::Validator libraryRule(std::function<void(double)> rule);
+/// The rules of the material's and the discretization's options, for --E, --nu, --density,
+/// --degree and --eta.
+extern const CLI::Validator kYoungsModulus, kPoissonRatio, kDensity, kDegree, kPenalty;
 
 /// Comma-separated finite numbers; throws CLI::ValidationError naming `option` unless there
 /// are exactly `count` of them.

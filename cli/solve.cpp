@@ -31,8 +31,8 @@ struct SolveCommandOptions {
   AdaptOptions adaptOptions;
   SolveOptions solve = [] {
     SolveOptions s;
-    s.degree = 2;  // the command's default (pipelines and the library default to 1)
-    return s;
+    s.discretization.basis.degree = 2;  // the command's own default; pipelines, scenes, Python
+    return s;                           // and the library take the basis's (1)
   }();
 };
 
@@ -65,7 +65,7 @@ void run(const SolveCommandOptions& o, const CommonOptions& common) {
   nlohmann::json surfaceJson;
   if (!o.surfaceOutput.empty()) {
     const Stopwatch watch;
-    const EmbeddedSurface e = model.embedSurface(o.embed, o.solve.degree);
+    const EmbeddedSurface e = model.embedSurface(o.embed, o.solve.discretization.basis.degree);
     const Eigen::Matrix<double, Eigen::Dynamic, 3> u =
         e.embedding->displacements(model.solution()->coefficients);
     std::vector<Vec3> deformed(e.surface.vertices.size());
@@ -101,9 +101,10 @@ void run(const SolveCommandOptions& o, const CommonOptions& common) {
   }
   if (!common.quiet) {
     const StaticReport& s = r.solve;
-    std::cout << o.input << ": " << toString(o.solve.method) << " p=" << o.solve.degree << ", "
-              << s.dofs << " DOFs, " << s.nonzeros << " nonzeros, eta " << s.eta << ", "
-              << toString(s.solver.used) << " (residual " << s.solver.residual
+    std::cout << o.input << ": " << toString(o.solve.discretization.method)
+              << " p=" << o.solve.discretization.basis.degree << ", " << s.dofs << " DOFs, "
+              << s.nonzeros << " nonzeros, eta " << s.eta << ", " << toString(s.solver.used)
+              << " (residual " << s.solver.residual
               << (s.solver.iterations ? ", " + std::to_string(s.solver.iterations) + " iterations"
                                       : std::string())
               << ")\n  integrate " << s.integrateSeconds << " s, assemble " << s.assembleSeconds
@@ -140,21 +141,22 @@ void addSolveCommand(CLI::App& app, const CommonOptions& common, int& exitCode) 
   cmd->add_option("mesh", o->input, "simulation mesh (.vtu)")->required()->check(CLI::ExistingFile);
   cmd->add_option("-o,--output", o->output, "output mesh with displacement and stress (.vtu)")
       ->required();
-  addChoice(*cmd, "--method", s.method, methodNames(), "DG method (interior penalty or BZ)");
-  addChoice(*cmd, "--bz-penalty", s.bzPenalty, bzPenaltyNames(),
+  DiscretizationOptions& d = s.discretization;
+  addChoice(*cmd, "--method", d.method, methodNames(), "DG method (interior penalty or BZ)");
+  addChoice(*cmd, "--bz-penalty", d.bzPenalty, bzPenaltyNames(),
             "--method bz: penalty ~1/h (fixed: cheap, its error stops falling) or the "
             "superpenalty ~h^-(2p+1) (super: converges at rate >= p, stiffer system)");
-  cmd->add_option("--degree", s.degree, "polynomial degree of the basis")
-      ->check(CLI::Range(1, 3))
+  cmd->add_option("--degree", d.basis.degree, "polynomial degree of the basis")
+      ->check(kDegree)
       ->capture_default_str();
   cmd->add_option("--E", s.material.youngsModulus, "Young's modulus")
-      ->check(kPositive)
+      ->check(kYoungsModulus)
       ->capture_default_str();
   cmd->add_option("--nu", s.material.poissonRatio, "Poisson's ratio, in (-1, 0.5)")
-      ->check(finiteRange(-0.999999, 0.499999999))
+      ->check(kPoissonRatio)
       ->capture_default_str();
   cmd->add_option("--density", s.material.density, "mass density (with --gravity)")
-      ->check(kNonNegative)
+      ->check(kDensity)
       ->capture_default_str();
   cmd->add_option_function<std::string>(
          "--gravity", [&s](const std::string& v) { s.gravity = parseVector(v, "--gravity"); },
@@ -163,16 +165,16 @@ void addSolveCommand(CLI::App& app, const CommonOptions& common, int& exitCode) 
   addRegionOptions(*cmd, "clamp", s.clamps, "clamp (u = 0, weakly)");
   addTractionOptions(*cmd, s.tractions);
   addChoice(*cmd, "--solver", s.solver, solverNames(), "linear solver");
-  addChoice(*cmd, "--penalty", s.penalty, penaltyNames(),
+  addChoice(*cmd, "--penalty", d.penalty.rule, penaltyNames(),
             "penalty choice: bound (guaranteed SPD), doubling (the paper's), fixed (--eta)");
   cmd->add_option_function<double>(
          "--eta",
-         [&s](double eta) {
-           s.eta = eta;
-           if (s.penalty == PenaltyRule::TraceBound) s.penalty = PenaltyRule::Fixed;
+         [&d](double eta) {
+           d.penalty.eta = eta;
+           if (d.penalty.rule == PenaltyRule::TraceBound) d.penalty.rule = PenaltyRule::Fixed;
          },
          "the penalty: fixed, or the first value of doubling")
-      ->check(kPositive);
+      ->check(kPenalty);
   AdaptOptions& a = o->adaptOptions;
   cmd->add_flag("--adapt", o->adapt,
                 "solve adaptively: solve, estimate, mark, refine until --target-error, "

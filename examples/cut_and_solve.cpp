@@ -62,7 +62,7 @@ int main(int argc, char** argv) {
 
     // 4. The checks of the whole mesh, with the moments the model keeps.
     polydg::MeshCheckOptions checks;
-    checks.degree = 2;
+    checks.physics.discretization.basis.degree = 2;
     const polydg::MeshCheck check = model.check(checks);
     if (!check.passed()) {
       std::cerr << "check failed: " << check.failures().front() << '\n';
@@ -73,7 +73,7 @@ int main(int argc, char** argv) {
     // 5. The solve: clamped below the lowest tenth of the height, under gravity.
     const double z = box.min().z() + 0.1 * box.sizes().z();
     polydg::SolveOptions solve;
-    solve.degree = 2;
+    solve.discretization.basis.degree = 2;
     solve.material = {.youngsModulus = 1e6, .poissonRatio = 0.3, .density = 1.0};
     solve.gravity = polydg::Vec3(0.0, 0.0, -9.81);
     solve.clamps = {polydg::FaceSelector::below(polydg::Plane::make(polydg::Vec3::UnitZ(), z))};

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 namespace polydg {
@@ -44,6 +45,20 @@ double JsonObjectReader::number(const std::string& key, double lo, double hi) {
       !(v.get<double>() >= lo && v.get<double>() <= hi))
     fail(at(key), "expected a number in [" + format(lo) + ", " + format(hi) + "]");
   return v.get<double>();
+}
+
+double JsonObjectReader::number(const std::string& key) {
+  const json& v = get(key);
+  if (!v.is_number() || !std::isfinite(v.get<double>())) fail(at(key), "expected a finite number");
+  return v.get<double>();
+}
+
+int JsonObjectReader::integer(const std::string& key) {
+  const json& v = get(key);
+  if (!v.is_number_integer() || v.get<long long>() < std::numeric_limits<int>::min() ||
+      v.get<long long>() > std::numeric_limits<int>::max())
+    fail(at(key), "expected an integer");
+  return v.get<int>();
 }
 
 int JsonObjectReader::integer(const std::string& key, int lo, int hi) {

@@ -35,8 +35,23 @@ class JsonObjectReader {
   const nlohmann::json& get(const std::string& key);
   /// A finite number in [lo, hi].
   double number(const std::string& key, double lo, double hi);
+  /// A finite number (for values whose option checks their range itself: see checked()).
+  double number(const std::string& key);
   /// An integer in [lo, hi].
   int integer(const std::string& key, int lo, int hi);
+  /// An integer (for values whose option checks their range itself).
+  int integer(const std::string& key);
+  /// Runs `check`, an option struct's check(), and reports what it refuses at the key it names
+  /// under this object ("FILE: PLACE.KEY: PROBLEM; HINT"). One rule, the option's own, for
+  /// files, Python and code alike.
+  template <class Check>
+  void checked(Check&& check) const {
+    try {
+      check();
+    } catch (const InvalidOption& e) {
+      fail(at(e.key), e.problem);
+    }
+  }
   bool boolean(const std::string& key);
   std::string string(const std::string& key);
   /// One of `names` (model/names.h), the choices listed in the error.

@@ -183,7 +183,6 @@ Model Model::fromSurface(const TriangleSurface& surface, const MeshOptions& opti
         if (!options.dgChecks) return;
         try {
           MeshCheckOptions checks;
-          checks.degree = 1;
           checks.geometry = false;
           checks.oneGridCellForAll = !options.adaptive;  // an octree's cells differ in size
           checks.rigidModes = GlobalCheck::Never;
@@ -288,12 +287,11 @@ OperationReport Model::mergeSlivers(const MergeRequest& request) {
 MeshCheck Model::check(const MeshCheckOptions& options) {
   State& s = *state_;
   s.requireUsable();
-  if (options.degree < 1 || options.degree > 3)
-    throw InputError("the degree of the DG checks must be 1, 2 or 3");
+  refuseInvalid([&] { options.physics.discretization.check(); });
   const bool dg = options.local || options.patchTest != GlobalCheck::Never ||
                   options.rigidModes != GlobalCheck::Never;
   // Integrate (once, for this and every later operation) only what the DG checks read.
-  const MomentCache* moments = dg ? &this->moments(2 * options.degree) : nullptr;
+  const MomentCache* moments = dg ? &this->moments(2 * options.degree()) : nullptr;
   MeshCheck c = checkMesh(mesh(), options, moments);
   if (c.geometry) s.valid = c.geometry->passed;
   return c;
@@ -367,28 +365,31 @@ void Model::State::adoptSolution(std::unique_ptr<DgBasis> basis, Eigen::VectorXd
   solution = std::move(u);
 }
 
+void SolveOptions::check() const {
+  try {
+    material.check();
+  } catch (const InvalidOption& e) {
+    throw InvalidOption("material." + e.key, e.problem);
+  }
+  discretization.check();
+  if (!gravity.allFinite()) throw InvalidOption("gravity", "must be three finite numbers");
+  for (const TractionLoad& t : tractions)
+    if (!t.traction.allFinite()) throw InvalidOption("traction", "must be three finite numbers");
+  if (clamps.empty() && displacements.empty())
+    throw InvalidOption("clamp",
+                        "nothing holds the body: give at least one clamp (a plane, "
+                        "below or box)");
+  if (!exactDisplacement != !exactGradient)
+    throw InvalidOption("exact", "an exact solution needs both its displacement and its gradient");
+  if (estimate && discretization.method != Method::IP)
+    throw InvalidOption("estimate", "the error estimate is for the IP method: use method ip");
+}
+
 SolveReport Model::solve(const SolveOptions& options) {
   if (options.adapt) return solveAdaptively(*this, options);
   State& s = *state_;
   s.requireUsable();
-  try {
-    options.material.check();
-  } catch (const std::invalid_argument& e) {
-    throw InputError(std::string(e.what()) + "; check E, nu and density");
-  }
-  if (options.degree < 1 || options.degree > 3) throw InputError("the degree must be 1, 2 or 3");
-  if (!options.gravity.allFinite()) throw InputError("gravity must be three finite numbers");
-  for (const TractionLoad& t : options.tractions)
-    if (!t.traction.allFinite()) throw InputError("a traction must be three finite numbers");
-  if (options.clamps.empty() && options.displacements.empty())
-    throw InputError("nothing holds the body: give at least one clamp (a plane, below or box)");
-  if (!options.exactDisplacement != !options.exactGradient)
-    throw InputError("an exact solution needs both its displacement and its gradient");
-  if (options.bzPenalty != BzPenalty::Fixed && options.method != Method::BZ)
-    throw InputError("the BZ penalty scaling \"" + toString(options.bzPenalty) +
-                     "\" is for the BZ method; use --method bz");
-  if (options.estimate && options.method != Method::IP)
-    throw InputError("the error estimate is for the IP method; use --method ip");
+  refuseInvalid([&] { options.check(); });
   const PolyMesh& m = mesh();
   s.requireValid();
   SolveReport report;
@@ -406,19 +407,12 @@ SolveReport Model::solve(const SolveOptions& options) {
   for (const TractionLoad& t : options.tractions) loads.tractions.push_back({t.where, t.traction});
   loads.gravity = options.gravity;
   StaticOptions so;
-  so.discretization.method = options.method;
-  so.discretization.bzPenalty = options.bzPenalty;
-  so.discretization.basis.degree = options.degree;
-  so.discretization.penalty.rule = options.penalty;
-  if (options.penalty != PenaltyRule::TraceBound) {
-    if (options.penalty == PenaltyRule::Fixed && !(options.eta > 0.0 && std::isfinite(options.eta)))
-      throw InputError("a fixed penalty needs a positive, finite eta");
-    if (options.eta > 0.0) so.discretization.penalty.eta = options.eta;
-  }
+  so.discretization = options.discretization;
   so.solver.kind = options.solver;
+  const int degree = options.discretization.basis.degree;
 
   const std::size_t before = facesIntegrated();
-  const MomentCache& moments = this->moments(2 * options.degree);
+  const MomentCache& moments = this->moments(2 * degree);
   StaticSolver solver(m, options.material, so, &moments);
   solver.integrate();
   solver.assemble(loads);
@@ -440,7 +434,7 @@ SolveReport Model::solve(const SolveOptions& options) {
   }
 
   if (options.exactDisplacement && options.exactGradient) {
-    const int q = std::max(options.degree + 4, 2 * options.degree + 2);
+    const int q = std::max(degree + 4, 2 * degree + 2);
     report.error =
         errorNorms(m, solver.basis(), *u, options.exactDisplacement, options.exactGradient, q);
     report.energyError =

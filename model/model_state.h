@@ -76,6 +76,16 @@ struct Model::State {
   }
 };
 
+/// Runs an option struct's check(): what it refuses is the caller's input (InputError).
+template <class Check>
+void refuseInvalid(Check&& check) {
+  try {
+    check();
+  } catch (const InvalidOption& e) {
+    throw InputError(e.what());
+  }
+}
+
 /// The options cuts and merges share, checked before the mesh is touched.
 inline void checkEditOptions(double sliverFraction, int checkDegree) {
   if (!(sliverFraction >= 0.0 && sliverFraction <= 1.0))

@@ -300,14 +300,14 @@ json toJson(const SolveReport& report) {
     tractions.push_back(t);
   }
   json j = {
-      {"method", toString(o.method)},
-      {"degree", o.degree},
+      {"method", toString(o.discretization.method)},
+      {"degree", o.discretization.basis.degree},
       {"material",
        {{"E", o.material.youngsModulus},
         {"nu", o.material.poissonRatio},
         {"density", o.material.density}}},
       {"gravity", vectorJson(o.gravity)},
-      {"penalty_rule", toString(o.penalty)},
+      {"penalty_rule", toString(o.discretization.penalty.rule)},
       {"clamps", clamps},
       {"tractions", tractions},
       {"elements", r.elements},
@@ -347,8 +347,8 @@ json toJson(const SolveReport& report) {
                               {"dirichlet", std::sqrt(report.estimate->dirichlet)}}
                        : json(nullptr)},
       {"adapt", adaptJson(report)}};
-  if (o.method == Method::BZ) {
-    j["bz_penalty"] = toString(o.bzPenalty);
+  if (o.discretization.method == Method::BZ) {
+    j["bz_penalty"] = toString(o.discretization.bzPenalty);
     j["bz_factor"] = r.bzFactor;
   }
   return j;
@@ -393,9 +393,9 @@ json toJson(const Scene& s) {
   j["material"] = {{"E", s.material.youngsModulus},
                    {"nu", s.material.poissonRatio},
                    {"density", s.material.density}};
-  j["method"] = toString(s.method);
-  if (s.method == Method::BZ) j["bz_penalty"] = toString(s.bzPenalty);
-  j["degree"] = s.degree;
+  j["method"] = toString(s.discretization.method);
+  if (s.discretization.method == Method::BZ) j["bz_penalty"] = toString(s.discretization.bzPenalty);
+  j["degree"] = s.discretization.basis.degree;
   j["corotational"] = s.corotational;
   j["integrator"] = nameOf(integratorNames(), s.integrator);
   j["solver"] = toString(s.solver);
@@ -403,7 +403,7 @@ json toJson(const Scene& s) {
   j["steps"] = s.steps;
   j["duration"] = s.steps * s.dt;
   j["gravity"] = vectorJson(s.gravity);
-  j["damping"] = {{"mass", s.massDamping}, {"stiffness", s.stiffnessDamping}};
+  j["damping"] = {{"mass", s.damping.mass}, {"stiffness", s.damping.stiffness}};
   j["fixed"] = json::array();
   for (const FaceSelector& f : s.fixed) j["fixed"].push_back(selectionJson(f));
   j["loads"] = json::array();

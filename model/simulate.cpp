@@ -35,38 +35,12 @@ Eigen::Matrix3d skew(const Vec3& w) {
 DynamicsOptions dynamicsOptions(const Scene& scene) {
   DynamicsOptions o;
   o.material = scene.material;
-  o.discretization.method = scene.method;
-  o.discretization.bzPenalty = scene.bzPenalty;
-  o.discretization.basis.degree = scene.degree;
+  o.discretization = scene.discretization;
   o.solver.kind = scene.solver;
   o.corotational = scene.corotational;
   o.integrator = scene.integrator;
-  o.massDamping = scene.massDamping;
-  o.stiffnessDamping = scene.stiffnessDamping;
+  o.damping = scene.damping;
   return o;
-}
-
-/// The checks of a scene made in code (parseScene() checks the same for files).
-void checkScene(const Scene& scene) {
-  try {
-    scene.material.check();
-  } catch (const std::invalid_argument& e) {
-    throw InputError(std::string(e.what()) + "; check E, nu and density");
-  }
-  if (scene.degree < 1 || scene.degree > 3) throw InputError("the degree must be 1, 2 or 3");
-  if (!(scene.dt > 0.0) || !std::isfinite(scene.dt))
-    throw InputError("the time step dt must be a positive number");
-  if (scene.steps < 1) throw InputError("the scene needs at least one step");
-  if (scene.bzPenalty != BzPenalty::Fixed && scene.method != Method::BZ)
-    throw InputError("the BZ penalty scaling is for the BZ method");
-  if (scene.outputEvery < 1) throw InputError("output every must be at least 1");
-  if (!(scene.massDamping >= 0.0) || !(scene.stiffnessDamping >= 0.0))
-    throw InputError("damping coefficients must not be negative");
-  if (!scene.gravity.allFinite() || !scene.velocity.allFinite() ||
-      !scene.angularVelocity.allFinite())
-    throw InputError("gravity and initial velocities must be finite");
-  for (const TimedTraction& t : scene.loads)
-    if (!t.traction.allFinite()) throw InputError("a traction must be three finite numbers");
 }
 
 /// Each vertex's share of the surface area: a third of its triangles' areas.
@@ -213,7 +187,7 @@ SimulationReport Model::simulate(const Scene& scene, const SimulateOptions& opti
   State& s = *state_;
   s.requireUsable();
   const Stopwatch wall;
-  checkScene(scene);
+  refuseInvalid([&] { checkScene(scene); });
   s.requireValid();
   SimulationReport report;
   report.scene = scene;
@@ -232,7 +206,7 @@ SimulationReport Model::simulate(const Scene& scene, const SimulateOptions& opti
   const std::size_t integratedBefore = facesIntegrated();
   auto build = [&]() {
     const Stopwatch t;
-    DynamicSolver solver(mesh(), moments(2 * scene.degree), loads, dynamics);
+    DynamicSolver solver(mesh(), moments(2 * scene.discretization.basis.degree), loads, dynamics);
     report.setupSeconds += t.seconds();
     return solver;
   };
@@ -256,7 +230,8 @@ SimulationReport Model::simulate(const Scene& scene, const SimulateOptions& opti
     const Stopwatch te;
     EmbeddingOptions eo;
     eo.support = scene.embed.support;
-    surface = embedSurface(scene.embed.file, scene.degree, eo, &solver.basis());
+    surface =
+        embedSurface(scene.embed.file, scene.discretization.basis.degree, eo, &solver.basis());
     info.surface = surface.file;
     info.points = surface.surface.vertices.size();
     info.triangles = surface.surface.triangles.size();
@@ -386,8 +361,9 @@ SimulationReport Model::simulate(const Scene& scene, const SimulateOptions& opti
     const SceneAdapt& a = scene.adapt;
     if (!a.enabled || k % a.every != 0) return false;
     const Stopwatch tr;
-    const ElementFields fields = elementFields(mesh(), solver.basis(), moments(2 * scene.degree),
-                                               solver.displacement(), scene.material);
+    const ElementFields fields =
+        elementFields(mesh(), solver.basis(), moments(2 * scene.discretization.basis.degree),
+                      solver.displacement(), scene.material);
     RefineRequest request;
     request.split = a.split;
     request.checks = CheckLevel::None;
@@ -542,7 +518,7 @@ SimulationReport Model::simulate(const Scene& scene, const SimulateOptions& opti
   }
 
   s.adoptSolution(std::make_unique<DgBasis>(solver.basis()), solver.displacement(), scene.material,
-                  moments(2 * scene.degree));
+                  moments(2 * scene.discretization.basis.degree));
   report.facesIntegrated = facesIntegrated() - integratedBefore;
   report.wallSeconds = wall.seconds();
   return report;

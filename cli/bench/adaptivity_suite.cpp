@@ -43,7 +43,7 @@ nlohmann::json roundJson(const AdaptRound& r) {
 /// the exact solution for the errors.
 SolveOptions b12Options(const ManufacturedProblem& problem) {
   SolveOptions o;
-  o.degree = 2;
+  o.discretization.basis.degree = 2;
   o.material = problem.material;
   o.displacements = {{FaceSelector::allBoundary(), problem.displacement}};
   o.bodyForce = problem.bodyForce;
@@ -79,7 +79,7 @@ SuiteOutput adaptivitySuite(const BenchOptions& o, bool quiet) {
     for (double tau : taus) {
       Model model(hexGridMesh(9, 2, 2, Box3(Vec3::Zero(), Vec3(9, 2, 2))));
       SolveOptions so;
-      so.degree = 1;
+      so.discretization.basis.degree = 1;
       so.material.youngsModulus = 1000.0;
       so.material.poissonRatio = 0.3;
       so.clamps = {FaceSelector::inPlane(0, 0.0)};

@@ -171,13 +171,13 @@ Model sphereModel(const TriangleSurface& surface, int cells, const std::string& 
 Scene dropScene(double duration, const SceneObstacle& obstacle) {
   Scene scene;
   scene.material = kMaterial;
-  scene.degree = 1;
+  scene.discretization.basis.degree = 1;
   scene.integrator = Integrator::BackwardEuler;
   scene.dt = kDt;
   scene.steps = static_cast<int>(std::lround(duration / kDt));
   scene.gravity = kGravity;
-  scene.massDamping = kMassDamping;
-  scene.stiffnessDamping = kStiffnessDamping;
+  scene.damping.mass = kMassDamping;
+  scene.damping.stiffness = kStiffnessDamping;
   scene.obstacles.push_back(obstacle);
   scene.contact.stiffness = kContactStiffness;
   scene.contact.points = ContactPoints::Surface;

@@ -70,8 +70,8 @@ std::vector<CutRequest> cutsThrough(const Box3& box) {
 /// the p-multigrid.
 SolveOptions clampedUnderGravity(const Box3& box, int up, int degree) {
   SolveOptions so;
-  so.method = Method::IP;
-  so.degree = degree;
+  so.discretization.method = Method::IP;
+  so.discretization.basis.degree = degree;
   so.material = benchmarkB2Material();
   so.gravity = -Vec3::Unit(up);
   so.clamps.push_back(FaceSelector::below(
@@ -84,8 +84,8 @@ SolveOptions clampedUnderGravity(const Box3& box, int up, int degree) {
 StaticReport cubeRun(int n, int degree) {
   Model cube(hexGridMesh(n, n, n, Box3(Vec3::Zero(), Vec3::Ones())));
   SolveOptions so;
-  so.method = Method::IP;
-  so.degree = degree;
+  so.discretization.method = Method::IP;
+  so.discretization.basis.degree = degree;
   so.material = benchmarkB2Material();
   so.gravity = Vec3(0, 0, -1);
   so.clamps.push_back(FaceSelector::inPlane(0, 0.0));

@@ -67,9 +67,7 @@ void linearFieldCoefficients(const DgBasis& basis, ElementId e, const LinearFiel
 
 StaticOptions staticOptions(const PhysicsCheckOptions& o) {
   StaticOptions s;
-  s.discretization.method = o.method;
-  s.discretization.basis = o.basis;
-  s.discretization.penalty = o.penalty;
+  s.discretization = o.discretization;
   s.solver.kind = SolverKind::Cholesky;
   return s;
 }

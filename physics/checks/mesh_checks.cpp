@@ -82,28 +82,26 @@ std::vector<std::string> MeshCheck::failures() const {
 
 MeshCheck checkMesh(const PolyMesh& mesh, const MeshCheckOptions& options,
                     const MomentCache* moments) {
-  if (options.degree < 1 || options.degree > 3)
-    throw std::invalid_argument("the degree of the DG checks must be 1, 2 or 3");
-  if (moments && moments->degree() < 2 * options.degree)
+  options.physics.discretization.check();
+  if (moments && moments->degree() < 2 * options.degree())
     throw std::invalid_argument("checkMesh: the moments are of degree " +
                                 std::to_string(moments->degree()) + ", the checks need " +
-                                std::to_string(2 * options.degree));
+                                std::to_string(2 * options.degree()));
   MeshCheck c;
-  c.degree = options.degree;
-  c.dofs = mesh.numElements() * 3 * numMonomials(options.degree);
+  c.degree = options.degree();
+  c.dofs = mesh.numElements() * 3 * numMonomials(options.degree());
   if (options.geometry) c.geometry = checkGeometry(mesh, options.geometryOptions);
   if (!c.geometryPassed()) {
     c.notes.push_back("DG checks skipped: the mesh failed the geometric validation");
     return c;
   }
-  PhysicsCheckOptions physics = options.physics;
-  physics.basis.degree = options.degree;
+  const PhysicsCheckOptions& physics = options.physics;
   const bool patch = wanted(options.patchTest, c.dofs, options, "global patch test", c.notes);
   const bool rigid = wanted(options.rigidModes, c.dofs, options, "global rigid modes", c.notes);
   // A global check reads every element's moments: integrate them once for all the checks.
   std::unique_ptr<MomentCache> own;
   if (!moments && (patch || rigid)) {
-    own = std::make_unique<MomentCache>(mesh, 2 * options.degree);
+    own = std::make_unique<MomentCache>(mesh, 2 * options.degree());
     c.facesIntegrated += own->update();
     moments = own.get();
   }
@@ -111,7 +109,7 @@ MeshCheck checkMesh(const PolyMesh& mesh, const MeshCheckOptions& options,
   if (options.local) {
     const Stopwatch watch;
     LocalDgCheckOptions local;
-    local.basis = physics.basis;
+    local.basis = physics.discretization.basis;
     local.material = physics.material;
     if (options.oneGridCellForAll) local.only = oneGridCellForAll(mesh);
     if (moments) {

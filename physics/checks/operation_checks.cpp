@@ -74,7 +74,7 @@ void checkOperation(const PolyMesh& mesh, const MomentCache& moments,
   }
   // Full: the whole-mesh checks of `polydg check`, both global checks whatever the size.
   MeshCheckOptions options;
-  options.degree = degree;
+  options.physics.discretization.basis.degree = degree;
   options.local = false;
   options.patchTest = GlobalCheck::Always;
   options.rigidModes = GlobalCheck::Always;

@@ -8,6 +8,16 @@
 
 namespace polydg {
 
+void DiscretizationOptions::check() const {
+  if (basis.degree < 1 || basis.degree > 3) throw InvalidOption("degree", "must be 1, 2 or 3");
+  if (bzPenalty != BzPenalty::Fixed && method != Method::BZ)
+    throw InvalidOption("bz_penalty", "the superpenalty is for the BZ method: use method bz");
+  if (penalty.rule == PenaltyRule::Fixed && !penalty.eta)
+    throw InvalidOption("eta", "a fixed penalty needs its eta");
+  if (penalty.eta && !(*penalty.eta > 0.0 && *penalty.eta < 1e300))
+    throw InvalidOption("eta", "the penalty must be a positive number");
+}
+
 double superpenaltyFactor(const PolyMesh& mesh, const DgBasis& basis, double referenceLength) {
   if (!(referenceLength >= 0.0 && std::isfinite(referenceLength)))
     throw std::invalid_argument("the BZ reference length must be positive and finite (or 0)");
@@ -48,8 +58,8 @@ FormCoefficients formCoefficients(const PolyMesh& mesh, const DgBasis& basis,
         form.elementEta = &elementEta;
       }
       break;
-    case PenaltyRule::Fixed: form.eta = disc.penalty.eta; break;
-    case PenaltyRule::Doubling: form.eta = disc.penalty.eta; break;
+    case PenaltyRule::Fixed: form.eta = disc.penalty.eta.value_or(0.0); break;
+    case PenaltyRule::Doubling: form.eta = disc.penalty.eta.value_or(kFirstDoublingEta); break;
   }
   if (!(form.eta > 0.0)) throw std::invalid_argument("the penalty eta must be positive");
   if (disc.method == Method::BZ && disc.bzPenalty == BzPenalty::Super) {

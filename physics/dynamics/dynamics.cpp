@@ -94,8 +94,8 @@ struct DynamicSolver::Impl final : SecondOrderSystem {
     stiffness->product(forceAtU().r, x, nullptr, out, nullptr);
   }
   Eigen::VectorXd externalForce(double t) const override;
-  double massDamping() const override { return options.massDamping; }
-  double stiffnessDamping() const override { return options.stiffnessDamping; }
+  double massDamping() const override { return options.damping.mass; }
+  double stiffnessDamping() const override { return options.damping.stiffness; }
   Eigen::VectorXd acceleration(const MotionState& s) const override;
   void beginStep(StepReport& report) override;
   Eigen::VectorXd solve(const ImplicitStep& step, StepReport& report) override;
@@ -116,7 +116,8 @@ void DynamicSolver::Impl::setup(const PolyMesh& m, const MomentCache& mc, const 
   moments = &mc;
   options = o;
   options.material.check();
-  if (!(o.massDamping >= 0.0) || !(o.stiffnessDamping >= 0.0))
+  options.discretization.check();
+  if (!(o.damping.mass >= 0.0) || !(o.damping.stiffness >= 0.0))
     throw std::invalid_argument("damping coefficients must not be negative");
   const int p = o.discretization.basis.degree;
   if (mc.degree() < 2 * p)
@@ -199,11 +200,11 @@ Eigen::VectorXd DynamicSolver::Impl::externalForce(double t) const {
 
 Eigen::VectorXd DynamicSolver::Impl::acceleration(const MotionState& s) const {
   Eigen::VectorXd rhs = externalForce(s.t) - forceAtU().f;
-  if (options.massDamping > 0.0 || options.stiffnessDamping > 0.0) {
+  if (options.damping.mass > 0.0 || options.damping.stiffness > 0.0) {
     Eigen::VectorXd mv, kv;
     massTimes(s.v, mv);
     stiffnessTimes(s.v, kv);
-    rhs -= options.massDamping * mv + options.stiffnessDamping * kv;
+    rhs -= options.damping.mass * mv + options.damping.stiffness * kv;
   }
   return mass->solve(rhs);
 }

@@ -46,8 +46,7 @@ struct DynamicsOptions {
   bool adaptivePreconditioner = true;
   bool corotational = true;
   Integrator integrator = Integrator::BackwardEuler;
-  double massDamping = 0.0;       ///< Rayleigh alpha: D = alpha M + beta K
-  double stiffnessDamping = 0.0;  ///< Rayleigh beta
+  RayleighDamping damping;  ///< D = alpha M + beta K
   /// CG with corotation: the step's matrix changes with the rotations; the preconditioner of
   /// an earlier matrix is kept until a step needs more than this many times the iterations of
   /// the first step after it was built, then rebuilt (a rebuild costs several iterations).

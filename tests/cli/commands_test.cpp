@@ -102,6 +102,14 @@ TEST_F(Commands, NonFiniteAndOutOfRangeValuesNameTheirOption) {
   expectRefused(runPolydg(solve + "--clamp x=0 --traction x=1:0,0"), "--traction");
   expectRefused(runPolydg(solve + "--clamp x=0 --eta inf"), "--eta");
   expectRefused(runPolydg(solve + "--clamp x=0 --method fem"), "--method");
+  // The material's and the discretization's own checks, named by the option.
+  expectRefused(runPolydg(solve + "--clamp x=0 --E 0"),
+                "Young's modulus must be a positive number");
+  expectRefused(runPolydg(solve + "--clamp x=0 --nu -1"), "Poisson's ratio must lie in (-1, 0.5)");
+  expectRefused(runPolydg(solve + "--clamp x=0 --degree 4"), "--degree");
+  expectRefused(runPolydg(solve + "--clamp x=0 --degree 0"), "must be 1, 2 or 3");
+  expectRefused(runPolydg(solve + "--clamp x=0 --eta 0"), "the penalty must be a positive number");
+  expectRefused(runPolydg("check " + mesh + " --degree 4"), "must be 1, 2 or 3");
   expectRefused(runPolydg("cut " + mesh + " -o " + path("c.vtu") + " --plane 1,0,0,nan"),
                 "--plane");
   expectRefused(runPolydg("cut " + mesh + " -o " + path("c.vtu") + " --plane 1,0,0,0 " +

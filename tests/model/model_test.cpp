@@ -91,13 +91,13 @@ TEST_F(ModelTest, EveryFaceIsIntegratedOnceAcrossCutCheckAndSolve) {
   EXPECT_EQ(model.facesIntegrated(), meshed + op.facesReintegrated);
 
   MeshCheckOptions check;
-  check.degree = 2;
+  check.physics.discretization.basis.degree = 2;
   const MeshCheck c = model.check(check);
   ASSERT_TRUE(c.passed());
   EXPECT_EQ(c.facesIntegrated, 0u);
 
   SolveOptions solve;
-  solve.degree = 2;
+  solve.discretization.basis.degree = 2;
   solve.clamps.push_back(FaceSelector::below(Plane::make(Vec3::UnitZ(), 0.0)));
   solve.gravity = Vec3(0.0, 0.0, -1.0);
   const SolveReport s = model.solve(solve);
@@ -106,7 +106,7 @@ TEST_F(ModelTest, EveryFaceIsIntegratedOnceAcrossCutCheckAndSolve) {
   EXPECT_EQ(model.facesIntegrated(), meshed + op.facesReintegrated);
 
   // A degree the cache does not hold integrates every face once more, and only once.
-  check.degree = 3;
+  check.physics.discretization.basis.degree = 3;
   const std::size_t faces = model.mesh().numFaces();
   model.check(check);
   model.check(check);
@@ -118,7 +118,7 @@ TEST_F(ModelTest, SelectionsPickTheFacesInTheirRegion) {
   Model model = unitBox(report);
   ASSERT_TRUE(report.passed());
   SolveOptions solve;
-  solve.degree = 1;
+  solve.discretization.basis.degree = 1;
   solve.gravity = Vec3(0.0, 0.0, -1.0);
   // The bottom z = 0: as a plane, as a half-space and as a thin box, the same 16 faces (the
   // unit box sliced by a 4 x 4 x 4 grid of cell 0.25 plus a layer of boundary cells).
@@ -192,7 +192,7 @@ TEST_F(ModelTest, SolveReportsAndWritesTheSolution) {
   MeshReport report;
   Model model = unitBox(report);
   SolveOptions solve;
-  solve.degree = 1;
+  solve.discretization.basis.degree = 1;
   solve.clamps = {FaceSelector::inPlane(2, 0.0)};
   solve.gravity = Vec3(0.0, 0.0, -1.0);
   const SolveReport r = model.solve(solve);
@@ -262,7 +262,7 @@ TEST_F(ModelTest, SplittingTheClampedFacesIntoManyTrianglesLeavesTheSolutionAlon
   so.clamps = {FaceSelector::inPlane(2, 0.15)};
   so.gravity = Vec3(0.0, 0.0, -1.0);
   for (int degree = 1; degree <= 2; ++degree) {
-    so.degree = degree;
+    so.discretization.basis.degree = degree;
     std::array<SolveReport, 2> r;
     for (int k = 0; k < 2; ++k) {
       MeshReport report;

@@ -129,6 +129,27 @@ TEST_F(PipelineTest, ErrorsNameTheFileAndThePlace) {
   EXPECT_NE(refused(R"({"steps": [{"step": "mesh", "cells": 4}, {"step": "mesh", "cells": 4}]})")
                 .find("steps[1]: the mesh step must be the first step"),
             std::string::npos);
+  // Values are the options' own checks (DiscretizationOptions, Material, SolveOptions), named
+  // at their keys: the rule a solve applies is the rule the file is read by.
+  const std::string clamp = R"("clamp": [{"below": [0, 0, 1, 0]}])";
+  const std::vector<std::pair<std::string, std::string>> values = {
+      {R"({"step": "check", "degree": 4})", "p.json: steps[0].degree: must be 1, 2 or 3"},
+      {R"({"step": "solve", "degree": 0, )" + clamp + "}", "steps[0].degree: must be 1, 2 or 3"},
+      {R"({"step": "solve", "penalty": "fixed", )" + clamp + "}",
+       "steps[0].eta: a fixed penalty needs its eta"},
+      {R"({"step": "solve", "eta": -1, )" + clamp + "}", "steps[0].eta: the penalty must be"},
+      {R"({"step": "solve", "bz_penalty": "super", )" + clamp + "}", "steps[0].bz_penalty: "},
+      {R"({"step": "solve", "material": {"E": 0}, )" + clamp + "}",
+       "steps[0].material.E: Young's modulus must be a positive number"},
+      {R"({"step": "solve", "material": {"nu": 0.6}, )" + clamp + "}", "steps[0].material.nu: "},
+      {R"({"step": "solve", "estimate": true, "method": "bz", )" + clamp + "}",
+       "steps[0].estimate: the error estimate is for the IP method"},
+      {R"({"step": "solve"})", "steps[0].clamp: nothing holds the body"},
+  };
+  for (const auto& [step, message] : values) {
+    const std::string got = refused(R"({"steps": [)" + step + "]}");
+    EXPECT_NE(got.find(message), std::string::npos) << step << "\n -> " << got;
+  }
 }
 
 }  // namespace

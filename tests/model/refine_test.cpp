@@ -28,7 +28,7 @@ Model barModel(const Vec3& offset = Vec3::Zero()) {
 /// B11's loads: E = 1000, nu = 0.3, clamped on x = 0, traction (0, 0, -1) on x = 9.
 SolveOptions barLoads(int degree, const Vec3& offset = Vec3::Zero()) {
   SolveOptions o;
-  o.degree = degree;
+  o.discretization.basis.degree = degree;
   o.material.youngsModulus = 1000.0;
   o.material.poissonRatio = 0.3;
   o.clamps = {FaceSelector::inPlane(0, offset.x())};
@@ -90,7 +90,7 @@ TEST(ModelRefine, RefinedMeshPassesTheDgChecksAndSolves) {
   const RefineReport r = model.refine(request);
   ASSERT_TRUE(r.operation.check.passed) << r.operation.check.failure;
   MeshCheckOptions checks;
-  checks.degree = 2;
+  checks.physics.discretization.basis.degree = 2;
   checks.patchTest = GlobalCheck::Always;
   checks.rigidModes = GlobalCheck::Always;
   const MeshCheck c = model.check(checks);

@@ -5,8 +5,10 @@
 
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <numbers>
 #include <regex>
+#include <tuple>
 
 #include "physics/dynamics/dynamics.h"
 #include "polydg/mesh/geometry_checks.h"
@@ -193,7 +195,7 @@ TEST(Simulate, DampedSimulationSettlesToTheStaticSolve) {
   // Model::solve with the same clamp, load and discretization.
   Model dynamic = beam(), statics = beam();
   SolveOptions so;
-  so.degree = 1;
+  so.discretization.basis.degree = 1;
   so.material = {1000, 0.3, 1};
   so.gravity = Vec3(0, 0, -1);
   so.clamps = {FaceSelector::inPlane(0, 0.0)};
@@ -217,13 +219,13 @@ TEST(Simulate, SceneKeyBzPenaltyReachesTheDiscretization) {
   // Model::solve's BZ super solution, which differs from BZ fixed's by far more than the tolerance.
   Model dynamic = beam(), statics = beam(), fixed = beam();
   SolveOptions so;
-  so.degree = 1;
-  so.method = Method::BZ;
+  so.discretization.basis.degree = 1;
+  so.discretization.method = Method::BZ;
   so.material = {1000, 0.3, 1};
   so.gravity = Vec3(0, 0, -1);
   so.clamps = {FaceSelector::inPlane(0, 0.0)};
   fixed.solve(so);
-  so.bzPenalty = BzPenalty::Super;
+  so.discretization.bzPenalty = BzPenalty::Super;
   statics.solve(so);
   json scene = json::parse(R"({"material": {"E": 1000, "nu": 0.3, "density": 1},
       "method": "bz", "bz_penalty": "super", "corotational": false, "dt": 5, "steps": 120,
@@ -283,7 +285,45 @@ TEST(Simulate, ScenesAreReadStrictly) {
   for (const auto& [scene, message] : bad) {
     const std::string got = refusal(scene);
     EXPECT_NE(got.find(message), std::string::npos) << scene << "\n -> " << got;
-    EXPECT_NE(got.find("see the scene format in README.md"), std::string::npos) << got;
+    EXPECT_NE(got.find("see the scene format in docs/guide.md"), std::string::npos) << got;
+  }
+}
+
+TEST(Simulate, OneCheckRefusesTheSameValuesInFilesAndInCode) {
+  // checkScene() is the one place: a file refuses a value at its key, and a scene made in code
+  // with the same value is refused by Model::simulate() with the same words.
+  const std::string base = R"("material": {"E": 1000, "nu": 0.3, "density": 1})";
+  const std::vector<std::tuple<std::string, std::function<void(Scene&)>, std::string>> cases = {
+      {R"("dt": 0, "steps": 3)", [](Scene& s) { s.dt = 0.0; },
+       "dt: the time step must be a positive number"},
+      {R"("dt": -0.1, "steps": 3)", [](Scene& s) { s.dt = -0.1; },
+       "dt: the time step must be a positive number"},
+      {R"("dt": 0.1, "steps": 0)", [](Scene& s) { s.steps = 0; }, "steps: must be"},
+      {R"("dt": 0.1, "steps": 3, "degree": 4)", [](Scene& s) { s.discretization.basis.degree = 4; },
+       "degree: must be 1, 2 or 3"},
+      {R"("dt": 0.1, "steps": 3, "bz_penalty": "super")",
+       [](Scene& s) { s.discretization.bzPenalty = BzPenalty::Super; }, "bz_penalty: "},
+      {R"("dt": 0.1, "steps": 3, "damping": {"mass": -1})", [](Scene& s) { s.damping.mass = -1; },
+       "damping.mass: must be a number >= 0"},
+      {R"("dt": 0.1, "steps": 3, "output": {"every": 0})", [](Scene& s) { s.outputEvery = 0; },
+       "output.every: "},
+      {R"("dt": 0.1, "steps": 3, "material": {"nu": 0.5})",
+       [](Scene& s) { s.material.poissonRatio = 0.5; }, "material.nu: "},
+  };
+  Model model = beam();
+  for (const auto& [keys, edit, message] : cases) {
+    std::string text = "{" + base + ", " + keys + "}";
+    if (keys.find("material") != std::string::npos) text = "{" + keys + "}";
+    const std::string got = refusal(text);
+    EXPECT_NE(got.find("scene.json: " + message), std::string::npos) << text << "\n -> " << got;
+    Scene scene = parseScene(json::parse("{" + base + R"(, "dt": 0.1, "steps": 3})"), "s");
+    edit(scene);
+    try {
+      model.simulate(scene, {});
+      ADD_FAILURE() << message << ": a scene made in code was not refused";
+    } catch (const InputError& e) {
+      EXPECT_EQ(std::string(e.what()).find(message), 0u) << e.what();
+    }
   }
 }
 

@@ -200,17 +200,13 @@ struct TractionLoad {
 
 /// A static solve (`polydg solve`, pipeline solve steps, Model.solve in Python).
 struct SolveOptions {
-  Method method = Method::IP;
-  /// Method::BZ: its penalty's scaling (DiscretizationOptions::bzPenalty); Super needs BZ.
-  BzPenalty bzPenalty = BzPenalty::Fixed;
-  int degree = 1;
   Material material;
+  /// Method, BZ penalty, basis degree and penalty rule (with eta for a fixed penalty).
+  DiscretizationOptions discretization;
   Vec3 gravity = Vec3::Zero();
   std::vector<FaceSelector> clamps;  ///< u = 0 (weakly) on each; at least one
   std::vector<TractionLoad> tractions;
   SolverKind solver = SolverKind::Auto;
-  PenaltyRule penalty = PenaltyRule::TraceBound;
-  double eta = 0.0;  ///< PenaltyRule::Fixed: the penalty; Doubling: the first value (0: 1)
   /// A body force per volume besides density * gravity (library and Python; empty: none).
   VectorField bodyForce;
   /// u = value (weakly) on each selection, besides the clamps (library and Python).
@@ -223,6 +219,10 @@ struct SolveOptions {
   GradientField exactGradient;
   /// Solve adaptively (the model is refined in place); unset: one solve.
   std::optional<AdaptOptions> adapt;
+
+  /// The one check of a solve's options (material, discretization, finite loads, something
+  /// that holds the body, the estimate's method): throws InvalidOption naming the key.
+  void check() const;
 };
 
 /// One round of an adaptive solve: the mesh it solved on and what it did next.

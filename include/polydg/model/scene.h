@@ -76,15 +76,16 @@ struct SceneAdapt {
 /// Everything a simulation needs besides the mesh.
 struct Scene {
   Material material;
-  Method method = Method::IP;
-  BzPenalty bzPenalty = BzPenalty::Fixed;  ///< Method::BZ: its penalty's scaling; Super needs BZ
-  int degree = 1;
+  /// Method, BZ penalty and basis degree (a scene keeps the default penalty rule).
+  DiscretizationOptions discretization;
   bool corotational = true;
   Integrator integrator = Integrator::BackwardEuler;
+  /// The time step: required (0 until given), checked by checkScene(), the one place, and the
+  /// argument of every step.
   double dt = 0.0;
   int steps = 0;  ///< "steps", or "duration" / dt rounded to the nearest whole step
   Vec3 gravity = Vec3::Zero();
-  double massDamping = 0.0, stiffnessDamping = 0.0;
+  RayleighDamping damping;
   std::vector<FaceSelector> fixed;      ///< regions held at u = 0; none: a free body
   std::vector<TimedTraction> loads;     ///< tractions, each until its time
   Vec3 velocity = Vec3::Zero();         ///< initial linear velocity
@@ -194,8 +195,13 @@ struct SimulationReport {
   std::size_t facesIntegrated = 0;  ///< by the simulation (moments of new faces after cuts)
 };
 
+/// The one check of a scene's values, for scenes read from files (parseScene() calls it) and
+/// made in code (Model::simulate() calls it): throws InvalidOption naming the key ("dt",
+/// "material.E", "cuts[2].time").
+void checkScene(const Scene& scene);
+
 /// The scene of a parsed JSON document; `file` names it in messages. Throws InputError
-/// ("FILE: PLACE: WHAT; see the scene format in README.md").
+/// ("FILE: PLACE: WHAT; see the scene format in docs/guide.md").
 Scene parseScene(const nlohmann::json& document, const std::string& file);
 /// The same from a file.
 Scene readScene(const std::string& file);

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <stdexcept>
+#include <string>
 
 namespace polydg {
 
@@ -15,6 +16,19 @@ struct Error : std::runtime_error {
 /// given (the CLI exits with 2). Nothing was changed or written.
 struct InputError : Error {
   using Error::Error;
+};
+
+/// A value an option may not take, named by its key in the formats users write (the keys of
+/// scenes, pipelines and Python: "E", "degree", "dt", "damping.mass"). The option's own check
+/// throws it; each front end says where the value came from (a file and its place, a
+/// command-line option).
+struct InvalidOption : std::invalid_argument {
+  InvalidOption(std::string key_, std::string problem_)
+      : std::invalid_argument(key_ + ": " + problem_),
+        key(std::move(key_)),
+        problem(std::move(problem_)) {}
+  std::string key;      ///< "E", "damping.mass", ...
+  std::string problem;  ///< "Young's modulus must be a positive number"
 };
 
 /// An operation that ran but whose result failed a check, or left nothing (the CLI exits

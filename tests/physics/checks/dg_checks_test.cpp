@@ -85,7 +85,7 @@ TEST_P(DgChecks, PatchTestReproducesLinearFields) {
   for (const NamedMesh& m : corpus()) {
     ASSERT_TRUE(checkGeometry(m.mesh).passed) << m.name;
     PhysicsCheckOptions options;
-    options.basis.degree = GetParam();
+    options.discretization.basis.degree = GetParam();
     const PatchTestResult r = patchTest(m.mesh, options);
     EXPECT_LT(r.relativeError, kPatchTolerance) << m.name;
     EXPECT_LT(r.maxElementError, kPatchTolerance) << m.name;
@@ -95,7 +95,7 @@ TEST_P(DgChecks, PatchTestReproducesLinearFields) {
 TEST_P(DgChecks, SixRigidZeroModesPerComponent) {
   for (const NamedMesh& m : corpus()) {
     PhysicsCheckOptions options;
-    options.basis.degree = GetParam();
+    options.discretization.basis.degree = GetParam();
     const ZeroModeReport r = rigidModes(m.mesh, options);
     EXPECT_EQ(r.zeroModes, 6 * r.components) << m.name;
     for (std::size_t c = 0; c < r.components; ++c)
@@ -111,8 +111,8 @@ TEST_P(DgChecks, ClampedStiffnessIsSymmetricPositiveDefinite) {
   for (const NamedMesh& m : corpus()) {
     for (Method method : {Method::IP, Method::BZ}) {
       PhysicsCheckOptions options;
-      options.basis.degree = GetParam();
-      options.method = method;
+      options.discretization.basis.degree = GetParam();
+      options.discretization.method = method;
       const DefinitenessReport r = definiteness(m.mesh, options);
       EXPECT_LT(r.asymmetry, kSymmetryTolerance) << m.name;
       EXPECT_TRUE(r.choleskySucceeded) << m.name;
@@ -126,14 +126,14 @@ INSTANTIATE_TEST_SUITE_P(Degrees, DgChecks, ::testing::Values(1, 2, 3),
 
 TEST(DgChecks, ScaledMonomialBasisPassesThePatchTest) {
   PhysicsCheckOptions options;
-  options.basis = {.degree = 2, .kind = BasisKind::ScaledMonomial};
+  options.discretization.basis = {.degree = 2, .kind = BasisKind::ScaledMonomial};
   EXPECT_LT(patchTest(lPrism(), options).relativeError, kPatchTolerance);
   EXPECT_EQ(rigidModes(lPrism(), options).zeroModes, 6u);
 }
 
 TEST(DgChecks, NearlyIncompressiblePatchTestAndRigidModes) {
   PhysicsCheckOptions options;
-  options.basis.degree = 2;
+  options.discretization.basis.degree = 2;
   options.material.poissonRatio = 0.4999;
   const PolyMesh grid = hexGridMesh(2, 2, 2, Box3(Vec3::Zero(), Vec3::Ones()));
   EXPECT_LT(patchTest(grid, options).relativeError, kPatchTolerance);

@@ -152,7 +152,7 @@ TEST(RegionChecks, WholeMeshAgreesWithTheGlobalChecks) {
   for (const PolyMesh& m : {two, grid4()}) {
     for (int degree : {1, 2}) {
       PhysicsCheckOptions global;
-      global.basis.degree = degree;
+      global.discretization.basis.degree = degree;
       const PatchTestResult patch = patchTest(m, global);
       const ZeroModeReport modes = rigidModes(m, global);
       const RegionDgCheck region = check(m, allOf(m), degree);

@@ -238,7 +238,7 @@ TEST(Dynamics, DampedMotionSettlesToTheStaticSolution) {
   const Eigen::VectorXd statics =
       solveStatic(beam.mesh, {1000.0, 0.3, 1.0}, loads, so, &beam.moments).coefficients;
   DynamicsOptions o = options(1, false, Integrator::BackwardEuler);
-  o.massDamping = 1.0;
+  o.damping.mass = 1.0;
   DynamicSolver solver(beam.mesh, beam.moments,
                        {{FaceSelector::inPlane(0, 0.0)}, {}, Vec3(0, 0, -1)}, o);
   double error = 1.0;

@@ -125,7 +125,7 @@ Rest restUnderEndLoad(const Cantilever& beam, double alpha, bool corotational) {
   o.discretization.basis.degree = 2;
   o.corotational = corotational;
   o.integrator = Integrator::BackwardEuler;
-  o.massDamping = 1.0;
+  o.damping.mass = 1.0;
   const double load = alpha * kEI / (kLength * kLength);
   const DynamicLoads loads{
       {FaceSelector::inPlane(0, 0.0)},

@@ -16,10 +16,8 @@ namespace polydg {
 
 /// The discretization checked (material and penalty as in a solve).
 struct PhysicsCheckOptions {
-  Method method = Method::IP;
-  BasisOptions basis{.degree = 1, .kind = BasisKind::Orthonormal};
-  PenaltyOptions penalty;
   Material material;
+  DiscretizationOptions discretization;
 };
 
 struct PatchTestResult {
@@ -42,7 +40,7 @@ inline constexpr double kLocalPatchTestTolerance = 1e-9;
 /// The discretization of the local checks: the IP method (BZ is inconsistent and fails any
 /// patch test), with the basis and material as in a solve.
 struct LocalDgCheckOptions {
-  BasisOptions basis{.degree = 1, .kind = BasisKind::Orthonormal};
+  BasisOptions basis;
   Material material;
   /// If not empty (one entry per element), only elements with a non-zero entry are checked;
   /// the others still give their neighbours the exact linear trace.
@@ -100,7 +98,6 @@ enum class GlobalCheck {
 };
 
 struct MeshCheckOptions {
-  int degree = 1;  ///< of the DG checks, 1..3
   /// The geometric validation (checkGeometry()). The DG checks presume a valid mesh and run only
   /// after it passed; a caller that validates in parallel itself (meshing) turns it off.
   bool geometry = true;
@@ -114,8 +111,10 @@ struct MeshCheckOptions {
   GlobalCheck patchTest = GlobalCheck::Never;       ///< patchTest() of the whole mesh
   GlobalCheck rigidModes = GlobalCheck::UpToLimit;  ///< rigidModes(): 6 per component
   std::size_t globalDofLimit = kGlobalRigidModesDofLimit;
-  PhysicsCheckOptions
-      physics;  ///< method, material, penalty of the DG checks (basis degree is `degree`)
+  PhysicsCheckOptions physics;  ///< material and discretization of the DG checks
+
+  /// The degree of the DG checks (physics.discretization.basis.degree).
+  int degree() const { return physics.discretization.basis.degree; }
 };
 
 /// What checkMesh() found; a check that did not run is empty and `notes` says why.

@@ -26,7 +26,7 @@ enum class BasisKind {
 };
 
 struct BasisOptions {
-  int degree = 2;  ///< total degree p, 1..3
+  int degree = 1;  ///< total degree p, 1..3
   BasisKind kind = BasisKind::Orthonormal;
 };
 

@@ -3,6 +3,8 @@
 // DiscretizationOptions, that every solve, check, time step and error estimate takes.
 #pragma once
 
+#include <optional>
+
 #include "polydg/physics/dg/dg_basis.h"
 
 namespace polydg {
@@ -38,17 +40,20 @@ enum class PenaltyRule {
   /// element (elementPenaltyThresholds()) unless PenaltyOptions::local is false, then the
   /// global penaltyThreshold().
   TraceBound,
-  /// The paper's rule (section 10): start at `eta` and double until the Cholesky
-  /// factorization succeeds. Costs one factorization per attempt.
+  /// The paper's rule (section 10): start at `eta` (unset: kFirstDoublingEta) and double
+  /// until the Cholesky factorization succeeds. Costs one factorization per attempt.
   Doubling,
-  /// eta = `eta` as given.
+  /// eta = `eta`, which must be given.
   Fixed,
 };
 
+/// PenaltyRule::Doubling's first eta when none is given.
+inline constexpr double kFirstDoublingEta = 1.0;
+
 struct PenaltyOptions {
   PenaltyRule rule = PenaltyRule::TraceBound;
-  double eta = 1.0;     ///< Fixed: the value; Doubling: the first value tried
-  double safety = 1.0;  ///< TraceBound: multiple of the threshold
+  std::optional<double> eta;  ///< Fixed: the value (required); Doubling: the first value tried
+  double safety = 1.0;        ///< TraceBound: multiple of the threshold
   /// TraceBound: each element's own bound eta_K (FormCoefficients::elementEta), so that a
   /// badly shaped element does not raise the penalty, and spoil the accuracy, everywhere; false:
   /// the largest bound for every face, as in the paper's global eta.
@@ -67,6 +72,11 @@ struct DiscretizationOptions {
   /// Degree of exactness of the quadrature for non-polynomial loads (body force function,
   /// Dirichlet data); -1 picks 2p + 2.
   int quadratureDegree = -1;
+
+  /// The one check of a discretization: throws InvalidOption (keys "degree", "bz_penalty",
+  /// "eta") unless the degree is 1, 2 or 3, the BZ superpenalty goes with the BZ method, a
+  /// fixed penalty has its eta and any eta is positive and finite.
+  void check() const;
 };
 
 }  // namespace polydg

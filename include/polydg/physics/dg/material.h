@@ -2,7 +2,7 @@
 // density, and the Lame parameters derived from them.
 #pragma once
 
-#include <stdexcept>
+#include "polydg/util/error.h"
 
 namespace polydg {
 
@@ -19,12 +19,16 @@ struct Material {
   double lambda() const {
     return youngsModulus * poissonRatio / ((1.0 + poissonRatio) * (1.0 - 2.0 * poissonRatio));
   }
-  /// Throws std::invalid_argument unless E > 0 and -1 < nu < 0.5 and density >= 0.
+  /// The one check of a material: throws InvalidOption (keys "E", "nu", "density") unless
+  /// 0 < E < 1e300, -0.999999 <= nu <= 0.499999999 (lambda finite and representable as nu
+  /// nears 1/2) and 0 <= density < 1e300.
   void check() const {
-    if (!(youngsModulus > 0.0)) throw std::invalid_argument("Young's modulus must be positive");
-    if (!(poissonRatio > -1.0 && poissonRatio < 0.5))
-      throw std::invalid_argument("Poisson's ratio must lie in (-1, 0.5)");
-    if (!(density >= 0.0)) throw std::invalid_argument("density must be non-negative");
+    if (!(youngsModulus > 0.0 && youngsModulus < 1e300))
+      throw InvalidOption("E", "Young's modulus must be a positive number");
+    if (!(poissonRatio >= -0.999999 && poissonRatio <= 0.499999999))
+      throw InvalidOption("nu", "Poisson's ratio must lie in (-1, 0.5), at most 0.499999999");
+    if (!(density >= 0.0 && density < 1e300))
+      throw InvalidOption("density", "the density must be a number >= 0");
   }
 };
 

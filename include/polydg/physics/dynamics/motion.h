@@ -22,6 +22,12 @@ enum class Integrator {
   Newmark,
 };
 
+/// Rayleigh damping D = mass M + stiffness K.
+struct RayleighDamping {
+  double mass = 0.0;
+  double stiffness = 0.0;
+};
+
 /// A constant traction on a region of the boundary that acts while t <= until.
 struct TimedTraction {
   FaceSelector where;
