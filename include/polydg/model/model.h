@@ -380,6 +380,7 @@ class Model {
 
  private:
   struct State;
+  friend class Simulation;  ///< model/simulation.h: a scene's run edits the model as it goes
   std::unique_ptr<State> state_;
 };
 
