@@ -13,7 +13,8 @@ RefineRequest RefinementFamilies::refinement(const ElementFields& fields,
   request.split = adapt.split;
   request.checks = CheckLevel::None;
   for (std::size_t e = 0; e < level_.size(); ++e)
-    if (level_[e] < adapt.maxLevel && std::abs(fields.principalStress[ElementId(e)]) > adapt.stress) {
+    if (level_[e] < adapt.maxLevel &&
+        std::abs(fields.principalStress[ElementId(e)]) > adapt.stress) {
       request.elements.push_back(ElementId(e));
       request.directions.push_back(fields.principalDirection[ElementId(e)]);
     }

@@ -87,7 +87,9 @@ std::string solverAction(const StepReport& r, SolverKind kind, bool first) {
 }
 
 /// Relative change from a to b.
-double relativeChange(double a, double b) { return std::abs(a - b) / std::max(std::abs(a), 1e-300); }
+double relativeChange(double a, double b) {
+  return std::abs(a - b) / std::max(std::abs(a), 1e-300);
+}
 
 }  // namespace
 
@@ -146,8 +148,7 @@ void Simulation::setInitialVelocity() {
 
 /// The surface carried along: the scene's "embed", or the contact points on the surface.
 void Simulation::embedSurface() {
-  contactOnSurface_ =
-      !scene_.obstacles.empty() && scene_.contact.points == ContactPoints::Surface;
+  contactOnSurface_ = !scene_.obstacles.empty() && scene_.contact.points == ContactPoints::Surface;
   if (!scene_.embed.enabled && !contactOnSurface_) return;
   const Stopwatch te;
   EmbeddingOptions eo;
@@ -257,8 +258,7 @@ void Simulation::finish() {
 /// the model's cut(); whether any was made.
 bool Simulation::cutsDue(double t) {
   bool made = false;
-  while (nextCut_ < scene_.cuts.size() &&
-         scene_.cuts[nextCut_].time <= t + 1e-9 * scene_.dt) {
+  while (nextCut_ < scene_.cuts.size() && scene_.cuts[nextCut_].time <= t + 1e-9 * scene_.dt) {
     const TimedCut& timed = scene_.cuts[nextCut_++];
     const Stopwatch tc;
     SimulationCut record;
@@ -294,10 +294,9 @@ bool Simulation::adaptationDue(int k) {
   const SceneAdapt& a = scene_.adapt;
   if (!a.enabled || k % a.every != 0) return false;
   const Stopwatch tr;
-  const ElementFields fields =
-      elementFields(model_.mesh(), solver_->basis(),
-                    model_.moments(2 * scene_.discretization.basis.degree),
-                    solver_->displacement(), scene_.material);
+  const ElementFields fields = elementFields(model_.mesh(), solver_->basis(),
+                                             model_.moments(2 * scene_.discretization.basis.degree),
+                                             solver_->displacement(), scene_.material);
   RefineRequest request = families_.refinement(fields, a);
   // A refinement if any element is marked, else a coarsening; the same steps around either.
   const bool coarsening = request.elements.empty();

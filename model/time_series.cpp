@@ -21,8 +21,8 @@ TimeSeries::TimeSeries(const fs::path& folder, VtuEncoding encoding)
 }
 
 SimulationFrame TimeSeries::write(const PolyMesh& mesh, const DynamicSolver& solver, int step,
-                                const TriangleSurface* surface,
-                                const Eigen::Matrix<double, Eigen::Dynamic, 3>* displacement) {
+                                  const TriangleSurface* surface,
+                                  const Eigen::Matrix<double, Eigen::Dynamic, 3>* displacement) {
   SimulationFrame frame;
   frame.step = step;
   frame.t = solver.time();

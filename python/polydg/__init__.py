@@ -234,7 +234,7 @@ def _simulate(self, scene, output=None, progress=None):
     ``scene``, with its cuts made at their times on this model. Afterwards the model holds the
     cut mesh and, as its solution, the final displacement (``element_displacements``, ``write``).
 
-    scene: a dict in the scene format of README.md (material, dt, steps or duration, gravity,
+    scene: a dict in the scene format of docs/guide.md (material, dt, steps or duration, gravity,
     fixed, loads, initial, cuts, embed, obstacles, contact, ...), or the path (str or
     os.PathLike) of a scene JSON file (files it names are relative to its folder; a dict's,
     to the working directory). Every key is checked before the run starts.
@@ -270,7 +270,7 @@ def _embedding_weights(self, surface=None, degree=None, support=2.0):
 
     surface: a surface file (any format ``read_surface`` reads), or None for the surface the
     mesh was sliced from (its provenance's source). degree: of the DG basis (default: the last
-    solution's, else 1). support: the kernels' support in element sizes (README, "Embedding").
+    solution's, else 1). support: the kernels' support in element sizes (docs/guide.md, "Embedded surfaces and collisions").
 
     Returns a dict: rows, cols (int64) and values (float64), the nonzeros of W with shape
     ``shape`` = (3 V, dofs), so that the surface's displacement is u = W @ U
