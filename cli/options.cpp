@@ -58,21 +58,22 @@ CLI::Validator libraryRule(std::function<void(double)> rule) {
       "", "NUMBER");
 }
 
-const CLI::Validator kYoungsModulus = libraryRule([](double e) {
-  Material m;
-  m.youngsModulus = e;
-  m.check();
-});
-const CLI::Validator kPoissonRatio = libraryRule([](double nu) {
-  Material m;
-  m.poissonRatio = nu;
-  m.check();
-});
-const CLI::Validator kDensity = libraryRule([](double rho) {
-  Material m;
-  m.density = rho;
-  m.check();
-});
+namespace {
+
+/// Material::check() of a material with `field` set to the value.
+CLI::Validator materialRule(double Material::*field) {
+  return libraryRule([field](double value) {
+    Material m;
+    m.*field = value;
+    m.check();
+  });
+}
+
+}  // namespace
+
+const CLI::Validator kYoungsModulus = materialRule(&Material::youngsModulus);
+const CLI::Validator kPoissonRatio = materialRule(&Material::poissonRatio);
+const CLI::Validator kDensity = materialRule(&Material::density);
 const CLI::Validator kDegree = libraryRule([](double p) {
   DiscretizationOptions d;
   d.basis.degree = p >= 0 && p <= 1e6 ? static_cast<int>(p) : -1;

@@ -86,6 +86,13 @@ std::string solverAction(const StepReport& r, SolverKind kind, bool first) {
   return cg + (first || r.preconditionerRebuilt ? "preconditioner built" : "preconditioner reused");
 }
 
+/// Stops the run at an edit whose checks failed (the model is then broken, as after cut()).
+void requirePassed(const OperationCheck& check, const char* what, double time) {
+  if (!check.passed)
+    throw CheckFailure(std::string(what) + " at t = " + std::to_string(time) + " failed (" +
+                       check.failure + "); the simulation stops there");
+}
+
 /// Relative change from a to b.
 double relativeChange(double a, double b) {
   return std::abs(a - b) / std::max(std::abs(a), 1e-300);
@@ -267,9 +274,7 @@ bool Simulation::cutsDue(double t) {
     const DgBasis oldBasis = solver_->basis();
     const Eigen::VectorXd oldU = solver_->displacement(), oldV = solver_->velocity();
     record.report = model_.cut(timed.request);
-    if (!record.report.check.passed)
-      throw CheckFailure("the cut at t = " + std::to_string(record.time) + " failed (" +
-                         record.report.check.failure + "); the simulation stops there");
+    requirePassed(record.report.check, "the cut", record.time);
     record.elementsAfter = model_.mesh().numElements();
     report_.cutSeconds += tc.seconds();
     families_.afterCut(record.report.lineage, record.elementsAfter);
@@ -313,18 +318,14 @@ bool Simulation::adaptationDue(int k) {
   if (coarsening) {
     record.coarsened = coarsenRequest.groups.size();
     const CoarsenReport c = model_.coarsen(coarsenRequest);
-    if (!c.operation.check.passed)
-      throw CheckFailure("the coarsening at t = " + std::to_string(record.time) + " failed (" +
-                         c.operation.check.failure + "); the simulation stops there");
+    requirePassed(c.operation.check, "the coarsening", record.time);
     lineage = c.operation.lineage;
     families_.afterCoarsening(lineage, model_.mesh().numElements());
   } else {
     if (a.split == RefineSplit::Octants) request.directions.clear();
     record.marked = request.elements.size();
     const RefineReport r = model_.refine(request);
-    if (!r.operation.check.passed)
-      throw CheckFailure("the refinement at t = " + std::to_string(record.time) + " failed (" +
-                         r.operation.check.failure + "); the simulation stops there");
+    requirePassed(r.operation.check, "the refinement", record.time);
     lineage = r.operation.lineage;
     std::unordered_set<std::uint32_t> refined;
     for (ElementId e : request.elements) refined.insert(e.value);

@@ -3,8 +3,8 @@
 // from library code that runs without the GIL. Private to python/.
 #pragma once
 
-#include <pybind11/pybind11.h>
 #include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
 
 #include <cstring>
 #include <optional>

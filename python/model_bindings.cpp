@@ -154,8 +154,7 @@ ElementId elementOf(std::int64_t e) {
   return ElementId(static_cast<std::uint32_t>(e));
 }
 
-py::object refine(Model& model, const std::vector<std::int64_t>& elements,
-                  const std::string& split,
+py::object refine(Model& model, const std::vector<std::int64_t>& elements, const std::string& split,
                   const std::optional<std::vector<std::array<double, 3>>>& directions,
                   std::optional<double> mergeSlivers, const std::string& validate) {
   RefineRequest request;
@@ -274,9 +273,7 @@ py::dict embed(Model& model, const std::string& surface, int degree, double supp
   options.support = support;
   if (deformed && !model.solution())
     throw InputError("the model has no solution to deform the surface with; solve first");
-  const int p = degree > 0         ? degree
-                : model.solution() ? model.solution()->basis->degree()
-                                   : 1;
+  const int p = degree > 0 ? degree : model.solution() ? model.solution()->basis->degree() : 1;
   EmbeddedSurface e;
   Eigen::Matrix<double, Eigen::Dynamic, 3> u;
   Eigen::SparseMatrix<double, Eigen::RowMajor, int> w;

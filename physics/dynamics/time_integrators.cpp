@@ -12,6 +12,29 @@ constexpr double kNewmarkBeta = 0.25, kNewmarkGamma = 0.5;
 /// one to two digits each (B7's spinning cube).
 constexpr int kSecondOrderSolves = 12;
 
+/// The coefficients of a step whose unknown x is the velocity at its end, V_{n+1}: U_{n+1} =
+/// u0 + c x and (M + c D + c^2 K_w) x = rhs - c f(U_n), the form of backward Euler (c = dt) and
+/// BDF2 (c = 2 dt / 3).
+ImplicitStep velocityStep(const SecondOrderSystem& system, const MotionState& s, double dt,
+                          double c) {
+  ImplicitStep p;
+  p.time = s.t + dt;
+  p.dt = dt;
+  p.cM = 1.0 + c * system.massDamping();
+  p.cK = c * system.stiffnessDamping() + c * c;
+  p.forceScale = c;
+  p.cU = c;
+  p.cV = 1.0;
+  return p;
+}
+
+/// Backward Euler's right-hand side M V_n + dt F(t_{n+1}) and u0 = U_n.
+void poseEuler(const SecondOrderSystem& system, const MotionState& s, ImplicitStep& p) {
+  system.massTimes(s.v, p.rhs);
+  p.rhs += p.dt * system.externalForce(p.time);
+  p.u0 = s.u;
+}
+
 }  // namespace
 
 Eigen::VectorXd TimeIntegrator::guess(const Eigen::VectorXd& last) const {
@@ -40,22 +63,13 @@ StepReport BackwardEuler::step(SecondOrderSystem& system, MotionState& s, double
   StepReport report;
   system.beginStep(report);
   const Stopwatch posing;
-  ImplicitStep p;
-  p.time = s.t + dt;
-  p.dt = dt;
-  p.cM = 1.0 + dt * system.massDamping();
-  p.cK = dt * system.stiffnessDamping() + dt * dt;
-  p.forceScale = dt;
-  system.massTimes(s.v, p.rhs);
-  p.rhs += dt * system.externalForce(p.time);
-  p.u0 = s.u;
-  p.cU = dt;
-  p.cV = 1.0;
+  ImplicitStep p = velocityStep(system, s, dt, dt);
+  poseEuler(system, s, p);
   p.guess = guess(s.v);
   report.assemblySeconds += posing.seconds();
   Eigen::VectorXd x = system.solve(p, report);
   remember(s.v);
-  s.u = s.u + dt * x;
+  s.u = p.u0 + dt * x;
   s.v = std::move(x);
   s.t = p.time;
   report.t = s.t;
@@ -77,12 +91,7 @@ StepReport Bdf2::step(SecondOrderSystem& system, MotionState& s, double dt) {
   // dt) is backward Euler's.
   const bool bdf2 = hasPrevious_ && dt == previousDt_;
   const double c = bdf2 ? 2.0 * dt / 3.0 : dt;
-  ImplicitStep p;
-  p.time = s.t + dt;
-  p.dt = dt;
-  p.cM = 1.0 + c * system.massDamping();
-  p.cK = c * system.stiffnessDamping() + c * c;
-  p.forceScale = c;
+  ImplicitStep p = velocityStep(system, s, dt, c);
   p.automaticSolves = kSecondOrderSolves;
   if (bdf2) {
     Eigen::VectorXd kd, mv;
@@ -91,12 +100,8 @@ StepReport Bdf2::step(SecondOrderSystem& system, MotionState& s, double dt) {
     p.rhs = mv + c * (system.externalForce(p.time) - kd);
     p.u0 = (4.0 * s.u - uPrevious_) / 3.0;
   } else {
-    system.massTimes(s.v, p.rhs);
-    p.rhs += dt * system.externalForce(p.time);
-    p.u0 = s.u;
+    poseEuler(system, s, p);
   }
-  p.cU = c;
-  p.cV = 1.0;
   p.guess = guess(s.v);
   report.assemblySeconds += posing.seconds();
   Eigen::VectorXd x = system.solve(p, report);
