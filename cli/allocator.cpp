@@ -4,7 +4,7 @@
 // Meshing builds hundreds of MB of small, short-lived buffers (plane splits, faces, element
 // lists) and solving allocates K and its preconditioner once, large. With glibc's malloc on
 // 4 KiB pages, `polydg mesh` of a 75k-triangle scan at 64 cells spent about a third of its wall
-// time in page faults (measured: 1.76 s median against 1.17 s with huge pages, same binary).
+// time in page faults.
 // jemalloc reads this string when it starts (before main), then /etc/malloc.conf, then the
 // environment variable MALLOC_CONF, each overriding the one before: a user who wants other
 // settings sets MALLOC_CONF. Where the system has transparent huge pages disabled ("never"),

@@ -123,8 +123,8 @@ double largestEigenvalue(const Eigen::MatrixXd& a) {
 }
 
 /// Asks the kernel for transparent huge pages on the 2 MiB-aligned part of a fresh, untouched
-/// allocation: K's arrays (69 MB for B2 with IP, p = 2) then fault in 2 MiB at a time instead
-/// of 4 KiB, which was a seventh of the assembly time. A hint only; ignored where unsupported.
+/// allocation: K's arrays then fault in 2 MiB at a time instead of 4 KiB, whose faults were a
+/// seventh of the assembly time. A hint only; ignored where unsupported.
 void adviseHugePages(void* data, std::size_t bytes) {
 #ifdef MADV_HUGEPAGE
   constexpr std::uintptr_t kHuge = std::uintptr_t(1) << 21;

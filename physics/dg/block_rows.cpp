@@ -11,8 +11,7 @@ namespace {
 /// The row-product kernels are compiled three times, for AVX-512 (x86-64-v4), AVX2 with FMA
 /// (x86-64-v3) and the x86-64 baseline (SSE2), and the loader picks the best the CPU has
 /// (GCC function multiversioning). The build itself targets the baseline, so the binary runs
-/// anywhere. On this machine (AVX-512), B2 with IP: the solve took 22.8-23.1 instead of
-/// 26.0 ms for p = 1, 148-161 instead of 169 ms for p = 2.
+/// anywhere; the wide clones take about a tenth off the solve (docs/benchmarks.md).
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
 #define POLYDG_SIMD_CLONES \
   __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
@@ -24,8 +23,8 @@ namespace {
 #define POLYDG_INLINE inline __attribute__((always_inline))
 
 /// out -= (A x)_e with N functions per component (0: a.n, known at run time only): compile-time
-/// sizes for the DG degrees let the short column loops unroll and vectorize (B2 with BZ,
-/// p = 1: the solve took 15.6 instead of 22.8 ms).
+/// sizes for the DG degrees let the short column loops unroll and vectorize (a third of the
+/// solve time, docs/benchmarks.md).
 template <int N, class T>
 POLYDG_INLINE void subtractRows(const BlockRows<T>& a, int e, const double* x, double* out) {
   const int n = N > 0 ? N : a.n, bs = 3 * n;

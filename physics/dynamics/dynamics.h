@@ -53,12 +53,11 @@ struct DynamicsOptions {
   double refreshRatio = 1.5;
   /// Corotation: solves per step. 1 is the paper's semi-implicit step (forces linearized once,
   /// at the step's start): right for backward Euler, whose step then keeps a spinning body's
-  /// angular momentum (B7: 1e-5 in a turn), but not for the second-order integrators, whose
-  /// once-linearized steps gain energy with fast rotations (B7: +28% angular momentum in a
-  /// turn). Further solves correct the force at the last solution's state with the same matrix
-  /// (modified Newton). 0: automatic, 1 for backward Euler, and for BDF2 and Newmark as many as
-  /// it takes for the relative correction to fall below correctionTolerance (at most 12; B7:
-  /// angular momentum kept to 4e-4 with Newmark).
+  /// angular momentum, but not for the second-order integrators, whose once-linearized steps
+  /// gain energy in fast rotations (B7 in docs/benchmarks.md). Further solves correct the force
+  /// at the last solution's state with the same matrix (modified Newton). 0: automatic, the
+  /// integrator's (1 for backward Euler; for BDF2 and Newmark as many as it takes for the
+  /// relative correction to fall below correctionTolerance, at most 12).
   int corotationSolves = 0;
   double correctionTolerance = 1e-6;
 };

@@ -11,8 +11,8 @@ namespace polydg {
 /// Keeps freed memory in the process for reuse instead of returning it to the kernel:
 /// polydg allocates and frees large arrays again and again (a stiffness matrix per solve, per
 /// pipeline input, per cut's region check), and memory fresh from the kernel must first be
-/// faulted in and zeroed, about 0.15 ms per MB here: B2's assembly with BZ and p = 2 (a 30 MB
-/// matrix) took 8 ms with fresh pages and 3 ms with reused ones. The price: the process keeps
+/// faulted in and zeroed, about 0.15 ms per MB, more than an assembly of it takes. The price:
+/// the process keeps
 /// its peak footprint until it exits (glibc only; elsewhere the default policy stays).
 inline void keepFreedMemory() {
 #ifdef M_MMAP_THRESHOLD

@@ -85,9 +85,9 @@ struct ZeroModeReport {
 
 /// Largest number of DOFs (elements x 3 numMonomials(degree)) for which the global zero modes
 /// are counted when GlobalCheck::UpToLimit asks for them (rigidModes(): assembly, then a CHOLMOD
-/// factorization and subspace iteration per component). Measured on sliced spheres, degree 1,
-/// two cores: 4.9k DOFs 0.22 s, 14k 0.9 s, 22k 1.5 s, 31k 2.6 s, 58k 6.0 s, 100k 12 s; the
-/// limit keeps the count under 2 s. Larger meshes get the element-local checks only.
+/// factorization and subspace iteration per component), whose cost grows faster than the DOFs:
+/// the limit keeps it under about 2 s on two cores (docs/benchmarks.md). Larger meshes get the
+/// element-local checks only.
 inline constexpr std::size_t kGlobalRigidModesDofLimit = 25'000;
 
 /// When a global check (one assembly and factorization of the whole mesh) runs.

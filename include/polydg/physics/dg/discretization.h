@@ -27,7 +27,7 @@ enum class BzPenalty {
   /// For p >= 2 it multiplies the penalty of the whole jump. For p = 1 it multiplies only the
   /// penalty of the jump's mean over each face (the rest of the jump keeps eta_F): on the whole
   /// jump it would force the solution towards continuous complete linears, which on a hex grid
-  /// are only the global linears, and the error locked (B1, n = 4 -> 8: L2 2.2e-3 -> 2.0e-3).
+  /// are only the global linears, and the error locked (B1's L2 error stalled at 2e-3).
   /// With continuous face means instead, the limit is a nonconforming P1 method (face-mean
   /// continuity, as Crouzeix-Raviart's), which passes the patch test: for a constant stress
   /// the missing flux term sigma n . int_F [v] vanishes. FormCoefficients::bzFactorOnMean.
