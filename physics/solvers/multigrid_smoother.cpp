@@ -16,8 +16,8 @@ namespace polydg::multigrid {
 namespace {
 
 /// D^-1 of one symmetric positive definite block D (column-major, BS x BS) into `inverse`;
-/// false if D is not positive definite. Fixed sizes: a 30 x 30 block inverts 3-4x faster
-/// than with Eigen's dynamic-size LLT (p = 2 setup on B2).
+/// false if D is not positive definite. Fixed sizes, which Eigen's LLT inverts several times
+/// faster than dynamic ones.
 template <int BS>
 bool invertBlock(const double* block, double* inverse) {
   using Mat = Eigen::Matrix<double, BS, BS>;

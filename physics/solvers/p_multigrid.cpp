@@ -50,31 +50,22 @@ constexpr Eigen::Index kSimplicialAggregateLimit = 1000;
 /// the angle between their unknowns in the energy inner product) is at least
 /// smootherStrongCoupling(p) = sqrt(3)/2, or 3/4 for p = 1 (physics/solvers/strong_coupling.h). On
 /// hex grids no pair is that strong, so their smoother is unchanged; across faces of elements
-/// clipped by the surface gamma comes close to 1. Measured when the penalty still grew with an
-/// element's face count (eq. 7's area(F), penaltyThreshold()): joining pairs down to 1/sqrt(2)
-/// helped the bunny more (p = 1: 58 instead of 64 iterations) but joined cube elements too and cost
-/// the cube 1-2 iterations at p = 2.
+/// clipped by the surface gamma comes close to 1. A lower threshold would join elements of hex
+/// grids too, which costs them iterations.
 ///
 /// Most blocks in one smoother group, and so most unknowns. Strong couplings chain along a
-/// clipped surface layer; groups of up to 16 took the bunny at p = 2 from 82 (up to 8) to 74
-/// iterations (with that penalty), and larger caps gave no more. Most groups are pairs.
+/// clipped surface layer; 16 blocks take in such chains, and larger caps saved no iterations.
+/// Most groups are pairs.
 constexpr int kMaxGroupBlocks = 16;
 constexpr int kMaxGroupUnknowns = kMaxGroupBlocks * kMaxBlock;
 
 /// When agglomeration stops. The coarsest level is factorized once and solved once per
 /// V-cycle; its factorization should cost about one V-cycle on K. A coarse matrix with 12 x 12
-/// blocks on a 3D mesh factorizes in about 13 N^2 flops for N unknowns (B2: 28.7 MFlop at
-/// 1,500 unknowns, 0.9 at 324), about what a V-cycle costs at 13 flops per nonzero of K when
-/// N^2 = nnz(K). So agglomeration continues while N^2 > nnz(K), and at least down to
-/// kCoarseUnknowns. On B2 (nnz(K) = 4.0e5 for BZ, p = 1) that is 125 linear groups (1,500
-/// unknowns), 27 quadratic ones (810) and 8 (240): 21 iterations (with linear groups of
-/// groups, 324 unknowns: 24; with the 1,500 exact: 21, but 10-13 ms of factorization instead
-/// of 0.7). For p = 2 (nnz(K) = 2.5e6) 125 quadratic groups (3,750) and 27 (810): 26
-/// iterations (the 1,500 unknowns of linear groups, when p = 2 went through degree 1, were
-/// kept exact: 25). Denser 30 x 30 blocks cost more flops per N^2 (about 2.5 times), but a
-/// bound scaled to them (N^2 <= 0.4 nnz(K)) cost iterations (a 24 x 24 x 1 plate, p = 2: 45
-/// instead of 36; the 48^3 cube, p = 1, BZ: 26 instead of 22) and saved neither memory nor
-/// time there (IP: 810 coarse unknowns instead of 6,480), so the rule stays.
+/// blocks on a 3D mesh factorizes in about 13 N^2 flops for N unknowns, about what a V-cycle
+/// costs at 13 flops per nonzero of K when N^2 = nnz(K). So agglomeration continues while
+/// N^2 > nnz(K), and at least down to kCoarseUnknowns. Denser 30 x 30 blocks cost more flops
+/// per N^2, but a bound scaled to them (N^2 <= 0.4 nnz(K)) cost iterations and saved neither
+/// memory nor time, so the rule stays.
 constexpr Eigen::Index kCoarseUnknowns = 600;
 
 /// Functions per component of degree `degree`: numMonomials, checked against the block size.
@@ -143,11 +134,8 @@ struct PMultigrid::Impl {
       Cholesky& c = *coarse[i];
       c.cholmod().print = 0;
       // Small coarse levels: simplicial. The supernodal solve calls the threaded BLAS twice
-      // per V-cycle and its thread hand-offs cost more than the solve (B2, 3000 unknowns of
-      // degree 0: 42 instead of 70 ms of CG iterations for p = 1, factorization 4 ms slower).
-      // Agglomeration levels have dense 12 x 12 (or 30 x 30) blocks, where the supernodal
-      // factorization wins sooner (B2: 324 unknowns 0.7 ms simplicial, 1.2 supernodal; 1,500
-      // unknowns 13.7 and 9.5-11 ms, the solves equally fast).
+      // per V-cycle and its thread hand-offs cost more than the solve. Agglomeration levels
+      // have dense 12 x 12 (or 30 x 30) blocks, where the supernodal factorization wins sooner.
       const Eigen::Index simplicialLimit =
           level.bs == 3 ? kSimplicialCoarseLimit : kSimplicialAggregateLimit;
       if (factored.rows() <= simplicialLimit) c.setMode(Eigen::CholmodSimplicialLLt);
@@ -231,8 +219,8 @@ struct PMultigrid::Impl {
   /// Keeps of an agglomeration level that is smoothed (not the coarsest) only what its
   /// smoother reads: its matrix by block rows in single precision, converted from the double
   /// ones that served the grouping and the Galerkin product of the next level, which are
-  /// freed. Holding them (and, then, a CSR matrix) at levels 1 and 2 took the peak memory of
-  /// `polydg solve` on the 48^3 cube (p = 1, IP, 1.3 million DOFs) from 1.77 to 1.94 GB.
+  /// freed: held (with, then, a CSR matrix) at levels 1 and 2, they would raise the peak memory
+  /// of a large solve.
   void keepSmootherCopyOnly(Level& level) {
     level.blocks.convertFrom(level.exact);
     level.useBlocks = true;
@@ -243,7 +231,7 @@ struct PMultigrid::Impl {
   /// Appends a coarser level that owns `matrix`. Re-points every owned matrix: the vector
   /// may have moved the levels. Eigen 3.4's SparseMatrix has no move constructor or
   /// assignment: a Level moved with its matrix, or a returned matrix assigned, copies every
-  /// nonzero (0.25 s of the 1.9 s setup on the 48^3 cube, p = 1); the matrix is swapped in.
+  /// nonzero; the matrix is swapped in.
   void push(Level&& level, SpMat matrix = SpMat()) {
     levels.push_back(std::move(level));
     levels.back().owned.swap(matrix);
@@ -280,8 +268,8 @@ struct PMultigrid::Impl {
                               else
                                 blockResidual(level, group[i], b, x, s + i * bs);
                             }
-                            // x_g += D_g^-1 s (D_g^-1 column-major): a plain loop, where Eigen's
-                            // dynamic-size GEMV call cost a tenth of the CG time on B2.
+                            // x_g += D_g^-1 s (D_g^-1 column-major): a plain loop, cheaper than
+                            // Eigen's dynamic-size GEMV call for blocks this small.
                             const double* inverse =
                                 level.inverses.data() +
                                 level.inverseOffset[static_cast<std::size_t>(g)];
@@ -478,12 +466,8 @@ bool PMultigrid::Impl::build(const SpMat* matrix, const BlockRows<double>* rows,
     // quadratic functions: groups of 4 x 4 x 4 cells and more span the thin parts of a real
     // model (the bunny's ears), which bend within a group (for p = 1, linear groups take the
     // Taylor parts of their parent's quadratics). They have an eighth of the blocks of the
-    // level before each (at p = 1 the first quadratic level, with 30 x 30 blocks, has 0.8 of
-    // the nonzeros of the linear level above it), so they sweep twice: a V-cycle with two
-    // agglomeration levels then needs about as many iterations as one with an exact first
-    // agglomeration level on B2 (not on the bunny at 16 cells: p = 1 34-37 against 31, p = 2
-    // 38-44 against 36-37, measured before groups kept the pieces of a cell apart and the p = 1
-    // smoother joined blocks from 3/4, which took it to 32-33 and 38-39; README, "Speed").
+    // level before each, so they sweep twice: a V-cycle with two agglomeration levels then
+    // needs about as many iterations as one with an exact first agglomeration level on B2.
     const double limit = std::max(static_cast<double>(kCoarseUnknowns), std::sqrt(nonzeros));
     while (static_cast<double>(m.levels.back().unknowns()) > limit) {
       const Eigen::Index before = m.levels.back().unknowns();
@@ -503,9 +487,9 @@ bool PMultigrid::Impl::build(const SpMat* matrix, const BlockRows<double>* rows,
     // Level 0 couples elements through the penalty, mu eta_F [u].[v], which couples equal
     // components only, and (IP) the lifting of the normal jump, which couples components
     // through n n^T. K stores the element blocks whole, so level 0 inherits explicit zeros
-    // that would make CHOLMOD factorize a coupled pattern: on B2 (3000 unknowns) 62 MFlop and
-    // 30-50 ms, against 7 MFlop and 5 ms once exact zeros are dropped (the three components
-    // then separate wherever the normals are axis-aligned, and for BZ everywhere).
+    // that would make CHOLMOD factorize a coupled pattern, several times the work of the
+    // pattern without them (the three components then separate wherever the normals are
+    // axis-aligned, and for BZ everywhere).
     m.levels.back().owned.prune([](Eigen::Index, Eigen::Index, double v) { return v != 0.0; });
   }
   std::atomic<bool> ok{true};
