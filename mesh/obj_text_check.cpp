@@ -14,15 +14,8 @@ namespace polydg {
 
 namespace {
 
-using surface_text::coordinateProblem;
-using surface_text::integerValue;
-using surface_text::isSpace;
-using surface_text::LineReader;
-using surface_text::numbers;
-using surface_text::quoted;
-using surface_text::realValue;
-using surface_text::splitWords;
-using surface_text::uncommented;
+// The line and word readers, number parsing and message wording of surface_text_reading.h.
+using namespace surface_text;
 
 /// Keywords that need no word here: groups, materials, display and rendering attributes, and
 /// the `p` and `l` primitives (counted, skipped by design).

@@ -16,15 +16,8 @@
 
 namespace polydg {
 
-using surface_text::coordinateProblem;
-using surface_text::integerValue;
-using surface_text::LineReader;
-using surface_text::numbers;
-using surface_text::quoted;
-using surface_text::realValue;
-using surface_text::splitWords;
-using surface_text::uncommented;
-using surface_text::WordReader;
+// The line and word readers, number parsing and message wording of surface_text_reading.h.
+using namespace surface_text;
 
 void ReadWarnings::add(std::size_t line, const std::string& what) {
   ++count_;
