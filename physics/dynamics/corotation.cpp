@@ -167,14 +167,14 @@ int CorotatedStiffness::partsOf(std::size_t i, const RowSlot& s, Part out[3]) co
 void CorotatedStiffness::product(const std::vector<Eigen::Matrix3d>& r, const Eigen::VectorXd& x,
                                  const Eigen::VectorXd* z, Eigen::VectorXd& out,
                                  double* energy) const {
-  detail::dispatchBasisDegree(
-      degree_, [&](auto p) { productOf<numMonomials(p())>(r, x, z, out, energy); });
+  detail::dispatchBasisDegree(degree_,
+                              [&](auto p) { productOf<numMonomials(p())>(r, x, z, out, energy); });
 }
 
 template <int N>
-void CorotatedStiffness::productOf(const std::vector<Eigen::Matrix3d>& r,
-                                   const Eigen::VectorXd& x, const Eigen::VectorXd* z,
-                                   Eigen::VectorXd& out, double* energy) const {
+void CorotatedStiffness::productOf(const std::vector<Eigen::Matrix3d>& r, const Eigen::VectorXd& x,
+                                   const Eigen::VectorXd* z, Eigen::VectorXd& out,
+                                   double* energy) const {
   constexpr int BS = 3 * N;
   using Vec = Eigen::Matrix<double, BS, 1>;
   using Components = Eigen::Matrix<double, N, 3>;  // column d: component d
@@ -205,9 +205,8 @@ void CorotatedStiffness::productOf(const std::vector<Eigen::Matrix3d>& r,
           };
           // Row i's block B against column element `col`, warped with element `source`'s
           // rotation (-1: not warped); B column-major or row-major.
-          auto apply = [&](const double* b, bool columnMajor, std::int64_t source,
-                           std::size_t col, bool rowDifference = false,
-                           bool columnDifference = false) {
+          auto apply = [&](const double* b, bool columnMajor, std::int64_t source, std::size_t col,
+                           bool rowDifference = false, bool columnDifference = false) {
             const bool warp = source >= 0 && corotational_;
             const Eigen::Matrix3d* rot = warp ? &r[static_cast<std::size_t>(source)] : nullptr;
             side(rot, col, columnDifference, w);

@@ -81,8 +81,8 @@ class CorotatedStiffness {
   void productOf(const std::vector<Eigen::Matrix3d>& r, const Eigen::VectorXd& x,
                  const Eigen::VectorXd* z, Eigen::VectorXd& out, double* energy) const;
   template <int N>
-  void assembleOf(const std::vector<Eigen::Matrix3d>& r, const std::vector<double>& mass,
-                  double cM, double cK, LocalMatrices& system) const;
+  void assembleOf(const std::vector<Eigen::Matrix3d>& r, const std::vector<double>& mass, double cM,
+                  double cK, LocalMatrices& system) const;
 
   SplitLocalMatrices parts_;
   bool corotational_ = true;

@@ -15,8 +15,7 @@ constexpr int kBlockJacobiLimit = 80;
 
 }  // namespace
 
-StepSolver::StepSolver(const StepSolverOptions& options, const ElementFrames& frames,
-                       int blockSize)
+StepSolver::StepSolver(const StepSolverOptions& options, const ElementFrames& frames, int blockSize)
     : options_(options), frames_(&frames), blockSize_(blockSize), active_(options.solver) {
   if (options_.adaptivePreconditioner) active_.preconditioner = CgPreconditioner::BlockJacobi;
   solver_ = LinearSolver(active_);
@@ -56,11 +55,12 @@ void StepSolver::prepare(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>
   }
 }
 
-void StepSolver::prepareWithContact(
-    const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix, StepReport& report) {
+void StepSolver::prepareWithContact(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix,
+                                    StepReport& report) {
   const bool direct = chooseSolver(matrix, active_) == SolverKind::Cholesky;
   if (!solver_.compute(matrix, blockSize_, direct ? nullptr : frames_) && direct)
-    throw std::runtime_error("the time step's system matrix with contacts is not positive definite");
+    throw std::runtime_error(
+        "the time step's system matrix with contacts is not positive definite");
   report.refactorized = direct;
   report.preconditionerRebuilt = !direct;
   ready_ = false;
