@@ -197,23 +197,30 @@ ElementData<std::uint32_t> connectedComponents(const PolyMesh& mesh, std::size_t
   return component;
 }
 
-GeometryCheck checkGeometry(const PolyMesh& mesh, const GeometryCheckOptions& options) {
-  GeometryCheck report;
-  Problems problems(report, options.maxMessages);
-  report.elements = mesh.numElements();
-  report.faces = mesh.numFaces();
+namespace {
 
-  // Faces: shape and planarity in parallel (the costly part), then links, duplicates and the
-  // report in order.
-  struct FaceCheck {
-    bool degenerate = false;
-    double planarity = 0.0;  ///< relative deviation, if beyond the tolerance; else 0
-    std::uint64_t key = 0;   ///< hash of the sorted vertex ids
-  };
-  std::vector<FaceCheck> checks(mesh.numFaces());
-  // Each face's area vector and bounds, once: the elements' volumes below reuse them.
-  FaceData<Vec3> areaVectors(mesh.numFaces(), Vec3::Zero());
-  FaceData<Box3> faceBoxes(mesh.numFaces());
+/// What checkGeometry() finds about one face in parallel.
+struct FaceCheck {
+  bool degenerate = false;
+  double planarity = 0.0;  ///< relative deviation, if beyond the tolerance; else 0
+  std::uint64_t key = 0;   ///< hash of the sorted vertex ids
+};
+
+/// Every face's FaceCheck, with its area vector and bounds, computed once: the elements'
+/// volumes reuse them.
+struct FaceMeasures {
+  std::vector<FaceCheck> checks;
+  FaceData<Vec3> areaVectors;
+  FaceData<Box3> boxes;
+};
+
+/// Shape and planarity of every face, in parallel (the costly part of the face checks).
+FaceMeasures measureFaces(const PolyMesh& mesh, const GeometryCheckOptions& options) {
+  FaceMeasures m{std::vector<FaceCheck>(mesh.numFaces()),
+                 FaceData<Vec3>(mesh.numFaces(), Vec3::Zero()), FaceData<Box3>(mesh.numFaces())};
+  std::vector<FaceCheck>& checks = m.checks;
+  FaceData<Vec3>& areaVectors = m.areaVectors;
+  FaceData<Box3>& faceBoxes = m.boxes;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.numFaces(), 1024),
                     [&](const tbb::blocked_range<std::size_t>& r) {
                       for (std::size_t i = r.begin(); i != r.end(); ++i) {
@@ -235,6 +242,13 @@ GeometryCheck checkGeometry(const PolyMesh& mesh, const GeometryCheckOptions& op
                           c.planarity = deviation / diameter;
                       }
                     });
+  return m;
+}
+
+/// Counts interior and boundary faces and reports, face by face in order, shape, planarity
+/// and links to elements.
+void reportFaces(const PolyMesh& mesh, const std::vector<FaceCheck>& checks, Problems& problems,
+                 GeometryCheck& report) {
   for (std::size_t i = 0; i < mesh.numFaces(); ++i) {
     const Face& face = mesh.face(FaceId(i));
     if (face.front.valid() && face.back.valid())
@@ -256,7 +270,11 @@ GeometryCheck checkGeometry(const PolyMesh& mesh, const GeometryCheckOptions& op
       problems.add(report.inconsistentFaces, describe("face used only from its back:", i));
     }
   }
-  // Duplicates: faces with equal vertex-set hashes, confirmed by comparing the sets.
+}
+
+/// Duplicates: faces with equal vertex-set hashes, confirmed by comparing the sets.
+void reportDuplicateFaces(const PolyMesh& mesh, const std::vector<FaceCheck>& checks,
+                          Problems& problems, GeometryCheck& report) {
   // (key, face) pairs sorted in parallel: faces with equal keys end up adjacent, by id.
   std::vector<std::pair<std::uint64_t, std::size_t>> keyed(mesh.numFaces());
   tbb::parallel_for(std::size_t(0), mesh.numFaces(), [&](std::size_t i) {
@@ -283,16 +301,20 @@ GeometryCheck checkGeometry(const PolyMesh& mesh, const GeometryCheckOptions& op
                            "elements, or twice with the same orientation)");
     a = b;
   }
+}
 
-  // Elements: closure and volume in parallel (they are the costly part), then links back to
-  // faces and the report in order.
+/// Elements: closure and volume in parallel (they are the costly part), then links back to
+/// faces and the report in order.
+void reportElements(const PolyMesh& mesh, const FaceMeasures& faces, Problems& problems,
+                    GeometryCheck& report) {
   std::vector<char> closed(mesh.numElements());
   std::vector<double> volumes(mesh.numElements());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.numElements(), 512),
                     [&](const tbb::blocked_range<std::size_t>& r) {
                       for (std::size_t i = r.begin(); i != r.end(); ++i) {
                         closed[i] = isClosed(mesh, ElementId(i));
-                        volumes[i] = signedVolume(mesh, ElementId(i), areaVectors, faceBoxes);
+                        volumes[i] =
+                            signedVolume(mesh, ElementId(i), faces.areaVectors, faces.boxes);
                       }
                     });
   bool first = true;
@@ -326,6 +348,20 @@ GeometryCheck checkGeometry(const PolyMesh& mesh, const GeometryCheckOptions& op
       problems.add(report.nonPositiveElements, msg.str());
     }
   }
+}
+
+}  // namespace
+
+GeometryCheck checkGeometry(const PolyMesh& mesh, const GeometryCheckOptions& options) {
+  GeometryCheck report;
+  Problems problems(report, options.maxMessages);
+  report.elements = mesh.numElements();
+  report.faces = mesh.numFaces();
+  // Faces: shape and planarity in parallel, then links, duplicates and the report in order.
+  const FaceMeasures faces = measureFaces(mesh, options);
+  reportFaces(mesh, faces.checks, problems, report);
+  reportDuplicateFaces(mesh, faces.checks, problems, report);
+  reportElements(mesh, faces, problems, report);
 
   connectedComponents(mesh, report.components);
   report.passed = report.openElements == 0 && report.nonPositiveElements == 0 &&

@@ -2,22 +2,24 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
-#include <numeric>
 #include <stdexcept>
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Exact_rational.h>
 
+#include "mesh/loop_tracing.h"
 #include "util/union_find.h"
 
 namespace polydg {
 
 namespace {
 
-using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
-using Point2 = Kernel::Point_2;
 using Exact = CGAL::Exact_rational;
+using loop_tracing::DirectedEdge;
+using loop_tracing::EdgeList;
+using loop_tracing::groupLoops;
+using loop_tracing::Small;
+using loop_tracing::traceLoops;
 
 /// Where segment p q meets `plane`, exactly: the point's coordinate k (p and q on opposite
 /// exact sides of the plane, so the denominator is not zero).
@@ -29,51 +31,6 @@ Exact exactCrossing(const Plane& plane, const Vec3& p, const Vec3& q, int k) {
   }
   const Exact t = (Exact(plane.offset) - np) / (nq - np);
   return Exact(p[k]) + t * (Exact(q[k]) - Exact(p[k]));
-}
-
-/// Projection of a plane with normal n onto the coordinate plane that drops n's largest
-/// component; `sign` is +1 when the projection keeps orientation (counter-clockwise about n
-/// stays counter-clockwise in 2D), -1 when it flips it.
-struct Projection {
-  int u = 0, w = 1;
-  int sign = 1;
-  explicit Projection(const Vec3& n) {
-    int k = 0;
-    if (std::abs(n.y()) > std::abs(n[k])) k = 1;
-    if (std::abs(n.z()) > std::abs(n[k])) k = 2;
-    u = (k + 1) % 3;
-    w = (k + 2) % 3;
-    sign = n[k] >= 0 ? 1 : -1;
-  }
-  Point2 operator()(const Vec3& p) const { return Point2(p[u], p[w]); }
-};
-
-struct DirectedEdge {
-  std::uint32_t from, to;
-};
-
-// Scratch containers of one split: most hold a handful of entries, kept inline (no allocation).
-template <class T, std::size_t N = 16>
-using Small = boost::container::small_vector<T, N>;
-using EdgeList = Small<DirectedEdge>;
-using LoopList = Small<Small<std::uint32_t>, 2>;
-
-/// Exact point-in-loop test in 2D: 1 inside, 0 outside, -1 on the boundary.
-int locate(const Point2& p, const std::vector<Point2>& loop) {
-  bool inside = false;
-  const std::size_t n = loop.size();
-  for (std::size_t i = 0; i < n; ++i) {
-    const Point2& a = loop[i];
-    const Point2& b = loop[(i + 1) % n];
-    const CGAL::Orientation o = CGAL::orientation(a, b, p);
-    if (o == CGAL::COLLINEAR && CGAL::collinear_are_ordered_along_line(a, p, b)) return -1;
-    if ((a.y() > p.y()) != (b.y() > p.y())) {
-      // The edge straddles the horizontal through p: does it cross to the right of p?
-      const bool upward = b.y() > a.y();
-      if ((o == CGAL::LEFT_TURN) == upward) inside = !inside;
-    }
-  }
-  return inside ? 1 : 0;
 }
 
 }  // namespace
@@ -189,124 +146,6 @@ Vec3 PlaneSplitter::polygonNormal(const PiecePolygon& polygon) const {
 
 namespace {
 
-/// Traces closed loops from directed edges; where several edges leave a vertex (a pinch), takes
-/// the first one clockwise from the reversed incoming edge, so the region to the left of each
-/// loop is a proper face (the loops at a pinch are kept apart). `normal` orients the plane.
-/// Loops come in the order of their first edge in `edges` and start with it, so callers give
-/// the edges in an order that follows the geometry: point ids do not, since the ids of points
-/// made by splits running in parallel depend on the schedule.
-template <class PointOf>
-LoopList traceLoops(const EdgeList& edges, const PointOf& points, const Vec3& normal) {
-  Small<std::size_t> order(edges.size());  // by start point, for finding the edges leaving one
-  std::iota(order.begin(), order.end(), 0);
-  std::sort(order.begin(), order.end(), [&](std::size_t i, std::size_t j) {
-    return edges[i].from != edges[j].from ? edges[i].from < edges[j].from : i < j;
-  });
-  auto outgoing = [&](std::uint32_t v) {
-    auto lo = std::lower_bound(order.begin(), order.end(), v,
-                               [&](std::size_t i, std::uint32_t x) { return edges[i].from < x; });
-    auto hi = lo;
-    while (hi != order.end() && edges[*hi].from == v) ++hi;
-    return std::make_pair(lo, hi);
-  };
-  const Projection project(normal);
-  auto angleFrom = [&](std::uint32_t at, std::uint32_t back, std::uint32_t to) {
-    const Vec3 r = points(back) - points(at), d = points(to) - points(at);
-    const double ru = r[project.u], rw = r[project.w], du = d[project.u], dw = d[project.w];
-    double a = std::atan2(project.sign * (ru * dw - rw * du), ru * du + rw * dw);
-    if (a <= 0) a += 2 * std::numbers::pi;  // (0, 2 pi]: going straight back ranks last
-    if (to == back) a = 0.0;
-    return a;
-  };
-
-  Small<char> used(edges.size(), 0);
-  LoopList loops;
-  for (std::size_t start = 0; start < edges.size(); ++start) {
-    if (used[start]) continue;
-    Small<std::uint32_t> loop{edges[start].from};
-    used[start] = 1;
-    std::size_t current = start;
-    for (std::size_t guard = 0;; ++guard) {
-      if (guard > edges.size()) throw std::logic_error("traceLoops: loop does not close");
-      const std::uint32_t v = edges[current].to, back = edges[current].from;
-      auto [lo, hi] = outgoing(v);
-      std::size_t best = edges.size();
-      double bestAngle = -1.0;
-      for (auto it = lo; it != hi; ++it) {
-        if (used[*it] && *it != start) continue;
-        const double a = angleFrom(v, back, edges[*it].to);
-        if (a > bestAngle) {
-          bestAngle = a;
-          best = *it;
-        }
-      }
-      if (best == edges.size())
-        throw std::logic_error("traceLoops: open chain of edges (the piece is not closed)");
-      if (best == start) break;
-      used[best] = 1;
-      loop.push_back(v);
-      current = best;
-    }
-    loops.push_back(std::move(loop));
-  }
-  return loops;
-}
-
-/// Groups loops into polygons: loops counter-clockwise about `normal` are outer boundaries,
-/// clockwise ones are holes, each put in the smallest outer loop that contains it. A loop whose
-/// rounded area is zero (its points collapsed by rounding) stays a polygon of its own: it is
-/// needed to keep the piece closed, and welding identical points removes it later.
-template <class PointOf>
-Small<PiecePolygon, 2> groupLoops(const LoopList& loops, const PointOf& points, const Vec3& normal,
-                                  FaceOrigin origin) {
-  const Vec3 n = normal.normalized();
-  Small<double, 4> area(loops.size());
-  for (std::size_t k = 0; k < loops.size(); ++k) {
-    const auto& loop = loops[k];
-    const Vec3& c = points(loop[0]);
-    Vec3 a = Vec3::Zero();
-    for (std::size_t i = 1; i + 1 < loop.size(); ++i)
-      a += (points(loop[i]) - c).cross(points(loop[i + 1]) - c);
-    area[k] = 0.5 * a.dot(n);
-  }
-  Small<std::size_t, 4> outers, holes;
-  for (std::size_t k = 0; k < loops.size(); ++k) {
-    if (loops[k].size() < 3) continue;
-    (area[k] >= 0 ? outers : holes).push_back(k);
-  }
-  Small<PiecePolygon, 2> polygons(outers.size());
-  for (std::size_t i = 0; i < outers.size(); ++i) {
-    polygons[i].vertices.assign(loops[outers[i]].begin(), loops[outers[i]].end());
-    polygons[i].loopEnd = {static_cast<std::uint32_t>(loops[outers[i]].size())};
-    polygons[i].origin = origin;
-  }
-  if (holes.empty()) return polygons;
-
-  const Projection project(n);
-  std::vector<std::vector<Point2>> outer2(outers.size());
-  for (std::size_t i = 0; i < outers.size(); ++i)
-    for (std::uint32_t v : loops[outers[i]]) outer2[i].push_back(project(points(v)));
-  for (std::size_t h : holes) {
-    std::size_t best = outers.size();
-    for (std::size_t i = 0; i < outers.size(); ++i) {
-      if (best != outers.size() && area[outers[i]] >= area[outers[best]]) continue;
-      // The hole is inside the outer loop if a hole vertex off that loop's boundary is inside.
-      for (std::uint32_t v : loops[h]) {
-        const int where = locate(project(points(v)), outer2[i]);
-        if (where < 0) continue;
-        if (where > 0) best = i;
-        break;
-      }
-    }
-    if (best == outers.size())
-      throw std::logic_error("groupLoops: a hole lies in no outer boundary");
-    PiecePolygon& p = polygons[best];
-    p.vertices.insert(p.vertices.end(), loops[h].begin(), loops[h].end());
-    p.loopEnd.push_back(static_cast<std::uint32_t>(p.vertices.size()));
-  }
-  return polygons;
-}
-
 PiecePolygon reversed(const PiecePolygon& p) {
   PiecePolygon r = p;
   for (std::size_t k = 0; k < p.numLoops(); ++k)
@@ -314,165 +153,217 @@ PiecePolygon reversed(const PiecePolygon& p) {
   return r;
 }
 
+/// A corner of a loop subdivided at the split plane, with its exact side of the plane.
+struct Corner {
+  std::uint32_t v;
+  int side;
+};
+using CornerLoop = Small<Corner>;
+/// A point on the cut line: (its rounded position along the line, its id).
+using LinePoint = std::pair<double, std::uint32_t>;
+
+/// The fast path of splitPolygon(): one loop that meets L in exactly two corners, both
+/// crossings. The boundary crosses L twice, so the polygon meets L in the one segment between
+/// them, and each side is its chain of corners closed by that segment. False (nothing added)
+/// for any other loop.
+bool splitAtTwoCrossings(const CornerLoop& loop, FaceOrigin origin, Piece& minus, Piece& plus) {
+  const std::size_t m = loop.size();
+  std::size_t zeros = 0, first = m, second = m;
+  for (std::size_t i = 0; i < m; ++i)
+    if (loop[i].side == 0) {
+      ++zeros;
+      (first == m ? first : second) = i;
+    }
+  if (zeros == 2 && second - first > 1 && second - first + 1 < m &&
+      loop[(first + m - 1) % m].side != loop[(first + 1) % m].side) {
+    // Corners first..second on one side, second..first (wrapping) on the other.
+    PiecePolygon a, b;
+    a.origin = b.origin = origin;
+    for (std::size_t i = first; i <= second; ++i) a.vertices.push_back(loop[i].v);
+    for (std::size_t i = second; i != first; i = (i + 1) % m) b.vertices.push_back(loop[i].v);
+    b.vertices.push_back(loop[first].v);
+    a.loopEnd = {static_cast<std::uint32_t>(a.vertices.size())};
+    b.loopEnd = {static_cast<std::uint32_t>(b.vertices.size())};
+    const bool aIsMinus = loop[first + 1].side < 0;
+    minus.push_back(std::move(aIsMinus ? a : b));
+    plus.push_back(std::move(aIsMinus ? b : a));
+    return true;
+  }
+  return false;
+}
+
 }  // namespace
 
-void PlaneSplitter::splitPolygon(const PiecePolygon& polygon, const SplitPlane& plane, Piece& minus,
-                                 Piece& plus) {
-  // 1. The loops with every crossing edge subdivided at its intersection point.
-  struct Corner {
-    std::uint32_t v;
-    int side;
-  };
-  Small<Small<Corner>, 2> loops(polygon.numLoops());
-  for (std::size_t k = 0; k < polygon.numLoops(); ++k) {
-    const std::size_t begin = polygon.loopBegin(k), end = polygon.loopEnd[k];
-    for (std::size_t i = begin; i < end; ++i) {
-      const std::uint32_t a = polygon.vertices[i];
-      const std::uint32_t b = polygon.vertices[i + 1 == end ? begin : i + 1];
-      const int sa = side(a, plane), sb = side(b, plane);
-      loops[k].push_back({a, sa});
-      if (sa * sb < 0) loops[k].push_back({edgePoint(a, b, plane), 0});
+/// Splitting one polygon that crosses the plane (splitPolygon()), step by step: its loops
+/// subdivided at the plane, the line L where its plane meets the split plane, its points on L
+/// in order along L, and the directed edges of each side.
+class PlaneSplitter::PolygonCut {
+ public:
+  /// 1. The loops with every crossing edge subdivided at its intersection point.
+  PolygonCut(PlaneSplitter& splitter, const PiecePolygon& polygon, const SplitPlane& plane)
+      : splitter_(splitter), polygon_(polygon), loops_(polygon.numLoops()) {
+    for (std::size_t k = 0; k < polygon.numLoops(); ++k) {
+      const std::size_t begin = polygon.loopBegin(k), end = polygon.loopEnd[k];
+      for (std::size_t i = begin; i < end; ++i) {
+        const std::uint32_t a = polygon.vertices[i];
+        const std::uint32_t b = polygon.vertices[i + 1 == end ? begin : i + 1];
+        const int sa = splitter.side(a, plane), sb = splitter.side(b, plane);
+        loops_[k].push_back({a, sa});
+        if (sa * sb < 0) loops_[k].push_back({splitter.edgePoint(a, b, plane), 0});
+      }
     }
   }
 
-  // Fast path: one loop that meets L in exactly two corners, both crossings. The boundary
-  // crosses L twice, so the polygon meets L in the one segment between them, and each side is
-  // its chain of corners closed by that segment.
-  if (loops.size() == 1) {
-    const auto& loop = loops[0];
-    const std::size_t m = loop.size();
-    std::size_t zeros = 0, first = m, second = m;
-    for (std::size_t i = 0; i < m; ++i)
-      if (loop[i].side == 0) {
-        ++zeros;
-        (first == m ? first : second) = i;
-      }
-    if (zeros == 2 && second - first > 1 && second - first + 1 < m &&
-        loop[(first + m - 1) % m].side != loop[(first + 1) % m].side) {
-      // Corners first..second on one side, second..first (wrapping) on the other.
-      PiecePolygon a, b;
-      a.origin = b.origin = polygon.origin;
-      for (std::size_t i = first; i <= second; ++i) a.vertices.push_back(loop[i].v);
-      for (std::size_t i = second; i != first; i = (i + 1) % m) b.vertices.push_back(loop[i].v);
-      b.vertices.push_back(loop[first].v);
-      a.loopEnd = {static_cast<std::uint32_t>(a.vertices.size())};
-      b.loopEnd = {static_cast<std::uint32_t>(b.vertices.size())};
-      const bool aIsMinus = loop[first + 1].side < 0;
-      minus.push_back(std::move(aIsMinus ? a : b));
-      plus.push_back(std::move(aIsMinus ? b : a));
-      return;
-    }
+  /// splitAtTwoCrossings() for a polygon of one loop; false otherwise.
+  bool splitFast(Piece& minus, Piece& plus) const {
+    return loops_.size() == 1 && splitAtTwoCrossings(loops_[0], polygon_.origin, minus, plus);
   }
 
-  // 2. Positions along the line L = polygon plane ∩ split plane, in the direction t that has
-  //    the minus side on its left (seen from the polygon's normal).
-  const Vec3 n = polygonNormal(polygon);
-  const Vec3 t = n.cross(plane.normal);
-  int k = 0;
-  if (std::abs(t.y()) > std::abs(t[k])) k = 1;
-  if (std::abs(t.z()) > std::abs(t[k])) k = 2;
-  const double direction = t[k] > 0 ? 1.0 : -1.0;
-  auto key = [&](std::uint32_t v) { return direction * point(v)[k]; };
+  /// 2. Positions along the line L = polygon plane ∩ split plane, in the direction t that has
+  ///    the minus side on its left (seen from the polygon's normal).
+  void orientLine(const SplitPlane& plane) {
+    n_ = splitter_.polygonNormal(polygon_);
+    t_ = n_.cross(plane.normal);
+    if (std::abs(t_.y()) > std::abs(t_[k_])) k_ = 1;
+    if (std::abs(t_.z()) > std::abs(t_[k_])) k_ = 2;
+    direction_ = t_[k_] > 0 ? 1.0 : -1.0;
+  }
 
-  // 3. Points on L, and parity toggles where the boundary crosses L (a run of on-L corners
-  //    entered from one side and left to the other).
-  Small<std::pair<double, std::uint32_t>> onLine;
-  Small<std::uint32_t> toggles;  // ids of the points where the boundary crosses L
-  Small<std::pair<std::uint32_t, std::uint32_t>> alongLine;  // boundary edges on L
-  for (const auto& loop : loops) {
-    const std::size_t m = loop.size();
-    std::size_t start = m;
-    for (std::size_t i = 0; i < m; ++i)
-      if (loop[i].side != 0) {
-        start = i;
-        break;
-      }
-    if (start == m) continue;  // a loop lying in L has no area; nothing to split
-    int before = loop[start].side;
-    for (std::size_t step = 1; step <= m; ++step) {
-      const Corner& c = loop[(start + step) % m];
-      if (c.side == 0) {
-        onLine.emplace_back(key(c.v), c.v);
-        const Corner& next = loop[(start + step + 1) % m];
-        if (next.side == 0) alongLine.emplace_back(std::min(c.v, next.v), std::max(c.v, next.v));
-        // Find where this run of on-L corners ends.
-        std::size_t run = step;
-        while (loop[(start + run + 1) % m].side == 0) ++run;
-        const int after = loop[(start + run + 1) % m].side;
-        if (after != before) toggles.push_back(c.v);
-        for (std::size_t r = step + 1; r <= run; ++r) {
-          const Corner& cr = loop[(start + r) % m];
-          onLine.emplace_back(key(cr.v), cr.v);
-          const Corner& cn = loop[(start + r + 1) % m];
-          if (cn.side == 0) alongLine.emplace_back(std::min(cr.v, cn.v), std::max(cr.v, cn.v));
+  /// 3. Points on L, and parity toggles where the boundary crosses L (a run of on-L corners
+  ///    entered from one side and left to the other).
+  void findLinePoints() {
+    for (const auto& loop : loops_) {
+      const std::size_t m = loop.size();
+      std::size_t start = m;
+      for (std::size_t i = 0; i < m; ++i)
+        if (loop[i].side != 0) {
+          start = i;
+          break;
         }
-        step = run;
-      } else {
-        before = c.side;
+      if (start == m) continue;  // a loop lying in L has no area; nothing to split
+      int before = loop[start].side;
+      for (std::size_t step = 1; step <= m; ++step) {
+        const Corner& c = loop[(start + step) % m];
+        if (c.side == 0) {
+          onLine_.emplace_back(key(c.v), c.v);
+          const Corner& next = loop[(start + step + 1) % m];
+          if (next.side == 0) alongLine_.emplace_back(std::min(c.v, next.v), std::max(c.v, next.v));
+          // Find where this run of on-L corners ends.
+          std::size_t run = step;
+          while (loop[(start + run + 1) % m].side == 0) ++run;
+          const int after = loop[(start + run + 1) % m].side;
+          if (after != before) toggles_.push_back(c.v);
+          for (std::size_t r = step + 1; r <= run; ++r) {
+            const Corner& cr = loop[(start + r) % m];
+            onLine_.emplace_back(key(cr.v), cr.v);
+            const Corner& cn = loop[(start + r + 1) % m];
+            if (cn.side == 0) alongLine_.emplace_back(std::min(cr.v, cn.v), std::max(cr.v, cn.v));
+          }
+          step = run;
+        } else {
+          before = c.side;
+        }
       }
     }
   }
-  // Order along t; rounded coordinates that tie are ordered exactly.
-  // A polygon of round-off size has no meaningful direction t; its points can then tie on
-  // coordinate k, and the other coordinates (exactly, in t's direction) order them instead.
-  auto before = [&](const std::pair<double, std::uint32_t>& x,
-                    const std::pair<double, std::uint32_t>& y) {
+
+  /// Orders the points on L along t, drops repeats and throws if two distinct points
+  /// coincide; sorts the toggles and the boundary edges on L for lookup.
+  void orderLinePoints() {
+    const auto before = [this](const LinePoint& x, const LinePoint& y) { return ahead(x, y); };
+    std::sort(onLine_.begin(), onLine_.end(), before);
+    onLine_.erase(std::unique(onLine_.begin(), onLine_.end(),
+                              [](const auto& x, const auto& y) { return x.second == y.second; }),
+                  onLine_.end());
+    for (std::size_t i = 0; i + 1 < onLine_.size(); ++i)
+      if (!before(onLine_[i], onLine_[i + 1])) {
+        throw std::runtime_error(
+            "plane split: two distinct points coincide on the cut line (self-touching face)");
+      }
+    std::sort(toggles_.begin(), toggles_.end());
+    std::sort(alongLine_.begin(), alongLine_.end());
+  }
+
+  /// 4. Directed edges of each side: boundary pieces plus closing segments along L. A boundary
+  ///    edge on L running along t has the polygon, and so the minus side, on its left: it goes
+  ///    to minus. Its direction is taken from the order the closing segments use (exact on
+  ///    ties): an edge whose ends tie in rounded coordinate k (an edge of round-off length, as
+  ///    from a surface vertex on one grid plane within round-off of another) must fall on the
+  ///    side its closing segments expect, or that side's loop stays open.
+  void sideEdges(EdgeList& minusEdges, EdgeList& plusEdges) const {
+    for (const auto& loop : loops_) {
+      const std::size_t m = loop.size();
+      for (std::size_t i = 0; i < m; ++i) {
+        const Corner& a = loop[i];
+        const Corner& b = loop[(i + 1) % m];
+        const DirectedEdge e{a.v, b.v};
+        if (a.side < 0 || b.side < 0)
+          minusEdges.push_back(e);
+        else if (a.side > 0 || b.side > 0)
+          plusEdges.push_back(e);
+        else
+          (ahead({key(a.v), a.v}, {key(b.v), b.v}) ? minusEdges : plusEdges).push_back(e);
+      }
+    }
+    std::size_t crossings = 0;
+    for (std::size_t i = 0; i + 1 < onLine_.size(); ++i) {
+      crossings +=
+          static_cast<std::size_t>(std::count(toggles_.begin(), toggles_.end(), onLine_[i].second));
+      if (crossings % 2 == 0) continue;  // outside the polygon
+      const std::uint32_t a = onLine_[i].second, b = onLine_[i + 1].second;
+      if (std::binary_search(alongLine_.begin(), alongLine_.end(),
+                             std::make_pair(std::min(a, b), std::max(a, b))))
+        continue;  // already a boundary edge
+      minusEdges.push_back({a, b});
+      plusEdges.push_back({b, a});
+    }
+  }
+
+  /// The polygon's normal (orientLine()).
+  const Vec3& normal() const { return n_; }
+
+ private:
+  /// Point v's position along L (rounded).
+  double key(std::uint32_t v) const { return direction_ * splitter_.point(v)[k_]; }
+
+  /// True if x comes before y along t. Rounded coordinates that tie are ordered exactly. A
+  /// polygon of round-off size has no meaningful direction t; its points can then tie on
+  /// coordinate k, and the other coordinates (exactly, in t's direction) order them instead.
+  bool ahead(const LinePoint& x, const LinePoint& y) const {
     if (x.first != y.first) return x.first < y.first;
     if (x.second == y.second) return false;
     for (int i = 0; i < 3; ++i) {
-      const int axis = (k + i) % 3;
-      const double sign = i == 0 ? direction : (t[axis] < 0 ? -1.0 : 1.0);
-      if (const int c = compareExactly(x.second, y.second, axis); c != 0) return sign * c < 0;
+      const int axis = (k_ + i) % 3;
+      const double sign = i == 0 ? direction_ : (t_[axis] < 0 ? -1.0 : 1.0);
+      if (const int c = splitter_.compareExactly(x.second, y.second, axis); c != 0)
+        return sign * c < 0;
     }
     return false;
-  };
-  std::sort(onLine.begin(), onLine.end(), before);
-  onLine.erase(std::unique(onLine.begin(), onLine.end(),
-                           [](const auto& x, const auto& y) { return x.second == y.second; }),
-               onLine.end());
-  for (std::size_t i = 0; i + 1 < onLine.size(); ++i)
-    if (!before(onLine[i], onLine[i + 1])) {
-      throw std::runtime_error(
-          "plane split: two distinct points coincide on the cut line (self-touching face)");
-    }
-  std::sort(toggles.begin(), toggles.end());
-  std::sort(alongLine.begin(), alongLine.end());
+  }
 
-  // 4. Directed edges of each side: boundary pieces plus closing segments along L. A boundary
-  //    edge on L running along t has the polygon, and so the minus side, on its left: it goes to
-  //    minus. Its direction is taken from the order the closing segments use (exact on ties): an
-  //    edge whose ends tie in rounded coordinate k (an edge of round-off length, as from a
-  //    surface vertex on one grid plane within round-off of another) must fall on the side its
-  //    closing segments expect, or that side's loop stays open.
+  PlaneSplitter& splitter_;
+  const PiecePolygon& polygon_;
+  Small<CornerLoop, 2> loops_;
+  Vec3 n_, t_;  ///< the polygon's normal and L's direction
+  int k_ = 0;   ///< the coordinate that orders points along L
+  double direction_ = 1.0;
+  Small<LinePoint> onLine_;
+  Small<std::uint32_t> toggles_;  // ids of the points where the boundary crosses L
+  Small<std::pair<std::uint32_t, std::uint32_t>> alongLine_;  // boundary edges on L
+};
+
+void PlaneSplitter::splitPolygon(const PiecePolygon& polygon, const SplitPlane& plane, Piece& minus,
+                                 Piece& plus) {
+  PolygonCut cut(*this, polygon, plane);
+  if (cut.splitFast(minus, plus)) return;
+  cut.orientLine(plane);
+  cut.findLinePoints();
+  cut.orderLinePoints();
   EdgeList minusEdges, plusEdges;
-  for (const auto& loop : loops) {
-    const std::size_t m = loop.size();
-    for (std::size_t i = 0; i < m; ++i) {
-      const Corner& a = loop[i];
-      const Corner& b = loop[(i + 1) % m];
-      const DirectedEdge e{a.v, b.v};
-      if (a.side < 0 || b.side < 0)
-        minusEdges.push_back(e);
-      else if (a.side > 0 || b.side > 0)
-        plusEdges.push_back(e);
-      else
-        (before({key(a.v), a.v}, {key(b.v), b.v}) ? minusEdges : plusEdges).push_back(e);
-    }
-  }
-  std::size_t crossings = 0;
-  for (std::size_t i = 0; i + 1 < onLine.size(); ++i) {
-    crossings +=
-        static_cast<std::size_t>(std::count(toggles.begin(), toggles.end(), onLine[i].second));
-    if (crossings % 2 == 0) continue;  // outside the polygon
-    const std::uint32_t a = onLine[i].second, b = onLine[i + 1].second;
-    if (std::binary_search(alongLine.begin(), alongLine.end(),
-                           std::make_pair(std::min(a, b), std::max(a, b))))
-      continue;  // already a boundary edge
-    minusEdges.push_back({a, b});
-    plusEdges.push_back({b, a});
-  }
+  cut.sideEdges(minusEdges, plusEdges);
 
   // 5. Loops, grouped into polygons with holes.
+  const Vec3& n = cut.normal();
   const auto pointOf = [this](std::uint32_t v) -> const Vec3& { return point(v); };
   for (auto& p : groupLoops(traceLoops(minusEdges, pointOf, n), pointOf, n, polygon.origin))
     minus.push_back(std::move(p));
@@ -480,66 +371,136 @@ void PlaneSplitter::splitPolygon(const PiecePolygon& polygon, const SplitPlane& 
     plus.push_back(std::move(p));
 }
 
+namespace {
+
+/// Where a polygon goes: wholly on one side (touching the plane or not), in the plane, or
+/// across it.
+enum class Place : signed char { Minus, Plus, InPlane, Across };
+
+/// Where each polygon of a piece goes, and which touch the plane.
+struct Placement {
+  Small<Place, 64> place;
+  Small<char, 64> touches;  ///< has a corner in the plane
+  bool anyInPlane = false;
+};
+
+/// The place of each polygon of `piece`, from its corners' sides of `plane`.
+Placement placePolygons(const PlaneSplitter& splitter, const Piece& piece,
+                        const SplitPlane& plane) {
+  Placement out{Small<Place, 64>(piece.size()), Small<char, 64>(piece.size(), 0)};
+  for (std::size_t i = 0; i < piece.size(); ++i) {
+    int lo = 1, hi = -1;
+    for (std::uint32_t v : piece[i].vertices) {
+      const int s = splitter.side(v, plane);
+      lo = std::min(lo, s);
+      hi = std::max(hi, s);
+    }
+    out.place[i] = hi <= 0 && lo < 0    ? Place::Minus
+                   : lo >= 0 && hi > 0  ? Place::Plus
+                   : lo == 0 && hi == 0 ? Place::InPlane
+                                        : Place::Across;
+    out.touches[i] = lo <= 0 && hi >= 0;
+    out.anyInPlane = out.anyInPlane || out.place[i] == Place::InPlane;
+  }
+  return out;
+}
+
+/// A connected set of polygons lying wholly in the plane (the points of a tip of round-off
+/// size beyond another plane, all rounded onto this one) encloses nothing: it goes whole to
+/// the minus side. Sent polygon by polygon to the sides they face away from, it would leave
+/// on each side a fold that no cap in this plane closes. Polygons are joined across the
+/// edges in the plane that they share (all edges of a polygon in the plane).
+void sendLooseFlatGroupsToMinus(const PlaneSplitter& splitter, const Piece& piece,
+                                const SplitPlane& plane, Placement& placement) {
+  Small<Place, 64>& place = placement.place;
+  const Small<char, 64>& touches = placement.touches;
+  Small<std::pair<std::uint64_t, std::uint32_t>, 32> edges;  // (edge in the plane, polygon)
+  for (std::size_t i = 0; i < piece.size(); ++i) {
+    if (!touches[i]) continue;
+    const PiecePolygon& polygon = piece[i];
+    for (std::size_t k = 0; k < polygon.numLoops(); ++k) {
+      const std::size_t begin = polygon.loopBegin(k), end = polygon.loopEnd[k];
+      for (std::size_t j = begin; j < end; ++j) {
+        const std::uint32_t a = polygon.vertices[j];
+        const std::uint32_t b = polygon.vertices[j + 1 == end ? begin : j + 1];
+        if (place[i] == Place::InPlane ||
+            (splitter.side(a, plane) == 0 && splitter.side(b, plane) == 0))
+          edges.emplace_back(std::uint64_t(std::min(a, b)) << 32 | std::max(a, b),
+                             static_cast<std::uint32_t>(i));
+      }
+    }
+  }
+  std::sort(edges.begin(), edges.end());
+  UnionFind joined(piece.size());
+  for (std::size_t e = 1; e < edges.size(); ++e)
+    if (edges[e].first == edges[e - 1].first) joined.unite(edges[e].second, edges[e - 1].second);
+  Small<char, 64> anchored(piece.size(), 0);  // joined to a polygon not in the plane
+  for (std::size_t i = 0; i < piece.size(); ++i)
+    if (touches[i] && place[i] != Place::InPlane)
+      anchored[joined.find(static_cast<std::uint32_t>(i))] = 1;
+  for (std::size_t i = 0; i < piece.size(); ++i)
+    if (place[i] == Place::InPlane && !anchored[joined.find(static_cast<std::uint32_t>(i))])
+      place[i] = Place::Minus;
+}
+
+/// The caps' edges: the minus side's edges in the plane that have no reverse within the minus
+/// side. Each such edge use as (undirected key, +1 if it runs from the lower id), summed per
+/// key; a net use makes that many edges, directed against the minus side's.
+EdgeList capEdges(const PlaneSplitter& splitter, const Piece& minus, const SplitPlane& plane) {
+  Small<std::pair<std::uint64_t, int>, 32> inPlane;
+  for (const PiecePolygon& polygon : minus) {
+    for (std::size_t k = 0; k < polygon.numLoops(); ++k) {
+      const std::size_t begin = polygon.loopBegin(k), end = polygon.loopEnd[k];
+      for (std::size_t i = begin; i < end; ++i) {
+        const std::uint32_t a = polygon.vertices[i];
+        const std::uint32_t b = polygon.vertices[i + 1 == end ? begin : i + 1];
+        if (splitter.side(a, plane) != 0 || splitter.side(b, plane) != 0) continue;
+        inPlane.emplace_back(std::uint64_t(std::min(a, b)) << 32 | std::max(a, b), a < b ? 1 : -1);
+      }
+    }
+  }
+  std::sort(inPlane.begin(), inPlane.end());
+  EdgeList edges;
+  for (std::size_t i = 0; i < inPlane.size();) {
+    const std::uint64_t key = inPlane[i].first;
+    int net = 0;
+    for (; i < inPlane.size() && inPlane[i].first == key; ++i) net += inPlane[i].second;
+    const auto lo = static_cast<std::uint32_t>(key >> 32);
+    const auto hi = static_cast<std::uint32_t>(key & 0xffffffffu);
+    for (int j = 0; j < std::abs(net); ++j)
+      edges.push_back(net > 0 ? DirectedEdge{hi, lo} : DirectedEdge{lo, hi});
+  }
+  return edges;
+}
+
+/// Sorts the caps' edges so that their loops start where traceLoops meets them in this order:
+/// by the positions of the edges' ends, so that the output does not depend on the point ids
+/// (schedule-dependent). Ids only break ties between distinct points at one position (an
+/// intersection that rounded onto a surface vertex: the vertex's id is the smaller whatever
+/// the schedule).
+void sortByPosition(const PlaneSplitter& splitter, EdgeList& edges) {
+  auto byPosition = [&splitter](std::uint32_t u, std::uint32_t v) {
+    const Vec3& p = splitter.point(u);
+    const Vec3& q = splitter.point(v);
+    if (p != q) return std::lexicographical_compare(p.data(), p.data() + 3, q.data(), q.data() + 3);
+    return u < v;
+  };
+  std::sort(edges.begin(), edges.end(), [&](const DirectedEdge& a, const DirectedEdge& b) {
+    return a.from != b.from ? byPosition(a.from, b.from) : byPosition(a.to, b.to);
+  });
+}
+
+}  // namespace
+
 PieceSplit PlaneSplitter::split(Piece piece, const SplitPlane& plane, FaceOrigin capOrigin) {
   PieceSplit out;
   out.minus.reserve(piece.size() + 8);
   out.plus.reserve(piece.size() + 8);
-  // Where each polygon goes: wholly on one side (touching the plane or not), in the plane, or
-  // across it.
-  enum class Place : signed char { Minus, Plus, InPlane, Across };
-  Small<Place, 64> place(piece.size());
-  Small<char, 64> touches(piece.size(), 0);  // has a corner in the plane
-  bool anyInPlane = false;
-  for (std::size_t i = 0; i < piece.size(); ++i) {
-    int lo = 1, hi = -1;
-    for (std::uint32_t v : piece[i].vertices) {
-      const int s = side(v, plane);
-      lo = std::min(lo, s);
-      hi = std::max(hi, s);
-    }
-    place[i] = hi <= 0 && lo < 0    ? Place::Minus
-               : lo >= 0 && hi > 0  ? Place::Plus
-               : lo == 0 && hi == 0 ? Place::InPlane
-                                    : Place::Across;
-    touches[i] = lo <= 0 && hi >= 0;
-    anyInPlane = anyInPlane || place[i] == Place::InPlane;
-  }
-  if (anyInPlane) {
-    // A connected set of polygons lying wholly in the plane (the points of a tip of round-off
-    // size beyond another plane, all rounded onto this one) encloses nothing: it goes whole to
-    // the minus side. Sent polygon by polygon to the sides they face away from, it would leave
-    // on each side a fold that no cap in this plane closes. Polygons are joined across the
-    // edges in the plane that they share (all edges of a polygon in the plane).
-    Small<std::pair<std::uint64_t, std::uint32_t>, 32> edges;  // (edge in the plane, polygon)
-    for (std::size_t i = 0; i < piece.size(); ++i) {
-      if (!touches[i]) continue;
-      const PiecePolygon& polygon = piece[i];
-      for (std::size_t k = 0; k < polygon.numLoops(); ++k) {
-        const std::size_t begin = polygon.loopBegin(k), end = polygon.loopEnd[k];
-        for (std::size_t j = begin; j < end; ++j) {
-          const std::uint32_t a = polygon.vertices[j];
-          const std::uint32_t b = polygon.vertices[j + 1 == end ? begin : j + 1];
-          if (place[i] == Place::InPlane || (side(a, plane) == 0 && side(b, plane) == 0))
-            edges.emplace_back(std::uint64_t(std::min(a, b)) << 32 | std::max(a, b),
-                               static_cast<std::uint32_t>(i));
-        }
-      }
-    }
-    std::sort(edges.begin(), edges.end());
-    UnionFind joined(piece.size());
-    for (std::size_t e = 1; e < edges.size(); ++e)
-      if (edges[e].first == edges[e - 1].first) joined.unite(edges[e].second, edges[e - 1].second);
-    Small<char, 64> anchored(piece.size(), 0);  // joined to a polygon not in the plane
-    for (std::size_t i = 0; i < piece.size(); ++i)
-      if (touches[i] && place[i] != Place::InPlane)
-        anchored[joined.find(static_cast<std::uint32_t>(i))] = 1;
-    for (std::size_t i = 0; i < piece.size(); ++i)
-      if (place[i] == Place::InPlane && !anchored[joined.find(static_cast<std::uint32_t>(i))])
-        place[i] = Place::Minus;
-  }
+  Placement placement = placePolygons(*this, piece, plane);
+  if (placement.anyInPlane) sendLooseFlatGroupsToMinus(*this, piece, plane, placement);
   for (std::size_t i = 0; i < piece.size(); ++i) {
     PiecePolygon& polygon = piece[i];
-    switch (place[i]) {
+    switch (placement.place[i]) {
       case Place::Minus: out.minus.push_back(std::move(polygon)); break;
       case Place::Plus: out.plus.push_back(std::move(polygon)); break;
       case Place::InPlane:  // it bounds the side it faces away from
@@ -555,48 +516,13 @@ PieceSplit PlaneSplitter::split(Piece piece, const SplitPlane& plane, FaceOrigin
   }
   if (out.minus.empty() || out.plus.empty()) return out;
 
-  // Caps: the minus side's edges in the plane that have no reverse within the minus side.
-  // Each such edge use as (undirected key, +1 if it runs from the lower id), summed per key.
-  Small<std::pair<std::uint64_t, int>, 32> inPlane;
-  for (const PiecePolygon& polygon : out.minus) {
-    for (std::size_t k = 0; k < polygon.numLoops(); ++k) {
-      const std::size_t begin = polygon.loopBegin(k), end = polygon.loopEnd[k];
-      for (std::size_t i = begin; i < end; ++i) {
-        const std::uint32_t a = polygon.vertices[i];
-        const std::uint32_t b = polygon.vertices[i + 1 == end ? begin : i + 1];
-        if (side(a, plane) != 0 || side(b, plane) != 0) continue;
-        inPlane.emplace_back(std::uint64_t(std::min(a, b)) << 32 | std::max(a, b), a < b ? 1 : -1);
-      }
-    }
-  }
-  std::sort(inPlane.begin(), inPlane.end());
-  EdgeList capEdges;
-  for (std::size_t i = 0; i < inPlane.size();) {
-    const std::uint64_t key = inPlane[i].first;
-    int net = 0;
-    for (; i < inPlane.size() && inPlane[i].first == key; ++i) net += inPlane[i].second;
-    const auto lo = static_cast<std::uint32_t>(key >> 32);
-    const auto hi = static_cast<std::uint32_t>(key & 0xffffffffu);
-    for (int j = 0; j < std::abs(net); ++j)
-      capEdges.push_back(net > 0 ? DirectedEdge{hi, lo} : DirectedEdge{lo, hi});
-  }
-  if (capEdges.empty()) return out;
+  // Caps: closing both sides in the plane.
+  EdgeList caps = capEdges(*this, out.minus, plane);
+  if (caps.empty()) return out;
+  sortByPosition(*this, caps);
   const auto pointOf = [this](std::uint32_t v) -> const Vec3& { return point(v); };
-  // The caps' loops start where traceLoops meets them in this order: by the positions of the
-  // edges' ends, so that the output does not depend on the point ids (schedule-dependent).
-  // Ids only break ties between distinct points at one position (an intersection that rounded
-  // onto a surface vertex: the vertex's id is the smaller whatever the schedule).
-  auto byPosition = [this](std::uint32_t u, std::uint32_t v) {
-    const Vec3& p = point(u);
-    const Vec3& q = point(v);
-    if (p != q) return std::lexicographical_compare(p.data(), p.data() + 3, q.data(), q.data() + 3);
-    return u < v;
-  };
-  std::sort(capEdges.begin(), capEdges.end(), [&](const DirectedEdge& a, const DirectedEdge& b) {
-    return a.from != b.from ? byPosition(a.from, b.from) : byPosition(a.to, b.to);
-  });
   for (PiecePolygon& cap :
-       groupLoops(traceLoops(capEdges, pointOf, plane.normal), pointOf, plane.normal, capOrigin)) {
+       groupLoops(traceLoops(caps, pointOf, plane.normal), pointOf, plane.normal, capOrigin)) {
     out.plus.push_back(reversed(cap));
     out.minus.push_back(std::move(cap));
     ++out.capPolygons;

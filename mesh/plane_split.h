@@ -96,8 +96,11 @@ class PlaneSplitter {
   std::uint32_t edgePoint(std::uint32_t u, std::uint32_t v, const SplitPlane& plane);
   /// Records `plane` under its id (for compareExactly) before points are made on it.
   void rememberPlane(const SplitPlane& plane);
+  /// Splits one polygon that crosses `plane` into polygons on each side.
   void splitPolygon(const PiecePolygon& polygon, const SplitPlane& plane, Piece& minus,
                     Piece& plus);
+  /// The steps of splitPolygon() and the state they share (plane_split.cpp).
+  class PolygonCut;
   Vec3 polygonNormal(const PiecePolygon& polygon) const;
 
   /// Exact comparison of two points on the cut line along coordinate k (used only when their

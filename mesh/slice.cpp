@@ -86,165 +86,24 @@ class Slicer {
     // more: they are freed beside the build, not after it.
     tbb::task_group release;
     release.run([this] { splitter_.reset(); });
-    // Points closer than the resolution of the coordinates are one point: 8 units in the last
-    // place of the largest coordinate, in every coordinate. Such points are intersections that
-    // are the same point mathematically but were built along different paths (or a surface
-    // vertex within round-off of a grid line); kept apart they would leave edges of round-off
-    // length, which VTK's polygon triangulation rejects. Welding moves geometry by at most that
-    // resolution and collapses the round-off faces on both sides of a shared face alike. Only
-    // points that elements use are kept, in order of first use (deterministic).
-    double largest = 0.0;
-    for (const Vec3& p : points) largest = std::max(largest, p.cwiseAbs().maxCoeff());
-    const double resolution = 8.0 * std::numeric_limits<double>::epsilon() * largest;
-
-    // Points in order of first use, then welded; vertex ids follow that order.
-    constexpr std::uint32_t kNone = 0xffffffffu;
-    std::vector<std::uint32_t> rank(points.size(), kNone), used;
-    for (const Leaf& leaf : leaves_)
-      for (const PiecePolygon& polygon : leaf.piece)
-        for (std::uint32_t v : polygon.vertices)
-          if (rank[v] == kNone) {
-            rank[v] = static_cast<std::uint32_t>(used.size());
-            used.push_back(v);
-          }
-    const std::vector<std::uint32_t> target = weldTargets(points, used, resolution);
-    VertexData<Vec3> positions;
-    positions.raw().reserve(used.size());
-    std::vector<std::uint32_t> vertexOfRank(used.size());
-    for (std::size_t i = 0; i < used.size(); ++i) {
-      if (target[i] == i) {
-        vertexOfRank[i] = static_cast<std::uint32_t>(positions.size());
-        positions.push_back(points[used[i]]);
-      } else {
-        vertexOfRank[i] = vertexOfRank[target[i]];
-        ++stats.weldedPoints;
-      }
-    }
-    auto vertexOf = [&](std::uint32_t v) { return VertexId(vertexOfRank[rank[v]]); };
-
-    // Each leaf's polygons on the welded vertices (in parallel), with the vertex-set key of the
-    // caps (interior faces), which are shared with the neighbouring cell's leaf. Polygons are
-    // numbered across all leaves (polygon i of leaf l is polygonBase[l] + i) and kept in flat
-    // arrays (WeldedPolygons): a Face is made only for each face of the mesh.
-    const std::size_t nl = leaves_.size();
-    std::vector<std::uint32_t> polygonBase(nl + 1, 0);
-    std::vector<std::size_t> cornerBase(nl + 1, 0), loopBase(nl + 1, 0);
-    tbb::parallel_for(std::size_t(0), nl, [&](std::size_t l) {
-      std::size_t corners = 0, loops = 0;
-      for (const PiecePolygon& polygon : leaves_[l].piece) {
-        corners += polygon.vertices.size();
-        loops += polygon.numLoops();
-      }
-      polygonBase[l + 1] = static_cast<std::uint32_t>(leaves_[l].piece.size());
-      cornerBase[l + 1] = corners;
-      loopBase[l + 1] = loops;
-    });
-    for (std::size_t l = 0; l < nl; ++l) {
-      polygonBase[l + 1] += polygonBase[l];
-      cornerBase[l + 1] += cornerBase[l];
-      loopBase[l + 1] += loopBase[l];
-    }
-    const std::size_t np = polygonBase[nl];
-    WeldedPolygons welded(np, cornerBase[nl], loopBase[nl]);
-    std::vector<char> kept(np, 0);
-    std::vector<std::uint64_t> keys(np, 0);
-    std::vector<FaceOrigin> origin(np);
-    std::atomic<std::size_t> collapsed{0};
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nl, 64),
-                      [&](const tbb::blocked_range<std::size_t>& r) {
-                        for (std::size_t l = r.begin(); l != r.end(); ++l) {
-                          const Piece& piece = leaves_[l].piece;
-                          std::size_t corner = cornerBase[l], loop = loopBase[l];
-                          for (std::size_t i = 0; i < piece.size(); ++i) {
-                            const std::size_t p = polygonBase[l] + i;
-                            origin[p] = piece[i].origin;
-                            if (!welded.weld(p, corner, loop, piece[i], vertexOf)) {
-                              ++collapsed;
-                            } else {
-                              kept[p] = 1;
-                              if (origin[p] == FaceOrigin::Interior)
-                                keys[p] = vertexSetKey(welded.corners(p));
-                            }
-                            corner += piece[i].vertices.size();
-                            loop += piece[i].numLoops();
-                          }
-                        }
-                      });
-    stats.collapsedPolygons = collapsed;
-
+    WeldedVertices vertices = weldPoints(points);
+    const LeafOffsets at = leafOffsets();
+    const LeafPolygons polygons = weldPolygons(at, vertices);
     // Caps meet their other side: the later of two reversed, equal polygons uses the earlier's
     // face (reversed), as findOrCreateFace would in leaf order.
-    const std::vector<std::uint32_t> sharesEarlier = matchCaps(welded, origin, kept, keys);
-
-    // Ids: elements for leaves that kept a polygon, faces for kept polygons that are not a
-    // later side, both in leaf order.
-    std::vector<std::uint32_t> elementOf(nl, kNone), faceBase(nl + 1, 0);
-    tbb::parallel_for(std::size_t(0), nl, [&](std::size_t l) {
-      std::uint32_t created = 0, any = 0;
-      for (std::size_t p = polygonBase[l]; p < polygonBase[l + 1]; ++p) {
-        any += kept[p];
-        created += kept[p] && sharesEarlier[p] == kNone;
-      }
-      faceBase[l + 1] = created;
-      elementOf[l] = any ? 0 : kNone;
-    });
-    std::uint32_t elements = 0;
-    for (std::size_t l = 0; l < nl; ++l) {
-      faceBase[l + 1] += faceBase[l];
-      if (elementOf[l] != kNone) elementOf[l] = elements++;
-    }
-    std::vector<std::uint32_t> faceId(np, kNone);
-    FaceData<Face> meshFaces(faceBase[nl]);
-    ElementData<Element> meshElements(elements);
-    // New faces first (their ids are known per leaf) ...
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nl, 64),
-                      [&](const tbb::blocked_range<std::size_t>& r) {
-                        for (std::size_t l = r.begin(); l != r.end(); ++l) {
-                          std::uint32_t next = faceBase[l];
-                          for (std::size_t p = polygonBase[l]; p < polygonBase[l + 1]; ++p) {
-                            if (!kept[p] || sharesEarlier[p] != kNone) continue;
-                            faceId[p] = next;
-                            Face& f = meshFaces[FaceId(std::size_t(next++))];
-                            welded.copyTo(p, f);
-                            f.origin = origin[p];
-                            f.front = ElementId(std::size_t(elementOf[l]));
-                          }
-                        }
-                      });
-    // ... then the later sides, which take the earlier side's face as its back.
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nl, 64),
-                      [&](const tbb::blocked_range<std::size_t>& r) {
-                        for (std::size_t l = r.begin(); l != r.end(); ++l) {
-                          if (elementOf[l] == kNone) continue;
-                          const ElementId e{std::size_t(elementOf[l])};
-                          FaceList& uses = meshElements[e].faces;
-                          for (std::size_t p = polygonBase[l]; p < polygonBase[l + 1]; ++p) {
-                            if (!kept[p]) continue;
-                            const std::uint32_t s = sharesEarlier[p];
-                            if (s == kNone) {
-                              uses.push_back({FaceId(std::size_t(faceId[p])), false});
-                              continue;
-                            }
-                            const FaceId f{static_cast<std::size_t>(faceId[s])};
-                            meshFaces[f].back = e;
-                            meshFaces[f].origin = FaceOrigin::Interior;
-                            uses.push_back({f, true});
-                          }
-                        }
-                      });
+    const std::vector<std::uint32_t> sharesEarlier =
+        matchCaps(polygons.welded, polygons.origin, polygons.kept, polygons.keys);
+    const MeshIds ids = numberMesh(at, polygons, sharesEarlier);
+    FaceData<Face> meshFaces(ids.faceBase[leaves_.size()]);
+    ElementData<Element> meshElements(ids.elements);
+    makeFacesAndElements(at, polygons, sharesEarlier, ids, meshFaces, meshElements);
     if (elementCell)
-      for (std::size_t l = 0; l < nl; ++l)
-        if (elementOf[l] != kNone) elementCell->push_back(leaves_[l].cell);
-    // The leaves are spent: their many small buffers are freed in parallel, not one by one
-    // when the slicer goes.
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nl, 256),
-                      [&](const tbb::blocked_range<std::size_t>& r) {
-                        for (std::size_t l = r.begin(); l != r.end(); ++l)
-                          Piece().swap(leaves_[l].piece);
-                      });
+      for (std::size_t l = 0; l < leaves_.size(); ++l)
+        if (ids.elementOf[l] != kNone) elementCell->push_back(leaves_[l].cell);
+    freeLeaves();
     release.wait();
     PolyMesh mesh;
-    mesh.assign(std::move(positions), std::move(meshFaces), std::move(meshElements));
+    mesh.assign(std::move(vertices.positions), std::move(meshFaces), std::move(meshElements));
     return mesh;
   }
 
@@ -419,7 +278,6 @@ class Slicer {
                                               const std::vector<FaceOrigin>& origin,
                                               const std::vector<char>& kept,
                                               const std::vector<std::uint64_t>& keys) {
-    constexpr std::uint32_t kNone = 0xffffffffu;
     const std::size_t np = kept.size();
     auto isCap = [&](std::size_t p) { return kept[p] && origin[p] == FaceOrigin::Interior; };
     // Caps in polygon order (that is, leaf order), gathered in parallel blocks.
@@ -460,6 +318,211 @@ class Slicer {
       }
     });
     return shares;
+  }
+
+  /// No point, polygon, element or face.
+  static constexpr std::uint32_t kNone = 0xffffffffu;
+
+  /// The points the leaves use, welded: each point's vertex, and the vertices' positions.
+  struct WeldedVertices {
+    std::vector<std::uint32_t> rank;          ///< point -> its order of first use, or kNone
+    std::vector<std::uint32_t> vertexOfRank;  ///< order of first use -> vertex id
+    VertexData<Vec3> positions;
+    VertexId operator()(std::uint32_t v) const { return VertexId(vertexOfRank[rank[v]]); }
+  };
+
+  /// Welds the points the leaves use; vertex ids follow their order of first use.
+  WeldedVertices weldPoints(const std::vector<Vec3>& points) {
+    // Points closer than the resolution of the coordinates are one point: 8 units in the last
+    // place of the largest coordinate, in every coordinate. Such points are intersections that
+    // are the same point mathematically but were built along different paths (or a surface
+    // vertex within round-off of a grid line); kept apart they would leave edges of round-off
+    // length, which VTK's polygon triangulation rejects. Welding moves geometry by at most that
+    // resolution and collapses the round-off faces on both sides of a shared face alike. Only
+    // points that elements use are kept, in order of first use (deterministic).
+    double largest = 0.0;
+    for (const Vec3& p : points) largest = std::max(largest, p.cwiseAbs().maxCoeff());
+    const double resolution = 8.0 * std::numeric_limits<double>::epsilon() * largest;
+
+    // Points in order of first use, then welded; vertex ids follow that order.
+    WeldedVertices out;
+    out.rank.assign(points.size(), kNone);
+    std::vector<std::uint32_t> used;
+    for (const Leaf& leaf : leaves_)
+      for (const PiecePolygon& polygon : leaf.piece)
+        for (std::uint32_t v : polygon.vertices)
+          if (out.rank[v] == kNone) {
+            out.rank[v] = static_cast<std::uint32_t>(used.size());
+            used.push_back(v);
+          }
+    const std::vector<std::uint32_t> target = weldTargets(points, used, resolution);
+    out.positions.raw().reserve(used.size());
+    out.vertexOfRank.resize(used.size());
+    for (std::size_t i = 0; i < used.size(); ++i) {
+      if (target[i] == i) {
+        out.vertexOfRank[i] = static_cast<std::uint32_t>(out.positions.size());
+        out.positions.push_back(points[used[i]]);
+      } else {
+        out.vertexOfRank[i] = out.vertexOfRank[target[i]];
+        ++stats.weldedPoints;
+      }
+    }
+    return out;
+  }
+
+  /// Where each leaf's polygons, corners and loops start when they are numbered across all
+  /// leaves (polygon i of leaf l is polygon[l] + i); the last entries are the totals.
+  struct LeafOffsets {
+    std::vector<std::uint32_t> polygon;
+    std::vector<std::size_t> corner, loop;
+  };
+
+  /// Counts the leaves' polygons, corners and loops (in parallel) and sums them up.
+  LeafOffsets leafOffsets() const {
+    const std::size_t nl = leaves_.size();
+    LeafOffsets at{std::vector<std::uint32_t>(nl + 1, 0), std::vector<std::size_t>(nl + 1, 0),
+                   std::vector<std::size_t>(nl + 1, 0)};
+    tbb::parallel_for(std::size_t(0), nl, [&](std::size_t l) {
+      std::size_t corners = 0, loops = 0;
+      for (const PiecePolygon& polygon : leaves_[l].piece) {
+        corners += polygon.vertices.size();
+        loops += polygon.numLoops();
+      }
+      at.polygon[l + 1] = static_cast<std::uint32_t>(leaves_[l].piece.size());
+      at.corner[l + 1] = corners;
+      at.loop[l + 1] = loops;
+    });
+    for (std::size_t l = 0; l < nl; ++l) {
+      at.polygon[l + 1] += at.polygon[l];
+      at.corner[l + 1] += at.corner[l];
+      at.loop[l + 1] += at.loop[l];
+    }
+    return at;
+  }
+
+  /// The leaves' polygons on the welded vertices, numbered across leaves (LeafOffsets), with
+  /// the vertex-set key of the caps (interior faces), which are shared with the neighbouring
+  /// cell's leaf.
+  struct LeafPolygons {
+    WeldedPolygons welded;
+    std::vector<char> kept;           ///< the polygon did not collapse
+    std::vector<std::uint64_t> keys;  ///< a kept cap's vertex-set key, else 0
+    std::vector<FaceOrigin> origin;
+  };
+
+  /// Each leaf's polygons on the welded vertices (in parallel), kept in flat arrays
+  /// (WeldedPolygons): a Face is made only for each face of the mesh.
+  LeafPolygons weldPolygons(const LeafOffsets& at, const WeldedVertices& vertexOf) {
+    const std::size_t nl = leaves_.size();
+    const std::size_t np = at.polygon[nl];
+    LeafPolygons out{WeldedPolygons(np, at.corner[nl], at.loop[nl]), std::vector<char>(np, 0),
+                     std::vector<std::uint64_t>(np, 0), std::vector<FaceOrigin>(np)};
+    std::atomic<std::size_t> collapsed{0};
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nl, 64),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        for (std::size_t l = r.begin(); l != r.end(); ++l) {
+                          const Piece& piece = leaves_[l].piece;
+                          std::size_t corner = at.corner[l], loop = at.loop[l];
+                          for (std::size_t i = 0; i < piece.size(); ++i) {
+                            const std::size_t p = at.polygon[l] + i;
+                            out.origin[p] = piece[i].origin;
+                            if (!out.welded.weld(p, corner, loop, piece[i], vertexOf)) {
+                              ++collapsed;
+                            } else {
+                              out.kept[p] = 1;
+                              if (out.origin[p] == FaceOrigin::Interior)
+                                out.keys[p] = vertexSetKey(out.welded.corners(p));
+                            }
+                            corner += piece[i].vertices.size();
+                            loop += piece[i].numLoops();
+                          }
+                        }
+                      });
+    stats.collapsedPolygons = collapsed;
+    return out;
+  }
+
+  /// The mesh's ids, in leaf order: an element for each leaf that kept a polygon, a face for
+  /// each kept polygon that is not a later side.
+  struct MeshIds {
+    std::vector<std::uint32_t> elementOf;  ///< each leaf's element, or kNone
+    std::vector<std::uint32_t> faceBase;   ///< each leaf's first new face; the last: the total
+    std::uint32_t elements = 0;
+  };
+
+  /// Numbers the elements and the new faces (counted per leaf in parallel).
+  MeshIds numberMesh(const LeafOffsets& at, const LeafPolygons& polygons,
+                     const std::vector<std::uint32_t>& sharesEarlier) const {
+    const std::size_t nl = leaves_.size();
+    MeshIds ids{std::vector<std::uint32_t>(nl, kNone), std::vector<std::uint32_t>(nl + 1, 0)};
+    tbb::parallel_for(std::size_t(0), nl, [&](std::size_t l) {
+      std::uint32_t created = 0, any = 0;
+      for (std::size_t p = at.polygon[l]; p < at.polygon[l + 1]; ++p) {
+        any += polygons.kept[p];
+        created += polygons.kept[p] && sharesEarlier[p] == kNone;
+      }
+      ids.faceBase[l + 1] = created;
+      ids.elementOf[l] = any ? 0 : kNone;
+    });
+    for (std::size_t l = 0; l < nl; ++l) {
+      ids.faceBase[l + 1] += ids.faceBase[l];
+      if (ids.elementOf[l] != kNone) ids.elementOf[l] = ids.elements++;
+    }
+    return ids;
+  }
+
+  /// Fills `meshFaces` and `meshElements` (sized by `ids`) in parallel: the new faces first
+  /// (their ids are known per leaf), then the later sides, which take the earlier side's face
+  /// as its back.
+  void makeFacesAndElements(const LeafOffsets& at, const LeafPolygons& polygons,
+                            const std::vector<std::uint32_t>& sharesEarlier, const MeshIds& ids,
+                            FaceData<Face>& meshFaces, ElementData<Element>& meshElements) const {
+    const std::size_t nl = leaves_.size();
+    std::vector<std::uint32_t> faceId(at.polygon[nl], kNone);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nl, 64),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        for (std::size_t l = r.begin(); l != r.end(); ++l) {
+                          std::uint32_t next = ids.faceBase[l];
+                          for (std::size_t p = at.polygon[l]; p < at.polygon[l + 1]; ++p) {
+                            if (!polygons.kept[p] || sharesEarlier[p] != kNone) continue;
+                            faceId[p] = next;
+                            Face& f = meshFaces[FaceId(std::size_t(next++))];
+                            polygons.welded.copyTo(p, f);
+                            f.origin = polygons.origin[p];
+                            f.front = ElementId(std::size_t(ids.elementOf[l]));
+                          }
+                        }
+                      });
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nl, 64),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        for (std::size_t l = r.begin(); l != r.end(); ++l) {
+                          if (ids.elementOf[l] == kNone) continue;
+                          const ElementId e{std::size_t(ids.elementOf[l])};
+                          FaceList& uses = meshElements[e].faces;
+                          for (std::size_t p = at.polygon[l]; p < at.polygon[l + 1]; ++p) {
+                            if (!polygons.kept[p]) continue;
+                            const std::uint32_t s = sharesEarlier[p];
+                            if (s == kNone) {
+                              uses.push_back({FaceId(std::size_t(faceId[p])), false});
+                              continue;
+                            }
+                            const FaceId f{static_cast<std::size_t>(faceId[s])};
+                            meshFaces[f].back = e;
+                            meshFaces[f].origin = FaceOrigin::Interior;
+                            uses.push_back({f, true});
+                          }
+                        }
+                      });
+  }
+
+  /// The leaves are spent: their many small buffers are freed in parallel, not one by one
+  /// when the slicer goes.
+  void freeLeaves() {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves_.size(), 256),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        for (std::size_t l = r.begin(); l != r.end(); ++l)
+                          Piece().swap(leaves_[l].piece);
+                      });
   }
 
   /// Pieces with more polygons than this are split into two tasks.

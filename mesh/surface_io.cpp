@@ -1,7 +1,7 @@
 // Reading surfaces: guard the header counts; read OBJ/OFF/PLY/STL in double precision through
 // CGAL's polygon-soup readers (after checks for what they misread) and everything else, or what
 // CGAL cannot read, through assimp with transforms baked in; then weld by exact position and
-// triangulate polygons exactly.
+// triangulate polygons exactly (mesh/surface_builder.h).
 #include "polydg/mesh/surface_io.h"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
@@ -34,12 +34,11 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
-#include <unordered_map>
 #include <utility>
 #include <variant>
 #include <vector>
 
-#include "mesh/face_triangulation.h"
+#include "mesh/surface_builder.h"
 #include "mesh/surface_text_check.h"
 
 namespace polydg {
@@ -503,99 +502,6 @@ std::variant<PolygonSoup, Reason> readWithCgal(const std::string& path,
   soup.warnings = warnings.lines();
   return soup;
 }
-
-// --- welding ----------------------------------------------------------------------------------
-
-/// A coordinate widened to double, with -0.0 replaced by 0.0: after this, two coordinates are
-/// equal exactly when their bits are.
-double canonical(double x) { return x == 0 ? 0.0 : x; }
-
-/// The bits of a canonical position; the weld key.
-using PositionKey = std::array<std::uint64_t, 3>;
-
-struct PositionKeyHash {
-  std::size_t operator()(const PositionKey& k) const noexcept {
-    std::uint64_t h = 0x9e3779b97f4a7c15ull;
-    for (std::uint64_t v : k) {
-      h ^= v + 0x9e3779b97f4a7c15ull + (h << 6) + (h >> 2);
-      h *= 0xff51afd7ed558ccdull;
-    }
-    return static_cast<std::size_t>(h ^ (h >> 33));
-  }
-};
-
-PositionKey keyOf(const Vec3& p) {
-  return {std::bit_cast<std::uint64_t>(p.x()), std::bit_cast<std::uint64_t>(p.y()),
-          std::bit_cast<std::uint64_t>(p.z())};
-}
-
-/// Builds the surface: triangles go in as given, vertices are shared by exact position and
-/// numbered in order of first use.
-class SurfaceBuilder {
- public:
-  SurfaceBuilder(const std::string& path, SurfaceReadInfo& info) : path_(path), info_(info) {}
-
-  /// Adds triangle (a, b, c), or counts it as degenerate if two corners are at one position.
-  void addTriangle(const Vec3& a, const Vec3& b, const Vec3& c) {
-    const PositionKey ka = keyOf(a), kb = keyOf(b), kc = keyOf(c);
-    if (ka == kb || kb == kc || kc == ka) {
-      ++info_.droppedDegenerate;
-      return;
-    }
-    surface_.triangles.push_back({id(ka, a), id(kb, b), id(kc, c)});
-  }
-
-  /// Adds the triangles of a planar polygon of four or more corners: its exact constrained
-  /// triangulation (triangulateFace), or a fan from the first corner, counted, if it has zero
-  /// area or crossing edges.
-  void addPolygon(const std::vector<Vec3>& corners) {
-    PolyMesh polygon;  // the polygon's distinct positions and one face through them
-    std::unordered_map<PositionKey, VertexId, PositionKeyHash> local;
-    Loop loop;
-    for (const Vec3& p : corners) {
-      auto [it, inserted] = local.try_emplace(keyOf(p));
-      if (inserted) it->second = polygon.addVertex(p);
-      loop.push_back(it->second);
-    }
-    std::vector<std::array<VertexId, 3>> triangles;
-    if (local.size() >= 3) {
-      const FaceId f = polygon.addFace({loop}, FaceOrigin::Surface);
-      try {
-        triangles = triangulateFace(polygon, f);
-      } catch (const std::runtime_error&) {
-        triangles.clear();
-      }
-    }
-    if (triangles.empty()) {
-      ++info_.fannedPolygons;
-      for (std::size_t k = 1; k + 1 < loop.size(); ++k)
-        triangles.push_back({loop[0], loop[k], loop[k + 1]});
-    }
-    for (const auto& t : triangles)
-      addTriangle(polygon.position(t[0]), polygon.position(t[1]), polygon.position(t[2]));
-  }
-
-  TriangleSurface take() { return std::move(surface_); }
-  std::size_t numTriangles() const { return surface_.triangles.size(); }
-  std::size_t numVertices() const { return surface_.vertices.size(); }
-
- private:
-  std::uint32_t id(const PositionKey& key, const Vec3& p) {
-    auto [it, inserted] =
-        welded_.try_emplace(key, static_cast<std::uint32_t>(surface_.vertices.size()));
-    if (inserted) {
-      if (surface_.vertices.size() == std::numeric_limits<std::uint32_t>::max())
-        fail(path_, "has more than 2^32 - 1 distinct vertices; split the file");
-      surface_.vertices.push_back(p);
-    }
-    return it->second;
-  }
-
-  const std::string& path_;
-  SurfaceReadInfo& info_;
-  TriangleSurface surface_;
-  std::unordered_map<PositionKey, std::uint32_t, PositionKeyHash> welded_;
-};
 
 }  // namespace
 

@@ -55,23 +55,9 @@ SolveOptions b12Options(const ManufacturedProblem& problem) {
 
 Model unitCube(int n) { return Model(hexGridMesh(n, n, n, Box3(Vec3::Zero(), Vec3::Ones()))); }
 
-}  // namespace
-
-SuiteOutput adaptivitySuite(const BenchOptions& o, bool quiet) {
-  SuiteOutput s{"adaptivity", nlohmann::json::object(), nlohmann::json::array(), {}};
-  auto log = [&](const std::string& line) {
-    if (!quiet) std::cout << line << std::endl;
-  };
-  s.json["setup"] = {
-      {"B11",
-       "bar [0,9]x[0,2]x[0,2] of 36 unit hexahedra, E = 1000, nu = 0.3, clamped on x = 0, "
-       "traction (0,0,-1) on x = 9, IP p = 1; refine where the element's mean stress has a "
-       "principal value above tau * the unrefined mesh's largest, until none does or 3 rounds"},
-      {"B12",
-       "unit cube, E = 1, nu = 0.3, u = 0.01 (1,1,1) exp(-|x-c|^2/(2 w^2)), w = 0.05, IP p = 2; "
-       "uniform n^3 hex grids against solve --adapt from n = 4 (Doerfler bulk 0.5, 1-to-8)"}};
-
-  // B11.
+/// B11: the bent bar of thesis Fig. 4.9 refined by principal stress, 1-to-8 and 1-to-2, beside
+/// the thesis's element counts.
+void runB11(const BenchOptions& o, SuiteOutput& s, const Log& log) {
   nlohmann::json b11 = nlohmann::json::array();
   const std::vector<double> taus =
       o.quick ? std::vector<double>{0.5} : std::vector<double>{0.25, 0.5, 0.75};
@@ -115,57 +101,59 @@ SuiteOutput adaptivitySuite(const BenchOptions& o, bool quiet) {
           std::to_string(thesis) + ")");
     }
   s.json["B11"] = b11;
+}
 
-  // B13: octree slicing of a sphere against the uniform grid, one after the other.
-  {
-    const TriangleSurface sphere = icosphere(Vec3::Zero(), 1.0, o.quick ? 4 : 6);
-    nlohmann::json b13 = nlohmann::json::array();
-    for (bool adaptive : {false, true}) {
-      MeshOptions options;
-      options.cells = o.quick ? 32 : 128;
-      options.adaptive = adaptive;
-      MeshReport report;
-      const Stopwatch watch;
-      const Model model = Model::fromSurface(sphere, options, report);
-      const double seconds = watch.seconds();
-      const MeshingReport& m = report.meshing;
-      b13.push_back({{"mesh", adaptive ? "octree" : "uniform"},
-                     {"triangles", sphere.triangles.size()},
-                     {"cells", options.cells},
-                     {"elements", model.mesh().numElements()},
-                     {"faces", m.faces},
-                     {"volume", m.outputVolume},
-                     {"volume_relative_error", m.volumeRelError},
-                     {"passed", report.passed()},
-                     {"levels", report.levels},
-                     {"elements_per_level", report.elementsPerLevel},
-                     {"refine_seconds", report.refineSeconds},
-                     {"seconds", seconds}});
-      s.rows.push_back({{"benchmark", "B13"},
-                        {"case", adaptive ? "octree" : "uniform"},
-                        {"elements", model.mesh().numElements()},
-                        {"dofs", nullptr},
-                        {"reference", nullptr},
-                        {"l2_error", nullptr},
-                        {"effectivity", nullptr}});
-      log(std::string("B13 ") + (adaptive ? "octree" : "uniform") + ": " +
-          std::to_string(model.mesh().numElements()) + " elements, " + std::to_string(m.faces) +
-          " faces, volume error " + shortNumber(m.volumeRelError) + ", " + shortNumber(seconds) +
-          " s");
-    }
-    s.json["B13"] = b13;
+/// B13: octree slicing of a sphere against the uniform grid, one after the other.
+void runB13(const BenchOptions& o, SuiteOutput& s, const Log& log) {
+  const TriangleSurface sphere = icosphere(Vec3::Zero(), 1.0, o.quick ? 4 : 6);
+  nlohmann::json b13 = nlohmann::json::array();
+  for (bool adaptive : {false, true}) {
+    MeshOptions options;
+    options.cells = o.quick ? 32 : 128;
+    options.adaptive = adaptive;
+    MeshReport report;
+    const Stopwatch watch;
+    const Model model = Model::fromSurface(sphere, options, report);
+    const double seconds = watch.seconds();
+    const MeshingReport& m = report.meshing;
+    b13.push_back({{"mesh", adaptive ? "octree" : "uniform"},
+                   {"triangles", sphere.triangles.size()},
+                   {"cells", options.cells},
+                   {"elements", model.mesh().numElements()},
+                   {"faces", m.faces},
+                   {"volume", m.outputVolume},
+                   {"volume_relative_error", m.volumeRelError},
+                   {"passed", report.passed()},
+                   {"levels", report.levels},
+                   {"elements_per_level", report.elementsPerLevel},
+                   {"refine_seconds", report.refineSeconds},
+                   {"seconds", seconds}});
+    s.rows.push_back({{"benchmark", "B13"},
+                      {"case", adaptive ? "octree" : "uniform"},
+                      {"elements", model.mesh().numElements()},
+                      {"dofs", nullptr},
+                      {"reference", nullptr},
+                      {"l2_error", nullptr},
+                      {"effectivity", nullptr}});
+    log(std::string("B13 ") + (adaptive ? "octree" : "uniform") + ": " +
+        std::to_string(model.mesh().numElements()) + " elements, " + std::to_string(m.faces) +
+        " faces, volume error " + shortNumber(m.volumeRelError) + ", " + shortNumber(seconds) +
+        " s");
   }
+  s.json["B13"] = b13;
+}
 
-  // B12: uniform grids.
-  const ManufacturedProblem problem = benchmarkB12Problem();
-  const SolveOptions base = b12Options(problem);
+/// A B12 run on a uniform grid: its DOFs and L2 error.
+struct UniformPoint {
+  std::size_t dofs;
+  double l2;
+};
+
+/// B12 on uniform grids: each run's figures (returned), rows, log line and point of `plot`;
+/// `points` receives the DOFs and L2 error of each run.
+nlohmann::json runB12Uniform(const BenchOptions& o, const SolveOptions& base, SuiteOutput& s,
+                             SeriesSet& plot, std::vector<UniformPoint>& points, const Log& log) {
   nlohmann::json uniform = nlohmann::json::array();
-  SeriesSet plot;
-  struct Point {
-    std::size_t dofs;
-    double l2;
-  };
-  std::vector<Point> uniformPoints;
   for (int n : o.quick ? std::vector<int>{4, 8} : std::vector<int>{8, 16, 32}) {
     Model model = unitCube(n);
     const Stopwatch watch;
@@ -186,13 +174,20 @@ SuiteOutput adaptivitySuite(const BenchOptions& o, bool quiet) {
                       {"reference", nullptr},
                       {"l2_error", r.error->l2},
                       {"effectivity", effectivity}});
-    uniformPoints.push_back({r.solve.dofs, r.error->l2});
+    points.push_back({r.solve.dofs, r.error->l2});
     plot.add("uniform", static_cast<double>(r.solve.dofs), r.error->l2);
     log("B12 uniform n " + std::to_string(n) + ": " + std::to_string(r.solve.dofs) +
         " DOFs, L2 error " + shortNumber(r.error->l2) + ", effectivity " +
         shortNumber(effectivity) + ", " + shortNumber(seconds) + " s");
   }
-  // B12: adaptive from n = 4, up to a fifth of the finest uniform grid's DOFs.
+  return uniform;
+}
+
+/// B12 adaptive from n = 4, up to a fifth of the finest uniform grid's DOFs, against the
+/// uniform runs (`uniform`, `uniformPoints`): writes B12's report and its plot.
+void runB12Adaptive(const BenchOptions& o, const SolveOptions& base, nlohmann::json uniform,
+                    const std::vector<UniformPoint>& uniformPoints, SuiteOutput& s, SeriesSet& plot,
+                    const Log& log) {
   Model model = unitCube(4);
   SolveOptions so = base;
   AdaptOptions a;
@@ -224,7 +219,7 @@ SuiteOutput adaptivitySuite(const BenchOptions& o, bool quiet) {
   }
   // DOFs the adaptive run needed to reach each uniform grid's L2 error.
   nlohmann::json reach = nlohmann::json::array();
-  for (const Point& u : uniformPoints) {
+  for (const UniformPoint& u : uniformPoints) {
     nlohmann::json j{{"uniform_dofs", u.dofs}, {"uniform_l2_error", u.l2}};
     j["adaptive_dofs"] = nullptr;
     for (const AdaptRound& round : r.rounds)
@@ -235,7 +230,7 @@ SuiteOutput adaptivitySuite(const BenchOptions& o, bool quiet) {
       }
     reach.push_back(j);
   }
-  s.json["B12"] = {{"uniform", uniform},
+  s.json["B12"] = {{"uniform", std::move(uniform)},
                    {"adaptive", rounds},
                    {"adaptive_seconds", watch.seconds()},
                    {"dofs_to_reach_uniform_error", reach},
@@ -245,6 +240,31 @@ SuiteOutput adaptivitySuite(const BenchOptions& o, bool quiet) {
                       {"DOFs", AxisScale::Log},
                       {"L2 error", AxisScale::Log},
                       plot.series()}});
+}
+
+}  // namespace
+
+SuiteOutput adaptivitySuite(const BenchOptions& o, bool quiet) {
+  SuiteOutput s{"adaptivity", nlohmann::json::object(), nlohmann::json::array(), {}};
+  const Log log = [&](const std::string& line) {
+    if (!quiet) std::cout << line << std::endl;
+  };
+  s.json["setup"] = {
+      {"B11",
+       "bar [0,9]x[0,2]x[0,2] of 36 unit hexahedra, E = 1000, nu = 0.3, clamped on x = 0, "
+       "traction (0,0,-1) on x = 9, IP p = 1; refine where the element's mean stress has a "
+       "principal value above tau * the unrefined mesh's largest, until none does or 3 rounds"},
+      {"B12",
+       "unit cube, E = 1, nu = 0.3, u = 0.01 (1,1,1) exp(-|x-c|^2/(2 w^2)), w = 0.05, IP p = 2; "
+       "uniform n^3 hex grids against solve --adapt from n = 4 (Doerfler bulk 0.5, 1-to-8)"}};
+  runB11(o, s, log);
+  runB13(o, s, log);
+  const ManufacturedProblem problem = benchmarkB12Problem();
+  const SolveOptions base = b12Options(problem);
+  SeriesSet plot;
+  std::vector<UniformPoint> uniformPoints;
+  nlohmann::json uniform = runB12Uniform(o, base, s, plot, uniformPoints, log);
+  runB12Adaptive(o, base, std::move(uniform), uniformPoints, s, plot, log);
   return s;
 }
 

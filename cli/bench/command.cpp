@@ -2,15 +2,11 @@
 // as DIR/NAME.json, DIR/NAME.csv and one or more plots DIR/NAME*.svg.
 //
 // Sample runs:
-//   polydg bench --suite all --out bench/          (every suite; about a minute on 2 cores,
-//                                                   plus 17 minutes for dynamics and 2 for
-//                                                   contact)
+//   polydg bench --suite all --out bench/          (every suite; dynamics takes the longest)
 //   polydg bench --suite stability --out bench/    (B4: conditioning, locking, scale)
 //   polydg bench --suite stability --out b/ --quick   (reduced sizes, as the tests run it)
-//   polydg bench --suite dynamics --out bench/     (B6, B7, time per step up to 1M DOFs;
-//                                                   17 minutes and 5 GB)
-//   polydg bench --suite contact --out bench/      (B9, embedding and collision speed; 2
-//                                                   minutes)
+//   polydg bench --suite dynamics --out bench/     (B6, B7, time per step up to 1M DOFs)
+//   polydg bench --suite contact --out bench/      (B9, embedding and collision speed)
 //   polydg bench --suite adaptivity --out bench/   (B11 and B12: refinement by stress and by
 //                                                   the error estimate)
 //   polydg bench --suite multigrid --out bench/    (CG iterations on the bunny and the torus,

@@ -202,8 +202,6 @@ DistanceFieldOptions bowlField(const TriangleSurface& obstacle, double bodyDiago
   return o;
 }
 
-using Log = std::function<void(const std::string&)>;
-
 /// Part 1: the embedding of the fine sphere's vertices for p = 1 and 2: setup, W, the update.
 /// Returns the median update seconds for p = 1 (part 3 compares it with a step).
 double embeddingPart(Model& model, const TriangleSurface& surface, SuiteOutput& s,
@@ -469,6 +467,110 @@ nlohmann::json stepPart(Model& model, const Sizes& z, double updateSeconds, Suit
   return part;
 }
 
+/// What a drop's steps show: the total energy against the start and from step to step, the
+/// deepest penetration, and the steps in contact.
+struct DropHistory {
+  double total0 = 0.0;  ///< the total energy at the start
+  double stepIncrease = -std::numeric_limits<double>::infinity(), stepIncreaseT = 0.0;
+  double growth = -std::numeric_limits<double>::infinity(), growthT = 0.0;
+  double deepest = 0.0, firstContact = -1.0;
+  int contactSteps = 0;
+  bool finite = true;
+};
+
+/// Scans the steps of a drop onto `obstacle`: each step is a row of `s` and a point of the
+/// plots.
+DropHistory scanDrop(const SimulationReport& report, const char* obstacle, SuiteOutput& s,
+                     SeriesSet& penetrationPlot, SeriesSet& energyPlot) {
+  DropHistory h;
+  const BodyState& b0 = report.initial;
+  h.total0 = b0.kinetic + b0.elastic + b0.gravity;
+  // Against the start, and (a stricter reading, for damped steps) against the step before.
+  double previous = h.total0;
+  for (std::size_t k = 0; k < report.steps.size(); ++k) {
+    const SimulationStep& step = report.steps[k];
+    const BodyState& b = step.state;
+    const double t = static_cast<double>(k + 1) * kDt;
+    const double total = b.kinetic + b.elastic + b.gravity + step.contact.energy;
+    h.finite = h.finite && std::isfinite(total) && std::isfinite(step.contact.deepest);
+    if (total - h.total0 > h.growth) h.growth = total - h.total0, h.growthT = t;
+    if (total - previous > h.stepIncrease) h.stepIncrease = total - previous, h.stepIncreaseT = t;
+    previous = total;
+    h.deepest = std::max(h.deepest, step.contact.deepest);
+    if (step.contact.contacts > 0) {
+      ++h.contactSteps;
+      if (h.firstContact < 0) h.firstContact = t;
+    }
+    s.rows.push_back({{"part", "b9"},
+                      {"obstacle", obstacle},
+                      {"t", t},
+                      {"contacts", step.contact.contacts},
+                      {"deepest", step.contact.deepest},
+                      {"kinetic", b.kinetic},
+                      {"elastic", b.elastic},
+                      {"gravity", b.gravity},
+                      {"contact_energy", step.contact.energy},
+                      {"total", total},
+                      {"com_z", b.centreOfMass.z()},
+                      {"step_seconds", step.seconds},
+                      {"collision_seconds", step.collisionSeconds}});
+    penetrationPlot.add(obstacle, t, step.contact.deepest);
+    energyPlot.add(obstacle, t, total);
+  }
+  return h;
+}
+
+/// The summary of a drop onto `obstacle` (B9's criteria: final penetration below the limit,
+/// energy that never grows beyond round-off of `energyScale`).
+nlohmann::json dropSummary(const SimulationReport& report, const char* obstacle,
+                           const DropHistory& h, double duration, double energyScale) {
+  const SimulationStep& last = report.steps.back();
+  const double finalPenetration = last.contact.deepest;
+  const bool grows = h.growth > kEnergyRoundoff * energyScale;
+  return {{"part", "b9_summary"},
+          {"obstacle", obstacle},
+          {"elements", report.elements},
+          {"dofs", report.dofs},
+          {"contact_points", report.embedding.contactPoints},
+          {"steps", report.steps.size()},
+          {"duration", duration},
+          {"contact_steps", h.contactSteps},
+          {"first_contact_t", h.firstContact >= 0 ? nlohmann::json(h.firstContact) : nullptr},
+          {"final_penetration", finalPenetration},
+          {"penetration_limit", kPenetrationLimit},
+          {"final_below_limit", finalPenetration < kPenetrationLimit},
+          {"max_penetration", h.deepest},
+          {"final_contacts", last.contact.contacts},
+          {"final_kinetic", last.state.kinetic},
+          {"final_com_z", last.state.centreOfMass.z()},
+          {"initial_total", h.total0},
+          {"max_energy_growth", h.growth},
+          {"max_energy_growth_t", h.growthT},
+          {"max_step_energy_increase", h.stepIncrease},
+          {"max_step_energy_increase_t", h.stepIncreaseT},
+          {"energy_scale", energyScale},
+          {"energy_growth_allowed", kEnergyRoundoff * energyScale},
+          {"energy_never_grows", !grows},
+          {"energies_finite", h.finite},
+          {"wall_seconds", report.wallSeconds}};
+}
+
+/// The log line of a drop onto `obstacle`.
+std::string dropLine(const SimulationReport& report, const char* obstacle, const DropHistory& h,
+                     double energyScale) {
+  const double finalPenetration = report.steps.back().contact.deepest;
+  const bool grows = h.growth > kEnergyRoundoff * energyScale;
+  return "B9 " + std::string(obstacle) + ": final penetration " + shortNumber(finalPenetration) +
+         " (limit " + shortNumber(kPenetrationLimit) + ": " +
+         (finalPenetration < kPenetrationLimit ? "below" : "ABOVE") + "), deepest " +
+         shortNumber(h.deepest) + ", " + std::to_string(h.contactSteps) +
+         " steps in contact from t = " + shortNumber(h.firstContact) + ", energy growth at most " +
+         shortNumber(h.growth) + " J (allowed " + shortNumber(kEnergyRoundoff * energyScale) +
+         "; largest increase over a step " + shortNumber(h.stepIncrease) +
+         " J at t = " + shortNumber(h.stepIncreaseT) + ")" + (grows ? ": ENERGY GROWS" : "") +
+         ", " + shortNumber(report.wallSeconds) + " s";
+}
+
 /// Part 4: B9's drops onto the ground and into the bowl with the coarse sphere.
 nlohmann::json b9Part(const Sizes& z, const fs::path& scratch, const std::string& bowlFile,
                       const TriangleSurface& bowlSurface, SuiteOutput& s, const Log& log) {
@@ -494,75 +596,8 @@ nlohmann::json b9Part(const Sizes& z, const fs::path& scratch, const std::string
     const Scene scene = dropScene(duration, o);
     log("B9 " + std::string(obstacle) + ": " + std::to_string(scene.steps) + " steps");
     const SimulationReport report = model.simulate(scene, {});
-    const BodyState& b0 = report.initial;
-    const double total0 = b0.kinetic + b0.elastic + b0.gravity;
-    // Against the start, and (a stricter reading, for damped steps) against the step before.
-    double stepIncrease = -std::numeric_limits<double>::infinity(), stepIncreaseT = 0.0,
-           previous = total0;
-    double growth = -std::numeric_limits<double>::infinity(), growthT = 0.0, deepest = 0.0,
-           firstContact = -1.0;
-    int contactSteps = 0;
-    bool finite = true;
-    for (std::size_t k = 0; k < report.steps.size(); ++k) {
-      const SimulationStep& step = report.steps[k];
-      const BodyState& b = step.state;
-      const double t = static_cast<double>(k + 1) * kDt;
-      const double total = b.kinetic + b.elastic + b.gravity + step.contact.energy;
-      finite = finite && std::isfinite(total) && std::isfinite(step.contact.deepest);
-      if (total - total0 > growth) growth = total - total0, growthT = t;
-      if (total - previous > stepIncrease) stepIncrease = total - previous, stepIncreaseT = t;
-      previous = total;
-      deepest = std::max(deepest, step.contact.deepest);
-      if (step.contact.contacts > 0) {
-        ++contactSteps;
-        if (firstContact < 0) firstContact = t;
-      }
-      s.rows.push_back({{"part", "b9"},
-                        {"obstacle", obstacle},
-                        {"t", t},
-                        {"contacts", step.contact.contacts},
-                        {"deepest", step.contact.deepest},
-                        {"kinetic", b.kinetic},
-                        {"elastic", b.elastic},
-                        {"gravity", b.gravity},
-                        {"contact_energy", step.contact.energy},
-                        {"total", total},
-                        {"com_z", b.centreOfMass.z()},
-                        {"step_seconds", step.seconds},
-                        {"collision_seconds", step.collisionSeconds}});
-      penetrationPlot.add(obstacle, t, step.contact.deepest);
-      energyPlot.add(obstacle, t, total);
-    }
-    const SimulationStep& last = report.steps.back();
-    const double finalPenetration = last.contact.deepest;
-    const bool grows = growth > kEnergyRoundoff * energyScale;
-    nlohmann::json j{
-        {"part", "b9_summary"},
-        {"obstacle", obstacle},
-        {"elements", report.elements},
-        {"dofs", report.dofs},
-        {"contact_points", report.embedding.contactPoints},
-        {"steps", report.steps.size()},
-        {"duration", duration},
-        {"contact_steps", contactSteps},
-        {"first_contact_t", firstContact >= 0 ? nlohmann::json(firstContact) : nullptr},
-        {"final_penetration", finalPenetration},
-        {"penetration_limit", kPenetrationLimit},
-        {"final_below_limit", finalPenetration < kPenetrationLimit},
-        {"max_penetration", deepest},
-        {"final_contacts", last.contact.contacts},
-        {"final_kinetic", last.state.kinetic},
-        {"final_com_z", last.state.centreOfMass.z()},
-        {"initial_total", total0},
-        {"max_energy_growth", growth},
-        {"max_energy_growth_t", growthT},
-        {"max_step_energy_increase", stepIncrease},
-        {"max_step_energy_increase_t", stepIncreaseT},
-        {"energy_scale", energyScale},
-        {"energy_growth_allowed", kEnergyRoundoff * energyScale},
-        {"energy_never_grows", !grows},
-        {"energies_finite", finite},
-        {"wall_seconds", report.wallSeconds}};
+    const DropHistory history = scanDrop(report, obstacle, s, penetrationPlot, energyPlot);
+    nlohmann::json j = dropSummary(report, obstacle, history, duration, energyScale);
     if (bowl) {
       j["obstacle_setup_seconds"] = report.embedding.obstacleSetupSeconds.front();
       // null: simulate's default.
@@ -572,15 +607,7 @@ nlohmann::json b9Part(const Sizes& z, const fs::path& scratch, const std::string
     }
     runs.push_back(j);
     s.rows.push_back(j);
-    log("B9 " + std::string(obstacle) + ": final penetration " + shortNumber(finalPenetration) +
-        " (limit " + shortNumber(kPenetrationLimit) + ": " +
-        (finalPenetration < kPenetrationLimit ? "below" : "ABOVE") + "), deepest " +
-        shortNumber(deepest) + ", " + std::to_string(contactSteps) +
-        " steps in contact from t = " + shortNumber(firstContact) + ", energy growth at most " +
-        shortNumber(growth) + " J (allowed " + shortNumber(kEnergyRoundoff * energyScale) +
-        "; largest increase over a step " + shortNumber(stepIncrease) +
-        " J at t = " + shortNumber(stepIncreaseT) + ")" + (grows ? ": ENERGY GROWS" : "") + ", " +
-        shortNumber(report.wallSeconds) + " s");
+    log(dropLine(report, obstacle, history, energyScale));
   }
   penetrationPlot.add("1% of the radius", 0.0, kPenetrationLimit);
   penetrationPlot.add("1% of the radius", duration, kPenetrationLimit);

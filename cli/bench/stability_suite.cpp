@@ -30,33 +30,9 @@ nlohmann::json conditionJson(const StabilityConditionRun& r) {
           {"beyond_double_precision", c.cond * std::numeric_limits<double>::epsilon() > 1.0}};
 }
 
-}  // namespace
-
-SuiteOutput stabilitySuite(const BenchOptions& o, bool quiet) {
-  SuiteOutput s{"stability", nlohmann::json::object(), nlohmann::json::array(), {}};
-  s.json["cond_method"] = kConditionMethod;
-  s.json["setup"] = {{"sliver",
-                      "3x3x3 unit cubes, centre cell split at x = 1 + volume_ratio; IP, E = 1, "
-                      "nu = 0.3, u = 0 weakly on the whole boundary; merged: mergeSlivers with "
-                      "the sliver rule at 0.01 of a cell (the meshing default): volume below "
-                      "0.01 of a cell, or 6 volume / surface area below 0.01^(1/3) = 0.215 of "
-                      "a cell (slabs thinner than 0.084 of a cell)"},
-                     {"thin_neck",
-                      "one element: blocks [0,1]^3 and [2,3]x[0,1]^2 joined by the neck "
-                      "[1,2]x[0,eps]x[0,1]; IP, clamped on x = 0"},
-                     {"incompressible",
-                      "B3 on the locking-test meshes: p = 1 160x4x8 with penalty doubling, "
-                      "p = 2 40x4x4; reference = Euler-Bernoulli + Timoshenko shear at nu"},
-                     {"scale",
-                      "B1 (n = 4 hex, p = 2; rel_error = L2 error / L2 norm of u) and B3 (40x4x4, "
-                      "p = 2; rel_error = tip / (scale * unscaled tip) - 1), lengths times scale, "
-                      "translated by offset"}};
-  const double eps = std::numeric_limits<double>::epsilon();
-  auto log = [&](const std::string& line) {
-    if (!quiet) std::cout << line << std::endl;
-  };
-
-  // Sliver.
+/// B4 sliver: condition estimates with and without the sliver merged, against the regular
+/// mesh's, per degree; `summary` receives whether the merged ones stay within 100 times.
+void runSliver(const BenchOptions& o, SuiteOutput& s, nlohmann::json& summary, const Log& log) {
   const std::vector<double> ratios =
       o.quick ? std::vector<double>{1, 2e-2, 1e-4, 1e-12}
               : std::vector<double>{1,    1e-1, 5e-2, 2e-2, 1e-2,  1e-3,  1e-4, 1e-5,
@@ -91,8 +67,18 @@ SuiteOutput stabilitySuite(const BenchOptions& o, bool quiet) {
   }
   s.json["sliver"] = sliver;
   s.json["sliver_regular_cond"] = regular;
+  summary["merged_sliver_within_100x_of_regular"] = mergedWithin100;
+  summary["merged_sliver_beyond_100x"] = mergedBeyond100;
+  s.plots.push_back({"stability_sliver.svg",
+                     {"B4 sliver: stiffness condition estimate (IP, clamped)",
+                      {"sliver volume / neighbour volume", AxisScale::Log},
+                      {"condition estimate (Lanczos)", AxisScale::Log},
+                      sliverPlot.series()}});
+}
 
-  // Thin neck.
+/// B4 thin neck: condition estimates of one non-convex element as its neck thins; `summary`
+/// receives their range.
+void runThinNeck(const BenchOptions& o, SuiteOutput& s, nlohmann::json& summary, const Log& log) {
   const std::vector<double> necks =
       o.quick ? std::vector<double>{1e-1, 1e-9}
               : std::vector<double>{1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9};
@@ -114,8 +100,19 @@ SuiteOutput stabilitySuite(const BenchOptions& o, bool quiet) {
           shortNumber(run.estimate.cond));
     }
   s.json["thin_neck"] = neck;
+  summary["thin_neck_cond_min"] = neckMin;
+  summary["thin_neck_cond_max"] = neckMax;
+  s.plots.push_back({"stability_thin_neck.svg",
+                     {"B4 thin neck: one non-convex element, clamped on x = 0",
+                      {"neck height eps", AxisScale::Log},
+                      {"condition estimate (Lanczos)", AxisScale::Log},
+                      neckPlot.series()}});
+}
 
-  // Near-incompressible.
+/// B4 near-incompressible: B3's tip deflection as nu approaches 1/2, against the reference;
+/// `summary` receives the worst relative error.
+void runIncompressible(const BenchOptions& o, SuiteOutput& s, nlohmann::json& summary,
+                       const Log& log) {
   const std::vector<double> nus = {0.3, 0.49, 0.499, 0.4999};
   nlohmann::json incompressible = nlohmann::json::array();
   SeriesSet tipPlot;
@@ -151,8 +148,19 @@ SuiteOutput stabilitySuite(const BenchOptions& o, bool quiet) {
     }
   }
   s.json["incompressible"] = incompressible;
+  summary["incompressible_worst_rel_error"] = worstTip;
+  summary["incompressible_within_5_percent"] = worstTip <= 0.05;
+  s.plots.push_back({"stability_incompressible.svg",
+                     {"B4 near-incompressible cantilever (B3): tip deflection",
+                      {"1/2 - nu", AxisScale::Log},
+                      {"tip deflection", AxisScale::Linear},
+                      tipPlot.series()}});
+}
 
-  // Scale and position.
+/// B4 scale and position: B1 and B3 scaled and moved, against the unscaled run and the
+/// round-off bound; `summary` receives the worst changes.
+void runScale(const BenchOptions& o, SuiteOutput& s, nlohmann::json& summary, const Log& log) {
+  const double eps = std::numeric_limits<double>::epsilon();
   nlohmann::json scale = nlohmann::json::array();
   SeriesSet scalePlot;
   double worstChange = 0.0, worstChangeOverBound = 0.0;
@@ -189,36 +197,45 @@ SuiteOutput stabilitySuite(const BenchOptions& o, bool quiet) {
       }
   }
   s.json["scale"] = scale;
-
-  s.json["summary"] = {{"merged_sliver_within_100x_of_regular", mergedWithin100},
-                       {"merged_sliver_beyond_100x", mergedBeyond100},
-                       {"thin_neck_cond_min", neckMin},
-                       {"thin_neck_cond_max", neckMax},
-                       {"incompressible_worst_rel_error", worstTip},
-                       {"incompressible_within_5_percent", worstTip <= 0.05},
-                       {"scale_worst_change", worstChange},
-                       {"scale_worst_change_over_roundoff_bound", worstChangeOverBound}};
-
-  s.plots.push_back({"stability_sliver.svg",
-                     {"B4 sliver: stiffness condition estimate (IP, clamped)",
-                      {"sliver volume / neighbour volume", AxisScale::Log},
-                      {"condition estimate (Lanczos)", AxisScale::Log},
-                      sliverPlot.series()}});
-  s.plots.push_back({"stability_thin_neck.svg",
-                     {"B4 thin neck: one non-convex element, clamped on x = 0",
-                      {"neck height eps", AxisScale::Log},
-                      {"condition estimate (Lanczos)", AxisScale::Log},
-                      neckPlot.series()}});
-  s.plots.push_back({"stability_incompressible.svg",
-                     {"B4 near-incompressible cantilever (B3): tip deflection",
-                      {"1/2 - nu", AxisScale::Log},
-                      {"tip deflection", AxisScale::Linear},
-                      tipPlot.series()}});
+  summary["scale_worst_change"] = worstChange;
+  summary["scale_worst_change_over_roundoff_bound"] = worstChangeOverBound;
   s.plots.push_back({"stability_scale.svg",
                      {"B4 scale and position: change against the unscaled run",
                       {"scale", AxisScale::Log},
                       {"relative change (exact 0 drawn at 2.2e-16)", AxisScale::Log},
                       scalePlot.series()}});
+}
+
+}  // namespace
+
+SuiteOutput stabilitySuite(const BenchOptions& o, bool quiet) {
+  SuiteOutput s{"stability", nlohmann::json::object(), nlohmann::json::array(), {}};
+  s.json["cond_method"] = kConditionMethod;
+  s.json["setup"] = {{"sliver",
+                      "3x3x3 unit cubes, centre cell split at x = 1 + volume_ratio; IP, E = 1, "
+                      "nu = 0.3, u = 0 weakly on the whole boundary; merged: mergeSlivers with "
+                      "the sliver rule at 0.01 of a cell (the meshing default): volume below "
+                      "0.01 of a cell, or 6 volume / surface area below 0.01^(1/3) = 0.215 of "
+                      "a cell (slabs thinner than 0.084 of a cell)"},
+                     {"thin_neck",
+                      "one element: blocks [0,1]^3 and [2,3]x[0,1]^2 joined by the neck "
+                      "[1,2]x[0,eps]x[0,1]; IP, clamped on x = 0"},
+                     {"incompressible",
+                      "B3 on the locking-test meshes: p = 1 160x4x8 with penalty doubling, "
+                      "p = 2 40x4x4; reference = Euler-Bernoulli + Timoshenko shear at nu"},
+                     {"scale",
+                      "B1 (n = 4 hex, p = 2; rel_error = L2 error / L2 norm of u) and B3 (40x4x4, "
+                      "p = 2; rel_error = tip / (scale * unscaled tip) - 1), lengths times scale, "
+                      "translated by offset"}};
+  const Log log = [&](const std::string& line) {
+    if (!quiet) std::cout << line << std::endl;
+  };
+  nlohmann::json summary = nlohmann::json::object();
+  runSliver(o, s, summary, log);
+  runThinNeck(o, s, summary, log);
+  runIncompressible(o, s, summary, log);
+  runScale(o, s, summary, log);
+  s.json["summary"] = summary;
   return s;
 }
 

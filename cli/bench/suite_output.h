@@ -4,6 +4,7 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>
@@ -14,6 +15,9 @@
 #include "cli/bench/problems.h"
 
 namespace polydg::bench {
+
+/// Where a suite's progress lines go: each is printed on stdout unless the suite runs quiet.
+using Log = std::function<void(const std::string&)>;
 
 /// A plot and the file (name only, no folder) it goes to.
 struct NamedPlot {

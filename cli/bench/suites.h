@@ -19,16 +19,15 @@
 //              period, per integrator), B7 (b) (the spinning cube, one turn: volume change and
 //              angular momentum, linear against corotational, per integrator), and wall time per
 //              step against DOFs (B10's beam under gravity, p = 1, corotational, 7.7k, 87k and
-//              960k DOFs, with rotation, assembly and solve apart). 17 minutes on 2 cores
-//              shared with a build (2026-12-02; 15 of them the 960k-DOF steps), 5 GB at most.
+//              960k DOFs, with rotation, assembly and solve apart). The longest suite, most of
+//              it the 960k-DOF steps, which also need the most memory.
 //   contact    B9 and collision handling: the MLS embedding of a 74,884-triangle sphere in a
 //              mesh of 4 cells per side (p = 1, 2: setup, W's nonzeros, time per surface update),
 //              100k obstacle queries against the ground and B9's bowl as distance fields (voxel
 //              diagonal / 100, simulate's default, and / 200), a step of the drop with that
 //              surface's vertices as contact points against its collision time and the surface
 //              update (the goal: each below 10%), and B9's drops onto the ground and into the
-//              bowl (contacts, penetration, energies per step). 80 to 120 s on 2 cores shared
-//              with builds (2026-12-02), 2.9 GB at most.
+//              bowl (contacts, penetration, energies per step).
 //   adaptivity B11 (the bent bar of thesis Fig. 4.9 refined by principal stress, 1-to-8 and 1-to-2
 //              at tau = 0.25, 0.5, 0.75, beside the thesis's 274 and 77) and B12 (the steep
 //              bump: uniform 8, 16, 32 against solve --adapt from 4; DOFs to each uniform L2

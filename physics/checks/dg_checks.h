@@ -15,9 +15,9 @@ namespace polydg {
 
 /// A mode is zero when its eigenvalue of the Jacobi-scaled stiffness D^(-1/2) K D^(-1/2)
 /// (unit diagonal, so its largest eigenvalue is at most the largest row count) is below this.
-/// Rigid motions give round-off, 1e-18 .. 1e-15 on the test corpus; the smallest elastic
-/// mode is above 1e-2 on regular meshes and above 5e-8 with a sliver of relative thickness
-/// 1e-6 (degree 3), so the threshold sits about four orders from both.
+/// Rigid motions give round-off (at most 1e-15) and the smallest elastic mode stays above 5e-8
+/// even beside a sliver of relative thickness 1e-6 (degree 3): the threshold sits about four
+/// orders from both.
 inline constexpr double kZeroModeThreshold = 1e-11;
 
 /// The patch test: u(x) = L b + A (x - x0) (a fixed general matrix A with |A| ~ 1, x0 and L
@@ -93,13 +93,11 @@ DefinitenessReport definiteness(const PolyMesh& mesh, const PhysicsCheckOptions&
 /// D^(-1/2) K_K D^(-1/2) (unit diagonal where the diagonal is positive; the constant functions
 /// have zero rows and keep scale 1), is below this times the matrix's largest absolute row sum
 /// (a bound on its largest eigenvalue). Negative eigenvalues count as zero modes too (an
-/// inverted element has more than six). Rigid motions give at most 6e-16 of that bound on the
-/// test corpus and a sliced sphere of 145k elements. Elastic modes stay above 2e-2 at degree 1
-/// whatever the shape (the scaling equalizes thin and long directions), but from degree 2 on
-/// an element of relative thickness t has bending modes at about 3.7 t^2: 3.7e-12 for the
-/// corpus' sliver with t = 1e-6. The threshold sits between the two, 200 times above the
-/// round-off and 37 times below that sliver (1e-10 would flag slivers thinner than 1e-5 at
-/// degree 2, which the solver handles: see kZeroModeThreshold).
+/// inverted element has more than six). Rigid motions give round-off, at most 6e-16 of that
+/// bound. Elastic modes stay above 2e-2 at degree 1 whatever the shape (the scaling equalizes
+/// thin and long directions), but from degree 2 on an element of relative thickness t has
+/// bending modes at about 3.7 t^2: 3.7e-12 at t = 1e-6. The threshold sits between the two, so
+/// that such slivers, which the solver handles (see kZeroModeThreshold), pass.
 inline constexpr double kElementZeroModeThreshold = 1e-13;
 
 /// The zero modes of one element's stiffness K_K (elementStiffness(), 3n x 3n) by the rule of
@@ -110,9 +108,8 @@ inline constexpr double kElementZeroModeThreshold = 1e-13;
 std::size_t elementZeroModes(const Eigen::MatrixXd& stiffness, int degree);
 
 /// Element-local DG checks of every element K, in parallel, with small dense matrices only
-/// (no global assembly or solve). Degree 1 costs about 7.5 us of CPU per element, 60% of it in
-/// faceRows(): 0.57 s on two cores for the 145k elements of a sphere sliced at 64 cells (plus
-/// 0.075 s for the degree 2 moments), about half the time of the slicing itself.
+/// (no global assembly or solve), cheap beside the slicing that made the mesh; most of the time
+/// goes to faceRows().
 ///
 /// 1. Rigid modes: the element stiffness K_K (elementStiffness(), the volume term) has exactly
 ///    6 zero modes, counted as the eigenvalues of its Jacobi-scaled form below
@@ -147,8 +144,8 @@ LocalDgCheck localDgChecks(const PolyMesh& mesh, const MomentCache& moments,
 /// checks read nothing else. The same checks and the same numbers as localDgChecks() on the
 /// whole mesh (the patch field uses the whole mesh's bounding box; the neighbours keep every
 /// face, so their coupling counts are unchanged), at a cost that grows with the selection, not
-/// the mesh: `polydg mesh` selects the 12% of a sliced sphere's elements that are not whole
-/// grid cells. Element ids in the result refer to `mesh`.
+/// the mesh: `polydg mesh` selects the elements of a sliced mesh that are not whole grid
+/// cells. Element ids in the result refer to `mesh`.
 LocalDgCheck localDgChecksOfSelection(const PolyMesh& mesh, const LocalDgCheckOptions& options);
 
 }  // namespace polydg

@@ -173,6 +173,216 @@ struct FaceBlocks {
   Eigen::MatrixXd self[2], other[2];
 };
 
+/// Copies the region's elements into `sub` (local ids 0 .. size - 1) and then, if there are
+/// any, their face neighbours outside it; `box` receives the region's bounds. Returns the
+/// region's size.
+std::size_t copyRegion(const PolyMesh& mesh, std::span<const char> region, SubMesh& sub,
+                       Box3& box) {
+  try {
+    for (std::size_t i = 0; i < region.size(); ++i)
+      if (region[i]) sub.add(ElementId(i));
+  } catch (const std::exception& e) {
+    throw std::invalid_argument(std::string("regionDgChecks: the region's faces are not used "
+                                            "consistently (") +
+                                e.what() + ")");
+  }
+  const std::size_t regionSize = sub.size();
+  if (regionSize == 0) return 0;
+  for (std::size_t i = 0; i < regionSize; ++i) {
+    const ElementId e = sub.global(ElementId(i));
+    box.extend(elementBounds(mesh, e));
+    for (const FaceUse& use : mesh.element(e).faces) {
+      const ElementId other = across(mesh, use.face, e);
+      if (other.valid() && !sub.contains(other)) sub.add(other);
+    }
+  }
+  return regionSize;
+}
+
+/// The caller's moments copied to the sub-mesh's faces, into `given` (nothing integrated).
+void copyMoments(const SubMesh& sub, const MomentCache& moments, MomentCache& given) {
+  const PolyMesh& local = sub.mesh();
+  for (std::size_t f = 0; f < local.numFaces(); ++f) {
+    const FaceId theirs = sub.globalFace(FaceId(f));
+    given.assignFace(FaceId(f),
+                     moments.face(theirs).first(static_cast<std::size_t>(given.stride())),
+                     moments.faceNormal(theirs));
+  }
+  given.update();
+}
+
+/// The region's rows of the IP system at a linear field's coefficients (the patch test),
+/// element by element, with what the count of zero modes needs of each element: its
+/// stiffness, its Jacobi scaling, its zero modes beyond 6 and the face terms it shares with
+/// other region elements.
+class RegionRows {
+ public:
+  RegionRows(const PolyMesh& local, std::size_t regionSize, const DgBasis& basis,
+             const MomentCache& given, const FormCoefficients& form, const Box3& box, int degree)
+      : stiffnesses(regionSize),
+        scales(regionSize),
+        surplus(regionSize, 0),
+        local_(local),
+        regionSize_(regionSize),
+        basis_(basis),
+        given_(given),
+        form_(form),
+        degree_(degree),
+        n_(basis.size()),
+        bs_(3 * n_) {
+    Eigen::Matrix3d gradient;
+    gradient << 0.31, -0.17, 0.23, 0.13, 0.27, -0.19, -0.29, 0.11, 0.21;
+    const Vec3 b = box.diagonal().norm() * Vec3(0.5, -0.6, 0.7), x0 = box.center();
+    exact_.resize(static_cast<Eigen::Index>(local.numElements()) * bs_);
+    for (std::size_t i = 0; i < local.numElements(); ++i)
+      exact_.segment(static_cast<Eigen::Index>(i) * bs_, bs_) =
+          linearFieldCoefficients(basis, ElementId(i), b, gradient, x0);
+    const Eigen::Matrix3d strain = 0.5 * (gradient + gradient.transpose());
+    stress_ = 2.0 * form.mu * strain + form.lambda * strain.trace() * Eigen::Matrix3d::Identity();
+  }
+
+  /// Region element i's rows: r = A U - F over them, its block of A tested for definiteness.
+  void addElement(std::size_t i) {
+    const ElementId e(i);
+    const auto ue = coefficients(e);
+    elementStiffness(basis_, given_, e, form_.mu, form_.lambda, stiffness_);
+    surplus[i] = static_cast<long long>(elementZeroModes(stiffness_, degree_)) - 6;
+    // r = A U - F over K's rows and, entry by entry, the size of the terms summed into it.
+    a_ = stiffness_;
+    r_ = stiffness_ * ue;
+    size_ = stiffness_.cwiseAbs() * ue.cwiseAbs();
+    diagonal_ = stiffness_.diagonal();
+    for (const FaceUse& use : local_.element(e).faces) addFace(e, use);
+    // Relative to the largest term in K's rows: round-off in the sum stays below a few
+    // machine epsilons of it, times the relative round-off of the matrices' entries.
+    const double largest = size_.maxCoeff();
+    const double relative = largest > 0.0    ? r_.cwiseAbs().maxCoeff() / largest
+                            : r_.isZero(0.0) ? 0.0
+                                             : std::numeric_limits<double>::infinity();
+    worstResidual_ =
+        std::max(worstResidual_,
+                 std::isfinite(relative) ? relative : std::numeric_limits<double>::infinity());
+    // K's block of the IP matrix (every face with its terms) is SPD on a valid element.
+    const Eigen::LDLT<Eigen::MatrixXd> ldlt(a_);
+    for (const double d : ldlt.vectorD()) definite_ = definite_ && d > 0.0;
+    scales[i] = zeroModeScaling(diagonal_, bs_);
+    stiffnesses[i] = stiffness_;
+  }
+
+  /// The largest relative residual of the rows, or infinity if an element's block is not
+  /// positive definite.
+  double patchTestResidual() const {
+    return definite_ ? worstResidual_ : std::numeric_limits<double>::infinity();
+  }
+
+  std::vector<Eigen::MatrixXd> stiffnesses;
+  std::vector<Eigen::VectorXd> scales;
+  std::unordered_map<std::uint32_t, FaceBlocks> faceBlocks;  // by local face
+  std::vector<long long> surplus;                            // element zero modes beyond 6
+
+ private:
+  Eigen::VectorXd::ConstSegmentReturnType coefficients(ElementId e) const {
+    return exact_.segment(static_cast<Eigen::Index>(e.index()) * bs_, bs_);
+  }
+  // Every face of the full problem has face terms: c_K is the element's face count.
+  int coupled(ElementId e) const { return static_cast<int>(local_.element(e).faces.size()); }
+
+  /// Face `use` of element e: its terms in K's rows, and for a face between region elements
+  /// its blocks kept.
+  void addFace(ElementId e, const FaceUse& use) {
+    const auto ue = coefficients(e);
+    const ElementId other = across(local_, use.face, e);
+    FaceView view;
+    view.face = use.face;
+    view.kind = other.valid() ? FaceKind::Interior : FaceKind::Dirichlet;
+    view.self = e;
+    view.other = other;
+    view.selfIsFront = !use.reversed;
+    view.selfCoupledFaces = coupled(e);
+    view.otherCoupledFaces = other.valid() ? coupled(other) : 0;
+    faceRows(local_, basis_, given_, view, form_, selfBlock_, otherBlock_);
+    a_ += selfBlock_;
+    if (other.valid()) {
+      // A Dirichlet face's S_F U_K is on both sides of A U = F: only its t_F is left below.
+      const auto uo = coefficients(other);
+      r_.noalias() += selfBlock_ * ue + otherBlock_ * uo;
+      size_.noalias() +=
+          selfBlock_.cwiseAbs() * ue.cwiseAbs() + otherBlock_.cwiseAbs() * uo.cwiseAbs();
+      if (other.index() < regionSize_) {
+        diagonal_ += selfBlock_.diagonal();
+        FaceBlocks& t = faceBlocks[use.face.value];
+        const int side = use.reversed ? 1 : 0;
+        t.self[side] = selfBlock_;
+        t.other[side] = otherBlock_;
+      }
+    } else {
+      const Vec3 normal =
+          use.reversed ? Vec3(-given_.faceNormal(use.face)) : given_.faceNormal(use.face);
+      const Vec3 traction = stress_ * normal;
+      const Eigen::VectorXd integrals = faceIntegrals(local_, basis_, use.face, e);
+      for (int d = 0; d < 3; ++d) {
+        r_.segment(d * n_, n_) -= traction[d] * integrals;
+        size_.segment(d * n_, n_) += std::abs(traction[d]) * integrals.cwiseAbs();
+      }
+    }
+  }
+
+  const PolyMesh& local_;
+  const std::size_t regionSize_;
+  const DgBasis& basis_;
+  const MomentCache& given_;
+  const FormCoefficients& form_;
+  const int degree_, n_, bs_;
+  Eigen::VectorXd exact_;   ///< the linear field's coefficients on every element
+  Eigen::Matrix3d stress_;  ///< its stress, constant
+  double worstResidual_ = 0.0;
+  bool definite_ = true;
+  // Scratch, reused from element to element.
+  Eigen::MatrixXd stiffness_, a_, selfBlock_, otherBlock_;
+  Eigen::VectorXd r_, size_, diagonal_;
+};
+
+/// Zero modes: 6 per element (its own stiffness), and per face between region elements the
+/// rigid motions it leaves free; components by union-find over the faces that join. Sets c's
+/// components, zero modes and loose faces.
+void countRegionZeroModes(const PolyMesh& local, const RegionRows& rows, int bs,
+                          RegionCoupling coupling, RegionDgCheck& c) {
+  const std::size_t regionSize = rows.stiffnesses.size();
+  UnionFind sets(regionSize);
+  std::vector<long long> faceSurplus;
+  std::vector<std::uint32_t> faceFront;
+  Eigen::MatrixXd pair(2 * bs, 2 * bs);
+  Eigen::VectorXd pairScale(2 * bs);
+  for (const auto& [f, t] : rows.faceBlocks) {
+    const Face& face = local.face(FaceId(std::size_t(f)));
+    const std::size_t front = face.front.index(), back = face.back.index();
+    pair << rows.stiffnesses[front] + t.self[0], t.other[0], t.other[1],
+        rows.stiffnesses[back] + t.self[1];
+    pairScale << rows.scales[front], rows.scales[back];
+    const std::size_t modes = countZeroModes(pair, pairScale);
+    if (coupling == RegionCoupling::HoldingFaces && modes > 6) {
+      ++c.looseFaces;
+      continue;
+    }
+    sets.unite(face.front.value, face.back.value);
+    // A face whose terms do not vanish on the rigid motions common to its two elements (fewer
+    // than 6) takes zero modes from its component. AllFaces joins hinges too, without counting
+    // their soft modes: a count over a component's cycles would take its global eigen-solve.
+    faceSurplus.push_back(std::min(static_cast<long long>(modes) - 6, 0LL));
+    faceFront.push_back(face.front.value);
+  }
+  std::vector<std::uint32_t> component;
+  c.components = sets.labels(component);
+  std::vector<long long> perComponent(c.components, 6);
+  for (std::size_t i = 0; i < regionSize; ++i) perComponent[component[i]] += rows.surplus[i];
+  for (std::size_t k = 0; k < faceSurplus.size(); ++k)
+    perComponent[component[faceFront[k]]] += faceSurplus[k];
+  for (const long long m : perComponent) {
+    c.zeroModesPerComponent.push_back(static_cast<std::size_t>(std::max(m, 0LL)));
+    c.zeroModes += c.zeroModesPerComponent.back();
+  }
+}
+
 }  // namespace
 
 RegionDgCheck regionDgChecks(const PolyMesh& mesh, const MomentCache& moments,
@@ -190,167 +400,29 @@ RegionDgCheck regionDgChecks(const PolyMesh& mesh, const MomentCache& moments,
   c.degree = degree;
   // The region (local ids 0 .. regionSize-1), then its neighbours outside it.
   SubMesh sub(mesh);
-  try {
-    for (std::size_t i = 0; i < region.size(); ++i)
-      if (region[i]) sub.add(ElementId(i));
-  } catch (const std::exception& e) {
-    throw std::invalid_argument(std::string("regionDgChecks: the region's faces are not used "
-                                            "consistently (") +
-                                e.what() + ")");
-  }
-  const std::size_t regionSize = sub.size();
+  Box3 box;
+  const std::size_t regionSize = copyRegion(mesh, region, sub, box);
   c.elements = regionSize;
   if (regionSize == 0) return c;
-  Box3 box;
-  for (std::size_t i = 0; i < regionSize; ++i) {
-    const ElementId e = sub.global(ElementId(i));
-    box.extend(elementBounds(mesh, e));
-    for (const FaceUse& use : mesh.element(e).faces) {
-      const ElementId other = across(mesh, use.face, e);
-      if (other.valid() && !sub.contains(other)) sub.add(other);
-    }
-  }
   const PolyMesh& local = sub.mesh();
 
   // 1. Moments: the caller's, copied to the sub-mesh (nothing integrated), and the region's
   //    recomputed from its geometry to compare.
   const int momentDegree = 2 * degree;
   MomentCache given(local, momentDegree);
-  for (std::size_t f = 0; f < local.numFaces(); ++f) {
-    const FaceId theirs = sub.globalFace(FaceId(f));
-    given.assignFace(FaceId(f),
-                     moments.face(theirs).first(static_cast<std::size_t>(given.stride())),
-                     moments.faceNormal(theirs));
-  }
-  given.update();
+  copyMoments(sub, moments, given);
   c.momentMismatch = momentMismatch(sub, regionSize, moments, momentDegree);
 
   // 2. The region's rows of the IP system at the linear field's coefficients, element by element.
   const DgBasis basis(local, given, options.basis);
-  const int n = basis.size(), bs = 3 * n;
   const FormCoefficients form{Method::IP, options.material.mu(), options.material.lambda(),
                               regionPenalty(sub, regionSize, basis, given)};
-  Eigen::Matrix3d gradient;
-  gradient << 0.31, -0.17, 0.23, 0.13, 0.27, -0.19, -0.29, 0.11, 0.21;
-  const Vec3 b = box.diagonal().norm() * Vec3(0.5, -0.6, 0.7), x0 = box.center();
-  Eigen::VectorXd exact(static_cast<Eigen::Index>(local.numElements()) * bs);
-  for (std::size_t i = 0; i < local.numElements(); ++i)
-    exact.segment(static_cast<Eigen::Index>(i) * bs, bs) =
-        linearFieldCoefficients(basis, ElementId(i), b, gradient, x0);
-  const Eigen::Matrix3d strain = 0.5 * (gradient + gradient.transpose());
-  const Eigen::Matrix3d stress =
-      2.0 * form.mu * strain + form.lambda * strain.trace() * Eigen::Matrix3d::Identity();
-  const auto coefficients = [&](ElementId e) {
-    return exact.segment(static_cast<Eigen::Index>(e.index()) * bs, bs);
-  };
-  // Every face of the full problem has face terms: c_K is the element's face count.
-  const auto coupled = [&](ElementId e) { return static_cast<int>(local.element(e).faces.size()); };
+  RegionRows rows(local, regionSize, basis, given, form, box, degree);
+  for (std::size_t i = 0; i < regionSize; ++i) rows.addElement(i);
+  c.patchTestResidual = rows.patchTestResidual();
 
-  std::vector<Eigen::MatrixXd> stiffnesses(regionSize);
-  std::vector<Eigen::VectorXd> scales(regionSize);
-  std::unordered_map<std::uint32_t, FaceBlocks> faceBlocks;  // by local face
-  std::vector<long long> surplus(regionSize, 0);             // element zero modes beyond 6
-  double worstResidual = 0.0;
-  bool definite = true;
-  Eigen::MatrixXd stiffness, a, selfBlock, otherBlock;
-  Eigen::VectorXd r, size, diagonal;
-  for (std::size_t i = 0; i < regionSize; ++i) {
-    const ElementId e(i);
-    const auto ue = coefficients(e);
-    elementStiffness(basis, given, e, form.mu, form.lambda, stiffness);
-    surplus[i] = static_cast<long long>(elementZeroModes(stiffness, degree)) - 6;
-    // r = A U - F over K's rows and, entry by entry, the size of the terms summed into it.
-    a = stiffness;
-    r = stiffness * ue;
-    size = stiffness.cwiseAbs() * ue.cwiseAbs();
-    diagonal = stiffness.diagonal();
-    for (const FaceUse& use : local.element(e).faces) {
-      const ElementId other = across(local, use.face, e);
-      FaceView view;
-      view.face = use.face;
-      view.kind = other.valid() ? FaceKind::Interior : FaceKind::Dirichlet;
-      view.self = e;
-      view.other = other;
-      view.selfIsFront = !use.reversed;
-      view.selfCoupledFaces = coupled(e);
-      view.otherCoupledFaces = other.valid() ? coupled(other) : 0;
-      faceRows(local, basis, given, view, form, selfBlock, otherBlock);
-      a += selfBlock;
-      if (other.valid()) {
-        // A Dirichlet face's S_F U_K is on both sides of A U = F: only its t_F is left below.
-        const auto uo = coefficients(other);
-        r.noalias() += selfBlock * ue + otherBlock * uo;
-        size.noalias() +=
-            selfBlock.cwiseAbs() * ue.cwiseAbs() + otherBlock.cwiseAbs() * uo.cwiseAbs();
-        if (other.index() < regionSize) {
-          diagonal += selfBlock.diagonal();
-          FaceBlocks& t = faceBlocks[use.face.value];
-          const int side = use.reversed ? 1 : 0;
-          t.self[side] = selfBlock;
-          t.other[side] = otherBlock;
-        }
-      } else {
-        const Vec3 normal =
-            use.reversed ? Vec3(-given.faceNormal(use.face)) : given.faceNormal(use.face);
-        const Vec3 traction = stress * normal;
-        const Eigen::VectorXd integrals = faceIntegrals(local, basis, use.face, e);
-        for (int d = 0; d < 3; ++d) {
-          r.segment(d * n, n) -= traction[d] * integrals;
-          size.segment(d * n, n) += std::abs(traction[d]) * integrals.cwiseAbs();
-        }
-      }
-    }
-    // Relative to the largest term in K's rows: round-off in the sum stays below a few
-    // machine epsilons of it, times the relative round-off of the matrices' entries.
-    const double largest = size.maxCoeff();
-    const double relative = largest > 0.0   ? r.cwiseAbs().maxCoeff() / largest
-                            : r.isZero(0.0) ? 0.0
-                                            : std::numeric_limits<double>::infinity();
-    worstResidual =
-        std::max(worstResidual,
-                 std::isfinite(relative) ? relative : std::numeric_limits<double>::infinity());
-    // K's block of the IP matrix (every face with its terms) is SPD on a valid element.
-    const Eigen::LDLT<Eigen::MatrixXd> ldlt(a);
-    for (const double d : ldlt.vectorD()) definite = definite && d > 0.0;
-    scales[i] = zeroModeScaling(diagonal, bs);
-    stiffnesses[i] = stiffness;
-  }
-  c.patchTestResidual = definite ? worstResidual : std::numeric_limits<double>::infinity();
-
-  // 3. Zero modes: 6 per element (its own stiffness), and per face between region elements the
-  //    rigid motions it leaves free; components by union-find over the faces that join.
-  UnionFind sets(regionSize);
-  std::vector<long long> faceSurplus;
-  std::vector<std::uint32_t> faceFront;
-  Eigen::MatrixXd pair(2 * bs, 2 * bs);
-  Eigen::VectorXd pairScale(2 * bs);
-  for (const auto& [f, t] : faceBlocks) {
-    const Face& face = local.face(FaceId(std::size_t(f)));
-    const std::size_t front = face.front.index(), back = face.back.index();
-    pair << stiffnesses[front] + t.self[0], t.other[0], t.other[1], stiffnesses[back] + t.self[1];
-    pairScale << scales[front], scales[back];
-    const std::size_t modes = countZeroModes(pair, pairScale);
-    if (coupling == RegionCoupling::HoldingFaces && modes > 6) {
-      ++c.looseFaces;
-      continue;
-    }
-    sets.unite(face.front.value, face.back.value);
-    // A face whose terms do not vanish on the rigid motions common to its two elements (fewer
-    // than 6) takes zero modes from its component. AllFaces joins hinges too, without counting
-    // their soft modes: a count over a component's cycles would take its global eigen-solve.
-    faceSurplus.push_back(std::min(static_cast<long long>(modes) - 6, 0LL));
-    faceFront.push_back(face.front.value);
-  }
-  std::vector<std::uint32_t> component;
-  c.components = sets.labels(component);
-  std::vector<long long> perComponent(c.components, 6);
-  for (std::size_t i = 0; i < regionSize; ++i) perComponent[component[i]] += surplus[i];
-  for (std::size_t k = 0; k < faceSurplus.size(); ++k)
-    perComponent[component[faceFront[k]]] += faceSurplus[k];
-  for (const long long m : perComponent) {
-    c.zeroModesPerComponent.push_back(static_cast<std::size_t>(std::max(m, 0LL)));
-    c.zeroModes += c.zeroModesPerComponent.back();
-  }
+  // 3. Zero modes per component of the region.
+  countRegionZeroModes(local, rows, 3 * basis.size(), coupling, c);
   c.seconds = start.seconds();
   return c;
 }

@@ -85,8 +85,9 @@ struct RegionDgCheck {
 ///     s_K = |K_K||U_K| + sum_F (|S_F||U_K| + |O_F||U_L|) + sum |t_F| (entrywise absolute values,
 ///     the size of the terms summed) must be below kRegionPatchResidualTolerance. Valid regions
 ///     give 1e-16 .. 1e-12 (slivers, a grid translated by 1e6); a vertex 1e-3 of a cell off its
-///     faces' planes 8.7e-7, a reversed face more. The solve of the former check, delta = -A^-1 r,
-///     vanishes exactly when r does (A SPD), so both test the same equations. One penalty, the
+///     faces' planes 8.7e-7, a reversed face more. Solving for delta = -A^-1 r would test the
+///     same equations (it vanishes exactly when r does, A SPD) at the cost of a solve. One
+///     penalty, the
 ///     largest local eta_K of localDgChecks() over the region, makes each element's block of
 ///     the IP matrix SPD: an element whose block is not (an inverted one) gives +inf.
 ///  2. Zero modes, with the region's boundary free: each element's own stiffness has exactly 6
@@ -101,11 +102,10 @@ struct RegionDgCheck {
 ///     difference to its component, and so does a joining face with fewer than 6 (terms that do
 ///     not vanish on a common rigid motion). HoldingFaces joins the faces that hold; AllFaces
 ///     joins every face without counting a hinge's soft modes (that count over a component's
-///     cycles would need its global eigen-solve). Differences from the former global count:
-///     a free sliver's bending (~3.7 t^2 from degree 2 on) is an elastic mode of the element,
-///     not a zero mode; a face that holds its two elements joins them even where it would not
-///     hold the larger groups they belong to (the former check released it, making two bodies;
-///     a mechanism needs a face that lets its own two elements move, which this catches).
+///     cycles would need its global eigen-solve). A free sliver's bending (~3.7 t^2 from degree
+///     2 on) is an elastic mode of the element, not a zero mode; a face that holds its two
+///     elements joins them even where it would not hold the larger groups they belong to: a
+///     mechanism needs a face that lets its own two elements move, which this catches.
 /// Costs O(region), proportional to its elements and faces: Face::front/back and element face
 /// lists, never a loop over the mesh (apart from one scan of the `region` flags). Throws
 /// std::invalid_argument if `region` has the wrong size, `moments` holds less than degree 2p,

@@ -163,8 +163,8 @@ class BandReader {
 
 /// Makes the band's distances exact. OpenVDB's voxelization gives every voxel within
 /// sqrt(3)/2 voxel of the surface its exact distance; it widens the band from there with the
-/// triangle nearest a nearby voxel, which is not always the one nearest the voxel: on a sphere of
-/// 50 voxels' radius some values 2-3 voxels out were 0.6 voxel too large (OpenVDB's optional
+/// triangle nearest a nearby voxel, which is not always the one nearest the voxel, so values a
+/// few voxels out can be too large by a good part of a voxel (OpenVDB's optional
 /// renormalization smooths them, but costs the exactness near the surface). The first sweep
 /// gives each voxel the distance to the nearest of the triangles nearest to it and its 26
 /// neighbours (BandReader::nearer()); a nearer triangle spreads one voxel per sweep, so the next

@@ -28,8 +28,8 @@ constexpr double kLatticeTolerance = 1e-6;
 
 /// The share of elements that must each lie in one cell for a lattice to be used. Not all:
 /// a sliver merged into its neighbour across a cell face makes one element of two cells, and
-/// slicing merges many (at 16 cells 88% of the bunny's 1,149 elements and 89% of the torus's
-/// 840 lie in one cell); with no lattice few boxes share the one extent and origin found.
+/// slicing merges many (about one element in ten of a sliced model spans two cells); with no
+/// lattice few boxes share the one extent and origin found.
 constexpr double kLatticeShare = 0.5;
 
 /// Monomial combinations of a group whose Gram eigenvalue over its blocks' weights
@@ -135,9 +135,8 @@ bool coupledSlot(const BlockRows<double>& rows, int k) {
 /// gets each group's box (the cells halved).
 /// Two blocks of one cell are pieces that a cut (or the surface) separates in it, coupled by
 /// no face; a component can still join them around the end of a finite cut inside the box,
-/// and one polynomial on both sides then cannot open the slit: the slowest mode of the bunny
-/// cut by a plane and a slit (p = 2: 44 CG iterations instead of 39, `bench --suite
-/// multigrid`), at every agglomeration level (a group of groups joins two groups of one box
+/// and one polynomial on both sides then cannot open the slit, which becomes the V-cycle's
+/// slowest mode, at every agglomeration level (a group of groups joins two groups of one box
 /// the same way). Pairs of coupled blocks are joined in the order of their blocks, each
 /// unless their sets share a cell (a set holds a few cells: up to 8, and merged slivers).
 std::vector<int> groupByCells(const BlockRows<double>& rows,
@@ -265,7 +264,7 @@ BlockRows<double> galerkinBlocks(const Agglomeration& fine, const BlockRows<doub
   // diagonal block, and IP's off-diagonal ones) is stored whole, an uncoupled one (BZ's) as
   // its three diagonal n x n parts. Written straight from the panels: a CSR matrix (made
   // full by Eigen's selfadjointView) and the block rows converted from it cost as much
-  // again as the panels, and the CSR matrix was the peak of the setup on the 48^3 cube.
+  // again as the panels, and the CSR matrix would set the setup's peak memory.
   struct Source {
     int block;  // B
     int slot;   // its slot in the panels of C (B <= C) or of B (B > C)

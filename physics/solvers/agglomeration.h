@@ -44,7 +44,7 @@ ElementFrames elementFrames(const DgBasis& basis, const PolyMesh& mesh);
 /// which most elements of a sliced mesh are) and the origin the lattice plane, at a multiple
 /// of h from the lower side of an element of that extent, at or below every box.
 /// Returns no cells (empty) unless at least half the boxes lie each within one cell (within
-/// 1e-6 h; the rest are mostly slivers merged across a cell face, 11-12% at 16 cells): a
+/// 1e-6 h; the rest are mostly slivers merged across a cell face): a
 /// tetrahedral or Voronoi mesh has no such lattice. An octree mesh is grouped on its most
 /// common cell size, each larger element in the cell of its centre.
 std::vector<Eigen::Vector3i> latticeCells(const std::vector<Eigen::AlignedBox3d>& boxes);

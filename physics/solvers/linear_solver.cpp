@@ -91,7 +91,7 @@ struct LinearSolver::Impl {
   PMultigrid multigrid;
   /// K by element block rows in double precision for CG's product: two thirds of the CSR
   /// matrix's bytes (no index per entry), when the blocks hold no more values than it has
-  /// nonzeros (B2, IP, p = 1: 0.31 -> 0.2 ms per product).
+  /// nonzeros.
   BlockRows<double> productBlocks;
   bool useProductBlocks = false;
   /// K given by block rows alone (compute(const BlockRows<double>&)): the caller's, the one

@@ -1,3 +1,6 @@
+// The p-multigrid preconditioner (physics/solvers/p_multigrid.h): its levels built and the
+// symmetric V-cycle over them. A level, its smoother and the coarse matrices of the degree levels
+// are in multigrid_level.h, multigrid_smoother.h and multigrid_coarsening.h.
 #include "physics/solvers/p_multigrid.h"
 
 #include <algorithm>
@@ -5,7 +8,6 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
-#include <numeric>
 #include <span>
 #include <stdexcept>
 
@@ -16,6 +18,9 @@
 
 #include "physics/dg/block_rows.h"
 #include "physics/solvers/agglomeration.h"
+#include "physics/solvers/multigrid_coarsening.h"
+#include "physics/solvers/multigrid_level.h"
+#include "physics/solvers/multigrid_smoother.h"
 #include "physics/solvers/strong_coupling.h"
 #include "polydg/integrate/monomials.h"
 
@@ -23,7 +28,17 @@ namespace polydg {
 
 namespace {
 
-using SpMat = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
+using multigrid::blockResidual;
+using multigrid::colourGroups;
+using multigrid::invertGroups;
+using multigrid::kMaxBlock;
+using multigrid::Level;
+using multigrid::restrictBlocks;
+using multigrid::restrictMatrix;
+using multigrid::singleBlocks;
+using multigrid::splitComponents;
+using multigrid::SpMat;
+using multigrid::Transfer;
 
 /// Unknowns up to which CHOLMOD factorizes the coarsest level simplicially (see
 /// factorizeCoarse()): a degree-0 level, and an agglomeration level (denser: 12 x 12 or 30 x 30
@@ -31,378 +46,27 @@ using SpMat = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
 constexpr Eigen::Index kSimplicialCoarseLimit = 30000;
 constexpr Eigen::Index kSimplicialAggregateLimit = 1000;
 
-/// Largest element block handled (3 numMonomials(3)).
-constexpr int kMaxBlock = 60;
-
 /// Smoother groups join blocks whose coupling strength gamma (couplingStrengths(), the cosine of
 /// the angle between their unknowns in the energy inner product) is at least
 /// smootherStrongCoupling(p) = sqrt(3)/2, or 3/4 for p = 1 (physics/solvers/strong_coupling.h). On
 /// hex grids no pair is that strong, so their smoother is unchanged; across faces of elements
-/// clipped by the surface gamma comes close to 1. Measured when the penalty still grew with an
-/// element's face count (eq. 7's area(F), penaltyThreshold()): joining pairs down to 1/sqrt(2)
-/// helped the bunny more (p = 1: 58 instead of 64 iterations) but joined cube elements too and cost
-/// the cube 1-2 iterations at p = 2.
+/// clipped by the surface gamma comes close to 1. A lower threshold would join elements of hex
+/// grids too, which costs them iterations.
 ///
 /// Most blocks in one smoother group, and so most unknowns. Strong couplings chain along a
-/// clipped surface layer; groups of up to 16 took the bunny at p = 2 from 82 (up to 8) to 74
-/// iterations (with that penalty), and larger caps gave no more. Most groups are pairs.
+/// clipped surface layer; 16 blocks take in such chains, and larger caps saved no iterations.
+/// Most groups are pairs.
 constexpr int kMaxGroupBlocks = 16;
 constexpr int kMaxGroupUnknowns = kMaxGroupBlocks * kMaxBlock;
 
 /// When agglomeration stops. The coarsest level is factorized once and solved once per
 /// V-cycle; its factorization should cost about one V-cycle on K. A coarse matrix with 12 x 12
-/// blocks on a 3D mesh factorizes in about 13 N^2 flops for N unknowns (B2: 28.7 MFlop at
-/// 1,500 unknowns, 0.9 at 324), about what a V-cycle costs at 13 flops per nonzero of K when
-/// N^2 = nnz(K). So agglomeration continues while N^2 > nnz(K), and at least down to
-/// kCoarseUnknowns. On B2 (nnz(K) = 4.0e5 for BZ, p = 1) that is 125 linear groups (1,500
-/// unknowns), 27 quadratic ones (810) and 8 (240): 21 iterations (with linear groups of
-/// groups, 324 unknowns: 24; with the 1,500 exact: 21, but 10-13 ms of factorization instead
-/// of 0.7). For p = 2 (nnz(K) = 2.5e6) 125 quadratic groups (3,750) and 27 (810): 26
-/// iterations (the 1,500 unknowns of linear groups, when p = 2 went through degree 1, were
-/// kept exact: 25). Denser 30 x 30 blocks cost more flops per N^2 (about 2.5 times), but a
-/// bound scaled to them (N^2 <= 0.4 nnz(K)) cost iterations (a 24 x 24 x 1 plate, p = 2: 45
-/// instead of 36; the 48^3 cube, p = 1, BZ: 26 instead of 22) and saved neither memory nor
-/// time there (IP: 810 coarse unknowns instead of 6,480), so the rule stays.
+/// blocks on a 3D mesh factorizes in about 13 N^2 flops for N unknowns, about what a V-cycle
+/// costs at 13 flops per nonzero of K when N^2 = nnz(K). So agglomeration continues while
+/// N^2 > nnz(K), and at least down to kCoarseUnknowns. Denser 30 x 30 blocks cost more flops
+/// per N^2, but a bound scaled to them (N^2 <= 0.4 nnz(K)) cost iterations and saved neither
+/// memory nor time, so the rule stays.
 constexpr Eigen::Index kCoarseUnknowns = 600;
-
-/// How a level's unknowns reach the next coarser level.
-enum class Transfer {
-  Degree,     ///< the first numMonomials(q) functions of each element (index maps)
-  Aggregate,  ///< polynomials of groups of blocks (weights per block)
-};
-
-/// One level: its matrix (the top level borrows K), functions per component, its smoother's
-/// groups of blocks with the inverses of their diagonal blocks, its colouring and its
-/// transfer to the next coarser level.
-struct Level {
-  const SpMat* matrix = nullptr;
-  SpMat owned;
-  /// The top level given by block rows alone (the caller's, double precision; no CSR matrix):
-  /// the smoother reads them as they are.
-  const BlockRows<double>* rows = nullptr;
-  int n = 0, bs = 0;
-  /// The smoother's blocks: groups of the level's blocks (elements or agglomerates) joined
-  /// along strong couplings (groupStrongCouplings()), most of them single blocks. Group g's
-  /// diagonal block inverted, (m bs) x (m bs) for its m blocks, column-major, at
-  /// inverses[inverseOffset[g]].
-  BlockGroups smootherGroups;
-  std::vector<std::size_t> inverseOffset;
-  std::vector<double> inverses;
-  /// The smoother's copy of the matrix in single precision (BlockRows): half the bytes of
-  /// the CSR values (a sixth for BZ's component-diagonal neighbour blocks) and no index per
-  /// entry, for a smoother bound by memory bandwidth. Symmetric like the matrix, so the
-  /// V-cycle stays symmetric (it is the V-cycle of the rounded matrix). Used when it stores
-  /// at most twice the matrix's nonzeros; otherwise the smoother reads the CSR matrix.
-  bool useBlocks = false;
-  BlockRows<float> blocks;
-  /// The matrix by block rows in double precision, for a level that is agglomerated: the
-  /// grouping reads its block graph and the Galerkin product its values (the top level's copy
-  /// is the caller's, `source`). An agglomeration level's Galerkin matrix is formed this way,
-  /// with no CSR matrix unless it is the coarsest.
-  BlockRows<double> exact;
-  const BlockRows<double>* source = nullptr;
-  /// Smoother groups of each colour, in increasing order (groups of one colour share no
-  /// entry); inLastColour[b] = 1 for the blocks of the last colour's groups.
-  std::vector<std::vector<int>> colours;
-  std::vector<std::uint8_t> inLastColour;
-  /// Gauss-Seidel sweeps before (and, reversed, after) the coarse correction.
-  int sweeps = 1;
-  Transfer transfer = Transfer::Degree;
-  /// Aggregate transfer: the groups of this level's blocks that are the next level's blocks.
-  Agglomeration groups;
-  // Scratch of apply(): right-hand side and solution of this level.
-  mutable Eigen::VectorXd b, x;
-
-  /// Blocks (elements or groups) of the level, and its unknowns.
-  Eigen::Index blockCount() const {
-    return rows                   ? rows->elements()
-           : useBlocks            ? blocks.elements()
-           : !exact.start.empty() ? exact.elements()
-                                  : matrix->cols() / bs;
-  }
-  Eigen::Index unknowns() const { return blockCount() * bs; }
-};
-
-/// The principal submatrix of `fine` (n functions per component) on the DOFs of the first
-/// `nc` functions of each component, renumbered (e, d, i) -> e 3 nc + d nc + i.
-SpMat restrictMatrix(const SpMat& fine, int n, int nc) {
-  const int bs = 3 * n, bsc = 3 * nc;
-  const Eigen::Index ne = fine.cols() / bs;
-  const Eigen::Index ncols = ne * bsc;
-  // Local fine index -> local coarse index (or -1), and coarse -> fine: no integer division
-  // per nonzero (the walks below were division-bound).
-  std::vector<int> toCoarse(static_cast<std::size_t>(bs), -1),
-      toFine(static_cast<std::size_t>(bsc));
-  for (int d = 0; d < 3; ++d)
-    for (int i = 0; i < nc; ++i) {
-      toCoarse[static_cast<std::size_t>(d * n + i)] = d * nc + i;
-      toFine[static_cast<std::size_t>(d * nc + i)] = d * n + i;
-    }
-  const int* outer = fine.outerIndexPtr();
-  const int* inner = fine.innerIndexPtr();
-  const double* values = fine.valuePtr();
-  // Calls visit(coarse row, fine position) for the kept entries of coarse column (e, local).
-  auto walk = [&](Eigen::Index e, int local, auto&& visit) {
-    const Eigen::Index fc = e * bs + toFine[static_cast<std::size_t>(local)];
-    int blockBase = -bs, blockEnd = 0, coarseBase = 0;
-    for (int k = outer[fc]; k < outer[fc + 1]; ++k) {
-      const int row = inner[k];
-      if (row >= blockEnd) {  // a new element block: rows are sorted
-        const int f = row / bs;
-        blockBase = f * bs;
-        blockEnd = blockBase + bs;
-        coarseBase = f * bsc;
-      }
-      const int c = toCoarse[static_cast<std::size_t>(row - blockBase)];
-      if (c >= 0) visit(coarseBase + c, k);
-    }
-  };
-  std::vector<int> counts(static_cast<std::size_t>(ncols) + 1, 0);
-  tbb::parallel_for(Eigen::Index(0), ne, [&](Eigen::Index e) {
-    for (int local = 0; local < bsc; ++local) {
-      int count = 0;
-      walk(e, local, [&](int, int) { ++count; });
-      counts[static_cast<std::size_t>(e * bsc + local) + 1] = count;
-    }
-  });
-  for (std::size_t c = 1; c < counts.size(); ++c) counts[c] += counts[c - 1];
-  SpMat coarse(ncols, ncols);
-  coarse.resizeNonZeros(counts.back());
-  std::copy(counts.begin(), counts.end(), coarse.outerIndexPtr());
-  int* cinner = coarse.innerIndexPtr();
-  double* cvalues = coarse.valuePtr();
-  tbb::parallel_for(Eigen::Index(0), ne, [&](Eigen::Index e) {
-    for (int local = 0; local < bsc; ++local) {
-      int pos = counts[static_cast<std::size_t>(e * bsc + local)];
-      // Fine rows are sorted and the renumbering is monotone: coarse rows come out sorted.
-      walk(e, local, [&](int row, int k) {
-        cinner[pos] = row;
-        cvalues[pos++] = values[k];
-      });
-    }
-  });
-  return coarse;
-}
-
-/// s = b_e - (A x)_e for element e's rows, from the block rows of `level`.
-inline void blockResidual(const Level& level, int e, const Eigen::VectorXd& b,
-                          const Eigen::VectorXd& x, double* s) {
-  const int bs = level.bs;
-  const Eigen::Index base = static_cast<Eigen::Index>(e) * bs;
-  if (level.rows) {
-    for (int c = 0; c < bs; ++c) s[c] = b[base + c];
-    level.rows->subtractRowProduct(e, x.data(), s);
-    return;
-  }
-  if (!level.useBlocks) {
-    const SpMat& a = *level.matrix;
-    const int* outer = a.outerIndexPtr();
-    const int* inner = a.innerIndexPtr();
-    const double* values = a.valuePtr();
-    // Column base + c of A is row base + c (symmetric storage).
-    for (int c = 0; c < bs; ++c) {
-      double sum = 0.0;
-      for (int k = outer[base + c]; k < outer[base + c + 1]; ++k) sum += values[k] * x[inner[k]];
-      s[c] = b[base + c] - sum;
-    }
-    return;
-  }
-  for (int c = 0; c < bs; ++c) s[c] = b[base + c];
-  level.blocks.subtractRowProduct(e, x.data(), s);
-}
-
-/// D^-1 of one symmetric positive definite block D (column-major, BS x BS) into `inverse`;
-/// false if D is not positive definite. Fixed sizes: a 30 x 30 block inverts 3-4x faster
-/// than with Eigen's dynamic-size LLT (p = 2 setup on B2).
-template <int BS>
-bool invertBlock(const double* block, double* inverse) {
-  using Mat = Eigen::Matrix<double, BS, BS>;
-  const Eigen::LLT<Mat> llt{Eigen::Map<const Mat>(block)};
-  if (llt.info() != Eigen::Success) return false;
-  Eigen::Map<Mat> out(inverse);
-  out = llt.solve(Mat::Identity());
-  return true;
-}
-
-bool invertBlock(int bs, const double* block, double* inverse) {
-  switch (bs) {
-    case 3: return invertBlock<3>(block, inverse);
-    case 12: return invertBlock<12>(block, inverse);
-    case 30: return invertBlock<30>(block, inverse);
-    case 60: return invertBlock<60>(block, inverse);
-    default: {
-      const Eigen::LLT<Eigen::MatrixXd> llt{Eigen::Map<const Eigen::MatrixXd>(block, bs, bs)};
-      if (llt.info() != Eigen::Success) return false;
-      Eigen::Map<Eigen::MatrixXd> out(inverse, bs, bs);
-      out = llt.solve(Eigen::MatrixXd::Identity(bs, bs));
-      return true;
-    }
-  }
-}
-
-/// Writes the diagonal block of `level`'s smoother group g into `block` ((m bs) x (m bs),
-/// column-major, zeroed by the caller), from the matrix as the smoother reads it.
-void groupBlock(const Level& level, int g, double* block) {
-  const int bs = level.bs;
-  const std::span<const int> group = level.smootherGroups.of(g);
-  const int m = static_cast<int>(group.size()), size = m * bs;
-  const int* members = group.data();
-  // The position of block f in the group, or -1.
-  auto local = [&](int f) {
-    const int* it = std::lower_bound(members, members + m, f);
-    return it != members + m && *it == f ? static_cast<int>(it - members) : -1;
-  };
-  auto copyRows = [&](const auto& rows) {
-    for (int i = 0; i < m; ++i)
-      for (int k = rows.start[static_cast<std::size_t>(members[i])];
-           k < rows.start[static_cast<std::size_t>(members[i]) + 1]; ++k)
-        if (const int j = local(rows.element[static_cast<std::size_t>(k)]); j >= 0)
-          rows.copySlot(static_cast<std::size_t>(k),
-                        block + static_cast<std::ptrdiff_t>(j) * bs * size + i * bs, size);
-  };
-  if (level.rows) {
-    copyRows(*level.rows);
-  } else if (level.useBlocks) {  // invert the block as the smoother sees it (single precision)
-    copyRows(level.blocks);
-  } else {
-    // Column c of block i is row c of it (symmetric storage).
-    for (int i = 0; i < m; ++i)
-      for (int c = 0; c < bs; ++c)
-        for (SpMat::InnerIterator it(*level.matrix, static_cast<Eigen::Index>(members[i]) * bs + c);
-             it; ++it)
-          if (const int j = local(static_cast<int>(it.row() / bs)); j >= 0)
-            block[static_cast<std::ptrdiff_t>(i * bs + c) * size + j * bs + it.row() % bs] =
-                it.value();
-  }
-}
-
-/// Inverts the diagonal blocks of `level`'s smoother groups; false if one is not positive
-/// definite.
-bool invertGroups(Level& level) {
-  const int bs = level.bs;
-  const BlockGroups& groups = level.smootherGroups;
-  const int ng = groups.groups();
-  level.inverseOffset.assign(static_cast<std::size_t>(ng) + 1, 0);
-  for (int g = 0; g < ng; ++g)
-    level.inverseOffset[static_cast<std::size_t>(g) + 1] =
-        level.inverseOffset[static_cast<std::size_t>(g)] +
-        static_cast<std::size_t>(groups.size(g) * bs) *
-            static_cast<std::size_t>(groups.size(g) * bs);
-  level.inverses.resize(level.inverseOffset.back());
-  std::atomic<bool> ok{true};
-  tbb::parallel_for(0, ng, [&](int g) {
-    const int size = groups.size(g) * bs;
-    double* inverse = level.inverses.data() + level.inverseOffset[static_cast<std::size_t>(g)];
-    if (size == bs) {
-      double block[kMaxBlock * kMaxBlock];
-      std::fill(block, block + bs * bs, 0.0);
-      groupBlock(level, g, block);
-      if (!invertBlock(bs, block, inverse)) ok = false;
-      return;
-    }
-    Eigen::MatrixXd block = Eigen::MatrixXd::Zero(size, size);
-    groupBlock(level, g, block.data());
-    if (!invertBlock(size, block.data(), inverse)) ok = false;
-  });
-  return ok;
-}
-
-/// Greedy colouring of `ne` elements, in order, each taking the first colour none of its
-/// neighbours has: forEachNeighbour(e, visit) calls visit(f) for each neighbour f of e. The
-/// elements of each colour, in increasing order.
-template <class ForEachNeighbour>
-std::vector<std::vector<int>> colourGreedily(int ne, ForEachNeighbour&& forEachNeighbour) {
-  std::vector<int> colour(static_cast<std::size_t>(ne), -1);
-  std::vector<int> seenBy;  // seenBy[c] == e: colour c is taken by a neighbour of e
-  std::vector<std::vector<int>> classes;
-  for (int e = 0; e < ne; ++e) {
-    forEachNeighbour(e, [&](int f) {
-      const int c = colour[static_cast<std::size_t>(f)];
-      if (c >= 0) seenBy[static_cast<std::size_t>(c)] = e;
-    });
-    int c = 0;
-    while (c < static_cast<int>(seenBy.size()) && seenBy[static_cast<std::size_t>(c)] == e) ++c;
-    if (c == static_cast<int>(seenBy.size())) {
-      seenBy.push_back(-1);
-      classes.emplace_back();
-    }
-    colour[static_cast<std::size_t>(e)] = c;
-    classes[static_cast<std::size_t>(c)].push_back(e);
-  }
-  return classes;
-}
-
-/// Calls visit(f) for each block f that shares a stored block with block e of `level` (e
-/// itself included), from the matrix as the smoother reads it.
-template <class Visit>
-void forEachNeighbour(const Level& level, int e, Visit&& visit) {
-  auto fromRows = [&](const auto& rows) {
-    for (int k = rows.start[static_cast<std::size_t>(e)];
-         k < rows.start[static_cast<std::size_t>(e) + 1]; ++k)
-      visit(rows.element[static_cast<std::size_t>(k)]);
-  };
-  if (level.rows) return fromRows(*level.rows);
-  if (level.useBlocks) return fromRows(level.blocks);
-  // Column e bs holds a row of every neighbour block (BZ blocks included: component 0).
-  for (SpMat::InnerIterator it(*level.matrix, static_cast<Eigen::Index>(e) * level.bs); it; ++it)
-    visit(static_cast<int>(it.row() / level.bs));
-}
-
-/// The colouring of `level`'s smoother groups (two groups are neighbours if a stored block
-/// couples one of each).
-std::vector<std::vector<int>> colourGroups(const Level& level) {
-  const BlockGroups& groups = level.smootherGroups;
-  std::vector<int> groupOf(groups.members.size());
-  for (int g = 0; g < groups.groups(); ++g)
-    for (int e : groups.of(g)) groupOf[static_cast<std::size_t>(e)] = g;
-  return colourGreedily(groups.groups(), [&](int g, auto&& visit) {
-    for (int e : groups.of(g))
-      forEachNeighbour(level, e, [&](int f) { visit(groupOf[static_cast<std::size_t>(f)]); });
-  });
-}
-
-/// Every block of `level` a group of its own.
-BlockGroups singleBlocks(int blocks) {
-  BlockGroups groups;
-  groups.start.resize(static_cast<std::size_t>(blocks) + 1);
-  groups.members.resize(static_cast<std::size_t>(blocks));
-  std::iota(groups.start.begin(), groups.start.end(), 0);
-  std::iota(groups.members.begin(), groups.members.end(), 0);
-  return groups;
-}
-
-/// The principal submatrix of `fine` on the first `nc` functions of each component, as
-/// restrictMatrix() gives it, from block rows.
-SpMat restrictBlocks(const BlockRows<double>& fine, int nc) {
-  BlockRows<double> coarse;
-  const int n = fine.n, bs = fine.bs, bsc = 3 * nc;
-  coarse.n = nc;
-  coarse.bs = bsc;
-  coarse.start = fine.start;
-  coarse.element = fine.element;
-  coarse.diagonal = fine.diagonal;
-  coarse.offset.assign(fine.offset.size(), 0);
-  for (std::size_t k = 0; k + 1 < fine.offset.size(); ++k)
-    coarse.offset[k + 1] =
-        coarse.offset[k] + static_cast<std::size_t>(fine.diagonal[k] ? 3 * nc * nc : bsc * bsc);
-  coarse.values.resize(coarse.offset.back());
-  tbb::parallel_for(std::size_t(0), fine.element.size(), [&](std::size_t k) {
-    const double* from = fine.values.data() + fine.offset[k];
-    double* to = coarse.values.data() + coarse.offset[k];
-    if (fine.diagonal[k]) {
-      for (int d = 0; d < 3; ++d)
-        for (int j = 0; j < nc; ++j)
-          for (int i = 0; i < nc; ++i) to[d * nc * nc + j * nc + i] = from[d * n * n + j * n + i];
-      return;
-    }
-    for (int dj = 0; dj < 3; ++dj)
-      for (int j = 0; j < nc; ++j)
-        for (int di = 0; di < 3; ++di)
-          for (int i = 0; i < nc; ++i)
-            to[(dj * nc + j) * bsc + di * nc + i] = from[(dj * n + j) * bs + di * n + i];
-  });
-  return coarse.toSparse();
-}
 
 /// Functions per component of degree `degree`: numMonomials, checked against the block size.
 int functionsOfBlock(int blockSize, int degree) {
@@ -410,52 +74,6 @@ int functionsOfBlock(int blockSize, int degree) {
   if (blockSize != 3 * n || blockSize > kMaxBlock)
     throw std::invalid_argument("PMultigrid: block size does not match the degree");
   return n;
-}
-
-/// The level-0 matrix `a` (unknown (e, d) at 3 e + d) split by displacement component, if
-/// no entry couples two components: `parts` = S_0, S_1, S_2 (one unknown per element), or
-/// just S_0 when the three are bitwise equal (a = I_3 (x) S_0). Returns false (parts empty)
-/// if components are coupled. BZ's level 0 is always I_3 (x) S: its only terms, the penalty
-/// mu eta_F [u].[v], treat the components alike. IP's lifting adds lambda n n^T per face,
-/// which couples components unless every coupled face is axis-aligned (hex grids: then
-/// uncoupled but different).
-bool splitComponents(const SpMat& a, std::vector<SpMat>& parts) {
-  parts.clear();
-  const Eigen::Index ne = a.cols() / 3;
-  const int* outer = a.outerIndexPtr();
-  const int* inner = a.innerIndexPtr();
-  const double* values = a.valuePtr();
-  std::atomic<bool> uncoupled{true}, equal{true};
-  tbb::parallel_for(Eigen::Index(0), ne, [&](Eigen::Index e) {
-    const int first = outer[3 * e], count = outer[3 * e + 1] - first;
-    for (int d = 0; d < 3; ++d) {
-      const int start = outer[3 * e + d], end = outer[3 * e + d + 1];
-      for (int k = start; k < end; ++k)
-        if (inner[k] % 3 != d) {
-          uncoupled = false;
-          return;
-        }
-      if (!equal) continue;
-      bool same = end - start == count;
-      for (int k = 0; same && k < count; ++k)
-        same = inner[start + k] == inner[first + k] + d && values[start + k] == values[first + k];
-      if (!same) equal = false;
-    }
-  });
-  if (!uncoupled) return false;
-  parts.resize(equal ? 1 : 3);
-  for (std::size_t d = 0; d < parts.size(); ++d) {
-    SpMat& part = parts[d];
-    part.resize(ne, ne);
-    std::vector<Eigen::Triplet<double>> entries;
-    entries.reserve(static_cast<std::size_t>(a.nonZeros() / 3));
-    for (Eigen::Index e = 0; e < ne; ++e)
-      for (int k = outer[3 * e + static_cast<Eigen::Index>(d)];
-           k < outer[3 * e + static_cast<Eigen::Index>(d) + 1]; ++k)
-        entries.emplace_back(inner[k] / 3, static_cast<int>(e), values[k]);
-    part.setFromTriplets(entries.begin(), entries.end());
-  }
-  return true;
 }
 
 }  // namespace
@@ -516,11 +134,8 @@ struct PMultigrid::Impl {
       Cholesky& c = *coarse[i];
       c.cholmod().print = 0;
       // Small coarse levels: simplicial. The supernodal solve calls the threaded BLAS twice
-      // per V-cycle and its thread hand-offs cost more than the solve (B2, 3000 unknowns of
-      // degree 0: 42 instead of 70 ms of CG iterations for p = 1, factorization 4 ms slower).
-      // Agglomeration levels have dense 12 x 12 (or 30 x 30) blocks, where the supernodal
-      // factorization wins sooner (B2: 324 unknowns 0.7 ms simplicial, 1.2 supernodal; 1,500
-      // unknowns 13.7 and 9.5-11 ms, the solves equally fast).
+      // per V-cycle and its thread hand-offs cost more than the solve. Agglomeration levels
+      // have dense 12 x 12 (or 30 x 30) blocks, where the supernodal factorization wins sooner.
       const Eigen::Index simplicialLimit =
           level.bs == 3 ? kSimplicialCoarseLimit : kSimplicialAggregateLimit;
       if (factored.rows() <= simplicialLimit) c.setMode(Eigen::CholmodSimplicialLLt);
@@ -604,8 +219,8 @@ struct PMultigrid::Impl {
   /// Keeps of an agglomeration level that is smoothed (not the coarsest) only what its
   /// smoother reads: its matrix by block rows in single precision, converted from the double
   /// ones that served the grouping and the Galerkin product of the next level, which are
-  /// freed. Holding them (and, then, a CSR matrix) at levels 1 and 2 took the peak memory of
-  /// `polydg solve` on the 48^3 cube (p = 1, IP, 1.3 million DOFs) from 1.77 to 1.94 GB.
+  /// freed: held (with, then, a CSR matrix) at levels 1 and 2, they would raise the peak memory
+  /// of a large solve.
   void keepSmootherCopyOnly(Level& level) {
     level.blocks.convertFrom(level.exact);
     level.useBlocks = true;
@@ -616,7 +231,7 @@ struct PMultigrid::Impl {
   /// Appends a coarser level that owns `matrix`. Re-points every owned matrix: the vector
   /// may have moved the levels. Eigen 3.4's SparseMatrix has no move constructor or
   /// assignment: a Level moved with its matrix, or a returned matrix assigned, copies every
-  /// nonzero (0.25 s of the 1.9 s setup on the 48^3 cube, p = 1); the matrix is swapped in.
+  /// nonzero; the matrix is swapped in.
   void push(Level&& level, SpMat matrix = SpMat()) {
     levels.push_back(std::move(level));
     levels.back().owned.swap(matrix);
@@ -653,8 +268,8 @@ struct PMultigrid::Impl {
                               else
                                 blockResidual(level, group[i], b, x, s + i * bs);
                             }
-                            // x_g += D_g^-1 s (D_g^-1 column-major): a plain loop, where Eigen's
-                            // dynamic-size GEMV call cost a tenth of the CG time on B2.
+                            // x_g += D_g^-1 s (D_g^-1 column-major): a plain loop, cheaper than
+                            // Eigen's dynamic-size GEMV call for blocks this small.
                             const double* inverse =
                                 level.inverses.data() +
                                 level.inverseOffset[static_cast<std::size_t>(g)];
@@ -851,12 +466,8 @@ bool PMultigrid::Impl::build(const SpMat* matrix, const BlockRows<double>* rows,
     // quadratic functions: groups of 4 x 4 x 4 cells and more span the thin parts of a real
     // model (the bunny's ears), which bend within a group (for p = 1, linear groups take the
     // Taylor parts of their parent's quadratics). They have an eighth of the blocks of the
-    // level before each (at p = 1 the first quadratic level, with 30 x 30 blocks, has 0.8 of
-    // the nonzeros of the linear level above it), so they sweep twice: a V-cycle with two
-    // agglomeration levels then needs about as many iterations as one with an exact first
-    // agglomeration level on B2 (not on the bunny at 16 cells: p = 1 34-37 against 31, p = 2
-    // 38-44 against 36-37, measured before groups kept the pieces of a cell apart and the p = 1
-    // smoother joined blocks from 3/4, which took it to 32-33 and 38-39; README, "Speed").
+    // level before each, so they sweep twice: a V-cycle with two agglomeration levels then
+    // needs about as many iterations as one with an exact first agglomeration level on B2.
     const double limit = std::max(static_cast<double>(kCoarseUnknowns), std::sqrt(nonzeros));
     while (static_cast<double>(m.levels.back().unknowns()) > limit) {
       const Eigen::Index before = m.levels.back().unknowns();
@@ -876,9 +487,9 @@ bool PMultigrid::Impl::build(const SpMat* matrix, const BlockRows<double>* rows,
     // Level 0 couples elements through the penalty, mu eta_F [u].[v], which couples equal
     // components only, and (IP) the lifting of the normal jump, which couples components
     // through n n^T. K stores the element blocks whole, so level 0 inherits explicit zeros
-    // that would make CHOLMOD factorize a coupled pattern: on B2 (3000 unknowns) 62 MFlop and
-    // 30-50 ms, against 7 MFlop and 5 ms once exact zeros are dropped (the three components
-    // then separate wherever the normals are axis-aligned, and for BZ everywhere).
+    // that would make CHOLMOD factorize a coupled pattern, several times the work of the
+    // pattern without them (the three components then separate wherever the normals are
+    // axis-aligned, and for BZ everywhere).
     m.levels.back().owned.prune([](Eigen::Index, Eigen::Index, double v) { return v != 0.0; });
   }
   std::atomic<bool> ok{true};

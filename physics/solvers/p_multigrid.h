@@ -28,26 +28,21 @@ struct ElementFrames;
 ///
 /// Agglomeration levels. Below degree 1, piecewise constants are a poor coarse space for
 /// elasticity: they cannot represent rotations, which cost nothing in K but much in the
-/// penalty between constants, so CG needed 31-38 iterations on B2 (p = 1). Instead, elements
-/// are grouped into agglomerates (the elements of 2 x 2 x 2 cells of the lattice the mesh was
-/// sliced on, split into face-coupled components; without a lattice, three rounds of pairing
-/// face neighbours, each round along one axis: physics/solvers/agglomeration.h) and the coarse
-/// space is the polynomial displacements of each agglomerate, rigid motions included: linear for p
-/// = 1 (12 unknowns per agglomerate), quadratic for p >= 2 (30), reached straight from degree 2 (P
-/// built from the frames; the Galerkin matrix P^T K P is formed block by block). Agglomerates are
-/// grouped again, with quadratic functions (for p = 1 too: each linear agglomerate takes the Taylor
-/// part of its group's quadratics; combinations its blocks cannot tell apart, as on a line of
-/// agglomerates, are dropped, Agglomeration::spans), until the coarsest level has few unknowns. B2,
-/// p = 1: 24 CG iterations instead of 38 (BZ) and 31 (IP) with linear agglomerates only, 21-22 with
-/// quadratic groups of them. Why quadratic: a thin part, one element thick, bends at little cost in
-/// K, but linear displacements per agglomerate bend it only through jumps between agglomerates,
-/// which pay the penalty; quadratic ones bend it inside each. A plate one element thick (24 x 24 x
-/// 1), p = 2: 36 CG iterations instead of 125 with the degree-1 level and linear agglomerates below
-/// it; the bunny at 16 cells 45 instead of 64 (p = 3: 47 instead of 72); B2 26-27 instead of 25-26.
-/// For p = 1 the first agglomeration level stays linear (quadratic agglomerates of linear
-/// elements take the bunny standing on its base from 34 to 25 iterations, but their level
-/// has as many nonzeros as K: slower); quadratic groups of them take it from 44 to 34 and a
-/// 2.4 x 2.4 x 0.1 plate meshed at 24 cells from 65 to 42 (README, "Speed").
+/// penalty between constants. Instead, elements are grouped into agglomerates (the elements of
+/// 2 x 2 x 2 cells of the lattice the mesh was sliced on, split into face-coupled components;
+/// without a lattice, three rounds of pairing face neighbours, each round along one axis:
+/// physics/solvers/agglomeration.h) and the coarse space is the polynomial displacements of each
+/// agglomerate, rigid motions included: linear for p = 1 (12 unknowns per agglomerate),
+/// quadratic for p >= 2 (30), reached straight from degree 2 (P built from the frames; the
+/// Galerkin matrix P^T K P is formed block by block). Agglomerates are grouped again, with
+/// quadratic functions (for p = 1 too: each linear agglomerate takes the Taylor part of its
+/// group's quadratics; combinations its blocks cannot tell apart, as on a line of agglomerates,
+/// are dropped, Agglomeration::spans), until the coarsest level has few unknowns. Why
+/// quadratic: a thin part, one element thick, bends at little cost in K, but linear
+/// displacements per agglomerate bend it only through jumps between agglomerates, which pay the
+/// penalty; quadratic ones bend it inside each. For p = 1 the first agglomeration level stays
+/// linear: quadratic agglomerates of linear elements save iterations, but their level has as
+/// many nonzeros as K, which makes the V-cycle slower.
 ///
 /// Smoother. Block Gauss-Seidel with one block per element or agglomerate, except where blocks
 /// are strongly coupled: blocks whose coupling strength gamma (the cosine of the angle between
@@ -58,9 +53,8 @@ struct ElementFrames;
 /// group is one block. Groups are visited colour by colour (a greedy colouring of the level's group
 /// graph, so that groups of one colour share no entry and are updated in parallel): colours in
 /// order before the coarse correction and in reverse order after it, which makes the V-cycle a
-/// symmetric positive definite operator (a valid CG preconditioner) whenever K is SPD. Bunny at 16
-/// cells, p = 2: 65 CG iterations instead of 73 without groups (torus cut: 39 instead of 49); the
-/// cube's 26 unchanged.
+/// symmetric positive definite operator (a valid CG preconditioner) whenever K is SPD. Groups
+/// save iterations on clipped meshes and leave hex grids as they are.
 ///
 /// Not thread-safe: apply() uses scratch vectors of the object.
 class PMultigrid {

@@ -43,9 +43,8 @@ double spectralNorm(const Mat& m) {
 }
 
 /// couplingStrengths() with blocks of BS x BS (Eigen::Dynamic: a.bs, known at run time only):
-/// fixed sizes keep the per-pair matrices on the stack. B2's cube (1,000 elements): 5 ms
-/// instead of 7-8 for p = 1; for p = 2 40-50 ms either way, mostly forming M (two triangular
-/// solves per pair), which costs B2's p = 2 setup about a fifth more.
+/// fixed sizes keep the per-pair matrices on the stack. At p = 2 forming M (two triangular
+/// solves per pair) costs the most either way.
 template <int BS, class T>
 void strengthsOfSize(const BlockRows<T>& a, std::vector<double>& strength) {
   using Mat = Eigen::Matrix<double, BS, BS>;

@@ -51,13 +51,11 @@ BlockGroups groupStrongCouplings(const BlockRows<T>& a, double threshold, int ma
 /// p (all its levels): gamma >= sqrt(3)/2 for p >= 2, where block Gauss-Seidel on the pair
 /// alone would remove less than a quarter (1 - gamma^2) of its error per sweep, and gamma >=
 /// 3/4 for p = 1 (less than 44%). Dimensionless. Both lie above every coupling of a hex grid
-/// at that degree, whose block Gauss-Seidel smooths well (B2's cube, IP / BZ: at most 0.53 /
-/// 0.64 for p = 1, 0.80 / 0.84 for p = 2; B1's at p = 3 0.86 / 0.84), so hex grids keep one
-/// block per element. Why lower for p = 1: clipped elements couple there at 0.75-0.87 too,
-/// and joining them took the bunny of `bench --suite multigrid` (p = 1) from 34 to 32 CG
-/// iterations (cut: 35 to 33; at 40 cells 34 to 31 and 37 to 33) in about the same time; at
-/// 1/sqrt(2) 31 and 32, but 40% slower at 40 cells (larger groups). At p = 2 the lower threshold
-/// joins most elements of the cube (30 x 30 blocks in groups of up to 16): 1.5x slower.
+/// at that degree, whose block Gauss-Seidel smooths well, so hex grids keep one block per
+/// element: B2's cube couples at most 0.64 at p = 1, and B1's at most 0.86 at p = 3. Why lower
+/// for p = 1: clipped elements couple there from 3/4 up too, and joining them saves iterations
+/// at about the same cost; a lower threshold makes larger groups and a slower smoother, and at
+/// p = 2 the threshold of p = 1 would join most elements of a hex grid.
 inline constexpr double kSmootherStrongCoupling = 0.86602540378443865;  // sqrt(3) / 2
 inline constexpr double kLinearSmootherStrongCoupling = 0.75;
 inline constexpr double smootherStrongCoupling(int degree) {

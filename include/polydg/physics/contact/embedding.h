@@ -25,6 +25,7 @@
 
 #include <cstdint>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -134,6 +135,26 @@ class SurfaceEmbedding {
   /// Locates and computes the rows of points `which` (pieces, support factors and Phi rows).
   Rows computeRows(const PolyMesh& mesh, const Samples& samples,
                    std::span<const std::uint32_t> which);
+  /// The element each of points `which` lies in, by their bounding boxes and, where those
+  /// disagree, a geometric test; a point in none takes the nearest box's (rows.outside).
+  std::vector<std::uint32_t> locatePoints(const PolyMesh& mesh, const Samples& samples,
+                                          std::span<const std::uint32_t> which, Rows& rows) const;
+  /// The Phi row of point x in `element` and `piece` (eq. 18), into `row`; returns the factor
+  /// its supports were widened by.
+  double fitRow(const Samples& samples, const Vec3& x, std::uint32_t element, std::uint32_t piece,
+                std::vector<std::pair<std::uint32_t, double>>& row) const;
+  /// update()'s steps. Each old sample's new twin (same position, support and row through the
+  /// renumbering `source`), or -1; `used` marks the new samples that have one.
+  std::vector<std::int64_t> matchSamples(const Samples& samples, std::span<const ElementId> source,
+                                         std::vector<char>& used) const;
+  /// The points that keep their rows: all their samples matched, in one piece (written to
+  /// `newPiece`), and no new sample reaching them.
+  std::vector<char> keptPoints(const Samples& samples, const std::vector<std::int64_t>& matched,
+                               const std::vector<char>& used,
+                               std::vector<std::uint32_t>& newPiece) const;
+  /// Phi from the kept points' rows (renumbered) and the others' new `rows`.
+  void mergeRows(const std::vector<char>& keep, const std::vector<std::int64_t>& matched,
+                 const Rows& rows, std::vector<std::uint32_t> newPiece);
 
   EmbeddingOptions options_;
   std::vector<Vec3> points_;

@@ -31,26 +31,20 @@ enum class CholeskyOrdering {
 
 struct SolverOptions {
   SolverKind kind = SolverKind::Auto;
-  /// METIS: 1.5-2x faster factorizations than CHOLMOD's default on the 3D DG matrices of B1/B2.
+  /// METIS: its nested dissection factorizes the 3D DG matrices faster than CHOLMOD's default.
   CholeskyOrdering ordering = CholeskyOrdering::Metis;
   /// Auto picks Cholesky up to this many unknowns and this many matrix nonzeros, else CG with
-  /// the p-multigrid preconditioner. Measured on B2 (quiet machine): p-multigrid CG beats
-  /// CHOLMOD already at 12,000 DOFs (the factor of a 3D DG matrix grows much faster than the
-  /// matrix: 2.9 GFlop for p = 1, 45 GFlop for p = 2 at 1000 elements); below a few
-  /// thousand DOFs the factorization is as fast and exact.
+  /// the p-multigrid preconditioner. The factor of a 3D DG matrix grows much faster than the
+  /// matrix, so p-multigrid CG wins early; below a few thousand DOFs the factorization is as
+  /// fast and exact.
   std::size_t directLimitDofs = 3000;
   std::size_t directLimitNonzeros = 40000000;
   CgPreconditioner preconditioner = CgPreconditioner::PMultigrid;
   /// CG stops when its recursively updated residual r (r -= alpha K p) has |r| <= tolerance |F|.
   /// LinearSolveReport::residual is the true |F - K U| / |F|, which round-off can hold above
-  /// the tolerance on stiff systems: the bunny of `bench --suite multigrid` at p = 2 stops at
-  /// 2.6e-8, and restarting CG from the true residual five times (164 iterations instead of 65)
-  /// left it at 1.7e-8: a round-off floor of this system, not drift that CG could remove. Measured
-  /// on B2 against CHOLMOD's solution (p-multigrid CG, p = 1 and 2): at 1e-10 the algebraic error
-  /// is 1e-12 (l2) and 3e-12 (energy norm) relative, at 1e-8 2e-11 / 2e-10; discretization errors
-  /// of these problems are 1e-2 .. 1e-6 relative (B1), so the algebraic error stays 6+ orders below
-  /// them. Each decade costs 2-4 p-multigrid iterations (B2, p = 1, with the piecewise constants as
-  /// coarse level: 27 iterations at 1e-8, 31 at 1e-10).
+  /// the tolerance on stiff systems: a round-off floor of the system, not drift that CG could
+  /// remove. At 1e-10 the algebraic error stays orders of magnitude below the discretization
+  /// errors (1e-2 .. 1e-6 relative on B1), and each decade costs only a few iterations.
   double tolerance = 1e-10;
   int maxIterations = 20000;
 };
