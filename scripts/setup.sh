@@ -9,7 +9,7 @@ packages=(
   libopenvdb-dev libboost-iostreams-dev
   libsuitesparse-dev libopenblas0-pthread libopenblas-pthread-dev
   libtbb-dev libjemalloc-dev libcli11-dev nlohmann-json3-dev
-  libgtest-dev libgmock-dev libbenchmark-dev libspectra-dev clang-format
+  libgtest-dev libgmock-dev libbenchmark-dev libspectra-dev clang-format universal-ctags
   python3-vtk9 python3-meshio python3-numpy assimp-testmodels
   pybind11-dev python3-pybind11 python3-dev python3-pytest python3-dask python3-distributed
   xvfb xauth  # scripts/render_images.py: Debian's VTK 9.1 renders only through an X server
