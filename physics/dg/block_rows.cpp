@@ -115,13 +115,18 @@ bool BlockRows<T>::build(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>
   tbb::parallel_for(0, ne, [&](int e) {
     std::vector<int>& nb = neighbours[static_cast<std::size_t>(e)];
     const int base = e * bs;
-    // Column e bs has a nonzero in every neighbour block (BZ's included: component 0).
-    int blockEnd = 0;
-    for (int k = outer[base]; k < outer[base + 1]; ++k)
-      if (inner[k] >= blockEnd) {
-        nb.push_back(inner[k] / bs);
-        blockEnd = (nb.back() + 1) * bs;
-      }
+    // Every block with an entry in any of e's columns: K's own pattern has one in column e bs
+    // of each, but added terms need not (contact couples only the normal components).
+    for (int c = base; c < base + bs; ++c) {
+      int blockEnd = 0;
+      for (int k = outer[c]; k < outer[c + 1]; ++k)
+        if (inner[k] >= blockEnd) {
+          nb.push_back(inner[k] / bs);
+          blockEnd = (nb.back() + 1) * bs;
+        }
+    }
+    std::sort(nb.begin(), nb.end());
+    nb.erase(std::unique(nb.begin(), nb.end()), nb.end());
     std::vector<std::uint8_t>& cp = coupled[static_cast<std::size_t>(e)];
     // Every block stored whole (IP's pattern): all slots full, no need to look further.
     const std::size_t stored = static_cast<std::size_t>(outer[base + bs] - outer[base]);

@@ -127,6 +127,36 @@ TEST(BlockRows, AssembledStraightIntoBlocksEqualTheCsrAssembly) {
       }
 }
 
+TEST(BlockRows, FindNeighboursCoupledOnlyThroughSomeComponents) {
+  // K plus contact terms k (w n)(w n)^T: a point on the ground (n = z) whose weights span two
+  // elements that share no face couples their z components only, so column 0 of one element's
+  // block has no entry in the other's. The block rows must still hold that coupling.
+  const PolyMesh mesh = benchmarkB1Mesh(BenchmarkMesh::Hex, 3);
+  const int degree = 1;
+  auto k = b1System(mesh, Method::BZ, degree).matrix;
+  const int n = static_cast<int>(k.rows() / mesh.numElements()) / 3, bs = 3 * n;
+  const int first = 0, last = static_cast<int>(mesh.numElements()) - 1;  // opposite corners
+  Eigen::SparseMatrix<double, Eigen::ColMajor, int> contact(k.rows(), k.cols());
+  std::vector<Eigen::Triplet<double, int>> t;
+  for (int a : {first, last})
+    for (int b : {first, last})
+      for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j)
+          t.emplace_back(a * bs + 2 * n + i, b * bs + 2 * n + j, 1e3 * (1 + i) * (1 + j));
+  contact.setFromTriplets(t.begin(), t.end());
+  k += contact;
+  k.makeCompressed();
+  BlockRows<double> rows;
+  ASSERT_TRUE(rows.build(k, n, 2.0));
+  const Eigen::VectorXd x = randomVector(k.cols());
+  Eigen::VectorXd expected, actual(k.rows());
+  symmetricProduct(k, x, expected);
+  for (int e = 0; e < static_cast<int>(mesh.numElements()); ++e)
+    rows.rowProduct(e, x.data(), actual.data() + static_cast<Eigen::Index>(e) * bs);
+  EXPECT_LT((actual - expected).norm(), 1e-14 * expected.norm());
+  EXPECT_LT((Eigen::MatrixXd(rows.toSparse()) - Eigen::MatrixXd(k)).norm(), 1e-12 * k.norm());
+}
+
 TEST(BlockRows, RefusesAPatternTooSparseForBlocks) {
   // The identity of a 2-element, bs = 3 matrix: the elements' own blocks are stored whole,
   // 9 values for 3 nonzeros each.
