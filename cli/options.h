@@ -41,10 +41,11 @@ Plane parseAxisPlane(const std::string& text, const std::string& option);
 /// "x1,y1,z1;x2,y2,z2;...": a convex planar polygon blade.
 Blade parsePolygon(const std::string& text, const std::string& option);
 
-/// Adds --NAME as a choice from `names`, stored in `target`; help lists the names.
-template <class E>
-CLI::Option* addChoice(CLI::App& cmd, const std::string& flag, E& target, const Names<E>& names,
-                       const std::string& help) {
+/// Adds --NAME as a choice from `names`, stored in `target` (an E or an optional E); help lists
+/// the names and `shown` as the default.
+template <class E, class Target>
+CLI::Option* addChoice(CLI::App& cmd, const std::string& flag, Target& target,
+                       const Names<E>& names, const std::string& help, E shown) {
   std::vector<std::string> keys;
   for (const auto& [name, value] : names) keys.push_back(name);
   return cmd
@@ -56,8 +57,14 @@ CLI::Option* addChoice(CLI::App& cmd, const std::string& flag, E& target, const 
               throw CLI::ValidationError(flag, "'" + s + "' is not one of " + listNames(names));
             target = *v;
           },
-          help + " (" + listNames(names) + "; default " + nameOf(names, target) + ")")
+          help + " (" + listNames(names) + "; default " + nameOf(names, shown) + ")")
       ->type_name(CLI::detail::join(keys, "|"));
+}
+
+template <class E>
+CLI::Option* addChoice(CLI::App& cmd, const std::string& flag, E& target, const Names<E>& names,
+                       const std::string& help) {
+  return addChoice(cmd, flag, target, names, help, target);
 }
 
 /// Adds the boundary-region options of a load: --PREFIX AXIS=VALUE, --PREFIX-plane

@@ -60,6 +60,7 @@ void run(const SolveCommandOptions& o, const CommonOptions& common) {
   SolveOptions options = o.solve;
   if (o.adapt) options.adapt = o.adaptOptions;
   const SolveReport r = model.solve(options);
+  for (const std::string& w : r.warnings) std::cerr << "polydg: warning: " << w << '\n';
   const WriteReport written = model.write(o.output);
   // The deformed embedded surface (physics/contact/embedding.h), written atomically.
   nlohmann::json surfaceJson;
@@ -144,8 +145,9 @@ void addSolveCommand(CLI::App& app, const CommonOptions& common, int& exitCode) 
   DiscretizationOptions& d = s.discretization;
   addChoice(*cmd, "--method", d.method, methodNames(), "DG method (interior penalty or BZ)");
   addChoice(*cmd, "--bz-penalty", d.bzPenalty, bzPenaltyNames(),
-            "--method bz: penalty ~1/h (fixed: cheap, its error stops falling) or the "
-            "superpenalty ~h^-(2p+1) (super: converges at rate >= p, stiffer system)");
+            "--method bz: the superpenalty ~h^-(2p+1) (super: converges at rate >= p, stiffer "
+            "system) or a penalty ~1/h (fixed: cheap, but its error does not fall with h)",
+            DiscretizationOptions::kDefaultBzPenalty);
   cmd->add_option("--degree", d.basis.degree, "polynomial degree of the basis")
       ->check(kDegree)
       ->capture_default_str();

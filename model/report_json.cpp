@@ -333,6 +333,7 @@ json toJson(const SolveReport& report) {
       {"max_von_mises", report.maxVonMises},
       {"max_jump", report.maxJump},
       {"faces_integrated", report.facesIntegrated},
+      {"warnings", report.warnings},
       {"timings_s",
        {{"integrate", r.integrateSeconds},
         {"assemble", r.assembleSeconds},
@@ -348,7 +349,7 @@ json toJson(const SolveReport& report) {
                        : json(nullptr)},
       {"adapt", adaptJson(report)}};
   if (o.discretization.method == Method::BZ) {
-    j["bz_penalty"] = toString(o.discretization.bzPenalty);
+    j["bz_penalty"] = toString(o.discretization.bzPenaltyInEffect());
     j["bz_factor"] = r.bzFactor;
   }
   return j;
@@ -394,7 +395,8 @@ json toJson(const Scene& s) {
                    {"nu", s.material.poissonRatio},
                    {"density", s.material.density}};
   j["method"] = toString(s.discretization.method);
-  if (s.discretization.method == Method::BZ) j["bz_penalty"] = toString(s.discretization.bzPenalty);
+  if (s.discretization.method == Method::BZ)
+    j["bz_penalty"] = toString(s.discretization.bzPenaltyInEffect());
   j["degree"] = s.discretization.basis.degree;
   j["corotational"] = s.corotational;
   j["integrator"] = nameOf(integratorNames(), s.integrator);

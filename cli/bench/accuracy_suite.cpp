@@ -97,7 +97,7 @@ SuiteOutput accuracySuite(const BenchOptions& o, bool quiet) {
         for (int n : accuracySizes(p, mesh, o.quick)) {
           StaticOptions so;
           so.discretization.method = variant.method;
-          so.discretization.bzPenalty = variant.bzPenalty;
+          if (variant.method == Method::BZ) so.discretization.bzPenalty = variant.bzPenalty;
           so.discretization.basis.degree = p;
           const BenchmarkRun r = runBenchmarkB1(n, so, mesh);
           if (!quiet) printRun(r);

@@ -10,8 +10,8 @@ namespace polydg {
 
 void DiscretizationOptions::check() const {
   if (basis.degree < 1 || basis.degree > 3) throw InvalidOption("degree", "must be 1, 2 or 3");
-  if (bzPenalty != BzPenalty::Fixed && method != Method::BZ)
-    throw InvalidOption("bz_penalty", "the superpenalty is for the BZ method: use method bz");
+  if (bzPenalty && method != Method::BZ)
+    throw InvalidOption("bz_penalty", "a BZ penalty is for the BZ method: use method bz");
   if (penalty.rule == PenaltyRule::Fixed && !penalty.eta)
     throw InvalidOption("eta", "a fixed penalty needs its eta");
   if (penalty.eta && !(*penalty.eta > 0.0 && *penalty.eta < 1e300))
@@ -62,7 +62,7 @@ FormCoefficients formCoefficients(const PolyMesh& mesh, const DgBasis& basis,
     case PenaltyRule::Doubling: form.eta = disc.penalty.eta.value_or(kFirstDoublingEta); break;
   }
   if (!(form.eta > 0.0)) throw std::invalid_argument("the penalty eta must be positive");
-  if (disc.method == Method::BZ && disc.bzPenalty == BzPenalty::Super) {
+  if (disc.method == Method::BZ && disc.bzPenaltyInEffect() == BzPenalty::Super) {
     form.bzFactor = superpenaltyFactor(mesh, basis, disc.bzReferenceLength);
     form.bzFactorOnMean = basis.degree() == 1;  // see BzPenalty::Super
   }

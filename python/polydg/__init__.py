@@ -174,9 +174,9 @@ def _solve(self, method="ip", degree=1, E=None, nu=None, density=None, gravity=N
     ``write``.
 
     method: "ip" (interior penalty) or "bz" (Babuska-Zlamal); degree: 1-3.
-    bz_penalty: with method="bz", "fixed" (the default: penalty ~1/h, cheap, but the error stops
-    falling under refinement) or "super" (the superpenalty ~h^-(2p+1): converges at rate >= p,
-    with a stiffer system).
+    bz_penalty: with method="bz", "super" (the default: the superpenalty ~h^-(2p+1), converges
+    at rate >= p, with a stiffer system) or "fixed" (penalty ~1/h, cheap, but its error does not
+    fall under refinement: the report's "warnings" says so).
     E: Young's modulus (default 1), nu: Poisson's ratio in (-1, 0.5) (default 0.3),
     density: mass density (default 1; with gravity), gravity: [gx, gy, gz] (acceleration).
     clamp: where u = 0 (weakly); a region or a list of regions (at least one). A region is a dict:

@@ -257,6 +257,8 @@ struct SolveReport {
   /// With an exact solution: L2 and H1 errors, and the error in the estimate's energy norm.
   std::optional<ErrorNorms> error;
   std::optional<EnergyError> energyError;
+  /// What the user should know about the result, a sentence each (BZ's fixed penalty).
+  std::vector<std::string> warnings;
 };
 
 /// The solution of the model's last solve, until the mesh changes.
