@@ -12,6 +12,7 @@
 
 #include "model_state.h"
 #include "physics/checks/mesh_checks.h"
+#include "physics/dg/reactions.h"
 #include "physics/solvers/error_estimator.h"
 #include "physics/solvers/static_solver.h"
 #include "polydg/mesh/geometry.h"
@@ -434,6 +435,8 @@ SolveReport Model::solve(const SolveOptions& options) {
                        std::to_string(report.solve.solver.residual) +
                        "); is every piece of the body clamped?");
   report.facesIntegrated = facesIntegrated() - before;
+  report.clampForces = dirichletForces(m, solver.basis(), solver.moments(), solver.roles(),
+                                       options.material, *u, loads.dirichlet.size());
   if (options.estimate) {
     report.estimate = estimateError(m, solver, options.material, loads, *u);
     report.energyNorm = std::sqrt(std::max(0.0, u->dot(solver.stiffnessTimes(*u))));

@@ -287,7 +287,8 @@ json toJson(const SolveReport& report) {
   const StaticReport& r = report.solve;
   const SolveOptions& o = report.options;
   const double dofs = static_cast<double>(r.dofs);
-  json clamps = json::array(), tractions = json::array();
+  json clamps = json::array(), tractions = json::array(), clampForces = json::array();
+  for (const Vec3& f : report.clampForces) clampForces.push_back(vectorJson(f));
   for (std::size_t i = 0; i < o.clamps.size(); ++i) {
     json c = selectionJson(o.clamps[i]);
     c["faces"] = i < report.clampFaces.size() ? report.clampFaces[i] : 0;
@@ -333,6 +334,7 @@ json toJson(const SolveReport& report) {
       {"max_von_mises", report.maxVonMises},
       {"max_jump", report.maxJump},
       {"faces_integrated", report.facesIntegrated},
+      {"clamp_forces", clampForces},
       {"warnings", report.warnings},
       {"timings_s",
        {{"integrate", r.integrateSeconds},

@@ -257,6 +257,11 @@ struct SolveReport {
   /// With an exact solution: L2 and H1 errors, and the error in the estimate's energy norm.
   std::optional<ErrorNorms> error;
   std::optional<EnergyError> energyError;
+  /// The force the body's stress puts on each clamp's faces, then on each prescribed
+  /// displacement's (SolveOptions::clamps, then displacements): int sigma(u_h) n dA, n out of
+  /// the body. At equilibrium the clamps' forces balance the loads; the reaction on the support
+  /// is their opposite.
+  std::vector<Vec3> clampForces;
   /// What the user should know about the result, a sentence each (BZ's fixed penalty).
   std::vector<std::string> warnings;
 };
