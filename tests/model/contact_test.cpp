@@ -156,6 +156,52 @@ TEST(Contact, RefiningWhileInContactKeepsTheContactOnTheNewElements) {
   EXPECT_NEAR(r.steps.back().state.centreOfMass.z(), kRadius, 0.05 * kRadius);
 }
 
+/// The unit cube [-0.5, 0.5]^2 x [0, 1] with each face fanned from its centre: the four bottom
+/// corners alike (no tilt at rest) and the bottom face's centre a vertex too.
+TriangleSurface fannedCube() {
+  TriangleSurface s;
+  for (int i = 0; i < 8; ++i)
+    s.vertices.push_back(Vec3(i & 1 ? 0.5 : -0.5, i & 2 ? 0.5 : -0.5, i & 4 ? 1.0 : 0.0));
+  // Each face's corners, counter-clockwise seen from outside.
+  const std::uint32_t faces[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
+                                     {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  for (const auto& f : faces) {
+    Vec3 centre = Vec3::Zero();
+    for (std::uint32_t v : f) centre += s.vertices[v] / 4.0;
+    const auto c = static_cast<std::uint32_t>(s.vertices.size());
+    s.vertices.push_back(centre);
+    for (int i = 0; i < 4; ++i) s.triangles.push_back({f[i], f[(i + 1) % 4], c});
+  }
+  return s;
+}
+
+TEST(Contact, ACubeAtRestSinksByItsWeightOverTheContactStiffness) {
+  // The penalty law f = k A d at each contact point: a cube resting on the ground on the five
+  // bottom vertices of its surface holds its weight when k d sum A = m g, A each vertex's third
+  // of its triangles' areas (4 x 1/2 + 1/3 here). The contact is soft enough (d about 4% of the
+  // edge) and the cube stiff enough (its sag about 1e-5) that the points sit at one depth.
+  const testing::TempDir dir("contact_rest");
+  const TriangleSurface box = fannedCube();
+  const std::string path = dir.write("cube.obj", objText(box));
+  MeshOptions options;
+  options.cells = 3;
+  MeshReport report;
+  Model model = Model::fromSurface(box, options, report, path);
+  ASSERT_TRUE(report.passed());
+  const double k = 1e5, weight = 1000 * 1.0 * 9.81, sumA = 4 * 0.5 + 1.0 / 3.0;
+  json scene = json::parse(R"({"material": {"E": 1e9, "nu": 0.3, "density": 1000},
+      "integrator": "euler", "dt": 0.005, "duration": 1.5, "gravity": [0, 0, -9.81],
+      "damping": {"mass": 20}, "obstacles": [{"below": [0, 0, 1, 0]}],
+      "contact": {"stiffness": 1e5}})");
+  const SimulationReport r = model.simulate(parseScene(scene, "rest.json"), {});
+  const SimulationStep& last = r.steps.back();
+  const double expected = weight / (k * sumA);
+  std::printf("cube at rest: %zu contacts, depth %.6g, m g / (k sum A) = %.6g, kinetic %.3g\n",
+              last.contact.contacts, last.contact.deepest, expected, last.state.kinetic);
+  EXPECT_EQ(last.contact.contacts, 5u);
+  EXPECT_NEAR(last.contact.deepest, expected, 2e-3 * expected);  // measured 4.8e-4
+}
+
 TEST(Contact, NodalContactAndFrictionOnASlope) {
   // A cube on the ground with gravity tilted by 20 degrees (a slope): with friction
   // mu = 0.5 > tan 20 = 0.36 it stays, without it slides with a = g sin 20.
