@@ -153,6 +153,7 @@ void refineAtSurface(Model& model, const Grid& coarse, int levels, double sliver
   report.coarseCellSize = coarse.cellSize;
   report.elementsPerLevel.assign(static_cast<std::size_t>(levels) + 1, 0);
   for (int l : level) report.elementsPerLevel[static_cast<std::size_t>(std::min(l, levels))] += 1;
+  report.elementLevels = std::move(level);
   report.refineSeconds = watch.seconds();
 }
 

@@ -227,6 +227,15 @@ TEST(ModelRefine, B11RefinesWhereThePrincipalStressIsLarge) {
   EXPECT_GT(counts[0], counts[1]);
 }
 
+/// The largest difference of refinement level between two elements that share a face.
+int largestLevelStep(const PolyMesh& mesh, const std::vector<int>& levels) {
+  int largest = 0;
+  for (const Face& f : mesh.faces())
+    if (f.front.valid() && f.back.valid())
+      largest = std::max(largest, std::abs(levels[f.front.index()] - levels[f.back.index()]));
+  return largest;
+}
+
 TEST(ModelRefine, OctreeSlicingFillsTheVolumeWithFewerElements) {
   // A sphere far from the origin and the bundled torus (a real model with a hole): the octree
   // mesh has the uniform mesh's volume, validates, passes the DG checks, has fewer elements, and
@@ -249,6 +258,15 @@ TEST(ModelRefine, OctreeSlicingFillsTheVolumeWithFewerElements) {
     std::size_t perLevel = 0;
     for (std::size_t n : octree.elementsPerLevel) perLevel += n;
     EXPECT_EQ(perLevel, a.mesh().numElements());
+    // One level at most between face neighbours, boundary pieces included, with and without
+    // the slivers merged (on the torus some balancing splits are needed, and without the merge
+    // nothing hides their absence).
+    ASSERT_EQ(octree.elementLevels.size(), a.mesh().numElements());
+    EXPECT_LE(largestLevelStep(a.mesh(), octree.elementLevels), 1);
+    options.sliverFraction = 0.0;
+    MeshReport unmerged;
+    const Model b = Model::fromSurface(surface, options, unmerged);
+    EXPECT_LE(largestLevelStep(b.mesh(), unmerged.elementLevels), 1);
     const double volume = uniform.meshing.outputVolume;
     EXPECT_NEAR(octree.meshing.outputVolume, volume, 1e-10 * volume);
     EXPECT_NEAR(octree.meshing.outputVolume, octree.meshing.inputVolume, 1e-10 * volume);

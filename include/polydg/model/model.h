@@ -83,6 +83,7 @@ struct MeshReport {
   int levels = 0;
   double coarseCellSize = 0.0;
   std::vector<std::size_t> elementsPerLevel;
+  std::vector<int> elementLevels;  ///< each element's level (0: a coarse grid cell or its piece)
   double refineSeconds = 0.0;
   std::string output;         ///< the file written, "" if none
   double readSeconds = 0.0;   ///< set by callers that read the surface (fromFile)
