@@ -5,6 +5,7 @@ python3-vtk9), printed as one line of JSON for the C++ tests (tests/support/writ
   written_figures.py SOLVED.vtu  -> {"cells", "volume", "displacement_integral": [x, y, z],
                                      "max_point_displacement"}
   written_figures.py SURFACE.vtp -> {"points", "max_point_displacement"}
+  written_figures.py FILE FILE... -> a JSON list, one object per file (one interpreter start)
 
 displacement_integral is sum over cells of volume x mean_displacement (the cell data a solve
 writes): the integral of the displacement over the body, so that for a load by gravity g on
@@ -36,6 +37,7 @@ def main(path):
 
 if __name__ == "__main__":
     try:
-        print(json.dumps(main(sys.argv[1])))
+        figures = [main(path) for path in sys.argv[1:]]
+        print(json.dumps(figures[0] if len(figures) == 1 else figures))
     except CheckFailed as failure:
         sys.exit(str(failure))

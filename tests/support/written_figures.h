@@ -6,6 +6,7 @@
 #include <array>
 #include <cstdio>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -14,11 +15,14 @@
 
 namespace polydg::testing {
 
-/// The JSON line of written_figures.py for `file` (null, with a test failure, if it fails).
-inline nlohmann::json writtenFigures(const std::string& file) {
+/// The JSON line of written_figures.py for `files` (an object for one file, a list for
+/// several; null, with a test failure, if it fails).
+inline nlohmann::json writtenFigures(const std::vector<std::string>& files) {
   EXPECT_TRUE(packages::pythonModule("vtkmodules.vtkIOXML", "python3-vtk9"));
-  const std::string command = packages::kSystemPython.string() + " " + POLYDG_SOURCE_DIR +
-                              "/tests/cli/written_figures.py '" + file + "' 2>&1";
+  std::string command =
+      packages::kSystemPython.string() + " " + POLYDG_SOURCE_DIR + "/tests/cli/written_figures.py";
+  for (const std::string& file : files) command += " '" + file + "'";
+  command += " 2>&1";
   FILE* pipe = popen(command.c_str(), "r");
   if (!pipe) {
     ADD_FAILURE() << "cannot run " << command;
@@ -32,6 +36,10 @@ inline nlohmann::json writtenFigures(const std::string& file) {
     return nullptr;
   }
   return nlohmann::json::parse(out);
+}
+
+inline nlohmann::json writtenFigures(const std::string& file) {
+  return writtenFigures(std::vector<std::string>{file});
 }
 
 /// Clapeyron's theorem for a solve under gravity alone: the strain energy 1/2 u^T K u equals
