@@ -1,15 +1,17 @@
 // `polydg bench` end to end through the binary, as a user runs it: the stability, cutting,
-// dynamics and contact suites with --quick (every file written, the B4 JSON keys and findings,
-// incremental cuts, B6's energy and period, B7's volume with and without corotation, the speed
-// rows, B9's contacts, penetration and energy, the embedding's and the queries' figures),
-// the meshing suite finding its model in share/polydg beside the binary (build tree and an
-// installation's layout) or in --data, the multigrid suite saying in one line how to get the
-// bunny and still running the torus, and an unknown suite refused with one line.
+// dynamics, contact and adaptivity suites with --quick (under ctest, all but cutting from the
+// one `--suite all --quick` run of tests/cli/bench_end_to_end.py; every file written, the B4 JSON
+// keys and findings, incremental cuts, B6's energy and period, B7's volume with and without
+// corotation, the speed rows, B9's contacts, penetration and energy, the embedding's and the
+// queries' figures), the meshing suite finding its model in share/polydg beside the binary (build
+// tree and an installation's layout) or in --data, the multigrid suite saying in one line how to
+// get the bunny and still running the torus, and an unknown suite refused with one line.
 #include <gtest/gtest.h>
 
 #include <unistd.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -28,14 +30,31 @@ using Result = polydg::testing::CommandResult;
 
 Result run(const std::string& arguments) { return polydg::testing::runPolydg(arguments); }
 
-TEST(BenchCommand, StabilitySuiteWritesJsonCsvAndPlots) {
+/// Where `polydg bench --suite SUITE --quick --quiet` wrote its files. Under ctest, the one run
+/// of every suite (`--suite all`, the fixture bench_all in tests/CMakeLists.txt) that
+/// POLYDG_BENCH_DIR names: the suites are not run twice. Run directly, a fresh run into a
+/// scratch folder (`scratch`: the caller removes it), which must succeed and print nothing.
+struct SuiteFiles {
+  fs::path dir;
+  bool scratch = false;
+  bool ok = false;
+};
+SuiteFiles quickSuite(const std::string& suite) {
+  if (const char* shared = std::getenv("POLYDG_BENCH_DIR")) return {shared, false, true};
   // Unique per process: two test runs at once must not share (and delete) the folder.
-  const fs::path dir =
-      fs::temp_directory_path() / ("polydg_bench_stability_" + std::to_string(getpid()));
+  const fs::path dir = fs::temp_directory_path() /
+                       ("polydg_bench_" + suite + "_" + std::to_string(getpid()) + "_out");
   fs::remove_all(dir);
-  const Result r = run("bench --suite stability --quick --quiet --out " + dir.string());
-  ASSERT_EQ(r.exitCode, 0) << r.out;
+  const Result r = run("bench --suite " + suite + " --quick --quiet --out " + dir.string());
+  EXPECT_EQ(r.exitCode, 0) << r.out;
   EXPECT_TRUE(r.out.empty()) << r.out;  // --quiet
+  return {dir, true, r.exitCode == 0};
+}
+
+TEST(BenchCommand, StabilitySuiteWritesJsonCsvAndPlots) {
+  const SuiteFiles files = quickSuite("stability");
+  ASSERT_TRUE(files.ok);
+  const fs::path& dir = files.dir;
   for (const char* file :
        {"stability.json", "stability.csv", "stability_sliver.svg", "stability_thin_neck.svg",
         "stability_incompressible.svg", "stability_scale.svg"})
@@ -93,7 +112,7 @@ TEST(BenchCommand, StabilitySuiteWritesJsonCsvAndPlots) {
   std::getline(csv, header);
   EXPECT_NE(header.find("case"), std::string::npos);
   EXPECT_NE(header.find("volume_ratio"), std::string::npos);
-  fs::remove_all(dir);
+  if (files.scratch) fs::remove_all(dir);
 }
 
 TEST(BenchCommand, CuttingSuiteReintegratesOnlyWhatEachCutTouched) {
@@ -129,12 +148,9 @@ TEST(BenchCommand, DynamicsSuiteKeepsEnergyAndVolumeWhereItShould) {
   constexpr double kCorotationalVolumeChange = 1.5e-3;
   constexpr double kLinearVolumeChange = 1.0;
   constexpr double kAngularMomentumChange = 0.01;
-  const fs::path dir =
-      fs::temp_directory_path() / ("polydg_bench_dynamics_" + std::to_string(getpid()));
-  fs::remove_all(dir);
-  const Result r = run("bench --suite dynamics --quick --quiet --out " + dir.string());
-  ASSERT_EQ(r.exitCode, 0) << r.out;
-  EXPECT_TRUE(r.out.empty()) << r.out;  // --quiet
+  const SuiteFiles files = quickSuite("dynamics");
+  ASSERT_TRUE(files.ok);
+  const fs::path& dir = files.dir;
   for (const char* file :
        {"dynamics.json", "dynamics.csv", "dynamics_energy.svg", "dynamics_volume.svg",
         "dynamics_momentum.svg", "dynamics_speed.svg", "dynamics_speed_phases.svg"})
@@ -189,7 +205,7 @@ TEST(BenchCommand, DynamicsSuiteKeepsEnergyAndVolumeWhereItShould) {
   std::getline(csv, header);
   for (const char* column : {"part", "integrator", "energy", "volume_change", "t_rotation"})
     EXPECT_NE(header.find(column), std::string::npos) << column;
-  fs::remove_all(dir);
+  if (files.scratch) fs::remove_all(dir);
 }
 
 TEST(BenchCommand, ContactSuiteDetectsContactAndKeepsEnergyFromGrowing) {
@@ -198,12 +214,9 @@ TEST(BenchCommand, ContactSuiteDetectsContactAndKeepsEnergyFromGrowing) {
   // the end (below B9's limit already); the total energy falls at every step (damping).
   constexpr double kPenetrationLimit = 0.005;  // B9: 1% of the radius
   constexpr double kEnergyRoundoff = 1e-9;     // of weight x radius (the suite's allowance)
-  const fs::path dir =
-      fs::temp_directory_path() / ("polydg_bench_contact_" + std::to_string(getpid()) + "_out");
-  fs::remove_all(dir);
-  const Result r = run("bench --suite contact --quick --quiet --out " + dir.string());
-  ASSERT_EQ(r.exitCode, 0) << r.out;
-  EXPECT_TRUE(r.out.empty()) << r.out;  // --quiet
+  const SuiteFiles files = quickSuite("contact");
+  ASSERT_TRUE(files.ok);
+  const fs::path& dir = files.dir;
   for (const char* file : {"contact.json", "contact.csv", "contact_step_time.svg",
                            "contact_penetration.svg", "contact_energy.svg"})
     EXPECT_TRUE(fs::exists(dir / file)) << file;
@@ -263,17 +276,15 @@ TEST(BenchCommand, ContactSuiteDetectsContactAndKeepsEnergyFromGrowing) {
        {"part", "obstacle", "deepest", "kinetic", "elastic", "gravity", "contact_energy", "total",
         "com_z", "weight_nonzeros", "query_seconds"})
     EXPECT_NE(header.find(column), std::string::npos) << column;
-  fs::remove_all(dir);
+  if (files.scratch) fs::remove_all(dir);
 }
 
 TEST(BenchCommand, AdaptivitySuiteRefinesWhereItShould) {
   // Quick sizes: B11 at tau = 0.5 (2 rounds), B13 at 32 cells of a 5,120-triangle sphere, B12 on
   // uniform 4^3 and 8^3 and 2 adaptive rounds from 4^3.
-  const fs::path dir =
-      fs::temp_directory_path() / ("polydg_bench_adaptivity_" + std::to_string(getpid()) + "_out");
-  fs::remove_all(dir);
-  const Result r = run("bench --suite adaptivity --quick --quiet --out " + dir.string());
-  ASSERT_EQ(r.exitCode, 0) << r.out;
+  const SuiteFiles files = quickSuite("adaptivity");
+  ASSERT_TRUE(files.ok);
+  const fs::path& dir = files.dir;
   for (const char* file : {"adaptivity.json", "adaptivity.csv", "adaptivity_b12.svg"})
     EXPECT_TRUE(fs::exists(dir / file)) << file;
   std::ifstream in(dir / "adaptivity.json");
@@ -296,7 +307,7 @@ TEST(BenchCommand, AdaptivitySuiteRefinesWhereItShould) {
   ASSERT_GE(adaptive.size(), 2u);
   for (const auto& round : adaptive) EXPECT_GE(round["effectivity"].get<double>(), 1.0);
   EXPECT_LT(adaptive.back()["l2_error"].get<double>(), adaptive.front()["l2_error"].get<double>());
-  fs::remove_all(dir);
+  if (files.scratch) fs::remove_all(dir);
 }
 
 TEST(BenchCommand, UnknownSuiteIsRefusedWithOneLine) {
