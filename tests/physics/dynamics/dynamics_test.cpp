@@ -3,6 +3,7 @@
 // the cantilever against its eigenproblem and Euler-Bernoulli (B6), energy behaviour of both
 // integrators, and the damped static limit against the static solver.
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <random>
 
@@ -169,7 +170,8 @@ TEST(Dynamics, CantileverPeriodMatchesItsEigenproblemAndEulerBernoulli) {
     x = y.normalized();
   }
   const double discretePeriod = 2 * kPi / std::sqrt(lambda);
-  EXPECT_NEAR(discretePeriod, 19.58, 0.03 * 19.58);
+  // Measured 19.620, +0.20% of Euler-Bernoulli's 19.58 (Timoshenko's shear: about +2% more).
+  EXPECT_NEAR(discretePeriod, 19.58, 0.006 * 19.58);
 
   for (Integrator integrator : {Integrator::Newmark, Integrator::Bdf2}) {
     DynamicSolver solver(beam.mesh, beam.moments,
@@ -192,11 +194,27 @@ TEST(Dynamics, CantileverPeriodMatchesItsEigenproblemAndEulerBernoulli) {
     }
     ASSERT_GE(crossings.size(), 19u);
     const double period = 2 * (crossings.back() - crossings.front()) / (crossings.size() - 1);
-    EXPECT_NEAR(period, discretePeriod, 0.01 * discretePeriod);
-    EXPECT_NEAR(period, 19.58, 0.03 * 19.58);
-    // Undamped, Newmark's energy stays within 1% over 10 periods; BDF2 dissipates the higher
-    // modes of the initial shape, (omega dt)^4 per step (2.5% of the energy here).
-    EXPECT_LT(worst, integrator == Integrator::Newmark ? 0.01 : 0.05);
+    std::printf(
+        "B6 integrator %d: period %.6f (discrete %.6f), worst energy change %.3e, final %.6f\n",
+        static_cast<int>(integrator), period, discretePeriod, worst,
+        (solver.state().kinetic + solver.state().elastic) / e0);
+    // Measured 19.635 (Newmark) and 19.632 (BDF2): +0.08% and +0.06% of the eigenproblem's
+    // period (the steps' period error and the crossings' interpolation), +0.28% and +0.26% of
+    // Euler-Bernoulli's (docs/benchmarks.md, B6).
+    EXPECT_NEAR(period, discretePeriod, 0.0025 * discretePeriod);
+    EXPECT_NEAR(period, 19.58, 0.008 * 19.58);
+    if (integrator == Integrator::Newmark) {
+      // Undamped and linear, the average-acceleration Newmark step conserves the energy
+      // exactly; what is left is round-off, summed over 2000 steps of Cholesky solves: measured
+      // 4.8e-11 (docs/benchmarks.md, B6: 7e-11). A step that damps or gains, even by (omega
+      // dt)^4, is far above this.
+      EXPECT_LT(worst, 1.5e-10);
+    } else {
+      // BDF2 dissipates the higher modes of the initial shape, (omega dt)^4 per step: measured
+      // 2.54e-2 (docs/benchmarks.md, B6: energy 0.975 after 10 periods).
+      EXPECT_GT(worst, 0.02);
+      EXPECT_LT(worst, 0.03);
+    }
   }
 }
 
