@@ -313,10 +313,16 @@ TEST(BenchCommand, AdaptivitySuiteRefinesWhereItShould) {
   EXPECT_LT(b13[1]["elements"].get<std::size_t>(), b13[0]["elements"].get<std::size_t>());
   EXPECT_NEAR(b13[1]["volume"].get<double>(), b13[0]["volume"].get<double>(),
               1e-10 * b13[0]["volume"].get<double>());
-  // The estimate bounds the error (effectivity >= 1) and adaptive rounds lower the error.
+  // The estimate's effectivity on the two adapted meshes, as measured (8.128 and 7.410;
+  // docs/benchmarks.md, B12: 8.1 falling to 3.5 over 13 meshes). It misses the specification,
+  // 0.3 to 3 (issue 'adaptivity'); until the estimator is fixed the figures are held to 10%, so
+  // that any change is noticed. Adaptive rounds lower the error.
+  constexpr double kEffectivity[] = {8.128, 7.410};
   const auto& adaptive = j["B12"]["adaptive"];
-  ASSERT_GE(adaptive.size(), 2u);
-  for (const auto& round : adaptive) EXPECT_GE(round["effectivity"].get<double>(), 1.0);
+  ASSERT_EQ(adaptive.size(), 2u);
+  for (std::size_t k = 0; k < adaptive.size(); ++k)
+    EXPECT_NEAR(adaptive[k]["effectivity"].get<double>(), kEffectivity[k], 0.1 * kEffectivity[k])
+        << adaptive[k].dump();
   EXPECT_LT(adaptive.back()["l2_error"].get<double>(), adaptive.front()["l2_error"].get<double>());
   fs::remove_all(dir);
 }
