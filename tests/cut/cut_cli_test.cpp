@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -71,17 +72,36 @@ TEST_F(CutCli, ReportsEveryOperation) {
   EXPECT_EQ(check.exitCode, 0) << check.out;
 }
 
-TEST_F(CutCli, PolygonReportsElementsLeftWhole) {
+TEST_F(CutCli, PolygonSplitsTheCellsInsideAndReportsThoseLeftWhole) {
+  // The rectangle [0.1, 0.85] x [0.2, 0.6] at z = 0.4 in the 4^3 grid of cells of 1/4 (the
+  // sliced cube numbers them x fastest, then y, then z: cell (i, j, k) is element i + 4 j +
+  // 16 k). Its plane crosses layer k = 1; the sections of cells (1, 1) and (2, 1) lie inside it
+  // (elements 21 and 22): those two are split; the 10 others of columns 0-3 x rows 0-2 cross its
+  // edge and are left whole; the rest are untouched. Removing the side above takes the split
+  // cells' upper pieces, 2 x (1/4)^2 x (0.5 - 0.4) = 0.0125, and nothing else.
   const Result r =
       run("cut " + input() + " -o " + path("out.vtu") +
-          " --polygon \"0.1,0.1,0.4;0.6,0.1,0.4;0.6,0.6,0.55;0.1,0.6,0.55\" --report " +
+          " --polygon \"0.1,0.2,0.4;0.85,0.2,0.4;0.85,0.6,0.4;0.1,0.6,0.4\" --remove-side + "
+          "--report " +
           path("r.json") + " --quiet");
   ASSERT_EQ(r.exitCode, 0) << r.out;
-  const auto op = readJson("r.json")["operations"][0];
+  const auto report = readJson("r.json");
+  const auto op = report["operations"][0];
   EXPECT_EQ(op["op"], "cut_polygon");
-  EXPECT_GT(op["elements_split"].get<int>(), 0);
-  EXPECT_GT(op["left_whole"]["count"].get<int>(), 0);
-  EXPECT_FALSE(op["left_whole"]["first_ids"].empty());
+  EXPECT_TRUE(op["validation"]["passed"].get<bool>());
+  EXPECT_EQ(op["elements_split"], 2);
+  EXPECT_EQ(op["pieces_created"], 4);
+  EXPECT_EQ(op["elements_removed"], 2);
+  EXPECT_NEAR(op["volume_removed"].get<double>(), 0.0125, 1e-15);
+  EXPECT_EQ(op["left_whole"]["count"], 10);
+  std::vector<int> whole;
+  for (int j = 0; j <= 2; ++j)
+    for (int i = 0; i <= 3; ++i)
+      if (!(j == 1 && (i == 1 || i == 2))) whole.push_back(i + 4 * j + 16);
+  EXPECT_EQ(op["left_whole"]["first_ids"].get<std::vector<int>>(), whole);
+  EXPECT_EQ(report["output"]["elements"], 64);  // 64 - 2 split + 4 pieces - 2 removed
+  EXPECT_NEAR(report["output"]["volume"].get<double>(), 1.0 - 0.0125, 1e-15);
+  EXPECT_EQ(report["output"]["components"], 1);
 }
 
 TEST_F(CutCli, BadArgumentsExitTwoWithOneLineAndNoOutput) {

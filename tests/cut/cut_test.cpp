@@ -3,14 +3,17 @@
 // side, finite polygon blades, and incremental moments against moments from scratch.
 #include "polydg/cut/cut.h"
 
+#include <array>
 #include <cmath>
 #include <random>
+#include <set>
 
 #include <gtest/gtest.h>
 
 #include "cut/mesh_editor.h"
 #include "mesh/primitives.h"
 #include "physics/checks/dg_checks.h"
+#include "polydg/mesh/geometry.h"
 #include "polydg/mesh/geometry_checks.h"
 
 namespace polydg {
@@ -299,18 +302,104 @@ TEST(Cut, ManyCutsKeepIncrementalMomentsExact) {
   expectConsistent(editor, 1.0);
 }
 
-TEST(Cut, PolygonBladeSplitsOnlyInside) {
-  MeshEditor editor(unitGrid(4));
-  const Blade blade = Blade::fromPolygon(
-      {Vec3(0.1, 0.1, 0.4), Vec3(0.6, 0.1, 0.4), Vec3(0.6, 0.6, 0.55), Vec3(0.1, 0.6, 0.55)});
-  const auto r = editor.cut(blade, noMerging());
-  EXPECT_TRUE(r.check.passed) << r.check.failure;
-  EXPECT_GT(r.elementsSplit, 0u);
-  EXPECT_FALSE(r.leftWhole.empty());
+/// The cell (i, j, k) of unitGrid(n) an element lies in (its bounds' centre).
+std::array<int, 3> gridCell(const PolyMesh& mesh, ElementId e, int n) {
+  const Vec3 centre = elementBounds(mesh, e).center();
+  return {static_cast<int>(std::floor(centre.x() * n)),
+          static_cast<int>(std::floor(centre.y() * n)),
+          static_cast<int>(std::floor(centre.z() * n))};
+}
+
+/// The area of a planar face, from its loops' corners (Newell), computed here.
+double loopArea(const PolyMesh& mesh, const Face& face) {
+  Vec3 sum = Vec3::Zero();
+  for (std::size_t k = 0; k < face.numLoops(); ++k) {
+    const auto loop = face.loop(k);
+    for (std::size_t i = 0; i < loop.size(); ++i)
+      sum += mesh.position(loop[i]).cross(mesh.position(loop[(i + 1) % loop.size()]));
+  }
+  return 0.5 * sum.norm();
+}
+
+/// A polygon cut of unitGrid(n) by the rectangle [x0, x1] x [y0, y1] in the plane z = c (c in
+/// no grid plane): the plane meets the cells of layer floor(c n), each in its square section.
+/// The cut splits exactly the cells whose section lies inside the rectangle (found here by
+/// arithmetic), in two, leaves those whose section meets the rectangle's edge (touching it
+/// included) whole and listed, and every other cell untouched; the slit is the split sections, once
+/// on each side: its area is the number of split cells times the section's area 1 / n^2 per side.
+void expectRectangleCut(int n, double x0, double x1, double y0, double y1, double c,
+                        std::size_t expectSplit, std::size_t expectWhole) {
+  const PolyMesh before = unitGrid(n);
+  MeshEditor editor(before);
+  const auto r = editor.cut(
+      Blade::fromPolygon({Vec3(x0, y0, c), Vec3(x1, y0, c), Vec3(x1, y1, c), Vec3(x0, y1, c)}),
+      noMerging());
+  ASSERT_TRUE(r.check.passed) << r.check.failure;
+  const int layer = static_cast<int>(std::floor(c * n));
+  std::set<std::array<int, 3>> inside, edge;
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      const double a0 = double(i) / n, a1 = double(i + 1) / n;
+      const double b0 = double(j) / n, b1 = double(j + 1) / n;
+      if (x0 <= a0 && a1 <= x1 && y0 <= b0 && b1 <= y1) {
+        inside.insert({i, j, layer});
+      } else if (a0 <= x1 && a1 >= x0 && b0 <= y1 && b1 >= y0) {  // meets it, edge included
+        edge.insert({i, j, layer});
+      }
+    }
+  ASSERT_EQ(inside.size(), expectSplit);  // the arithmetic above, against the case's own count
+  ASSERT_EQ(edge.size(), expectWhole);
+  EXPECT_EQ(r.elementsSplit, inside.size());
+  EXPECT_EQ(r.piecesCreated, 2 * inside.size());
+  EXPECT_EQ(editor.mesh().numElements(), before.numElements() + inside.size());
+  // Which cells were split, from the elements' shapes: a piece spans less than its cell's
+  // height. The rest are whole cells, each its lineage's own source.
+  std::set<std::array<int, 3>> split, whole;
+  const double h = 1.0 / n;
+  for (std::size_t e = 0; e < editor.mesh().numElements(); ++e) {
+    const ElementId id(e);
+    const Box3 bounds = elementBounds(editor.mesh(), id);
+    const std::vector<ElementId> sources = r.lineage.sources(id);
+    ASSERT_EQ(sources.size(), 1u) << "element " << e;
+    if (bounds.sizes().z() < h - 1e-12) {
+      split.insert(gridCell(editor.mesh(), id, n));
+      EXPECT_EQ(gridCell(before, sources[0], n), gridCell(editor.mesh(), id, n));
+    } else {
+      EXPECT_EQ(sources[0], id) << "element " << e;
+      EXPECT_NEAR(editor.moments().volume(id), h * h * h, 1e-15) << "element " << e;
+    }
+  }
+  EXPECT_EQ(split, inside);
+  for (ElementId e : r.leftWhole) whole.insert(gridCell(editor.mesh(), e, n));
+  EXPECT_EQ(r.leftWhole.size(), whole.size());
+  EXPECT_EQ(whole, edge);
+  // The slit: boundary faces in z = c, the split sections once on each side.
+  double area[2] = {0.0, 0.0};
+  for (const Face& face : editor.mesh().faces()) {
+    if (face.origin != FaceOrigin::Cut) continue;
+    EXPECT_TRUE(face.isBoundary());
+    for (VertexId v : face.vertices) EXPECT_NEAR(editor.mesh().position(v).z(), c, 1e-15);
+    area[editor.moments().centroid(face.front).z() > c] += loopArea(editor.mesh(), face);
+  }
+  for (double side : area) EXPECT_NEAR(side, double(inside.size()) / (n * n), 1e-15);
   expectConsistent(editor, 1.0);
   std::size_t components = 0;
   connectedComponents(editor.mesh(), components);
   EXPECT_EQ(components, 1u);  // a slit, not a separation
+}
+
+TEST(Cut, PolygonBladeSplitsExactlyTheCellsWhoseSectionLiesInside) {
+  // 4^3 cells of 1/4; the rectangle [0.1, 0.85] x [0.2, 0.6] at z = 0.4 holds the sections of
+  // columns (1, 1) and (2, 1) and crosses those of 10 more. The slit is those two sections,
+  // 2 x 1/16 = 0.125 a side: less than the rectangle's 0.3, whose rest lies in cells left whole.
+  expectRectangleCut(4, 0.1, 0.85, 0.2, 0.6, 0.4, 2, 10);
+  // A rectangle on the grid lines, [0.25, 0.75] x [0.25, 0.5]: the same two cells, and the
+  // slit is the rectangle itself, 0.125 a side. The 10 neighbours whose sections touch its edge
+  // are listed as left whole.
+  expectRectangleCut(4, 0.25, 0.75, 0.25, 0.5, 0.4, 2, 10);
+  // A finer grid, 8^3: [0.3, 0.9] x [0.05, 0.45] at z = 0.7 holds columns 3-6 x rows 1-2 and
+  // crosses the 16 around them.
+  expectRectangleCut(8, 0.3, 0.9, 0.05, 0.45, 0.7, 8, 16);
 }
 
 // A polygon cut leaves the elements at its edge whole, with its new points inserted on their

@@ -1,8 +1,17 @@
 // Local validation of a cut (the region DG checks) agrees with full validation: random plane
-// cuts through a sliced "Swiss cheese" block, 35 crossing through-holes whose walls lie 2^-24
+// cuts through a sliced "Swiss cheese" block, 19 crossing through-holes whose walls lie 2^-24
 // beyond the grid planes (testing::cheeseWallsOffGrid), so that many elements touch their
 // neighbours through faces that thin as well as through whole faces, pass `local` exactly when
 // they pass `full`, and, the mesh being valid, both pass.
+//
+// The size is the smallest measured that still shows the failure this test was written for
+// (local validation counting the soft modes of elements held only through such thin faces:
+// "18 zero modes for 2 components, expected 12", full validation passing). With that failure
+// put back (2026-12-04: faces that hold nothing joining their elements, their soft modes
+// counted), local failed 10 of 30 cuts at 16 cells along x (970 elements; 110 s of full
+// validation on a loaded machine), 14 of 30 at 12 cells (424 elements, 30 s), 5 of 30 at 8
+// cells (156 elements). At 12 cells the first 15 cuts hold 8 of the failures, at least one in
+// each batch of 5 (cuts 0, 3, 4; 6; 10, 11, 12, 14).
 #include <cstdio>
 #include <random>
 #include <sstream>
@@ -25,15 +34,15 @@ namespace {
 constexpr std::uint64_t kSeed = 20261204;
 /// Cuts, each on a fresh copy of the sliced block (as `polydg cut b.vtu --plane ...` runs them),
 /// made in batches of kCutsPerBatch (one ctest entry each: full validation of every cut is
-/// most of the cost, ~2 s a cut on a loaded machine).
-constexpr int kCuts = 30;
-constexpr int kCutsPerBatch = 10;
+/// most of the cost, ~1 s a cut on a loaded machine).
+constexpr int kCuts = 15;
+constexpr int kCutsPerBatch = 5;
 
-/// The cheese of the test, meshed once: 35 crossing holes, 16 cells along x.
+/// The cheese of the test, meshed once: 19 crossing holes, 12 cells along x (424 elements).
 const MeshingResult& cheeseBlock() {
   static const MeshingResult block = [] {
     MeshingOptions meshing;
-    meshing.cellsAlongLongest = 16;
+    meshing.cellsAlongLongest = 12;
     const CheeseWalls walls =
         testing::cheeseWallsOffGrid(Box3(Vec3::Zero(), Vec3(11, 10, 3)), meshing.cellsAlongLongest);
     return meshSurface(swissCheeseBlock(walls), meshing);

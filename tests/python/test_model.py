@@ -86,7 +86,9 @@ def test_every_operation_reports_what_the_command_line_reports(tmp_path):
         assert solve[key] == cli_solve[key], key
     # CHOLMOD's factorization runs OpenBLAS kernels chosen per process (the command sets
     # OPENBLAS_CORETYPE for this CPU; a Python process keeps OpenBLAS's own choice): the same
-    # figures to round-off.
+    # figures to round-off. This checks that the two front ends agree; the figures themselves
+    # are checked against closed forms in test_uniaxial_bar.py (a bar in tension, both front
+    # ends) and tests/model/model_test.cpp (a column under its own weight).
     for key in ("energy", "max_displacement", "max_von_mises", "max_jump"):
         assert solve[key] == pytest.approx(cli_solve[key], rel=1e-12), key
 

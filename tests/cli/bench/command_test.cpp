@@ -63,9 +63,10 @@ TEST(BenchCommand, StabilitySuiteWritesJsonCsvAndPlots) {
   const nlohmann::json j = nlohmann::json::parse(in);
   EXPECT_TRUE(j["cond_method"].get<std::string>().find("Lanczos") != std::string::npos);
   ASSERT_FALSE(j["sliver"].empty());
-  // The figures of the quick cases against those measured (tests/cli/bench/b4_measurements.h):
-  // merged slivers (ratios 2e-2, 1e-4 and 1e-12) near the regular grid and within 100x of it
-  // (issue 5), the thin neck bounded.
+  // The figures of the quick cases against polydg's (tests/cli/bench/b4_measurements.h, where
+  // stability_test.cpp checks the estimates against a dense eigendecomposition): merged slivers
+  // (ratios 2e-2, 1e-4 and 1e-12) near the regular grid and within 100x of it (issue 5), the
+  // thin neck bounded.
   EXPECT_TRUE(j["summary"]["merged_sliver_within_100x_of_regular"].get<bool>()) << j["summary"];
   for (const nlohmann::json& s : j["sliver"]) {
     ASSERT_TRUE(s.contains("volume_ratio") && s.contains("merged") && s.contains("cond"));
@@ -73,39 +74,34 @@ TEST(BenchCommand, StabilitySuiteWritesJsonCsvAndPlots) {
     const int p = s["degree"].get<int>();
     if (ratio == 1.0) {
       EXPECT_EQ(s["cond_over_regular"].get<double>(), 1.0) << s.dump();
+      EXPECT_TRUE(measured::sameCondition(s["cond"].get<double>(), measured::kRegularCond[p - 1]))
+          << s.dump();
     } else if (s["merged"].get<bool>()) {
-      EXPECT_TRUE(measured::within(s["cond_over_regular"].get<double>(),
-                                   measured::kMergedSliverOverRegular[p - 1],
-                                   measured::kConditionMargin))
+      EXPECT_TRUE(measured::sameCondition(s["cond_over_regular"].get<double>(),
+                                          measured::mergedSliverOverRegular(ratio, p)))
           << s.dump();
     }
   }
   for (const nlohmann::json& s : j["thin_neck"]) {
     ASSERT_TRUE(s["positive_definite"].get<bool>()) << s.dump();
     const int p = s["degree"].get<int>();
-    EXPECT_LE(s["cond"].get<double>(),
-              measured::kThinNeckCondMax[p - 1] * measured::kConditionMargin)
-        << s.dump();
-    EXPECT_GE(s["cond"].get<double>(),
-              measured::kThinNeckCondMin[p - 1] / measured::kConditionMargin)
+    EXPECT_TRUE(measured::sameCondition(s["cond"].get<double>(),
+                                        measured::thinNeckCond(s["eps"].get<double>(), p)))
         << s.dump();
   }
   EXPECT_EQ(j["incompressible"].size(), 8u);  // 4 values of nu, p = 1 and 2
   for (const nlohmann::json& s : j["incompressible"])
     EXPECT_TRUE(s.contains("tip") && s.contains("reference") && s.contains("nu"));
   EXPECT_EQ(j["scale"].size(), 12u);  // B1 and B3, 3 scales, 2 offsets
-  // Each scaled or translated run changes its figure by no more than measured (with the margin):
-  // the unscaled, untranslated run by nothing.
+  // Each scaled or translated run keeps its figure up to the round-off its computation allows
+  // (measured::scaleChangeBound); the unscaled run at the origin exactly.
   for (const nlohmann::json& s : j["scale"]) {
-    const double scale = s["scale"].get<double>();
-    const bool translated = s["offset"][0].get<double>() != 0.0;
     const ScaleProblem problem =
         s["problem"].get<std::string>() == "B1" ? ScaleProblem::B1 : ScaleProblem::B3;
-    double bound = 0.0;
-    for (const measured::ScaleCase& c : measured::kScaleCases)
-      if (c.problem == problem && c.scale == scale && c.translated == translated)
-        bound = measured::kScaleChangeMargin * c.measuredChange;
-    EXPECT_LE(s["change"].get<double>(), bound) << s.dump();
+    EXPECT_LE(s["change"].get<double>(),
+              measured::scaleChangeBound(problem, s["coordinate_resolution"].get<double>(),
+                                         s["cond"].get<double>()))
+        << s.dump();
   }
   std::ifstream csv(dir / "stability.csv");
   std::string header;
@@ -137,17 +133,32 @@ TEST(BenchCommand, CuttingSuiteReintegratesOnlyWhatEachCutTouched) {
   fs::remove_all(dir);
 }
 
+/// B7 of the quick dynamics suite (a quarter turn in 50 steps) per integrator, corotated: the
+/// largest volume change and angular momentum change measured 2026-12-04, each bound 2.5 times
+/// the figure. Backward Euler's straight steps stretch the spinning cube by (omega dt)^2 =
+/// 9.87e-4 per step, which the elastic forces hold at that size; the second-order integrators
+/// keep it far smaller, and lose angular momentum to their corrections' tolerance.
+struct SpinFigures {
+  const char* integrator;
+  double volumeChange, angularMomentumChange;
+};
+constexpr SpinFigures kCorotatedSpin[] = {
+    {"euler", 9.87e-4, 2.1e-6}, {"bdf2", 4.4e-5, 1.38e-3}, {"newmark", 1.95e-4, 4.4e-4}};
+constexpr double kSpinMargin = 2.5;
+
 TEST(BenchCommand, DynamicsSuiteKeepsEnergyAndVolumeWhereItShould) {
-  // B6 over one period of dt = T/200: Newmark (undamped, linear) keeps the energy, backward
-  // Euler loses some, every integrator sees two zero crossings, half a period apart.
-  constexpr double kNewmarkEnergyChange = 0.01;
-  constexpr double kPeriodTolerance = 0.05;  // of Euler-Bernoulli's 19.58 (Timoshenko: +2%)
+  // B6 over one period of dt = T/200: Newmark (undamped, linear) keeps the energy to round-off
+  // (measured 4.6e-11; docs/benchmarks.md, B6: 7e-11 over 10 periods), backward Euler loses
+  // some (measured: 0.797 left), every integrator sees two zero crossings, half a period apart.
+  constexpr double kNewmarkEnergyChange = 1.5e-10;
+  // Of Euler-Bernoulli's 19.58 on the quick, coarser beam: measured +0.66% (backward Euler),
+  // +1.8% (BDF2), +1.9% (Newmark); Timoshenko's shear adds about 2%.
+  constexpr double kPeriodTolerance = 0.04;
   // B7 over a quarter turn of 50 steps: the linear model's infinitesimal rotation grows the
-  // volume by theta^2 (2.47 at pi/2); with corotation the change is of the order of
-  // (omega dt)^2 = 9.9e-4 (backward Euler's step moves along the tangent) or below.
-  constexpr double kCorotationalVolumeChange = 1.5e-3;
-  constexpr double kLinearVolumeChange = 1.0;
-  constexpr double kAngularMomentumChange = 0.01;
+  // volume by theta^2 = 2.4674 at pi/2 (measured 2.4674 with each integrator), and keeps the
+  // angular momentum to round-off (measured 1.3e-12 at most).
+  constexpr double kLinearVolumeChange = 2.4674011;
+  constexpr double kLinearAngularMomentumChange = 1e-11;
   const SuiteFiles files = quickSuite("dynamics");
   ASSERT_TRUE(files.ok);
   const fs::path& dir = files.dir;
@@ -167,12 +178,17 @@ TEST(BenchCommand, DynamicsSuiteKeepsEnergyAndVolumeWhereItShould) {
     EXPECT_GE(run["zero_crossings"].get<int>(), 2) << run.dump();
     EXPECT_NEAR(run["period_over_euler_bernoulli"].get<double>(), 1.0, kPeriodTolerance)
         << run.dump();
+    // No integrator gains energy beyond round-off (backward Euler and BDF2 start at their
+    // largest: energy_max is 1 exactly).
     EXPECT_LE(run["energy_max"].get<double>(), 1.0 + kNewmarkEnergyChange) << run.dump();
     if (integrator == "newmark") {
       EXPECT_LT(run["energy_worst_change"].get<double>(), kNewmarkEnergyChange) << run.dump();
     }
-    if (integrator == "euler") {
-      EXPECT_LT(run["energy_final"].get<double>(), 0.99) << run.dump();
+    if (integrator == "euler") {  // measured 0.797
+      EXPECT_NEAR(run["energy_final"].get<double>(), 0.797, 0.02) << run.dump();
+    }
+    if (integrator == "bdf2") {  // measured 0.9895
+      EXPECT_NEAR(run["energy_final"].get<double>(), 0.9895, 0.005) << run.dump();
     }
   }
 
@@ -180,15 +196,21 @@ TEST(BenchCommand, DynamicsSuiteKeepsEnergyAndVolumeWhereItShould) {
   ASSERT_EQ(b7["runs"].size(), 6u);  // 3 integrators, linear and corotational
   for (const nlohmann::json& run : b7["runs"]) {
     const double change = run["volume_change_max"].get<double>();
+    const double momentum = run["angular_momentum_change_max"].get<double>();
     if (run["corotational"].get<bool>()) {
-      EXPECT_LT(change, kCorotationalVolumeChange) << run.dump();
+      const std::string integrator = run["integrator"].get<std::string>();
+      const auto figures =
+          std::find_if(std::begin(kCorotatedSpin), std::end(kCorotatedSpin),
+                       [&](const SpinFigures& f) { return integrator == f.integrator; });
+      ASSERT_NE(figures, std::end(kCorotatedSpin)) << run.dump();
+      EXPECT_LT(change, kSpinMargin * figures->volumeChange) << run.dump();
+      EXPECT_LT(momentum, kSpinMargin * figures->angularMomentumChange) << run.dump();
     } else {
-      EXPECT_GT(change, kLinearVolumeChange) << run.dump();
+      EXPECT_NEAR(change, kLinearVolumeChange, 1e-6) << run.dump();
+      EXPECT_LT(momentum, kLinearAngularMomentumChange) << run.dump();
     }
-    // Free body: no momentum appears, the angular momentum stays.
-    EXPECT_LT(run["momentum_max"].get<double>(), 1e-9) << run.dump();
-    EXPECT_LT(run["angular_momentum_change_max"].get<double>(), kAngularMomentumChange)
-        << run.dump();
+    // Free body: no momentum appears (measured 3.4e-13 at most).
+    EXPECT_LT(run["momentum_max"].get<double>(), 1e-12) << run.dump();
   }
 
   const nlohmann::json& speed = j["speed"]["runs"];
@@ -302,10 +324,16 @@ TEST(BenchCommand, AdaptivitySuiteRefinesWhereItShould) {
   EXPECT_LT(b13[1]["elements"].get<std::size_t>(), b13[0]["elements"].get<std::size_t>());
   EXPECT_NEAR(b13[1]["volume"].get<double>(), b13[0]["volume"].get<double>(),
               1e-10 * b13[0]["volume"].get<double>());
-  // The estimate bounds the error (effectivity >= 1) and adaptive rounds lower the error.
+  // The estimate's effectivity on the two adapted meshes, as measured (8.128 and 7.410;
+  // docs/benchmarks.md, B12: 8.1 falling to 3.5 over 13 meshes). It misses the specification,
+  // 0.3 to 3 (issue 'adaptivity'); until the estimator is fixed the figures are held to 10%, so
+  // that any change is noticed. Adaptive rounds lower the error.
+  constexpr double kEffectivity[] = {8.128, 7.410};
   const auto& adaptive = j["B12"]["adaptive"];
-  ASSERT_GE(adaptive.size(), 2u);
-  for (const auto& round : adaptive) EXPECT_GE(round["effectivity"].get<double>(), 1.0);
+  ASSERT_EQ(adaptive.size(), 2u);
+  for (std::size_t k = 0; k < adaptive.size(); ++k)
+    EXPECT_NEAR(adaptive[k]["effectivity"].get<double>(), kEffectivity[k], 0.1 * kEffectivity[k])
+        << adaptive[k].dump();
   EXPECT_LT(adaptive.back()["l2_error"].get<double>(), adaptive.front()["l2_error"].get<double>());
   if (files.scratch) fs::remove_all(dir);
 }

@@ -3,6 +3,7 @@
 // the cantilever against its eigenproblem and Euler-Bernoulli (B6), energy behaviour of both
 // integrators, and the damped static limit against the static solver.
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <random>
 
@@ -84,17 +85,28 @@ TEST(Dynamics, RigidRotationHasNoCorotatedElasticForce) {
   }
 }
 
+/// B7 (b) per integrator (backward Euler, BDF2, Newmark), corotated, as measured 2026-12-04: the
+/// volume change and the relative angular momentum change after one turn (docs/benchmarks.md,
+/// B7: 2.4e-5 and 5.6e-5 for the volume, 4e-4 for Newmark's angular momentum). Each is held to
+/// 2.5 times its figure. Backward Euler's straight steps stretch a spinning body by (omega dt)^2
+/// = 9.9e-4 per step, which the elastic forces hold near that size; BDF2 and Newmark correct
+/// the force until their corrections are small, which costs some angular momentum.
+constexpr double kSpinVolumeChange[] = {9.61e-4, 2.42e-5, 5.59e-5};
+constexpr double kSpinAngularMomentumChange[] = {8.5e-6, 1.30e-3, 2.48e-4};
+constexpr double kSpinMargin = 2.5;
+
 TEST(Dynamics, SpinningCubeKeepsItsVolumeWithCorotation) {
   // B7 (b): omega = (0, 0, 1) about the centroid, one full turn in 200 steps. The linear
-  // model's infinitesimal rotation inflates the cube (40 times its volume in a turn).
+  // model's infinitesimal rotation inflates the cube (39.48 times its volume in a turn, with
+  // each integrator), keeping the angular momentum to round-off (measured 1.9e-11).
   const PolyMesh mesh = hexGridMesh(4, 4, 4, Box3(Vec3::Zero(), Vec3::Ones()));
   MomentCache moments(mesh, 2);
   moments.update();
   const Vec3 c(0.5, 0.5, 0.5);
   Eigen::Matrix3d spin;  // omega x (x - c)
   spin << 0, -1, 0, 1, 0, 0, 0, 0, 0;
+  int index = 0;
   for (Integrator integrator : {Integrator::BackwardEuler, Integrator::Bdf2, Integrator::Newmark}) {
-    double change[2];
     for (bool corotational : {false, true}) {
       DynamicSolver solver(mesh, moments, {}, options(1, corotational, integrator));
       const Eigen::VectorXd v = solver.affineField(spin, Vec3::Zero(), c);
@@ -104,20 +116,25 @@ TEST(Dynamics, SpinningCubeKeepsItsVolumeWithCorotation) {
       const Vec3 l0 = solver.state().angularMomentum;
       EXPECT_NEAR(l0.z(), 1.0 / 6.0, 1e-12);  // I_zz omega of the unit cube
       for (int k = 0; k < 200; ++k) solver.step(2 * kPi / 200);
-      change[corotational] = std::abs(solver.deformedVolume() / v0 - 1.0);
+      const double change = std::abs(solver.deformedVolume() / v0 - 1.0);
       const BodyState s = solver.state();
-      // No external force: the momentum stays zero, the angular momentum is kept.
-      EXPECT_LT(s.momentum.norm(), 1e-9 * l0.norm());
-      EXPECT_NEAR(s.angularMomentum.z(), l0.z(), 0.002 * l0.z())
-          << "corotational " << corotational << ", integrator " << static_cast<int>(integrator);
+      const double momentum = std::abs(s.angularMomentum.z() / l0.z() - 1.0);
+      std::printf(
+          "B7 integrator %d corotational %d: volume change %.3e, angular momentum %.3e, "
+          "momentum %.2e\n",
+          index, corotational, change, momentum, s.momentum.norm() / l0.norm());
+      // No external force: the momentum stays zero (measured 1.5e-11 at most).
+      EXPECT_LT(s.momentum.norm(), 5e-11 * l0.norm());
+      if (corotational) {
+        EXPECT_LT(change, kSpinMargin * kSpinVolumeChange[index]) << "integrator " << index;
+        EXPECT_LT(momentum, kSpinMargin * kSpinAngularMomentumChange[index])
+            << "integrator " << index;
+      } else {
+        EXPECT_NEAR(change, 39.48, 0.01 * 39.48) << "integrator " << index;
+        EXPECT_LT(momentum, 1e-10) << "integrator " << index;
+      }
     }
-    // The second-order integrators keep the volume to 0.1% (5e-5 and 2e-5 here); backward
-    // Euler's straight steps stretch a spinning body by (omega dt)^2 = 9.9e-4 per step, which
-    // the elastic forces hold near that size (9.6e-4 here).
-    const double dtOmega = 2 * kPi / 200;
-    EXPECT_LT(change[1], integrator == Integrator::BackwardEuler ? 2 * dtOmega * dtOmega : 1e-3)
-        << "integrator " << static_cast<int>(integrator);
-    EXPECT_GT(change[0], 10.0) << "integrator " << static_cast<int>(integrator);
+    ++index;
   }
 }
 
@@ -169,7 +186,8 @@ TEST(Dynamics, CantileverPeriodMatchesItsEigenproblemAndEulerBernoulli) {
     x = y.normalized();
   }
   const double discretePeriod = 2 * kPi / std::sqrt(lambda);
-  EXPECT_NEAR(discretePeriod, 19.58, 0.03 * 19.58);
+  // Measured 19.620, +0.20% of Euler-Bernoulli's 19.58 (Timoshenko's shear: about +2% more).
+  EXPECT_NEAR(discretePeriod, 19.58, 0.006 * 19.58);
 
   for (Integrator integrator : {Integrator::Newmark, Integrator::Bdf2}) {
     DynamicSolver solver(beam.mesh, beam.moments,
@@ -192,11 +210,27 @@ TEST(Dynamics, CantileverPeriodMatchesItsEigenproblemAndEulerBernoulli) {
     }
     ASSERT_GE(crossings.size(), 19u);
     const double period = 2 * (crossings.back() - crossings.front()) / (crossings.size() - 1);
-    EXPECT_NEAR(period, discretePeriod, 0.01 * discretePeriod);
-    EXPECT_NEAR(period, 19.58, 0.03 * 19.58);
-    // Undamped, Newmark's energy stays within 1% over 10 periods; BDF2 dissipates the higher
-    // modes of the initial shape, (omega dt)^4 per step (2.5% of the energy here).
-    EXPECT_LT(worst, integrator == Integrator::Newmark ? 0.01 : 0.05);
+    std::printf(
+        "B6 integrator %d: period %.6f (discrete %.6f), worst energy change %.3e, final %.6f\n",
+        static_cast<int>(integrator), period, discretePeriod, worst,
+        (solver.state().kinetic + solver.state().elastic) / e0);
+    // Measured 19.635 (Newmark) and 19.632 (BDF2): +0.08% and +0.06% of the eigenproblem's
+    // period (the steps' period error and the crossings' interpolation), +0.28% and +0.26% of
+    // Euler-Bernoulli's (docs/benchmarks.md, B6).
+    EXPECT_NEAR(period, discretePeriod, 0.0025 * discretePeriod);
+    EXPECT_NEAR(period, 19.58, 0.008 * 19.58);
+    if (integrator == Integrator::Newmark) {
+      // Undamped and linear, the average-acceleration Newmark step conserves the energy
+      // exactly; what is left is round-off, summed over 2000 steps of Cholesky solves: measured
+      // 4.8e-11 (docs/benchmarks.md, B6: 7e-11). A step that damps or gains, even by (omega
+      // dt)^4, is far above this.
+      EXPECT_LT(worst, 1.5e-10);
+    } else {
+      // BDF2 dissipates the higher modes of the initial shape, (omega dt)^4 per step: measured
+      // 2.54e-2 (docs/benchmarks.md, B6: energy 0.975 after 10 periods).
+      EXPECT_GT(worst, 0.02);
+      EXPECT_LT(worst, 0.03);
+    }
   }
 }
 

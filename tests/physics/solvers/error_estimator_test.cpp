@@ -1,8 +1,8 @@
 // The residual error estimator of physics/solvers/error_estimator.h: it vanishes where the IP
 // solution is exact (polynomial solutions of degree <= p, on hexahedra and sliced polyhedra, with
-// Dirichlet and traction faces), it bounds the true DG energy error of a Gaussian bump (B12's field
-// with a wider bump) from above within a factor of 8 (not B12's acceptance window [0.3, 3]:
-// measured 4.8 to 6), falls at the error's rate under uniform refinement, and is largest where the
+// Dirichlet and traction faces), its effectivity on a Gaussian bump (B12's field with a wider
+// bump) is the one measured (4.9 and 6.0: it misses B12's specification, 0.3 to 3; issue
+// 'adaptivity'), it falls at the error's rate under uniform refinement, and is largest where the
 // bump is; DgBasis::hessians(), which it uses; and the markings.
 #include <algorithm>
 #include <array>
@@ -22,10 +22,19 @@ namespace {
 
 /// The solution must make the estimate vanish to this, relative to the energy of u.
 constexpr double kExactTolerance = 1e-8;
-/// Estimate / true DG energy error of the bump tests: the estimate bounds the error (>= 1) and
-/// overestimates it by at most 8 (measured 4.9 to 6.0; B12 asks for [0.3, 3], which these
-/// standard constants do not reach).
-constexpr double kLowestEffectivity = 1.0, kHighestEffectivity = 8.0;
+/// Estimate / true DG energy error of the bump tests, as measured (2026-12-04), per mesh. The
+/// specification asks for an effectivity in [0.3, 3], an estimate within 3x of the error (the
+/// guide's Known limits); this estimator MISSES it (issue 'adaptivity': its standard constants
+/// overestimate by 5-6 here, by up to 8 on B12 itself). Until that issue fixes the estimator,
+/// the test holds the figures it has, within kEffectivityChange either way, so that any change
+/// of the estimate or of the error is noticed; the fix then replaces them with the
+/// specification's window.
+struct MeasuredEffectivity {
+  int n;
+  double effectivity;
+};
+constexpr MeasuredEffectivity kBumpEffectivity[] = {{4, 6.035}, {8, 4.855}};
+constexpr double kEffectivityChange = 0.1;
 /// Least share of the squared estimate held by the elements within 2 w of the bump's centre.
 constexpr double kNearShare = 0.5;
 /// Largest difference between the rates of the estimate and of the error from n = 4 to 8.
@@ -235,20 +244,20 @@ EstimatedSolve solveBump(double width, int n, int quadratureDegree) {
 //   n = 4: 6.04 (7.41), n = 8: 4.86 (6.57), n = 16: 4.79 (6.52);
 //   the real B12 (w = 0.05): n = 4: 8.26, 8: 7.05, 16: 5.36.
 // The residual term is ~80% of the estimate. The estimate bounds the error from above on every
-// mesh, and stays within the factor asserted here; B12's acceptance window [0.3, 3] is NOT met
-// with these standard constants (see physics/solvers/error_estimator.h).
+// mesh, but B12's specification [0.3, 3] is NOT met with these standard constants (see
+// physics/solvers/error_estimator.h; issue 'adaptivity').
 constexpr double kBumpWidth = 0.15;
 constexpr int kBumpQuadrature = 8;
 
-TEST(ErrorEstimator, BoundsTheErrorOfAGaussianBumpAndIsLargestAtTheBump) {
-  for (int n : {4, 8}) {
+TEST(ErrorEstimator, HasTheMeasuredEffectivityOnAGaussianBumpAndIsLargestAtTheBump) {
+  for (const auto& [n, measuredEffectivity] : kBumpEffectivity) {
     SCOPED_TRACE("n = " + std::to_string(n));
     const EstimatedSolve s = solveBump(kBumpWidth, n, kBumpQuadrature);
     const double effectivity = s.estimate.total / s.error.total();
     std::printf("n = %d: %zu DOFs, estimate %.4e, error %.4e (broken %.4e), effectivity %.3f\n", n,
                 s.dofs, s.estimate.total, s.error.total(), s.error.broken, effectivity);
-    EXPECT_GE(effectivity, kLowestEffectivity);
-    EXPECT_LE(effectivity, kHighestEffectivity);
+    // Not the specification's [0.3, 3] (issue 'adaptivity'): the figure measured, to 10%.
+    EXPECT_NEAR(effectivity, measuredEffectivity, kEffectivityChange * measuredEffectivity);
     // The largest indicator sits on one of the 8 elements around the bump's centre (a grid
     // vertex), and the elements within 2 w of it hold most of the estimate.
     const PolyMesh mesh = hexGridMesh(n, n, n, Box3(Vec3::Zero(), Vec3::Ones()));
