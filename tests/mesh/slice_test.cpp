@@ -7,8 +7,10 @@
 
 #include <iomanip>
 #include <iostream>
+#include <limits>
 
 #include "polydg/integrate/moment_cache.h"
+#include "polydg/mesh/geometry.h"
 #include "polydg/mesh/geometry_checks.h"
 #include "polydg/mesh/surface_shapes.h"
 
@@ -25,6 +27,7 @@ constexpr double kPartVolumeTolerance = 1e-12;
 struct Sliced {
   PolyMesh mesh;
   SliceStats stats;
+  std::vector<std::array<int, 3>> elementCell;
   GeometryCheck geometry;
   double volume = 0.0;
   std::size_t hexahedra = 0;
@@ -33,7 +36,7 @@ struct Sliced {
 
 Sliced slice(const TriangleSurface& surface, const Grid& grid) {
   Sliced s;
-  s.mesh = sliceSurface(surface, grid, &s.stats);
+  s.mesh = sliceSurface(surface, grid, &s.stats, &s.elementCell);
   s.geometry = checkGeometry(s.mesh);
   MomentCache moments(s.mesh, 0);
   moments.update();
@@ -152,6 +155,24 @@ TEST(Slice, TipOfRoundOffSizeBeyondAGridPlane) {
     }
 }
 
+/// Every element is a piece of its cell: its corners lie in the cell's box, widened by the
+/// resolution of the coordinates (welding moves points by at most 8 ulps of the largest).
+void expectElementsInTheirCells(const Sliced& s, const Grid& grid) {
+  ASSERT_EQ(s.elementCell.size(), s.mesh.numElements());
+  double largest = 0.0;
+  for (const Vec3& p : s.mesh.positions().raw())
+    largest = std::max(largest, p.cwiseAbs().maxCoeff());
+  const double resolution = 8.0 * std::numeric_limits<double>::epsilon() * largest;
+  std::size_t outside = 0;
+  for (std::size_t e = 0; e < s.mesh.numElements(); ++e) {
+    const Box3 box = elementBounds(s.mesh, ElementId(e));
+    for (int a = 0; a < 3; ++a)
+      outside += box.min()[a] < grid.plane(a, s.elementCell[e][a]) - resolution ||
+                 box.max()[a] > grid.plane(a, s.elementCell[e][a] + 1) + resolution;
+  }
+  EXPECT_EQ(outside, 0u);
+}
+
 TEST(Slice, TwistedPartsTaperedToAPoint) {
   // A CAD-like part (twistedTaperedPrism): a 20 x 10 rectangle extruded 40 high in 200 thin
   // slices, turning once and tapering to an apex. Many corners lie within round-off of grid
@@ -168,13 +189,18 @@ TEST(Slice, TwistedPartsTaperedToAPoint) {
         part = combine(part, boxSurface(Box3(offset + Vec3(-5, 20, 0), offset + Vec3(5, 30, 5))));
       }
       const double exact = enclosedVolume(part);
-      for (const int cells : {16, 32, 48, 64}) {
+      for (const int cells : {16, 32, 48, 58, 64}) {
         const std::string name = std::string(boxes ? "twist and boxes" : "twist") +
                                  (offset.x() == 0 ? " at the origin, " : " 1e6 away, ") +
                                  std::to_string(cells) + " cells";
         SCOPED_TRACE(name);
-        const Sliced s = slice(part, Grid::withCellsAlongLongest(bounds(part), cells));
+        const Grid grid = Grid::withCellsAlongLongest(bounds(part), cells);
+        const Sliced s = slice(part, grid);
         expectGood(s, exact, boxes ? 4 : 1);
+        expectElementsInTheirCells(s, grid);
+        // Each piece of a cell stays its own element: the two sides of a sliver that rounding
+        // puts on one polygon cancel in their cell (at 58 cells), no element is merged.
+        EXPECT_EQ(s.stats.mergedElements, 0u);
         EXPECT_NEAR(s.volume, exact, kPartVolumeTolerance * exact);
         EXPECT_NEAR(s.geometry.volume, exact, kPartVolumeTolerance * exact);
         std::cout << name << ": " << s.mesh.numElements() << " elements, volume "
