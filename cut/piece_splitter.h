@@ -331,10 +331,14 @@ class Splitter {
     const auto [it, inserted] = newVertices_.try_emplace(local, VertexId());
     if (inserted) {
       const Vec3& p = splitter_->point(local);
-      // A constructed point that rounded onto one of the elements' vertices is that vertex.
+      // A constructed point that rounded onto one of the elements' vertices is that vertex, and
+      // one that rounded onto another constructed point is that point (distinct exact points,
+      // closer than the coordinates resolve).
       const auto same = byPosition_.find({p.x(), p.y(), p.z()});
       if (same != byPosition_.end()) return it->second = meshOf_[same->second];
-      it->second = mesh_.addVertex(p);
+      const auto [made, first] = newByPosition_.try_emplace({p.x(), p.y(), p.z()}, VertexId());
+      if (!first) return it->second = made->second;
+      it->second = made->second = mesh_.addVertex(p);
       tags_.resize(mesh_.numVertices());
       tags_[it->second.index()] = {planeId_};
     }
@@ -442,6 +446,7 @@ class Splitter {
     }
   };
   std::unordered_map<std::array<double, 3>, std::uint32_t, PositionHash> byPosition_;
+  std::unordered_map<std::array<double, 3>, VertexId, PositionHash> newByPosition_;
   std::map<std::uint32_t, FaceParts> faces_;
   bool coupled_ = false;
   std::map<std::vector<std::uint32_t>, FaceId> capFaces_;  ///< coupled caps by vertex set

@@ -18,6 +18,20 @@
 
 namespace polydg {
 
+bool isDegenerateFace(const PolyMesh& mesh, FaceId f, const Vec3& area) {
+  const Face& face = mesh.face(f);
+  for (std::size_t k = 0; k < face.numLoops(); ++k)
+    if (face.loop(k).size() < 3) return true;
+  boost::container::small_vector<VertexId, 8> sorted(face.vertices.begin(), face.vertices.end());
+  std::sort(sorted.begin(), sorted.end());
+  if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) return true;
+  return area.squaredNorm() == 0.0;
+}
+
+bool isDegenerateFace(const PolyMesh& mesh, FaceId f) {
+  return isDegenerateFace(mesh, f, areaVector(mesh, f));
+}
+
 namespace {
 
 class Problems {
@@ -37,22 +51,6 @@ class Problems {
 
 std::string describe(const char* what, std::size_t index) {
   return std::string(what) + " " + std::to_string(index);
-}
-
-/// Checks a face's loops: each has >= 3 vertices and no vertex appears twice in the face; and
-/// its area vector (`area`, areaVector()) is not zero.
-bool isDegenerate(const PolyMesh& mesh, FaceId f, const Vec3& area) {
-  const Face& face = mesh.face(f);
-  for (std::size_t k = 0; k < face.numLoops(); ++k)
-    if (face.loop(k).size() < 3) return true;
-  boost::container::small_vector<VertexId, 8> sorted(face.vertices.begin(), face.vertices.end());
-  std::sort(sorted.begin(), sorted.end());
-  if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) return true;
-  return area.squaredNorm() == 0.0;
-}
-
-bool isDegenerate(const PolyMesh& mesh, FaceId f) {
-  return isDegenerate(mesh, f, areaVector(mesh, f));
 }
 
 /// True if every directed edge of the element's oriented faces is matched by its reverse:
@@ -158,7 +156,7 @@ GeometryCheck checkGeometryOf(const PolyMesh& mesh, std::span<const ElementId> e
                      "face " + std::to_string(f.index()) + " lists element " +
                          std::to_string(side.index()) + " which does not use it");
     }
-    if (isDegenerate(mesh, f)) {
+    if (isDegenerateFace(mesh, f)) {
       problems.add(report.degenerateFaces, describe("degenerate face", f.index()));
     } else if (const double excess = planarityExcess(mesh, f, options); excess > 0) {
       std::ostringstream msg;
@@ -230,7 +228,7 @@ FaceMeasures measureFaces(const PolyMesh& mesh, const GeometryCheckOptions& opti
                         c.key = vertexSetKey({face.vertices.data(), face.vertices.size()});
                         areaVectors[f] = areaVector(mesh, f);
                         faceBoxes[f] = faceBounds(mesh, f);
-                        c.degenerate = isDegenerate(mesh, f, areaVectors[f]);
+                        c.degenerate = isDegenerateFace(mesh, f, areaVectors[f]);
                         if (c.degenerate) continue;
                         const Box3& box = faceBoxes[f];
                         const double deviation = planarityDeviation(mesh, f, areaVectors[f]);

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "polydg/mesh/geometry.h"
+#include "polydg/mesh/geometry_checks.h"
 #include "util/union_find.h"
 
 #include <tbb/parallel_for.h>
@@ -18,9 +19,11 @@ PolyMesh mergeElements(const PolyMesh& mesh, const std::vector<std::uint32_t>& g
   if (group.size() != mesh.numElements())
     throw std::invalid_argument("mergeElements: one group per element is needed");
   const std::size_t nf = mesh.numFaces();
+  auto dropped = [&](ElementId e) { return e.valid() && group[e.index()] == kDroppedElement; };
   auto inside = [&](const Face& face) {
-    return face.front.valid() && face.back.valid() &&
-           group[face.front.index()] == group[face.back.index()];
+    return (face.front.valid() && face.back.valid() &&
+            group[face.front.index()] == group[face.back.index()]) ||
+           dropped(face.front) || dropped(face.back);
   };
   // Kept faces numbered in order: counts per block, running starts, then ids (in parallel).
   constexpr std::size_t kBlock = 8192;
@@ -49,9 +52,10 @@ PolyMesh mergeElements(const PolyMesh& mesh, const std::vector<std::uint32_t>& g
   // Each group's face uses: its members' in element order (a short serial pass).
   ElementData<Element> elements(groups);
   for (std::size_t e = 0; e < mesh.numElements(); ++e)
-    for (const FaceUse& use : mesh.element(ElementId(e)).faces)
-      if (newId[use.face.index()].valid())
-        elements[ElementId(group[e])].faces.push_back({newId[use.face.index()], use.reversed});
+    if (group[e] != kDroppedElement)
+      for (const FaceUse& use : mesh.element(ElementId(e)).faces)
+        if (newId[use.face.index()].valid())
+          elements[ElementId(group[e])].faces.push_back({newId[use.face.index()], use.reversed});
   PolyMesh out;
   out.assign(mesh.positions(), std::move(faces), std::move(elements));
   return out;
@@ -154,6 +158,116 @@ PolyMesh mergeSlivers(PolyMesh mesh, double volumeThreshold, SliverMergeReport* 
   // Number the groups in order of their first element.
   const std::size_t count = groups.labels(r.group);
   PolyMesh out = count == n ? std::move(mesh) : mergeElements(mesh, r.group, count);
+  if (report) *report = std::move(r);
+  return out;
+}
+
+namespace {
+
+/// Groups of elements joined by mergeDegenerateElements(): each group's volume and members at
+/// its representative.
+class DegenerateGroups {
+ public:
+  DegenerateGroups(const PolyMesh& mesh, const std::vector<double>& faceArea)
+      : mesh_(mesh), faceArea_(faceArea), sets_(mesh.numElements()) {}
+
+  UnionFind& sets() { return sets_; }
+
+  /// Starts the volumes and members from the elements' volumes and the current sets.
+  void gather(const std::vector<double>& elementVolume) {
+    const std::size_t n = elementVolume.size();
+    volume_.assign(n, 0.0);
+    members_.assign(n, {});
+    for (std::uint32_t e = 0; e < n; ++e) {
+      volume_[sets_.find(e)] += elementVolume[e];
+      members_[sets_.find(e)].push_back(e);
+    }
+  }
+
+  /// Joins group g (a representative) to its neighbours until its volume is positive; false if
+  /// it has no neighbour left before that.
+  bool joinUntilPositive(std::uint32_t g, std::size_t& merges) {
+    std::map<std::uint32_t, double> shared;
+    while (!(volume_[g] > 0.0)) {
+      shared.clear();
+      for (std::uint32_t m : members_[g])
+        for (const FaceUse& use : mesh_.element(ElementId(m)).faces) {
+          const Face& face = mesh_.face(use.face);
+          if (!face.front.valid() || !face.back.valid()) continue;
+          const std::uint32_t other = sets_.find((use.reversed ? face.front : face.back).value);
+          if (other != g) shared[other] += faceArea_[use.face.index()];
+        }
+      if (shared.empty()) return false;
+      const auto best = std::max_element(shared.begin(), shared.end(),
+                                         [](auto& a, auto& b) { return a.second < b.second; });
+      const std::uint32_t target = best->first;
+      sets_.unite(g, target);  // target stays the representative
+      volume_[target] += volume_[g];
+      members_[target].insert(members_[target].end(), members_[g].begin(), members_[g].end());
+      members_[g].clear();
+      ++merges;
+      g = target;
+    }
+    return true;
+  }
+
+  double volume(std::uint32_t g) const { return volume_[g]; }
+
+ private:
+  const PolyMesh& mesh_;
+  const std::vector<double>& faceArea_;
+  UnionFind sets_;
+  std::vector<double> volume_;
+  std::vector<std::vector<std::uint32_t>> members_;
+};
+
+}  // namespace
+
+PolyMesh mergeDegenerateElements(PolyMesh mesh, DegenerateMergeReport* report) {
+  const std::size_t n = mesh.numElements(), nf = mesh.numFaces();
+  std::vector<double> faceArea(nf);
+  std::vector<char> degenerate(nf);
+  tbb::parallel_for(std::size_t(0), nf, [&](std::size_t f) {
+    const Vec3 a = areaVector(mesh, FaceId(f));
+    faceArea[f] = a.norm();
+    degenerate[f] = isDegenerateFace(mesh, FaceId(f), a);
+  });
+  std::vector<double> volume(n);
+  tbb::parallel_for(std::size_t(0), n,
+                    [&](std::size_t e) { volume[e] = signedVolume(mesh, ElementId(e)); });
+  DegenerateMergeReport r;
+  DegenerateGroups groups(mesh, faceArea);
+  UnionFind& sets = groups.sets();
+  for (std::size_t f = 0; f < nf; ++f) {
+    const Face& face = mesh.face(FaceId(f));
+    if (!degenerate[f] || !face.front.valid() || !face.back.valid()) continue;
+    if (sets.find(face.front.value) == sets.find(face.back.value)) continue;
+    sets.unite(face.front.value, face.back.value);
+    ++r.merged;
+  }
+  groups.gather(volume);
+  std::vector<char> dropped(n, 0);
+  for (std::uint32_t e = 0; e < n; ++e)
+    if (sets.find(e) == e && !(groups.volume(e) > 0.0) && !groups.joinUntilPositive(e, r.merged))
+      dropped[sets.find(e)] = 1;
+  for (std::uint32_t e = 0; e < n; ++e) r.dropped += dropped[sets.find(e)];
+  if (r.merged == 0 && r.dropped == 0) {
+    r.group.resize(n);
+    std::iota(r.group.begin(), r.group.end(), 0u);
+    if (report) *report = std::move(r);
+    return mesh;
+  }
+  // Groups in order of their first element; dropped ones left out.
+  std::vector<std::uint32_t> label(n, kDroppedElement);
+  r.group.assign(n, kDroppedElement);
+  std::uint32_t count = 0;
+  for (std::uint32_t e = 0; e < n; ++e) {
+    const std::uint32_t g = sets.find(e);
+    if (dropped[g]) continue;
+    if (label[g] == kDroppedElement) label[g] = count++;
+    r.group[e] = label[g];
+  }
+  PolyMesh out = mergeElements(mesh, r.group, count);
   if (report) *report = std::move(r);
   return out;
 }

@@ -4,9 +4,6 @@
 #include <cmath>
 #include <stdexcept>
 
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/Exact_rational.h>
-
 #include "mesh/loop_tracing.h"
 #include "util/union_find.h"
 
@@ -14,134 +11,31 @@ namespace polydg {
 
 namespace {
 
-using Exact = CGAL::Exact_rational;
 using loop_tracing::DirectedEdge;
 using loop_tracing::EdgeList;
 using loop_tracing::groupLoops;
 using loop_tracing::Small;
 using loop_tracing::traceLoops;
 
-/// Where segment p q meets `plane`, exactly: the point's coordinate k (p and q on opposite
-/// exact sides of the plane, so the denominator is not zero).
-Exact exactCrossing(const Plane& plane, const Vec3& p, const Vec3& q, int k) {
-  Exact np(0), nq(0);
-  for (int i = 0; i < 3; ++i) {
-    np += Exact(plane.normal[i]) * Exact(p[i]);
-    nq += Exact(plane.normal[i]) * Exact(q[i]);
-  }
-  const Exact t = (Exact(plane.offset) - np) / (nq - np);
-  return Exact(p[k]) + t * (Exact(q[k]) - Exact(p[k]));
-}
-
 }  // namespace
 
 PlaneSplitter::PlaneSplitter(const std::vector<Vec3>& points) : PlaneSplitter(points, {}) {}
 
 PlaneSplitter::PlaneSplitter(const std::vector<Vec3>& points,
-                             const std::vector<std::uint32_t>& onPlane) {
-  if (!onPlane.empty() && onPlane.size() != points.size())
-    throw std::invalid_argument("PlaneSplitter: one plane id per point");
-  records_.reserve(2 * points.size());
-  for (std::size_t i = 0; i < points.size(); ++i)
-    records_.push_back({points[i], onPlane.empty() ? kNoPlane : onPlane[i], 0, 0});
-}
+                             const std::vector<std::uint32_t>& onPlane)
+    : points_(points, onPlane) {}
 
 void PlaneSplitter::reserve(std::size_t points) {
-  records_.reserve(points);
+  points_.reserve(points);
   edgePoints_.rehash(points);
-  byPosition_.rehash(points);
-}
-
-std::vector<Vec3> PlaneSplitter::points() const {
-  std::vector<Vec3> out;
-  out.reserve(records_.size());
-  for (const PointRecord& r : records_) out.push_back(r.position);
-  return out;
-}
-
-int PlaneSplitter::compareExactly(std::uint32_t v, std::uint32_t w, int k) const {
-  auto exact = [&](std::uint32_t id) -> Exact {
-    const PointRecord& r = records_[id];
-    if (r.a == r.b) return Exact(r.position[k]);  // a given point: exactly where it is
-    decltype(planes_)::const_accessor found;
-    if (!planes_.find(found, r.onPlane)) throw std::logic_error("compareExactly: unknown plane");
-    return exactCrossing(found->second, records_[r.a].position, records_[r.b].position, k);
-  };
-  const Exact a = exact(v), b = exact(w);
-  return a < b ? -1 : (b < a ? 1 : 0);
-}
-
-int PlaneSplitter::side(std::uint32_t v, const SplitPlane& plane) const {
-  const PointRecord& r = records_[v];
-  if (r.onPlane == plane.id) return 0;
-  return plane.side(r.position);
 }
 
 std::uint32_t PlaneSplitter::edgePoint(std::uint32_t u, std::uint32_t v, const SplitPlane& plane) {
-  // Interpolate from the lexicographically smaller end, so the point depends only on the
-  // edge's geometry and the plane (not on ids or the order of calls).
-  const Vec3& pu = records_[u].position;
-  const Vec3& pv = records_[v].position;
-  const bool uFirst =
-      std::lexicographical_compare(pu.data(), pu.data() + 3, pv.data(), pv.data() + 3) ||
-      (pu == pv && u < v);
-  const std::uint32_t a = uFirst ? u : v, b = uFirst ? v : u;
   decltype(edgePoints_)::accessor edge;
   if (!edgePoints_.insert(edge, EdgeKey{std::min(u, v), std::max(u, v), plane.id}))
     return edge->second;  // made already (we held no lock while another thread made it)
-  const Vec3 p = records_[a].position, q = records_[b].position;
-  Vec3 r;
-  if (plane.axis >= 0) {
-    const int k = plane.axis;
-    const double t = (plane.offset - p[k]) / (q[k] - p[k]);
-    r = p + t * (q - p);
-    r[k] = plane.offset;
-  } else {
-    const double dp = plane.normal.dot(p) - plane.offset;
-    const double dq = plane.normal.dot(q) - plane.offset;
-    if (dp != dq) {
-      // Rounded distances on one side (the ends within round-off of the plane) give t outside
-      // [0, 1]: the clamp below puts the point on the nearer end, where it welds.
-      r = p + (dp / (dp - dq)) * (q - p);
-    } else {
-      // The exact sides differ but the rounded distances are equal (both ends within round-off
-      // of the plane, e.g. points that two mirror-image planes made on one edge): the
-      // interpolation would divide by zero. The exact intersection, rounded, instead.
-      for (int i = 0; i < 3; ++i) r[i] = CGAL::to_double(exactCrossing(plane, p, q, i));
-    }
-  }
-  // Stay inside the edge's box, so later side tests against other planes keep the order of
-  // the edge's endpoints.
-  for (int i = 0; i < 3; ++i) r[i] = std::clamp(r[i], std::min(p[i], q[i]), std::max(p[i], q[i]));
-  const std::array<double, 3> position{r.x() + 0.0, r.y() + 0.0, r.z() + 0.0};
-  decltype(byPosition_)::accessor at;
-  if (!byPosition_.insert(at, position) && side(at->second, plane) == 0) {
-    edge->second = at->second;
-    return at->second;
-  }
-  const auto id =
-      static_cast<std::uint32_t>(records_.push_back({r, plane.id, a, b}) - records_.begin());
-  at->second = id;
-  edge->second = id;
-  return id;
-}
-
-void PlaneSplitter::rememberPlane(const SplitPlane& plane) {
-  decltype(planes_)::const_accessor known;
-  if (!planes_.find(known, plane.id)) planes_.insert({plane.id, plane});
-}
-
-Vec3 PlaneSplitter::polygonNormal(const PiecePolygon& polygon) const {
-  const Vec3& c = point(polygon.vertices.front());
-  Vec3 n = Vec3::Zero();
-  for (std::size_t k = 0; k < polygon.numLoops(); ++k) {
-    const std::size_t begin = polygon.loopBegin(k), end = polygon.loopEnd[k];
-    for (std::size_t i = begin; i < end; ++i) {
-      const std::size_t j = i + 1 == end ? begin : i + 1;
-      n += (point(polygon.vertices[i]) - c).cross(point(polygon.vertices[j]) - c);
-    }
-  }
-  return n;
+  edge->second = points_.addCrossing(u, v, plane, plane.id);
+  return edge->second;
 }
 
 namespace {
@@ -159,8 +53,6 @@ struct Corner {
   int side;
 };
 using CornerLoop = Small<Corner>;
-/// A point on the cut line: (its rounded position along the line, its id).
-using LinePoint = std::pair<double, std::uint32_t>;
 
 /// The fast path of splitPolygon(): one loop that meets L in exactly two corners, both
 /// crossings. The boundary crosses L twice, so the polygon meets L in the one segment between
@@ -219,14 +111,37 @@ class PlaneSplitter::PolygonCut {
     return loops_.size() == 1 && splitAtTwoCrossings(loops_[0], polygon_.origin, minus, plus);
   }
 
-  /// 2. Positions along the line L = polygon plane ∩ split plane, in the direction t that has
-  ///    the minus side on its left (seen from the polygon's normal).
+  /// 2. Positions along the line L = polygon plane ∩ split plane, in the direction t = n x
+  ///    normal that has the minus side on its left (seen from the polygon's area vector n): L is
+  ///    ordered by a coordinate k along which t is exactly not zero (the largest, if it can), in
+  ///    the exact sign of t_k. The projection that keeps the polygon's orientation traces the
+  ///    sides' loops.
   void orientLine(const SplitPlane& plane) {
-    n_ = splitter_.polygonNormal(polygon_);
-    t_ = n_.cross(plane.normal);
-    if (std::abs(t_.y()) > std::abs(t_[k_])) k_ = 1;
-    if (std::abs(t_.z()) > std::abs(t_[k_])) k_ = 2;
-    direction_ = t_[k_] > 0 ? 1.0 : -1.0;
+    const SplitPoints& points = splitter_.splitPoints();
+    const PolygonLoops loops = loopsOf(polygon_);
+    projection_ = points.projectionOf(loops);
+    // An approximate t ranks the coordinates; the exact signs decide.
+    Vec3 n = Vec3::Zero();
+    const Vec3& c = points.position(polygon_.vertices.front());
+    for (std::size_t k = 0; k < polygon_.numLoops(); ++k) {
+      const std::size_t begin = polygon_.loopBegin(k), end = polygon_.loopEnd[k];
+      for (std::size_t i = begin; i < end; ++i) {
+        const std::size_t j = i + 1 == end ? begin : i + 1;
+        n += (points.position(polygon_.vertices[i]) - c)
+                 .cross(points.position(polygon_.vertices[j]) - c);
+      }
+    }
+    const Vec3 t = n.cross(plane.normal);
+    std::array<int, 3> axes{0, 1, 2};
+    std::stable_sort(axes.begin(), axes.end(),
+                     [&](int a, int b) { return std::abs(t[a]) > std::abs(t[b]); });
+    k_ = -1;
+    for (int a : axes) {
+      tSign_[a] = points.normalCrossSign(loops, plane.normal, a);
+      if (k_ < 0 && tSign_[a] != 0) k_ = a;
+    }
+    if (k_ < 0)
+      throw std::logic_error("plane split: a polygon crossing the plane is parallel to it");
   }
 
   /// 3. Points on L, and parity toggles where the boundary crosses L (a run of on-L corners
@@ -245,7 +160,7 @@ class PlaneSplitter::PolygonCut {
       for (std::size_t step = 1; step <= m; ++step) {
         const Corner& c = loop[(start + step) % m];
         if (c.side == 0) {
-          onLine_.emplace_back(key(c.v), c.v);
+          onLine_.push_back(c.v);
           const Corner& next = loop[(start + step + 1) % m];
           if (next.side == 0) alongLine_.emplace_back(std::min(c.v, next.v), std::max(c.v, next.v));
           // Find where this run of on-L corners ends.
@@ -255,7 +170,7 @@ class PlaneSplitter::PolygonCut {
           if (after != before) toggles_.push_back(c.v);
           for (std::size_t r = step + 1; r <= run; ++r) {
             const Corner& cr = loop[(start + r) % m];
-            onLine_.emplace_back(key(cr.v), cr.v);
+            onLine_.push_back(cr.v);
             const Corner& cn = loop[(start + r + 1) % m];
             if (cn.side == 0) alongLine_.emplace_back(std::min(cr.v, cn.v), std::max(cr.v, cn.v));
           }
@@ -267,14 +182,12 @@ class PlaneSplitter::PolygonCut {
     }
   }
 
-  /// Orders the points on L along t, drops repeats and throws if two distinct points
+  /// Orders the points on L along t (exactly), drops repeats and throws if two distinct points
   /// coincide; sorts the toggles and the boundary edges on L for lookup.
   void orderLinePoints() {
-    const auto before = [this](const LinePoint& x, const LinePoint& y) { return ahead(x, y); };
+    const auto before = [this](std::uint32_t x, std::uint32_t y) { return ahead(x, y); };
     std::sort(onLine_.begin(), onLine_.end(), before);
-    onLine_.erase(std::unique(onLine_.begin(), onLine_.end(),
-                              [](const auto& x, const auto& y) { return x.second == y.second; }),
-                  onLine_.end());
+    onLine_.erase(std::unique(onLine_.begin(), onLine_.end()), onLine_.end());
     for (std::size_t i = 0; i + 1 < onLine_.size(); ++i)
       if (!before(onLine_[i], onLine_[i + 1])) {
         throw std::runtime_error(
@@ -286,10 +199,7 @@ class PlaneSplitter::PolygonCut {
 
   /// 4. Directed edges of each side: boundary pieces plus closing segments along L. A boundary
   ///    edge on L running along t has the polygon, and so the minus side, on its left: it goes
-  ///    to minus. Its direction is taken from the order the closing segments use (exact on
-  ///    ties): an edge whose ends tie in rounded coordinate k (an edge of round-off length, as
-  ///    from a surface vertex on one grid plane within round-off of another) must fall on the
-  ///    side its closing segments expect, or that side's loop stays open.
+  ///    to minus (the exact order of its ends along L, as for the closing segments).
   void sideEdges(EdgeList& minusEdges, EdgeList& plusEdges) const {
     for (const auto& loop : loops_) {
       const std::size_t m = loop.size();
@@ -302,15 +212,15 @@ class PlaneSplitter::PolygonCut {
         else if (a.side > 0 || b.side > 0)
           plusEdges.push_back(e);
         else
-          (ahead({key(a.v), a.v}, {key(b.v), b.v}) ? minusEdges : plusEdges).push_back(e);
+          (ahead(a.v, b.v) ? minusEdges : plusEdges).push_back(e);
       }
     }
     std::size_t crossings = 0;
     for (std::size_t i = 0; i + 1 < onLine_.size(); ++i) {
       crossings +=
-          static_cast<std::size_t>(std::count(toggles_.begin(), toggles_.end(), onLine_[i].second));
+          static_cast<std::size_t>(std::count(toggles_.begin(), toggles_.end(), onLine_[i]));
       if (crossings % 2 == 0) continue;  // outside the polygon
-      const std::uint32_t a = onLine_[i].second, b = onLine_[i + 1].second;
+      const std::uint32_t a = onLine_[i], b = onLine_[i + 1];
       if (std::binary_search(alongLine_.begin(), alongLine_.end(),
                              std::make_pair(std::min(a, b), std::max(a, b))))
         continue;  // already a boundary edge
@@ -319,24 +229,20 @@ class PlaneSplitter::PolygonCut {
     }
   }
 
-  /// The polygon's normal (orientLine()).
-  const Vec3& normal() const { return n_; }
+  /// The projection that keeps the polygon's orientation (orientLine()).
+  const Projection& projection() const { return projection_; }
 
  private:
-  /// Point v's position along L (rounded).
-  double key(std::uint32_t v) const { return direction_ * splitter_.point(v)[k_]; }
-
-  /// True if x comes before y along t. Rounded coordinates that tie are ordered exactly. A
-  /// polygon of round-off size has no meaningful direction t; its points can then tie on
-  /// coordinate k, and the other coordinates (exactly, in t's direction) order them instead.
-  bool ahead(const LinePoint& x, const LinePoint& y) const {
-    if (x.first != y.first) return x.first < y.first;
-    if (x.second == y.second) return false;
+  /// True if point x comes before point y along t: exactly, by coordinate k_. Points that tie in
+  /// it (the same point, or, on a face that is not planar, points off L) are ordered by the other
+  /// coordinates, exactly, in t's direction.
+  bool ahead(std::uint32_t x, std::uint32_t y) const {
+    if (x == y) return false;
+    const SplitPoints& points = splitter_.splitPoints();
     for (int i = 0; i < 3; ++i) {
       const int axis = (k_ + i) % 3;
-      const double sign = i == 0 ? direction_ : (t_[axis] < 0 ? -1.0 : 1.0);
-      if (const int c = splitter_.compareExactly(x.second, y.second, axis); c != 0)
-        return sign * c < 0;
+      const int sign = tSign_[axis] < 0 ? -1 : 1;
+      if (const int c = points.compare(x, y, axis); c != 0) return sign * c < 0;
     }
     return false;
   }
@@ -344,10 +250,10 @@ class PlaneSplitter::PolygonCut {
   PlaneSplitter& splitter_;
   const PiecePolygon& polygon_;
   Small<CornerLoop, 2> loops_;
-  Vec3 n_, t_;  ///< the polygon's normal and L's direction
-  int k_ = 0;   ///< the coordinate that orders points along L
-  double direction_ = 1.0;
-  Small<LinePoint> onLine_;
+  Projection projection_;
+  std::array<int, 3> tSign_{0, 0, 0};  ///< exact signs of L's direction t
+  int k_ = 0;                          ///< the coordinate that orders points along L
+  Small<std::uint32_t> onLine_;
   Small<std::uint32_t> toggles_;  // ids of the points where the boundary crosses L
   Small<std::pair<std::uint32_t, std::uint32_t>> alongLine_;  // boundary edges on L
 };
@@ -363,12 +269,11 @@ void PlaneSplitter::splitPolygon(const PiecePolygon& polygon, const SplitPlane& 
   cut.sideEdges(minusEdges, plusEdges);
 
   // 5. Loops, grouped into polygons with holes.
-  const Vec3& n = cut.normal();
-  const auto pointOf = [this](std::uint32_t v) -> const Vec3& { return point(v); };
-  for (auto& p : groupLoops(traceLoops(minusEdges, pointOf, n), pointOf, n, polygon.origin))
-    minus.push_back(std::move(p));
-  for (auto& p : groupLoops(traceLoops(plusEdges, pointOf, n), pointOf, n, polygon.origin))
-    plus.push_back(std::move(p));
+  const Projection& p = cut.projection();
+  for (auto& q : groupLoops(traceLoops(minusEdges, points_, p), points_, p, polygon.origin))
+    minus.push_back(std::move(q));
+  for (auto& q : groupLoops(traceLoops(plusEdges, points_, p), points_, p, polygon.origin))
+    plus.push_back(std::move(q));
 }
 
 namespace {
@@ -475,15 +380,15 @@ EdgeList capEdges(const PlaneSplitter& splitter, const Piece& minus, const Split
 
 /// Sorts the caps' edges so that their loops start where traceLoops meets them in this order:
 /// by the positions of the edges' ends, so that the output does not depend on the point ids
-/// (schedule-dependent). Ids only break ties between distinct points at one position (an
-/// intersection that rounded onto a surface vertex: the vertex's id is the smaller whatever
-/// the schedule).
+/// (schedule-dependent): by rounded position, then, for distinct points at one rounded
+/// position, by exact position.
 void sortByPosition(const PlaneSplitter& splitter, EdgeList& edges) {
   auto byPosition = [&splitter](std::uint32_t u, std::uint32_t v) {
     const Vec3& p = splitter.point(u);
     const Vec3& q = splitter.point(v);
     if (p != q) return std::lexicographical_compare(p.data(), p.data() + 3, q.data(), q.data() + 3);
-    return u < v;
+    const int c = splitter.splitPoints().compareLexicographically(u, v);
+    return c != 0 ? c < 0 : u < v;
   };
   std::sort(edges.begin(), edges.end(), [&](const DirectedEdge& a, const DirectedEdge& b) {
     return a.from != b.from ? byPosition(a.from, b.from) : byPosition(a.to, b.to);
@@ -504,11 +409,11 @@ PieceSplit PlaneSplitter::split(Piece piece, const SplitPlane& plane, FaceOrigin
       case Place::Minus: out.minus.push_back(std::move(polygon)); break;
       case Place::Plus: out.plus.push_back(std::move(polygon)); break;
       case Place::InPlane:  // it bounds the side it faces away from
-        (polygonNormal(polygon).dot(plane.normal) > 0 ? out.minus : out.plus)
+        (points_.normalDotSign(loopsOf(polygon), plane.normal) > 0 ? out.minus : out.plus)
             .push_back(std::move(polygon));
         break;
       case Place::Across:
-        if (out.polygonsSplit == 0) rememberPlane(plane);
+        if (out.polygonsSplit == 0) points_.rememberPlane(plane, plane.id);
         splitPolygon(polygon, plane, out.minus, out.plus);
         ++out.polygonsSplit;
         break;
@@ -520,9 +425,8 @@ PieceSplit PlaneSplitter::split(Piece piece, const SplitPlane& plane, FaceOrigin
   EdgeList caps = capEdges(*this, out.minus, plane);
   if (caps.empty()) return out;
   sortByPosition(*this, caps);
-  const auto pointOf = [this](std::uint32_t v) -> const Vec3& { return point(v); };
-  for (PiecePolygon& cap :
-       groupLoops(traceLoops(caps, pointOf, plane.normal), pointOf, plane.normal, capOrigin)) {
+  const Projection p = SplitPoints::projectionOf(plane.normal);
+  for (PiecePolygon& cap : groupLoops(traceLoops(caps, points_, p), points_, p, capOrigin)) {
     out.plus.push_back(reversed(cap));
     out.minus.push_back(std::move(cap));
     ++out.capPolygons;

@@ -1,17 +1,17 @@
-// Splitting closed polyhedral pieces by a plane, robustly: exact side tests, one shared vertex
-// per (edge, plane) intersection, non-convex faces and faces with holes, vertices and faces
-// lying in the plane. The building block of hexahedral slicing and of plane cutting.
+// Splitting closed polyhedral pieces by a plane, robustly: exact predicates over exact points
+// (every side, order and turn is that of the exact geometry), one shared vertex per (edge,
+// plane) intersection, non-convex faces and faces with holes, vertices and faces lying in the
+// plane. The building block of hexahedral slicing and of plane cutting.
 #pragma once
 
 #include <array>
 #include <cstdint>
-#include <unordered_map>
 
 #include <tbb/concurrent_hash_map.h>
-#include <tbb/concurrent_vector.h>
 #include <boost/container/small_vector.hpp>
 #include <vector>
 
+#include "mesh/split_points.h"
 #include "polydg/mesh/plane.h"
 #include "polydg/mesh/poly_mesh.h"
 
@@ -52,14 +52,17 @@ struct PieceSplit {
   std::size_t capPolygons = 0;
 };
 
-/// Owns the point array and the map of intersection points, so that every edge crossed by a
-/// plane yields one point, whichever polygon asks for it. split() may run concurrently on
-/// different pieces: points are appended to a concurrent vector and each (edge, plane) point is
-/// made under that key's lock. Point coordinates do not depend on the order of calls.
+/// Owns the points (mesh/split_points.h) and the map of intersection points, so that every
+/// edge crossed by a plane yields one point, whichever polygon asks for it. Every decision of a
+/// split is an exact predicate over the points' exact positions: a point made on a plane is
+/// exactly on it, and its exact position, not its rounded one, decides its side of every other
+/// plane. split() may run concurrently on different pieces: points are appended concurrently
+/// and each (edge, plane) point is made under that key's lock. Point coordinates do not depend
+/// on the order of calls.
 class PlaneSplitter {
  public:
   /// The plane id of a point on no plane by construction.
-  static constexpr std::uint32_t kNoPlane = 0xffffffffu;
+  static constexpr std::uint32_t kNoPlane = SplitPoints::kNoPlane;
 
   /// Starts from `points`, none of them on a plane by construction.
   explicit PlaneSplitter(const std::vector<Vec3>& points);
@@ -68,18 +71,22 @@ class PlaneSplitter {
   /// it. side() says 0 for it on that plane, as for the points this splitter makes.
   PlaneSplitter(const std::vector<Vec3>& points, const std::vector<std::uint32_t>& onPlane);
 
-  /// Sizes the point array and the tables of shared points for about `points` points in all
+  /// Sizes the point array and the table of shared points for about `points` points in all
   /// (a hint: they grow as needed either way, but growing them costs time).
   void reserve(std::size_t points);
 
-  std::size_t numPoints() const { return records_.size(); }
-  const Vec3& point(std::uint32_t v) const { return records_[v].position; }
-  /// A copy of all points, in id order.
-  std::vector<Vec3> points() const;
+  std::size_t numPoints() const { return points_.size(); }
+  /// Point v's rounded position.
+  const Vec3& point(std::uint32_t v) const { return points_.position(v); }
+  /// A copy of all points' rounded positions, in id order.
+  std::vector<Vec3> points() const { return points_.positions(); }
+  /// The points with their exact positions and predicates.
+  const SplitPoints& splitPoints() const { return points_; }
 
-  /// -1, 0, +1: the side of point v. Exact: axis-aligned planes compare coordinates, other
-  /// planes use an exact predicate; a point made on this plane is on it by definition.
-  int side(std::uint32_t v, const SplitPlane& plane) const;
+  /// -1, 0, +1: the exact side of point v; a point made on this plane is on it by definition.
+  int side(std::uint32_t v, const SplitPlane& plane) const {
+    return points_.side(v, plane, plane.id);
+  }
 
   /// Splits a closed piece. Polygons wholly on one side (touching the plane or not) go to that
   /// side; polygons lying in the plane go to the side they face away from, except that polygons
@@ -94,26 +101,13 @@ class PlaneSplitter {
 
  private:
   std::uint32_t edgePoint(std::uint32_t u, std::uint32_t v, const SplitPlane& plane);
-  /// Records `plane` under its id (for compareExactly) before points are made on it.
-  void rememberPlane(const SplitPlane& plane);
   /// Splits one polygon that crosses `plane` into polygons on each side.
   void splitPolygon(const PiecePolygon& polygon, const SplitPlane& plane, Piece& minus,
                     Piece& plus);
   /// The steps of splitPolygon() and the state they share (plane_split.cpp).
   class PolygonCut;
-  Vec3 polygonNormal(const PiecePolygon& polygon) const;
 
-  /// Exact comparison of two points on the cut line along coordinate k (used only when their
-  /// rounded coordinates tie): constructed points are recomputed in rational arithmetic from
-  /// the edge and plane that define them. Returns -1, 0, +1.
-  int compareExactly(std::uint32_t v, std::uint32_t w, int k) const;
-
-  struct PointRecord {
-    Vec3 position;
-    std::uint32_t onPlane = kNoPlane;  ///< id of the plane it lies on by construction
-    std::uint32_t a = 0, b = 0;  ///< the edge it was made on (a's point <= b's); a == b: given
-  };
-  tbb::concurrent_vector<PointRecord> records_;
+  SplitPoints points_;
 
   struct EdgeKey {
     std::uint32_t a, b, plane;
@@ -127,21 +121,12 @@ class PlaneSplitter {
     static bool equal(const EdgeKey& x, const EdgeKey& y) { return x == y; }
   };
   tbb::concurrent_hash_map<EdgeKey, std::uint32_t, EdgeKeyHashCompare> edgePoints_;
-  struct PositionHashCompare {
-    static std::size_t hash(const std::array<double, 3>& p) {
-      std::size_t h = 0;
-      for (double x : p) h = h * 0x9E3779B97F4A7C15ull + std::hash<double>{}(x);
-      return h;
-    }
-    static bool equal(const std::array<double, 3>& x, const std::array<double, 3>& y) {
-      return x == y;
-    }
-  };
-  /// Constructed points by exact position: a new intersection point that rounds onto an
-  /// existing one on the same plane is that point (otherwise distinct points at one position
-  /// would make zero-length edges and, at the next plane, coincident crossings).
-  tbb::concurrent_hash_map<std::array<double, 3>, std::uint32_t, PositionHashCompare> byPosition_;
-  tbb::concurrent_hash_map<std::uint32_t, SplitPlane> planes_;  ///< every plane used, by id
 };
+
+/// A polygon's loops as a PolygonLoops view (for the predicates of SplitPoints).
+inline PolygonLoops loopsOf(const PiecePolygon& polygon) {
+  return {{polygon.vertices.data(), polygon.vertices.size()},
+          {polygon.loopEnd.data(), polygon.loopEnd.size()}};
+}
 
 }  // namespace polydg

@@ -11,7 +11,10 @@
 #include <stdexcept>
 #include <tuple>
 
+#include "mesh/flat_faces.h"
 #include "mesh/plane_split.h"
+#include "mesh/welded_polygons.h"
+#include "polydg/mesh/merge_elements.h"
 #include "util/stopwatch.h"
 
 #include <tbb/concurrent_vector.h>
@@ -90,9 +93,10 @@ class Slicer {
     const LeafOffsets at = leafOffsets();
     const LeafPolygons polygons = weldPolygons(at, vertices);
     // Caps meet their other side: the later of two reversed, equal polygons uses the earlier's
-    // face (reversed), as findOrCreateFace would in leaf order.
-    const std::vector<std::uint32_t> sharesEarlier =
-        matchCaps(polygons.welded, polygons.origin, polygons.kept, polygons.keys);
+    // face (reversed), as findOrCreateFace would in leaf order; so do two polygons on the
+    // surface that rounding made reversed and equal.
+    const std::vector<std::uint32_t> sharesEarlier = matchSides(
+        polygons.welded, polygons.origin, polygons.kept, polygons.touched, polygons.keys);
     const MeshIds ids = numberMesh(at, polygons, sharesEarlier);
     FaceData<Face> meshFaces(ids.faceBase[leaves_.size()]);
     ElementData<Element> meshElements(ids.elements);
@@ -116,204 +120,58 @@ class Slicer {
     std::size_t part;  ///< index of the piece among its cell's connected pieces
   };
 
-  /// For used point i (in order of first use), the earliest kept point within `resolution`
-  /// (in every coordinate) before it, or i itself if there is none: i is then kept. Points are
-  /// bucketed in cells 64 times the resolution, offset by half a cell so that grid planes (at
-  /// dyadic multiples of the resolution) run through cell centres, and sorted by cell. A point's
-  /// search box meets
-  /// its own cell, whose earlier points sit just before it in that order, and only rarely (when
-  /// it lies within the resolution of a cell side) a neighbouring cell, found by binary search.
-  /// The search runs in parallel, the rare welds are resolved in order.
-  static std::vector<std::uint32_t> weldTargets(const std::vector<Vec3>& points,
-                                                const std::vector<std::uint32_t>& used,
-                                                double resolution) {
-    using Cell = std::array<std::int64_t, 3>;
-    const double cellSize = 64.0 * resolution;
-    auto cellIndex = [&](double x) {
-      return cellSize > 0 ? static_cast<std::int64_t>(std::floor(x / cellSize + 0.5)) : 0;
-    };
-    std::vector<std::pair<Cell, std::uint32_t>> sorted(used.size());
-    tbb::parallel_for(std::size_t(0), used.size(), [&](std::size_t i) {
-      const Vec3& p = points[used[i]];
-      sorted[i] = {{cellIndex(p.x()), cellIndex(p.y()), cellIndex(p.z())},
-                   static_cast<std::uint32_t>(i)};
-    });
-    tbb::parallel_sort(sorted.begin(), sorted.end());
-    std::vector<std::uint32_t> position(used.size());
-    tbb::parallel_for(std::size_t(0), used.size(), [&](std::size_t s) {
-      position[sorted[s].second] = static_cast<std::uint32_t>(s);
-    });
-    tbb::concurrent_vector<std::pair<std::uint32_t, std::uint32_t>> near;  // (later, earlier)
-    auto nearPoint = [&](std::size_t i, std::uint32_t j) {
-      if ((points[used[j]] - points[used[i]]).cwiseAbs().maxCoeff() <= resolution)
-        near.push_back({static_cast<std::uint32_t>(i), j});
-    };
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, used.size(), 4096),
-                      [&](const tbb::blocked_range<std::size_t>& r) {
-                        for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                          const Vec3& p = points[used[i]];
-                          const std::size_t at = position[i];
-                          const Cell& own = sorted[at].first;
-                          // Earlier points of the own cell: just before i in the sorted order.
-                          for (std::size_t s = at; s > 0 && sorted[s - 1].first == own; --s)
-                            nearPoint(i, sorted[s - 1].second);
-                          Cell lo, hi;
-                          for (int a = 0; a < 3; ++a) {
-                            lo[a] = cellIndex(p[a] - resolution);
-                            hi[a] = cellIndex(p[a] + resolution);
-                          }
-                          if (lo == own && hi == own) continue;
-                          for (std::int64_t x = lo[0]; x <= hi[0]; ++x)
-                            for (std::int64_t y = lo[1]; y <= hi[1]; ++y)
-                              for (std::int64_t z = lo[2]; z <= hi[2]; ++z) {
-                                const Cell c{x, y, z};
-                                if (c == own) continue;
-                                auto it = std::lower_bound(sorted.begin(), sorted.end(),
-                                                           std::make_pair(c, 0u));
-                                for (; it != sorted.end() && it->first == c && it->second < i; ++it)
-                                  nearPoint(i, it->second);
-                              }
-                        }
-                      });
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs(near.begin(), near.end());
-    std::sort(pairs.begin(), pairs.end());
-    std::vector<std::uint32_t> target(used.size());
-    std::iota(target.begin(), target.end(), 0u);
-    for (const auto& [later, earlier] : pairs)
-      if (target[later] == later && target[earlier] == earlier) target[later] = earlier;
-    return target;
-  }
-
-  /// Polygons on welded vertices, in flat arrays: polygon p's corners (all loops, concatenated)
-  /// start at cornerStart_[p], its loop ends (relative to its first corner) at loopStart_[p].
-  /// The room for each polygon is that of the polygon before welding (welding only drops
-  /// corners and loops), given by the caller.
-  class WeldedPolygons {
-   public:
-    WeldedPolygons(std::size_t polygons, std::size_t corners, std::size_t loops)
-        : cornerStart_(polygons),
-          cornerCount_(polygons, 0),
-          loopStart_(polygons),
-          loopCount_(polygons, 0),
-          corners_(corners),
-          loopEnds_(loops) {}
-
-    /// `polygon` on welded vertices as polygon p, with room from `corner` and `loop` on:
-    /// consecutive repeats dropped, loops of fewer than 3 corners removed. False if the outer
-    /// loop collapsed (the polygon is gone).
-    template <class VertexOf>
-    bool weld(std::size_t p, std::size_t corner, std::size_t loop, const PiecePolygon& polygon,
-              const VertexOf& vertexOf) {
-      cornerStart_[p] = corner;
-      loopStart_[p] = loop;
-      VertexId* out = corners_.data() + corner;
-      std::uint32_t n = 0, loops = 0;
-      for (std::size_t k = 0; k < polygon.numLoops(); ++k) {
-        const std::uint32_t begin = n;
-        for (std::size_t i = polygon.loopBegin(k); i < polygon.loopEnd[k]; ++i) {
-          const VertexId v = vertexOf(polygon.vertices[i]);
-          if (n == begin || out[n - 1] != v) out[n++] = v;
-        }
-        while (n > begin + 1 && out[begin] == out[n - 1]) --n;
-        if (n >= begin + 3) {
-          loopEnds_[loop + loops++] = n;
-        } else {
-          n = begin;
-          if (k == 0) break;  // the outer boundary collapsed: the polygon is gone
-        }
-      }
-      cornerCount_[p] = n;
-      loopCount_[p] = loops;
-      return loops > 0;
-    }
-
-    std::span<const VertexId> corners(std::size_t p) const {
-      return {corners_.data() + cornerStart_[p], cornerCount_[p]};
-    }
-    std::span<const std::uint32_t> loopEnds(std::size_t p) const {
-      return {loopEnds_.data() + loopStart_[p], loopCount_[p]};
-    }
-    /// Polygon p's loops into `face` (vertices and loop ends).
-    void copyTo(std::size_t p, Face& face) const {
-      const auto c = corners(p);
-      const auto e = loopEnds(p);
-      face.vertices.assign(c.begin(), c.end());
-      face.loopEnd.assign(e.begin(), e.end());
-    }
-
-   private:
-    std::vector<std::size_t> cornerStart_;
-    std::vector<std::uint32_t> cornerCount_;
-    std::vector<std::size_t> loopStart_;
-    std::vector<std::uint32_t> loopCount_;
-    std::vector<VertexId> corners_;
-    std::vector<std::uint32_t> loopEnds_;
-  };
-
-  /// True if polygon b is polygon a reversed (isReverseOf), checked without allocating for
-  /// the common case of one loop: the same cycle, traversed the other way, from any start.
-  static bool isReversedPolygon(const WeldedPolygons& welded, std::size_t a, std::size_t b) {
-    const auto x = welded.corners(a), y = welded.corners(b);
-    if (welded.loopEnds(a).size() != 1 || welded.loopEnds(b).size() != 1) {
-      Face face;
-      welded.copyTo(a, face);
-      return isReverseOf(face, y, welded.loopEnds(b));
-    }
-    const std::size_t n = x.size();
-    if (y.size() != n) return false;
-    for (std::size_t j = 0; j < n; ++j) {  // every start (a pinched loop repeats a vertex)
-      if (y[j] != x[0]) continue;
-      std::size_t i = 1;
-      while (i < n && x[i] == y[(j + n - i) % n]) ++i;
-      if (i == n) return true;
-    }
-    return false;
-  }
-
-  /// For each polygon (numbered across leaves): kNone, or the number of the earlier cap whose
-  /// face it shares. Kept caps are grouped by vertex-set key (sorted in parallel); within a
-  /// group, in leaf order, a cap takes the first earlier open cap that is its reverse, and that
-  /// cap is then closed.
-  static std::vector<std::uint32_t> matchCaps(const WeldedPolygons& welded,
-                                              const std::vector<FaceOrigin>& origin,
-                                              const std::vector<char>& kept,
-                                              const std::vector<std::uint64_t>& keys) {
+  /// For each polygon (numbered across leaves): kNone, or the number of the earlier polygon
+  /// whose face it shares. Caps are shared with the neighbouring cell's leaf. So are the
+  /// polygons on the surface that rounding made the reverse of one in another leaf (`touched`:
+  /// they have a vertex that several points were welded into): two elements whose parts on
+  /// either side of a gap thinner than the coordinates resolve now touch there. Candidates are
+  /// grouped by vertex-set key (sorted in parallel); within a group, in leaf order, each takes
+  /// the first earlier open one of its kind (cap or surface) that is its reverse, which is then
+  /// closed.
+  static std::vector<std::uint32_t> matchSides(const WeldedPolygons& welded,
+                                               const std::vector<FaceOrigin>& origin,
+                                               const std::vector<char>& kept,
+                                               const std::vector<char>& touched,
+                                               const std::vector<std::uint64_t>& keys) {
     const std::size_t np = kept.size();
-    auto isCap = [&](std::size_t p) { return kept[p] && origin[p] == FaceOrigin::Interior; };
-    // Caps in polygon order (that is, leaf order), gathered in parallel blocks.
+    auto isCap = [&](std::size_t p) { return origin[p] == FaceOrigin::Interior; };
+    auto candidate = [&](std::size_t p) { return kept[p] && (isCap(p) || touched[p]); };
+    // Candidates in polygon order (that is, leaf order), gathered in parallel blocks.
     constexpr std::size_t kBlock = 16384;
     const std::size_t blocks = (np + kBlock - 1) / kBlock;
     std::vector<std::size_t> blockBase(blocks + 1, 0);
     tbb::parallel_for(std::size_t(0), blocks, [&](std::size_t b) {
       std::size_t count = 0;
-      for (std::size_t p = b * kBlock; p < std::min(np, (b + 1) * kBlock); ++p) count += isCap(p);
+      for (std::size_t p = b * kBlock; p < std::min(np, (b + 1) * kBlock); ++p)
+        count += candidate(p);
       blockBase[b + 1] = count;
     });
     for (std::size_t b = 0; b < blocks; ++b) blockBase[b + 1] += blockBase[b];
-    std::vector<std::pair<std::uint64_t, std::uint32_t>> caps(blockBase[blocks]);  // (key, p)
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> sides(blockBase[blocks]);  // (key, p)
     tbb::parallel_for(std::size_t(0), blocks, [&](std::size_t b) {
       std::size_t next = blockBase[b];
       for (std::size_t p = b * kBlock; p < std::min(np, (b + 1) * kBlock); ++p)
-        if (isCap(p)) caps[next++] = {keys[p], static_cast<std::uint32_t>(p)};
+        if (candidate(p)) sides[next++] = {keys[p], static_cast<std::uint32_t>(p)};
     });
-    tbb::parallel_sort(caps.begin(), caps.end());
+    tbb::parallel_sort(sides.begin(), sides.end());
     std::vector<std::uint32_t> groupStart;
-    for (std::size_t c = 0; c < caps.size(); ++c)
-      if (c == 0 || caps[c].first != caps[c - 1].first)
+    for (std::size_t c = 0; c < sides.size(); ++c)
+      if (c == 0 || sides[c].first != sides[c - 1].first)
         groupStart.push_back(static_cast<std::uint32_t>(c));
-    groupStart.push_back(static_cast<std::uint32_t>(caps.size()));
+    groupStart.push_back(static_cast<std::uint32_t>(sides.size()));
     std::vector<std::uint32_t> shares(np, kNone);
     tbb::parallel_for(std::size_t(0), groupStart.size() - 1, [&](std::size_t g) {
       boost::container::small_vector<std::uint32_t, 4> open;
       for (std::size_t c = groupStart[g]; c < groupStart[g + 1]; ++c) {
+        const std::uint32_t p = sides[c].second;
         auto match = std::find_if(open.begin(), open.end(), [&](std::uint32_t o) {
-          return isReversedPolygon(welded, o, caps[c].second);
+          return isCap(o) == isCap(p) && welded.isReversed(o, p);
         });
         if (match != open.end()) {
-          shares[caps[c].second] = *match;
+          shares[p] = *match;
           open.erase(match);
         } else {
-          open.push_back(caps[c].second);
+          open.push_back(p);
         }
       }
     });
@@ -328,18 +186,23 @@ class Slicer {
     std::vector<std::uint32_t> rank;          ///< point -> its order of first use, or kNone
     std::vector<std::uint32_t> vertexOfRank;  ///< order of first use -> vertex id
     VertexData<Vec3> positions;
+    std::vector<char> shared;  ///< per vertex: two or more points were welded into it
     VertexId operator()(std::uint32_t v) const { return VertexId(vertexOfRank[rank[v]]); }
   };
 
   /// Welds the points the leaves use; vertex ids follow their order of first use.
   WeldedVertices weldPoints(const std::vector<Vec3>& points) {
-    // Points closer than the resolution of the coordinates are one point: 8 units in the last
-    // place of the largest coordinate, in every coordinate. Such points are intersections that
-    // are the same point mathematically but were built along different paths (or a surface
-    // vertex within round-off of a grid line); kept apart they would leave edges of round-off
-    // length, which VTK's polygon triangulation rejects. Welding moves geometry by at most that
-    // resolution and collapses the round-off faces on both sides of a shared face alike. Only
-    // points that elements use are kept, in order of first use (deterministic).
+    // Points closer than the resolution of the coordinates are one vertex: 8 units in the last
+    // place of the largest coordinate, in every coordinate. The slicing is exact, and such
+    // points are distinct exact points where a part of the solid is thinner than the coordinates
+    // resolve (a surface vertex within round-off of a grid plane, a grid line within round-off
+    // of a surface edge); kept apart they would leave edges of round-off length, which VTK's
+    // polygon triangulation rejects. Welding moves geometry by at most that resolution. What it
+    // collapses goes alike on both sides of a shared polygon (WeldedPolygons::weld,
+    // cancelReversedPairs, matchSides); after the build, faces it leaves flat are dissolved
+    // into their edges (dissolveFlatFaces) and elements it leaves flat are merged into a
+    // neighbour (mergeDegenerateElements). Only points that elements use are kept, in order of
+    // first use (deterministic).
     double largest = 0.0;
     for (const Vec3& p : points) largest = std::max(largest, p.cwiseAbs().maxCoeff());
     const double resolution = 8.0 * std::numeric_limits<double>::epsilon() * largest;
@@ -367,6 +230,9 @@ class Slicer {
         ++stats.weldedPoints;
       }
     }
+    out.shared.assign(out.positions.size(), 0);
+    for (std::size_t i = 0; i < used.size(); ++i)
+      if (target[i] != i) out.shared[out.vertexOfRank[i]] = 1;
     return out;
   }
 
@@ -401,12 +267,12 @@ class Slicer {
   }
 
   /// The leaves' polygons on the welded vertices, numbered across leaves (LeafOffsets), with
-  /// the vertex-set key of the caps (interior faces), which are shared with the neighbouring
-  /// cell's leaf.
+  /// the vertex-set key of those that may share a face with another leaf's (matchSides).
   struct LeafPolygons {
     WeldedPolygons welded;
     std::vector<char> kept;           ///< the polygon did not collapse
-    std::vector<std::uint64_t> keys;  ///< a kept cap's vertex-set key, else 0
+    std::vector<char> touched;        ///< it has a vertex that several points were welded into
+    std::vector<std::uint64_t> keys;  ///< a kept cap's or touched polygon's vertex-set key
     std::vector<FaceOrigin> origin;
   };
 
@@ -416,30 +282,61 @@ class Slicer {
     const std::size_t nl = leaves_.size();
     const std::size_t np = at.polygon[nl];
     LeafPolygons out{WeldedPolygons(np, at.corner[nl], at.loop[nl]), std::vector<char>(np, 0),
-                     std::vector<std::uint64_t>(np, 0), std::vector<FaceOrigin>(np)};
+                     std::vector<char>(np, 0), std::vector<std::uint64_t>(np, 0),
+                     std::vector<FaceOrigin>(np)};
     std::atomic<std::size_t> collapsed{0};
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nl, 64),
-                      [&](const tbb::blocked_range<std::size_t>& r) {
-                        for (std::size_t l = r.begin(); l != r.end(); ++l) {
-                          const Piece& piece = leaves_[l].piece;
-                          std::size_t corner = at.corner[l], loop = at.loop[l];
-                          for (std::size_t i = 0; i < piece.size(); ++i) {
-                            const std::size_t p = at.polygon[l] + i;
-                            out.origin[p] = piece[i].origin;
-                            if (!out.welded.weld(p, corner, loop, piece[i], vertexOf)) {
-                              ++collapsed;
-                            } else {
-                              out.kept[p] = 1;
-                              if (out.origin[p] == FaceOrigin::Interior)
-                                out.keys[p] = vertexSetKey(out.welded.corners(p));
-                            }
-                            corner += piece[i].vertices.size();
-                            loop += piece[i].numLoops();
-                          }
-                        }
-                      });
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, nl, 64), [&](const tbb::blocked_range<std::size_t>& r) {
+          for (std::size_t l = r.begin(); l != r.end(); ++l) {
+            const Piece& piece = leaves_[l].piece;
+            std::size_t corner = at.corner[l], loop = at.loop[l];
+            for (std::size_t i = 0; i < piece.size(); ++i) {
+              const std::size_t p = at.polygon[l] + i;
+              out.origin[p] = piece[i].origin;
+              if (!out.welded.weld(p, corner, loop, piece[i], vertexOf)) {
+                ++collapsed;
+              } else {
+                out.kept[p] = 1;
+                const auto corners = out.welded.corners(p);
+                out.touched[p] = std::any_of(corners.begin(), corners.end(), [&](VertexId v) {
+                  return vertexOf.shared[v.index()];
+                });
+                if (out.origin[p] == FaceOrigin::Interior || out.touched[p])
+                  out.keys[p] = vertexSetKey(corners);
+              }
+              corner += piece[i].vertices.size();
+              loop += piece[i].numLoops();
+            }
+          }
+        });
     stats.collapsedPolygons = collapsed;
+    cancelReversedPairs(at, out);
     return out;
+  }
+
+  /// Within each leaf, two kept polygons that are each other's reverse on the welded vertices
+  /// (the two sides of a part of the solid thinner than the coordinates resolve, rounded onto
+  /// one polygon) bound nothing between them: both are dropped, so the leaf stays closed. Only
+  /// polygons with a vertex that several points were welded into can be such a pair (the exact
+  /// polygons of a leaf are distinct). A dropped cap leaves its other side (in the neighbouring
+  /// leaf) unmatched: it becomes a face on the surface (makeFacesAndElements). A leaf left
+  /// without polygons has no element.
+  void cancelReversedPairs(const LeafOffsets& at, LeafPolygons& out) {
+    std::atomic<std::size_t> cancelled{0};
+    tbb::parallel_for(std::size_t(0), leaves_.size(), [&](std::size_t l) {
+      boost::container::small_vector<std::pair<std::uint64_t, std::uint32_t>, 16> keyed;
+      for (std::uint32_t p = at.polygon[l]; p < at.polygon[l + 1]; ++p)
+        if (out.kept[p] && out.touched[p]) keyed.emplace_back(out.keys[p], p);
+      std::sort(keyed.begin(), keyed.end());
+      for (std::size_t i = 0; i < keyed.size(); ++i)
+        for (std::size_t j = i + 1; j < keyed.size() && keyed[j].first == keyed[i].first; ++j) {
+          const std::uint32_t a = keyed[i].second, b = keyed[j].second;
+          if (!out.kept[a] || !out.kept[b] || !out.welded.isReversed(a, b)) continue;
+          out.kept[a] = out.kept[b] = 0;
+          cancelled += 2;
+        }
+    });
+    stats.collapsedPolygons += cancelled;
   }
 
   /// The mesh's ids, in leaf order: an element for each leaf that kept a polygon, a face for
@@ -473,26 +370,29 @@ class Slicer {
 
   /// Fills `meshFaces` and `meshElements` (sized by `ids`) in parallel: the new faces first
   /// (their ids are known per leaf), then the later sides, which take the earlier side's face
-  /// as its back.
+  /// as its back (an interior face, whatever the earlier side was).
   void makeFacesAndElements(const LeafOffsets& at, const LeafPolygons& polygons,
                             const std::vector<std::uint32_t>& sharesEarlier, const MeshIds& ids,
                             FaceData<Face>& meshFaces, ElementData<Element>& meshElements) const {
     const std::size_t nl = leaves_.size();
     std::vector<std::uint32_t> faceId(at.polygon[nl], kNone);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nl, 64),
-                      [&](const tbb::blocked_range<std::size_t>& r) {
-                        for (std::size_t l = r.begin(); l != r.end(); ++l) {
-                          std::uint32_t next = ids.faceBase[l];
-                          for (std::size_t p = at.polygon[l]; p < at.polygon[l + 1]; ++p) {
-                            if (!polygons.kept[p] || sharesEarlier[p] != kNone) continue;
-                            faceId[p] = next;
-                            Face& f = meshFaces[FaceId(std::size_t(next++))];
-                            polygons.welded.copyTo(p, f);
-                            f.origin = polygons.origin[p];
-                            f.front = ElementId(std::size_t(ids.elementOf[l]));
-                          }
-                        }
-                      });
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, nl, 64), [&](const tbb::blocked_range<std::size_t>& r) {
+          for (std::size_t l = r.begin(); l != r.end(); ++l) {
+            std::uint32_t next = ids.faceBase[l];
+            for (std::size_t p = at.polygon[l]; p < at.polygon[l + 1]; ++p) {
+              if (!polygons.kept[p] || sharesEarlier[p] != kNone) continue;
+              faceId[p] = next;
+              Face& f = meshFaces[FaceId(std::size_t(next++))];
+              polygons.welded.copyTo(p, f);
+              // A cap is interior once its other side uses it (below); one whose
+              // other side was cancelled lies on the surface.
+              f.origin = polygons.origin[p] == FaceOrigin::Interior ? FaceOrigin::Surface
+                                                                    : polygons.origin[p];
+              f.front = ElementId(std::size_t(ids.elementOf[l]));
+            }
+          }
+        });
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nl, 64),
                       [&](const tbb::blocked_range<std::size_t>& r) {
                         for (std::size_t l = r.begin(); l != r.end(); ++l) {
@@ -635,6 +535,17 @@ PolyMesh sliceSurface(const TriangleSurface& surface, const Grid& grid, SliceSta
   phase.restart();
   if (elementCell) elementCell->clear();
   PolyMesh mesh = slicer.build(elementCell);
+  slicer.stats.flatFaces = dissolveFlatFaces(mesh);
+  DegenerateMergeReport merge;
+  mesh = mergeDegenerateElements(std::move(mesh), &merge);
+  slicer.stats.mergedElements = merge.merged;
+  slicer.stats.droppedElements = merge.dropped;
+  if (elementCell && (merge.merged > 0 || merge.dropped > 0)) {
+    std::vector<std::array<int, 3>> cells(mesh.numElements());
+    for (std::size_t e = merge.group.size(); e-- > 0;)  // each group's first element's cell
+      if (merge.group[e] != kDroppedElement) cells[merge.group[e]] = (*elementCell)[e];
+    *elementCell = std::move(cells);
+  }
   slicer.stats.secondsBuilding = phase.seconds();
   if (stats) *stats = slicer.stats;
   return mesh;

@@ -198,6 +198,41 @@ TriangleSurface boxSurface(const Box3& box) {
   return s;
 }
 
+TriangleSurface twistedTaperedPrism(const Vec3& offset, double width, double depth, double height,
+                                    int slices, double turns) {
+  if (!(width > 0) || !(depth > 0) || !(height > 0) || slices < 1)
+    throw std::invalid_argument(
+        "twistedTaperedPrism: width, depth and height must be positive, slices at least 1");
+  TriangleSurface s;
+  const std::array<std::array<double, 2>, 4> corners = {{{-width / 2, -depth / 2},
+                                                         {width / 2, -depth / 2},
+                                                         {width / 2, depth / 2},
+                                                         {-width / 2, depth / 2}}};
+  for (int k = 0; k < slices; ++k) {
+    const double scale = 1.0 - double(k) / slices;
+    const double angle = 2.0 * std::numbers::pi * turns * k / slices;
+    const double c = std::cos(angle), sn = std::sin(angle);
+    for (const auto& [x, y] : corners)
+      s.vertices.emplace_back(scale * (c * x - sn * y) + offset.x(),
+                              scale * (sn * x + c * y) + offset.y(),
+                              height * k / slices + offset.z());
+  }
+  const auto apex = static_cast<std::uint32_t>(s.vertices.size());
+  s.vertices.emplace_back(offset.x(), offset.y(), height + offset.z());
+  s.triangles.push_back({0, 2, 1});  // the bottom, facing -z
+  s.triangles.push_back({0, 3, 2});
+  for (std::uint32_t k = 0; k + 1 < std::uint32_t(slices); ++k)
+    for (std::uint32_t i = 0; i < 4; ++i) {
+      const std::uint32_t a = 4 * k + i, b = 4 * k + (i + 1) % 4;
+      const std::uint32_t c = 4 * (k + 1) + (i + 1) % 4, d = 4 * (k + 1) + i;
+      s.triangles.push_back({a, b, c});
+      s.triangles.push_back({a, c, d});
+    }
+  const std::uint32_t last = 4 * std::uint32_t(slices - 1);
+  for (std::uint32_t i = 0; i < 4; ++i) s.triangles.push_back({last + i, last + (i + 1) % 4, apex});
+  return s;
+}
+
 namespace {
 /// Hole rows of swissCheeseBlock() along an axis with n cells.
 bool isHoleRow(int i, int n) { return i % 3 == 1 && i + 1 < n; }

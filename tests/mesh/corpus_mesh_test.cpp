@@ -18,6 +18,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <iostream>
 #include <map>
 #include <optional>
@@ -36,8 +37,10 @@
 #include "polydg/mesh/geometry.h"
 #include "polydg/mesh/meshing.h"
 #include "polydg/mesh/surface_io.h"
+#include "polydg/mesh/surface_shapes.h"
 #include "tests/support/assimp_models.h"
 #include "tests/support/packages.h"
+#include "tests/support/temp_dir.h"
 
 namespace polydg {
 namespace {
@@ -126,9 +129,9 @@ struct Classes {
   double worstVolumeError = 0.0;
 };
 
-/// Meshes the model at `path` directly and, if refused, with --repair wrap, checking what the
-/// independent facts demand of each.
-Result meshModel(const std::string& path, Classes& classes) {
+/// Meshes the model at `path` directly (at `cells` along the longest side) and, if refused, with
+/// --repair wrap, checking what the independent facts demand of each.
+Result meshModel(const std::string& path, Classes& classes, int cells = kCells) {
   TriangleSurface surface;
   try {
     surface = readSurface(path);
@@ -151,7 +154,7 @@ Result meshModel(const std::string& path, Classes& classes) {
     ++classes.clean;
 
   MeshingOptions options;
-  options.cellsAlongLongest = kCells;
+  options.cellsAlongLongest = cells;
   try {
     const MeshingResult r = meshSurface(surface, options);
     EXPECT_TRUE(r.report.geometry.passed) << path;
@@ -241,6 +244,49 @@ TEST(CorpusMeshing, EveryModelMeshesOrIsRefusedAsItsSurfaceDemands) {
   EXPECT_GT(classes.selfIntersecting, 0u);
   EXPECT_GT(classes.open, 0u);
   EXPECT_GT(classes.nonManifold, 0u);
+}
+
+/// `surface` as OBJ text, coordinates to 17 digits (read back exactly).
+std::string objText(const TriangleSurface& surface) {
+  std::string text;
+  char line[96];
+  for (const Vec3& p : surface.vertices) {
+    std::snprintf(line, sizeof line, "v %.17g %.17g %.17g\n", p.x(), p.y(), p.z());
+    text += line;
+  }
+  for (const auto& t : surface.triangles) {
+    std::snprintf(line, sizeof line, "f %u %u %u\n", t[0] + 1, t[1] + 1, t[2] + 1);
+    text += line;
+  }
+  return text;
+}
+
+TEST(CorpusMeshing, TwistedCadPartsMeshDirectly) {
+  // CAD-like parts beside the corpus, made here and read back from OBJ files like it: a 20 x 10
+  // rectangle extruded 40 high in 200 slices, turning once and tapering to an apex
+  // (twistedTaperedPrism: corners within round-off of grid planes, sliver triangles at the
+  // apex), alone and beside three boxes. CGAL finds them closed, manifold and free of
+  // self-intersections, so each must mesh directly, valid, with CGAL's volume, at every cell
+  // count here. (Far from the origin, CGAL's volume, a sum of tetrahedra on the origin, is no
+  // reference to round-off: Slice.TwistedPartsTaperedToAPoint slices the parts there.)
+  const testing::TempDir dir("corpus_parts");
+  const TriangleSurface twist = twistedTaperedPrism(Vec3::Zero(), 20, 10, 40, 200, 1.0);
+  TriangleSurface parts = combine(twist, boxSurface(Box3(Vec3(20, -5, 0), Vec3(30, 5, 10))));
+  parts = combine(parts, boxSurface(Box3(Vec3(-30, -5, 0), Vec3(-20, 5, 20))));
+  parts = combine(parts, boxSurface(Box3(Vec3(-5, 20, 0), Vec3(5, 30, 5))));
+  const std::vector<std::string> files = {dir.write("twist.obj", objText(twist)),
+                                          dir.write("twist_parts.obj", objText(parts))};
+  const std::vector<int> cellCounts = {8, 16, 24, 32, 48, 64};
+  Classes classes;
+  for (const std::string& file : files)
+    for (const int cells : cellCounts) {
+      const Result r = meshModel(file, classes, cells);
+      EXPECT_EQ(r.outcome, Outcome::Direct) << file << " at " << cells << " cells: " << r.detail;
+      std::cout << "  " << fs::path(file).filename().string() << " at " << cells
+                << " cells: " << r.elements << " elements\n";
+    }
+  EXPECT_EQ(classes.clean, cellCounts.size() * files.size());
+  std::cout << "worst relative volume error: " << classes.worstVolumeError << "\n";
 }
 
 }  // namespace

@@ -75,5 +75,44 @@ TEST(MergeElements, SliverMergingKeepsASlicedSphereValid) {
   }
 }
 
+TEST(MergeElements, DegenerateElementsJoinTheirNeighbourOrGo) {
+  // The unit cube with a flat element on its top face (the top used from behind, and the same
+  // square again facing up: no volume), and a flat element alone (a square and its reverse).
+  // The first joins the cube, which is whole again; the second, with no neighbour, goes.
+  PolyMesh mesh = boxMesh(Box3(Vec3::Zero(), Vec3::Ones()));
+  FaceId top;
+  for (const FaceUse& use : mesh.element(ElementId(0)).faces) {
+    const Face& face = mesh.face(use.face);
+    bool up = true;
+    for (VertexId v : face.vertices) up = up && mesh.position(v).z() == 1.0;
+    if (up) top = use.face;
+  }
+  ASSERT_TRUE(top.valid());
+  const std::vector<VertexId> square(mesh.face(top).vertices.begin(),
+                                     mesh.face(top).vertices.end());
+  const std::uint32_t end[] = {4};
+  const FaceId lid = mesh.addFace(square, end, FaceOrigin::Surface);
+  mesh.addElementFromFaces(std::vector<FaceUse>{{top, true}, {lid, false}});
+  std::vector<VertexId> far;
+  for (const Vec3& p : {Vec3(5, 0, 0), Vec3(6, 0, 0), Vec3(6, 1, 0), Vec3(5, 1, 0)})
+    far.push_back(mesh.addVertex(p));
+  const FaceId down = mesh.addFace(far, end, FaceOrigin::Surface);
+  std::reverse(far.begin(), far.end());
+  const FaceId up = mesh.addFace(far, end, FaceOrigin::Surface);
+  mesh.addElementFromFaces(std::vector<FaceUse>{{down, false}, {up, false}});
+  EXPECT_FALSE(checkGeometry(mesh).passed);
+
+  DegenerateMergeReport report;
+  const PolyMesh repaired = mergeDegenerateElements(mesh, &report);
+  const GeometryCheck check = checkGeometry(repaired);
+  EXPECT_TRUE(check.passed) << (check.messages.empty() ? "" : check.messages.front());
+  EXPECT_EQ(repaired.numElements(), 1u);
+  EXPECT_EQ(repaired.element(ElementId(0)).faces.size(), 6u);
+  EXPECT_NEAR(check.volume, 1.0, kVolumeTolerance);
+  EXPECT_EQ(report.merged, 1u);
+  EXPECT_EQ(report.dropped, 1u);
+  EXPECT_EQ(report.group, (std::vector<std::uint32_t>{0, 0, kDroppedElement}));
+}
+
 }  // namespace
 }  // namespace polydg

@@ -45,6 +45,12 @@ struct GeometryCheck {
   std::vector<std::string> messages;  ///< the first few problems, one line each
 };
 
+/// The checks' test of one face: degenerate if a loop has fewer than 3 vertices, a vertex appears
+/// twice in the face, or its area vector is zero (as computed, in double precision).
+bool isDegenerateFace(const PolyMesh& mesh, FaceId f);
+/// The same, with the face's area vector (areaVector()) already computed.
+bool isDegenerateFace(const PolyMesh& mesh, FaceId f, const Vec3& area);
+
 /// Runs every check over the whole mesh.
 GeometryCheck checkGeometry(const PolyMesh& mesh, const GeometryCheckOptions& options = {});
 

@@ -15,10 +15,15 @@
 
 namespace polydg {
 
+/// A group for mergeElements(): the element is left out, with its faces (it may share faces only
+/// with elements also left out).
+inline constexpr std::uint32_t kDroppedElement = 0xffffffffu;
+
 /// A new mesh in which the elements of each group form one element: `group[e]` is element e's
-/// group, 0 .. groups-1, and new element g is group g. Faces between members of a group are
-/// removed; all other faces are kept as they are, in their order. Vertices are kept (same ids).
-/// The same mesh as PolyMesh::mergeElementGroups on a copy, built in parallel.
+/// group, 0 .. groups-1, or kDroppedElement, and new element g is group g. Faces between members
+/// of a group, and faces of dropped elements, are removed; all other faces are kept as they are,
+/// in their order. Vertices are kept (same ids). Without dropped elements, the same mesh as
+/// PolyMesh::mergeElementGroups on a copy, built in parallel.
 PolyMesh mergeElements(const PolyMesh& mesh, const std::vector<std::uint32_t>& group,
                        std::size_t groups);
 
@@ -102,5 +107,22 @@ SliverMergeSummary mergeSliverGroups(const std::vector<std::uint32_t>& candidate
 /// grid cell's volume) by mergeSliverGroups: every element that is a sliver, until none with a
 /// neighbour is left. Deterministic.
 PolyMesh mergeSlivers(PolyMesh mesh, double volumeThreshold, SliverMergeReport* report = nullptr);
+
+/// What mergeDegenerateElements() did.
+struct DegenerateMergeReport {
+  std::size_t merged = 0;            ///< merges of two groups of elements
+  std::size_t dropped = 0;           ///< elements left out: flat, and sharing no face with another
+  std::vector<std::uint32_t> group;  ///< new element of each old element, or kDroppedElement
+};
+
+/// Repairs what rounding exact geometry to doubles leaves where a part of the solid is thinner
+/// than the coordinates resolve (a mesh made exactly, as slicing makes it, is otherwise valid):
+/// the two elements of a degenerate interior face (isDegenerateFace) become one, and a group of
+/// elements whose volume (the sum of its elements' signedVolume) is not positive joins the
+/// neighbouring group it shares the most face area with, until it is positive. A group with no
+/// neighbour left is dropped, with its faces (all on the boundary). The groups are numbered in
+/// order of their first element. Deterministic; the mesh is returned as it is when nothing is
+/// degenerate (the usual case).
+PolyMesh mergeDegenerateElements(PolyMesh mesh, DegenerateMergeReport* report = nullptr);
 
 }  // namespace polydg

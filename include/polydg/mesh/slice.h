@@ -35,7 +35,10 @@ struct SliceStats {
   std::size_t leafCells = 0;          ///< cells that hold part of the solid
   std::size_t multiPieceCells = 0;    ///< cells holding two or more disconnected pieces
   std::size_t collapsedPolygons = 0;  ///< polygons removed when rounding made points equal
-  std::size_t weldedPoints = 0;       ///< points within coordinate resolution of another
+  std::size_t weldedPoints = 0;       ///< points at the same rounded position as another
+  std::size_t flatFaces = 0;          ///< faces rounding left flat, dissolved into their edges
+  std::size_t mergedElements = 0;     ///< merges of elements rounding left degenerate
+  std::size_t droppedElements = 0;    ///< elements rounding left flat, alone: left out
   double secondsSplitting = 0.0;      ///< wall time of the recursive plane splits
   double secondsBuilding = 0.0;       ///< wall time of welding and assembling the PolyMesh
 };
@@ -46,6 +49,13 @@ using ProgressFn = std::function<void(double)>;
 /// Slices the solid bounded by `surface` (closed, manifold, outward-oriented; several shells
 /// and cavities are fine) with `grid`. Faces on the surface are tagged `Surface`, faces between
 /// cells are interior. `elementCell` (optional) receives each element's cell index (i, j, k).
+/// The slicing is exact (every decision on exact points). Its points are then rounded to
+/// doubles, and those closer than 8 ulps of the largest coordinate welded; where a part of the
+/// solid is thinner than that, what welding collapses goes alike on both sides of every shared
+/// face, a face left flat is dissolved into the edges it lies on, and an element left flat (or
+/// with a degenerate face between it and a neighbour) is merged into a neighbour
+/// (mergeDegenerateElements; its cell is then that of its first part), so the mesh passes
+/// checkGeometry().
 PolyMesh sliceSurface(const TriangleSurface& surface, const Grid& grid, SliceStats* stats = nullptr,
                       std::vector<std::array<int, 3>>* elementCell = nullptr,
                       const ProgressFn& progress = {});

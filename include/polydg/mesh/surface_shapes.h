@@ -1,6 +1,7 @@
 // Closed triangle surfaces made in code, whose enclosed volume is known exactly from their
-// vertices: spheres, a bowl, tori, torus knots, boxes, blocks with through-holes, and their
-// combinations (several shells, cavities). Used by tests, benchmarks and examples.
+// vertices: spheres, a bowl, tori, torus knots, boxes, a twisted tapered prism, blocks with
+// through-holes, and their combinations (several shells, cavities). Used by tests, benchmarks
+// and examples.
 #pragma once
 
 #include <array>
@@ -39,6 +40,19 @@ TriangleSurface torusKnot(int p, int q, double R, double a, double r, int nu, in
 
 /// The surface of an axis-aligned box, two triangles per side.
 TriangleSurface boxSurface(const Box3& box);
+
+/// A CAD-like part: the rectangle `width` x `depth` (centred on the z axis, sides along x and
+/// y) extruded `height` along +z in `slices` slices, turning `turns` full turns about the z axis
+/// and tapering linearly to a point, the apex, at the top. Slice k (0 .. slices - 1) is the
+/// rectangle scaled by 1 - k / slices and turned by 2 pi turns k / slices, at z = height k /
+/// slices; the last joins the apex with four triangles. `offset` moves the whole part. 8 slices
+/// - 2 triangles, outward-oriented, closed and manifold, without self-intersections for a
+/// small turn per slice (1 turn in 200 slices). Its corners come from std::cos and std::sin, so
+/// many lie within round-off of a plane they are meant to be on (x = 3.75 at a quarter turn),
+/// as a CAD export's do; near the apex its triangles are slivers. Throws std::invalid_argument
+/// for a size not positive or fewer than one slice.
+TriangleSurface twistedTaperedPrism(const Vec3& offset, double width, double depth, double height,
+                                    int slices, double turns);
 
 /// Cell walls along x, y and z of swissCheeseBlock(): each list increasing, first and last
 /// the block's sides, so walls[a].size() - 1 cells along axis a.

@@ -1,0 +1,120 @@
+#include "mesh/welded_polygons.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <tbb/concurrent_vector.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
+#include <boost/container/small_vector.hpp>
+
+namespace polydg {
+
+std::vector<std::uint32_t> weldTargets(const std::vector<Vec3>& points,
+                                       const std::vector<std::uint32_t>& used, double resolution) {
+  using Cell = std::array<std::int64_t, 3>;
+  const double cellSize = 64.0 * resolution;
+  auto cellIndex = [&](double x) {
+    return cellSize > 0 ? static_cast<std::int64_t>(std::floor(x / cellSize + 0.5)) : 0;
+  };
+  std::vector<std::pair<Cell, std::uint32_t>> sorted(used.size());
+  tbb::parallel_for(std::size_t(0), used.size(), [&](std::size_t i) {
+    const Vec3& p = points[used[i]];
+    sorted[i] = {{cellIndex(p.x()), cellIndex(p.y()), cellIndex(p.z())},
+                 static_cast<std::uint32_t>(i)};
+  });
+  tbb::parallel_sort(sorted.begin(), sorted.end());
+  std::vector<std::uint32_t> position(used.size());
+  tbb::parallel_for(std::size_t(0), used.size(), [&](std::size_t s) {
+    position[sorted[s].second] = static_cast<std::uint32_t>(s);
+  });
+  tbb::concurrent_vector<std::pair<std::uint32_t, std::uint32_t>> near;  // (later, earlier)
+  auto nearPoint = [&](std::size_t i, std::uint32_t j) {
+    if ((points[used[j]] - points[used[i]]).cwiseAbs().maxCoeff() <= resolution)
+      near.push_back({static_cast<std::uint32_t>(i), j});
+  };
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, used.size(), 4096),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                        const Vec3& p = points[used[i]];
+                        const std::size_t at = position[i];
+                        const Cell& own = sorted[at].first;
+                        // Earlier points of the own cell: just before i in the sorted order.
+                        for (std::size_t s = at; s > 0 && sorted[s - 1].first == own; --s)
+                          nearPoint(i, sorted[s - 1].second);
+                        Cell lo, hi;
+                        for (int a = 0; a < 3; ++a) {
+                          lo[a] = cellIndex(p[a] - resolution);
+                          hi[a] = cellIndex(p[a] + resolution);
+                        }
+                        if (lo == own && hi == own) continue;
+                        for (std::int64_t x = lo[0]; x <= hi[0]; ++x)
+                          for (std::int64_t y = lo[1]; y <= hi[1]; ++y)
+                            for (std::int64_t z = lo[2]; z <= hi[2]; ++z) {
+                              const Cell c{x, y, z};
+                              if (c == own) continue;
+                              auto it = std::lower_bound(sorted.begin(), sorted.end(),
+                                                         std::make_pair(c, 0u));
+                              for (; it != sorted.end() && it->first == c && it->second < i; ++it)
+                                nearPoint(i, it->second);
+                            }
+                      }
+                    });
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs(near.begin(), near.end());
+  std::sort(pairs.begin(), pairs.end());
+  std::vector<std::uint32_t> target(used.size());
+  std::iota(target.begin(), target.end(), 0u);
+  for (const auto& [later, earlier] : pairs)
+    if (target[later] == later && target[earlier] == earlier) target[later] = earlier;
+  return target;
+}
+
+std::size_t simplifyWalk(std::span<VertexId> walk, std::uint32_t& size) {
+  // The walk as a stack: a vertex met again closes the cycle from its first visit, which is
+  // popped off; the stack left at the end is the last cycle.
+  boost::container::small_vector<VertexId, 16> stack, kept;
+  std::size_t cycles = 0;
+  auto close = [&](std::size_t from) {
+    if (stack.size() - from >= 3) {
+      ++cycles;
+      kept.assign(stack.begin() + static_cast<std::ptrdiff_t>(from), stack.end());
+    }
+    stack.resize(from + 1);
+  };
+  for (std::size_t i = 0; i < size; ++i) {
+    const auto seen = std::find(stack.begin(), stack.end(), walk[i]);
+    if (seen == stack.end())
+      stack.push_back(walk[i]);
+    else
+      close(static_cast<std::size_t>(seen - stack.begin()));
+  }
+  if (stack.size() >= 3) {
+    ++cycles;
+    kept.assign(stack.begin(), stack.end());
+  }
+  if (cycles == 1) {
+    std::copy(kept.begin(), kept.end(), walk.begin());
+    size = static_cast<std::uint32_t>(kept.size());
+  }
+  return cycles;
+}
+
+bool WeldedPolygons::isReversed(std::size_t a, std::size_t b) const {
+  const auto x = corners(a), y = corners(b);
+  if (loopEnds(a).size() != 1 || loopEnds(b).size() != 1) {
+    Face face;
+    copyTo(a, face);
+    return isReverseOf(face, y, loopEnds(b));
+  }
+  const std::size_t n = x.size();
+  if (y.size() != n) return false;
+  for (std::size_t j = 0; j < n; ++j) {  // every start (a pinched loop repeats a vertex)
+    if (y[j] != x[0]) continue;
+    std::size_t i = 1;
+    while (i < n && x[i] == y[(j + n - i) % n]) ++i;
+    if (i == n) return true;
+  }
+  return false;
+}
+
+}  // namespace polydg

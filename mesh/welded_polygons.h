@@ -1,0 +1,106 @@
+// Rounding the exact points of slicing (mesh/slice.cpp) to the mesh's vertices: points closer
+// than the coordinates' resolution welded into one vertex, and polygons on the welded vertices
+// in flat arrays, with what welding collapsed (repeated corners, spikes, loops without area)
+// taken out the same way on both sides of every shared polygon.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "mesh/plane_split.h"
+#include "polydg/mesh/poly_mesh.h"
+
+namespace polydg {
+
+/// For used point i (in order of first use: points[used[i]]), the earliest kept point within
+/// `resolution` (in every coordinate) before it, or i itself if there is none: i is then kept.
+/// Points are bucketed in cells 64 times the resolution, offset by half a cell so that grid
+/// planes (at dyadic multiples of the resolution) run through cell centres, and sorted by cell.
+/// A point's search box meets its own cell, whose earlier points sit just before it in that
+/// order, and only rarely (when it lies within the resolution of a cell side) a neighbouring
+/// cell, found by binary search. The search runs in parallel, the rare welds are resolved in
+/// order.
+std::vector<std::uint32_t> weldTargets(const std::vector<Vec3>& points,
+                                       const std::vector<std::uint32_t>& used, double resolution);
+
+/// A closed walk of vertices split into simple cycles at its repeated vertices; walks there and
+/// back (a spike: fewer than 3 corners) are dropped, since their edges cancel. Returns the
+/// number of cycles left with 3 or more corners; if it is one, `walk` becomes it. (Two or more
+/// are left as they are: the loop touches itself, a degenerate face that the mesh's repair,
+/// mergeDegenerateElements, takes out when it lies between two elements.)
+std::size_t simplifyWalk(std::span<VertexId> walk, std::uint32_t& size);
+
+/// Polygons on welded vertices, in flat arrays: polygon p's corners (all loops, concatenated)
+/// start at cornerStart_[p], its loop ends (relative to its first corner) at loopStart_[p].
+/// The room for each polygon is that of the polygon before welding (welding only drops
+/// corners and loops), given by the caller.
+class WeldedPolygons {
+ public:
+  WeldedPolygons(std::size_t polygons, std::size_t corners, std::size_t loops)
+      : cornerStart_(polygons),
+        cornerCount_(polygons, 0),
+        loopStart_(polygons),
+        loopCount_(polygons, 0),
+        corners_(corners),
+        loopEnds_(loops) {}
+
+  /// `polygon` on welded vertices as polygon p, with room from `corner` and `loop` on:
+  /// consecutive repeats dropped, spikes taken out (simplifyWalk), loops of fewer than 3
+  /// corners removed. False if the outer loop collapsed (the polygon is gone).
+  template <class VertexOf>
+  bool weld(std::size_t p, std::size_t corner, std::size_t loop, const PiecePolygon& polygon,
+            const VertexOf& vertexOf) {
+    cornerStart_[p] = corner;
+    loopStart_[p] = loop;
+    VertexId* out = corners_.data() + corner;
+    std::uint32_t n = 0, loops = 0;
+    for (std::size_t k = 0; k < polygon.numLoops(); ++k) {
+      const std::uint32_t begin = n;
+      for (std::size_t i = polygon.loopBegin(k); i < polygon.loopEnd[k]; ++i) {
+        const VertexId v = vertexOf(polygon.vertices[i]);
+        if (n == begin || out[n - 1] != v) out[n++] = v;
+      }
+      while (n > begin + 1 && out[begin] == out[n - 1]) --n;
+      std::uint32_t size = n - begin;
+      if (size >= 3 && simplifyWalk({out + begin, size}, size) == 0) size = 0;
+      n = begin + size;
+      if (n >= begin + 3) {
+        loopEnds_[loop + loops++] = n;
+      } else {
+        n = begin;
+        if (k == 0) break;  // the outer boundary collapsed: the polygon is gone
+      }
+    }
+    cornerCount_[p] = n;
+    loopCount_[p] = loops;
+    return loops > 0;
+  }
+
+  std::span<const VertexId> corners(std::size_t p) const {
+    return {corners_.data() + cornerStart_[p], cornerCount_[p]};
+  }
+  std::span<const std::uint32_t> loopEnds(std::size_t p) const {
+    return {loopEnds_.data() + loopStart_[p], loopCount_[p]};
+  }
+  /// Polygon p's loops into `face` (vertices and loop ends).
+  void copyTo(std::size_t p, Face& face) const {
+    const auto c = corners(p);
+    const auto e = loopEnds(p);
+    face.vertices.assign(c.begin(), c.end());
+    face.loopEnd.assign(e.begin(), e.end());
+  }
+  /// True if polygon b is polygon a reversed (isReverseOf), checked without allocating for the
+  /// common case of one loop: the same cycle, traversed the other way, from any start.
+  bool isReversed(std::size_t a, std::size_t b) const;
+
+ private:
+  std::vector<std::size_t> cornerStart_;
+  std::vector<std::uint32_t> cornerCount_;
+  std::vector<std::size_t> loopStart_;
+  std::vector<std::uint32_t> loopCount_;
+  std::vector<VertexId> corners_;
+  std::vector<std::uint32_t> loopEnds_;
+};
+
+}  // namespace polydg
