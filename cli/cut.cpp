@@ -73,6 +73,13 @@ void run(const CutCommandOptions& o, bool quiet, int& exitCode) {
     const OperationReport r = model.cut(request);
     report["operations"].push_back(toJson(r));
     progress.update(double(i + 1) / double(blades.size()));
+    if (!r.leftWhole.empty())
+      std::cerr << "polydg: warning: operation " << i + 1 << " (" << describe(blades[i])
+                << "): " << r.leftWhole.size()
+                << " element(s) at the polygon's edge left whole and listed in the report's "
+                   "left_whole ("
+                << r.elementsSplit
+                << " split); a finer mesh or a larger polygon splits more of them\n";
     if (!r.check.passed) {
       failure = "operation " + std::to_string(i + 1) + " (" + r.op + ", " + describe(blades[i]) +
                 ") failed its " + toString(r.check.level) + " validation: " + r.check.failure;

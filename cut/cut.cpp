@@ -112,6 +112,19 @@ void checkOptions(const CutOptions& options) {
     throw std::invalid_argument("the validation degree must be 1, 2 or 3");
 }
 
+/// A section's loops as points.
+std::vector<std::vector<Vec3>> capLoops(const cut_detail::Splitter& splitter,
+                                        const std::vector<PiecePolygon>& cap) {
+  std::vector<std::vector<Vec3>> loops;
+  for (const PiecePolygon& polygon : cap)
+    for (std::size_t k = 0; k < polygon.numLoops(); ++k) {
+      auto& loop = loops.emplace_back();
+      for (std::size_t i = polygon.loopBegin(k); i < polygon.loopEnd[k]; ++i)
+        loop.push_back(splitter.point(polygon.vertices[i]));
+    }
+  return loops;
+}
+
 }  // namespace
 
 OperationReport MeshEditor::cut(const Blade& blade, const CutOptions& options) {
@@ -203,7 +216,9 @@ OperationReport MeshEditor::cutInPlace(const Blade& blade, const CutOptions& opt
           in += polygon->inside(splitter.point(v));
         }
       if (in != total) {
-        if (in > 0) edit.leftWhole().insert(e);
+        // At the polygon's edge, listed, if its section meets the polygon at all (a strip or a
+        // polygon inside one section has no corner of it inside).
+        if (in > 0 || polygon->meets(capLoops(splitter, caps.first))) edit.leftWhole().insert(e);
         unsplit.push_back(e);
         continue;
       }

@@ -94,6 +94,10 @@ TEST_F(CutCli, PolygonSplitsTheCellsInsideAndReportsThoseLeftWhole) {
   EXPECT_EQ(op["elements_removed"], 2);
   EXPECT_NEAR(op["volume_removed"].get<double>(), 0.0125, 1e-15);
   EXPECT_EQ(op["left_whole"]["count"], 10);
+  // The terminal says so too, with --quiet: a warning, not progress.
+  EXPECT_NE(r.out.find("operation 1 (polygon"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("10 element(s) at the polygon's edge left whole"), std::string::npos)
+      << r.out;
   std::vector<int> whole;
   for (int j = 0; j <= 2; ++j)
     for (int i = 0; i <= 3; ++i)

@@ -402,6 +402,14 @@ TEST(Cut, PolygonBladeSplitsExactlyTheCellsWhoseSectionLiesInside) {
   expectRectangleCut(8, 0.3, 0.9, 0.05, 0.45, 0.7, 8, 16);
 }
 
+TEST(Cut, PolygonHoldingNoSectionListsTheCellsItMeets) {
+  // A strip [0.3, 0.4] x [0.1, 0.9] narrower than a cell holds no section and has no corner of
+  // one inside it: it splits nothing and lists the 4 cells of column 1 it crosses as left whole.
+  expectRectangleCut(4, 0.3, 0.4, 0.1, 0.9, 0.4, 0, 4);
+  // A square inside one cell's section: that one cell.
+  expectRectangleCut(4, 0.3, 0.45, 0.55, 0.7, 0.4, 0, 1);
+}
+
 // A polygon cut leaves the elements at its edge whole, with its new points inserted on their
 // edges: on its plane by construction, though rounded off it. The whole plane's cut after it
 // splits those elements, and the splitter sees those points on the plane as the cut does (one
