@@ -427,7 +427,7 @@ SolveReport Model::solve(const SolveOptions& options) {
   try {
     u = &solver.solve();
   } catch (const std::runtime_error& e) {
-    throw CheckFailure(std::string(e.what()) + "; hold every piece of the body with a clamp");
+    throw CheckFailure(e.what());
   }
   report.solve = solver.report();
   if (!report.solve.solver.success)

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <optional>
+#include <sstream>
 #include <stdexcept>
 
 #include <tbb/parallel_for.h>
@@ -13,6 +14,18 @@
 #include "util/stopwatch.h"
 
 namespace polydg {
+
+namespace {
+
+/// A number as the terminal shows it: 6 significant digits.
+std::string formatNumber(double x) {
+  std::ostringstream s;
+  s << x;
+  return s.str();
+}
+
+}  // namespace
+
 
 namespace {
 using SpMat = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
@@ -154,10 +167,19 @@ const Eigen::VectorXd& StaticSolver::solve() {
     const bool computed =
         rows_ ? solver_.compute(*rows_, &frames)
               : solver_.compute(system_.matrix, system_.blockSize, direct ? nullptr : &frames);
-    if (!computed && definiteCheck)
+    if (!computed && definiteCheck) {
+      // A fixed penalty below the coercivity bound is the likelier cause than a loose body.
+      const PenaltyOptions& penalty = options_.discretization.penalty;
+      if (penalty.rule == PenaltyRule::Fixed && penalty.eta && *penalty.eta < report_.etaThreshold)
+        throw std::runtime_error(
+            "the stiffness matrix is not positive definite: the fixed penalty eta = " +
+            formatNumber(*penalty.eta) + " is below the bound " +
+            formatNumber(report_.etaThreshold) +
+            " that guarantees it; raise --eta or use --penalty bound");
       throw std::runtime_error(
-          "the stiffness matrix is not positive definite: is the body held by a Dirichlet "
-          "condition (e.g. --clamp)?");
+          "the stiffness matrix is not positive definite: is every piece of the body held by a "
+          "Dirichlet condition (e.g. --clamp)?");
+    }
     factorized_ = true;
   }
   coefficients_ = solver_.solve(system_.rhs, report_.solver);

@@ -191,7 +191,9 @@ def penalty(polydg, work):
           1e-11, relative=False)
     _, err = run([polydg, "solve", mesh, "-o", work / "half.vtu", "--E", E, "--quiet", *common,
                   "--penalty", "fixed", "--eta", doubled["eta"] / 2], expect=1)
-    check("not positive definite" in err, "fixed at half of it fails: " + err.strip())
+    check("not positive definite" in err and "is below the bound" in err and
+          "raise --eta or use --penalty bound" in err,
+          "fixed at half of it fails, naming the penalty: " + err.strip())
     stiff, _ = bent("stiff", "--penalty", "fixed", "--eta", 8 * doubled["eta"])
     check(stiff["max_displacement"] < fixed["max_displacement"],
           "a larger --eta stiffens: %.9g < %.9g" % (stiff["max_displacement"],
