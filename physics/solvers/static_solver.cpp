@@ -26,7 +26,6 @@ std::string formatNumber(double x) {
 
 }  // namespace
 
-
 namespace {
 using SpMat = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
 /// Doubling gives up after this many factorizations (eta grows by 2^kMaxDoublings).
