@@ -209,8 +209,10 @@ TEST(BenchCommand, DynamicsSuiteKeepsEnergyAndVolumeWhereItShould) {
       EXPECT_NEAR(change, kLinearVolumeChange, 1e-6) << run.dump();
       EXPECT_LT(momentum, kLinearAngularMomentumChange) << run.dump();
     }
-    // Free body: no momentum appears (measured 3.4e-13 at most).
-    EXPECT_LT(run["momentum_max"].get<double>(), 1e-12) << run.dump();
+    // Free body: no momentum appears beyond the solver's tolerance (measured 3.4e-13 at most
+    // with CHOLMOD, 3.6e-12 with CG, the default for corotated steps since 2026-12-04).
+    EXPECT_LT(run["momentum_max"].get<double>(), run["corotational"].get<bool>() ? 1e-11 : 1e-12)
+        << run.dump();
   }
 
   const nlohmann::json& speed = j["speed"]["runs"];
