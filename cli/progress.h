@@ -14,8 +14,8 @@ class ProgressBar {
   ProgressBar(const ProgressBar&) = delete;
   ProgressBar& operator=(const ProgressBar&) = delete;
 
-  /// Fraction done in [0, 1].
-  void update(double fraction);
+  /// Fraction done in [0, 1], and a note after the percentage (e.g. a rate).
+  void update(double fraction, const std::string& note = "");
   /// Clears the line.
   void finish();
   bool enabled() const { return enabled_; }
@@ -24,6 +24,7 @@ class ProgressBar {
   std::string label_;
   bool enabled_ = false;
   bool drawn_ = false;
+  std::size_t noteWidth_ = 0;  ///< the widest note drawn, to clear
   std::chrono::steady_clock::time_point last_{};
 };
 

@@ -4,8 +4,10 @@
 // Sample run:
 //   polydg simulate beam.vtu --scene fall.json -o beam_fall --report fall.json
 #include <algorithm>
+#include <chrono>
 #include <filesystem>
 #include <iostream>
+#include <sstream>
 
 #include "cli/commands.h"
 #include "cli/options.h"
@@ -48,8 +50,26 @@ void run(const SimulateCommandOptions& o, const CommonOptions& common) {
   ProgressBar bar("simulate", common.quiet);
   SimulateOptions options;
   options.outputDir = o.output;
-  options.progress = [&bar](const SimulationProgress& p) {
-    bar.update(static_cast<double>(p.step) / p.steps);
+  // Steps per second over the last second or so: the frame rate as the user feels it.
+  std::chrono::steady_clock::time_point windowStart;
+  int windowStep = -1;  // the first report opens the window (after the set-up)
+  std::string rate;
+  options.progress = [&](const SimulationProgress& p) {
+    const auto now = std::chrono::steady_clock::now();
+    if (windowStep < 0) {
+      windowStart = now;
+      windowStep = p.step;
+    }
+    const double seconds = std::chrono::duration<double>(now - windowStart).count();
+    if (seconds >= 1.0 && p.step > windowStep) {
+      std::ostringstream s;
+      s.precision(3);
+      s << (p.step - windowStep) / seconds << " steps/s";
+      rate = s.str();
+      windowStart = now;
+      windowStep = p.step;
+    }
+    bar.update(static_cast<double>(p.step) / p.steps, rate);
   };
   const SimulationReport r = model.simulate(scene, options);
   bar.finish();
@@ -63,16 +83,21 @@ void run(const SimulateCommandOptions& o, const CommonOptions& common) {
   if (!common.quiet) {
     const BodyState& last = r.steps.back().state;
     int iterations = 0;
-    for (const SimulationStep& s : r.steps) iterations += s.step.iterations;
+    double stepping = 0.0;
+    for (const SimulationStep& s : r.steps) {
+      iterations += s.step.iterations;
+      stepping += s.seconds;
+    }
     const double n = static_cast<double>(r.steps.size());
     std::cout << o.input << ": " << r.elements << " elements, " << r.dofs << " DOFs, "
               << r.steps.size() << " steps of dt " << scene.dt << " ("
               << (scene.corotational ? "corotational" : "linear") << ", "
               << nameOf(integratorNames(), scene.integrator) << ")"
               << (iterations ? ", " + std::to_string(iterations) + " CG iterations" : "") << '\n'
-              << "  per step: rotation " << r.rotationSeconds / n << " s, assembly "
-              << r.assemblySeconds / n << " s, solve " << r.solveSeconds / n << " s; "
-              << r.cuts.size() << " cuts, " << r.frames.size() << " frames\n"
+              << "  per step: " << stepping / n << " s (" << n / stepping << " steps/s): rotation "
+              << r.rotationSeconds / n << " s, assembly " << r.assemblySeconds / n << " s, solve "
+              << r.solveSeconds / n << " s; " << r.cuts.size() << " cuts, " << r.frames.size()
+              << " frames\n"
               << "  at t = " << r.steps.back().step.t << ": kinetic " << last.kinetic
               << ", elastic " << last.elastic << ", gravity " << last.gravity << '\n';
     const SimulationEmbedding& e = r.embedding;

@@ -353,7 +353,9 @@ void finishOperation(MeshEditor::State& s, Edit& edit, double volumeBefore, Chec
   report.lineage = edit.lineage();
   report.facesTotal = s.mesh.numFaces();
   OperationCheck& v = report.check;
+  const Stopwatch checking;
   checkOperation(s.mesh, *s.moments, touched, s.region, level, degree, sliverThreshold, v);
+  v.seconds = checking.seconds();
   v.volumeRelError =
       std::abs(volumeBefore - report.volumeRemoved - s.volume) / std::abs(volumeBefore);
   if (!(v.volumeRelError <= kVolumeBalanceTolerance)) {

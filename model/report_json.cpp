@@ -487,6 +487,9 @@ json toJson(const SimulationReport& r) {
       step["collision_seconds"] = s.collisionSeconds;
     }
     step["seconds"] = s.seconds;
+    step["rotation_seconds"] = s.step.rotationSeconds;
+    step["assembly_seconds"] = s.step.assemblySeconds;
+    step["solve_seconds"] = s.step.solveSeconds;
     steps.push_back(std::move(step));
   }
   j["steps"] = std::move(steps);
@@ -498,7 +501,15 @@ json toJson(const SimulationReport& r) {
                     {"exact", c.exact},
                     {"extended", c.extended},
                     {"operation", toJson(c.report)},
-                    {"seconds", c.seconds}});
+                    {"seconds", c.seconds},
+                    {"cut_seconds",
+                     {{"cut", c.cutSeconds},
+                      {"check", c.checkSeconds},
+                      {"solver", c.solverSeconds},
+                      {"transfer", c.transferSeconds},
+                      {"next_step", c.nextStepSeconds ? json(*c.nextStepSeconds) : json(nullptr)},
+                      {"latency", c.nextStepSeconds ? json(c.seconds + *c.nextStepSeconds)
+                                                    : json(nullptr)}}}});
   j["cuts"] = std::move(cuts);
   json refinements = json::array();
   for (const SimulationRefinement& f : r.refinements)

@@ -238,6 +238,10 @@ void Simulation::step(int k) {
                        "): " + e.what() + "; try a smaller dt");
   }
   step.seconds = ts.seconds();
+  // The cuts made at the last step boundary: this step completes their latency.
+  for (std::size_t i = report_.cuts.size() - cutsAwaitingStep_; i < report_.cuts.size(); ++i)
+    report_.cuts[i].nextStepSeconds = step.seconds;
+  cutsAwaitingStep_ = 0;
   step.solver = solverAction(step.step, solver_->solverKind(), freshSolver_);
   freshSolver_ = false;
   step.state = solver_->state();
@@ -276,17 +280,22 @@ bool Simulation::cutsDue(double t) {
     record.report = model_.cut(timed.request);
     requirePassed(record.report.check, "the cut", record.time);
     record.elementsAfter = model_.mesh().numElements();
-    report_.cutSeconds += tc.seconds();
+    record.cutSeconds = tc.seconds();
+    record.checkSeconds = record.report.check.seconds;
     families_.afterCut(record.report.lineage, record.elementsAfter);
+    const Stopwatch ts;
     solver_.emplace(makeSolver());
+    record.solverSeconds = ts.seconds();
     const Stopwatch tt;
     TransferCounts counts;
     afterEdit(record.report.lineage, oldBasis, oldU, oldV, record.time, false, &counts);
     record.exact = counts.exact;
     record.extended = counts.extended;
+    record.transferSeconds = tt.seconds();
     record.seconds = tc.seconds();
-    report_.cutSeconds += tt.seconds();
+    report_.cutSeconds += record.seconds;
     report_.cuts.push_back(std::move(record));
+    ++cutsAwaitingStep_;
     editedSinceFrame_ = true;
     made = true;
   }

@@ -78,6 +78,7 @@ class Simulation {
   std::size_t nextCut_ = 0;
   bool editedSinceFrame_ = false;
   bool freshSolver_ = true;  ///< no step since the solver was made (its first factorization)
+  std::size_t cutsAwaitingStep_ = 0;  ///< cuts of the last step boundary, before their next step
 };
 
 }  // namespace polydg

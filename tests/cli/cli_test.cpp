@@ -309,6 +309,16 @@ TEST_F(Cli, SimulateRunsTheExampleSceneAndWritesATimeSeries) {
   EXPECT_EQ(cut["exact"], cut["elements_after"]);
   EXPECT_EQ(cut["operation"]["volume_removed"].get<double>(), 0.0);
   EXPECT_LT(cut["operation"]["validation"]["volume_rel_error"].get<double>(), 1e-12);
+  // Its latency: the cut, the new solver and the fields carried over (its "seconds"), then the
+  // next step.
+  const auto& latency = cut["cut_seconds"];
+  for (const char* phase : {"cut", "check", "solver", "transfer", "next_step"})
+    EXPECT_GT(latency[phase].get<double>(), 0.0) << phase;
+  EXPECT_DOUBLE_EQ(latency["latency"].get<double>(),
+                   cut["seconds"].get<double>() + latency["next_step"].get<double>());
+  for (const char* phase : {"rotation_seconds", "assembly_seconds", "solve_seconds"})
+    EXPECT_TRUE(j["steps"][0].contains(phase)) << phase;
+  EXPECT_NE(r.out.find(" steps/s)"), std::string::npos) << r.out;
   // The physics of the run, step by step (the beam: mass 10, gravity (0, 0, -1)): the gravity
   // term -F_g.U is m g dz of the centre of mass, and backward Euler without damping or loads
   // only dissipates: kinetic + elastic + gravity never grows (measured: it falls by at least

@@ -162,7 +162,7 @@ def frames(polydg, work):
     mesh = bar_mesh(polydg, work)
     dt, steps, every = 0.02, 9, 2
     # CHOLMOD: the fall then holds to round-off (CG, the default for corotated steps, holds it
-    # to its tolerance, 1e-10 of the right-hand side).
+    # to its tolerance, 1e-8 of the right-hand side).
     scene = {"material": MATERIAL, "dt": dt, "steps": steps, "fixed": [],
              "gravity": [0, 0, -G], "output": {"every": every}, "solver": "cholesky"}
     r, out = simulate(polydg, work, mesh, "frames", scene)

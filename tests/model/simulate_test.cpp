@@ -89,6 +89,15 @@ TEST(Simulate, CutWhileMovingFreesAHalfThatFallsWithGravity) {
     EXPECT_NEAR(model.volume(), 10.0, 1e-10 * 10);
     EXPECT_GT(cut.elementsAfter, cut.elementsBefore);
     EXPECT_EQ(cut.exact, cut.elementsAfter);  // no sliver here: every element took its parent's
+    // Its latency by phase: the phases lie within the whole, the checks within the cut, and
+    // the step after it completes the latency (its steps run on).
+    EXPECT_LE(cut.cutSeconds + cut.solverSeconds + cut.transferSeconds, cut.seconds);
+    EXPECT_GT(cut.cutSeconds, 0.0);
+    EXPECT_GT(cut.solverSeconds, 0.0);
+    EXPECT_LE(cut.checkSeconds, cut.cutSeconds);
+    EXPECT_GT(cut.checkSeconds, 0.0);  // local checks by default
+    ASSERT_TRUE(cut.nextStepSeconds.has_value());
+    EXPECT_GT(*cut.nextStepSeconds, 0.0);
     const Half freed = half(model, true);
     EXPECT_NEAR(freed.volume, 4.9, 1e-10);
     z[k - 1] = freed.centroid.z() + freed.first.z() / freed.volume;
@@ -118,7 +127,9 @@ TEST(Simulate, CutCarriesTheFieldsOverExactly) {
   // cut split (the band 5 < x < 5.5) and over the others is the uncut simulation's to
   // round-off: the pieces took their parents' polynomials exactly. Nothing pops.
   Model cut = beam(), whole = beam();
-  cut.simulate(parseScene(b10Scene(1.0), "b10"), {});
+  const SimulationReport r = cut.simulate(parseScene(b10Scene(1.0), "b10"), {});
+  ASSERT_EQ(r.cuts.size(), 1u);
+  EXPECT_FALSE(r.cuts[0].nextStepSeconds.has_value());  // the run ended with the cut
   whole.simulate(parseScene(b10Scene(1.0, false), "b10"), {});
   EXPECT_GT(cut.mesh().numElements(), whole.mesh().numElements());
   for (auto [lo, hi] : {std::pair{-1.0, 5.0}, std::pair{5.0, 5.5}, std::pair{5.5, 11.0}}) {

@@ -134,7 +134,12 @@ struct SimulationCut {
   /// Elements that took one parent's polynomials exactly, and merged slivers (several
   /// sources) that took their first source's (the neighbour's) polynomials extended over them.
   std::size_t exact = 0, extended = 0;
-  double seconds = 0.0;
+  double seconds = 0.0;  ///< the cut, the new solver and the fields carried over
+  /// The cut's latency by phase, from its request to the next completed step: the model's cut
+  /// (split, merge, re-integration and its checks, `checkSeconds` of it), the new solver, the
+  /// fields carried over, and the next step (none if the run ended with the cut).
+  double cutSeconds = 0.0, checkSeconds = 0.0, solverSeconds = 0.0, transferSeconds = 0.0;
+  std::optional<double> nextStepSeconds;
 };
 
 /// A refinement during a simulation (scene "adapt"): the fields went to the children exactly,

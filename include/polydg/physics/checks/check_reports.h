@@ -160,6 +160,7 @@ struct OperationCheck {
   std::size_t zeroModes = 0;    ///< expected: 6 * regionComponents
   double volumeRelError = 0.0;  ///< |V_before - V_removed - V_after| / V_before
   std::string failure;          ///< first failed check, one line; empty when passed
+  double seconds = 0.0;         ///< wall time of the checks
 };
 
 }  // namespace polydg
