@@ -3,6 +3,7 @@
 #include "cli/bench/problems.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <functional>
 #include <iostream>
@@ -12,6 +13,7 @@
 
 #include "mesh/primitives.h"
 #include "physics/dynamics/dynamics.h"
+#include "polydg/model/model.h"
 #include "polydg/model/names.h"
 #include "polydg/model/scene.h"
 #include "polydg/physics/dg/post_process.h"
@@ -372,6 +374,69 @@ nlohmann::json speedPart(bool quick, SuiteOutput& s,
           {"runs", runs}};
 }
 
+/// Cut latency: B10's beam on a 10k x k x k hex grid (p = 1, corotational, backward Euler, dt =
+/// 0.01, clamped at x = 0 under gravity (0, 0, -1)) cut at its third step by planes that touch
+/// more and more of it; each cut's phases from the request to the next completed step.
+nlohmann::json cutLatencyPart(bool quick, SuiteOutput& s,
+                              const std::function<void(const std::string&)>& log) {
+  const int k = quick ? 4 : 13;
+  const PolyMesh mesh = hexGridMesh(10 * k, k, k, Box3(Vec3::Zero(), Vec3(10, 1, 1)));
+  const std::string grid = gridName(10 * k, k, k);
+  struct CutPlane {
+    const char* what;
+    std::array<double, 4> plane;
+  };
+  // Off the grid planes: a column of cells, a layer along the beam, a diagonal band.
+  const CutPlane blades[] = {
+      {"column", {1, 0, 0, 5.05}}, {"layer", {0, 1, 0, 0.53}}, {"diagonal", {0, 1, 1, 1.03}}};
+  nlohmann::json runs = nlohmann::json::array();
+  for (const CutPlane& blade : blades) {
+    Model model(mesh);
+    const nlohmann::json scene = {{"material",
+                                   {{"E", kMaterial.youngsModulus},
+                                    {"nu", kMaterial.poissonRatio},
+                                    {"density", kMaterial.density}}},
+                                  {"integrator", "euler"},
+                                  {"dt", 0.01},
+                                  {"steps", 4},
+                                  {"gravity", {0, 0, -1}},
+                                  {"fixed", {{{"plane", {1, 0, 0, 0}}}}},
+                                  {"cuts", {{{"time", 0.02}, {"plane", blade.plane}}}}};
+    const SimulationReport r = model.simulate(parseScene(scene, "cut latency"), {});
+    const SimulationCut& cut = r.cuts.at(0);
+    const double touched =
+        static_cast<double>(cut.report.elementsSplit) / static_cast<double>(cut.elementsBefore);
+    const double step = 0.5 * (r.steps[0].seconds + r.steps[1].seconds);
+    const double next = cut.nextStepSeconds.value_or(0.0);
+    nlohmann::json j{{"part", "cut_latency"},
+                     {"grid", grid},
+                     {"blade", blade.what},
+                     {"plane", blade.plane},
+                     {"elements", cut.elementsBefore},
+                     {"dofs", 12 * cut.elementsBefore},
+                     {"elements_split", cut.report.elementsSplit},
+                     {"touched_fraction", touched},
+                     {"t_cut", cut.cutSeconds},
+                     {"t_check", cut.checkSeconds},
+                     {"t_solver", cut.solverSeconds},
+                     {"t_transfer", cut.transferSeconds},
+                     {"t_next_step", next},
+                     {"t_latency", cut.seconds + next},
+                     {"t_step_before", step}};
+    runs.push_back(j);
+    s.rows.push_back(j);
+    log("cut latency " + grid + ", " + blade.what + " (" + shortNumber(100 * touched) +
+        "% of the elements split): " + shortNumber(cut.seconds + next) + " s (cut " +
+        shortNumber(cut.cutSeconds) + ", solver " + shortNumber(cut.solverSeconds) + ", transfer " +
+        shortNumber(cut.transferSeconds) + ", next step " + shortNumber(next) +
+        "; a step before it " + shortNumber(step) + ")");
+  }
+  return {{"setup", "B10's beam [0,10]x[0,1]x[0,1], " + grid +
+                        " hex grid, p = 1, corotational, backward Euler, dt = 0.01; one plane "
+                        "cut at t = 0.02 (local checks); times are wall seconds"},
+          {"runs", runs}};
+}
+
 }  // namespace
 
 SuiteOutput dynamicsSuite(const BenchOptions& o, bool quiet) {
@@ -382,6 +447,7 @@ SuiteOutput dynamicsSuite(const BenchOptions& o, bool quiet) {
   s.json["b6"] = b6Part(o.quick, s, log);
   s.json["b7"] = b7Part(o.quick, s, log);
   s.json["speed"] = speedPart(o.quick, s, log);
+  s.json["cut_latency"] = cutLatencyPart(o.quick, s, log);
   return s;
 }
 

@@ -224,6 +224,24 @@ TEST(BenchCommand, DynamicsSuiteKeepsEnergyAndVolumeWhereItShould) {
     for (const char* phase : {"t_step", "t_rotation", "t_assembly", "t_solve", "steps_per_second"})
       EXPECT_TRUE(run[phase].is_number()) << phase << ": " << run.dump();
   }
+  // Cut latency on the 40x4x4 beam (640 elements): a column x = 5.05 splits its 4 x 4 cells, a
+  // layer y = 0.53 the 40 x 4 of one row, the diagonal y + z = 1.03 the 7 cells a line crosses
+  // in a 4 x 4 section (4 + 4 - 1), 40 times. The phases lie within the latency.
+  const nlohmann::json& cuts = j["cut_latency"]["runs"];
+  ASSERT_EQ(cuts.size(), 3u);
+  const std::size_t split[] = {16, 160, 280};
+  for (std::size_t i = 0; i < cuts.size(); ++i) {
+    const nlohmann::json& run = cuts[i];
+    EXPECT_EQ(run["elements"], 640) << run.dump();
+    EXPECT_EQ(run["elements_split"].get<std::size_t>(), split[i]) << run.dump();
+    double phases = 0.0;
+    for (const char* phase : {"t_cut", "t_solver", "t_transfer", "t_next_step"}) {
+      EXPECT_GT(run[phase].get<double>(), 0.0) << phase << ": " << run.dump();
+      phases += run[phase].get<double>();
+    }
+    EXPECT_LE(phases, run["t_latency"].get<double>()) << run.dump();
+    EXPECT_LE(run["t_check"].get<double>(), run["t_cut"].get<double>()) << run.dump();
+  }
   std::ifstream csv(dir / "dynamics.csv");
   std::string header;
   std::getline(csv, header);
