@@ -28,7 +28,8 @@ def beam():
 
 def without_timings(value):
     if isinstance(value, dict):
-        return {k: without_timings(v) for k, v in value.items() if k not in TIMING}
+        return {k: without_timings(v) for k, v in value.items()
+                if k not in TIMING and not k.endswith("_seconds")}
     if isinstance(value, list):
         return [without_timings(v) for v in value]
     return value
