@@ -1,7 +1,9 @@
 // Penalty contact on embedded points (physics/contact/contact.h).
 #include "physics/contact/contact.h"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <unordered_map>
@@ -42,39 +44,22 @@ void ContactModel::refresh() {
     throw std::invalid_argument("ContactModel: the embedding's points changed; make it again");
   dofs_ = e.numElements() * 3 * static_cast<std::size_t>(e.basisSize());
   active_.clear();
-  cachedCoefficients_.resize(0);
-}
-
-const Eigen::Matrix<double, Eigen::Dynamic, 3>& ContactModel::displacementsOf(
-    const Eigen::VectorXd& u) {
-  // A step's end state is measured, then linearized about at the next step's start: the same
-  // coefficients, one surface update.
-  if (cachedCoefficients_.size() != u.size() || cachedCoefficients_ != u) {
-    cachedDisplacement_ = embedding_->displacements(u);
-    cachedCoefficients_ = u;
+  startDisplacement_.clear();
+  const std::size_t np = e.numPoints();
+  rowScale_.assign(np, 0.0);
+  double extent = 0.0;
+  for (std::size_t p = 0; p < np; ++p) {
+    const SparseRow row = e.weightRow(p);
+    double sum = 0.0;
+    for (double w : row.values) sum += std::abs(w);
+    rowScale_[p] = std::sqrt(3.0) * sum;
+    extent = std::max(extent, e.points()[p].cwiseAbs().maxCoeff());
   }
-  return cachedDisplacement_;
-}
-
-Eigen::Matrix<double, Eigen::Dynamic, 3> ContactModel::positionsOf(
-    const Eigen::Matrix<double, Eigen::Dynamic, 3>& displacement) const {
-  Eigen::Matrix<double, Eigen::Dynamic, 3> x(displacement.rows(), 3);
-  for (std::size_t p = 0; p < embedding_->numPoints(); ++p)
-    x.row(static_cast<Eigen::Index>(p)) =
-        embedding_->points()[p].transpose() + displacement.row(static_cast<Eigen::Index>(p));
-  return x;
-}
-
-ContactModel::Active ContactModel::contact(std::size_t point, std::uint32_t obstacle,
-                                           const ObstacleQuery& q,
-                                           const Eigen::Matrix<double, Eigen::Dynamic, 3>& at) {
-  Active a;
-  a.point = static_cast<std::uint32_t>(point);
-  a.obstacle = obstacle;
-  a.distance = q.distance;
-  a.normal = q.normal;
-  a.position = at.row(static_cast<Eigen::Index>(point)).transpose();
-  return a;
+  maxObstacleSpeed_ = 0.0;
+  for (const Obstacle& o : obstacles_)
+    maxObstacleSpeed_ = std::max(maxObstacleSpeed_, o.velocity().norm());
+  pad_ = 1e-9 * (1.0 + extent);
+  clearanceU_.resize(0);  // measured again at the next use
 }
 
 double ContactModel::takeQuerySeconds() {
@@ -83,9 +68,9 @@ double ContactModel::takeQuerySeconds() {
   return s;
 }
 
-void ContactModel::queryAll(const Eigen::Matrix<double, Eigen::Dynamic, 3>& positions, double t,
+void ContactModel::queryAll(const std::vector<Vec3>& positions, double t,
                             std::vector<ObstacleQuery>& out, std::vector<std::uint32_t>& which) {
-  const std::size_t np = static_cast<std::size_t>(positions.rows());
+  const std::size_t np = positions.size();
   out.assign(np, ObstacleQuery{std::numeric_limits<double>::infinity(), Vec3::Zero()});
   which.assign(np, 0);
   std::vector<Vec3> inside;
@@ -96,9 +81,8 @@ void ContactModel::queryAll(const Eigen::Matrix<double, Eigen::Dynamic, 3>& posi
     inside.clear();
     index.clear();
     for (std::size_t p = 0; p < np; ++p) {
-      const Vec3 x = positions.row(static_cast<Eigen::Index>(p)).transpose();
-      if (box.contains(x)) {
-        inside.push_back(x);
+      if (box.contains(positions[p])) {
+        inside.push_back(positions[p]);
         index.push_back(static_cast<std::uint32_t>(p));
       }
     }
@@ -112,27 +96,80 @@ void ContactModel::queryAll(const Eigen::Matrix<double, Eigen::Dynamic, 3>& posi
   }
 }
 
+void ContactModel::measureClearances(const Eigen::VectorXd& u, double t) {
+  const SurfaceEmbedding& e = *embedding_;
+  const std::size_t np = e.numPoints();
+  const Eigen::Matrix<double, Eigen::Dynamic, 3> d = e.displacements(u);
+  std::vector<Vec3> x(np);
+  for (std::size_t p = 0; p < np; ++p)
+    x[p] = e.points()[p] + d.row(static_cast<Eigen::Index>(p)).transpose();
+  clearance_.assign(np, std::numeric_limits<double>::infinity());
+  std::vector<ObstacleQuery> q(np);
+  for (const Obstacle& o : obstacles_) {
+    if (o.isHalfSpace()) {
+      o.query(x, t, q);  // exact distance
+      for (std::size_t p = 0; p < np; ++p) clearance_[p] = std::min(clearance_[p], q[p].distance);
+      continue;
+    }
+    const Box3 box = o.bounds(t);
+    for (std::size_t p = 0; p < np; ++p) {
+      const Vec3 outside = (box.min() - x[p]).cwiseMax(x[p] - box.max()).cwiseMax(Vec3::Zero());
+      clearance_[p] = std::min(clearance_[p], outside.norm());
+    }
+  }
+  clearanceU_ = u;
+  clearanceT_ = t;
+}
+
+const std::vector<std::uint32_t>& ContactModel::candidates(const Eigen::VectorXd& u, double t) {
+  const std::size_t np = embedding_->numPoints();
+  auto select = [&]() {
+    const double moved = (u - clearanceU_).lpNorm<Eigen::Infinity>();
+    const double swept = maxObstacleSpeed_ * std::abs(t - clearanceT_);
+    candidates_.clear();
+    for (std::size_t p = 0; p < np; ++p)
+      if (clearance_[p] - rowScale_[p] * moved - swept <= pad_)
+        candidates_.push_back(static_cast<std::uint32_t>(p));
+  };
+  if (clearanceU_.size() == u.size()) select();
+  // Measured again when they have lost their use, unless they were of little use when fresh
+  // (a body inside a surface obstacle's box).
+  if (clearanceU_.size() != u.size() ||
+      (4 * candidates_.size() > np && candidates_.size() > 2 * measuredCandidates_)) {
+    measureClearances(u, t);
+    select();
+    measuredCandidates_ = candidates_.size();
+  }
+  return candidates_;
+}
+
 ContactLinearization ContactModel::linearize(const Eigen::VectorXd& u, const Eigen::VectorXd& v,
                                              double tNext, double dt) {
   const Stopwatch watch;
   const SurfaceEmbedding& e = *embedding_;
   tNext_ = tNext;
-  startDisplacement_ = displacementsOf(u);
-  const Eigen::Matrix<double, Eigen::Dynamic, 3> velocity = e.displacements(v);
-  const std::size_t np = e.numPoints();
-  const Eigen::Matrix<double, Eigen::Dynamic, 3> predicted =
-      positionsOf(startDisplacement_ + dt * velocity);
+  startCoefficients_ = u;
+  // Points that may touch at the predicted state u + dt v.
+  const std::vector<std::uint32_t>& points = candidates(u + dt * v, tNext);
+  const std::size_t nc = points.size();
+  std::vector<Vec3> start(nc), velocity(nc), predicted(nc);
+  for (std::size_t k = 0; k < nc; ++k) {
+    start[k] = e.displacement(points[k], u);
+    velocity[k] = e.displacement(points[k], v);
+    predicted[k] = e.points()[points[k]] + (start[k] + dt * velocity[k]);
+  }
   std::vector<ObstacleQuery> q;
   std::vector<std::uint32_t> which;
   queryAll(predicted, tNext, q, which);
   active_.clear();
-  for (std::size_t p = 0; p < np; ++p) {
-    if (!(q[p].distance < 0.0) || q[p].normal.isZero()) continue;
-    Active a = contact(p, which[p], q[p], predicted);
-    const Vec3 relative =
-        velocity.row(static_cast<Eigen::Index>(p)).transpose() - obstacles_[which[p]].velocity();
+  startDisplacement_.clear();
+  for (std::size_t k = 0; k < nc; ++k) {
+    if (!(q[k].distance < 0.0) || q[k].normal.isZero()) continue;
+    Active a{points[k], which[k], q[k].distance, q[k].normal, predicted[k], Vec3::Zero()};
+    const Vec3 relative = velocity[k] - obstacles_[which[k]].velocity();
     a.slip = relative - a.normal * a.normal.dot(relative);
     active_.push_back(a);
+    startDisplacement_.emplace(points[k], start[k]);
   }
   querySeconds_ += watch.seconds();
   return build();
@@ -141,30 +178,34 @@ ContactLinearization ContactModel::linearize(const Eigen::VectorXd& u, const Eig
 bool ContactModel::adjust(const Eigen::VectorXd& uNew) {
   const Stopwatch watch;
   const SurfaceEmbedding& e = *embedding_;
-  const Eigen::Matrix<double, Eigen::Dynamic, 3>& disp = displacementsOf(uNew);
-  const std::size_t np = e.numPoints();
   bool changed = false;
   // Drop contacts whose linearized force pulls at the new state.
-  std::vector<char> isActive(np, 0);
+  std::unordered_map<std::uint32_t, char> isActive;
   std::vector<Active> kept;
   for (const Active& a : active_) {
-    const Vec3 x = e.points()[a.point];
-    const Vec3 y = x + disp.row(a.point).transpose();
+    const Vec3 y = e.points()[a.point] + e.displacement(a.point, uNew);
     if (a.distance + a.normal.dot(y - a.position) > 0.0) {
       changed = true;
       continue;
     }
     kept.push_back(a);
-    isActive[a.point] = 1;
+    isActive.emplace(a.point, 1);
   }
   // Add points that end inside an obstacle.
-  const Eigen::Matrix<double, Eigen::Dynamic, 3> positions = positionsOf(disp);
+  std::vector<std::uint32_t> points;
+  for (std::uint32_t p : candidates(uNew, tNext_))
+    if (!isActive.count(p)) points.push_back(p);
+  std::vector<Vec3> positions(points.size());
+  for (std::size_t k = 0; k < points.size(); ++k)
+    positions[k] = e.points()[points[k]] + e.displacement(points[k], uNew);
   std::vector<ObstacleQuery> q;
   std::vector<std::uint32_t> which;
   queryAll(positions, tNext_, q, which);
-  for (std::size_t p = 0; p < np; ++p) {
-    if (isActive[p] || !(q[p].distance < 0.0) || q[p].normal.isZero()) continue;
-    kept.push_back(contact(p, which[p], q[p], positions));  // no slip yet: full friction
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    if (!(q[k].distance < 0.0) || q[k].normal.isZero()) continue;
+    // No slip yet: full friction. u~_n at the step's start for its force.
+    kept.push_back({points[k], which[k], q[k].distance, q[k].normal, positions[k], Vec3::Zero()});
+    startDisplacement_.try_emplace(points[k], e.displacement(points[k], startCoefficients_));
     changed = true;
   }
   active_ = std::move(kept);
@@ -203,7 +244,7 @@ ContactLinearization ContactModel::build() const {
     const Active& a = active_[static_cast<std::size_t>(k)];
     const double ka = options_.stiffness * areas_[a.point];
     const SparseRow row = e.weightRow(a.point);
-    const Vec3 uStart = startDisplacement_.row(a.point).transpose();
+    const Vec3 uStart = startDisplacement_.at(a.point);
     // f(U_n) = -k a (phi(q) + n . (u~_n - u~_q)) n, u~_q = q - x.
     const double gap = a.distance + a.normal.dot(e.points()[a.point] + uStart - a.position);
     Vec3 force = -ka * gap * a.normal;
@@ -259,16 +300,20 @@ ContactLinearization ContactModel::build() const {
 
 ContactMeasure ContactModel::measure(const Eigen::VectorXd& u, double t) {
   const Stopwatch watch;
-  const Eigen::Matrix<double, Eigen::Dynamic, 3> positions = positionsOf(displacementsOf(u));
+  const SurfaceEmbedding& e = *embedding_;
+  const std::vector<std::uint32_t>& points = candidates(u, t);
+  std::vector<Vec3> positions(points.size());
+  for (std::size_t k = 0; k < points.size(); ++k)
+    positions[k] = e.points()[points[k]] + e.displacement(points[k], u);
   std::vector<ObstacleQuery> q;
   std::vector<std::uint32_t> which;
   queryAll(positions, t, q, which);
   ContactMeasure m;
-  for (std::size_t p = 0; p < q.size(); ++p) {
-    if (!(q[p].distance < 0.0)) continue;
+  for (std::size_t k = 0; k < q.size(); ++k) {
+    if (!(q[k].distance < 0.0)) continue;
     ++m.contacts;
-    m.deepest = std::max(m.deepest, -q[p].distance);
-    m.energy += 0.5 * options_.stiffness * areas_[p] * q[p].distance * q[p].distance;
+    m.deepest = std::max(m.deepest, -q[k].distance);
+    m.energy += 0.5 * options_.stiffness * areas_[points[k]] * q[k].distance * q[k].distance;
   }
   querySeconds_ += watch.seconds();
   return m;

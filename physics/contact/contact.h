@@ -21,6 +21,8 @@
 // velocity, taken implicitly (D += W^T c_t (I - n n^T) W), so it only dissipates.
 #pragma once
 
+#include <cstdint>
+#include <unordered_map>
 #include <vector>
 
 #include <Eigen/Core>
@@ -90,26 +92,36 @@ class ContactModel {
     Vec3 slip = Vec3::Zero();      ///< tangential velocity relative to the obstacle at start
   };
   /// Deepest obstacle at each of the given positions (distance >= 0 where none).
-  void queryAll(const Eigen::Matrix<double, Eigen::Dynamic, 3>& positions, double t,
-                std::vector<ObstacleQuery>& out, std::vector<std::uint32_t>& which);
+  void queryAll(const std::vector<Vec3>& positions, double t, std::vector<ObstacleQuery>& out,
+                std::vector<std::uint32_t>& which);
   ContactLinearization build() const;
-  /// Undeformed points plus `displacement`.
-  Eigen::Matrix<double, Eigen::Dynamic, 3> positionsOf(
-      const Eigen::Matrix<double, Eigen::Dynamic, 3>& displacement) const;
-  /// A contact of `point` with `obstacle`, linearized about its position in `at`.
-  static Active contact(std::size_t point, std::uint32_t obstacle, const ObstacleQuery& q,
-                        const Eigen::Matrix<double, Eigen::Dynamic, 3>& at);
-  /// The points' displacements for coefficients u (the last result kept: see contact.cpp).
-  const Eigen::Matrix<double, Eigen::Dynamic, 3>& displacementsOf(const Eigen::VectorXd& u);
+  /// The points that may be inside an obstacle at coefficients u and time t, ascending: all
+  /// but those whose clearance, less how far they and the obstacles can have moved since it
+  /// was measured, stays positive. Measures the clearances again (a product with W over every
+  /// point) when they rule out fewer than three quarters of the points.
+  const std::vector<std::uint32_t>& candidates(const Eigen::VectorXd& u, double t);
+  void measureClearances(const Eigen::VectorXd& u, double t);
 
   const SurfaceEmbedding* embedding_;
   std::vector<double> areas_;
   std::vector<Obstacle> obstacles_;
   ContactOptions options_;
   std::vector<Active> active_;
-  Eigen::Matrix<double, Eigen::Dynamic, 3> startDisplacement_;  ///< u~_n of every point
-  Eigen::VectorXd cachedCoefficients_;
-  Eigen::Matrix<double, Eigen::Dynamic, 3> cachedDisplacement_;
+  /// u~_n of the candidate points of the last linearize() (the active points among them).
+  std::unordered_map<std::uint32_t, Vec3> startDisplacement_;
+  Eigen::VectorXd startCoefficients_;  ///< U_n of the last linearize()
+  // Culling (W's product over every point was most of a step's collision handling): each
+  // point's clearance, a lower bound of its signed distance to every obstacle (the exact
+  // distance to a half-space, the distance to a surface obstacle's box, 0 inside that box) at
+  // coefficients clearanceU_ and time clearanceT_. A point moves at most
+  // rowScale_ |U' - U|_inf (sqrt 3 times its weights' absolute sum) and the obstacles at most
+  // maxObstacleSpeed_ |t' - t|, both distances 1-Lipschitz: a clearance larger than that (plus
+  // pad_, against rounding) rules contact out.
+  std::vector<double> rowScale_, clearance_;
+  Eigen::VectorXd clearanceU_;
+  double clearanceT_ = 0.0, maxObstacleSpeed_ = 0.0, pad_ = 0.0;
+  std::vector<std::uint32_t> candidates_;
+  std::size_t measuredCandidates_ = 0;  ///< candidates right after the clearances were measured
   double tNext_ = 0.0, querySeconds_ = 0.0;
   std::size_t dofs_ = 0;
 };

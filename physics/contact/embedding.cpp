@@ -333,18 +333,9 @@ Eigen::Matrix<double, Eigen::Dynamic, 3> SurfaceEmbedding::displacements(
   Eigen::Matrix<double, Eigen::Dynamic, 3> out(static_cast<Eigen::Index>(np), 3);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, np, 1024),
                     [&](const tbb::blocked_range<std::size_t>& range) {
-                      for (std::size_t p = range.begin(); p != range.end(); ++p) {
-                        double sum[3] = {0.0, 0.0, 0.0};
-                        for (std::size_t q = weightStart_[p]; q < weightStart_[p + 1]; ++q) {
-                          const std::size_t c = weightColumns_[q], e = c / n, i = c % n;
-                          const double* u = coefficients.data() + e * 3 * n + i;
-                          const double w = weightValues_[q];
-                          sum[0] += w * u[0];
-                          sum[1] += w * u[n];
-                          sum[2] += w * u[2 * n];
-                        }
-                        out.row(static_cast<Eigen::Index>(p)) << sum[0], sum[1], sum[2];
-                      }
+                      for (std::size_t p = range.begin(); p != range.end(); ++p)
+                        out.row(static_cast<Eigen::Index>(p)) =
+                            displacement(p, coefficients).transpose();
                     });
   return out;
 }

@@ -103,6 +103,20 @@ class SurfaceEmbedding {
   /// The displacement of every point for DG coefficients in LinearSystem's layout
   /// (U[(e * 3 + d) * n + i]); #points by 3.
   Eigen::Matrix<double, Eigen::Dynamic, 3> displacements(const Eigen::VectorXd& coefficients) const;
+  /// The displacement of point p alone, the same sum as displacements() row p.
+  Vec3 displacement(std::size_t p, const Eigen::VectorXd& coefficients) const {
+    const std::size_t n = static_cast<std::size_t>(n_);
+    double sum[3] = {0.0, 0.0, 0.0};
+    for (std::size_t q = weightStart_[p]; q < weightStart_[p + 1]; ++q) {
+      const std::size_t c = weightColumns_[q], e = c / n, i = c % n;
+      const double* u = coefficients.data() + e * 3 * n + i;
+      const double w = weightValues_[q];
+      sum[0] += w * u[0];
+      sum[1] += w * u[n];
+      sum[2] += w * u[2 * n];
+    }
+    return Vec3(sum[0], sum[1], sum[2]);
+  }
 
   const std::vector<Vec3>& samplePositions() const { return samplePositions_; }
   /// Row p of W = Phi S (eq. 19): scalar coefficient columns e * n + i (ascending) and weights

@@ -1,0 +1,93 @@
+// ContactModel's culling (physics/contact/contact.h): the points it rules out by their
+// clearance never touch. Its measure of contacts, deepest penetration and penalty energy equals
+// a brute-force evaluation over every point, bit for bit, along a path of states that moves the
+// body through a moving ground and a box obstacle in steps small and large (clearances reused,
+// and measured again).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <random>
+#include <vector>
+
+#include "mesh/primitives.h"
+#include "physics/contact/contact.h"
+#include "polydg/integrate/moment_cache.h"
+#include "polydg/mesh/surface_shapes.h"
+#include "polydg/physics/dg/dg_basis.h"
+
+namespace polydg {
+namespace {
+
+/// Contacts, deepest penetration and energy from every point's position and every obstacle.
+ContactMeasure bruteForce(const SurfaceEmbedding& embedding, const std::vector<Obstacle>& obstacles,
+                          const std::vector<double>& areas, double stiffness,
+                          const Eigen::VectorXd& u, double t) {
+  const auto d = embedding.displacements(u);
+  ContactMeasure m;
+  for (std::size_t p = 0; p < embedding.numPoints(); ++p) {
+    const Vec3 x = embedding.points()[p] + d.row(static_cast<Eigen::Index>(p)).transpose();
+    double distance = std::numeric_limits<double>::infinity();
+    for (const Obstacle& o : obstacles)
+      if (o.bounds(t).contains(x)) distance = std::min(distance, o.query(x, t).distance);
+    if (!(distance < 0.0)) continue;
+    ++m.contacts;
+    m.deepest = std::max(m.deepest, -distance);
+    m.energy += 0.5 * stiffness * areas[p] * distance * distance;
+  }
+  return m;
+}
+
+TEST(ContactModel, CulledPointsNeverTouch) {
+  // A 4^3 grid of the cube [-0.5, 0.5]^2 x [0.5, 1.5], p = 1, and a sphere of 642 points inside
+  // it; the ground z <= 0 rising at 0.3 per unit time and a box obstacle beside it.
+  const PolyMesh mesh = hexGridMesh(4, 4, 4, Box3(Vec3(-0.5, -0.5, 0.5), Vec3(0.5, 0.5, 1.5)));
+  MomentCache moments(mesh, 2);
+  moments.update();
+  const DgBasis basis(mesh, moments, {1});
+  const SurfaceEmbedding embedding(mesh, basis, icosphere(Vec3(0, 0, 1), 0.45, 3).vertices);
+  const std::vector<double> areas(embedding.numPoints(), 1e-3);
+  DistanceFieldOptions field;
+  field.voxel = 0.05;
+  field.exteriorBand = 0.1;
+  field.interiorBand = 0.5;
+  const std::vector<Obstacle> obstacles = {
+      Obstacle::halfSpace(Plane::make(Vec3(0, 0, 1), 0.0), Vec3(0, 0, 0.3)),
+      Obstacle::fromSurface(boxSurface(Box3(Vec3(0.8, -1, -1), Vec3(1.6, 1, 0.9))), field)};
+  ContactOptions options;
+  options.stiffness = 1e4;
+  ContactModel model(embedding, areas, obstacles, options);
+
+  // A path of states: a translation down and sideways with a random deformation on top, in
+  // steps that vary from small (clearances reused) to large (measured again).
+  const Eigen::Index n = basis.size();
+  std::mt19937_64 rng(20261204);
+  std::uniform_real_distribution<double> noise(-1.0, 1.0);
+  Eigen::VectorXd u(static_cast<Eigen::Index>(mesh.numElements()) * 3 * n);
+  std::size_t touching = 0, states = 0;
+  double t = 0.0;
+  for (int k = 0; k < 120; ++k) {
+    const double s = (k % 17 == 0) ? 0.2 : 0.004;  // now and then a jump
+    t += s;
+    const Vec3 shift(0.9 * t, 0.0, -1.2 * t);
+    for (std::size_t e = 0; e < mesh.numElements(); ++e)
+      for (int d = 0; d < 3; ++d)
+        u.segment((static_cast<Eigen::Index>(e) * 3 + d) * n, n) =
+            affineCoefficients(basis, ElementId(e), shift[d], Vec3::Zero(), Vec3::Zero());
+    for (Eigen::Index i = 0; i < u.size(); ++i) u[i] += 0.01 * noise(rng);
+    const ContactMeasure culled = model.measure(u, t);
+    const ContactMeasure brute = bruteForce(embedding, obstacles, areas, options.stiffness, u, t);
+    ASSERT_EQ(culled.contacts, brute.contacts) << "state " << k;
+    ASSERT_EQ(culled.deepest, brute.deepest) << "state " << k;
+    ASSERT_EQ(culled.energy, brute.energy) << "state " << k;
+    touching += brute.contacts > 0;
+    ++states;
+  }
+  std::printf("%zu of %zu states touch\n", touching, states);
+  // The path crosses both obstacles: some states touch, some do not.
+  EXPECT_GT(touching, 10u);
+  EXPECT_LT(touching, states);
+}
+
+}  // namespace
+}  // namespace polydg
