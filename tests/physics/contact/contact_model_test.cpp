@@ -2,7 +2,7 @@
 // clearance never touch. Its measure of contacts, deepest penetration and penalty energy equals
 // a brute-force evaluation over every point, bit for bit, along a path of states that moves the
 // body through a moving ground and a box obstacle in steps small and large (clearances reused,
-// and measured again).
+// and measured again), and with the body still as the ground rises into it.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -80,6 +80,17 @@ TEST(ContactModel, CulledPointsNeverTouch) {
     ASSERT_EQ(culled.contacts, brute.contacts) << "state " << k;
     ASSERT_EQ(culled.deepest, brute.deepest) << "state " << k;
     ASSERT_EQ(culled.energy, brute.energy) << "state " << k;
+    touching += brute.contacts > 0;
+    ++states;
+  }
+  // The body still and the ground rising into it: only the obstacle moves.
+  u.setZero();
+  for (int k = 0; k <= 60; ++k) {
+    t = 0.05 * k;  // the ground at 0.3 t passes the sphere's bottom, 0.55, at t = 1.83
+    const ContactMeasure culled = model.measure(u, t);
+    const ContactMeasure brute = bruteForce(embedding, obstacles, areas, options.stiffness, u, t);
+    ASSERT_EQ(culled.contacts, brute.contacts) << "time " << t;
+    ASSERT_EQ(culled.deepest, brute.deepest) << "time " << t;
     touching += brute.contacts > 0;
     ++states;
   }
