@@ -234,8 +234,11 @@ void Simulation::step(int k) {
   try {
     step.step = solver_->step(scene_.dt);
   } catch (const std::runtime_error& e) {
+    // The solver's message carries its own hint where it has a better one than a smaller dt.
+    const std::string what = e.what();
     throw CheckFailure("step " + std::to_string(k) + " (t = " + std::to_string(solver_->time()) +
-                       "): " + e.what() + "; try a smaller dt");
+                       "): " + what +
+                       (what.find("; try ") == std::string::npos ? "; try a smaller dt" : ""));
   }
   step.seconds = ts.seconds();
   // The cuts made at the last step boundary: this step completes their latency.

@@ -72,8 +72,10 @@ Eigen::VectorXd StepSolver::solve(const Eigen::VectorXd& rhs, const Eigen::Vecto
   LinearSolveReport lr;
   Eigen::VectorXd x = solver_.solve(rhs, lr, &guess);
   if (!lr.success)
-    throw std::runtime_error("the time step's solve failed (CG did not converge, residual " +
-                             std::to_string(lr.residual) + ")");
+    throw std::runtime_error("the time step's solve failed (CG did not converge in " +
+                             std::to_string(lr.iterations) + " iterations, residual " +
+                             std::to_string(lr.residual) +
+                             "); try the scene's \"solver\": \"cholesky\" or a smaller dt");
   report.iterations += lr.iterations;
   report.residual = lr.residual;
   return x;

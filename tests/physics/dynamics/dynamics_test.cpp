@@ -370,5 +370,27 @@ TEST(Dynamics, ConjugateGradientStepsAgreeWithCholeskyAndSwitchPreconditioner) {
   }
 }
 
+TEST(Dynamics, AStepWhoseCgFailsNamesWhatHelps) {
+  // CG held to one iteration cannot solve a loaded step: the error names the direct solver and
+  // a smaller step, the two things that help.
+  const PolyMesh mesh = hexGridMesh(4, 1, 1, Box3(Vec3::Zero(), Vec3(4, 1, 1)));
+  MomentCache moments(mesh, 2);
+  moments.update();
+  DynamicsOptions o = options(1, true, Integrator::BackwardEuler);
+  o.solver.kind = SolverKind::ConjugateGradient;
+  o.solver.maxIterations = 1;
+  DynamicSolver solver(mesh, moments, {{FaceSelector::inPlane(0, 0.0)}, {}, Vec3(0, 0, -1)}, o);
+  try {
+    solver.step(0.01);
+    FAIL() << "the step solved";
+  } catch (const std::runtime_error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("CG did not converge in 1 iterations"), std::string::npos) << what;
+    EXPECT_NE(what.find("try the scene's \"solver\": \"cholesky\" or a smaller dt"),
+              std::string::npos)
+        << what;
+  }
+}
+
 }  // namespace
 }  // namespace polydg
