@@ -2,8 +2,10 @@
 #include "physics/contact/contact.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <stdexcept>
 #include <string>
 #include <unordered_map>
@@ -238,8 +240,35 @@ ContactLinearization ContactModel::build() const {
   const Eigen::Index m = static_cast<Eigen::Index>(3 * columns.size());
   const Eigen::Index contacts = static_cast<Eigen::Index>(active_.size());
   const bool friction = options_.friction > 0.0;
-  Eigen::MatrixXd g = Eigen::MatrixXd::Zero(m, contacts);
-  Eigen::MatrixXd h = friction ? Eigen::MatrixXd::Zero(m, 2 * contacts) : Eigen::MatrixXd();
+  // Contacts with one normal (all of a half-space's) share n n^T and their tangents: their
+  // K_c is (sum_k k a_k w_k w_k^T) (x) n n^T, a Gram matrix of the scalar columns, a ninth of
+  // the product (the ground's 2,400 contacts in B9 took 17 ms of a 58 ms step the other way).
+  const Eigen::Index ms = static_cast<Eigen::Index>(columns.size());
+  std::map<std::array<double, 3>, std::vector<Eigen::Index>> byNormal;
+  for (Eigen::Index k = 0; k < contacts; ++k) {
+    const Vec3& n = active_[static_cast<std::size_t>(k)].normal;
+    byNormal[{n.x(), n.y(), n.z()}].push_back(k);
+  }
+  const bool grouped = 8 * byNormal.size() <= static_cast<std::size_t>(contacts);
+  std::vector<Eigen::Index> group(static_cast<std::size_t>(contacts)), slot(group.size());
+  std::vector<Vec3> groupNormal;
+  for (const auto& [normal, members] : byNormal) {
+    for (std::size_t i = 0; i < members.size(); ++i) {
+      group[static_cast<std::size_t>(members[i])] = static_cast<Eigen::Index>(groupNormal.size());
+      slot[static_cast<std::size_t>(members[i])] = static_cast<Eigen::Index>(i);
+    }
+    groupNormal.emplace_back(normal[0], normal[1], normal[2]);
+  }
+  std::vector<Eigen::MatrixXd> gs, hs;  // grouped: ms x (members) scalar columns
+  if (grouped)
+    for (const auto& [normal, members] : byNormal) {
+      const Eigen::Index size = static_cast<Eigen::Index>(members.size());
+      gs.push_back(Eigen::MatrixXd::Zero(ms, size));
+      if (friction) hs.push_back(Eigen::MatrixXd::Zero(ms, size));
+    }
+  Eigen::MatrixXd g = grouped ? Eigen::MatrixXd() : Eigen::MatrixXd::Zero(m, contacts);
+  Eigen::MatrixXd h =
+      friction && !grouped ? Eigen::MatrixXd::Zero(m, 2 * contacts) : Eigen::MatrixXd();
   for (Eigen::Index k = 0; k < contacts; ++k) {
     const Active& a = active_[static_cast<std::size_t>(k)];
     const double ka = options_.stiffness * areas_[a.point];
@@ -264,11 +293,19 @@ ContactLinearization ContactModel::build() const {
     for (std::size_t j = 0; j < row.columns.size(); ++j) {
       const Eigen::Index base = 3 * static_cast<Eigen::Index>(local.at(row.columns[j]));
       const double w = row.values[j];
+      if (grouped) {
+        const std::size_t gk = static_cast<std::size_t>(group[static_cast<std::size_t>(k)]);
+        const Eigen::Index sk2 = slot[static_cast<std::size_t>(k)];
+        gs[gk](base / 3, sk2) = sk * w;
+        if (friction) hs[gk](base / 3, sk2) = sc * w;
+      }
       for (int d = 0; d < 3; ++d) {
-        g(base + d, k) = sk * w * a.normal[d];
-        if (friction) {
-          h(base + d, 2 * k) = sc * w * t1[d];
-          h(base + d, 2 * k + 1) = sc * w * t2[d];
+        if (!grouped) {
+          g(base + d, k) = sk * w * a.normal[d];
+          if (friction) {
+            h(base + d, 2 * k) = sc * w * t1[d];
+            h(base + d, 2 * k + 1) = sc * w * t2[d];
+          }
         }
         out.force[dof(row.columns[j], d)] += w * force[d];
       }
@@ -289,11 +326,32 @@ ContactLinearization ContactModel::build() const {
     result.setFromTriplets(t.begin(), t.end());
     return result;
   };
-  const Eigen::MatrixXd kc = g * g.transpose();
-  out.stiffness = scatter(kc);
-  if (friction) {
-    const Eigen::MatrixXd ctm = h * h.transpose();
-    out.damping = scatter(ctm);
+  // S (x) B into the 3 x 3 blocks of an m x m matrix.
+  auto expand = [&](const Eigen::MatrixXd& scalar, const Eigen::Matrix3d& b, Eigen::MatrixXd& to) {
+    for (Eigen::Index j = 0; j < ms; ++j)
+      for (Eigen::Index i = 0; i < ms; ++i)
+        if (scalar(i, j) != 0.0) to.block<3, 3>(3 * i, 3 * j) += scalar(i, j) * b;
+  };
+  if (grouped) {
+    Eigen::MatrixXd kc = Eigen::MatrixXd::Zero(m, m), ctm;
+    if (friction) ctm = Eigen::MatrixXd::Zero(m, m);
+    for (std::size_t gk = 0; gk < gs.size(); ++gk) {
+      const Vec3& n = groupNormal[gk];
+      expand(gs[gk] * gs[gk].transpose(), n * n.transpose(), kc);
+      if (friction) {
+        const Vec3 t1 = n.unitOrthogonal(), t2 = n.cross(t1);
+        expand(hs[gk] * hs[gk].transpose(), t1 * t1.transpose() + t2 * t2.transpose(), ctm);
+      }
+    }
+    out.stiffness = scatter(kc);
+    if (friction) out.damping = scatter(ctm);
+  } else {
+    const Eigen::MatrixXd kc = g * g.transpose();
+    out.stiffness = scatter(kc);
+    if (friction) {
+      const Eigen::MatrixXd ctm = h * h.transpose();
+      out.damping = scatter(ctm);
+    }
   }
   return out;
 }

@@ -102,5 +102,69 @@ TEST(ContactModel, CulledPointsNeverTouch) {
   EXPECT_LT(touching, states);
 }
 
+TEST(ContactModel, ContactStiffnessIsTheSumOfThePointsPenalties) {
+  // K_c = sum over the points in contact of k a (w (x) n)(w (x) n)^T: for any coefficient change
+  // dU, dU^T K_c dU = sum k a (n . (W dU)_p)^2 over those points, with the points in contact
+  // found here by brute force (the predicted position inside a half-space). A ground and a
+  // wall: contacts in two groups of one normal each (the Gram path), and a single contact
+  // with a third normal beside them.
+  const PolyMesh mesh = hexGridMesh(4, 4, 4, Box3(Vec3(-0.5, -0.5, 0.5), Vec3(0.5, 0.5, 1.5)));
+  MomentCache moments(mesh, 2);
+  moments.update();
+  const DgBasis basis(mesh, moments, {1});
+  const SurfaceEmbedding embedding(mesh, basis, icosphere(Vec3(0, 0, 1), 0.45, 3).vertices);
+  std::vector<double> areas(embedding.numPoints());
+  for (std::size_t p = 0; p < areas.size(); ++p) areas[p] = 1e-3 * (1.0 + 0.01 * double(p % 7));
+  const std::vector<Obstacle> obstacles = {
+      Obstacle::halfSpace(Plane::make(Vec3(0, 0, 1), 0.6)),    // z <= 0.6
+      Obstacle::halfSpace(Plane::make(Vec3(-1, 0, 0), 0.38)),  // x >= 0.38
+      Obstacle::halfSpace(Plane::make(Vec3(1, 1, 1), -0.3))};  // touches nothing
+  ContactOptions options;
+  options.stiffness = 1e4;
+  options.friction = 0.3;
+  options.slipSpeed = 0.01;
+  ContactModel model(embedding, areas, obstacles, options);
+  const Eigen::Index n = basis.size();
+  const Eigen::VectorXd u =
+      Eigen::VectorXd::Zero(static_cast<Eigen::Index>(mesh.numElements()) * 3 * n);
+  const ContactLinearization c = model.linearize(u, u, 0.01, 0.01);
+  // Brute force: the deepest obstacle of each point, as the model takes it.
+  std::vector<Vec3> normals;
+  std::vector<std::size_t> points;
+  for (std::size_t p = 0; p < embedding.numPoints(); ++p) {
+    double deepest = std::numeric_limits<double>::infinity();
+    Vec3 normal = Vec3::Zero();
+    for (const Obstacle& o : obstacles) {
+      const ObstacleQuery q = o.query(embedding.points()[p], 0.01);
+      if (q.distance < deepest) {
+        deepest = q.distance;
+        normal = q.normal;
+      }
+    }
+    if (deepest < 0.0) {
+      points.push_back(p);
+      normals.push_back(normal);
+    }
+  }
+  ASSERT_EQ(c.contacts, points.size());
+  EXPECT_GT(points.size(), 20u);
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  for (int trial = 0; trial < 3; ++trial) {
+    Eigen::VectorXd du(u.size());
+    for (Eigen::Index i = 0; i < du.size(); ++i) du[i] = unit(rng);
+    const Eigen::Matrix<double, Eigen::Dynamic, 3> w = embedding.displacements(du);
+    double expected = 0.0;
+    for (std::size_t k = 0; k < points.size(); ++k) {
+      const double s = normals[k].dot(w.row(static_cast<Eigen::Index>(points[k])).transpose());
+      expected += options.stiffness * areas[points[k]] * s * s;
+    }
+    const double got = du.dot(c.stiffness * du);
+    EXPECT_NEAR(got, expected, 1e-12 * expected) << "trial " << trial;
+    // The friction damping is positive semidefinite and vanishes on normal motion only.
+    EXPECT_GE(du.dot(c.damping * du), 0.0);
+  }
+}
+
 }  // namespace
 }  // namespace polydg
