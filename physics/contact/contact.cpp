@@ -19,6 +19,38 @@ namespace {
 using SpMat = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
 using Triplets = std::vector<Eigen::Triplet<double, int>>;
 
+/// Contacts grouped by their exact normal: contact k is member slot[k] of group group[k].
+struct NormalGroups {
+  std::vector<Eigen::Index> group, slot, size;
+  std::vector<Vec3> normal;
+};
+
+NormalGroups groupByNormal(const std::vector<Vec3>& normals) {
+  std::map<std::array<double, 3>, std::vector<Eigen::Index>> byNormal;
+  for (std::size_t k = 0; k < normals.size(); ++k)
+    byNormal[{normals[k].x(), normals[k].y(), normals[k].z()}].push_back(
+        static_cast<Eigen::Index>(k));
+  NormalGroups g;
+  g.group.resize(normals.size());
+  g.slot.resize(normals.size());
+  for (const auto& [normal, members] : byNormal) {
+    for (std::size_t i = 0; i < members.size(); ++i) {
+      g.group[static_cast<std::size_t>(members[i])] = static_cast<Eigen::Index>(g.normal.size());
+      g.slot[static_cast<std::size_t>(members[i])] = static_cast<Eigen::Index>(i);
+    }
+    g.normal.emplace_back(normal[0], normal[1], normal[2]);
+    g.size.push_back(static_cast<Eigen::Index>(members.size()));
+  }
+  return g;
+}
+
+/// to += scalar (x) b: scalar's entry (i, j) times b in the 3 x 3 block (i, j).
+void addKronecker(const Eigen::MatrixXd& scalar, const Eigen::Matrix3d& b, Eigen::MatrixXd& to) {
+  for (Eigen::Index j = 0; j < scalar.cols(); ++j)
+    for (Eigen::Index i = 0; i < scalar.rows(); ++i)
+      if (scalar(i, j) != 0.0) to.block<3, 3>(3 * i, 3 * j) += scalar(i, j) * b;
+}
+
 }  // namespace
 
 ContactModel::ContactModel(const SurfaceEmbedding& points, std::vector<double> areas,
@@ -242,27 +274,15 @@ ContactLinearization ContactModel::build() const {
   const bool friction = options_.friction > 0.0;
   // Contacts with one normal (all of a half-space's) share n n^T and their tangents: their
   // K_c is (sum_k k a_k w_k w_k^T) (x) n n^T, a Gram matrix of the scalar columns, a ninth of
-  // the product (the ground's 2,400 contacts in B9 took 17 ms of a 58 ms step the other way).
+  // the product (the ground's 2,400 contacts in B9 took 38 ms of a 58 ms step the other way).
   const Eigen::Index ms = static_cast<Eigen::Index>(columns.size());
-  std::map<std::array<double, 3>, std::vector<Eigen::Index>> byNormal;
-  for (Eigen::Index k = 0; k < contacts; ++k) {
-    const Vec3& n = active_[static_cast<std::size_t>(k)].normal;
-    byNormal[{n.x(), n.y(), n.z()}].push_back(k);
-  }
-  const bool grouped = 8 * byNormal.size() <= static_cast<std::size_t>(contacts);
-  std::vector<Eigen::Index> group(static_cast<std::size_t>(contacts)), slot(group.size());
-  std::vector<Vec3> groupNormal;
-  for (const auto& [normal, members] : byNormal) {
-    for (std::size_t i = 0; i < members.size(); ++i) {
-      group[static_cast<std::size_t>(members[i])] = static_cast<Eigen::Index>(groupNormal.size());
-      slot[static_cast<std::size_t>(members[i])] = static_cast<Eigen::Index>(i);
-    }
-    groupNormal.emplace_back(normal[0], normal[1], normal[2]);
-  }
+  std::vector<Vec3> normals;
+  for (const Active& a : active_) normals.push_back(a.normal);
+  const NormalGroups groups = groupByNormal(normals);
+  const bool grouped = 8 * groups.normal.size() <= static_cast<std::size_t>(contacts);
   std::vector<Eigen::MatrixXd> gs, hs;  // grouped: ms x (members) scalar columns
   if (grouped)
-    for (const auto& [normal, members] : byNormal) {
-      const Eigen::Index size = static_cast<Eigen::Index>(members.size());
+    for (Eigen::Index size : groups.size) {
       gs.push_back(Eigen::MatrixXd::Zero(ms, size));
       if (friction) hs.push_back(Eigen::MatrixXd::Zero(ms, size));
     }
@@ -294,8 +314,8 @@ ContactLinearization ContactModel::build() const {
       const Eigen::Index base = 3 * static_cast<Eigen::Index>(local.at(row.columns[j]));
       const double w = row.values[j];
       if (grouped) {
-        const std::size_t gk = static_cast<std::size_t>(group[static_cast<std::size_t>(k)]);
-        const Eigen::Index sk2 = slot[static_cast<std::size_t>(k)];
+        const std::size_t gk = static_cast<std::size_t>(groups.group[static_cast<std::size_t>(k)]);
+        const Eigen::Index sk2 = groups.slot[static_cast<std::size_t>(k)];
         gs[gk](base / 3, sk2) = sk * w;
         if (friction) hs[gk](base / 3, sk2) = sc * w;
       }
@@ -326,21 +346,15 @@ ContactLinearization ContactModel::build() const {
     result.setFromTriplets(t.begin(), t.end());
     return result;
   };
-  // S (x) B into the 3 x 3 blocks of an m x m matrix.
-  auto expand = [&](const Eigen::MatrixXd& scalar, const Eigen::Matrix3d& b, Eigen::MatrixXd& to) {
-    for (Eigen::Index j = 0; j < ms; ++j)
-      for (Eigen::Index i = 0; i < ms; ++i)
-        if (scalar(i, j) != 0.0) to.block<3, 3>(3 * i, 3 * j) += scalar(i, j) * b;
-  };
   if (grouped) {
     Eigen::MatrixXd kc = Eigen::MatrixXd::Zero(m, m), ctm;
     if (friction) ctm = Eigen::MatrixXd::Zero(m, m);
     for (std::size_t gk = 0; gk < gs.size(); ++gk) {
-      const Vec3& n = groupNormal[gk];
-      expand(gs[gk] * gs[gk].transpose(), n * n.transpose(), kc);
+      const Vec3& normal = groups.normal[gk];
+      addKronecker(gs[gk] * gs[gk].transpose(), normal * normal.transpose(), kc);
       if (friction) {
-        const Vec3 t1 = n.unitOrthogonal(), t2 = n.cross(t1);
-        expand(hs[gk] * hs[gk].transpose(), t1 * t1.transpose() + t2 * t2.transpose(), ctm);
+        const Vec3 t1 = normal.unitOrthogonal(), t2 = normal.cross(t1);
+        addKronecker(hs[gk] * hs[gk].transpose(), t1 * t1.transpose() + t2 * t2.transpose(), ctm);
       }
     }
     out.stiffness = scatter(kc);
