@@ -17,6 +17,8 @@ from pathlib import Path
 import meshio
 import numpy as np
 
+from end_to_end_support import box_obj
+
 # Measured 2026-12-01: tip 4.001911 against 4.031200, -0.73% (the library's face-quadrature tip on
 # the same mesh is -0.7%, README "Stability"); the bound is the 1% the solve must reach, which
 # leaves 0.27% for changes a user would not notice and fails on any loss of accuracy beyond.
@@ -31,18 +33,6 @@ def timoshenko_tip():
     return L**3 / (3.0 * E * i) + L / (5.0 / 6.0 * g * 1.0)
 
 
-def write_beam(path):
-    corners = [(x, y, z) for x in (0.0, L) for y in (0.0, 1.0) for z in (0.0, 1.0)]
-    # Outward triangles of the box (vertex k = 4 ix + 2 iy + iz, 1-based in OBJ).
-    faces = [(1, 2, 4), (1, 4, 3), (5, 7, 8), (5, 8, 6), (1, 5, 6), (1, 6, 2),
-             (3, 4, 8), (3, 8, 7), (1, 3, 7), (1, 7, 5), (2, 6, 8), (2, 8, 4)]
-    with open(path, "w") as out:
-        for c in corners:
-            out.write("v %r %r %r\n" % c)
-        for f in faces:
-            out.write("f %d %d %d\n" % f)
-
-
 def run(command):
     done = subprocess.run(command, capture_output=True, text=True)
     if done.returncode != 0:
@@ -54,7 +44,7 @@ def main():
     polydg, work = sys.argv[1], Path(sys.argv[2])
     work.mkdir(parents=True, exist_ok=True)
     beam = work / "beam.obj"
-    write_beam(beam)
+    box_obj(beam, (0.0, 0.0, 0.0), (L, 1.0, 1.0))
     run([polydg, "mesh", str(beam), "--cell", "0.25", "-o", str(work / "beam.vtu"), "--quiet"])
     run([polydg, "solve", str(work / "beam.vtu"), "-o", str(work / "solved.vtu"), "--degree",
          "2", "--E", str(E), "--nu", str(NU), "--clamp", "x=0", "--traction", "x=10:0,0,-1",
