@@ -38,14 +38,28 @@ ContactMeasure bruteForce(const SurfaceEmbedding& embedding, const std::vector<O
   return m;
 }
 
-TEST(ContactModel, CulledPointsNeverTouch) {
-  // A 4^3 grid of the cube [-0.5, 0.5]^2 x [0.5, 1.5], p = 1, and a sphere of 642 points inside
-  // it; the ground z <= 0 rising at 0.3 per unit time and a box obstacle beside it.
-  const PolyMesh mesh = hexGridMesh(4, 4, 4, Box3(Vec3(-0.5, -0.5, 0.5), Vec3(0.5, 0.5, 1.5)));
-  MomentCache moments(mesh, 2);
+/// The moments, computed.
+const MomentCache& updated(MomentCache& moments) {
   moments.update();
-  const DgBasis basis(mesh, moments, {1});
-  const SurfaceEmbedding embedding(mesh, basis, icosphere(Vec3(0, 0, 1), 0.45, 3).vertices);
+  return moments;
+}
+
+/// A 4^3 grid of the cube [-0.5, 0.5]^2 x [0.5, 1.5], p = 1, and a sphere of 642 points
+/// (radius 0.45 about (0, 0, 1)) embedded in it.
+struct SphereInACube {
+  PolyMesh mesh = hexGridMesh(4, 4, 4, Box3(Vec3(-0.5, -0.5, 0.5), Vec3(0.5, 0.5, 1.5)));
+  MomentCache moments{mesh, 2};
+  DgBasis basis{mesh, updated(moments), {1}};
+  SurfaceEmbedding embedding{mesh, basis, icosphere(Vec3(0, 0, 1), 0.45, 3).vertices};
+};
+
+TEST(ContactModel, CulledPointsNeverTouch) {
+  // The sphere in the cube; the ground z <= 0 rising at 0.3 per unit time and a box obstacle
+  // beside it.
+  const SphereInACube body;
+  const PolyMesh& mesh = body.mesh;
+  const DgBasis& basis = body.basis;
+  const SurfaceEmbedding& embedding = body.embedding;
   const std::vector<double> areas(embedding.numPoints(), 1e-3);
   DistanceFieldOptions field;
   field.voxel = 0.05;
@@ -106,13 +120,12 @@ TEST(ContactModel, ContactStiffnessIsTheSumOfThePointsPenalties) {
   // K_c = sum over the points in contact of k a (w (x) n)(w (x) n)^T: for any coefficient change
   // dU, dU^T K_c dU = sum k a (n . (W dU)_p)^2 over those points, with the points in contact
   // found here by brute force (the predicted position inside a half-space). A ground and a
-  // wall: contacts in two groups of one normal each (the Gram path), and a single contact
-  // with a third normal beside them.
-  const PolyMesh mesh = hexGridMesh(4, 4, 4, Box3(Vec3(-0.5, -0.5, 0.5), Vec3(0.5, 0.5, 1.5)));
-  MomentCache moments(mesh, 2);
-  moments.update();
-  const DgBasis basis(mesh, moments, {1});
-  const SurfaceEmbedding embedding(mesh, basis, icosphere(Vec3(0, 0, 1), 0.45, 3).vertices);
+  // wall: contacts in two groups of one normal each (the Gram path), and a third plane that
+  // touches nothing.
+  const SphereInACube body;
+  const PolyMesh& mesh = body.mesh;
+  const DgBasis& basis = body.basis;
+  const SurfaceEmbedding& embedding = body.embedding;
   std::vector<double> areas(embedding.numPoints());
   for (std::size_t p = 0; p < areas.size(); ++p) areas[p] = 1e-3 * (1.0 + 0.01 * double(p % 7));
   const std::vector<Obstacle> obstacles = {
