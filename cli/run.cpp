@@ -14,6 +14,7 @@
 #include "cli/progress.h"
 #include "model/files.h"
 #include "polydg/model/pipeline.h"
+#include "util/format.h"
 
 namespace polydg::cli {
 
@@ -28,12 +29,6 @@ struct RunOptions {
   std::string out;
   std::string report;
 };
-
-std::string formatNumber(double x, int precision) {
-  std::ostringstream s;
-  s << std::setprecision(precision) << x;
-  return s.str();
-}
 
 void printSummary(const std::vector<InputOutcome>& outcomes, std::ostream& out) {
   std::size_t width = 5;

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "mesh/surface_repair.h"
+#include "util/format.h"
 #include "util/stopwatch.h"
 
 namespace polydg {
@@ -62,12 +63,7 @@ double cellSizeFor(const Box3& box, const MeshingOptions& o) {
 }
 
 /// "1.27e+30": a length for a message.
-std::string shortNumber(double x) {
-  std::ostringstream out;
-  out.precision(3);
-  out << x;
-  return out.str();
-}
+std::string shortNumber(double x) { return formatNumber(x, 3); }
 
 /// Refuses a surface whose lengths would overflow or underflow downstream (kLargestLength and
 /// kSmallestLength) and returns the cell size.

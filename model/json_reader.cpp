@@ -1,4 +1,5 @@
 #include "model/json_reader.h"
+#include "util/format.h"
 
 #include <cmath>
 #include <fstream>
@@ -8,14 +9,6 @@
 namespace polydg {
 
 using nlohmann::json;
-
-namespace {
-std::string format(double x) {
-  std::ostringstream s;
-  s << x;
-  return s.str();
-}
-}  // namespace
 
 JsonObjectReader::JsonObjectReader(const json& object, std::string place, std::string file,
                                    std::string hint)
@@ -43,7 +36,7 @@ double JsonObjectReader::number(const std::string& key, double lo, double hi) {
   const json& v = get(key);
   if (!v.is_number() || !std::isfinite(v.get<double>()) ||
       !(v.get<double>() >= lo && v.get<double>() <= hi))
-    fail(at(key), "expected a number in [" + format(lo) + ", " + format(hi) + "]");
+    fail(at(key), "expected a number in [" + formatNumber(lo) + ", " + formatNumber(hi) + "]");
   return v.get<double>();
 }
 

@@ -14,6 +14,7 @@
 #include "model/json_reader.h"
 #include "polydg/mesh/surface_io.h"
 #include "polydg/model/report_json.h"
+#include "util/format.h"
 #include "util/stopwatch.h"
 
 namespace polydg {
@@ -248,13 +249,6 @@ std::string substituteStem(const std::string& path, const std::string& stem) {
        at = out.find("{stem}", at + stem.size()))
     out.replace(at, 6, stem);
   return out;
-}
-
-/// x with `precision` significant digits.
-std::string formatNumber(double x, int precision = 6) {
-  std::ostringstream s;
-  s << std::setprecision(precision) << x;
-  return s.str();
 }
 
 bool isVolumeMesh(const std::string& path) {

@@ -7,6 +7,7 @@
 #include "cli/bench/csv.h"
 #include "model/files.h"
 #include "polydg/model/names.h"
+#include "util/format.h"
 
 namespace polydg::bench {
 
@@ -37,11 +38,7 @@ std::string upper(std::string s) {
   return s;
 }
 
-std::string shortNumber(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3g", v);
-  return buf;
-}
+std::string shortNumber(double v) { return formatNumber(v, 3); }
 
 nlohmann::json runJson(const BenchmarkRun& r) {
   return {{"method", toString(r.method)},

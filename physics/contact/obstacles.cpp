@@ -21,6 +21,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "util/format.h"
 #include "util/stopwatch.h"
 
 namespace polydg {
@@ -45,22 +46,17 @@ void requireFiniteVelocity(const char* where, const Vec3& velocity) {
     throw std::invalid_argument(std::string(where) + ": the velocity must be finite");
 }
 
-std::string number(double x) {
-  std::ostringstream s;
-  s << x;
-  return s.str();
-}
-
 void checkOptions(const DistanceFieldOptions& o) {
   const std::string where = "Obstacle::fromSurface: ";
   if (!(std::isfinite(o.voxel) && o.voxel > 0))
     throw std::invalid_argument(where + "the voxel size must be positive and finite (got " +
-                                number(o.voxel) + ")");
+                                formatNumber(o.voxel) + ")");
   const auto band = [&](const char* name, double width) {
     if (!(std::isfinite(width) && width >= kMinBandVoxels * o.voxel))
-      throw std::invalid_argument(
-          where + "the " + name + " band must be finite and at least " + number(kMinBandVoxels) +
-          " voxels, " + number(kMinBandVoxels * o.voxel) + " (got " + number(width) + ")");
+      throw std::invalid_argument(where + "the " + name + " band must be finite and at least " +
+                                  formatNumber(kMinBandVoxels) + " voxels, " +
+                                  formatNumber(kMinBandVoxels * o.voxel) + " (got " +
+                                  formatNumber(width) + ")");
   };
   band("exterior", o.exteriorBand);
   band("interior", o.interiorBand);
@@ -87,7 +83,7 @@ void checkSurface(const TriangleSurface& s) {
         " misoriented edges): an obstacle is the inside of a closed surface");
   const double volume = enclosedVolume(s);
   if (!(volume > 0))
-    throw std::invalid_argument(where + "the surface encloses volume " + number(volume) +
+    throw std::invalid_argument(where + "the surface encloses volume " + formatNumber(volume) +
                                 ": it must be oriented outward (reverse it)");
 }
 
@@ -289,8 +285,8 @@ Obstacle Obstacle::fromSurface(const TriangleSurface& surface, const DistanceFie
   const Box3 box = polydg::bounds(surface);
   const double across = box.sizes().maxCoeff() / options.voxel;
   if (across > kMaxVoxelsAcross)
-    throw std::invalid_argument("Obstacle::fromSurface: the surface is " + number(across) +
-                                " voxels across, more than " + number(kMaxVoxelsAcross) +
+    throw std::invalid_argument("Obstacle::fromSurface: the surface is " + formatNumber(across) +
+                                " voxels across, more than " + formatNumber(kMaxVoxelsAcross) +
                                 ": use a larger voxel");
   openvdb::initialize();  // idempotent; registers OpenVDB's types
 

@@ -11,20 +11,10 @@
 
 #include "physics/dg/block_rows.h"
 #include "physics/solvers/agglomeration.h"
+#include "util/format.h"
 #include "util/stopwatch.h"
 
 namespace polydg {
-
-namespace {
-
-/// A number as the terminal shows it: 6 significant digits.
-std::string formatNumber(double x) {
-  std::ostringstream s;
-  s << x;
-  return s.str();
-}
-
-}  // namespace
 
 namespace {
 using SpMat = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
