@@ -124,26 +124,36 @@ def obj_volume(path):
     return np.einsum("ij,ij->", v[t[:, 0]], np.cross(v[t[:, 1]], v[t[:, 2]])) / 6.0
 
 
+def read_xml(reader_type, path, size):
+    """The dataset a VTK XML reader of `reader_type` reads from `path`; CheckFailed if it reports
+    an error or `size` of the dataset is 0."""
+    reader = reader_type()
+    reader.SetFileName(str(path))
+    reader.Update()
+    data = reader.GetOutput()
+    if reader.GetErrorCode() != 0 or data is None or size(data) == 0:
+        raise CheckFailed("VTK could not read %s" % path)
+    return data
+
+
+def arrays_of(attributes):
+    """A VTK point or cell data's arrays by name, as float numpy arrays."""
+    arrays = {}
+    for k in range(attributes.GetNumberOfArrays()):
+        a = attributes.GetArray(k)
+        arrays[a.GetName()] = vtk_to_numpy(a).astype(float)
+    return arrays
+
+
 class Vtu:
     """A VTU file read by VTK: points, each cell's faces (lists of point ids), point, cell and
     (numeric) field data as numpy arrays."""
 
     def __init__(self, path):
-        reader = vtkXMLUnstructuredGridReader()
-        reader.SetFileName(str(path))
-        reader.Update()
-        grid = reader.GetOutput()
-        if reader.GetErrorCode() != 0 or grid is None or grid.GetNumberOfCells() == 0:
-            raise CheckFailed("VTK could not read %s" % path)
+        grid = read_xml(vtkXMLUnstructuredGridReader, path, lambda g: g.GetNumberOfCells())
         self.points = vtk_to_numpy(grid.GetPoints().GetData()).astype(float)
-        self.point_data = {}
-        for k in range(grid.GetPointData().GetNumberOfArrays()):
-            a = grid.GetPointData().GetArray(k)
-            self.point_data[a.GetName()] = vtk_to_numpy(a).astype(float)
-        self.cell_data = {}
-        for k in range(grid.GetCellData().GetNumberOfArrays()):
-            a = grid.GetCellData().GetArray(k)
-            self.cell_data[a.GetName()] = vtk_to_numpy(a).astype(float)
+        self.point_data = arrays_of(grid.GetPointData())
+        self.cell_data = arrays_of(grid.GetCellData())
         self.field_data = {}
         for k in range(grid.GetFieldData().GetNumberOfArrays()):
             a = grid.GetFieldData().GetArray(k)
@@ -201,17 +211,8 @@ class Vtu:
 
 def read_vtp(path):
     """Points and point data of a VTP surface, read by VTK."""
-    reader = vtkXMLPolyDataReader()
-    reader.SetFileName(str(path))
-    reader.Update()
-    data = reader.GetOutput()
-    if reader.GetErrorCode() != 0 or data is None or data.GetNumberOfPoints() == 0:
-        raise CheckFailed("VTK could not read %s" % path)
-    arrays = {}
-    for k in range(data.GetPointData().GetNumberOfArrays()):
-        a = data.GetPointData().GetArray(k)
-        arrays[a.GetName()] = vtk_to_numpy(a).astype(float)
-    return vtk_to_numpy(data.GetPoints().GetData()).astype(float), arrays
+    data = read_xml(vtkXMLPolyDataReader, path, lambda d: d.GetNumberOfPoints())
+    return vtk_to_numpy(data.GetPoints().GetData()).astype(float), arrays_of(data.GetPointData())
 
 
 def read_pvd(path):
