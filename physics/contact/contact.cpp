@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <string>
 #include <unordered_map>
+#include <unordered_set>
 
 #include "util/stopwatch.h"
 
@@ -214,24 +215,23 @@ bool ContactModel::adjust(const Eigen::VectorXd& uNew) {
   const SurfaceEmbedding& e = *embedding_;
   bool changed = false;
   // Drop contacts whose linearized force pulls at the new state.
-  std::unordered_map<std::uint32_t, char> isActive;
+  std::unordered_set<std::uint32_t> isActive;
   std::vector<Active> kept;
   for (const Active& a : active_) {
-    const Vec3 y = e.points()[a.point] + e.displacement(a.point, uNew);
+    const Vec3 y = e.position(a.point, uNew);
     if (a.distance + a.normal.dot(y - a.position) > 0.0) {
       changed = true;
       continue;
     }
     kept.push_back(a);
-    isActive.emplace(a.point, 1);
+    isActive.insert(a.point);
   }
   // Add points that end inside an obstacle.
   std::vector<std::uint32_t> points;
   for (std::uint32_t p : candidates(uNew, tNext_))
     if (!isActive.count(p)) points.push_back(p);
   std::vector<Vec3> positions(points.size());
-  for (std::size_t k = 0; k < points.size(); ++k)
-    positions[k] = e.points()[points[k]] + e.displacement(points[k], uNew);
+  for (std::size_t k = 0; k < points.size(); ++k) positions[k] = e.position(points[k], uNew);
   std::vector<ObstacleQuery> q;
   std::vector<std::uint32_t> which;
   queryAll(positions, tNext_, q, which);
@@ -375,8 +375,7 @@ ContactMeasure ContactModel::measure(const Eigen::VectorXd& u, double t) {
   const SurfaceEmbedding& e = *embedding_;
   const std::vector<std::uint32_t>& points = candidates(u, t);
   std::vector<Vec3> positions(points.size());
-  for (std::size_t k = 0; k < points.size(); ++k)
-    positions[k] = e.points()[points[k]] + e.displacement(points[k], u);
+  for (std::size_t k = 0; k < points.size(); ++k) positions[k] = e.position(points[k], u);
   std::vector<ObstacleQuery> q;
   std::vector<std::uint32_t> which;
   queryAll(positions, t, q, which);

@@ -117,6 +117,10 @@ class SurfaceEmbedding {
     }
     return Vec3(sum[0], sum[1], sum[2]);
   }
+  /// Point p displaced by `coefficients`.
+  Vec3 position(std::size_t p, const Eigen::VectorXd& coefficients) const {
+    return points_[p] + displacement(p, coefficients);
+  }
 
   const std::vector<Vec3>& samplePositions() const { return samplePositions_; }
   /// Row p of W = Phi S (eq. 19): scalar coefficient columns e * n + i (ascending) and weights
