@@ -234,11 +234,9 @@ void Simulation::step(int k) {
   try {
     step.step = solver_->step(scene_.dt);
   } catch (const std::runtime_error& e) {
-    // The solver's message carries its own hint where it has a better one than a smaller dt.
-    const std::string what = e.what();
+    // The step solver's message ends with what helps.
     throw CheckFailure("step " + std::to_string(k) + " (t = " + std::to_string(solver_->time()) +
-                       "): " + what +
-                       (what.find("; try ") == std::string::npos ? "; try a smaller dt" : ""));
+                       "): " + e.what());
   }
   step.seconds = ts.seconds();
   // The cuts made at the last step boundary: this step completes their latency.

@@ -13,6 +13,12 @@ namespace {
 /// against 14 of the other at dt = 0.01.
 constexpr int kBlockJacobiLimit = 80;
 
+/// A step's matrix that is not positive definite: a smaller step is what helps.
+[[noreturn]] void throwNotDefinite(const std::string& matrix, const std::string& why) {
+  throw std::runtime_error("the time step's " + matrix + " is not positive definite" + why +
+                           "; try a smaller dt");
+}
+
 }  // namespace
 
 StepSolver::StepSolver(const StepSolverOptions& options, const ElementFrames& frames, int blockSize)
@@ -34,9 +40,7 @@ void StepSolver::prepare(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>
   if (!ready_) {
     const bool direct = chooseSolver(matrix, active_) == SolverKind::Cholesky;
     if (!solver_.compute(matrix, blockSize_, direct ? nullptr : frames_) && direct)
-      throw std::runtime_error(
-          "the time step's system matrix is not positive definite (a corotated element "
-          "turned inside out?)");
+      throwNotDefinite("system matrix", " (a corotated element turned inside out?)");
     report.refactorized = direct;
     report.preconditionerRebuilt = !direct;
     ready_ = true;
@@ -46,9 +50,7 @@ void StepSolver::prepare(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>
     const bool refresh = !direct && baselineIterations_ >= 0 &&
                          lastIterations_ > options_.refreshRatio * std::max(baselineIterations_, 1);
     if (!solver_.update(matrix, refresh, frames_) && direct)
-      throw std::runtime_error(
-          "the time step's system matrix is not positive definite (a corotated element "
-          "turned inside out?)");
+      throwNotDefinite("system matrix", " (a corotated element turned inside out?)");
     report.refactorized = direct;
     report.preconditionerRebuilt = refresh;
     if (refresh) baselineIterations_ = -1;
@@ -59,8 +61,7 @@ void StepSolver::prepareWithContact(const Eigen::SparseMatrix<double, Eigen::Col
                                     StepReport& report) {
   const bool direct = chooseSolver(matrix, active_) == SolverKind::Cholesky;
   if (!solver_.compute(matrix, blockSize_, direct ? nullptr : frames_) && direct)
-    throw std::runtime_error(
-        "the time step's system matrix with contacts is not positive definite");
+    throwNotDefinite("system matrix with contacts", "");
   report.refactorized = direct;
   report.preconditionerRebuilt = !direct;
   ready_ = false;
