@@ -38,6 +38,7 @@ class Simulation {
  private:
   // Setup.
   DynamicSolver makeSolver();
+  void replaceSolver();
   void setInitialVelocity();
   void embedSurface();
   void setUpContact();
