@@ -331,72 +331,18 @@ LocalMatrices localMatricesOf(const PolyMesh& mesh, const DgBasis& basis,
 BlockRows<double> assembleBlockRows(const PolyMesh& mesh, const DgBasis& basis,
                                     const MomentCache& moments, const FaceRoles& roles,
                                     const FormCoefficients& form) {
-  const int n = basis.size(), bs = 3 * n;
-  const bool bz = form.method == Method::BZ;
   const std::vector<std::vector<std::uint32_t>> neighbours = coupledNeighbours(mesh, roles);
-  const std::size_t ne = neighbours.size();
-  BlockRows<double> rows;
-  rows.n = n;
-  rows.bs = bs;
-  rows.start.assign(ne + 1, 0);
-  for (std::size_t e = 0; e < ne; ++e)
-    rows.start[e + 1] = rows.start[e] + static_cast<int>(neighbours[e].size());
-  const std::size_t slots = static_cast<std::size_t>(rows.start.back());
-  rows.element.resize(slots);
-  rows.diagonal.resize(slots);
-  rows.offset.assign(slots + 1, 0);
-  std::size_t k = 0;
-  for (std::size_t e = 0; e < ne; ++e)
-    for (const std::uint32_t f : neighbours[e]) {
-      rows.element[k] = static_cast<int>(f);
-      // BZ's neighbour blocks couple equal components only: three n x n blocks.
-      rows.diagonal[k] = bz && f != e ? 1 : 0;
-      rows.offset[k + 1] =
-          rows.offset[k] + static_cast<std::size_t>(rows.diagonal[k] ? 3 * n * n : bs * bs);
-      ++k;
-    }
-  rows.values.resize(rows.offset.back());
-  // Element e writes its own row's slots of itself and of each f > e, and row f's slot of e
-  // (the transpose): every slot has one writer.
-  forEachElementRows(
-      mesh, basis, moments, roles, form, neighbours, true, kAllFaceTerms, kAllFaceTerms, true,
-      [&](std::size_t e, const Eigen::MatrixXd& self, const double* coupling) {
-        const auto& b = neighbours[e];
-        const std::size_t first = static_cast<std::size_t>(rows.start[e]);
-        const std::size_t own = static_cast<std::size_t>(
-            std::lower_bound(b.begin(), b.end(), static_cast<std::uint32_t>(e)) - b.begin());
-        Eigen::Map<Eigen::MatrixXd>(rows.values.data() + rows.offset[first + own], bs, bs) = self;
-        for (std::size_t t = own + 1; t < b.size(); ++t) {
-          const std::size_t f = b[t];
-          // K_ef(c, j) = block(c, j), the block row-major.
-          const double* block = coupling + (t - own - 1) * static_cast<std::size_t>(bs * bs);
-          const auto& bf = neighbours[f];
-          const std::size_t back =
-              static_cast<std::size_t>(rows.start[f]) +
-              static_cast<std::size_t>(
-                  std::lower_bound(bf.begin(), bf.end(), static_cast<std::uint32_t>(e)) -
-                  bf.begin());
-          double* ef = rows.values.data() + rows.offset[first + t];
-          double* fe = rows.values.data() + rows.offset[back];
-          if (bz) {  // component d's n x n blocks, column-major; K_fe = K_ef^T
-            for (int d = 0; d < 3; ++d)
-              for (int j = 0; j < n; ++j)
-                for (int c = 0; c < n; ++c) {
-                  const double v = block[(d * n + c) * bs + d * n + j];
-                  ef[d * n * n + j * n + c] = v;
-                  fe[d * n * n + c * n + j] = v;
-                }
-            continue;
-          }
-          for (int j = 0; j < bs; ++j)
-            for (int c = 0; c < bs; ++c) {
-              const double v = block[c * bs + j];
-              ef[j * bs + c] = v;
-              fe[c * bs + j] = v;
-            }
-        }
-      });
+  BlockRows<double> rows = blockRowsLayout(neighbours, basis.size(), form.method == Method::BZ);
+  forEachElementRows(mesh, basis, moments, roles, form, neighbours, true, kAllFaceTerms,
+                     kAllFaceTerms, true,
+                     [&](std::size_t e, const Eigen::MatrixXd& self, const double* coupling) {
+                       writeElementRows(rows, neighbours, e, self.data(), coupling);
+                     });
   return rows;
+}
+
+BlockRows<double> blockRowsLayout(const LocalMatrices& local) {
+  return blockRowsLayout(local.neighbours, local.functions, local.componentDiagonalCoupling);
 }
 
 LocalMatrices localMatrices(const PolyMesh& mesh, const DgBasis& basis, const MomentCache& moments,

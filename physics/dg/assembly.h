@@ -166,6 +166,10 @@ BlockRows<double> assembleBlockRows(const PolyMesh& mesh, const DgBasis& basis,
                                     const MomentCache& moments, const FaceRoles& roles,
                                     const FormCoefficients& form);
 
+/// Block rows of the local matrices' layout (the same neighbours), values unset: for a time
+/// step's matrix written straight into them (CorotatedStiffness::assemble).
+BlockRows<double> blockRowsLayout(const LocalMatrices& local);
+
 /// Writes K from `local` into `matrix`, which has the pattern assembleStiffness() made for
 /// local matrices of the same layout: new values (a warped stiffness, a time step's system
 /// matrix) without a new matrix. Throws std::invalid_argument for another size or pattern.

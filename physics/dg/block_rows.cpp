@@ -247,4 +247,71 @@ Eigen::SparseMatrix<double, Eigen::ColMajor, int> BlockRows<T>::toSparse() const
 template struct BlockRows<float>;
 template struct BlockRows<double>;
 
+BlockRows<double> blockRowsLayout(const std::vector<std::vector<std::uint32_t>>& neighbours, int n,
+                                  bool componentDiagonal) {
+  const int bs = 3 * n;
+  const std::size_t ne = neighbours.size();
+  BlockRows<double> rows;
+  rows.n = n;
+  rows.bs = bs;
+  rows.start.assign(ne + 1, 0);
+  for (std::size_t e = 0; e < ne; ++e)
+    rows.start[e + 1] = rows.start[e] + static_cast<int>(neighbours[e].size());
+  const std::size_t slots = static_cast<std::size_t>(rows.start.back());
+  rows.element.resize(slots);
+  rows.diagonal.resize(slots);
+  rows.offset.assign(slots + 1, 0);
+  std::size_t k = 0;
+  for (std::size_t e = 0; e < ne; ++e)
+    for (const std::uint32_t f : neighbours[e]) {
+      rows.element[k] = static_cast<int>(f);
+      rows.diagonal[k] = componentDiagonal && f != e ? 1 : 0;
+      rows.offset[k + 1] =
+          rows.offset[k] + static_cast<std::size_t>(rows.diagonal[k] ? 3 * n * n : bs * bs);
+      ++k;
+    }
+  rows.values.resize(rows.offset.back());
+  return rows;
+}
+
+void writeElementRows(BlockRows<double>& rows,
+                      const std::vector<std::vector<std::uint32_t>>& neighbours, std::size_t e,
+                      const double* self, const double* coupling) {
+  const int n = rows.n, bs = rows.bs;
+  const std::size_t bb = static_cast<std::size_t>(bs) * static_cast<std::size_t>(bs);
+  const auto& b = neighbours[e];
+  const std::size_t first = static_cast<std::size_t>(rows.start[e]);
+  const std::size_t own = static_cast<std::size_t>(
+      std::lower_bound(b.begin(), b.end(), static_cast<std::uint32_t>(e)) - b.begin());
+  std::copy(self, self + bb, rows.values.data() + rows.offset[first + own]);
+  for (std::size_t t = own + 1; t < b.size(); ++t) {
+    const std::size_t f = b[t];
+    // K_ef(c, j) = block(c, j), the block row-major.
+    const double* block = coupling + (t - own - 1) * bb;
+    const auto& bf = neighbours[f];
+    const std::size_t back =
+        static_cast<std::size_t>(rows.start[f]) +
+        static_cast<std::size_t>(
+            std::lower_bound(bf.begin(), bf.end(), static_cast<std::uint32_t>(e)) - bf.begin());
+    double* ef = rows.values.data() + rows.offset[first + t];
+    double* fe = rows.values.data() + rows.offset[back];
+    if (rows.diagonal[first + t]) {  // component d's n x n blocks, column-major; K_fe = K_ef^T
+      for (int d = 0; d < 3; ++d)
+        for (int j = 0; j < n; ++j)
+          for (int c = 0; c < n; ++c) {
+            const double v = block[(d * n + c) * bs + d * n + j];
+            ef[d * n * n + j * n + c] = v;
+            fe[d * n * n + c * n + j] = v;
+          }
+      continue;
+    }
+    for (int j = 0; j < bs; ++j)
+      for (int c = 0; c < bs; ++c) {
+        const double v = block[c * bs + j];
+        ef[j * bs + c] = v;
+        fe[c * bs + j] = v;
+      }
+  }
+}
+
 }  // namespace polydg

@@ -124,6 +124,20 @@ struct BlockRows {
 extern template struct BlockRows<float>;
 extern template struct BlockRows<double>;
 
+/// The layout of a DG matrix's block rows, values allocated but unset: element e's slots
+/// against neighbours[e] (sorted, e included), n functions per component; with
+/// `componentDiagonal` (BZ) the slots between neighbours hold three n x n blocks.
+BlockRows<double> blockRowsLayout(const std::vector<std::vector<std::uint32_t>>& neighbours, int n,
+                                  bool componentDiagonal);
+
+/// Writes element e's blocks into `rows` (blockRowsLayout(neighbours, ...)): its diagonal block
+/// `self` (bs x bs, column-major), and its block against each neighbour f > e in order
+/// (`coupling`, bs x bs each, row-major) into its row and, transposed, into f's. Every slot
+/// has one writer, so elements can be written in parallel.
+void writeElementRows(BlockRows<double>& rows,
+                      const std::vector<std::vector<std::uint32_t>>& neighbours, std::size_t e,
+                      const double* self, const double* coupling);
+
 /// x += M s for a dense bs x bs column-major M (an element's inverse diagonal block in the
 /// p-multigrid smoother), compiled like BlockRows::subtractRowProduct.
 void addDenseProduct(int bs, const double* matrix, const double* s, double* x);

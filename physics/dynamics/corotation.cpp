@@ -2,12 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 #include <Eigen/SVD>
 
+#include "physics/dg/block_rows.h"
 #include "physics/dg/polynomial_tables.h"
 
 namespace polydg {
@@ -56,6 +58,17 @@ CorotatedStiffness::CorotatedStiffness(const DgBasis& basis, const MomentCache& 
       ne_(parts_.jumps.neighbours.size()) {
   buildSlots();
   elementTerms(basis, moments, origin);
+  // Elements with a Dirichlet face: the others' Dirichlet blocks are zero, and assembling skips
+  // warping them (2 of the 15 warps of an element with six neighbours).
+  const std::size_t bb = static_cast<std::size_t>(bs_) * bs_;
+  clamped_.assign(ne_, 0);
+  for (const std::vector<double>* dir : {&parts_.dirichletTrial, &parts_.dirichletTest})
+    if (dir->size() == ne_ * bb)
+      for (std::size_t i = 0; i < ne_; ++i)
+        if (std::any_of(dir->begin() + static_cast<std::ptrdiff_t>(i * bb),
+                        dir->begin() + static_cast<std::ptrdiff_t>((i + 1) * bb),
+                        [](double v) { return v != 0.0; }))
+          clamped_[i] = 1;
 }
 
 void CorotatedStiffness::buildSlots() {
@@ -252,14 +265,39 @@ void CorotatedStiffness::productOf(const std::vector<Eigen::Matrix3d>& r, const 
 void CorotatedStiffness::assemble(const std::vector<Eigen::Matrix3d>& r,
                                   const std::vector<double>& mass, double cM, double cK,
                                   LocalMatrices& system) const {
+  const std::size_t bb = static_cast<std::size_t>(bs_) * bs_;
+  // Element i's blocks straight into the arrays of `system`.
+  const auto into = [&](std::size_t i, std::vector<double>&) {
+    return std::pair{system.diagonal.data() + i * bb,
+                     system.coupling.data() + parts_.jumps.couplingStart[i] * bb};
+  };
+  const auto written = [](std::size_t, const double*, const double*) {};
   detail::dispatchBasisDegree(
-      degree_, [&](auto p) { assembleOf<numMonomials(p())>(r, mass, cM, cK, system); });
+      degree_, [&](auto p) { assembleOf<numMonomials(p())>(r, mass, cM, cK, into, written); });
 }
 
-template <int N>
+void CorotatedStiffness::assemble(const std::vector<Eigen::Matrix3d>& r,
+                                  const std::vector<double>& mass, double cM, double cK,
+                                  BlockRows<double>& rows) const {
+  const std::size_t bb = static_cast<std::size_t>(bs_) * bs_;
+  // Element i's blocks into a buffer of the thread, then into its row and (transposed) its
+  // neighbours' rows: one pass over the rows and no LocalMatrices.
+  const auto into = [&](std::size_t i, std::vector<double>& buffer) {
+    const std::size_t couplings = parts_.jumps.couplingStart[i + 1] - parts_.jumps.couplingStart[i];
+    buffer.resize((1 + couplings) * bb);
+    return std::pair{buffer.data(), buffer.data() + bb};
+  };
+  const auto written = [&](std::size_t i, const double* diagonal, const double* coupling) {
+    writeElementRows(rows, parts_.jumps.neighbours, i, diagonal, coupling);
+  };
+  detail::dispatchBasisDegree(
+      degree_, [&](auto p) { assembleOf<numMonomials(p())>(r, mass, cM, cK, into, written); });
+}
+
+template <int N, class Into, class Written>
 void CorotatedStiffness::assembleOf(const std::vector<Eigen::Matrix3d>& r,
                                     const std::vector<double>& mass, double cM, double cK,
-                                    LocalMatrices& system) const {
+                                    const Into& into, const Written& written) const {
   const int n = n_, bs = bs_;
   const std::size_t bb = static_cast<std::size_t>(bs) * bs;
   const bool bz = parts_.jumps.componentDiagonalCoupling;
@@ -267,8 +305,9 @@ void CorotatedStiffness::assembleOf(const std::vector<Eigen::Matrix3d>& r,
   tbb::parallel_for(
       tbb::blocked_range<std::size_t>(0, ne_, 32),
       [&](const tbb::blocked_range<std::size_t>& range) {
+        std::vector<double> buffer;
         for (std::size_t i = range.begin(); i != range.end(); ++i) {
-          double* d = system.diagonal.data() + i * bb;
+          const auto [d, couplingBlocks] = into(i, buffer);
           const double* js = parts_.jumps.diagonal.data() + i * bb;
           const double* ss = parts_.rowStrain.diagonal.data() + i * bb;
           for (std::size_t k = 0; k < bb; ++k) d[k] = cK * js[k];
@@ -278,6 +317,7 @@ void CorotatedStiffness::assembleOf(const std::vector<Eigen::Matrix3d>& r,
             for (std::size_t k = 0; k < bb; ++k) d[k] += cK * ss[k];
           if (!bz) {
             for (const std::vector<double>* dir : {&parts_.dirichletTrial, &parts_.dirichletTest}) {
+              if (!clamped_[i]) break;
               if (warp)
                 addWarped<N>(r[i], dir->data() + i * bb, cK, d);
               else
@@ -303,10 +343,10 @@ void CorotatedStiffness::assembleOf(const std::vector<Eigen::Matrix3d>& r,
           const auto firstGreater =
               std::upper_bound(nb.begin(), nb.end(), static_cast<std::uint32_t>(i));
           std::size_t slot = parts_.jumps.couplingStart[i];
-          for (auto it = firstGreater; it != nb.end(); ++it, ++slot) {
+          double* c = couplingBlocks;
+          for (auto it = firstGreater; it != nb.end(); ++it, ++slot, c += bb) {
             // Coupling blocks are row-major: as column-major they are the transposed block,
             // (R1 B R2^T)^T = R2 B^T R1^T.
-            double* c = system.coupling.data() + slot * bb;
             const double* jc = parts_.jumps.coupling.data() + slot * bb;
             for (std::size_t k = 0; k < bb; ++k) c[k] = cK * jc[k];
             if (bz) continue;
@@ -322,6 +362,7 @@ void CorotatedStiffness::assembleOf(const std::vector<Eigen::Matrix3d>& r,
               for (std::size_t k = 0; k < bb; ++k) c[k] += cK * (rc[k] + oc[k]);
             }
           }
+          written(i, d, couplingBlocks);
         }
       });
 }

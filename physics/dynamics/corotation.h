@@ -55,6 +55,9 @@ class CorotatedStiffness {
   /// element's n x n scalar mass block, column-major.
   void assemble(const std::vector<Eigen::Matrix3d>& r, const std::vector<double>& mass, double cM,
                 double cK, LocalMatrices& system) const;
+  /// The same straight into block rows of layout()'s pattern (blockRowsLayout(layout())).
+  void assemble(const std::vector<Eigen::Matrix3d>& r, const std::vector<double>& mass, double cM,
+                double cK, BlockRows<double>& rows) const;
 
  private:
   /// One block of an element's rows: against element `other`, read from `block` of the split
@@ -80,9 +83,11 @@ class CorotatedStiffness {
   template <int N>
   void productOf(const std::vector<Eigen::Matrix3d>& r, const Eigen::VectorXd& x,
                  const Eigen::VectorXd* z, Eigen::VectorXd& out, double* energy) const;
-  template <int N>
+  /// Element i's blocks of cM M + cK K_w, written where into(i, buffer) points (its diagonal
+  /// block, then its coupling blocks with neighbours f > i), then passed to written(i, ...).
+  template <int N, class Into, class Written>
   void assembleOf(const std::vector<Eigen::Matrix3d>& r, const std::vector<double>& mass, double cM,
-                  double cK, LocalMatrices& system) const;
+                  double cK, const Into& into, const Written& written) const;
 
   SplitLocalMatrices parts_;
   bool corotational_ = true;
@@ -91,7 +96,8 @@ class CorotatedStiffness {
   std::size_t ne_ = 0;
   std::vector<std::size_t> rowStart_;
   std::vector<RowSlot> slots_;
-  std::vector<double> gradients_;  ///< (1/|K|) int d_k phi_i at k * n + i, 3n per element
+  std::vector<std::uint8_t> clamped_;  ///< 1: the element has a Dirichlet face
+  std::vector<double> gradients_;      ///< (1/|K|) int d_k phi_i at k * n + i, 3n per element
   Eigen::VectorXd x0_;
 };
 

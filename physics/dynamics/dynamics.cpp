@@ -10,6 +10,7 @@
 #include <tbb/parallel_reduce.h>
 
 #include "integrate/quadrature.h"
+#include "physics/dg/block_rows.h"
 #include "physics/dg/form_coefficients.h"
 #include "physics/dynamics/corotation.h"
 #include "physics/dynamics/mass_matrix.h"
@@ -48,11 +49,18 @@ struct DynamicSolver::Impl final : SecondOrderSystem {
   ElementFrames frames;
   std::optional<StepSolver> stepSolver;
   LoadVectors loads;
-  LocalMatrices system;  ///< the blocks of the step's matrix cM M + cK K_w
+  /// CG: the step's matrix cM M + cK K_w by block rows, warped straight into them each time it
+  /// changes; CG multiplies with them and its preconditioner is built from them.
+  BlockRows<double> rows;
+  bool byRows = false;
+  LocalMatrices system;  ///< Cholesky: the blocks of the step's matrix, for `matrix`
+  /// Cholesky, and a step with contact terms (another pattern): the step's matrix in CSR,
+  /// written when needed.
   SpMat matrix;
+  bool matrixCurrent = false;
   SpMat contactMatrix;  ///< matrix plus the step's contact terms
   ContactModel* contact = nullptr;
-  bool assembled = false;  ///< `matrix` has its pattern
+  bool assembled = false;  ///< `system` holds the step's matrix of some step
   double lastCM = 0.0, lastCK = 0.0;
   MotionState state;
   std::unique_ptr<TimeIntegrator> integrator;
@@ -102,6 +110,7 @@ struct DynamicSolver::Impl final : SecondOrderSystem {
 
   // The parts of solve().
   bool assembleSystem(const ImplicitStep& step, StepReport& report);
+  const SpMat& csrMatrix();
   int solvesPerPass(const ImplicitStep& step) const;
   Eigen::VectorXd correct(const ImplicitStep& step, const Eigen::VectorXd& base, Eigen::VectorXd x,
                           int solves, StepReport& report, double& notSolving);
@@ -132,7 +141,6 @@ void DynamicSolver::Impl::setup(const PolyMesh& m, const MomentCache& mc, const 
   stiffness.emplace(*basis, mc, splitLocalMatrices(m, *basis, mc, roles, form), mass->centre(),
                     options.corotational);
   assembleLoads(l, lc);
-  system = stiffness->layout();  // layout; values are written per step
   frames = elementFrames(*basis, m);
   SolverOptions solver = options.solver;
   // A corotated step's matrix changes every step: Cholesky would factorize it again each time,
@@ -141,6 +149,13 @@ void DynamicSolver::Impl::setup(const PolyMesh& m, const MomentCache& mc, const 
   stepSolver.emplace(
       StepSolverOptions{solver, options.adaptivePreconditioner, options.refreshRatio}, frames,
       3 * basis->size());
+  rows = blockRowsLayout(stiffness->layout());
+  byRows = chooseSolver(static_cast<std::size_t>(rows.elements()) * rows.bs, rows.entries(),
+                        solver) == SolverKind::ConjugateGradient;
+  if (!byRows) {
+    rows = BlockRows<double>();
+    system = stiffness->layout();  // layout; values are written per step
+  }
   state.u = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(m.numElements()) * 3 * basis->size());
   state.v = state.u;
   state.a = state.u;
@@ -229,17 +244,33 @@ bool DynamicSolver::Impl::assembleSystem(const ImplicitStep& step, StepReport& r
   lastCM = step.cM;
   lastCK = step.cK;
   if (changed) {
-    stiffness->assemble(forceAtU().r, mass->blocks(), step.cM, step.cK, system);
-    if (!assembled) {
-      SpMat k = assembleStiffness(system);
-      matrix.swap(k);
-      assembled = true;
+    assembled = true;
+    matrixCurrent = false;
+    if (byRows) {
+      stiffness->assemble(forceAtU().r, mass->blocks(), step.cM, step.cK, rows);
     } else {
-      refillStiffness(system, matrix);
+      stiffness->assemble(forceAtU().r, mass->blocks(), step.cM, step.cK, system);
+      csrMatrix();
     }
   }
   report.assemblySeconds += t.seconds();
   return changed;
+}
+
+/// The step's matrix in CSR, written from the rows or `system` if it changed since.
+const SpMat& DynamicSolver::Impl::csrMatrix() {
+  if (matrixCurrent) return matrix;
+  if (byRows) {
+    SpMat k = rows.toSparse();
+    matrix.swap(k);
+  } else if (matrix.size() == 0) {
+    SpMat k = assembleStiffness(system);
+    matrix.swap(k);
+  } else {
+    refillStiffness(system, matrix);
+  }
+  matrixCurrent = true;
+  return matrix;
 }
 
 int DynamicSolver::Impl::solvesPerPass(const ImplicitStep& step) const {
@@ -311,10 +342,12 @@ Eigen::VectorXd DynamicSolver::Impl::solve(const ImplicitStep& step, StepReport&
     report.contactPasses = pass;
     const Eigen::VectorXd base =
         terms.empty() ? step.rhs : Eigen::VectorXd(step.rhs + contactRhs());
-    if (terms.empty()) {
+    if (terms.empty() && byRows) {
+      stepSolver->prepare(rows, matrixChanged, report);
+    } else if (terms.empty()) {
       stepSolver->prepare(matrix, matrixChanged, report);
     } else {
-      contactMatrix = matrix + (step.forceScale * step.cU) * terms.stiffness;
+      contactMatrix = csrMatrix() + (step.forceScale * step.cU) * terms.stiffness;
       if (terms.damping.nonZeros() > 0)
         contactMatrix += (step.forceScale * step.cV) * terms.damping;
       stepSolver->prepareWithContact(contactMatrix, report);

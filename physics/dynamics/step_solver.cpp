@@ -57,6 +57,21 @@ void StepSolver::prepare(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>
   }
 }
 
+void StepSolver::prepare(const BlockRows<double>& rows, bool changed, StepReport& report) {
+  if (!ready_) {
+    solver_.computeForUpdates(rows, frames_);
+    report.preconditionerRebuilt = true;
+    ready_ = true;
+    baselineIterations_ = -1;
+  } else if (changed) {
+    const bool refresh = baselineIterations_ >= 0 &&
+                         lastIterations_ > options_.refreshRatio * std::max(baselineIterations_, 1);
+    solver_.update(rows, refresh, frames_);
+    report.preconditionerRebuilt = refresh;
+    if (refresh) baselineIterations_ = -1;
+  }
+}
+
 void StepSolver::prepareWithContact(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix,
                                     StepReport& report) {
   const bool direct = chooseSolver(matrix, active_) == SolverKind::Cholesky;

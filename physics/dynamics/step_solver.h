@@ -34,6 +34,10 @@ class StepSolver {
   /// std::runtime_error if Cholesky finds the matrix not positive definite.
   void prepare(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix, bool changed,
                StepReport& report);
+  /// The same for CG with the step's matrix by block rows (same layout every step, rewritten
+  /// in place; no CSR matrix): its preconditioner built the first time and after
+  /// prepareWithContact(), else, if `changed`, kept or rebuilt by the refresh rule.
+  void prepare(const BlockRows<double>& rows, bool changed, StepReport& report);
   /// The same for a matrix with contact terms (another pattern): factorized or its
   /// preconditioner built anew, and again for the next step's matrix.
   void prepareWithContact(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix,

@@ -97,6 +97,7 @@ struct LinearSolver::Impl {
   /// K given by block rows alone (compute(const BlockRows<double>&)): the caller's, the one
   /// copy of K, read by the product and the smoother; `matrix` is then null.
   const BlockRows<double>* rows = nullptr;
+  bool rowsRewritten = false;  ///< computeForUpdates(): the preconditioner keeps its own copy
 
   const BlockRows<double>* productRows() const {
     return rows ? rows : useProductBlocks ? &productBlocks : nullptr;
@@ -141,6 +142,8 @@ struct LinearSolver::Impl {
     preconditioner = CgPreconditioner::BlockJacobi;
     return buildBlockJacobi();
   }
+
+  bool computeFromRows(const BlockRows<double>& rows, const ElementFrames* frames);
 
   bool buildBlockJacobi() {
     const Eigen::Index nb = rows ? rows->elements() : matrix->rows() / blockSize;
@@ -257,7 +260,18 @@ bool LinearSolver::compute(const SpMat& matrix, int blockSize, const ElementFram
 }
 
 bool LinearSolver::compute(const BlockRows<double>& rows, const ElementFrames* frames) {
-  Impl& m = *impl_;
+  impl_->rowsRewritten = false;
+  return impl_->computeFromRows(rows, frames);
+}
+
+bool LinearSolver::computeForUpdates(const BlockRows<double>& rows, const ElementFrames* frames) {
+  impl_->rowsRewritten = true;
+  return impl_->computeFromRows(rows, frames);
+}
+
+bool LinearSolver::Impl::computeFromRows(const BlockRows<double>& rows,
+                                         const ElementFrames* frames) {
+  Impl& m = *this;
   if (m.options.kind == SolverKind::Cholesky)
     throw std::invalid_argument(
         "LinearSolver::compute: block rows are for conjugate gradients; Cholesky needs the "
@@ -273,7 +287,8 @@ bool LinearSolver::compute(const BlockRows<double>& rows, const ElementFrames* f
   bool ok = true;
   const int degree = m.degreeOfBlock();
   if (m.preconditioner == CgPreconditioner::PMultigrid && degree >= 0) {
-    ok = m.multigrid.compute(rows, degree, frames);
+    ok = m.rowsRewritten ? m.multigrid.computeCopy(rows, degree, frames)
+                         : m.multigrid.compute(rows, degree, frames);
   } else {
     m.preconditioner = CgPreconditioner::BlockJacobi;
     ok = m.buildBlockJacobi();
@@ -303,6 +318,18 @@ bool LinearSolver::update(const SpMat& matrix, bool refreshPreconditioner,
   }
   m.factorSeconds = t0.seconds();
   return ok;
+}
+
+bool LinearSolver::update(const BlockRows<double>& rows, bool refreshPreconditioner,
+                          const ElementFrames* frames) {
+  Impl& m = *impl_;
+  if (m.rows != &rows || !m.rowsRewritten)
+    throw std::invalid_argument("LinearSolver::update: not the rows given to computeForUpdates()");
+  if (!refreshPreconditioner) {
+    m.factorSeconds = 0.0;
+    return true;
+  }
+  return m.computeFromRows(rows, frames);
 }
 
 Eigen::VectorXd LinearSolver::solve(const Eigen::VectorXd& rhs, LinearSolveReport& report) {

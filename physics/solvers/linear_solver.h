@@ -42,6 +42,11 @@ class LinearSolver {
   /// matrix and the copies the iteration makes of it). Throws std::invalid_argument if the
   /// options ask for Cholesky. Returns false as compute() does.
   bool compute(const BlockRows<double>& rows, const ElementFrames* frames = nullptr);
+  /// The same for block rows that the caller rewrites between solves, same layout (a time
+  /// step's matrix, written straight by rows: no CSR matrix): the product reads them as they
+  /// are; the preconditioner keeps its own copy (the p-multigrid's smoother in single
+  /// precision, block-Jacobi's inverses), rebuilt by update() when asked.
+  bool computeForUpdates(const BlockRows<double>& rows, const ElementFrames* frames = nullptr);
   /// New values of the matrix (`matrix`, with the pattern of the one given to compute(), must
   /// stay alive): Cholesky factorizes them numerically again, keeping the symbolic analysis;
   /// CG multiplies with them, and rebuilds its preconditioner only if `refreshPreconditioner`
@@ -50,6 +55,11 @@ class LinearSolver {
   /// std::invalid_argument for another pattern.
   bool update(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix,
               bool refreshPreconditioner, const ElementFrames* frames = nullptr);
+  /// New values in the rows given to computeForUpdates(): the product reads them already; the
+  /// preconditioner is rebuilt from them only if `refreshPreconditioner`. Throws
+  /// std::invalid_argument for other rows.
+  bool update(const BlockRows<double>& rows, bool refreshPreconditioner,
+              const ElementFrames* frames = nullptr);
   /// Solves K U = F; fills `report` (times of this solve; factorSeconds from compute()).
   Eigen::VectorXd solve(const Eigen::VectorXd& rhs, LinearSolveReport& report);
   /// The same with CG starting from `guess` (if not null; Cholesky ignores it): the last time

@@ -412,6 +412,11 @@ bool PMultigrid::compute(const BlockRows<double>& rows, int degree, const Elemen
   return impl_->build(nullptr, &rows, degree, nullptr, frames);
 }
 
+bool PMultigrid::computeCopy(const BlockRows<double>& rows, int degree,
+                             const ElementFrames* frames) {
+  return impl_->build(nullptr, &rows, degree, &rows, frames);
+}
+
 bool PMultigrid::Impl::build(const SpMat* matrix, const BlockRows<double>* rows, int degree,
                              const BlockRows<double>* matrixBlocks, const ElementFrames* frames) {
   Impl& m = *this;
@@ -492,6 +497,10 @@ bool PMultigrid::Impl::build(const SpMat* matrix, const BlockRows<double>* rows,
     // axis-aligned, and for BZ everywhere).
     m.levels.back().owned.prune([](Eigen::Index, Eigen::Index, double v) { return v != 0.0; });
   }
+  // Rows given to be copied (computeCopy()): read for the levels below, then converted for the
+  // top level's smoother like a CSR matrix's (prepareSmoother()).
+  if (rows != nullptr && matrixBlocks == rows && m.levels.size() > 1)
+    m.levels.front().rows = nullptr;
   std::atomic<bool> ok{true};
   // The smoothers' blocks and the coarsest level's factorization (serial in CHOLMOD) side by
   // side.

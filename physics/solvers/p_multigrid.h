@@ -83,6 +83,13 @@ class PMultigrid {
   /// principal submatrices. The one copy of K a CG solve then keeps.
   bool compute(const BlockRows<double>& rows, int degree, const ElementFrames* frames = nullptr);
 
+  /// The same from K by block rows that the caller rewrites between applications (a time
+  /// step's matrix): the levels are built from them, and the smoother keeps its own copy in
+  /// single precision, so the V-cycle stays the one of the matrix it was built for (symmetric
+  /// positive definite) while the rows change. `rows` is read during the call only.
+  bool computeCopy(const BlockRows<double>& rows, int degree,
+                   const ElementFrames* frames = nullptr);
+
   /// z = M^-1 r: one V-cycle for K z = r from z = 0.
   void apply(const Eigen::VectorXd& r, Eigen::VectorXd& z) const;
 

@@ -167,5 +167,49 @@ TEST(BlockRows, RefusesAPatternTooSparseForBlocks) {
   EXPECT_EQ(rows.values.size(), 18u);
 }
 
+TEST(BlockRows, RewrittenInPlaceTheyKeepThePreconditionerOfTheirFirstValues) {
+  // A time step's rows (computeForUpdates()): CG multiplies with the current values, the
+  // p-multigrid keeps its copy of the values it was built for. Doubled in place, K's solution
+  // halves in as many iterations (P^-1 of K preconditions 2K alike).
+  for (CgPreconditioner preconditioner :
+       {CgPreconditioner::PMultigrid, CgPreconditioner::BlockJacobi}) {
+    const FramedSystem s = b2FramedSystem(Method::IP, 1);
+    BlockRows<double> rows;
+    ASSERT_TRUE(rows.build(s.system.matrix, 4, 2.0));
+    SolverOptions cg;
+    cg.kind = SolverKind::ConjugateGradient;
+    cg.preconditioner = preconditioner;
+    LinearSolver solver(cg);
+    ASSERT_TRUE(solver.computeForUpdates(rows, &s.frames));
+    LinearSolveReport first, doubled, rebuilt;
+    const Eigen::VectorXd u = solver.solve(s.system.rhs, first);
+    ASSERT_TRUE(first.success);
+    for (double& v : rows.values) v *= 2.0;
+    ASSERT_TRUE(solver.update(rows, false, &s.frames));
+    const Eigen::VectorXd half = solver.solve(s.system.rhs, doubled);
+    EXPECT_TRUE(doubled.success);
+    EXPECT_EQ(doubled.iterations, first.iterations);
+    EXPECT_LT((2.0 * half - u).norm(), 1e-7 * u.norm());
+    EXPECT_LT(doubled.residual, 1e-8);
+    // Another matrix, not a multiple (every element's own block doubled again): rebuilt on
+    // update, the preconditioner is the one a new solver builds for it.
+    for (int e = 0; e < rows.elements(); ++e)
+      for (int k = rows.start[e]; k < rows.start[e + 1]; ++k)
+        if (rows.element[k] == e)
+          for (std::size_t v = rows.offset[k]; v < rows.offset[k + 1]; ++v) rows.values[v] *= 2.0;
+    ASSERT_TRUE(solver.update(rows, true, &s.frames));
+    solver.solve(s.system.rhs, rebuilt);
+    const BlockRows<double> copy = rows;
+    LinearSolver fresh(cg);
+    ASSERT_TRUE(fresh.computeForUpdates(copy, &s.frames));
+    LinearSolveReport reference;
+    fresh.solve(s.system.rhs, reference);
+    EXPECT_TRUE(rebuilt.success);
+    EXPECT_EQ(rebuilt.iterations, reference.iterations);
+    BlockRows<double> other = rows;
+    EXPECT_THROW(solver.update(other, false, &s.frames), std::invalid_argument);
+  }
+}
+
 }  // namespace
 }  // namespace polydg
