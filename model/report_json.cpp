@@ -566,9 +566,11 @@ json toJson(const SimulationReport& r) {
                     {"rotation", r.rotationSeconds},
                     {"assembly", r.assemblySeconds},
                     {"solve", r.solveSeconds},
+                    {"state", r.stateSeconds},
                     {"cut", r.cutSeconds},
                     {"output", r.outputSeconds},
                     {"surface", r.surfaceSeconds},
+                    {"finish", r.finishSeconds},
                     {"wall", r.wallSeconds},
                     {"per_step", (r.rotationSeconds + r.assemblySeconds + r.solveSeconds) / n}};
   return j;

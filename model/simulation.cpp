@@ -136,14 +136,12 @@ Simulation::Simulation(Model& model, Model::State& state, const Scene& scene,
   report_.initial = solver_->state();
   embedSurface();
   setUpContact();
+  report_.setupSeconds = wall_.seconds();  // the checks, the solver, the embedding and contact
 }
 
 DynamicSolver Simulation::makeSolver() {
-  const Stopwatch t;
-  DynamicSolver solver(model_.mesh(), model_.moments(2 * scene_.discretization.basis.degree),
+  return DynamicSolver(model_.mesh(), model_.moments(2 * scene_.discretization.basis.degree),
                        loads_, dynamics_);
-  report_.setupSeconds += t.seconds();
-  return solver;
 }
 
 /// The solver of the edited mesh. The old one goes first: its memory (the local matrices and the
@@ -230,7 +228,9 @@ SimulationReport Simulation::run() {
     if (k % scene_.outputEvery == 0 || k == scene_.steps || editedSinceFrame_) writeFrame(k);
     if (options_.progress) options_.progress({k, scene_.steps, solver_->time()});
   }
+  const Stopwatch tf;
   finish();
+  report_.finishSeconds = tf.seconds();
   report_.wallSeconds = wall_.seconds();
   return std::move(report_);
 }
@@ -253,11 +253,13 @@ void Simulation::step(int k) {
   cutsAwaitingStep_ = 0;
   step.solver = solverAction(step.step, solver_->solverKind(), freshSolver_);
   freshSolver_ = false;
+  const Stopwatch tr;
   step.state = solver_->state();
   if (contact_) {
     step.contact = contact_->measure(solver_->displacement(), solver_->time());
     step.collisionSeconds = step.step.contactQuerySeconds + contact_->takeQuerySeconds();
   }
+  report_.stateSeconds += tr.seconds();
   report_.rotationSeconds += step.step.rotationSeconds;
   report_.assemblySeconds += step.step.assemblySeconds;
   report_.solveSeconds += step.step.solveSeconds;
@@ -325,7 +327,10 @@ bool Simulation::adaptationDue(int k) {
   const bool coarsening = request.elements.empty();
   const CoarsenRequest coarsenRequest =
       coarsening ? families_.coarsening(fields, a) : CoarsenRequest{};
-  if (coarsening && coarsenRequest.groups.empty()) return false;
+  if (coarsening && coarsenRequest.groups.empty()) {
+    report_.cutSeconds += tr.seconds();  // the marking, which found nothing to do
+    return false;
+  }
   SimulationRefinement record;
   record.time = solver_->time();
   record.elementsBefore = model_.mesh().numElements();

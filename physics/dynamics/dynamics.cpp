@@ -229,9 +229,11 @@ Eigen::VectorXd DynamicSolver::Impl::acceleration(const MotionState& s) const {
 }
 
 void DynamicSolver::Impl::beginStep(StepReport& report) {
-  // The rotations and f(U_n): computed here, unless state() already did after the last step;
-  // counted in this step's phases either way.
+  // The rotations and f(U_n): computed by the last step (and counted there), unless the state
+  // was set since.
+  const bool computedHere = !current;
   const ForceAtU& at = forceAtU();
+  if (!computedHere) return;
   report.rotationSeconds += at.rotationSeconds;
   report.assemblySeconds += at.forceSeconds;
 }
@@ -464,6 +466,10 @@ StepReport DynamicSolver::step(double dt) {
   Impl& m = *impl_;
   StepReport report = m.integrator->step(m, m.state, dt);
   m.stateChanged();  // the rotations and the force belong to the old displacement
+  // Those of the new one, which the next step and the state's energy both need: counted here.
+  const Impl::ForceAtU& at = m.forceAtU();
+  report.rotationSeconds += at.rotationSeconds;
+  report.assemblySeconds += at.forceSeconds;
   return report;
 }
 

@@ -7,7 +7,7 @@ a moving obstacle that reaches the body at the step the kinematics say.
 The body is a bar [0, 4] x [0, 1] x [0, 1] sliced by `polydg mesh --cells 8` (32 elements), with
 density 2: mass m = 8, inertia about its centre I = m/12 diag(1 + 1, 16 + 1, 16 + 1).
 
-Groups (one ctest each): initial, integrators, frames, obstacle.
+Groups (one ctest each): initial, integrators, frames, phases, obstacle.
 Usage: simulate_end_to_end.py GROUP POLYDG WORKDIR
 """
 import json
@@ -195,6 +195,39 @@ def frames(polydg, work):
               len(vtu.cell_data["von_mises"]), len(reference.cells))
 
 
+# --- phases --------------------------------------------------------------------------------
+
+# The phases of the report's timings_s that together make its wall time (surface is a part of
+# output; read happens before the run's clock starts).
+PHASES = ["setup", "rotation", "assembly", "solve", "state", "cut", "output", "finish"]
+
+
+def phases(polydg, work):
+    """The report's phase times add up to its wall time within 5% (issue 31): a clamped bar
+    under gravity on 256 elements, cut mid-run, a frame every 5 steps; every phase that ran is
+    counted once (the cut's new solver in cut, not again in setup)."""
+    obj = box_obj(work / "long_bar.obj", (0.0, 0.0, 0.0), (4.0, 1.0, 1.0))
+    mesh = work / "long_bar.vtu"
+    run([polydg, "mesh", obj, "--cells", 16, "-o", mesh, "--quiet"])
+    scene = {"material": MATERIAL, "dt": 0.01, "steps": 30, "gravity": [0, 0, -G],
+             "fixed": [{"plane": [1, 0, 0, 0]}], "output": {"every": 5},
+             "cuts": [{"time": 0.15, "plane": [1, 0, 0, 2.1], "remove_side": "none"}]}
+    r, _ = simulate(polydg, work, mesh, "phases", scene)
+    t = r["timings_s"]
+    for key in PHASES:
+        check(t[key] >= 0.0, "timings_s.%s = %.3g s, not negative" % (key, t[key]))
+    check(t["cut"] > 0.0 and r["cuts"][0]["cut_seconds"]["solver"] > 0.0,
+          "the cut ran (%.3g s, its new solver %.3g s)" % (t["cut"],
+                                                           r["cuts"][0]["cut_seconds"]["solver"]))
+    check(t["surface"] <= t["output"], "surface %.3g s within output %.3g s" % (t["surface"],
+                                                                                 t["output"]))
+    close("the phases' sum against the wall time", sum(t[k] for k in PHASES), t["wall"], 0.05)
+    steps = sum(s["rotation_seconds"] + s["assembly_seconds"] + s["solve_seconds"]
+                for s in r["steps"])
+    close("the steps' phases against rotation + assembly + solve", steps,
+          t["rotation"] + t["assembly"] + t["solve"], 1e-9)
+
+
 # --- obstacle ------------------------------------------------------------------------------
 
 def obstacle(polydg, work):
@@ -231,7 +264,7 @@ def obstacle(polydg, work):
 
 
 GROUPS = {"initial": initial, "integrators": integrators, "frames": frames,
-          "obstacle": obstacle}
+          "phases": phases, "obstacle": obstacle}
 
 if __name__ == "__main__":
     main(GROUPS, sys.argv)

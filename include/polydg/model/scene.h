@@ -191,12 +191,18 @@ struct SimulationReport {
   std::vector<SimulationFrame> frames;
   std::string pvd;  ///< the collection file, "" without output (null in the JSON report)
   SimulationEmbedding embedding;
-  /// Seconds of surface updates for output frames (embedding displacements), all frames.
+  /// Seconds of surface updates for output frames (embedding displacements), all frames: a part
+  /// of outputSeconds.
   double surfaceSeconds = 0.0;
-  /// Totals of the phases: setup (bases, matrices, loads, after each cut too), rotation,
-  /// assembly, solve, cut, output.
+  /// Totals of the phases, which add up to the wall time: setup (the checks, bases, matrices,
+  /// loads, the initial state, embedding and contact), rotation, assembly, solve, state (each
+  /// step's reported energies, momenta and contact measures), cut (and refinement: each edit
+  /// with its new solver and the fields carried over, and the marking of an adaptation that
+  /// found nothing to do), output (frames), finish (the final mesh
+  /// and displacement handed to the model).
   double setupSeconds = 0.0, rotationSeconds = 0.0, assemblySeconds = 0.0, solveSeconds = 0.0,
-         cutSeconds = 0.0, outputSeconds = 0.0, wallSeconds = 0.0;
+         stateSeconds = 0.0, cutSeconds = 0.0, outputSeconds = 0.0, finishSeconds = 0.0,
+         wallSeconds = 0.0;
   std::size_t facesIntegrated = 0;  ///< by the simulation (moments of new faces after cuts)
 };
 

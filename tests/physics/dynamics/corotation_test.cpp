@@ -35,8 +35,9 @@ struct Body {
     const StaticSolver& s = *statics;
     mass = std::make_unique<MassMatrix>(s.basis(), s.moments(), 2.5);
     stiffness = std::make_unique<CorotatedStiffness>(
-        s.basis(), s.moments(), splitLocalMatrices(mesh, s.basis(), s.moments(), s.roles(), s.form()),
-        mass->centre(), true);
+        s.basis(), s.moments(),
+        splitLocalMatrices(mesh, s.basis(), s.moments(), s.roles(), s.form()), mass->centre(),
+        true);
   }
   SpMat stiffnessMatrix() const {
     const StaticSolver& s = *statics;
@@ -110,9 +111,10 @@ TEST(CorotatedStiffness, BlockRowsEqualTheLocalMatricesAssemblyForAnyRotations) 
       const std::size_t ne = body.mesh.numElements();
       std::vector<Eigen::Matrix3d> r(ne);
       for (std::size_t e = 0; e < ne; ++e)
-        r[e] = Eigen::AngleAxisd(0.05 * static_cast<double>(e),
-                                 Eigen::Vector3d(1, 0.3 * static_cast<double>(e % 5), -1).normalized())
-                   .toRotationMatrix();
+        r[e] =
+            Eigen::AngleAxisd(0.05 * static_cast<double>(e),
+                              Eigen::Vector3d(1, 0.3 * static_cast<double>(e % 5), -1).normalized())
+                .toRotationMatrix();
       LocalMatrices system = body.stiffness->layout();
       body.stiffness->assemble(r, body.mass->blocks(), 1.0, 0.01, system);
       const SpMat csr = assembleStiffness(system);
