@@ -12,6 +12,7 @@
 #include "physics/dg/local_integrators.h"
 #include "polydg/physics/dg/loads.h"
 #include "polydg/physics/dg/material.h"
+#include "util/uninitialized.h"
 
 namespace polydg {
 
@@ -111,11 +112,11 @@ struct LocalMatrices {
   bool componentDiagonalCoupling = false;  ///< BZ: coupling blocks couple equal components only
   /// Neighbours of each element through interior faces, sorted, the element itself included.
   std::vector<std::vector<std::uint32_t>> neighbours;
-  std::vector<double> diagonal;  ///< element e's block at e * blockSize^2
+  UninitializedVector<double> diagonal;  ///< element e's block at e * blockSize^2
   /// Element e's coupling blocks, one per neighbour f > e in order, start at block
   /// couplingStart[e] (each blockSize^2 values).
   std::vector<std::size_t> couplingStart;
-  std::vector<double> coupling;
+  UninitializedVector<double> coupling;
 };
 
 /// The element and face matrices of `form` (both IP and BZ), in parallel over elements.
@@ -141,12 +142,12 @@ struct SplitLocalMatrices {
   /// column-major) per neighbour in the order of `neighbours` without K, from block
   /// neighbourStart[K]. Zero for BZ.
   std::vector<std::size_t> neighbourStart;
-  std::vector<double> neighbourLifting;
+  UninitializedVector<double> neighbourLifting;
   /// IP, per element (3n x 3n, column-major): the terms of its Dirichlet faces with the strain
   /// of the trial function (consistency) and with that of the test function (symmetry, and
   /// the lifting). Apart because the jump on a Dirichlet face is against the fixed outside:
   /// warped, it is R^T (X - X0) = R^T U, where an interior face's is R^T X - X0 on both sides.
-  std::vector<double> dirichletTrial, dirichletTest;
+  UninitializedVector<double> dirichletTrial, dirichletTest;
 };
 
 SplitLocalMatrices splitLocalMatrices(const PolyMesh& mesh, const DgBasis& basis,

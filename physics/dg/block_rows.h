@@ -16,6 +16,8 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 
+#include "util/uninitialized.h"
+
 namespace polydg {
 
 /// Element e's rows (block size bs = 3n, e's DOFs [e bs, (e + 1) bs)) as blocks against the
@@ -24,29 +26,6 @@ namespace polydg {
 /// column-major) or, when the block couples equal displacement components only (BZ's
 /// neighbour blocks), component-diagonal: its three n x n diagonal blocks one after the other,
 /// each column-major (a third of the values).
-/// An allocator whose value-less construct() default-initializes: resize() of a vector of
-/// numbers leaves them unset, where std::allocator zeroes them in one serial pass. For arrays
-/// that are filled right after, in parallel (at 1.3 million DOFs the zeroing of the block rows
-/// was a serial pass over 1.3 GB).
-template <class T>
-struct UninitializedAllocator : std::allocator<T> {
-  template <class U>
-  struct rebind {
-    using other = UninitializedAllocator<U>;
-  };
-  UninitializedAllocator() = default;
-  template <class U>
-  UninitializedAllocator(const UninitializedAllocator<U>&) noexcept {}
-  template <class U>
-  void construct(U* p) noexcept(std::is_nothrow_default_constructible_v<U>) {
-    ::new (static_cast<void*>(p)) U;
-  }
-  template <class U, class... Args>
-  void construct(U* p, Args&&... args) {
-    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
-  }
-};
-
 template <class T>
 struct BlockRows {
   int bs = 0, n = 0;
