@@ -25,6 +25,11 @@ namespace {
 
 using SpMat = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
 
+/// CG leaves the contact terms of at most this many active points out of its preconditioner
+/// (each adds an outlying eigenvalue, about an iteration); more, and the preconditioner is built
+/// again with them.
+constexpr std::size_t kContactsOutsidePreconditioner = 64;
+
 /// The body's loads as vectors: gravity's, and each traction's while it acts.
 struct LoadVectors {
   Eigen::VectorXd gravity;
@@ -59,6 +64,8 @@ struct DynamicSolver::Impl final : SecondOrderSystem {
   SpMat matrix;
   bool matrixCurrent = false;
   SpMat contactMatrix;  ///< matrix plus the step's contact terms
+  SpMat contactTerms;   ///< the step's contact terms alone, when CG leaves them out of its
+                        ///< preconditioner
   ContactModel* contact = nullptr;
   bool assembled = false;  ///< `system` holds the step's matrix of some step
   double lastCM = 0.0, lastCK = 0.0;
@@ -348,6 +355,10 @@ Eigen::VectorXd DynamicSolver::Impl::solve(const ImplicitStep& step, StepReport&
       stepSolver->prepare(rows, matrixChanged, report);
     } else if (terms.empty()) {
       stepSolver->prepare(matrix, matrixChanged, report);
+    } else if (byRows && terms.contacts <= kContactsOutsidePreconditioner) {
+      contactTerms = (step.forceScale * step.cU) * terms.stiffness;
+      if (terms.damping.nonZeros() > 0) contactTerms += (step.forceScale * step.cV) * terms.damping;
+      stepSolver->prepareWithAddedTerms(rows, contactTerms, matrixChanged, report);
     } else {
       contactMatrix = csrMatrix() + (step.forceScale * step.cU) * terms.stiffness;
       if (terms.damping.nonZeros() > 0)

@@ -70,6 +70,15 @@ void StepSolver::prepare(const BlockRows<double>& rows, bool changed, StepReport
     report.preconditionerRebuilt = refresh;
     if (refresh) baselineIterations_ = -1;
   }
+  solver_.setAddedTerms(nullptr);
+}
+
+void StepSolver::prepareWithAddedTerms(
+    const BlockRows<double>& rows, const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& terms,
+    bool changed, StepReport& report) {
+  prepare(rows, changed, report);
+  solver_.setAddedTerms(&terms);
+  addedTerms_ = true;
 }
 
 void StepSolver::prepareWithContact(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix,
@@ -98,8 +107,12 @@ Eigen::VectorXd StepSolver::solve(const Eigen::VectorXd& rhs, const Eigen::Vecto
 }
 
 void StepSolver::endStep(StepReport& report) {
-  lastIterations_ = report.iterations;
-  if (baselineIterations_ < 0) baselineIterations_ = report.iterations;
+  // Contact terms outside the preconditioner add iterations that a new one would not save.
+  if (!addedTerms_) {
+    lastIterations_ = report.iterations;
+    if (baselineIterations_ < 0) baselineIterations_ = report.iterations;
+  }
+  addedTerms_ = false;
   report.preconditioner = active_.preconditioner;
   if (solver_.kind() == SolverKind::ConjugateGradient && options_.adaptivePreconditioner &&
       active_.preconditioner == CgPreconditioner::BlockJacobi &&

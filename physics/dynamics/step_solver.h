@@ -38,6 +38,12 @@ class StepSolver {
   /// in place; no CSR matrix): its preconditioner built the first time and after
   /// prepareWithContact(), else, if `changed`, kept or rebuilt by the refresh rule.
   void prepare(const BlockRows<double>& rows, bool changed, StepReport& report);
+  /// The same with the step's contact terms `terms` left out of the preconditioner (few contact
+  /// points): prepare(rows, ...), and CG multiplies with the rows plus `terms`, which must stay
+  /// alive while solving. The refresh rule counts the steps without such terms only.
+  void prepareWithAddedTerms(const BlockRows<double>& rows,
+                             const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& terms,
+                             bool changed, StepReport& report);
   /// The same for a matrix with contact terms (another pattern): factorized or its
   /// preconditioner built anew, and again for the next step's matrix.
   void prepareWithContact(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix,
@@ -60,6 +66,7 @@ class StepSolver {
   LinearSolver solver_;
   bool ready_ = false;  ///< factorized, or preconditioner built, for the matrix without contacts
   bool switchToMultigrid_ = false;
+  bool addedTerms_ = false;  ///< this step solved with terms outside the preconditioner
   int baselineIterations_ = -1, lastIterations_ = 0;
 };
 

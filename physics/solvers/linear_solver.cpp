@@ -103,11 +103,27 @@ struct LinearSolver::Impl {
     return rows ? rows : useProductBlocks ? &productBlocks : nullptr;
   }
 
-  /// y = K x; returns x.y. One pass (and one hand-off between threads) with the block rows.
+  /// setAddedTerms(): added to the product.
+  const SpMat* added = nullptr;
+
+  /// y = K x (+ T x); returns x.y. One pass (and one hand-off between threads) with the block
+  /// rows.
   double productDot(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
     const BlockRows<double>* blocks = productRows();
-    if (!blocks) {
-      symmetricProduct(*matrix, x, y);
+    if (!blocks || added) {
+      if (blocks) {
+        y.resize(x.size());
+        const int ne = static_cast<int>(x.size() / blockSize);
+        tbb::parallel_for(tbb::blocked_range<int>(0, ne, 64),
+                          [&](const tbb::blocked_range<int>& r) {
+                            for (int e = r.begin(); e != r.end(); ++e)
+                              blocks->rowProduct(
+                                  e, x.data(), y.data() + static_cast<Eigen::Index>(e) * blockSize);
+                          });
+      } else {
+        symmetricProduct(*matrix, x, y);
+      }
+      if (added) y.noalias() += *added * x;
       return parallelDot(x, y);
     }
     y.resize(x.size());
@@ -240,6 +256,7 @@ SolverKind LinearSolver::kind() const { return impl_->kind; }
 
 bool LinearSolver::compute(const SpMat& matrix, int blockSize, const ElementFrames* frames) {
   Impl& m = *impl_;
+  m.added = nullptr;
   m.matrix = &matrix;
   m.rows = nullptr;
   m.blockSize = blockSize;
@@ -272,6 +289,7 @@ bool LinearSolver::computeForUpdates(const BlockRows<double>& rows, const Elemen
 bool LinearSolver::Impl::computeFromRows(const BlockRows<double>& rows,
                                          const ElementFrames* frames) {
   Impl& m = *this;
+  m.added = nullptr;
   if (m.options.kind == SolverKind::Cholesky)
     throw std::invalid_argument(
         "LinearSolver::compute: block rows are for conjugate gradients; Cholesky needs the "
@@ -330,6 +348,13 @@ bool LinearSolver::update(const BlockRows<double>& rows, bool refreshPreconditio
     return true;
   }
   return m.computeFromRows(rows, frames);
+}
+
+void LinearSolver::setAddedTerms(const SpMat* terms) {
+  if (terms && impl_->kind == SolverKind::Cholesky)
+    throw std::invalid_argument(
+        "LinearSolver::setAddedTerms: Cholesky factorized the matrix alone");
+  impl_->added = terms;
 }
 
 Eigen::VectorXd LinearSolver::solve(const Eigen::VectorXd& rhs, LinearSolveReport& report) {

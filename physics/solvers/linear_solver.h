@@ -60,6 +60,11 @@ class LinearSolver {
   /// std::invalid_argument for other rows.
   bool update(const BlockRows<double>& rows, bool refreshPreconditioner,
               const ElementFrames* frames = nullptr);
+  /// CG: the product becomes K x + T x with `terms` T (symmetric positive semidefinite, few
+  /// nonzeros, alive while used; null: none), the preconditioner stays K's. For a time step's
+  /// contact terms: a few points add as many outlying eigenvalues, which cost CG about as many
+  /// iterations, where a preconditioner built again costs tens of V-cycles. compute() clears it.
+  void setAddedTerms(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>* terms);
   /// Solves K U = F; fills `report` (times of this solve; factorSeconds from compute()).
   Eigen::VectorXd solve(const Eigen::VectorXd& rhs, LinearSolveReport& report);
   /// The same with CG starting from `guess` (if not null; Cholesky ignores it): the last time
