@@ -27,8 +27,8 @@ using SpMat = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
 
 /// CG leaves the contact terms of at most this many active points out of its preconditioner
 /// (each adds an outlying eigenvalue, an iteration or two); more, and the preconditioner is built
-/// again with them. B9 at 1,736 elements: up to 15 points the kept one is faster (0.082
-/// against 0.129 s a step), from 19 about even or slower.
+/// again with them. The bound is where B9's drop found the two about even (docs/benchmarks.md,
+/// "Measurements behind the code's constants").
 constexpr std::size_t kContactsOutsidePreconditioner = 16;
 
 /// The body's loads as vectors: gravity's, and each traction's while it acts.
