@@ -142,8 +142,27 @@ def multigrid(polydg, out):
         check(r["residual"] <= 1e-10, name + ": residual %.3g" % r["residual"])
 
 
+def published(polydg, out):
+    """The dynamics suite's peers are the sources' own figures, labelled as published: Zhang et
+    al. 2017, Table 1 (shared/papers/zhang2017-smoothed-fem-corotational.txt): nodes 0.16k to
+    11.77k (DOFs 3 x nodes), total time per step 1.43 to 107.13 ms, on a 2.3 GHz dual core."""
+    data = read_json(out / "dynamics.json")
+    rows = data["speed"]["published"]
+    check(all(r["published"] for r in rows), "every peer row is marked published")
+    zhang = [(r["dofs"], r["t_step"]) for r in rows if r["source"].startswith("Zhang")]
+    equal("Zhang et al. 2017 rows (DOFs, seconds per step)", zhang,
+          [(480, 1.43e-3), (2790, 7.50e-3), (8400, 25.12e-3), (18750, 56.08e-3),
+           (35310, 107.13e-3)])
+    check(all("2.3 GHz" in r["machine"] for r in rows if r["source"].startswith("Zhang")),
+          "Zhang et al.'s machine: the paper's 2.3 GHz dual core")
+    others = sorted(r["source"] for r in rows if "dofs" not in r)
+    equal("peers given by elements only", others, ["Dick et al. 2011", "Sase et al. 2015"])
+    svg = (out / "dynamics_speed.svg").read_text()
+    check("published: Zhang et al. 2017" in svg, "dynamics_speed.svg shows the published curve")
+
+
 GROUPS = {"run": run_all, "all": all_suites, "accuracy": accuracy, "table41": table41,
-          "multigrid": multigrid}
+          "multigrid": multigrid, "published": published}
 
 if __name__ == "__main__":
-    main(GROUPS, sys.argv, keep=("all", "accuracy", "table41", "multigrid"))
+    main(GROUPS, sys.argv, keep=("all", "accuracy", "table41", "multigrid", "published"))
