@@ -32,7 +32,7 @@ struct BlockRows {
   std::vector<int> start, element;
   std::vector<std::size_t> offset;
   std::vector<std::uint8_t> diagonal;  ///< 1: component-diagonal slot
-  std::vector<T, UninitializedAllocator<T>> values;
+  UninitializedVector<T> values;
 
   /// Builds the rows of `a` (symmetric, both triangles stored, columns sorted) with n
   /// functions per component. Returns false, and keeps no values, if the blocks would store
