@@ -298,75 +298,77 @@ template <int N, class Into, class Written>
 void CorotatedStiffness::assembleOf(const std::vector<Eigen::Matrix3d>& r,
                                     const std::vector<double>& mass, double cM, double cK,
                                     const Into& into, const Written& written) const {
-  const int n = n_, bs = bs_;
-  const std::size_t bb = static_cast<std::size_t>(bs) * bs;
-  const bool bz = parts_.jumps.componentDiagonalCoupling;
-  const bool warp = corotational_;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ne_, 32),
                     [&](const tbb::blocked_range<std::size_t>& range) {
                       std::vector<double> buffer;
                       for (std::size_t i = range.begin(); i != range.end(); ++i) {
-                        const auto [d, couplingBlocks] = into(i, buffer);
-                        const double* js = parts_.jumps.diagonal.data() + i * bb;
-                        const double* ss = parts_.rowStrain.diagonal.data() + i * bb;
-                        for (std::size_t k = 0; k < bb; ++k) d[k] = cK * js[k];
-                        if (warp)
-                          addWarped<N>(r[i], ss, cK, d);
-                        else
-                          for (std::size_t k = 0; k < bb; ++k) d[k] += cK * ss[k];
-                        if (!bz) {
-                          for (const UninitializedVector<double>* dir :
-                               {&parts_.dirichletTrial, &parts_.dirichletTest}) {
-                            if (!clamped_[i]) break;
-                            if (warp)
-                              addWarped<N>(r[i], dir->data() + i * bb, cK, d);
-                            else
-                              for (std::size_t q = 0; q < bb; ++q) d[q] += cK * (*dir)[i * bb + q];
-                          }
-                          const std::size_t first = parts_.neighbourStart[i];
-                          std::size_t k = 0;
-                          for (std::uint32_t f : parts_.jumps.neighbours[i]) {
-                            if (f == i) continue;
-                            const double* nl = parts_.neighbourLifting.data() + (first + k++) * bb;
-                            if (warp)
-                              addWarped<N>(r[f], nl, cK, d);
-                            else
-                              for (std::size_t q = 0; q < bb; ++q) d[q] += cK * nl[q];
-                          }
-                        }
-                        const double* me = mass.data() + i * n * n;
-                        for (int c = 0; c < 3; ++c)
-                          for (int fi = 0; fi < n; ++fi)
-                            for (int fj = 0; fj < n; ++fj)
-                              d[static_cast<std::size_t>(c * n + fj) * bs + c * n + fi] +=
-                                  cM * me[fj * n + fi];
-                        const auto& nb = parts_.jumps.neighbours[i];
-                        const auto firstGreater =
-                            std::upper_bound(nb.begin(), nb.end(), static_cast<std::uint32_t>(i));
-                        std::size_t slot = parts_.jumps.couplingStart[i];
-                        double* c = couplingBlocks;
-                        for (auto it = firstGreater; it != nb.end(); ++it, ++slot, c += bb) {
-                          // Coupling blocks are row-major: as column-major they are the transposed
-                          // block, (R1 B R2^T)^T = R2 B^T R1^T.
-                          const double* jc = parts_.jumps.coupling.data() + slot * bb;
-                          for (std::size_t k = 0; k < bb; ++k) c[k] = cK * jc[k];
-                          if (bz) continue;
-                          const double* rc = parts_.rowStrain.coupling.data() + slot * bb;
-                          const double* oc = parts_.columnStrain.coupling.data() + slot * bb;
-                          if (warp) {
-                            const Eigen::Matrix3d& rf = r[*it];
-                            // Read each row-major block column-major (its transpose) and write the
-                            // transpose of the warped block: R_f B^T R_f^T etc. with the roles
-                            // swapped.
-                            addWarped<N>(r[i], rc, cK, c);
-                            addWarped<N>(rf, oc, cK, c);
-                          } else {
-                            for (std::size_t k = 0; k < bb; ++k) c[k] += cK * (rc[k] + oc[k]);
-                          }
-                        }
-                        written(i, d, couplingBlocks);
+                        const auto [diagonal, coupling] = into(i, buffer);
+                        elementBlocks<N>(r, mass, cM, cK, i, diagonal, coupling);
+                        written(i, diagonal, coupling);
                       }
                     });
+}
+
+template <int N>
+void CorotatedStiffness::elementBlocks(const std::vector<Eigen::Matrix3d>& r,
+                                       const std::vector<double>& mass, double cM, double cK,
+                                       std::size_t i, double* d, double* c) const {
+  const int n = n_, bs = bs_;
+  const std::size_t bb = static_cast<std::size_t>(bs) * bs;
+  const bool bz = parts_.jumps.componentDiagonalCoupling;
+  const bool warp = corotational_;
+  const double* js = parts_.jumps.diagonal.data() + i * bb;
+  const double* ss = parts_.rowStrain.diagonal.data() + i * bb;
+  for (std::size_t k = 0; k < bb; ++k) d[k] = cK * js[k];
+  if (warp)
+    addWarped<N>(r[i], ss, cK, d);
+  else
+    for (std::size_t k = 0; k < bb; ++k) d[k] += cK * ss[k];
+  if (!bz) {
+    if (clamped_[i])
+      for (const UninitializedVector<double>* dir :
+           {&parts_.dirichletTrial, &parts_.dirichletTest}) {
+        if (warp)
+          addWarped<N>(r[i], dir->data() + i * bb, cK, d);
+        else
+          for (std::size_t q = 0; q < bb; ++q) d[q] += cK * (*dir)[i * bb + q];
+      }
+    const std::size_t first = parts_.neighbourStart[i];
+    std::size_t k = 0;
+    for (std::uint32_t f : parts_.jumps.neighbours[i]) {
+      if (f == i) continue;
+      const double* nl = parts_.neighbourLifting.data() + (first + k++) * bb;
+      if (warp)
+        addWarped<N>(r[f], nl, cK, d);
+      else
+        for (std::size_t q = 0; q < bb; ++q) d[q] += cK * nl[q];
+    }
+  }
+  const double* me = mass.data() + i * n * n;
+  for (int comp = 0; comp < 3; ++comp)
+    for (int fi = 0; fi < n; ++fi)
+      for (int fj = 0; fj < n; ++fj)
+        d[static_cast<std::size_t>(comp * n + fj) * bs + comp * n + fi] += cM * me[fj * n + fi];
+  const auto& nb = parts_.jumps.neighbours[i];
+  const auto firstGreater = std::upper_bound(nb.begin(), nb.end(), static_cast<std::uint32_t>(i));
+  std::size_t slot = parts_.jumps.couplingStart[i];
+  for (auto it = firstGreater; it != nb.end(); ++it, ++slot, c += bb) {
+    // Coupling blocks are row-major: as column-major they are the transposed block,
+    // (R1 B R2^T)^T = R2 B^T R1^T.
+    const double* jc = parts_.jumps.coupling.data() + slot * bb;
+    for (std::size_t k = 0; k < bb; ++k) c[k] = cK * jc[k];
+    if (bz) continue;
+    const double* rc = parts_.rowStrain.coupling.data() + slot * bb;
+    const double* oc = parts_.columnStrain.coupling.data() + slot * bb;
+    if (warp) {
+      // Read each row-major block column-major (its transpose) and write the transpose of the
+      // warped block: R_f B^T R_f^T etc. with the roles swapped.
+      addWarped<N>(r[i], rc, cK, c);
+      addWarped<N>(r[*it], oc, cK, c);
+    } else {
+      for (std::size_t k = 0; k < bb; ++k) c[k] += cK * (rc[k] + oc[k]);
+    }
+  }
 }
 
 }  // namespace polydg

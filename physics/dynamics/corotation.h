@@ -88,6 +88,11 @@ class CorotatedStiffness {
   template <int N, class Into, class Written>
   void assembleOf(const std::vector<Eigen::Matrix3d>& r, const std::vector<double>& mass, double cM,
                   double cK, const Into& into, const Written& written) const;
+  /// Element i's blocks of cM M + cK K_w: its diagonal block into `d` (column-major), its
+  /// coupling blocks with neighbours f > i, one after the other, into `c` (row-major).
+  template <int N>
+  void elementBlocks(const std::vector<Eigen::Matrix3d>& r, const std::vector<double>& mass,
+                     double cM, double cK, std::size_t i, double* d, double* c) const;
 
   SplitLocalMatrices parts_;
   bool corotational_ = true;

@@ -68,7 +68,7 @@ struct DynamicSolver::Impl final : SecondOrderSystem {
   SpMat contactTerms;   ///< the step's contact terms alone, when CG leaves them out of its
                         ///< preconditioner
   ContactModel* contact = nullptr;
-  bool assembled = false;  ///< `system` holds the step's matrix of some step
+  bool assembled = false;  ///< the step's matrix (rows or `system`) was assembled once
   double lastCM = 0.0, lastCK = 0.0;
   MotionState state;
   std::unique_ptr<TimeIntegrator> integrator;

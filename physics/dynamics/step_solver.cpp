@@ -47,14 +47,20 @@ void StepSolver::prepare(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>
     baselineIterations_ = -1;
   } else if (changed) {
     const bool direct = solver_.kind() == SolverKind::Cholesky;
-    const bool refresh = !direct && baselineIterations_ >= 0 &&
-                         lastIterations_ > options_.refreshRatio * std::max(baselineIterations_, 1);
+    const bool refresh = !direct && refreshDue();
     if (!solver_.update(matrix, refresh, frames_) && direct)
       throwNotDefinite("system matrix", " (a corotated element turned inside out?)");
     report.refactorized = direct;
     report.preconditionerRebuilt = refresh;
     if (refresh) baselineIterations_ = -1;
   }
+}
+
+/// The refresh rule: the last step needed more than refreshRatio times the iterations of the
+/// first step after the preconditioner was built.
+bool StepSolver::refreshDue() const {
+  return baselineIterations_ >= 0 &&
+         lastIterations_ > options_.refreshRatio * std::max(baselineIterations_, 1);
 }
 
 void StepSolver::prepare(const BlockRows<double>& rows, bool changed, StepReport& report) {
@@ -64,8 +70,7 @@ void StepSolver::prepare(const BlockRows<double>& rows, bool changed, StepReport
     ready_ = true;
     baselineIterations_ = -1;
   } else if (changed) {
-    const bool refresh = baselineIterations_ >= 0 &&
-                         lastIterations_ > options_.refreshRatio * std::max(baselineIterations_, 1);
+    const bool refresh = refreshDue();
     solver_.update(rows, refresh, frames_);
     report.preconditionerRebuilt = refresh;
     if (refresh) baselineIterations_ = -1;

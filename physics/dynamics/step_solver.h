@@ -59,6 +59,8 @@ class StepSolver {
   SolverKind kind() const { return solver_.kind(); }
 
  private:
+  bool refreshDue() const;
+
   StepSolverOptions options_;
   const ElementFrames* frames_;
   int blockSize_;

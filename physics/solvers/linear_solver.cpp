@@ -106,24 +106,22 @@ struct LinearSolver::Impl {
   /// setAddedTerms(): added to the product.
   const SpMat* added = nullptr;
 
-  /// y = K x (+ T x); returns x.y. One pass (and one hand-off between threads) with the block
-  /// rows.
+  /// y = K x (+ T x); returns x.y.
   double productDot(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
+    double dot = matrixProductDot(x, y);
+    if (added) {
+      const Eigen::VectorXd t = *added * x;
+      y += t;
+      dot += x.dot(t);
+    }
+    return dot;
+  }
+
+  /// y = K x; returns x.y. One pass (and one hand-off between threads) with the block rows.
+  double matrixProductDot(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
     const BlockRows<double>* blocks = productRows();
-    if (!blocks || added) {
-      if (blocks) {
-        y.resize(x.size());
-        const int ne = static_cast<int>(x.size() / blockSize);
-        tbb::parallel_for(tbb::blocked_range<int>(0, ne, 64),
-                          [&](const tbb::blocked_range<int>& r) {
-                            for (int e = r.begin(); e != r.end(); ++e)
-                              blocks->rowProduct(
-                                  e, x.data(), y.data() + static_cast<Eigen::Index>(e) * blockSize);
-                          });
-      } else {
-        symmetricProduct(*matrix, x, y);
-      }
-      if (added) y.noalias() += *added * x;
+    if (!blocks) {
+      symmetricProduct(*matrix, x, y);
       return parallelDot(x, y);
     }
     y.resize(x.size());
