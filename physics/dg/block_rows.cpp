@@ -192,6 +192,37 @@ bool BlockRows<T>::build(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>
 }
 
 template <class T>
+void BlockRows<T>::layOutInOrder(const std::vector<int>& order) {
+  std::vector<std::size_t> moved(offset.size());
+  std::vector<std::size_t> rowStart(order.size() + 1, 0);
+  std::size_t next = 0;
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    const auto e = static_cast<std::size_t>(order[i]);
+    rowStart[i] = next;
+    for (auto k = static_cast<std::size_t>(start[e]); k < static_cast<std::size_t>(start[e + 1]);
+         ++k) {
+      moved[k] = next;
+      next += static_cast<std::size_t>(diagonal[k] ? 3 * n * n : bs * bs);
+    }
+  }
+  rowStart[order.size()] = next;
+  if (offset.size() > static_cast<std::size_t>(start.back())) moved.back() = next;  // the end of the values, if kept
+  UninitializedVector<T> laidOut(next);
+  tbb::parallel_for(std::size_t(0), order.size(), [&](std::size_t i) {
+    const auto e = static_cast<std::size_t>(order[i]);
+    for (auto k = static_cast<std::size_t>(start[e]); k < static_cast<std::size_t>(start[e + 1]);
+         ++k) {
+      const std::size_t size = diagonal[k] ? 3 * n * n : bs * bs;
+      std::copy(values.begin() + static_cast<std::ptrdiff_t>(offset[k]),
+                values.begin() + static_cast<std::ptrdiff_t>(offset[k] + size),
+                laidOut.begin() + static_cast<std::ptrdiff_t>(moved[k]));
+    }
+  });
+  values.swap(laidOut);
+  offset.swap(moved);
+}
+
+template <class T>
 const T* BlockRows<T>::diagonalBlock(int e) const {
   std::size_t slot = static_cast<std::size_t>(start[static_cast<std::size_t>(e)]);
   while (element[slot] != e) ++slot;

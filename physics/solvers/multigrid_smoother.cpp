@@ -127,13 +127,19 @@ bool invertGroups(Level& level) {
   const int bs = level.bs;
   const BlockGroups& groups = level.smootherGroups;
   const int ng = groups.groups();
-  level.inverseOffset.assign(static_cast<std::size_t>(ng) + 1, 0);
-  for (int g = 0; g < ng; ++g)
-    level.inverseOffset[static_cast<std::size_t>(g) + 1] =
-        level.inverseOffset[static_cast<std::size_t>(g)] +
-        static_cast<std::size_t>(groups.size(g) * bs) *
+  level.inverseOffset.assign(static_cast<std::size_t>(ng), 0);
+  std::size_t next = 0;
+  const auto place = [&](int g) {
+    level.inverseOffset[static_cast<std::size_t>(g)] = next;
+    next += static_cast<std::size_t>(groups.size(g) * bs) *
             static_cast<std::size_t>(groups.size(g) * bs);
-  level.inverses.resize(level.inverseOffset.back());
+  };
+  if (level.colours.empty())
+    for (int g = 0; g < ng; ++g) place(g);
+  else
+    for (const std::vector<int>& colour : level.colours)
+      for (int g : colour) place(g);
+  level.inverses.resize(next);
   std::atomic<bool> ok{true};
   tbb::parallel_for(0, ng, [&](int g) {
     const int size = groups.size(g) * bs;
@@ -161,6 +167,15 @@ std::vector<std::vector<int>> colourGroups(const Level& level) {
     for (int e : groups.of(g))
       forEachNeighbour(level, e, [&](int f) { visit(groupOf[static_cast<std::size_t>(f)]); });
   });
+}
+
+std::vector<int> sweepOrder(const Level& level) {
+  std::vector<int> order;
+  order.reserve(static_cast<std::size_t>(level.blockCount()));
+  for (const std::vector<int>& colour : level.colours)
+    for (int g : colour)
+      for (int e : level.smootherGroups.of(g)) order.push_back(e);
+  return order;
 }
 
 BlockGroups singleBlocks(int blocks) {

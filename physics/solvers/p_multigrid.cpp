@@ -36,6 +36,7 @@ using multigrid::Level;
 using multigrid::restrictBlocks;
 using multigrid::restrictMatrix;
 using multigrid::singleBlocks;
+using multigrid::sweepOrder;
 using multigrid::splitComponents;
 using multigrid::SpMat;
 using multigrid::Transfer;
@@ -174,6 +175,7 @@ struct PMultigrid::Impl {
       for (int g : level.colours.back())
         for (int e : level.smootherGroups.of(g))
           level.inLastColour[static_cast<std::size_t>(e)] = 1;
+    if (level.useBlocks) level.blocks.layOutInOrder(sweepOrder(level));
     return invertGroups(level);
   }
 

@@ -154,6 +154,37 @@ TEST(BlockRows, FindNeighboursCoupledOnlyThroughSomeComponents) {
   EXPECT_LT(compare(k, mesh.numElements(), 2.0).productError, 1e-14);
 }
 
+TEST(BlockRows, LaidOutInAnOrderTheyStreamInItAndMultiplyAsBefore) {
+  // The smoother's copy laid out colour by colour: BZ's rows mix whole and component-diagonal
+  // slots, so every slot size moves.
+  const Eigen::SparseMatrix<double, Eigen::ColMajor, int> k =
+      b1System(benchmarkB1Mesh(BenchmarkMesh::Sliced, 3), Method::BZ, 1).matrix;
+  BlockRows<float> rows;
+  ASSERT_TRUE(rows.build(k, 4, 1.0));
+  const int ne = rows.elements();
+  const Eigen::VectorXd x = randomVector(k.cols());
+  Eigen::VectorXd before(k.rows()), after(k.rows());
+  for (int e = 0; e < ne; ++e) rows.rowProduct(e, x.data(), before.data() + e * rows.bs);
+  std::vector<int> order(static_cast<std::size_t>(ne));
+  for (int e = 0; e < ne; ++e) order[static_cast<std::size_t>(e)] = e;
+  std::shuffle(order.begin(), order.end(), std::mt19937(20261204));
+  const std::size_t stored = rows.values.size();
+  rows.layOutInOrder(order);
+  EXPECT_EQ(rows.values.size(), stored);
+  // Each row starts where the one before it in `order` ends: one stream.
+  std::size_t next = 0;
+  for (int e : order)
+    for (int s = rows.start[static_cast<std::size_t>(e)];
+         s < rows.start[static_cast<std::size_t>(e) + 1]; ++s) {
+      const auto slot = static_cast<std::size_t>(s);
+      ASSERT_EQ(rows.offset[slot], next) << "element " << e;
+      next += rows.diagonal[slot] ? 3u * 16u : 144u;
+    }
+  EXPECT_EQ(next, stored);
+  for (int e = 0; e < ne; ++e) rows.rowProduct(e, x.data(), after.data() + e * rows.bs);
+  EXPECT_EQ((after - before).cwiseAbs().maxCoeff(), 0.0);
+}
+
 TEST(BlockRows, RefusesAPatternTooSparseForBlocks) {
   // The identity of a 2-element, bs = 3 matrix: the elements' own blocks are stored whole,
   // 9 values for 3 nonzeros each.
