@@ -206,7 +206,8 @@ void BlockRows<T>::layOutInOrder(const std::vector<int>& order) {
     }
   }
   rowStart[order.size()] = next;
-  if (offset.size() > static_cast<std::size_t>(start.back())) moved.back() = next;  // the end of the values, if kept
+  if (offset.size() > static_cast<std::size_t>(start.back()))
+    moved.back() = next;  // the end of the values, if kept
   UninitializedVector<T> laidOut(next);
   tbb::parallel_for(std::size_t(0), order.size(), [&](std::size_t i) {
     const auto e = static_cast<std::size_t>(order[i]);

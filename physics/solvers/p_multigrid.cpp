@@ -36,9 +36,9 @@ using multigrid::Level;
 using multigrid::restrictBlocks;
 using multigrid::restrictMatrix;
 using multigrid::singleBlocks;
-using multigrid::sweepOrder;
 using multigrid::splitComponents;
 using multigrid::SpMat;
+using multigrid::sweepOrder;
 using multigrid::Transfer;
 
 /// Unknowns up to which CHOLMOD factorizes the coarsest level simplicially (see
