@@ -11,6 +11,9 @@
 #include <unordered_map>
 #include <unordered_set>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include "util/stopwatch.h"
 
 namespace polydg {
@@ -50,6 +53,16 @@ void addKronecker(const Eigen::MatrixXd& scalar, const Eigen::Matrix3d& b, Eigen
   for (Eigen::Index j = 0; j < scalar.cols(); ++j)
     for (Eigen::Index i = 0; i < scalar.rows(); ++i)
       if (scalar(i, j) != 0.0) to.block<3, 3>(3 * i, 3 * j) += scalar(i, j) * b;
+}
+
+/// f(k) for k = 0 .. count - 1 on both cores: a point's position is a sparse row of about a
+/// hundred weights, and a resting body has thousands of candidate points each pass.
+template <class F>
+void forEachPoint(std::size_t count, const F& f) {
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 256),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t k = r.begin(); k != r.end(); ++k) f(k);
+                    });
 }
 
 }  // namespace
@@ -188,11 +201,11 @@ ContactLinearization ContactModel::linearize(const Eigen::VectorXd& u, const Eig
   const std::vector<std::uint32_t>& points = candidates(u + dt * v, tNext);
   const std::size_t nc = points.size();
   std::vector<Vec3> start(nc), velocity(nc), predicted(nc);
-  for (std::size_t k = 0; k < nc; ++k) {
+  forEachPoint(nc, [&](std::size_t k) {
     start[k] = e.displacement(points[k], u);
     velocity[k] = e.displacement(points[k], v);
     predicted[k] = e.points()[points[k]] + (start[k] + dt * velocity[k]);
-  }
+  });
   std::vector<ObstacleQuery> q;
   std::vector<std::uint32_t> which;
   queryAll(predicted, tNext, q, which);
@@ -217,9 +230,12 @@ bool ContactModel::adjust(const Eigen::VectorXd& uNew) {
   // Drop contacts whose linearized force pulls at the new state.
   std::unordered_set<std::uint32_t> isActive;
   std::vector<Active> kept;
-  for (const Active& a : active_) {
-    const Vec3 y = e.position(a.point, uNew);
-    if (a.distance + a.normal.dot(y - a.position) > 0.0) {
+  std::vector<Vec3> activeAt(active_.size());
+  forEachPoint(active_.size(),
+               [&](std::size_t k) { activeAt[k] = e.position(active_[k].point, uNew); });
+  for (std::size_t k = 0; k < active_.size(); ++k) {
+    const Active& a = active_[k];
+    if (a.distance + a.normal.dot(activeAt[k] - a.position) > 0.0) {
       changed = true;
       continue;
     }
@@ -231,7 +247,7 @@ bool ContactModel::adjust(const Eigen::VectorXd& uNew) {
   for (std::uint32_t p : candidates(uNew, tNext_))
     if (!isActive.count(p)) points.push_back(p);
   std::vector<Vec3> positions(points.size());
-  for (std::size_t k = 0; k < points.size(); ++k) positions[k] = e.position(points[k], uNew);
+  forEachPoint(points.size(), [&](std::size_t k) { positions[k] = e.position(points[k], uNew); });
   std::vector<ObstacleQuery> q;
   std::vector<std::uint32_t> which;
   queryAll(positions, tNext_, q, which);
