@@ -38,10 +38,15 @@ void poseEuler(const SecondOrderSystem& system, const MotionState& s, ImplicitSt
 }  // namespace
 
 Eigen::VectorXd TimeIntegrator::guess(const Eigen::VectorXd& last) const {
+  if (hasTwo_) return Eigen::VectorXd(3.0 * (last - previous_) + beforePrevious_);
   return hasPrevious_ ? Eigen::VectorXd(2.0 * last - previous_) : last;
 }
 
 void TimeIntegrator::remember(const Eigen::VectorXd& last) {
+  if (hasPrevious_) {
+    beforePrevious_.swap(previous_);
+    hasTwo_ = true;
+  }
   previous_ = last;
   hasPrevious_ = true;
 }
