@@ -146,10 +146,14 @@ DynamicSolver Simulation::makeSolver() {
 
 /// The solver of the edited mesh. The old one goes first: its memory (the local matrices and the
 /// solver's, hundreds of MB at 20k elements) is then reused, where fresh pages would be faulted
-/// in and zeroed, which took most of a new solver's time on this machine.
+/// in and zeroed, which took most of a new solver's time on this machine. The new one starts
+/// with the preconditioner the old one had come to (the edit changes a few elements, not the
+/// conditioning of the body).
 void Simulation::replaceSolver() {
+  const CgPreconditioner used = solver_->preconditioner();
   solver_.reset();
   solver_.emplace(makeSolver());
+  solver_->startWith(used);
 }
 
 /// The scene's initial velocity, linear and angular about the centre of mass; undeformed.

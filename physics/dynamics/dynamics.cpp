@@ -489,6 +489,13 @@ void DynamicSolver::setContact(ContactModel* contact) {
   impl_->contact = contact;
   impl_->stepSolver->reset();
 }
+CgPreconditioner DynamicSolver::preconditioner() const {
+  return impl_->stepSolver->preconditioner();
+}
+void DynamicSolver::startWith(CgPreconditioner preconditioner) {
+  impl_->stepSolver->startWith(preconditioner);
+}
+
 BodyState DynamicSolver::state() const { return impl_->bodyState(); }
 
 Eigen::VectorXd DynamicSolver::elasticForce() const { return impl_->forceAtU().f; }

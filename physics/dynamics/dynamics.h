@@ -98,6 +98,12 @@ class DynamicSolver {
   /// Collisions for the following steps (physics/contact/contact.h), or none (null). The model must
   /// outlive its use and have this solver's DOF layout (make it again after a cut).
   void setContact(ContactModel* contact);
+  /// The preconditioner CG's steps use now (block-Jacobi first, then the p-multigrid once a
+  /// step needs many iterations; DynamicsOptions::adaptivePreconditioner).
+  CgPreconditioner preconditioner() const;
+  /// Steps start with `preconditioner` if it is the p-multigrid: for the solver of a mesh a cut
+  /// edited, whose solver before had switched to it.
+  void startWith(CgPreconditioner preconditioner);
 
   /// Advances one step of length dt (positive: the caller's to check, where it reads it) with
   /// the options' integrator. Throws std::runtime_error if the step's system is not positive

@@ -27,6 +27,16 @@ StepSolver::StepSolver(const StepSolverOptions& options, const ElementFrames& fr
   solver_ = LinearSolver(active_);
 }
 
+void StepSolver::startWith(CgPreconditioner preconditioner) {
+  if (!options_.adaptivePreconditioner || preconditioner != CgPreconditioner::PMultigrid ||
+      active_.preconditioner == preconditioner)
+    return;
+  active_.preconditioner = preconditioner;
+  solver_ = LinearSolver(active_);
+  ready_ = false;
+  switchToMultigrid_ = false;
+}
+
 void StepSolver::beginStep() {
   if (!switchToMultigrid_) return;
   active_.preconditioner = CgPreconditioner::PMultigrid;
