@@ -370,6 +370,32 @@ TEST(Dynamics, ConjugateGradientStepsAgreeWithCholeskyAndSwitchPreconditioner) {
   }
 }
 
+TEST(Dynamics, WarmStartsExtrapolateTheLastThreeStepsQuadratically) {
+  // A free body falling under gravity g with mass damping alpha: backward Euler's velocities
+  // are v_n = v_inf (1 - rho^n), rho = 1 / (1 + dt alpha), v_inf = g / alpha. Extrapolated
+  // quadratically from the last three, the next is off by the third difference, about
+  // g dt^3 alpha^2: against the right-hand side (M v_n, v_n ~ n dt g) a relative residual of
+  // (dt alpha)^2 / n = 1e-10 / n, below CG's 1e-8; what is left is the steps' own rounding
+  // within that tolerance, which the extrapolation carries with weights 3, 3, 1: one
+  // iteration at most. Linearly extrapolated the start is off by (dt alpha) / n = 1e-5 / n,
+  // two or three block-Jacobi iterations on this mass-dominated system.
+  const PolyMesh mesh = hexGridMesh(4, 1, 1, Box3(Vec3::Zero(), Vec3(4, 1, 1)));
+  MomentCache moments(mesh, 2);
+  moments.update();
+  DynamicsOptions o = options(1, false, Integrator::BackwardEuler);
+  o.solver.kind = SolverKind::ConjugateGradient;
+  o.damping.mass = 1e-3;
+  const double dt = 0.01;
+  DynamicSolver solver(mesh, moments, {{}, {}, Vec3(0, 0, -1)}, o);
+  for (int k = 1; k <= 8; ++k) {
+    const StepReport r = solver.step(dt);
+    if (k >= 3) EXPECT_LE(r.iterations, 1) << "step " << k;
+  }
+  const double rho = 1.0 / (1.0 + dt * o.damping.mass), vInf = 1.0 / o.damping.mass;
+  EXPECT_NEAR(solver.state().momentum.z() / solver.mass(), -vInf * (1.0 - std::pow(rho, 8)),
+              1e-8 * 8 * dt);
+}
+
 TEST(Dynamics, AStepWhoseCgFailsNamesWhatHelps) {
   // CG held to one iteration cannot solve a loaded step: the error names the direct solver and
   // a smaller step, the two things that help.
