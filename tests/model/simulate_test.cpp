@@ -106,6 +106,25 @@ TEST(Simulate, CutWhileMovingFreesAHalfThatFallsWithGravity) {
   EXPECT_NEAR(acceleration, 1.0, 0.01);
 }
 
+TEST(Simulate, ACutKeepsThePreconditionerTheStepsHadComeTo) {
+  // CG on B10's beam with steps long enough that block-Jacobi needs more than 80 iterations:
+  // the steps switch to the p-multigrid, and after the cut the new solver starts with it (its
+  // first step builds it) instead of finding out again with block-Jacobi.
+  json scene = b10Scene(2.0);
+  scene["dt"] = 0.5;
+  scene["solver"] = "cg";
+  Model model = beam();
+  const SimulationReport r = model.simulate(parseScene(scene, "b10"), {});
+  ASSERT_EQ(r.cuts.size(), 1u);
+  ASSERT_EQ(r.steps.size(), 4u);
+  EXPECT_EQ(r.steps[0].step.preconditioner, CgPreconditioner::BlockJacobi);
+  EXPECT_GT(r.steps[0].step.iterations, 80);
+  for (std::size_t k = 1; k < r.steps.size(); ++k)
+    EXPECT_EQ(r.steps[k].step.preconditioner, CgPreconditioner::PMultigrid) << "step " << k;
+  EXPECT_EQ(r.steps[2].solver, "cg (p-multigrid): preconditioner built");  // after the cut
+  EXPECT_EQ(r.steps[3].solver, "cg (p-multigrid): preconditioner reused");
+}
+
 /// int u and the volume over the elements whose centroid x lies in [lo, hi).
 std::pair<Vec3, double> band(Model& model, double lo, double hi) {
   const MomentCache& moments = model.moments(2);
