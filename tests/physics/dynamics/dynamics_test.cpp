@@ -389,7 +389,9 @@ TEST(Dynamics, WarmStartsExtrapolateTheLastThreeStepsQuadratically) {
   DynamicSolver solver(mesh, moments, {{}, {}, Vec3(0, 0, -1)}, o);
   for (int k = 1; k <= 8; ++k) {
     const StepReport r = solver.step(dt);
-    if (k >= 3) EXPECT_LE(r.iterations, 1) << "step " << k;
+    if (k >= 3) {
+      EXPECT_LE(r.iterations, 1) << "step " << k;
+    }
   }
   const double rho = 1.0 / (1.0 + dt * o.damping.mass), vInf = 1.0 / o.damping.mass;
   EXPECT_NEAR(solver.state().momentum.z() / solver.mass(), -vInf * (1.0 - std::pow(rho, 8)),
