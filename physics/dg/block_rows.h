@@ -124,7 +124,7 @@ void writeElementRows(BlockRows<double>& rows,
                       const double* self, const double* coupling);
 
 /// x += M s for a dense bs x bs column-major M (an element's inverse diagonal block in the
-/// p-multigrid smoother), compiled like BlockRows::subtractRowProduct.
+/// p-multigrid smoother or block-Jacobi), compiled like BlockRows::subtractRowProduct.
 void addDenseProduct(int bs, const double* matrix, const double* s, double* x);
 
 }  // namespace polydg

@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 #include <Eigen/CholmodSupport>
@@ -86,7 +87,10 @@ struct LinearSolver::Impl {
   int blockSize = 0;
   double factorSeconds = 0.0;
   std::unique_ptr<Eigen::CholmodSupernodalLLT<SpMat, Eigen::Lower>> cholesky;
-  std::vector<Eigen::MatrixXd> blockInverses;
+  /// Block-Jacobi: the inverse of element b's diagonal block at b bs^2, column-major, one
+  /// array (applied by addDenseProduct(): per-element Eigen matrices and their dynamic-size
+  /// products cost three quarters of a matrix product an iteration).
+  std::vector<double> blockInverses;
   CgPreconditioner preconditioner = CgPreconditioner::BlockJacobi;
   PMultigrid multigrid;
   /// K by element block rows in double precision for CG's product: two thirds of the CSR
@@ -161,7 +165,8 @@ struct LinearSolver::Impl {
 
   bool buildBlockJacobi() {
     const Eigen::Index nb = rows ? rows->elements() : matrix->rows() / blockSize;
-    blockInverses.assign(static_cast<std::size_t>(nb), Eigen::MatrixXd());
+    const auto bb = static_cast<std::size_t>(blockSize) * static_cast<std::size_t>(blockSize);
+    blockInverses.resize(static_cast<std::size_t>(nb) * bb);
     std::atomic<bool> ok{true};
     tbb::parallel_for(Eigen::Index(0), nb, [&](Eigen::Index b) {
       const Eigen::Index base = b * blockSize;
@@ -181,7 +186,9 @@ struct LinearSolver::Impl {
       } else {
         block = llt.solve(Eigen::MatrixXd::Identity(blockSize, blockSize));
       }
-      blockInverses[static_cast<std::size_t>(b)] = std::move(block);
+      std::copy(
+          block.data(), block.data() + bb,
+          blockInverses.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(b) * bb));
     });
     return ok;
   }
@@ -192,10 +199,16 @@ struct LinearSolver::Impl {
       return;
     }
     z.resize(r.size());
-    tbb::parallel_for(std::size_t(0), blockInverses.size(), [&](std::size_t b) {
-      const Eigen::Index base = static_cast<Eigen::Index>(b) * blockSize;
-      z.segment(base, blockSize).noalias() = blockInverses[b] * r.segment(base, blockSize);
-    });
+    const auto bb = static_cast<std::size_t>(blockSize) * static_cast<std::size_t>(blockSize);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blockInverses.size() / bb, 64),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+                        for (std::size_t b = range.begin(); b != range.end(); ++b) {
+                          const Eigen::Index base = static_cast<Eigen::Index>(b) * blockSize;
+                          z.segment(base, blockSize).setZero();
+                          addDenseProduct(blockSize, blockInverses.data() + b * bb, r.data() + base,
+                                          z.data() + base);
+                        }
+                      });
   }
 
   Eigen::VectorXd conjugateGradient(const Eigen::VectorXd& f, LinearSolveReport& report,
