@@ -391,7 +391,7 @@ ContactMeasure ContactModel::measure(const Eigen::VectorXd& u, double t) {
   const SurfaceEmbedding& e = *embedding_;
   const std::vector<std::uint32_t>& points = candidates(u, t);
   std::vector<Vec3> positions(points.size());
-  for (std::size_t k = 0; k < points.size(); ++k) positions[k] = e.position(points[k], u);
+  forEachPoint(points.size(), [&](std::size_t k) { positions[k] = e.position(points[k], u); });
   std::vector<ObstacleQuery> q;
   std::vector<std::uint32_t> which;
   queryAll(positions, t, q, which);
