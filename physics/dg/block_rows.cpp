@@ -194,30 +194,22 @@ bool BlockRows<T>::build(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>
 template <class T>
 void BlockRows<T>::layOutInOrder(const std::vector<int>& order) {
   std::vector<std::size_t> moved(offset.size());
-  std::vector<std::size_t> rowStart(order.size() + 1, 0);
   std::size_t next = 0;
-  for (std::size_t i = 0; i < order.size(); ++i) {
-    const auto e = static_cast<std::size_t>(order[i]);
-    rowStart[i] = next;
-    for (auto k = static_cast<std::size_t>(start[e]); k < static_cast<std::size_t>(start[e + 1]);
+  for (int e : order)
+    for (int k = start[static_cast<std::size_t>(e)]; k < start[static_cast<std::size_t>(e) + 1];
          ++k) {
-      moved[k] = next;
-      next += static_cast<std::size_t>(diagonal[k] ? 3 * n * n : bs * bs);
+      moved[static_cast<std::size_t>(k)] = next;
+      next += slotSize(static_cast<std::size_t>(k));
     }
-  }
-  rowStart[order.size()] = next;
   if (offset.size() > static_cast<std::size_t>(start.back()))
     moved.back() = next;  // the end of the values, if kept
   UninitializedVector<T> laidOut(next);
   tbb::parallel_for(std::size_t(0), order.size(), [&](std::size_t i) {
     const auto e = static_cast<std::size_t>(order[i]);
     for (auto k = static_cast<std::size_t>(start[e]); k < static_cast<std::size_t>(start[e + 1]);
-         ++k) {
-      const std::size_t size = diagonal[k] ? 3 * n * n : bs * bs;
-      std::copy(values.begin() + static_cast<std::ptrdiff_t>(offset[k]),
-                values.begin() + static_cast<std::ptrdiff_t>(offset[k] + size),
-                laidOut.begin() + static_cast<std::ptrdiff_t>(moved[k]));
-    }
+         ++k)
+      std::copy_n(values.begin() + static_cast<std::ptrdiff_t>(offset[k]), slotSize(k),
+                  laidOut.begin() + static_cast<std::ptrdiff_t>(moved[k]));
   });
   values.swap(laidOut);
   offset.swap(moved);
@@ -298,8 +290,7 @@ BlockRows<double> blockRowsLayout(const std::vector<std::vector<std::uint32_t>>&
     for (const std::uint32_t f : neighbours[e]) {
       rows.element[k] = static_cast<int>(f);
       rows.diagonal[k] = componentDiagonal && f != e ? 1 : 0;
-      rows.offset[k + 1] =
-          rows.offset[k] + static_cast<std::size_t>(rows.diagonal[k] ? 3 * n * n : bs * bs);
+      rows.offset[k + 1] = rows.offset[k] + rows.slotSize(k);
       ++k;
     }
   rows.values.resize(rows.offset.back());

@@ -64,6 +64,11 @@ struct BlockRows {
   /// blocks of p = 1 is 4 KB, the span a hardware prefetcher stops at).
   void layOutInOrder(const std::vector<int>& order);
 
+  /// The values slot k stores: bs^2, or 3 n^2 if component-diagonal.
+  std::size_t slotSize(std::size_t k) const {
+    return static_cast<std::size_t>(diagonal[k] ? 3 * n * n : bs * bs);
+  }
+
   /// The diagonal block of element e, bs x bs column-major (a full slot).
   const T* diagonalBlock(int e) const;
 

@@ -326,8 +326,9 @@ Eigen::VectorXd DynamicSolver::Impl::correct(const ImplicitStep& step, const Eig
 /// out = K_w y with the step's rotations `r`: from the step's block rows, A = cM M + cK K_w,
 /// as (A y - cM M y) / cK, one pass over the rows CG streams anyway, where the product from
 /// the split element blocks reads several times their bytes and warps every part (most of a
-/// correction's force computation at 87k DOFs). The mass part is no larger than the
-/// stiffness part at the steps corrections are made for (cM M against cK K_w).
+/// correction's force computation at 87k DOFs). The subtraction costs digits as the mass
+/// part outweighs the stiffness part, cM |M y| / (cK |K_w y|); on B10's beam at dt = 0.01 the
+/// BDF2 and Newmark states are those of the product from the split blocks to 1e-15.
 void DynamicSolver::Impl::stiffnessTimesAssembled(const ImplicitStep& step,
                                                   const std::vector<Eigen::Matrix3d>& r,
                                                   const Eigen::VectorXd& y,

@@ -1,5 +1,7 @@
 #include "physics/dynamics/time_integrators.h"
 
+#include <algorithm>
+
 #include "util/stopwatch.h"
 
 namespace polydg {
@@ -38,17 +40,14 @@ void poseEuler(const SecondOrderSystem& system, const MotionState& s, ImplicitSt
 }  // namespace
 
 Eigen::VectorXd TimeIntegrator::guess(const Eigen::VectorXd& last) const {
-  if (hasTwo_) return Eigen::VectorXd(3.0 * (last - previous_) + beforePrevious_);
-  return hasPrevious_ ? Eigen::VectorXd(2.0 * last - previous_) : last;
+  if (remembered_ == 2) return Eigen::VectorXd(3.0 * (last - previous_) + beforePrevious_);
+  return remembered_ == 1 ? Eigen::VectorXd(2.0 * last - previous_) : last;
 }
 
 void TimeIntegrator::remember(const Eigen::VectorXd& last) {
-  if (hasPrevious_) {
-    beforePrevious_.swap(previous_);
-    hasTwo_ = true;
-  }
+  beforePrevious_.swap(previous_);
   previous_ = last;
-  hasPrevious_ = true;
+  remembered_ = std::min(remembered_ + 1, 2);
 }
 
 std::unique_ptr<TimeIntegrator> makeTimeIntegrator(Integrator kind) {

@@ -84,14 +84,11 @@ class TimeIntegrator {
   /// records the value before a step.
   Eigen::VectorXd guess(const Eigen::VectorXd& last) const;
   void remember(const Eigen::VectorXd& last);
-  void forget() {
-    hasPrevious_ = false;
-    hasTwo_ = false;
-  }
+  void forget() { remembered_ = 0; }
 
  private:
   Eigen::VectorXd previous_, beforePrevious_;
-  bool hasPrevious_ = false, hasTwo_ = false;
+  int remembered_ = 0;  ///< of previous_ and beforePrevious_, those that hold a value
 };
 
 /// The integrator `kind` names.

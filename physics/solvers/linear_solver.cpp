@@ -87,9 +87,8 @@ struct LinearSolver::Impl {
   int blockSize = 0;
   double factorSeconds = 0.0;
   std::unique_ptr<Eigen::CholmodSupernodalLLT<SpMat, Eigen::Lower>> cholesky;
-  /// Block-Jacobi: the inverse of element b's diagonal block at b bs^2, column-major, one
-  /// array (applied by addDenseProduct(): per-element Eigen matrices and their dynamic-size
-  /// products cost three quarters of a matrix product an iteration).
+  /// Block-Jacobi: the inverse of element b's diagonal block at b bs^2, column-major, in one
+  /// array (no allocation per element), applied by addDenseProduct() like the smoother's.
   std::vector<double> blockInverses;
   CgPreconditioner preconditioner = CgPreconditioner::BlockJacobi;
   PMultigrid multigrid;

@@ -153,6 +153,13 @@ struct Beam {
   Beam() { moments.update(); }
 };
 
+/// Four unit cubes in a row, p = 1 (moments of degree 2).
+struct Bar {
+  PolyMesh mesh = hexGridMesh(4, 1, 1, Box3(Vec3::Zero(), Vec3(4, 1, 1)));
+  MomentCache moments{mesh, 2};
+  Bar() { moments.update(); }
+};
+
 /// B6's initial displacement: the static solution under the end traction (0, 0, -0.01).
 Eigen::VectorXd b6InitialDisplacement(const Beam& beam, int degree) {
   StaticOptions o;
@@ -379,14 +386,12 @@ TEST(Dynamics, WarmStartsExtrapolateTheLastThreeStepsQuadratically) {
   // within that tolerance, which the extrapolation carries with weights 3, 3, 1: one
   // iteration at most. Linearly extrapolated the start is off by (dt alpha) / n = 1e-5 / n,
   // two or three block-Jacobi iterations on this mass-dominated system.
-  const PolyMesh mesh = hexGridMesh(4, 1, 1, Box3(Vec3::Zero(), Vec3(4, 1, 1)));
-  MomentCache moments(mesh, 2);
-  moments.update();
+  const Bar bar;
   DynamicsOptions o = options(1, false, Integrator::BackwardEuler);
   o.solver.kind = SolverKind::ConjugateGradient;
   o.damping.mass = 1e-3;
   const double dt = 0.01;
-  DynamicSolver solver(mesh, moments, {{}, {}, Vec3(0, 0, -1)}, o);
+  DynamicSolver solver(bar.mesh, bar.moments, {{}, {}, Vec3(0, 0, -1)}, o);
   for (int k = 1; k <= 8; ++k) {
     const StepReport r = solver.step(dt);
     if (k >= 3) {
@@ -401,13 +406,12 @@ TEST(Dynamics, WarmStartsExtrapolateTheLastThreeStepsQuadratically) {
 TEST(Dynamics, AStepWhoseCgFailsNamesWhatHelps) {
   // CG held to one iteration cannot solve a loaded step: the error names the direct solver and
   // a smaller step, the two things that help.
-  const PolyMesh mesh = hexGridMesh(4, 1, 1, Box3(Vec3::Zero(), Vec3(4, 1, 1)));
-  MomentCache moments(mesh, 2);
-  moments.update();
+  const Bar bar;
   DynamicsOptions o = options(1, true, Integrator::BackwardEuler);
   o.solver.kind = SolverKind::ConjugateGradient;
   o.solver.maxIterations = 1;
-  DynamicSolver solver(mesh, moments, {{FaceSelector::inPlane(0, 0.0)}, {}, Vec3(0, 0, -1)}, o);
+  DynamicSolver solver(bar.mesh, bar.moments, {{FaceSelector::inPlane(0, 0.0)}, {}, Vec3(0, 0, -1)},
+                       o);
   try {
     solver.step(0.01);
     FAIL() << "the step solved";
