@@ -4,23 +4,14 @@
 
 #include <tbb/parallel_for.h>
 
+#include "util/simd_clones.h"
+
 namespace polydg {
 
 namespace {
 
-/// The row-product kernels are compiled three times, for AVX-512 (x86-64-v4), AVX2 with FMA
-/// (x86-64-v3) and the x86-64 baseline (SSE2), and the loader picks the best the CPU has
-/// (GCC function multiversioning). The build itself targets the baseline, so the binary runs
-/// anywhere; the wide clones take about a tenth off the solve (docs/benchmarks.md).
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-#define POLYDG_SIMD_CLONES \
-  __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
-#else
-#define POLYDG_SIMD_CLONES
-#endif
-
-/// Kernels inlined into each clone, so that each is compiled for the clone's instructions.
-#define POLYDG_INLINE inline __attribute__((always_inline))
+// The row-product kernels are compiled for the CPU's vector instructions (util/simd_clones.h):
+// the wide clones take about a tenth off the solve (docs/benchmarks.md).
 
 /// out -= (A x)_e with N functions per component (0: a.n, known at run time only): compile-time
 /// sizes for the DG degrees let the short column loops unroll and vectorize (a third of the

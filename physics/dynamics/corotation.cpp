@@ -11,33 +11,9 @@
 
 #include "physics/dg/block_rows.h"
 #include "physics/dg/polynomial_tables.h"
+#include "physics/dynamics/corotation_kernels.h"
 
 namespace polydg {
-
-namespace {
-
-/// out += s (R (x) I_N) B (R (x) I_N)^T for a 3N x 3N column-major block B, into the
-/// column-major out: N x N blocks, B'_dc = sum_ab R(d, a) B_ab R(c, b).
-template <int N>
-void addWarped(const Eigen::Matrix3d& r, const double* b, double s, double* out) {
-  constexpr int BS = 3 * N;
-  const Eigen::Map<const Eigen::Matrix<double, BS, BS>> in(b);
-  Eigen::Map<Eigen::Matrix<double, BS, BS>> o(out);
-  Eigen::Matrix<double, BS, BS> t;  // (R (x) I) B
-  for (int d = 0; d < 3; ++d)
-    for (int c = 0; c < 3; ++c)
-      t.template block<N, N>(d * N, c * N).noalias() =
-          r(d, 0) * in.template block<N, N>(0, c * N) +
-          r(d, 1) * in.template block<N, N>(N, c * N) +
-          r(d, 2) * in.template block<N, N>(2 * N, c * N);
-  for (int d = 0; d < 3; ++d)
-    for (int c = 0; c < 3; ++c)
-      o.template block<N, N>(d * N, c * N) += (s * r(c, 0)) * t.template block<N, N>(d * N, 0) +
-                                              (s * r(c, 1)) * t.template block<N, N>(d * N, N) +
-                                              (s * r(c, 2)) * t.template block<N, N>(d * N, 2 * N);
-}
-
-}  // namespace
 
 Eigen::Matrix3d polarRotation(const Eigen::Matrix3d& f) {
   const Eigen::JacobiSVD<Eigen::Matrix3d> svd(f, Eigen::ComputeFullU | Eigen::ComputeFullV);
@@ -191,8 +167,6 @@ void CorotatedStiffness::productOf(const std::vector<Eigen::Matrix3d>& r, const 
   constexpr int BS = 3 * N;
   using Vec = Eigen::Matrix<double, BS, 1>;
   using Components = Eigen::Matrix<double, N, 3>;  // column d: component d
-  using Block = Eigen::Matrix<double, BS, BS>;
-  using RowBlock = Eigen::Matrix<double, BS, BS, Eigen::RowMajor>;
   out.setZero(x.size());
   const bool bz = parts_.jumps.componentDiagonalCoupling;
   const std::size_t bb = static_cast<std::size_t>(BS) * BS;
@@ -223,10 +197,7 @@ void CorotatedStiffness::productOf(const std::vector<Eigen::Matrix3d>& r, const 
             const bool warp = source >= 0 && corotational_;
             const Eigen::Matrix3d* rot = warp ? &r[static_cast<std::size_t>(source)] : nullptr;
             side(rot, col, columnDifference, w);
-            if (columnMajor)
-              y.noalias() = Eigen::Map<const Block>(b) * w;
-            else
-              y.noalias() = Eigen::Map<const RowBlock>(b) * w;
+            blockTimes(N, b, columnMajor, w.data(), y.data());
             if (rot)
               Eigen::Map<Components>(oa.data()).noalias() +=
                   Eigen::Map<const Components>(y.data()) * rot->transpose();
@@ -237,7 +208,7 @@ void CorotatedStiffness::productOf(const std::vector<Eigen::Matrix3d>& r, const 
               sum += 0.5 * wa.dot(y);
             }
           };
-          if (!bz) {  // the Dirichlet faces' strain terms
+          if (!bz && clamped_[i]) {  // the Dirichlet faces' strain terms (zero elsewhere)
             const auto self = static_cast<std::int64_t>(i);
             apply(parts_.dirichletTrial.data() + i * bb, true, self, i, true, false);
             apply(parts_.dirichletTest.data() + i * bb, true, self, i, false, true);
@@ -321,7 +292,7 @@ void CorotatedStiffness::elementBlocks(const std::vector<Eigen::Matrix3d>& r,
   const double* ss = parts_.rowStrain.diagonal.data() + i * bb;
   for (std::size_t k = 0; k < bb; ++k) d[k] = cK * js[k];
   if (warp)
-    addWarped<N>(r[i], ss, cK, d);
+    addWarpedBlock(N, r[i].data(), ss, cK, d);
   else
     for (std::size_t k = 0; k < bb; ++k) d[k] += cK * ss[k];
   if (!bz) {
@@ -329,7 +300,7 @@ void CorotatedStiffness::elementBlocks(const std::vector<Eigen::Matrix3d>& r,
       for (const UninitializedVector<double>* dir :
            {&parts_.dirichletTrial, &parts_.dirichletTest}) {
         if (warp)
-          addWarped<N>(r[i], dir->data() + i * bb, cK, d);
+          addWarpedBlock(N, r[i].data(), dir->data() + i * bb, cK, d);
         else
           for (std::size_t q = 0; q < bb; ++q) d[q] += cK * (*dir)[i * bb + q];
       }
@@ -339,7 +310,7 @@ void CorotatedStiffness::elementBlocks(const std::vector<Eigen::Matrix3d>& r,
       if (f == i) continue;
       const double* nl = parts_.neighbourLifting.data() + (first + k++) * bb;
       if (warp)
-        addWarped<N>(r[f], nl, cK, d);
+        addWarpedBlock(N, r[f].data(), nl, cK, d);
       else
         for (std::size_t q = 0; q < bb; ++q) d[q] += cK * nl[q];
     }
@@ -363,8 +334,8 @@ void CorotatedStiffness::elementBlocks(const std::vector<Eigen::Matrix3d>& r,
     if (warp) {
       // Read each row-major block column-major (its transpose) and write the transpose of the
       // warped block: R_f B^T R_f^T etc. with the roles swapped.
-      addWarped<N>(r[i], rc, cK, c);
-      addWarped<N>(r[*it], oc, cK, c);
+      addWarpedBlock(N, r[i].data(), rc, cK, c);
+      addWarpedBlock(N, r[*it].data(), oc, cK, c);
     } else {
       for (std::size_t k = 0; k < bb; ++k) c[k] += cK * (rc[k] + oc[k]);
     }
