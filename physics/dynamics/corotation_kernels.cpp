@@ -12,7 +12,7 @@ template <int N>
 POLYDG_INLINE void addWarpedOf(int n, const double* r, const double* b, double s, double* out) {
   const int nn = N > 0 ? N : n, bs = 3 * nn;
   constexpr int kMax = N > 0 ? 9 * N * N : 3600;  // degree 3 (n = 20) at most
-  double t[kMax];                                  // T = (R (x) I) B, column-major
+  double t[kMax];                                 // T = (R (x) I) B, column-major
   for (int col = 0; col < bs; ++col) {
     const double* bc = b + col * bs;
     double* tc = t + col * bs;
