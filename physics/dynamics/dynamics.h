@@ -57,7 +57,8 @@ struct DynamicsOptions {
   /// gain energy in fast rotations (B7 in docs/benchmarks.md). Further solves correct the force
   /// at the last solution's state with the same matrix (modified Newton). 0: automatic, the
   /// integrator's (1 for backward Euler; for BDF2 and Newmark as many as it takes for the
-  /// relative correction to fall below correctionTolerance, at most 12).
+  /// relative correction, or the correction times the rate at which corrections shrink,
+  /// measured on earlier ones, to fall below correctionTolerance; at most 12).
   int corotationSolves = 0;
   double correctionTolerance = 1e-6;
 };

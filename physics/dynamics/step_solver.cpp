@@ -108,9 +108,10 @@ void StepSolver::prepareWithContact(const Eigen::SparseMatrix<double, Eigen::Col
 }
 
 Eigen::VectorXd StepSolver::solve(const Eigen::VectorXd& rhs, const Eigen::VectorXd& guess,
-                                  StepReport& report) {
+                                  StepReport& report, double tolerance) {
   LinearSolveReport lr;
-  Eigen::VectorXd x = solver_.solve(rhs, lr, &guess);
+  Eigen::VectorXd x =
+      solver_.solve(rhs, lr, &guess, std::max(tolerance, options_.solver.tolerance));
   if (!lr.success)
     throw std::runtime_error("the time step's solve failed (CG did not converge in " +
                              std::to_string(lr.iterations) + " iterations, residual " +

@@ -49,9 +49,10 @@ class StepSolver {
   void prepareWithContact(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix,
                           StepReport& report);
   /// The solution of the prepared matrix for `rhs`, starting from `guess`; its iterations and
-  /// residual go to `report`. Throws std::runtime_error if CG does not converge.
+  /// residual go to `report`. Throws std::runtime_error if CG does not converge. CG stops at
+  /// `tolerance` (relative to |rhs|) if above the solver's.
   Eigen::VectorXd solve(const Eigen::VectorXd& rhs, const Eigen::VectorXd& guess,
-                        StepReport& report);
+                        StepReport& report, double tolerance = 0.0);
   /// A step ended: the refresh rule's counts and the preconditioner switch.
   void endStep(StepReport& report);
   /// The next prepare() starts over (the system changed: contact set or removed).

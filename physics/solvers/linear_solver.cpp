@@ -211,7 +211,7 @@ struct LinearSolver::Impl {
   }
 
   Eigen::VectorXd conjugateGradient(const Eigen::VectorXd& f, LinearSolveReport& report,
-                                    const Eigen::VectorXd* guess) const {
+                                    const Eigen::VectorXd* guess, double tolerance) const {
     const double fNorm = std::sqrt(parallelDot(f, f));
     Eigen::VectorXd u = Eigen::VectorXd::Zero(f.size());
     if (fNorm == 0.0) {
@@ -227,7 +227,7 @@ struct LinearSolver::Impl {
     precondition(r, z);
     p = z;
     double rz = parallelDot(r, z);
-    const double target = options.tolerance * fNorm;
+    const double target = tolerance * fNorm;
     int it = 0;
     double rNorm = std::sqrt(parallelDot(r, r));
     while (it < options.maxIterations && rNorm > target) {
@@ -372,7 +372,7 @@ Eigen::VectorXd LinearSolver::solve(const Eigen::VectorXd& rhs, LinearSolveRepor
 }
 
 Eigen::VectorXd LinearSolver::solve(const Eigen::VectorXd& rhs, LinearSolveReport& report,
-                                    const Eigen::VectorXd* guess) {
+                                    const Eigen::VectorXd* guess, double tolerance) {
   Impl& m = *impl_;
   report = LinearSolveReport{};
   report.used = m.kind;
@@ -385,7 +385,7 @@ Eigen::VectorXd LinearSolver::solve(const Eigen::VectorXd& rhs, LinearSolveRepor
     u = report.success ? Eigen::VectorXd(m.cholesky->solve(rhs))
                        : Eigen::VectorXd::Zero(rhs.size());
   } else {
-    u = m.conjugateGradient(rhs, report, guess);
+    u = m.conjugateGradient(rhs, report, guess, tolerance > 0.0 ? tolerance : m.options.tolerance);
   }
   report.solveSeconds = t0.seconds();
   Eigen::VectorXd ku;

@@ -68,9 +68,10 @@ class LinearSolver {
   /// Solves K U = F; fills `report` (times of this solve; factorSeconds from compute()).
   Eigen::VectorXd solve(const Eigen::VectorXd& rhs, LinearSolveReport& report);
   /// The same with CG starting from `guess` (if not null; Cholesky ignores it): the last time
-  /// step's solution saves iterations.
+  /// step's solution saves iterations. A `tolerance` above 0 replaces the options' for this
+  /// solve (CG; a solve whose result a further solve corrects needs less).
   Eigen::VectorXd solve(const Eigen::VectorXd& rhs, LinearSolveReport& report,
-                        const Eigen::VectorXd* guess);
+                        const Eigen::VectorXd* guess, double tolerance = 0.0);
 
   SolverKind kind() const;
 
