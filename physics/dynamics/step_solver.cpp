@@ -9,9 +9,11 @@ namespace polydg {
 namespace {
 
 /// Block-Jacobi CG until a solve needs more than this many iterations, then the p-multigrid:
-/// a block-Jacobi iteration costs a seventh of a V-cycle, and B10's beam needs 45 of the one
-/// against 14 of the other at dt = 0.01.
-constexpr int kBlockJacobiLimit = 80;
+/// on B10's beam a block-Jacobi iteration costs a fifth of a V-cycle (1.75 against 7.7 ms at
+/// 87k DOFs, 23.5 against 115 ms at 960k), and a solve takes 7-15 V-cycles; with 80, Newmark's
+/// 68 block-Jacobi iterations a solve at 960k DOFs cost 3.67 s a step where BDF2's V-cycles
+/// took 2.34 (docs/benchmarks.md).
+constexpr int kBlockJacobiLimit = 50;
 
 /// A step's matrix that is not positive definite: a smaller step is what helps.
 [[noreturn]] void throwNotDefinite(const std::string& matrix, const std::string& why) {
