@@ -348,10 +348,12 @@ TEST(Dynamics, Bdf2RestartsWhenTheStepChanges) {
 
 TEST(Dynamics, ConjugateGradientStepsAgreeWithCholeskyAndSwitchPreconditioner) {
   // The beam under gravity, corotational, with CG forced: the same states as CHOLMOD's to the
-  // CG tolerance. Small steps (mass-dominated systems) stay with block-Jacobi; large steps
-  // need many block-Jacobi iterations and switch to the p-multigrid for the next step.
+  // CG tolerance. Small steps (mass-dominated systems) stay with block-Jacobi; larger steps
+  // need more than 50 block-Jacobi iterations and switch to the p-multigrid for the next step
+  // (measured: 71 then 12 V-cycles at dt = 0.05, where a V-cycle costs 4-5 block-Jacobi
+  // iterations).
   const Beam beam;
-  for (double dt : {0.01, 2.0}) {
+  for (double dt : {0.01, 0.05, 2.0}) {
     Eigen::VectorXd u[2];
     for (SolverKind kind : {SolverKind::Cholesky, SolverKind::ConjugateGradient}) {
       DynamicsOptions o = options(1, true, Integrator::BackwardEuler);
@@ -363,11 +365,11 @@ TEST(Dynamics, ConjugateGradientStepsAgreeWithCholeskyAndSwitchPreconditioner) {
       u[kind == SolverKind::ConjugateGradient] = solver.displacement();
       if (kind == SolverKind::Cholesky) continue;
       EXPECT_EQ(steps[0].preconditioner, CgPreconditioner::BlockJacobi);
-      if (dt < 0.1) {
+      if (dt < 0.03) {
         for (const StepReport& r : steps)
           EXPECT_EQ(r.preconditioner, CgPreconditioner::BlockJacobi);
       } else {
-        EXPECT_GT(steps[0].iterations, 80);
+        EXPECT_GT(steps[0].iterations, 50) << "dt " << dt;
         EXPECT_EQ(steps[1].preconditioner, CgPreconditioner::PMultigrid);
         EXPECT_TRUE(steps[1].preconditionerRebuilt);
         EXPECT_LT(steps[1].iterations, steps[0].iterations);
