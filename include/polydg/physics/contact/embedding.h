@@ -105,17 +105,13 @@ class SurfaceEmbedding {
   Eigen::Matrix<double, Eigen::Dynamic, 3> displacements(const Eigen::VectorXd& coefficients) const;
   /// The displacement of point p alone, the same sum as displacements() row p.
   Vec3 displacement(std::size_t p, const Eigen::VectorXd& coefficients) const {
-    const std::size_t n = static_cast<std::size_t>(n_);
-    double sum[3] = {0.0, 0.0, 0.0};
-    for (std::size_t q = weightStart_[p]; q < weightStart_[p + 1]; ++q) {
-      const std::size_t c = weightColumns_[q], e = c / n, i = c % n;
-      const double* u = coefficients.data() + e * 3 * n + i;
-      const double w = weightValues_[q];
-      sum[0] += w * u[0];
-      sum[1] += w * u[n];
-      sum[2] += w * u[2 * n];
+    // n known when compiling: a column's element and function without a division per weight.
+    switch (n_) {
+      case 4: return displacementOf<4>(p, coefficients);
+      case 10: return displacementOf<10>(p, coefficients);
+      case 20: return displacementOf<20>(p, coefficients);
+      default: return displacementOf<0>(p, coefficients);
     }
-    return Vec3(sum[0], sum[1], sum[2]);
   }
   /// Point p displaced by `coefficients`.
   Vec3 position(std::size_t p, const Eigen::VectorXd& coefficients) const {
@@ -145,6 +141,22 @@ class SurfaceEmbedding {
 
  private:
   struct Samples;
+
+  /// displacement() with N functions per element (0: n_).
+  template <int N>
+  Vec3 displacementOf(std::size_t p, const Eigen::VectorXd& coefficients) const {
+    const std::size_t n = N > 0 ? static_cast<std::size_t>(N) : static_cast<std::size_t>(n_);
+    double sum[3] = {0.0, 0.0, 0.0};
+    for (std::size_t q = weightStart_[p]; q < weightStart_[p + 1]; ++q) {
+      const std::size_t c = weightColumns_[q], e = c / n, i = c % n;
+      const double* u = coefficients.data() + e * 3 * n + i;
+      const double w = weightValues_[q];
+      sum[0] += w * u[0];
+      sum[1] += w * u[n];
+      sum[2] += w * u[2 * n];
+    }
+    return Vec3(sum[0], sum[1], sum[2]);
+  }
   static Samples clustered(Samples&& raw);
   Samples makeSamples(const PolyMesh& mesh, const DgBasis& basis) const;
   SurfaceEmbedding() = default;
