@@ -107,9 +107,10 @@ TEST(Simulate, CutWhileMovingFreesAHalfThatFallsWithGravity) {
 }
 
 TEST(Simulate, ACutKeepsThePreconditionerTheStepsHadComeTo) {
-  // CG on B10's beam with steps long enough that block-Jacobi needs more than 80 iterations:
-  // the steps switch to the p-multigrid, and after the cut the new solver starts with it (its
-  // first step builds it) instead of finding out again with block-Jacobi.
+  // CG on B10's beam with steps long enough that block-Jacobi needs more than 80 iterations
+  // (the switch comes after 50): the steps switch to the p-multigrid, and after the cut the new
+  // solver starts with it (its first step builds it) instead of finding out again with
+  // block-Jacobi.
   json scene = b10Scene(2.0);
   scene["dt"] = 0.5;
   scene["solver"] = "cg";

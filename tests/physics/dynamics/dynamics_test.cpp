@@ -409,7 +409,7 @@ TEST(Dynamics, CorrectionsStopWhenTheErrorLeftIsBelowTheTolerance) {
   // B10's clamped beam falling under gravity, corotated, with BDF2 and Newmark: each step's
   // corrections shrink by a rate measured on earlier ones (about 1e-3 here), so a step stops
   // when the last correction times that rate is below the tolerance, and its first solve only
-  // needs to be accurate to a hundredth of the correction that follows it. The states must
+  // needs to be accurate to a tenth of the correction that follows it. The states must
   // stay those of corrections run to the end (12 solves every step) to the tolerance.
   const Beam beam;
   const DynamicLoads loads{{FaceSelector::inPlane(0, 0.0)}, {}, Vec3(0, 0, -1)};
