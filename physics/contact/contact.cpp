@@ -8,6 +8,7 @@
 #include <map>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -55,6 +56,24 @@ void addKronecker(const Eigen::MatrixXd& scalar, const Eigen::Matrix3d& b, Eigen
       if (scalar(i, j) != 0.0) to.block<3, 3>(3 * i, 3 * j) += scalar(i, j) * b;
 }
 
+/// Row p of W: its nonzero weights and their scalar coefficient columns e * n + i, ascending.
+struct WeightRow {
+  std::vector<std::uint32_t> columns;
+  std::vector<double> values;
+};
+WeightRow weightRow(const SurfaceEmbedding& e, std::size_t p) {
+  const WeightBlocks blocks = e.weightBlocks(p);
+  const std::size_t n = static_cast<std::size_t>(e.basisSize());
+  WeightRow row;
+  for (std::size_t k = 0; k < blocks.elements.size(); ++k)
+    for (std::size_t i = 0; i < n; ++i)
+      if (const double w = blocks.values[k * n + i]; w != 0.0) {
+        row.columns.push_back(static_cast<std::uint32_t>(blocks.elements[k] * n + i));
+        row.values.push_back(w);
+      }
+  return row;
+}
+
 /// f(k) for k = 0 .. count - 1 on both cores: a point's position is a sparse row of about a
 /// hundred weights, and a resting body has thousands of candidate points each pass.
 template <class F>
@@ -63,6 +82,21 @@ void forEachPoint(std::size_t count, const F& f) {
                     [&](const tbb::blocked_range<std::size_t>& r) {
                       for (std::size_t k = r.begin(); k != r.end(); ++k) f(k);
                     });
+}
+
+/// The rows of W of `points` and a compact numbering of the columns they reach: columns[local[c]]
+/// is c, in order of first appearance.
+std::tuple<std::vector<WeightRow>, std::unordered_map<std::uint32_t, std::uint32_t>,
+           std::vector<std::uint32_t>>
+rowsAndColumns(const SurfaceEmbedding& e, const std::vector<std::uint32_t>& points) {
+  std::vector<WeightRow> rows(points.size());
+  forEachPoint(points.size(), [&](std::size_t k) { rows[k] = weightRow(e, points[k]); });
+  std::unordered_map<std::uint32_t, std::uint32_t> local;
+  std::vector<std::uint32_t> columns;
+  for (const WeightRow& row : rows)
+    for (std::uint32_t c : row.columns)
+      if (local.emplace(c, static_cast<std::uint32_t>(columns.size())).second) columns.push_back(c);
+  return {std::move(rows), std::move(local), std::move(columns)};
 }
 
 }  // namespace
@@ -95,12 +129,19 @@ void ContactModel::refresh() {
   startDisplacement_.clear();
   const std::size_t np = e.numPoints();
   rowScale_.assign(np, 0.0);
+  translationGain_.assign(np, 0.0);
+  const std::vector<double>& constant = e.constantValues();
+  const std::size_t n = static_cast<std::size_t>(e.basisSize());
   double extent = 0.0;
   for (std::size_t p = 0; p < np; ++p) {
-    const SparseRow row = e.weightRow(p);
-    double sum = 0.0;
-    for (double w : row.values) sum += std::abs(w);
+    const WeightBlocks row = e.weightBlocks(p);
+    double sum = 0.0, gain = 0.0;
+    for (std::size_t k = 0; k < row.elements.size(); ++k) {
+      for (std::size_t i = 0; i < n; ++i) sum += std::abs(row.values[k * n + i]);
+      gain += row.values[k * n] / constant[row.elements[k]];
+    }
     rowScale_[p] = std::sqrt(3.0) * sum;
+    translationGain_[p] = gain;
     extent = std::max(extent, e.points()[p].cwiseAbs().maxCoeff());
   }
   maxObstacleSpeed_ = 0.0;
@@ -108,6 +149,10 @@ void ContactModel::refresh() {
     maxObstacleSpeed_ = std::max(maxObstacleSpeed_, o.velocity().norm());
   pad_ = 1e-9 * (1.0 + extent);
   clearanceU_.resize(0);  // measured again at the next use
+  knownU_.resize(0);
+  knownDisplacement_.assign(np, Vec3::Zero());
+  known_.assign(np, 0);
+  knownStamp_ = 0;
 }
 
 double ContactModel::takeQuerySeconds() {
@@ -167,16 +212,41 @@ void ContactModel::measureClearances(const Eigen::VectorXd& u, double t) {
   }
   clearanceU_ = u;
   clearanceT_ = t;
+  ++clearanceMeasurements_;
+}
+
+std::pair<Vec3, double> ContactModel::translationAndRest(const Eigen::VectorXd& change) const {
+  const std::vector<double>& constant = embedding_->constantValues();
+  const std::size_t n = static_cast<std::size_t>(embedding_->basisSize());
+  const std::size_t ne = constant.size();
+  Vec3 low = Vec3::Constant(std::numeric_limits<double>::infinity()), high = -low;
+  for (std::size_t el = 0; el < ne; ++el)
+    for (std::size_t d = 0; d < 3; ++d) {
+      const double mean = change[static_cast<Eigen::Index>((el * 3 + d) * n)] * constant[el];
+      low[static_cast<Eigen::Index>(d)] = std::min(low[static_cast<Eigen::Index>(d)], mean);
+      high[static_cast<Eigen::Index>(d)] = std::max(high[static_cast<Eigen::Index>(d)], mean);
+    }
+  const Vec3 t = ne == 0 ? Vec3::Zero() : Vec3(0.5 * (low + high));
+  double rest = 0.0;
+  for (std::size_t el = 0; el < ne; ++el)
+    for (std::size_t d = 0; d < 3; ++d) {
+      const double* c = change.data() + (el * 3 + d) * n;
+      rest = std::max(rest, std::abs(c[0] - t[static_cast<Eigen::Index>(d)] / constant[el]));
+      for (std::size_t i = 1; i < n; ++i) rest = std::max(rest, std::abs(c[i]));
+    }
+  return {t, rest};
 }
 
 const std::vector<std::uint32_t>& ContactModel::candidates(const Eigen::VectorXd& u, double t) {
   const std::size_t np = embedding_->numPoints();
   auto select = [&]() {
-    const double moved = (u - clearanceU_).lpNorm<Eigen::Infinity>();
+    const auto [translation, rest] = translationAndRest(u - clearanceU_);
+    const double shift = translation.norm();
     const double swept = maxObstacleSpeed_ * std::abs(t - clearanceT_);
     candidates_.clear();
     for (std::size_t p = 0; p < np; ++p)
-      if (clearance_[p] - rowScale_[p] * moved - swept <= pad_)
+      if (clearance_[p] - std::abs(translationGain_[p]) * shift - rowScale_[p] * rest - swept <=
+          pad_)
         candidates_.push_back(static_cast<std::uint32_t>(p));
   };
   if (clearanceU_.size() == u.size()) select();
@@ -191,6 +261,26 @@ const std::vector<std::uint32_t>& ContactModel::candidates(const Eigen::VectorXd
   return candidates_;
 }
 
+void ContactModel::displacementsAt(const std::vector<std::uint32_t>& points,
+                                   const Eigen::VectorXd& u, std::vector<Vec3>& out) {
+  if (knownU_.size() != u.size() || knownU_ != u) {
+    knownU_ = u;
+    if (++knownStamp_ == 0) {  // wrapped: forget every stamp
+      std::fill(known_.begin(), known_.end(), 0);
+      knownStamp_ = 1;
+    }
+  }
+  out.resize(points.size());
+  forEachPoint(points.size(), [&](std::size_t k) {
+    const std::uint32_t p = points[k];
+    if (known_[p] != knownStamp_) {
+      knownDisplacement_[p] = embedding_->displacement(p, u);
+      known_[p] = knownStamp_;
+    }
+    out[k] = knownDisplacement_[p];
+  });
+}
+
 ContactLinearization ContactModel::linearize(const Eigen::VectorXd& u, const Eigen::VectorXd& v,
                                              double tNext, double dt) {
   const Stopwatch watch;
@@ -200,9 +290,9 @@ ContactLinearization ContactModel::linearize(const Eigen::VectorXd& u, const Eig
   // Points that may touch at the predicted state u + dt v.
   const std::vector<std::uint32_t>& points = candidates(u + dt * v, tNext);
   const std::size_t nc = points.size();
-  std::vector<Vec3> start(nc), velocity(nc), predicted(nc);
+  std::vector<Vec3> start, velocity(nc), predicted(nc);
+  displacementsAt(points, u, start);
   forEachPoint(nc, [&](std::size_t k) {
-    start[k] = e.displacement(points[k], u);
     velocity[k] = e.displacement(points[k], v);
     predicted[k] = e.points()[points[k]] + (start[k] + dt * velocity[k]);
   });
@@ -230,12 +320,14 @@ bool ContactModel::adjust(const Eigen::VectorXd& uNew) {
   // Drop contacts whose linearized force pulls at the new state.
   std::unordered_set<std::uint32_t> isActive;
   std::vector<Active> kept;
-  std::vector<Vec3> activeAt(active_.size());
-  forEachPoint(active_.size(),
-               [&](std::size_t k) { activeAt[k] = e.position(active_[k].point, uNew); });
+  std::vector<std::uint32_t> activePoints(active_.size());
+  for (std::size_t k = 0; k < active_.size(); ++k) activePoints[k] = active_[k].point;
+  std::vector<Vec3> moved;
+  displacementsAt(activePoints, uNew, moved);
   for (std::size_t k = 0; k < active_.size(); ++k) {
     const Active& a = active_[k];
-    if (a.distance + a.normal.dot(activeAt[k] - a.position) > 0.0) {
+    const Vec3 at = e.points()[a.point] + moved[k];
+    if (a.distance + a.normal.dot(at - a.position) > 0.0) {
       changed = true;
       continue;
     }
@@ -246,8 +338,9 @@ bool ContactModel::adjust(const Eigen::VectorXd& uNew) {
   std::vector<std::uint32_t> points;
   for (std::uint32_t p : candidates(uNew, tNext_))
     if (!isActive.count(p)) points.push_back(p);
-  std::vector<Vec3> positions(points.size());
-  forEachPoint(points.size(), [&](std::size_t k) { positions[k] = e.position(points[k], uNew); });
+  std::vector<Vec3> positions;
+  displacementsAt(points, uNew, positions);
+  for (std::size_t k = 0; k < points.size(); ++k) positions[k] += e.points()[points[k]];
   std::vector<ObstacleQuery> q;
   std::vector<std::uint32_t> which;
   queryAll(positions, tNext_, q, which);
@@ -272,12 +365,9 @@ ContactLinearization ContactModel::build() const {
   out.contacts = active_.size();
   out.force = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(dofs_));
   if (active_.empty()) return out;
-  // The coefficients the active points move: a compact numbering of their W columns.
-  std::unordered_map<std::uint32_t, std::uint32_t> local;
-  std::vector<std::uint32_t> columns;
-  for (const Active& a : active_)
-    for (std::uint32_t c : e.weightRow(a.point).columns)
-      if (local.emplace(c, static_cast<std::uint32_t>(columns.size())).second) columns.push_back(c);
+  std::vector<std::uint32_t> points(active_.size());
+  for (std::size_t k = 0; k < active_.size(); ++k) points[k] = active_[k].point;
+  const auto [rows, local, columns] = rowsAndColumns(e, points);
   auto dof = [&](std::uint32_t column, int d) {
     const std::size_t el = column / n, i = column % n;
     return static_cast<Eigen::Index>((el * 3 + static_cast<std::size_t>(d)) * n + i);
@@ -308,7 +398,7 @@ ContactLinearization ContactModel::build() const {
   for (Eigen::Index k = 0; k < contacts; ++k) {
     const Active& a = active_[static_cast<std::size_t>(k)];
     const double ka = options_.stiffness * areas_[a.point];
-    const SparseRow row = e.weightRow(a.point);
+    const WeightRow& row = rows[static_cast<std::size_t>(k)];
     const Vec3 uStart = startDisplacement_.at(a.point);
     // f(U_n) = -k a (phi(q) + n . (u~_n - u~_q)) n, u~_q = q - x.
     const double gap = a.distance + a.normal.dot(e.points()[a.point] + uStart - a.position);
@@ -390,8 +480,9 @@ ContactMeasure ContactModel::measure(const Eigen::VectorXd& u, double t) {
   const Stopwatch watch;
   const SurfaceEmbedding& e = *embedding_;
   const std::vector<std::uint32_t>& points = candidates(u, t);
-  std::vector<Vec3> positions(points.size());
-  forEachPoint(points.size(), [&](std::size_t k) { positions[k] = e.position(points[k], u); });
+  std::vector<Vec3> positions;
+  displacementsAt(points, u, positions);
+  for (std::size_t k = 0; k < points.size(); ++k) positions[k] += e.points()[points[k]];
   std::vector<ObstacleQuery> q;
   std::vector<std::uint32_t> which;
   queryAll(positions, t, q, which);

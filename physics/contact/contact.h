@@ -23,6 +23,7 @@
 
 #include <cstdint>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -81,6 +82,11 @@ class ContactModel {
   std::size_t numPoints() const { return embedding_->numPoints(); }
   /// Wall seconds spent in obstacle queries (and point positions) since the last call.
   double takeQuerySeconds();
+  /// The points the last linearize(), adjust() or measure() looked at: those the clearances
+  /// did not rule out.
+  std::size_t candidateCount() const { return candidates_.size(); }
+  /// How often the clearances were measured (a product with W over every point each time).
+  std::size_t clearanceMeasurements() const { return clearanceMeasurements_; }
 
  private:
   struct Active {
@@ -100,6 +106,14 @@ class ContactModel {
   /// was measured, stays positive. Measures the clearances again (a product with W over every
   /// point) when they rule out fewer than three quarters of the points.
   const std::vector<std::uint32_t>& candidates(const Eigen::VectorXd& u, double t);
+  /// The translation t of the split of `change` (coefficients) into T(t) + D (t: the midpoint
+  /// of the elements' mean displacements' range, per component), and |D|_inf.
+  std::pair<Vec3, double> translationAndRest(const Eigen::VectorXd& change) const;
+  /// The displacements of `points` at coefficients u into `out`: kept from the last call with
+  /// the same u (a step's last solve, the measure of its end state and the next step's start
+  /// all ask for the same points at the same U), computed on both cores for the others.
+  void displacementsAt(const std::vector<std::uint32_t>& points, const Eigen::VectorXd& u,
+                       std::vector<Vec3>& out);
   void measureClearances(const Eigen::VectorXd& u, double t);
 
   const SurfaceEmbedding* embedding_;
@@ -113,15 +127,24 @@ class ContactModel {
   // Culling (W's product over every point was most of a step's collision handling): each
   // point's clearance, a lower bound of its signed distance to every obstacle (the exact
   // distance to a half-space, the distance to a surface obstacle's box, 0 inside that box) at
-  // coefficients clearanceU_ and time clearanceT_. A point moves at most
-  // rowScale_ |U' - U|_inf (sqrt 3 times its weights' absolute sum) and the obstacles at most
-  // maxObstacleSpeed_ |t' - t|, both distances 1-Lipschitz: a clearance larger than that (plus
-  // pad_, against rounding) rules contact out.
-  std::vector<double> rowScale_, clearance_;
+  // coefficients clearanceU_ and time clearanceT_. U' - U is split into a uniform translation
+  // T(t) and the rest D (movedBound()); point p then moves at most
+  // |translationGain_[p]| |t| + rowScale_[p] |D|_inf (W_p T(t) = translationGain_[p] t, about t
+  // as W reproduces constants; rowScale_ is sqrt 3 times the weights' absolute sum) and the
+  // obstacles at most maxObstacleSpeed_ |t' - t|, both distances 1-Lipschitz: a clearance
+  // larger than that (plus pad_, against rounding) rules contact out. Without the translation
+  // a falling body's every point was a candidate a step or two after each measurement.
+  std::vector<double> rowScale_, translationGain_, clearance_;
   Eigen::VectorXd clearanceU_;
   double clearanceT_ = 0.0, maxObstacleSpeed_ = 0.0, pad_ = 0.0;
   std::vector<std::uint32_t> candidates_;
   std::size_t measuredCandidates_ = 0;  ///< candidates right after the clearances were measured
+  std::size_t clearanceMeasurements_ = 0;
+  // displacementsAt()'s memory: point p's displacement at knownU_ where known_[p] == knownStamp_.
+  Eigen::VectorXd knownU_;
+  std::vector<Vec3> knownDisplacement_;
+  std::vector<std::uint32_t> known_;
+  std::uint32_t knownStamp_ = 0;
   double tNext_ = 0.0, querySeconds_ = 0.0;
   std::size_t dofs_ = 0;
 };

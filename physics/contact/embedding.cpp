@@ -17,6 +17,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "mesh/face_triangulation.h"
+#include "physics/contact/embedding_kernels.h"
 #include "physics/contact/embedding_samples.h"
 #include "polydg/mesh/geometry.h"
 #include "util/stopwatch.h"
@@ -272,6 +273,7 @@ SurfaceEmbedding::SurfaceEmbedding(const PolyMesh& mesh, const DgBasis& basis,
 void SurfaceEmbedding::adopt(Samples&& s) {
   numPieces_ = s.numPieces;
   numElements_ = s.elementPiece.size();
+  constant_ = std::move(s.constant);
   samplePositions_ = std::move(s.positions);
   sampleRadius_ = std::move(s.radius);
   samplePiece_ = std::move(s.piece);
@@ -352,30 +354,49 @@ void SurfaceEmbedding::computeWeights() {
     }
     compressRow(row);
   });
+  // Rows are sorted by column (compressRow), so an element's functions are adjacent.
+  const std::size_t n = static_cast<std::size_t>(n_);
   weightStart_.assign(1, 0);
-  weightColumns_.clear();
+  weightElements_.clear();
   weightValues_.clear();
   for (const auto& row : rows) {
     for (const auto& [c, v] : row) {
-      weightColumns_.push_back(c);
-      weightValues_.push_back(v);
+      const std::uint32_t element = static_cast<std::uint32_t>(c / n);
+      if (weightElements_.size() == weightStart_.back() || weightElements_.back() != element) {
+        weightElements_.push_back(element);
+        weightValues_.resize(weightValues_.size() + n, 0.0);
+      }
+      weightValues_[(weightElements_.size() - 1) * n + c % n] = v;
     }
-    weightStart_.push_back(weightColumns_.size());
+    weightStart_.push_back(weightElements_.size());
   }
 }
 
-SparseRow SurfaceEmbedding::weightRow(std::size_t p) const {
+WeightBlocks SurfaceEmbedding::weightBlocks(std::size_t p) const {
   const std::size_t b = weightStart_[p], e = weightStart_[p + 1];
-  return {{weightColumns_.data() + b, e - b}, {weightValues_.data() + b, e - b}};
+  const std::size_t n = static_cast<std::size_t>(n_);
+  return {{weightElements_.data() + b, e - b}, {weightValues_.data() + b * n, (e - b) * n}};
+}
+
+Vec3 SurfaceEmbedding::displacement(std::size_t p, const Eigen::VectorXd& coefficients) const {
+  const std::size_t b = weightStart_[p];
+  double out[3];
+  blockWeightedSum(n_, weightElements_.data() + b, weightStart_[p + 1] - b,
+                   weightValues_.data() + b * static_cast<std::size_t>(n_), coefficients.data(),
+                   out);
+  return Vec3(out[0], out[1], out[2]);
 }
 
 Eigen::SparseMatrix<double, Eigen::RowMajor, int> SurfaceEmbedding::weights() const {
+  const std::size_t n = static_cast<std::size_t>(n_);
   std::vector<Eigen::Triplet<double, int>> triplets;
   triplets.reserve(weightValues_.size());
   for (std::size_t p = 0; p < numPoints(); ++p)
-    for (std::size_t q = weightStart_[p]; q < weightStart_[p + 1]; ++q)
-      triplets.emplace_back(static_cast<int>(p), static_cast<int>(weightColumns_[q]),
-                            weightValues_[q]);
+    for (std::size_t k = weightStart_[p]; k < weightStart_[p + 1]; ++k)
+      for (std::size_t i = 0; i < n; ++i)
+        if (weightValues_[k * n + i] != 0.0)
+          triplets.emplace_back(static_cast<int>(p), static_cast<int>(weightElements_[k] * n + i),
+                                weightValues_[k * n + i]);
   Eigen::SparseMatrix<double, Eigen::RowMajor, int> w(
       static_cast<int>(numPoints()), static_cast<int>(numElements_ * static_cast<std::size_t>(n_)));
   w.setFromTriplets(triplets.begin(), triplets.end());

@@ -60,6 +60,7 @@ SurfaceEmbedding::Samples SurfaceEmbedding::clustered(Samples&& raw) {
   SurfaceEmbedding::Samples out;
   out.numPieces = raw.numPieces;
   out.elementPiece = std::move(raw.elementPiece);
+  out.constant = std::move(raw.constant);
   out.boxes = std::move(raw.boxes);
   out.largestRadius = raw.largestRadius;
   std::vector<std::pair<std::uint32_t, double>> row;
@@ -92,6 +93,9 @@ SurfaceEmbedding::Samples SurfaceEmbedding::makeSamples(const PolyMesh& mesh,
   for (const Face& f : mesh.faces())
     if (f.front.valid() && f.back.valid()) groups.unite(f.front.value, f.back.value);
   s.elementPiece.resize(ne);
+  s.constant.resize(ne);
+  // The scaled monomials start with 1, so phi_0 = T[0][0] everywhere in the element.
+  for (std::size_t e = 0; e < ne; ++e) s.constant[e] = basis.coefficients(ElementId(e))(0, 0);
   {
     std::unordered_map<std::uint32_t, std::uint32_t> label;
     for (std::size_t e = 0; e < ne; ++e) {

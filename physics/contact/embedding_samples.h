@@ -41,6 +41,7 @@ struct SurfaceEmbedding::Samples {
   std::vector<double> values;
   std::size_t numPieces = 0;
   std::vector<std::uint32_t> elementPiece;
+  std::vector<double> constant;  ///< phi_0 of each element: the basis's constant function
   /// The vertex samples of each element (ElementLinear).
   std::vector<std::size_t> elementSampleStart{0};
   std::vector<std::uint32_t> elementSamples;

@@ -116,6 +116,68 @@ TEST(ContactModel, CulledPointsNeverTouch) {
   EXPECT_LT(touching, states);
 }
 
+TEST(ContactModel, ARigidTranslationRulesOutThePointsItKeepsClear) {
+  // The sphere (bottom at z = 0.55) above the ground z <= 0: the clearances are measured at
+  // rest, then the body moves down rigidly by s with a deformation of 1e-6 on top. A point
+  // then moves by s (W reproduces the translation) up to the deformation, so exactly the
+  // points within s of the ground (and a sliver for the deformation) stay candidates. A bound
+  // by the largest coefficient change alone (sqrt 3 times a point's absolute weights, which
+  // exceed 1, times s over the constant function's value) kept every point from s = 0.05 on.
+  const SphereInACube body;
+  const PolyMesh& mesh = body.mesh;
+  const DgBasis& basis = body.basis;
+  const SurfaceEmbedding& embedding = body.embedding;
+  const std::vector<double> areas(embedding.numPoints(), 1e-3);
+  const std::vector<Obstacle> ground = {Obstacle::halfSpace(Plane::make(Vec3(0, 0, 1), 0.0))};
+  ContactOptions options;
+  options.stiffness = 1e4;
+  ContactModel model(embedding, areas, ground, options);
+  const Eigen::Index n = basis.size();
+  Eigen::VectorXd u = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(mesh.numElements()) * 3 * n);
+  EXPECT_EQ(model.measure(u, 0.0).contacts, 0u);  // measures the clearances at rest
+  EXPECT_EQ(model.clearanceMeasurements(), 1u);
+  std::mt19937_64 rng(20261204);
+  std::uniform_real_distribution<double> noise(-1.0, 1.0);
+  for (double s : {0.05, 0.3, 0.5, 0.58, 0.62}) {
+    for (std::size_t e = 0; e < mesh.numElements(); ++e)
+      u.segment((static_cast<Eigen::Index>(e) * 3 + 2) * n, n) =
+          affineCoefficients(basis, ElementId(e), -s, Vec3::Zero(), Vec3::Zero());
+    for (Eigen::Index i = 0; i < u.size(); ++i) u[i] += 1e-6 * noise(rng);
+    const ContactMeasure culled = model.measure(u, 0.0);
+    EXPECT_EQ(culled.contacts, bruteForce(embedding, ground, areas, 1e4, u, 0.0).contacts)
+        << "shift " << s;
+    std::size_t within = 0;  // points the translation brings within 1e-4 of the ground
+    for (const Vec3& x : embedding.points()) within += x.z() <= s + 1e-4;
+    EXPECT_LE(model.candidateCount(), within) << "shift " << s;
+    EXPECT_GE(model.candidateCount(), culled.contacts) << "shift " << s;
+    EXPECT_LT(10 * model.candidateCount(), embedding.numPoints()) << "shift " << s;
+    if (s > 0.55) {  // the bottom is at 0.55
+      EXPECT_GT(culled.contacts, 0u) << "shift " << s;
+    }
+  }
+  EXPECT_EQ(model.clearanceMeasurements(), 1u);  // the translations needed none again
+  // Elements translated by different amounts (x > 0 down by s, the others by s / 2): the
+  // translation taken out is their range's midpoint, and what is left of each element's
+  // constant part bounds the rest; the measure still equals the brute force's.
+  ContactModel split(embedding, areas, ground, options);
+  u.setZero();
+  EXPECT_EQ(split.measure(u, 0.0).contacts, 0u);
+  for (double s : {0.2, 0.62, 0.7, 0.8}) {
+    for (std::size_t e = 0; e < mesh.numElements(); ++e) {
+      const double down = basis.centre(ElementId(e)).x() > 0.0 ? s : 0.5 * s;
+      u.segment((static_cast<Eigen::Index>(e) * 3 + 2) * n, n) =
+          affineCoefficients(basis, ElementId(e), -down, Vec3::Zero(), Vec3::Zero());
+    }
+    const ContactMeasure culled = split.measure(u, 0.0);
+    const ContactMeasure brute = bruteForce(embedding, ground, areas, 1e4, u, 0.0);
+    EXPECT_EQ(culled.contacts, brute.contacts) << "shift " << s;
+    EXPECT_EQ(culled.deepest, brute.deepest) << "shift " << s;
+    if (s >= 0.7) {  // the half moving s reaches the ground (its weights blend in the other's)
+      EXPECT_GT(brute.contacts, 0u) << "shift " << s;
+    }
+  }
+}
+
 TEST(ContactModel, ContactStiffnessIsTheSumOfThePointsPenalties) {
   // K_c = sum over the points in contact of k a (w (x) n)(w (x) n)^T: for any coefficient change
   // dU, dU^T K_c dU = sum k a (n . (W dU)_p)^2 over those points, with the points in contact

@@ -72,6 +72,28 @@ TEST_P(EmbeddingTest, ReproducesAffineFieldsOnSlicedAndCutMeshes) {
       const auto [field, u] = affine(basis, centre);
       EXPECT_LT(relativeError(embedding, u, field), kAffineTolerance)
           << "degree " << degree << ", centre " << centre.transpose() << ", pass " << pass;
+      // A uniform field is 1 / constantValues() on each element's first function alone.
+      ASSERT_EQ(embedding.constantValues().size(), model.mesh().numElements());
+      for (std::size_t e = 0; e < model.mesh().numElements(); ++e) {
+        const Eigen::VectorXd one =
+            affineCoefficients(basis, ElementId(e), 1.0, Vec3::Zero(), centre);
+        EXPECT_NEAR(one[0] * embedding.constantValues()[e], 1.0, 1e-12) << "element " << e;
+        EXPECT_LT(one.tail(one.size() - 1).lpNorm<Eigen::Infinity>(), 1e-12 * std::abs(one[0]));
+      }
+      // Each point's displacement, summed by element blocks, is its row of W times U.
+      const Eigen::SparseMatrix<double, Eigen::RowMajor, int> w = embedding.weights();
+      const Eigen::Index n = basis.size();
+      const Eigen::Index ne = static_cast<Eigen::Index>(basis.numElements());
+      for (int d = 0; d < 3; ++d) {
+        Eigen::VectorXd component(ne * n);
+        for (Eigen::Index e = 0; e < ne; ++e)
+          component.segment(e * n, n) = u.segment((e * 3 + d) * n, n);
+        const Eigen::VectorXd product = w * component;
+        for (std::size_t p = 0; p < embedding.numPoints(); ++p)
+          ASSERT_NEAR(embedding.displacement(p, u)[d], product[static_cast<Eigen::Index>(p)],
+                      1e-13 * (1.0 + std::abs(product[static_cast<Eigen::Index>(p)])))
+              << "point " << p << ", component " << d;
+      }
       if (pass == 0) {  // then the same through a cut that keeps both sides
         CutRequest cut;
         const Vec3 normal = Vec3(1, 0.3, 0.2).normalized();

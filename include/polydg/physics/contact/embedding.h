@@ -62,9 +62,10 @@ struct EmbeddingUpdate {
   double seconds = 0.0;
 };
 
-/// One sparse row: column indices and values.
-struct SparseRow {
-  std::span<const std::uint32_t> columns;
+/// One row of W by elements: the elements a point's weights reach, ascending, and for each the
+/// weights of its n scalar functions (n values an element, zero where a function has none).
+struct WeightBlocks {
+  std::span<const std::uint32_t> elements;
   std::span<const double> values;
 };
 
@@ -99,32 +100,30 @@ class SurfaceEmbedding {
   /// Scalar functions per element of the basis the weights were computed for, and elements.
   int basisSize() const { return n_; }
   std::size_t numElements() const { return numElements_; }
+  /// The value of each element's first basis function, a constant: a uniform displacement t
+  /// has the coefficient t_d / constantValues()[e] on it and 0 on the others.
+  const std::vector<double>& constantValues() const { return constant_; }
 
   /// The displacement of every point for DG coefficients in LinearSystem's layout
   /// (U[(e * 3 + d) * n + i]); #points by 3.
   Eigen::Matrix<double, Eigen::Dynamic, 3> displacements(const Eigen::VectorXd& coefficients) const;
   /// The displacement of point p alone, the same sum as displacements() row p.
-  Vec3 displacement(std::size_t p, const Eigen::VectorXd& coefficients) const {
-    // n known when compiling: a column's element and function without a division per weight.
-    switch (n_) {
-      case 4: return displacementOf<4>(p, coefficients);
-      case 10: return displacementOf<10>(p, coefficients);
-      case 20: return displacementOf<20>(p, coefficients);
-      default: return displacementOf<0>(p, coefficients);
-    }
-  }
+  Vec3 displacement(std::size_t p, const Eigen::VectorXd& coefficients) const;
   /// Point p displaced by `coefficients`.
   Vec3 position(std::size_t p, const Eigen::VectorXd& coefficients) const {
     return points_[p] + displacement(p, coefficients);
   }
 
   const std::vector<Vec3>& samplePositions() const { return samplePositions_; }
-  /// Row p of W = Phi S (eq. 19): scalar coefficient columns e * n + i (ascending) and weights
-  /// W_i(x_p); component d of the point's displacement is sum_i W_i U[(e * 3 + d) * n + i].
-  SparseRow weightRow(std::size_t p) const;
-  /// W, #points by (elements * n), row-major.
+  /// Row p of W = Phi S (eq. 19) by elements: the weight W_i(x_p) of element e's function i is
+  /// values[k * n + i] where elements[k] = e; component d of the point's displacement is
+  /// sum W_i U[(e * 3 + d) * n + i]. Stored so: a point's weights cover all n functions of
+  /// each element its samples lie in, and an element's block is read as one short vector.
+  WeightBlocks weightBlocks(std::size_t p) const;
+  /// W, #points by (elements * n), row-major (its nonzero weights).
   Eigen::SparseMatrix<double, Eigen::RowMajor, int> weights() const;
-  /// Nonzeros of W (what a surface update reads), and of Phi and S (kept for updates).
+  /// Weights W stores (n an element block: what a surface update reads), and the nonzeros of
+  /// Phi and S (kept for updates).
   std::size_t weightNonzeros() const { return weightValues_.size(); }
   std::size_t storedNonzeros() const { return pointValues_.size() + sampleValues_.size(); }
 
@@ -142,21 +141,6 @@ class SurfaceEmbedding {
  private:
   struct Samples;
 
-  /// displacement() with N functions per element (0: n_).
-  template <int N>
-  Vec3 displacementOf(std::size_t p, const Eigen::VectorXd& coefficients) const {
-    const std::size_t n = N > 0 ? static_cast<std::size_t>(N) : static_cast<std::size_t>(n_);
-    double sum[3] = {0.0, 0.0, 0.0};
-    for (std::size_t q = weightStart_[p]; q < weightStart_[p + 1]; ++q) {
-      const std::size_t c = weightColumns_[q], e = c / n, i = c % n;
-      const double* u = coefficients.data() + e * 3 * n + i;
-      const double w = weightValues_[q];
-      sum[0] += w * u[0];
-      sum[1] += w * u[n];
-      sum[2] += w * u[2 * n];
-    }
-    return Vec3(sum[0], sum[1], sum[2]);
-  }
   static Samples clustered(Samples&& raw);
   Samples makeSamples(const PolyMesh& mesh, const DgBasis& basis) const;
   SurfaceEmbedding() = default;
@@ -204,11 +188,13 @@ class SurfaceEmbedding {
   std::vector<std::size_t> pointStart_;
   std::vector<std::uint32_t> pointColumns_;
   std::vector<double> pointValues_;
-  // W = Phi S in CSR form.
+  // W = Phi S by element blocks: point p's blocks are weightStart_[p] .. weightStart_[p + 1],
+  // block k of element weightElements_[k] with n weights from weightValues_[k * n].
   std::vector<std::size_t> weightStart_;
-  std::vector<std::uint32_t> weightColumns_;
+  std::vector<std::uint32_t> weightElements_;
   std::vector<double> weightValues_;
   std::size_t numElements_ = 0;
+  std::vector<double> constant_;  ///< phi_0 of each element
   void computeWeights();
   double setupSeconds_ = 0.0;
 };
