@@ -351,6 +351,7 @@ void finishOperation(MeshEditor::State& s, Edit& edit, double volumeBefore, Chec
   s.volume = volumeBefore - oldVolume + newVolume;
   report.leftWhole = edit.leftWhole().sorted();
   report.lineage = edit.lineage();
+  report.touched = touched;
   report.facesTotal = s.mesh.numFaces();
   OperationCheck& v = report.check;
   const Stopwatch checking;

@@ -500,6 +500,7 @@ json toJson(const SimulationReport& r) {
                     {"elements_after", c.elementsAfter},
                     {"exact", c.exact},
                     {"extended", c.extended},
+                    {"solver_elements", c.solverElements},
                     {"operation", toJson(c.report)},
                     {"seconds", c.seconds},
                     {"cut_seconds",

@@ -144,16 +144,23 @@ DynamicSolver Simulation::makeSolver() {
                        loads_, dynamics_);
 }
 
-/// The solver of the edited mesh. The old one goes first: its memory (the local matrices and the
-/// solver's, hundreds of MB at 20k elements) is then reused, where fresh pages would be faulted
-/// in and zeroed, which took most of a new solver's time on this machine. The new one starts
-/// with the preconditioner the old one had come to (the edit changes a few elements, not the
-/// conditioning of the body).
-void Simulation::replaceSolver() {
+/// The solver of the mesh `edit` changed: it takes over the old one's blocks of the elements
+/// the edit left alone, and the old one's other memory is freed before the new one allocates
+/// its own (fresh pages faulted in and zeroed took most of a new solver's time on this
+/// machine). The new one starts with the preconditioner the old one had come to (the edit
+/// changes a few elements, not the conditioning of the body). Returns the elements whose
+/// blocks were computed.
+std::size_t Simulation::replaceSolver(const OperationReport& edit) {
   const CgPreconditioner used = solver_->preconditioner();
+  std::vector<char> changed(model_.mesh().numElements(), 0);
+  for (ElementId e : edit.touched) changed[e.index()] = 1;
+  for (const auto& [id, sources] : edit.lineage.changed) changed[id] = 1;  // made or moved
+  DynamicSolver before = std::move(*solver_);
   solver_.reset();
-  solver_.emplace(makeSolver());
+  solver_.emplace(model_.mesh(), model_.moments(2 * scene_.discretization.basis.degree), loads_,
+                  dynamics_, std::move(before), changed);
   solver_->startWith(used);
+  return solver_->elementsComputed();
 }
 
 /// The scene's initial velocity, linear and angular about the centre of mass; undeformed.
@@ -299,7 +306,7 @@ bool Simulation::cutsDue(double t) {
     record.checkSeconds = record.report.check.seconds;
     families_.afterCut(record.report.lineage, record.elementsAfter);
     const Stopwatch ts;
-    replaceSolver();
+    record.solverElements = replaceSolver(record.report);
     record.solverSeconds = ts.seconds();
     const Stopwatch tt;
     TransferCounts counts;
@@ -341,27 +348,27 @@ bool Simulation::adaptationDue(int k) {
   const BodyState before = solver_->state();
   const DgBasis oldBasis = solver_->basis();
   const Eigen::VectorXd oldU = solver_->displacement(), oldV = solver_->velocity();
-  ElementLineage lineage;
+  OperationReport edit;
   if (coarsening) {
     record.coarsened = coarsenRequest.groups.size();
     const CoarsenReport c = model_.coarsen(coarsenRequest);
     requirePassed(c.operation.check, "the coarsening", record.time);
-    lineage = c.operation.lineage;
-    families_.afterCoarsening(lineage, model_.mesh().numElements());
+    edit = c.operation;
+    families_.afterCoarsening(edit.lineage, model_.mesh().numElements());
   } else {
     if (a.split == RefineSplit::Octants) request.directions.clear();
     record.marked = request.elements.size();
     const RefineReport r = model_.refine(request);
     requirePassed(r.operation.check, "the refinement", record.time);
-    lineage = r.operation.lineage;
+    edit = r.operation;
     std::unordered_set<std::uint32_t> refined;
     for (ElementId e : request.elements) refined.insert(e.value);
-    families_.afterRefinement(lineage, model_.mesh().numElements(), refined);
+    families_.afterRefinement(edit.lineage, model_.mesh().numElements(), refined);
   }
   record.elementsAfter = model_.mesh().numElements();
-  replaceSolver();
+  replaceSolver(edit);
   TransferCounts counts;
-  afterEdit(lineage, oldBasis, oldU, oldV, record.time, coarsening, &counts);
+  afterEdit(edit.lineage, oldBasis, oldU, oldV, record.time, coarsening, &counts);
   record.exact = counts.exact;
   record.extended = counts.extended;
   const BodyState after = solver_->state();

@@ -38,7 +38,7 @@ class Simulation {
  private:
   // Setup.
   DynamicSolver makeSolver();
-  void replaceSolver();
+  std::size_t replaceSolver(const OperationReport& edit);
   void setInitialVelocity();
   void embedSurface();
   void setUpContact();

@@ -473,6 +473,7 @@ nlohmann::json cutLatencyPart(bool quick, SuiteOutput& s,
                      {"t_cut", cut.cutSeconds},
                      {"t_check", cut.checkSeconds},
                      {"t_solver", cut.solverSeconds},
+                     {"solver_elements", cut.solverElements},
                      {"t_transfer", cut.transferSeconds},
                      {"t_next_step", next},
                      {"t_latency", cut.seconds + next},
@@ -481,7 +482,8 @@ nlohmann::json cutLatencyPart(bool quick, SuiteOutput& s,
     s.rows.push_back(j);
     log("cut latency " + grid + ", " + blade.what + " (" + shortNumber(100 * touched) +
         "% of the elements split): " + shortNumber(cut.seconds + next) + " s (cut " +
-        shortNumber(cut.cutSeconds) + ", solver " + shortNumber(cut.solverSeconds) + ", transfer " +
+        shortNumber(cut.cutSeconds) + ", solver " + shortNumber(cut.solverSeconds) + " for " +
+        std::to_string(cut.solverElements) + " elements, transfer " +
         shortNumber(cut.transferSeconds) + ", next step " + shortNumber(next) +
         "; a step before it " + shortNumber(step) + ")");
   }

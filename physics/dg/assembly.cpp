@@ -6,6 +6,7 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 
 #include <tbb/parallel_for.h>
 #include <Eigen/Eigenvalues>
@@ -213,9 +214,6 @@ ElementData<double> elementPenaltyThresholds(const PolyMesh& mesh, const DgBasis
   return required;
 }
 
-namespace {
-
-/// Neighbours of each element (sorted, with self), through coupled interior faces.
 std::vector<std::vector<std::uint32_t>> coupledNeighbours(const PolyMesh& mesh,
                                                           const FaceRoles& roles) {
   std::vector<std::vector<std::uint32_t>> neighbours(mesh.numElements());
@@ -234,25 +232,29 @@ std::vector<std::vector<std::uint32_t>> coupledNeighbours(const PolyMesh& mesh,
   return neighbours;
 }
 
-/// The rows of each element of a form with a choice of terms: the element stiffness if
-/// `element`, the face terms `diagonalTerms` (FaceTerms bits) in the diagonal blocks and
-/// `couplingTerms` in the coupling blocks. For each element e, in parallel,
-/// store(e, diagonal, coupling) receives e's diagonal block (bs x bs, column-major) and its
-/// coupling blocks with its neighbours f > e (in the order of `neighbours`, each bs x bs
-/// row-major: column (e, c) of K reads row c of the block), in a scratch buffer.
+namespace {
+
+/// The rows of each element (of `only`, if not empty) of a form with a choice of terms: the element
+/// stiffness if `element`, the face terms `diagonalTerms` (FaceTerms bits) in the diagonal blocks
+/// and `couplingTerms` in the coupling blocks. For each element e, in parallel, store(e, diagonal,
+/// coupling) receives e's diagonal block (bs x bs, column-major) and its coupling blocks with its
+/// neighbours f > e (in the order of `neighbours`, each bs x bs row-major: column (e, c) of K reads
+/// row c of the block), in a scratch buffer.
 template <class Store>
 void forEachElementRows(const PolyMesh& mesh, const DgBasis& basis, const MomentCache& moments,
                         const FaceRoles& roles, const FormCoefficients& form,
                         const std::vector<std::vector<std::uint32_t>>& neighbours, bool element,
-                        int diagonalTerms, int couplingTerms, bool dirichletFaces, Store&& store) {
+                        int diagonalTerms, int couplingTerms, bool dirichletFaces,
+                        std::span<const std::uint32_t> only, Store&& store) {
   const int bs = 3 * basis.size();
   const std::size_t bb = static_cast<std::size_t>(bs) * static_cast<std::size_t>(bs);
   tbb::parallel_for(
-      tbb::blocked_range<std::size_t>(0, mesh.numElements(), 16),
+      tbb::blocked_range<std::size_t>(0, only.empty() ? mesh.numElements() : only.size(), 16),
       [&](const tbb::blocked_range<std::size_t>& r) {
         Eigen::MatrixXd self, faceSelf, faceOther;
         std::vector<double> coupling;
-        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+        for (std::size_t k = r.begin(); k != r.end(); ++k) {
+          const std::size_t i = only.empty() ? k : only[k];
           const ElementId e(i);
           const auto& b = neighbours[i];
           const auto firstGreater = std::upper_bound(b.begin(), b.end(), e.value);
@@ -317,7 +319,7 @@ LocalMatrices localMatricesOf(const PolyMesh& mesh, const DgBasis& basis,
   local.coupling.resize(local.couplingStart[ne] * bb);
   forEachElementRows(
       mesh, basis, moments, roles, form, local.neighbours, element, diagonalTerms, couplingTerms,
-      dirichletFaces, [&](std::size_t i, const Eigen::MatrixXd& self, const double* coupling) {
+      dirichletFaces, {}, [&](std::size_t i, const Eigen::MatrixXd& self, const double* coupling) {
         Eigen::Map<Eigen::MatrixXd>(local.diagonal.data() + i * bb, self.rows(), self.cols()) =
             self;
         std::copy(coupling, coupling + (local.couplingStart[i + 1] - local.couplingStart[i]) * bb,
@@ -334,7 +336,7 @@ BlockRows<double> assembleBlockRows(const PolyMesh& mesh, const DgBasis& basis,
   const std::vector<std::vector<std::uint32_t>> neighbours = coupledNeighbours(mesh, roles);
   BlockRows<double> rows = blockRowsLayout(neighbours, basis.size(), form.method == Method::BZ);
   forEachElementRows(mesh, basis, moments, roles, form, neighbours, true, kAllFaceTerms,
-                     kAllFaceTerms, true,
+                     kAllFaceTerms, true, {},
                      [&](std::size_t e, const Eigen::MatrixXd& self, const double* coupling) {
                        writeElementRows(rows, neighbours, e, self.data(), coupling);
                      });
@@ -350,60 +352,59 @@ LocalMatrices localMatrices(const PolyMesh& mesh, const DgBasis& basis, const Mo
   return localMatricesOf(mesh, basis, moments, roles, form, true, kAllFaceTerms, kAllFaceTerms);
 }
 
-SplitLocalMatrices splitLocalMatrices(const PolyMesh& mesh, const DgBasis& basis,
-                                      const MomentCache& moments, const FaceRoles& roles,
-                                      const FormCoefficients& form) {
-  SplitLocalMatrices split;
-  split.rowStrain = localMatricesOf(mesh, basis, moments, roles, form, true,
-                                    kTrialStrainTerms | kTestStrainTerms, kTestStrainTerms, false);
-  split.columnStrain = localMatricesOf(mesh, basis, moments, roles, form, false, 0,
-                                       kTrialStrainTerms | kOtherLiftingTerms);
-  split.jumps = localMatricesOf(mesh, basis, moments, roles, form, false, kJumpTerms, kJumpTerms);
-
-  // The neighbours' lifting terms in each diagonal block, one block per neighbour.
-  const std::size_t ne = mesh.numElements();
+void writeSplitRows(SplitLocalMatrices& split, const PolyMesh& mesh, const DgBasis& basis,
+                    const MomentCache& moments, const FaceRoles& roles,
+                    const FormCoefficients& form, std::span<const std::uint32_t> elements) {
   const int bs = split.jumps.blockSize;
   const std::size_t bb = static_cast<std::size_t>(bs) * static_cast<std::size_t>(bs);
-  split.neighbourStart.assign(ne + 1, 0);
-  for (std::size_t i = 0; i < ne; ++i)
-    split.neighbourStart[i + 1] = split.neighbourStart[i] + split.jumps.neighbours[i].size() - 1;
-  // Zeroed in parallel: hundreds of MB at 20k elements, where one serial pass (and the page
-  // faults it takes) was most of the solver's set-up.
-  assignZeros(split.neighbourLifting, split.neighbourStart[ne] * bb);
-  assignZeros(split.dirichletTrial, ne * bb);
-  assignZeros(split.dirichletTest, ne * bb);
-  if (form.method != Method::IP) return split;
-  tbb::parallel_for(
-      tbb::blocked_range<std::size_t>(0, ne, 16), [&](const tbb::blocked_range<std::size_t>& r) {
-        Eigen::MatrixXd faceSelf, faceOther;
-        for (std::size_t i = r.begin(); i != r.end(); ++i) {
-          const ElementId e(i);
-          const auto& b = split.jumps.neighbours[i];
-          for (const FaceUse& use : mesh.element(e).faces) {
-            if (roles.kind[use.face] == FaceKind::Dirichlet) {
-              const FaceView view = viewOf(roles, use.face, sideOf(roles, use.face, e));
-              for (auto [terms, out] : {std::pair{kTrialStrainTerms, &split.dirichletTrial},
-                                        std::pair{kTestStrainTerms, &split.dirichletTest}}) {
-                faceRows(mesh, basis, moments, view, form, faceSelf, faceOther, false, terms);
-                Eigen::Map<Eigen::MatrixXd>(out->data() + i * bb, bs, bs) += faceSelf;
-              }
-              continue;
-            }
-            if (roles.kind[use.face] != FaceKind::Interior) continue;
-            const FaceView view = viewOf(roles, use.face, sideOf(roles, use.face, e));
-            faceRows(mesh, basis, moments, view, form, faceSelf, faceOther, false,
-                     kOtherLiftingTerms);
-            // Slot of the neighbour among e's neighbours without e itself.
-            auto t = static_cast<std::size_t>(
-                std::lower_bound(b.begin(), b.end(), view.other.value) - b.begin());
-            if (view.other.value > e.value) --t;
-            Eigen::Map<Eigen::MatrixXd>(
-                split.neighbourLifting.data() + (split.neighbourStart[i] + t) * bb, bs, bs) +=
-                faceSelf;
-          }
+  const auto& neighbours = split.jumps.neighbours;
+  // Strain of the rows' element, of the columns' element, and none (the penalty).
+  const std::tuple<LocalMatrices*, bool, int, int, bool> parts[] = {
+      {&split.rowStrain, true, kTrialStrainTerms | kTestStrainTerms, kTestStrainTerms, false},
+      {&split.columnStrain, false, 0, kTrialStrainTerms | kOtherLiftingTerms, true},
+      {&split.jumps, false, kJumpTerms, kJumpTerms, true}};
+  for (const auto& [local, element, diagonalTerms, couplingTerms, dirichletFaces] : parts)
+    forEachElementRows(
+        mesh, basis, moments, roles, form, neighbours, element, diagonalTerms, couplingTerms,
+        dirichletFaces, elements,
+        [&, local = local](std::size_t i, const Eigen::MatrixXd& self, const double* coupling) {
+          Eigen::Map<Eigen::MatrixXd>(local->diagonal.data() + i * bb, bs, bs) = self;
+          std::copy(coupling, coupling + greaterNeighbours(neighbours, i) * bb,
+                    local->coupling.data() + local->couplingStart[i] * bb);
+        });
+  // The neighbours' lifting terms in each diagonal block, one block per neighbour, and the
+  // Dirichlet faces' strain terms.
+  tbb::parallel_for(std::size_t(0), elements.size(), [&](std::size_t k) {
+    const std::size_t i = elements[k];
+    const std::size_t lifting = neighbours[i].size() - 1;
+    double* nl = split.neighbourLifting.data() + split.neighbourStart[i] * bb;
+    std::fill(nl, nl + lifting * bb, 0.0);
+    for (UninitializedVector<double>* dir : {&split.dirichletTrial, &split.dirichletTest})
+      std::fill(dir->data() + i * bb, dir->data() + (i + 1) * bb, 0.0);
+    if (form.method != Method::IP) return;
+    Eigen::MatrixXd faceSelf, faceOther;
+    const ElementId e(i);
+    const auto& b = neighbours[i];
+    for (const FaceUse& use : mesh.element(e).faces) {
+      if (roles.kind[use.face] == FaceKind::Dirichlet) {
+        const FaceView view = viewOf(roles, use.face, sideOf(roles, use.face, e));
+        for (auto [terms, out] : {std::pair{kTrialStrainTerms, &split.dirichletTrial},
+                                  std::pair{kTestStrainTerms, &split.dirichletTest}}) {
+          faceRows(mesh, basis, moments, view, form, faceSelf, faceOther, false, terms);
+          Eigen::Map<Eigen::MatrixXd>(out->data() + i * bb, bs, bs) += faceSelf;
         }
-      });
-  return split;
+        continue;
+      }
+      if (roles.kind[use.face] != FaceKind::Interior) continue;
+      const FaceView view = viewOf(roles, use.face, sideOf(roles, use.face, e));
+      faceRows(mesh, basis, moments, view, form, faceSelf, faceOther, false, kOtherLiftingTerms);
+      // Slot of the neighbour among e's neighbours without e itself.
+      auto t = static_cast<std::size_t>(std::lower_bound(b.begin(), b.end(), view.other.value) -
+                                        b.begin());
+      if (view.other.value > e.value) --t;
+      Eigen::Map<Eigen::MatrixXd>(nl + t * bb, bs, bs) += faceSelf;
+    }
+  });
 }
 
 Eigen::SparseMatrix<double, Eigen::ColMajor, int> assembleStiffness(const LocalMatrices& local) {

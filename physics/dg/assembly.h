@@ -3,8 +3,10 @@
 // integrators element by element (in parallel, each element writing only its own rows).
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include <Eigen/SparseCore>
@@ -113,11 +115,25 @@ struct LocalMatrices {
   /// Neighbours of each element through interior faces, sorted, the element itself included.
   std::vector<std::vector<std::uint32_t>> neighbours;
   UninitializedVector<double> diagonal;  ///< element e's block at e * blockSize^2
-  /// Element e's coupling blocks, one per neighbour f > e in order, start at block
-  /// couplingStart[e] (each blockSize^2 values).
+  /// Element e's coupling blocks, one per neighbour f > e in order (greaterNeighbours()), start
+  /// at block couplingStart[e] (each blockSize^2 values); couplingStart[#elements] is the
+  /// number of blocks stored. In element order, except after updateSplitLocalMatrices(), which
+  /// appends the blocks it recomputes and leaves the old ones unused.
   std::vector<std::size_t> couplingStart;
   UninitializedVector<double> coupling;
 };
+
+/// Neighbours of each element (sorted, with itself) through coupled interior faces.
+std::vector<std::vector<std::uint32_t>> coupledNeighbours(const PolyMesh& mesh,
+                                                          const FaceRoles& roles);
+
+/// How many of element i's neighbours come after it: the number of its coupling blocks.
+inline std::size_t greaterNeighbours(const std::vector<std::vector<std::uint32_t>>& neighbours,
+                                     std::size_t i) {
+  const auto& b = neighbours[i];
+  return static_cast<std::size_t>(
+      b.end() - std::upper_bound(b.begin(), b.end(), static_cast<std::uint32_t>(i)));
+}
 
 /// The element and face matrices of `form` (both IP and BZ), in parallel over elements.
 LocalMatrices localMatrices(const PolyMesh& mesh, const DgBasis& basis, const MomentCache& moments,
@@ -140,7 +156,7 @@ struct SplitLocalMatrices {
   /// IP: the lifting terms of each neighbour L in element K's diagonal block (they complete
   /// L's lambda terms, warped with L's rotation): for element K, one block (3n x 3n,
   /// column-major) per neighbour in the order of `neighbours` without K, from block
-  /// neighbourStart[K]. Zero for BZ.
+  /// neighbourStart[K] (laid out as couplingStart). Zero for BZ.
   std::vector<std::size_t> neighbourStart;
   UninitializedVector<double> neighbourLifting;
   /// IP, per element (3n x 3n, column-major): the terms of its Dirichlet faces with the strain
@@ -153,6 +169,25 @@ struct SplitLocalMatrices {
 SplitLocalMatrices splitLocalMatrices(const PolyMesh& mesh, const DgBasis& basis,
                                       const MomentCache& moments, const FaceRoles& roles,
                                       const FormCoefficients& form);
+
+/// After an edit of the mesh `split` was made for: the split matrices of `mesh`, in place,
+/// with the rows recomputed only for the elements that need it and the others' kept: an
+/// element keeps its rows if it had its id before, is not `fresh` (the caller's mark for an
+/// element whose shape, faces, basis or penalty changed), has the same neighbours as before and
+/// none of them is fresh. Recomputed coupling and lifting blocks are appended; once the unused
+/// ones outnumber those in use, everything is laid out and computed again. Returns the number
+/// of elements whose rows were computed.
+std::size_t updateSplitLocalMatrices(SplitLocalMatrices& split, const PolyMesh& mesh,
+                                     const DgBasis& basis, const MomentCache& moments,
+                                     const FaceRoles& roles, const FormCoefficients& form,
+                                     const std::vector<char>& fresh);
+
+/// The rows of `elements` of the split matrices, written where `split`'s layout (neighbours,
+/// couplingStart, neighbourStart; arrays sized) puts them: the three parts' diagonal and
+/// coupling blocks, the neighbours' lifting blocks and the Dirichlet blocks.
+void writeSplitRows(SplitLocalMatrices& split, const PolyMesh& mesh, const DgBasis& basis,
+                    const MomentCache& moments, const FaceRoles& roles,
+                    const FormCoefficients& form, std::span<const std::uint32_t> elements);
 
 /// K from the local matrices: both triangles, each column written once, in parallel over
 /// elements. With BZ, blocks between neighbours couple equal components only and are stored

@@ -254,7 +254,7 @@ void CorotatedStiffness::assemble(const std::vector<Eigen::Matrix3d>& r,
   // Element i's blocks into a buffer of the thread, then into its row and (transposed) its
   // neighbours' rows: one pass over the rows and no LocalMatrices.
   const auto into = [&](std::size_t i, std::vector<double>& buffer) {
-    const std::size_t couplings = parts_.jumps.couplingStart[i + 1] - parts_.jumps.couplingStart[i];
+    const std::size_t couplings = greaterNeighbours(parts_.jumps.neighbours, i);
     buffer.resize((1 + couplings) * bb);
     return std::pair{buffer.data(), buffer.data() + bb};
   };

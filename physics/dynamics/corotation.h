@@ -39,6 +39,9 @@ class CorotatedStiffness {
   const Eigen::VectorXd& undeformed() const { return x0_; }
   /// The layout of the assembled blocks (the penalty's: every coupled pair of elements).
   const LocalMatrices& layout() const { return parts_.jumps; }
+  /// Gives the split matrices back (for updateSplitLocalMatrices() after an edit); the
+  /// stiffness is empty afterwards.
+  SplitLocalMatrices release() && { return std::move(parts_); }
 
   /// Element i's mean deformation gradient I + (1/|K|) int_K grad u for the displacement `u`.
   Eigen::Matrix3d deformationGradient(std::size_t i, const Eigen::VectorXd& u) const;

@@ -56,6 +56,7 @@ struct DynamicSolver::Impl final : SecondOrderSystem {
   ElementPenalties penalties;
   FormCoefficients form;
   std::vector<std::size_t> clampFaces, tractionFaces;
+  std::size_t elementsComputed = 0;
   std::optional<MassMatrix> mass;
   std::optional<CorotatedStiffness> stiffness;
   ElementFrames frames;
@@ -95,7 +96,10 @@ struct DynamicSolver::Impl final : SecondOrderSystem {
   mutable std::optional<ForceAtU> current;
 
   void setup(const PolyMesh& m, const MomentCache& mc, const DynamicLoads& l,
-             const DynamicsOptions& o);
+             const DynamicsOptions& o, std::unique_ptr<Impl> before = nullptr,
+             const std::vector<char>* changed = nullptr);
+  /// The split matrices: computed, or updated from those of the solver before an edit.
+  SplitLocalMatrices splitParts(std::unique_ptr<Impl> before, const std::vector<char>* changed);
   void classify(const DynamicLoads& l, LoadCase& lc);
   void assembleLoads(const DynamicLoads& l, const LoadCase& lc);
   const ForceAtU& forceAtU() const;
@@ -139,7 +143,8 @@ struct DynamicSolver::Impl final : SecondOrderSystem {
 };
 
 void DynamicSolver::Impl::setup(const PolyMesh& m, const MomentCache& mc, const DynamicLoads& l,
-                                const DynamicsOptions& o) {
+                                const DynamicsOptions& o, std::unique_ptr<Impl> before,
+                                const std::vector<char>* changed) {
   mesh = &m;
   moments = &mc;
   options = o;
@@ -156,9 +161,10 @@ void DynamicSolver::Impl::setup(const PolyMesh& m, const MomentCache& mc, const 
   double threshold = 0.0;
   form = formCoefficients(m, *basis, mc, roles, options.material, o.discretization, penalties,
                           threshold);
+  // The split matrices before the rest, so that the old solver's memory is freed first.
+  SplitLocalMatrices parts = splitParts(std::move(before), changed);
   mass.emplace(*basis, mc, options.material.density);
-  stiffness.emplace(*basis, mc, splitLocalMatrices(m, *basis, mc, roles, form), mass->centre(),
-                    options.corotational);
+  stiffness.emplace(*basis, mc, std::move(parts), mass->centre(), options.corotational);
   assembleLoads(l, lc);
   frames = elementFrames(*basis, m);
   SolverOptions solver = options.solver;
@@ -179,6 +185,41 @@ void DynamicSolver::Impl::setup(const PolyMesh& m, const MomentCache& mc, const 
   state.v = state.u;
   state.a = state.u;
   integrator = makeTimeIntegrator(options.integrator);
+}
+
+SplitLocalMatrices DynamicSolver::Impl::splitParts(std::unique_ptr<Impl> before,
+                                                   const std::vector<char>* changed) {
+  const std::size_t ne = mesh->numElements();
+  const DiscretizationOptions& d = options.discretization;
+  // Every face term changes with a global penalty or the BZ factor; the basis size with p.
+  const bool reusable =
+      before && before->stiffness && changed && changed->size() == ne &&
+      before->basis->size() == basis->size() && before->options.discretization.method == d.method &&
+      before->form.bzFactor == form.bzFactor && (form.elementEta || before->form.eta == form.eta) &&
+      !before->form.elementEta == !form.elementEta;
+  if (!reusable) {
+    before.reset();
+    elementsComputed = ne;
+    return splitLocalMatrices(*mesh, *basis, *moments, roles, form);
+  }
+  // Fresh: what the edit changed, and elements whose basis or penalty differ from before.
+  std::vector<char> fresh = *changed;
+  const std::size_t old = before->basis->numElements();
+  const std::size_t n2 = static_cast<std::size_t>(basis->size() * basis->size());
+  for (std::size_t i = 0; i < ne; ++i) {
+    if (fresh[i] || i >= old) continue;
+    const ElementId e(i);
+    const auto a = basis->coefficients(e), b = before->basis->coefficients(e);
+    fresh[i] = basis->centre(e) != before->basis->centre(e) ||
+               basis->scale(e) != before->basis->scale(e) ||
+               !std::equal(a.data(), a.data() + n2, b.data()) ||
+               (form.elementEta && penalties.eta[e] != before->penalties.eta[e]) ||
+               (form.elementFaceArea && penalties.faceArea[e] != before->penalties.faceArea[e]);
+  }
+  SplitLocalMatrices parts = std::move(*before->stiffness).release();
+  before.reset();
+  elementsComputed = updateSplitLocalMatrices(parts, *mesh, *basis, *moments, roles, form, fresh);
+  return parts;
 }
 
 /// The faces each clamp and traction selects (face roles, and the counts per selection).
@@ -505,11 +546,19 @@ DynamicSolver::DynamicSolver(const PolyMesh& mesh, const MomentCache& moments,
   impl_->setup(mesh, moments, loads, options);
   impl_->integrator->init(*impl_, impl_->state);
 }
+DynamicSolver::DynamicSolver(const PolyMesh& mesh, const MomentCache& moments,
+                             const DynamicLoads& loads, const DynamicsOptions& options,
+                             DynamicSolver&& before, const std::vector<char>& changed)
+    : impl_(std::make_unique<Impl>()) {
+  impl_->setup(mesh, moments, loads, options, std::move(before.impl_), &changed);
+  impl_->integrator->init(*impl_, impl_->state);
+}
 DynamicSolver::~DynamicSolver() = default;
 DynamicSolver::DynamicSolver(DynamicSolver&&) noexcept = default;
 DynamicSolver& DynamicSolver::operator=(DynamicSolver&&) noexcept = default;
 
 const DgBasis& DynamicSolver::basis() const { return *impl_->basis; }
+std::size_t DynamicSolver::elementsComputed() const { return impl_->elementsComputed; }
 SolverKind DynamicSolver::solverKind() const { return impl_->stepSolver->kind(); }
 const DynamicsOptions& DynamicSolver::options() const { return impl_->options; }
 std::size_t DynamicSolver::dofs() const { return static_cast<std::size_t>(impl_->state.u.size()); }

@@ -73,11 +73,23 @@ class DynamicSolver {
   /// std::invalid_argument for bad options and InputError-worthy selections are the caller's.
   DynamicSolver(const PolyMesh& mesh, const MomentCache& moments, const DynamicLoads& loads,
                 const DynamicsOptions& options);
+  /// The same after an edit of the mesh `before` was made for, `changed[e]` set for every
+  /// element of `mesh` the edit made, moved or changed (its id, shape or faces not those of
+  /// before). The split element and face blocks of the others are taken over from `before`
+  /// (updateSplitLocalMatrices(): those of elements next to a changed one are computed again),
+  /// so that the work grows with the edit, not the body; `before` is emptied and must not be
+  /// used again. Its state is not carried over (setState()).
+  DynamicSolver(const PolyMesh& mesh, const MomentCache& moments, const DynamicLoads& loads,
+                const DynamicsOptions& options, DynamicSolver&& before,
+                const std::vector<char>& changed);
   ~DynamicSolver();
   DynamicSolver(DynamicSolver&&) noexcept;
   DynamicSolver& operator=(DynamicSolver&&) noexcept;
 
   const DgBasis& basis() const;
+  /// The elements whose blocks the solver computed when it was made: all, or after an edit
+  /// those the edit changed and their neighbours.
+  std::size_t elementsComputed() const;
   /// The solver the steps use (known after the first step; Auto before).
   SolverKind solverKind() const;
   const DynamicsOptions& options() const;

@@ -3,10 +3,13 @@
 // time series on disk.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <numbers>
+#include <random>
 #include <regex>
 #include <tuple>
 
@@ -89,6 +92,9 @@ TEST(Simulate, CutWhileMovingFreesAHalfThatFallsWithGravity) {
     EXPECT_NEAR(model.volume(), 10.0, 1e-10 * 10);
     EXPECT_GT(cut.elementsAfter, cut.elementsBefore);
     EXPECT_EQ(cut.exact, cut.elementsAfter);  // no sliver here: every element took its parent's
+    // The new solver computed the blocks of the column of 4 cells the cut split (8 pieces) and
+    // of the columns on either side (8 cells); the old solver's served the other 68 elements.
+    EXPECT_EQ(cut.solverElements, 16u);
     // Its latency by phase: the phases lie within the whole, the checks within the cut, and
     // the step after it completes the latency (its steps run on).
     EXPECT_LE(cut.cutSeconds + cut.solverSeconds + cut.transferSeconds, cut.seconds);
@@ -411,6 +417,84 @@ TEST(Simulate, WritesAParaViewTimeSeries) {
                           "cg_iterations", "seconds"})
     EXPECT_TRUE(report["steps"][0].contains(key)) << key;
   fs::remove_all(dir);
+}
+
+/// The elements an edit made, moved or changed (DynamicSolver's `changed`).
+std::vector<char> changedBy(const OperationReport& edit, std::size_t elements) {
+  std::vector<char> changed(elements, 0);
+  for (ElementId e : edit.touched) changed[e.index()] = 1;
+  for (const auto& [id, sources] : edit.lineage.changed) changed[id] = 1;
+  return changed;
+}
+
+TEST(Simulate, ASolverMadeFromTheOneBeforeACutEqualsAFreshOne) {
+  // The beam (40 x 4 x 4 cells) cut four times (across, along it, at a slant, along it again),
+  // each time a solver made from the one before and a fresh one: the same elastic force and
+  // the same step, bit for bit, with the blocks computed again only around the cut (or all
+  // laid out anew once the unused ones outnumber those in use). Then a refinement.
+  MeshOptions options;
+  options.cells = 40;
+  MeshReport meshed;
+  Model model = Model::fromSurface(boxSurface(Box3(Vec3::Zero(), Vec3(10, 1, 1))), options, meshed,
+                                   "beam.obj");
+  DynamicsOptions o;
+  o.material = {1000, 0.3, 1};
+  o.discretization.basis.degree = 1;
+  DynamicLoads loads;
+  loads.gravity = Vec3(0, 0, -1);
+  loads.clamps = {FaceSelector::inPlane(0, 0.0)};
+  auto solverOf = [&](Model& m) { return DynamicSolver(m.mesh(), m.moments(2), loads, o); };
+  DynamicSolver kept = solverOf(model);
+  EXPECT_EQ(kept.elementsComputed(), model.mesh().numElements());
+  std::mt19937_64 rng(20261204);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::vector<std::string> rebuilt;
+  auto check = [&](const OperationReport& edit, const std::string& what) {
+    ASSERT_TRUE(edit.check.passed) << what;
+    const std::size_t ne = model.mesh().numElements();
+    DynamicSolver updated(model.mesh(), model.moments(2), loads, o, std::move(kept),
+                          changedBy(edit, ne));
+    DynamicSolver fresh = solverOf(model);
+    // Computed again: the changed elements and their neighbours, and no other.
+    const std::vector<char> changed = changedBy(edit, ne);
+    std::vector<char> again = changed;
+    for (const Face& f : model.mesh().faces())
+      if (f.front.valid() && f.back.valid() &&
+          (changed[f.front.index()] || changed[f.back.index()]))
+        again[f.front.index()] = again[f.back.index()] = 1;
+    const auto expected = static_cast<std::size_t>(std::count(again.begin(), again.end(), 1));
+    EXPECT_LT(expected, ne) << what;
+    if (updated.elementsComputed() == ne)
+      rebuilt.push_back(what);  // the unused blocks had come to outnumber the used ones
+    else
+      EXPECT_EQ(updated.elementsComputed(), expected) << what;
+    Eigen::VectorXd u(static_cast<Eigen::Index>(fresh.dofs())), v(u.size());
+    for (Eigen::Index i = 0; i < u.size(); ++i) {
+      u[i] = 0.05 * unit(rng);
+      v[i] = 0.1 * unit(rng);
+    }
+    for (DynamicSolver* s : {&updated, &fresh}) s->setState(1.0, u, v);
+    EXPECT_EQ(updated.elasticForce(), fresh.elasticForce()) << what;
+    updated.step(0.05);
+    fresh.step(0.05);
+    EXPECT_EQ(updated.displacement(), fresh.displacement()) << what;
+    EXPECT_EQ(updated.velocity(), fresh.velocity()) << what;
+    kept = std::move(updated);
+  };
+  for (const auto& [plane, what] :
+       {std::pair{Plane::make(Vec3(1, 0, 0), 5.1), "across"},
+        std::pair{Plane::make(Vec3(0, 1, 0), 0.53), "along"},
+        std::pair{Plane::make(Vec3(1, 0.4, 0.3).normalized(), 3.3), "at a slant"},
+        std::pair{Plane::make(Vec3(0, 0, 1), 0.46), "along, again"}}) {
+    CutRequest cut;
+    cut.blade = Blade::plane(plane.normal, plane.offset);
+    check(model.cut(cut), what);
+  }
+  RefineRequest refine;
+  for (std::uint32_t e : {3u, 40u, 41u, 77u}) refine.elements.push_back(ElementId(e));
+  check(model.refine(refine).operation, "refined");
+  // Two cuts along the beam computed most blocks twice: the second time all were laid out anew.
+  EXPECT_EQ(rebuilt, std::vector<std::string>{"along, again"});
 }
 
 TEST(Simulate, TorusRotatedRigidlyHasNoCorotatedForceAndKeepsItsVolumeSpinning) {

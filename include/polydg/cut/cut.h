@@ -95,6 +95,9 @@ struct OperationReport {
   std::vector<ElementId> leftWhole;
   OperationCheck check;
   ElementLineage lineage;
+  /// The elements the operation made or whose faces changed (ids after it, ascending): every
+  /// other element has its id, shape and faces of before.
+  std::vector<ElementId> touched;
   double seconds = 0.0;
 };
 

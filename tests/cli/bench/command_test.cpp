@@ -241,7 +241,11 @@ TEST(BenchCommand, DynamicsSuiteKeepsEnergyAndVolumeWhereItShould) {
     }
     EXPECT_LE(phases, run["t_latency"].get<double>()) << run.dump();
     EXPECT_LE(run["t_check"].get<double>(), run["t_cut"].get<double>()) << run.dump();
+    // The new solver computed the blocks of the pieces and their neighbours only.
+    EXPECT_LT(run["solver_elements"].get<std::size_t>(), 640 + split[i]) << run.dump();
   }
+  // The column's 32 pieces and the 2 x 16 cells beside them.
+  EXPECT_EQ(cuts[0]["solver_elements"], 64) << cuts[0].dump();
   std::ifstream csv(dir / "dynamics.csv");
   std::string header;
   std::getline(csv, header);
