@@ -431,7 +431,8 @@ TEST(Simulate, ASolverMadeFromTheOneBeforeACutEqualsAFreshOne) {
   // The beam (40 x 4 x 4 cells) cut four times (across, along it, at a slant, along it again),
   // each time a solver made from the one before and a fresh one: the same elastic force and
   // the same step, bit for bit, with the blocks computed again only around the cut (or all
-  // laid out anew once the unused ones outnumber those in use). Then a refinement.
+  // laid out anew once the unused ones outnumber those in use). Then a refinement, and a
+  // coarsening that moves elements to other ids.
   MeshOptions options;
   options.cells = 40;
   MeshReport meshed;
@@ -493,6 +494,26 @@ TEST(Simulate, ASolverMadeFromTheOneBeforeACutEqualsAFreshOne) {
   RefineRequest refine;
   for (std::uint32_t e : {3u, 40u, 41u, 77u}) refine.elements.push_back(ElementId(e));
   check(model.refine(refine).operation, "refined");
+  // Pairs of elements near the start merged: the last elements (pieces of the cuts) move into
+  // the ids the merge frees, so the old solver's blocks under those ids are other elements'.
+  CoarsenRequest coarsen;
+  std::vector<char> used(model.mesh().numElements(), 0);
+  for (const Face& f : model.mesh().faces()) {
+    if (coarsen.groups.size() == 3) break;
+    if (!f.front.valid() || !f.back.valid() || f.front.index() > 100 || f.back.index() > 100 ||
+        used[f.front.index()] || used[f.back.index()])
+      continue;
+    used[f.front.index()] = used[f.back.index()] = 1;
+    coarsen.groups.push_back({f.front, f.back});
+  }
+  ASSERT_EQ(coarsen.groups.size(), 3u);
+  const OperationReport merged = model.coarsen(coarsen).operation;
+  std::size_t moved = 0;  // elements that only changed id
+  for (const auto& [id, sources] : merged.lineage.changed)
+    moved += sources.size() == 1 &&
+             !std::binary_search(merged.touched.begin(), merged.touched.end(), ElementId(id));
+  EXPECT_GT(moved, 0u);
+  check(merged, "merged");
   // Two cuts along the beam computed most blocks twice: the second time all were laid out anew.
   EXPECT_EQ(rebuilt, std::vector<std::string>{"along, again"});
 }
