@@ -191,9 +191,11 @@ SplitLocalMatrices DynamicSolver::Impl::splitParts(std::unique_ptr<Impl> before,
                                                    const std::vector<char>* changed) {
   const std::size_t ne = mesh->numElements();
   const DiscretizationOptions& d = options.discretization;
-  // Every face term changes with a global penalty or the BZ factor; the basis size with p.
+  // Every term changes with the material, a global penalty or the BZ factor; the blocks'
+  // size with p.
   const bool reusable =
       before && before->stiffness && changed && changed->size() == ne &&
+      before->form.mu == form.mu && before->form.lambda == form.lambda &&
       before->basis->size() == basis->size() && before->options.discretization.method == d.method &&
       before->form.bzFactor == form.bzFactor && (form.elementEta || before->form.eta == form.eta) &&
       !before->form.elementEta == !form.elementEta;

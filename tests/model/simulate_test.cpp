@@ -516,6 +516,12 @@ TEST(Simulate, ASolverMadeFromTheOneBeforeACutEqualsAFreshOne) {
   check(merged, "merged");
   // Two cuts along the beam computed most blocks twice: the second time all were laid out anew.
   EXPECT_EQ(rebuilt, std::vector<std::string>{"along, again"});
+  // Another material, the mesh unchanged: none of the old blocks fit, all are computed.
+  const std::size_t ne = model.mesh().numElements();
+  o.material = {2000, 0.3, 1};
+  const DynamicSolver stiffer(model.mesh(), model.moments(2), loads, o, std::move(kept),
+                              std::vector<char>(ne, 0));
+  EXPECT_EQ(stiffer.elementsComputed(), ne);
 }
 
 TEST(Simulate, TorusRotatedRigidlyHasNoCorotatedForceAndKeepsItsVolumeSpinning) {
