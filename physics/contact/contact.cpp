@@ -10,7 +10,6 @@
 #include <string>
 #include <tuple>
 #include <unordered_map>
-#include <unordered_set>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -126,8 +125,8 @@ void ContactModel::refresh() {
     throw std::invalid_argument("ContactModel: the embedding's points changed; make it again");
   dofs_ = e.numElements() * 3 * static_cast<std::size_t>(e.basisSize());
   active_.clear();
-  startDisplacement_.clear();
   const std::size_t np = e.numPoints();
+  isActive_.assign(np, 0);
   rowScale_.assign(np, 0.0);
   translationGain_.assign(np, 0.0);
   const std::vector<double>& constant = e.constantValues();
@@ -300,14 +299,12 @@ ContactLinearization ContactModel::linearize(const Eigen::VectorXd& u, const Eig
   std::vector<std::uint32_t> which;
   queryAll(predicted, tNext, q, which);
   active_.clear();
-  startDisplacement_.clear();
   for (std::size_t k = 0; k < nc; ++k) {
     if (!(q[k].distance < 0.0) || q[k].normal.isZero()) continue;
-    Active a{points[k], which[k], q[k].distance, q[k].normal, predicted[k], Vec3::Zero()};
+    Active a{points[k], which[k], q[k].distance, q[k].normal, predicted[k], Vec3::Zero(), start[k]};
     const Vec3 relative = velocity[k] - obstacles_[which[k]].velocity();
     a.slip = relative - a.normal * a.normal.dot(relative);
     active_.push_back(a);
-    startDisplacement_.emplace(points[k], start[k]);
   }
   querySeconds_ += watch.seconds();
   return build();
@@ -318,7 +315,6 @@ bool ContactModel::adjust(const Eigen::VectorXd& uNew) {
   const SurfaceEmbedding& e = *embedding_;
   bool changed = false;
   // Drop contacts whose linearized force pulls at the new state.
-  std::unordered_set<std::uint32_t> isActive;
   std::vector<Active> kept;
   std::vector<std::uint32_t> activePoints(active_.size());
   for (std::size_t k = 0; k < active_.size(); ++k) activePoints[k] = active_[k].point;
@@ -332,12 +328,13 @@ bool ContactModel::adjust(const Eigen::VectorXd& uNew) {
       continue;
     }
     kept.push_back(a);
-    isActive.insert(a.point);
+    isActive_[a.point] = 1;
   }
   // Add points that end inside an obstacle.
   std::vector<std::uint32_t> points;
   for (std::uint32_t p : candidates(uNew, tNext_))
-    if (!isActive.count(p)) points.push_back(p);
+    if (!isActive_[p]) points.push_back(p);
+  for (const Active& a : kept) isActive_[a.point] = 0;
   std::vector<Vec3> positions;
   displacementsAt(points, uNew, positions);
   for (std::size_t k = 0; k < points.size(); ++k) positions[k] += e.points()[points[k]];
@@ -347,8 +344,8 @@ bool ContactModel::adjust(const Eigen::VectorXd& uNew) {
   for (std::size_t k = 0; k < points.size(); ++k) {
     if (!(q[k].distance < 0.0) || q[k].normal.isZero()) continue;
     // No slip yet: full friction. u~_n at the step's start for its force.
-    kept.push_back({points[k], which[k], q[k].distance, q[k].normal, positions[k], Vec3::Zero()});
-    startDisplacement_.try_emplace(points[k], e.displacement(points[k], startCoefficients_));
+    kept.push_back({points[k], which[k], q[k].distance, q[k].normal, positions[k], Vec3::Zero(),
+                    e.displacement(points[k], startCoefficients_)});
     changed = true;
   }
   active_ = std::move(kept);
@@ -399,7 +396,7 @@ ContactLinearization ContactModel::build() const {
     const Active& a = active_[static_cast<std::size_t>(k)];
     const double ka = options_.stiffness * areas_[a.point];
     const WeightRow& row = rows[static_cast<std::size_t>(k)];
-    const Vec3 uStart = startDisplacement_.at(a.point);
+    const Vec3 uStart = a.start;
     // f(U_n) = -k a (phi(q) + n . (u~_n - u~_q)) n, u~_q = q - x.
     const double gap = a.distance + a.normal.dot(e.points()[a.point] + uStart - a.position);
     Vec3 force = -ka * gap * a.normal;

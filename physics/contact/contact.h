@@ -22,7 +22,6 @@
 #pragma once
 
 #include <cstdint>
-#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -96,6 +95,7 @@ class ContactModel {
     Vec3 normal = Vec3::Zero();
     Vec3 position = Vec3::Zero();  ///< q
     Vec3 slip = Vec3::Zero();      ///< tangential velocity relative to the obstacle at start
+    Vec3 start = Vec3::Zero();     ///< u~_n, its displacement at the step's start
   };
   /// Deepest obstacle at each of the given positions (distance >= 0 where none).
   void queryAll(const std::vector<Vec3>& positions, double t, std::vector<ObstacleQuery>& out,
@@ -121,8 +121,7 @@ class ContactModel {
   std::vector<Obstacle> obstacles_;
   ContactOptions options_;
   std::vector<Active> active_;
-  /// u~_n of the candidate points of the last linearize() (the active points among them).
-  std::unordered_map<std::uint32_t, Vec3> startDisplacement_;
+  std::vector<char> isActive_;         ///< adjust()'s scratch: 1 for the points it keeps
   Eigen::VectorXd startCoefficients_;  ///< U_n of the last linearize()
   // Culling (W's product over every point was most of a step's collision handling): each
   // point's clearance, a lower bound of its signed distance to every obstacle (the exact
