@@ -178,6 +178,37 @@ TEST(ContactModel, ARigidTranslationRulesOutThePointsItKeepsClear) {
   }
 }
 
+TEST(ContactModel, AdjustDropsPointsThatLeaveAndTakesBackThoseThatReturn) {
+  // The sphere (bottom at z = 0.55) on the ground z <= 0.6: the points below 0.6 are in
+  // contact at rest. The body lifted by 0.2 leaves the ground (every contact dropped), and
+  // back at rest the same points are taken back.
+  const SphereInACube body;
+  const PolyMesh& mesh = body.mesh;
+  const DgBasis& basis = body.basis;
+  const SurfaceEmbedding& embedding = body.embedding;
+  const std::vector<double> areas(embedding.numPoints(), 1e-3);
+  const std::vector<Obstacle> ground = {Obstacle::halfSpace(Plane::make(Vec3(0, 0, 1), 0.6))};
+  ContactOptions options;
+  options.stiffness = 1e4;
+  ContactModel model(embedding, areas, ground, options);
+  const Eigen::Index n = basis.size();
+  const Eigen::VectorXd rest =
+      Eigen::VectorXd::Zero(static_cast<Eigen::Index>(mesh.numElements()) * 3 * n);
+  Eigen::VectorXd lifted = rest;
+  for (std::size_t e = 0; e < mesh.numElements(); ++e)
+    lifted.segment((static_cast<Eigen::Index>(e) * 3 + 2) * n, n) =
+        affineCoefficients(basis, ElementId(e), 0.2, Vec3::Zero(), Vec3::Zero());
+  const std::size_t below = bruteForce(embedding, ground, areas, 1e4, rest, 0.01).contacts;
+  ASSERT_GT(below, 10u);
+  EXPECT_EQ(model.linearize(rest, rest, 0.01, 0.01).contacts, below);
+  EXPECT_FALSE(model.adjust(rest));  // nothing pulls, nothing new
+  EXPECT_EQ(model.relinearize().contacts, below);
+  EXPECT_TRUE(model.adjust(lifted));
+  EXPECT_EQ(model.relinearize().contacts, 0u);
+  EXPECT_TRUE(model.adjust(rest));
+  EXPECT_EQ(model.relinearize().contacts, below);
+}
+
 TEST(ContactModel, ContactStiffnessIsTheSumOfThePointsPenalties) {
   // K_c = sum over the points in contact of k a (w (x) n)(w (x) n)^T: for any coefficient change
   // dU, dU^T K_c dU = sum k a (n . (W dU)_p)^2 over those points, with the points in contact
