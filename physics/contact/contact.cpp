@@ -280,6 +280,20 @@ void ContactModel::displacementsAt(const std::vector<std::uint32_t>& points,
   });
 }
 
+std::vector<Vec3> ContactModel::positionsAt(const std::vector<std::uint32_t>& points,
+                                            const Eigen::VectorXd& u) {
+  std::vector<Vec3> positions;
+  displacementsAt(points, u, positions);
+  for (std::size_t k = 0; k < points.size(); ++k) positions[k] += embedding_->points()[points[k]];
+  return positions;
+}
+
+std::vector<std::uint32_t> ContactModel::activePoints() const {
+  std::vector<std::uint32_t> points(active_.size());
+  for (std::size_t k = 0; k < active_.size(); ++k) points[k] = active_[k].point;
+  return points;
+}
+
 ContactLinearization ContactModel::linearize(const Eigen::VectorXd& u, const Eigen::VectorXd& v,
                                              double tNext, double dt) {
   const Stopwatch watch;
@@ -316,14 +330,10 @@ bool ContactModel::adjust(const Eigen::VectorXd& uNew) {
   bool changed = false;
   // Drop contacts whose linearized force pulls at the new state.
   std::vector<Active> kept;
-  std::vector<std::uint32_t> activePoints(active_.size());
-  for (std::size_t k = 0; k < active_.size(); ++k) activePoints[k] = active_[k].point;
-  std::vector<Vec3> moved;
-  displacementsAt(activePoints, uNew, moved);
+  const std::vector<Vec3> at = positionsAt(activePoints(), uNew);
   for (std::size_t k = 0; k < active_.size(); ++k) {
     const Active& a = active_[k];
-    const Vec3 at = e.points()[a.point] + moved[k];
-    if (a.distance + a.normal.dot(at - a.position) > 0.0) {
+    if (a.distance + a.normal.dot(at[k] - a.position) > 0.0) {
       changed = true;
       continue;
     }
@@ -335,9 +345,7 @@ bool ContactModel::adjust(const Eigen::VectorXd& uNew) {
   for (std::uint32_t p : candidates(uNew, tNext_))
     if (!isActive_[p]) points.push_back(p);
   for (const Active& a : kept) isActive_[a.point] = 0;
-  std::vector<Vec3> positions;
-  displacementsAt(points, uNew, positions);
-  for (std::size_t k = 0; k < points.size(); ++k) positions[k] += e.points()[points[k]];
+  const std::vector<Vec3> positions = positionsAt(points, uNew);
   std::vector<ObstacleQuery> q;
   std::vector<std::uint32_t> which;
   queryAll(positions, tNext_, q, which);
@@ -362,9 +370,7 @@ ContactLinearization ContactModel::build() const {
   out.contacts = active_.size();
   out.force = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(dofs_));
   if (active_.empty()) return out;
-  std::vector<std::uint32_t> points(active_.size());
-  for (std::size_t k = 0; k < active_.size(); ++k) points[k] = active_[k].point;
-  const auto [rows, local, columns] = rowsAndColumns(e, points);
+  const auto [rows, local, columns] = rowsAndColumns(e, activePoints());
   auto dof = [&](std::uint32_t column, int d) {
     const std::size_t el = column / n, i = column % n;
     return static_cast<Eigen::Index>((el * 3 + static_cast<std::size_t>(d)) * n + i);
@@ -475,11 +481,8 @@ ContactLinearization ContactModel::build() const {
 
 ContactMeasure ContactModel::measure(const Eigen::VectorXd& u, double t) {
   const Stopwatch watch;
-  const SurfaceEmbedding& e = *embedding_;
   const std::vector<std::uint32_t>& points = candidates(u, t);
-  std::vector<Vec3> positions;
-  displacementsAt(points, u, positions);
-  for (std::size_t k = 0; k < points.size(); ++k) positions[k] += e.points()[points[k]];
+  const std::vector<Vec3> positions = positionsAt(points, u);
   std::vector<ObstacleQuery> q;
   std::vector<std::uint32_t> which;
   queryAll(positions, t, q, which);

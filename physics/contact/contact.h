@@ -114,6 +114,10 @@ class ContactModel {
   /// all ask for the same points at the same U), computed on both cores for the others.
   void displacementsAt(const std::vector<std::uint32_t>& points, const Eigen::VectorXd& u,
                        std::vector<Vec3>& out);
+  /// The same points displaced: their positions at u.
+  std::vector<Vec3> positionsAt(const std::vector<std::uint32_t>& points, const Eigen::VectorXd& u);
+  /// The points of the active contacts, in their order.
+  std::vector<std::uint32_t> activePoints() const;
   void measureClearances(const Eigen::VectorXd& u, double t);
 
   const SurfaceEmbedding* embedding_;
@@ -127,7 +131,7 @@ class ContactModel {
   // point's clearance, a lower bound of its signed distance to every obstacle (the exact
   // distance to a half-space, the distance to a surface obstacle's box, 0 inside that box) at
   // coefficients clearanceU_ and time clearanceT_. U' - U is split into a uniform translation
-  // T(t) and the rest D (movedBound()); point p then moves at most
+  // T(t) and the rest D (translationAndRest()); point p then moves at most
   // |translationGain_[p]| |t| + rowScale_[p] |D|_inf (W_p T(t) = translationGain_[p] t, about t
   // as W reproduces constants; rowScale_ is sqrt 3 times the weights' absolute sum) and the
   // obstacles at most maxObstacleSpeed_ |t' - t|, both distances 1-Lipschitz: a clearance

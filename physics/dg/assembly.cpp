@@ -295,6 +295,17 @@ void forEachElementRows(const PolyMesh& mesh, const DgBasis& basis, const Moment
       });
 }
 
+/// Element i's diagonal block and coupling blocks (forEachElementRows()' store) where `local`'s
+/// layout puts them.
+void storeElementRows(LocalMatrices& local, std::size_t i, const Eigen::MatrixXd& self,
+                      const double* coupling) {
+  const std::size_t bb =
+      static_cast<std::size_t>(local.blockSize) * static_cast<std::size_t>(local.blockSize);
+  Eigen::Map<Eigen::MatrixXd>(local.diagonal.data() + i * bb, self.rows(), self.cols()) = self;
+  std::copy(coupling, coupling + greaterNeighbours(local.neighbours, i) * bb,
+            local.coupling.data() + local.couplingStart[i] * bb);
+}
+
 /// localMatrices() with a choice of terms (forEachElementRows()).
 LocalMatrices localMatricesOf(const PolyMesh& mesh, const DgBasis& basis,
                               const MomentCache& moments, const FaceRoles& roles,
@@ -309,22 +320,15 @@ LocalMatrices localMatricesOf(const PolyMesh& mesh, const DgBasis& basis,
       static_cast<std::size_t>(local.blockSize) * static_cast<std::size_t>(local.blockSize);
   local.neighbours = coupledNeighbours(mesh, roles);
   local.couplingStart.assign(ne + 1, 0);
-  for (std::size_t i = 0; i < ne; ++i) {
-    const auto& b = local.neighbours[i];
-    const std::size_t greater = static_cast<std::size_t>(
-        b.end() - std::upper_bound(b.begin(), b.end(), static_cast<std::uint32_t>(i)));
-    local.couplingStart[i + 1] = local.couplingStart[i] + greater;
-  }
+  for (std::size_t i = 0; i < ne; ++i)
+    local.couplingStart[i + 1] = local.couplingStart[i] + greaterNeighbours(local.neighbours, i);
   local.diagonal.resize(ne * bb);
   local.coupling.resize(local.couplingStart[ne] * bb);
-  forEachElementRows(
-      mesh, basis, moments, roles, form, local.neighbours, element, diagonalTerms, couplingTerms,
-      dirichletFaces, {}, [&](std::size_t i, const Eigen::MatrixXd& self, const double* coupling) {
-        Eigen::Map<Eigen::MatrixXd>(local.diagonal.data() + i * bb, self.rows(), self.cols()) =
-            self;
-        std::copy(coupling, coupling + (local.couplingStart[i + 1] - local.couplingStart[i]) * bb,
-                  local.coupling.data() + local.couplingStart[i] * bb);
-      });
+  forEachElementRows(mesh, basis, moments, roles, form, local.neighbours, element, diagonalTerms,
+                     couplingTerms, dirichletFaces, {},
+                     [&](std::size_t i, const Eigen::MatrixXd& self, const double* coupling) {
+                       storeElementRows(local, i, self, coupling);
+                     });
   return local;
 }
 
@@ -368,9 +372,7 @@ void writeSplitRows(SplitLocalMatrices& split, const PolyMesh& mesh, const DgBas
         mesh, basis, moments, roles, form, neighbours, element, diagonalTerms, couplingTerms,
         dirichletFaces, elements,
         [&, local = local](std::size_t i, const Eigen::MatrixXd& self, const double* coupling) {
-          Eigen::Map<Eigen::MatrixXd>(local->diagonal.data() + i * bb, bs, bs) = self;
-          std::copy(coupling, coupling + greaterNeighbours(neighbours, i) * bb,
-                    local->coupling.data() + local->couplingStart[i] * bb);
+          storeElementRows(*local, i, self, coupling);
         });
   // The neighbours' lifting terms in each diagonal block, one block per neighbour, and the
   // Dirichlet faces' strain terms.
