@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <functional>
 #include <random>
 #include <vector>
 
@@ -51,14 +52,29 @@ struct SphereInACube {
   MomentCache moments{mesh, 2};
   DgBasis basis{mesh, updated(moments), {1}};
   SurfaceEmbedding embedding{mesh, basis, icosphere(Vec3(0, 0, 1), 0.45, 3).vertices};
+
+  /// The coefficients of each element translated by shift(e) (uniform within it).
+  Eigen::VectorXd translatedBy(const std::function<Vec3(ElementId)>& shift) const {
+    const Eigen::Index n = basis.size();
+    Eigen::VectorXd u(static_cast<Eigen::Index>(mesh.numElements()) * 3 * n);
+    for (std::size_t e = 0; e < mesh.numElements(); ++e)
+      for (int d = 0; d < 3; ++d)
+        u.segment((static_cast<Eigen::Index>(e) * 3 + d) * n, n) = affineCoefficients(
+            basis, ElementId(e), shift(ElementId(e))[d], Vec3::Zero(), Vec3::Zero());
+    return u;
+  }
+  /// Every element translated by `shift`.
+  Eigen::VectorXd translated(const Vec3& shift) const {
+    return translatedBy([&](ElementId) { return shift; });
+  }
+  /// Rest: no displacement.
+  Eigen::VectorXd rest() const { return translated(Vec3::Zero()); }
 };
 
 TEST(ContactModel, CulledPointsNeverTouch) {
   // The sphere in the cube; the ground z <= 0 rising at 0.3 per unit time and a box obstacle
   // beside it.
   const SphereInACube body;
-  const PolyMesh& mesh = body.mesh;
-  const DgBasis& basis = body.basis;
   const SurfaceEmbedding& embedding = body.embedding;
   const std::vector<double> areas(embedding.numPoints(), 1e-3);
   DistanceFieldOptions field;
@@ -74,20 +90,15 @@ TEST(ContactModel, CulledPointsNeverTouch) {
 
   // A path of states: a translation down and sideways with a random deformation on top, in
   // steps that vary from small (clearances reused) to large (measured again).
-  const Eigen::Index n = basis.size();
   std::mt19937_64 rng(20261204);
   std::uniform_real_distribution<double> noise(-1.0, 1.0);
-  Eigen::VectorXd u(static_cast<Eigen::Index>(mesh.numElements()) * 3 * n);
+  Eigen::VectorXd u;
   std::size_t touching = 0, states = 0;
   double t = 0.0;
   for (int k = 0; k < 120; ++k) {
     const double s = (k % 17 == 0) ? 0.2 : 0.004;  // now and then a jump
     t += s;
-    const Vec3 shift(0.9 * t, 0.0, -1.2 * t);
-    for (std::size_t e = 0; e < mesh.numElements(); ++e)
-      for (int d = 0; d < 3; ++d)
-        u.segment((static_cast<Eigen::Index>(e) * 3 + d) * n, n) =
-            affineCoefficients(basis, ElementId(e), shift[d], Vec3::Zero(), Vec3::Zero());
+    u = body.translated(Vec3(0.9 * t, 0.0, -1.2 * t));
     for (Eigen::Index i = 0; i < u.size(); ++i) u[i] += 0.01 * noise(rng);
     const ContactMeasure culled = model.measure(u, t);
     const ContactMeasure brute = bruteForce(embedding, obstacles, areas, options.stiffness, u, t);
@@ -124,7 +135,6 @@ TEST(ContactModel, ARigidTranslationRulesOutThePointsItKeepsClear) {
   // by the largest coefficient change alone (sqrt 3 times a point's absolute weights, which
   // exceed 1, times s over the constant function's value) kept every point from s = 0.05 on.
   const SphereInACube body;
-  const PolyMesh& mesh = body.mesh;
   const DgBasis& basis = body.basis;
   const SurfaceEmbedding& embedding = body.embedding;
   const std::vector<double> areas(embedding.numPoints(), 1e-3);
@@ -132,16 +142,13 @@ TEST(ContactModel, ARigidTranslationRulesOutThePointsItKeepsClear) {
   ContactOptions options;
   options.stiffness = 1e4;
   ContactModel model(embedding, areas, ground, options);
-  const Eigen::Index n = basis.size();
-  Eigen::VectorXd u = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(mesh.numElements()) * 3 * n);
+  Eigen::VectorXd u = body.rest();
   EXPECT_EQ(model.measure(u, 0.0).contacts, 0u);  // measures the clearances at rest
   EXPECT_EQ(model.clearanceMeasurements(), 1u);
   std::mt19937_64 rng(20261204);
   std::uniform_real_distribution<double> noise(-1.0, 1.0);
   for (double s : {0.05, 0.3, 0.5, 0.58, 0.62}) {
-    for (std::size_t e = 0; e < mesh.numElements(); ++e)
-      u.segment((static_cast<Eigen::Index>(e) * 3 + 2) * n, n) =
-          affineCoefficients(basis, ElementId(e), -s, Vec3::Zero(), Vec3::Zero());
+    u = body.translated(Vec3(0, 0, -s));
     for (Eigen::Index i = 0; i < u.size(); ++i) u[i] += 1e-6 * noise(rng);
     const ContactMeasure culled = model.measure(u, 0.0);
     EXPECT_EQ(culled.contacts, bruteForce(embedding, ground, areas, 1e4, u, 0.0).contacts)
@@ -160,14 +167,10 @@ TEST(ContactModel, ARigidTranslationRulesOutThePointsItKeepsClear) {
   // translation taken out is their range's midpoint, and what is left of each element's
   // constant part bounds the rest; the measure still equals the brute force's.
   ContactModel split(embedding, areas, ground, options);
-  u.setZero();
-  EXPECT_EQ(split.measure(u, 0.0).contacts, 0u);
+  EXPECT_EQ(split.measure(body.rest(), 0.0).contacts, 0u);
   for (double s : {0.2, 0.62, 0.7, 0.8}) {
-    for (std::size_t e = 0; e < mesh.numElements(); ++e) {
-      const double down = basis.centre(ElementId(e)).x() > 0.0 ? s : 0.5 * s;
-      u.segment((static_cast<Eigen::Index>(e) * 3 + 2) * n, n) =
-          affineCoefficients(basis, ElementId(e), -down, Vec3::Zero(), Vec3::Zero());
-    }
+    u = body.translatedBy(
+        [&](ElementId e) { return Vec3(0, 0, basis.centre(e).x() > 0.0 ? -s : -0.5 * s); });
     const ContactMeasure culled = split.measure(u, 0.0);
     const ContactMeasure brute = bruteForce(embedding, ground, areas, 1e4, u, 0.0);
     EXPECT_EQ(culled.contacts, brute.contacts) << "shift " << s;
@@ -183,21 +186,13 @@ TEST(ContactModel, AdjustDropsPointsThatLeaveAndTakesBackThoseThatReturn) {
   // contact at rest. The body lifted by 0.2 leaves the ground (every contact dropped), and
   // back at rest the same points are taken back.
   const SphereInACube body;
-  const PolyMesh& mesh = body.mesh;
-  const DgBasis& basis = body.basis;
   const SurfaceEmbedding& embedding = body.embedding;
   const std::vector<double> areas(embedding.numPoints(), 1e-3);
   const std::vector<Obstacle> ground = {Obstacle::halfSpace(Plane::make(Vec3(0, 0, 1), 0.6))};
   ContactOptions options;
   options.stiffness = 1e4;
   ContactModel model(embedding, areas, ground, options);
-  const Eigen::Index n = basis.size();
-  const Eigen::VectorXd rest =
-      Eigen::VectorXd::Zero(static_cast<Eigen::Index>(mesh.numElements()) * 3 * n);
-  Eigen::VectorXd lifted = rest;
-  for (std::size_t e = 0; e < mesh.numElements(); ++e)
-    lifted.segment((static_cast<Eigen::Index>(e) * 3 + 2) * n, n) =
-        affineCoefficients(basis, ElementId(e), 0.2, Vec3::Zero(), Vec3::Zero());
+  const Eigen::VectorXd rest = body.rest(), lifted = body.translated(Vec3(0, 0, 0.2));
   const std::size_t below = bruteForce(embedding, ground, areas, 1e4, rest, 0.01).contacts;
   ASSERT_GT(below, 10u);
   EXPECT_EQ(model.linearize(rest, rest, 0.01, 0.01).contacts, below);
