@@ -207,6 +207,11 @@ void addSolveCommand(CLI::App& app, const CommonOptions& common, int& exitCode) 
                   "of the first solve's largest")
       ->check(CLI::Range(1e-6, 1.0))
       ->capture_default_str();
+  cmd->add_option("--max-level", a.maxLevel,
+                  "--adapt-by stress: how often an element may be split (1: once, as the "
+                  "thesis's Fig. 4.9; children are not marked again)")
+      ->check(CLI::Range(1, 8))
+      ->capture_default_str();
   cmd->add_option("--report", o->report, "write the figures as JSON to this file");
   cmd->add_option("--surface", o->surfaceOutput,
                   "write the deformed embedded surface (MLS embedding) to this .vtp file");

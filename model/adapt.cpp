@@ -275,11 +275,15 @@ SolveReport solveAdaptively(Model& model, const SolveOptions& options) {
   if (a.targetError && !(*a.targetError > 0.0 && std::isfinite(*a.targetError)))
     throw InputError("the target error must be a positive number");
   if (a.maxDofs && *a.maxDofs == 0) throw InputError("the DOF budget must be positive");
+  if (a.maxLevel < 1 || a.maxLevel > 8)
+    throw InputError("the largest refinement level must be between 1 and 8");
   SolveOptions once = options;
   once.adapt.reset();
   once.estimate = a.criterion == AdaptCriterion::Error;
   std::vector<AdaptRound> rounds;
   double stressThreshold = 0.0;
+  // How often each element's ancestors in the first mesh were split (Stress).
+  std::vector<int> level(model.mesh().numElements(), 0);
   for (int round = 0;; ++round) {
     AdaptRound r;
     const Stopwatch solveWatch;
@@ -298,9 +302,12 @@ SolveReport solveAdaptively(Model& model, const SolveOptions& options) {
     std::vector<ElementId> marked;
     if (a.criterion == AdaptCriterion::Stress) {
       for (std::size_t e = 0; e < r.elements; ++e)
-        if (std::abs(u.fields.principalStress[ElementId(e)]) > stressThreshold)
+        if (level[e] < a.maxLevel &&
+            std::abs(u.fields.principalStress[ElementId(e)]) > stressThreshold)
           marked.push_back(ElementId(e));
-      if (marked.empty()) r.stop = "no element's principal stress exceeds the threshold";
+      if (marked.empty())
+        r.stop = "no element below the largest level (" + std::to_string(a.maxLevel) +
+                 ") has a principal stress above the threshold";
     } else {
       marked = markByError(report, a, r);
     }
@@ -335,6 +342,9 @@ SolveReport solveAdaptively(Model& model, const SolveOptions& options) {
                          refined.operation.check.failure + ")");
     r.refineSeconds = refineWatch.seconds();
     r.elementsAfter = model.mesh().numElements();
+    std::unordered_set<std::uint32_t> split;
+    for (ElementId e : request.elements) split.insert(e.value);
+    level = levelsAfter(level, refined.operation.lineage, r.elementsAfter, split);
     rounds.push_back(r);
   }
 }

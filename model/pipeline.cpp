@@ -128,7 +128,7 @@ CheckStep checkStep(JsonObjectReader& r) {
 
 /// The "adapt" key of a solve: true (the defaults), false, or an object of "by" ("error",
 /// "stress"), "split" ("octants", "halves"), "target_error", "max_dofs", "max_rounds", "bulk",
-/// "stress_fraction".
+/// "stress_fraction", "max_level".
 std::optional<AdaptOptions> adaptOptions(JsonObjectReader& r) {
   const json& value = r.get("adapt");
   if (value.is_boolean()) return value.get<bool>() ? std::optional(AdaptOptions{}) : std::nullopt;
@@ -141,6 +141,7 @@ std::optional<AdaptOptions> adaptOptions(JsonObjectReader& r) {
   if (o.has("max_rounds")) a.maxRounds = o.integer("max_rounds", 0, 20);
   if (o.has("bulk")) a.bulk = o.number("bulk", 1e-6, 1.0);
   if (o.has("stress_fraction")) a.stressFraction = o.number("stress_fraction", 1e-6, 1.0);
+  if (o.has("max_level")) a.maxLevel = o.integer("max_level", 1, 8);
   o.finish();
   return a;
 }

@@ -277,6 +277,7 @@ json adaptJson(const SolveReport& report) {
           {"max_dofs", a.maxDofs ? json(*a.maxDofs) : json(nullptr)},
           {"bulk", a.bulk},
           {"stress_fraction", a.stressFraction},
+          {"max_level", a.maxLevel},
           {"max_rounds", a.maxRounds},
           {"rounds", rounds}};
 }

@@ -188,7 +188,8 @@ def _solve(self, method="ip", degree=1, E=None, nu=None, density=None, gravity=N
     dict of "by" ("error": the a posteriori estimate, or "stress": the largest principal
     stress), "split" ("octants" 1-to-8 or "halves" 1-to-2), "target_error" (stop below this
     fraction of the energy norm), "max_dofs", "max_rounds" (default 3), "bulk" (share of the
-    squared estimate to refine, default 0.5), "stress_fraction" (default 0.5). The report's
+    squared estimate to refine, default 0.5), "stress_fraction" (default 0.5), "max_level" (how
+    often stress may split an element, default 1). The report's
     "adapt" holds every round.
     estimate: add the a posteriori error estimate to the report (IP only).
 

@@ -353,10 +353,10 @@ def adapt_stress(polydg, work):
     mesh = bar_mesh(polydg, work)
     w = 10.0
 
-    def run_stress(name, fraction, split, max_rounds):
+    def run_stress(name, fraction, split, max_rounds, *more):
         r, vtu = solve(polydg, work, mesh, name, "--clamp", "x=0", "--degree", 2, "--gravity",
                        "10,0,0", "--adapt", "--adapt-by", "stress", "--stress-fraction",
-                       fraction, "--split", split, "--max-rounds", max_rounds)
+                       fraction, "--split", split, "--max-rounds", max_rounds, *more)
         return r, r["adapt"]["rounds"], vtu
 
     # Octants, fraction 0.8: x_c < L - 0.8 * 3.75 = 1 is the first 2 columns of 4 elements.
@@ -375,7 +375,14 @@ def adapt_stress(polydg, work):
 
     # Halves across the principal direction (x), fraction 0.5: x_c < 2.125, the first 4
     # columns (16 elements); their 32 halves all lie below 2.125 again.
-    r, rounds, vtu = run_stress("stress_halves", 0.5, "halves", 2)
+    # By default (--max-level 1) the halves, whose stress the refinement raised above the
+    # threshold, are not split again: the rounds end after one.
+    r, rounds, _ = run_stress("stress_halves_level1", 0.5, "halves", 2)
+    equal("stress halves 0.5, level 1: max_level, marked, elements",
+          (r["adapt"]["max_level"], [a["marked"] for a in rounds],
+           [a["elements"] for a in rounds]), (1, [16, 0], [32, 48]))
+    check("largest level" in rounds[-1]["stop"], "stops at the largest level: " + rounds[-1]["stop"])
+    r, rounds, vtu = run_stress("stress_halves", 0.5, "halves", 2, "--max-level", 2)
     equal("stress halves 0.5: marked per round", [a["marked"] for a in rounds[:2]], [16, 32])
     equal("stress halves 0.5: elements per round", [a["elements"] for a in rounds],
           [32, 48, 80])

@@ -39,10 +39,11 @@ def test_refine_keeps_the_solution_and_the_volume(split):
 
 def test_adaptive_solves_report_their_rounds():
     model = beam()
-    report = model.solve(degree=1, adapt={"by": "stress", "split": "halves", "max_rounds": 2},
-                         **LOADS)
+    report = model.solve(degree=1, adapt={"by": "stress", "split": "halves", "max_rounds": 2,
+                                          "max_level": 2}, **LOADS)
     rounds = report["adapt"]["rounds"]
     assert report["adapt"]["criterion"] == "stress" and len(rounds) == 3
+    assert report["adapt"]["max_level"] == 2
     assert rounds[0]["elements"] == 10 and rounds[-1]["elements"] == model.num_elements
     assert rounds[-1]["stop"] is not None and rounds[0]["marked"] > 0
 
@@ -107,6 +108,9 @@ def test_bad_requests_raise():
         model.refine([1], split="halves")  # no solution to take the directions from
     with pytest.raises(polydg.Error):
         model.solve(degree=1, adapt={"by": "stress", "bulk": 2}, **LOADS)
+    for level in (0, 9):
+        with pytest.raises(polydg.Error, match="max_level"):
+            model.solve(degree=1, adapt={"by": "stress", "max_level": level}, **LOADS)
     assert model.num_elements == 10
 
 

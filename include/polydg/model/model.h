@@ -189,7 +189,13 @@ struct AdaptOptions {
   /// Stress: refine elements whose largest absolute principal stress exceeds this fraction of
   /// the first solve's largest.
   double stressFraction = 0.5;
-  /// Refinement rounds at most (Stress: the levels of Fig. 4.9).
+  /// Stress: how often an element of the first mesh may be split, 1 to 8. An element split
+  /// that often is not marked again: a child's mean stress rises above its parent's only
+  /// because it averages over less of the stress's gradient (the outer fibre of a bent bar),
+  /// so a fixed threshold would otherwise re-mark most children every round. 1 is Fig. 4.9's
+  /// one level; later rounds still mark elements whose stress the refinement raised.
+  int maxLevel = 1;
+  /// Refinement rounds at most.
   int maxRounds = 3;
 };
 
