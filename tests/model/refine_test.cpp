@@ -306,5 +306,47 @@ TEST(ModelRefine, OctreeSlicingFillsTheVolumeWithFewerElements) {
   }
 }
 
+TEST(ModelRefine, AManyHoledBlockMeshesAdaptivelyAndRefinesByStress) {
+  // The Swiss-cheese block (27 holes, 11 x 10 x 9 unit cells) with 11 cells along x: its walls
+  // lie on the planes of every octree level, so faces touch the split planes along lines and at
+  // points. The octree mesh keeps the exact volume and validates; refined by stress (octants
+  // and halves across principal directions no grid has), it validates again.
+  const Box3 box(Vec3::Zero(), Vec3(11, 10, 9));
+  const std::array<int, 3> n{11, 10, 9};
+  const double volume = swissCheeseVolume(uniformCheeseWalls(box, n));
+  MeshOptions options;
+  options.cells = 11;
+  options.adaptive = true;
+  const TriangleSurface surface = swissCheeseBlock(box, n);
+  for (RefineSplit split : {RefineSplit::Octants, RefineSplit::Halves}) {
+    MeshReport meshed;
+    Model model = Model::fromSurface(surface, options, meshed);
+    ASSERT_TRUE(meshed.passed()) << meshed.failures().front();
+    EXPECT_GE(meshed.levels, 2);
+    EXPECT_LT(std::abs(meshed.meshing.outputVolume - volume), 1e-12 * volume);
+    const std::size_t before = model.mesh().numElements();
+    SolveOptions o;
+    o.discretization.basis.degree = 1;
+    o.material.youngsModulus = 1000.0;
+    o.material.density = 1.0;
+    o.gravity = Vec3(0, 0, -10);
+    o.clamps = {FaceSelector::inPlane(2, 0.0)};
+    AdaptOptions a;
+    a.criterion = AdaptCriterion::Stress;
+    a.split = split;
+    a.maxRounds = 1;
+    o.adapt = a;
+    const SolveReport r = model.solve(o);
+    ASSERT_EQ(r.rounds.size(), 2u);
+    EXPECT_GT(r.rounds[0].marked, 0u);
+    EXPECT_GT(model.mesh().numElements(), before);
+    EXPECT_TRUE(checkGeometry(model.mesh()).passed);
+    double total = 0.0;
+    for (std::size_t e = 0; e < model.mesh().numElements(); ++e)
+      total += model.moments(0).volume(ElementId(e));
+    EXPECT_LT(std::abs(total - volume), 1e-12 * volume);
+  }
+}
+
 }  // namespace
 }  // namespace polydg
