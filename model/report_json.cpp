@@ -342,11 +342,10 @@ json toJson(const SolveReport& report) {
         {"assemble", r.assembleSeconds},
         {"solve", r.solveSeconds},
         {"factorize", r.solver.factorSeconds}}},
-      {"estimate",
-       report.estimate ? json{{"total", report.estimate->total},
+      {"estimate", report.estimate
+                       ? json{{"total", report.estimate->total},
                               {"energy_norm", report.energyNorm},
-                              {"residual", std::sqrt(report.estimate->residual)},
-                              {"traction_jump", std::sqrt(report.estimate->tractionJump)},
+                              {"local", std::sqrt(report.estimate->local)},
                               {"displacement_jump", std::sqrt(report.estimate->displacementJump)},
                               {"dirichlet", std::sqrt(report.estimate->dirichlet)}}
                        : json(nullptr)},

@@ -1,18 +1,23 @@
 // The adaptivity suite: B11 (thesis Fig. 4.9's bent bar refined by principal stress, 1-to-8 and
-// 1-to-2, beside the thesis's counts) and B12 (a steep Gaussian bump: uniform grids against
-// `solve --adapt` by the error estimate, DOFs to reach each uniform grid's L2 error, and the
-// estimator's effectivity on every mesh). Both run through Model::solve(), as `polydg solve
-// --adapt` does.
+// 1-to-2, beside the thesis's counts), B12 (a steep Gaussian bump, p = 1-3: uniform grids
+// against `solve --adapt` by the error estimate, DOFs to reach each uniform grid's L2 error, and
+// the estimator's effectivity on every mesh), B13 (octree slicing against the uniform grid) and
+// the estimator against reference solves on an L-prism and the torus. All run through Model,
+// as `polydg solve --adapt` and `polydg mesh --adaptive` do.
 #include <algorithm>
+#include <filesystem>
 #include <iostream>
 #include <string>
 #include <vector>
 
+#include "cli/bench/reference_error.h"
 #include "cli/bench/suites.h"
 #include "mesh/primitives.h"
+#include "polydg/mesh/surface_io.h"
 #include "polydg/mesh/surface_shapes.h"
 #include "polydg/model/model.h"
 #include "polydg/model/names.h"
+#include "polydg/util/error.h"
 #include "util/stopwatch.h"
 
 namespace polydg::bench {
@@ -149,17 +154,36 @@ struct UniformPoint {
   double l2;
 };
 
-/// B12 on uniform grids: each run's figures (returned), rows, log line and point of `plot`;
-/// `points` receives the DOFs and L2 error of each run.
+/// The effectivities of a suite's meshes, lowest and highest.
+struct EffectivityRange {
+  double lowest = 1e300, highest = 0.0;
+  void add(double e) {
+    lowest = std::min(lowest, e);
+    highest = std::max(highest, e);
+  }
+};
+
+/// B12's uniform grids for degree p (quick: 4, 8; else 8, 16 and, below p = 3, 32).
+std::vector<int> b12Grids(const BenchOptions& o, int p) {
+  if (o.quick) return {4, 8};
+  return p < 3 ? std::vector<int>{8, 16, 32} : std::vector<int>{8, 16};
+}
+
+/// B12 on uniform grids of degree base's p: each run's figures (returned), rows, log line and
+/// point of `plot`; `points` receives the DOFs and L2 error of each run.
 nlohmann::json runB12Uniform(const BenchOptions& o, const SolveOptions& base, SuiteOutput& s,
-                             SeriesSet& plot, std::vector<UniformPoint>& points, const Log& log) {
+                             SeriesSet& plot, std::vector<UniformPoint>& points,
+                             EffectivityRange& range, const Log& log) {
+  const int p = base.discretization.basis.degree;
+  const std::string degree = "p = " + std::to_string(p);
   nlohmann::json uniform = nlohmann::json::array();
-  for (int n : o.quick ? std::vector<int>{4, 8} : std::vector<int>{8, 16, 32}) {
+  for (int n : b12Grids(o, p)) {
     Model model = unitCube(n);
     const Stopwatch watch;
     const SolveReport r = model.solve(base);
     const double seconds = watch.seconds();
     const double effectivity = r.estimate->total / r.energyError->total();
+    range.add(effectivity);
     uniform.push_back({{"n", n},
                        {"dofs", r.solve.dofs},
                        {"l2_error", r.error->l2},
@@ -168,26 +192,29 @@ nlohmann::json runB12Uniform(const BenchOptions& o, const SolveOptions& base, Su
                        {"effectivity", effectivity},
                        {"seconds", seconds}});
     s.rows.push_back({{"benchmark", "B12"},
-                      {"case", "uniform n " + std::to_string(n)},
+                      {"case", degree + " uniform n " + std::to_string(n)},
                       {"elements", model.mesh().numElements()},
                       {"dofs", r.solve.dofs},
                       {"reference", nullptr},
                       {"l2_error", r.error->l2},
                       {"effectivity", effectivity}});
     points.push_back({r.solve.dofs, r.error->l2});
-    plot.add("uniform", static_cast<double>(r.solve.dofs), r.error->l2);
-    log("B12 uniform n " + std::to_string(n) + ": " + std::to_string(r.solve.dofs) +
+    plot.add("uniform " + degree, static_cast<double>(r.solve.dofs), r.error->l2);
+    log("B12 " + degree + " uniform n " + std::to_string(n) + ": " + std::to_string(r.solve.dofs) +
         " DOFs, L2 error " + shortNumber(r.error->l2) + ", effectivity " +
         shortNumber(effectivity) + ", " + shortNumber(seconds) + " s");
   }
   return uniform;
 }
 
-/// B12 adaptive from n = 4, up to a fifth of the finest uniform grid's DOFs, against the
-/// uniform runs (`uniform`, `uniformPoints`): writes B12's report and its plot.
-void runB12Adaptive(const BenchOptions& o, const SolveOptions& base, nlohmann::json uniform,
-                    const std::vector<UniformPoint>& uniformPoints, SuiteOutput& s, SeriesSet& plot,
-                    const Log& log) {
+/// B12 adaptive from n = 4 with degree base's p, up to a fifth of the finest uniform grid's
+/// DOFs, against the uniform runs (`uniform`, `uniformPoints`): B12's report for that degree.
+nlohmann::json runB12Adaptive(const BenchOptions& o, const SolveOptions& base,
+                              nlohmann::json uniform,
+                              const std::vector<UniformPoint>& uniformPoints, SuiteOutput& s,
+                              SeriesSet& plot, EffectivityRange& all, const Log& log) {
+  const int p = base.discretization.basis.degree;
+  const std::string degree = "p = " + std::to_string(p);
   Model model = unitCube(4);
   SolveOptions so = base;
   AdaptOptions a;
@@ -199,21 +226,21 @@ void runB12Adaptive(const BenchOptions& o, const SolveOptions& base, nlohmann::j
   const Stopwatch watch;
   const SolveReport r = model.solve(so);
   nlohmann::json rounds = nlohmann::json::array();
-  double lowestEffectivity = 1e300, highestEffectivity = 0.0;
+  EffectivityRange range;
   for (const AdaptRound& round : r.rounds) {
     rounds.push_back(roundJson(round));
     const double effectivity = round.estimate / round.energyError;
-    lowestEffectivity = std::min(lowestEffectivity, effectivity);
-    highestEffectivity = std::max(highestEffectivity, effectivity);
-    plot.add("adaptive", static_cast<double>(round.dofs), round.l2Error);
+    range.add(effectivity);
+    all.add(effectivity);
+    plot.add("adaptive " + degree, static_cast<double>(round.dofs), round.l2Error);
     s.rows.push_back({{"benchmark", "B12"},
-                      {"case", "adaptive"},
+                      {"case", degree + " adaptive"},
                       {"elements", round.elements},
                       {"dofs", round.dofs},
                       {"reference", nullptr},
                       {"l2_error", round.l2Error},
                       {"effectivity", effectivity}});
-    log("B12 adaptive: " + std::to_string(round.elements) + " elements, " +
+    log("B12 " + degree + " adaptive: " + std::to_string(round.elements) + " elements, " +
         std::to_string(round.dofs) + " DOFs, L2 error " + shortNumber(round.l2Error) +
         ", effectivity " + shortNumber(effectivity));
   }
@@ -230,16 +257,77 @@ void runB12Adaptive(const BenchOptions& o, const SolveOptions& base, nlohmann::j
       }
     reach.push_back(j);
   }
-  s.json["B12"] = {{"uniform", std::move(uniform)},
-                   {"adaptive", rounds},
-                   {"adaptive_seconds", watch.seconds()},
-                   {"dofs_to_reach_uniform_error", reach},
-                   {"effectivity_range", {lowestEffectivity, highestEffectivity}}};
-  s.plots.push_back({"adaptivity_b12.svg",
-                     {"B12 steep bump: L2 error against DOFs (IP, p = 2)",
-                      {"DOFs", AxisScale::Log},
-                      {"L2 error", AxisScale::Log},
-                      plot.series()}});
+  return {{"degree", p},
+          {"uniform", std::move(uniform)},
+          {"adaptive", rounds},
+          {"adaptive_seconds", watch.seconds()},
+          {"dofs_to_reach_uniform_error", reach},
+          {"effectivity_range", {range.lowest, range.highest}}};
+}
+
+/// The estimator on problems without a closed form, against a reference solve of the same
+/// degree on the mesh split twice into octants: a sliced L-prism (its re-entrant edge a stress
+/// singularity) pulled round its corner, and the sliced torus hanging under gravity.
+nlohmann::json runReferenceChecks(const BenchOptions& o, SuiteOutput& s, EffectivityRange& all,
+                                  const Log& log) {
+  struct Case {
+    std::string name, file;
+    int cells;
+    SolveOptions options;
+  };
+  SolveOptions pulled;
+  pulled.material.youngsModulus = 1000.0;
+  pulled.material.poissonRatio = 0.3;
+  pulled.clamps = {FaceSelector::inPlane(1, 2.0)};
+  pulled.tractions = {{FaceSelector::inPlane(0, 2.0), Vec3(0, 10, 0)}};
+  SolveOptions hanging;
+  hanging.material = pulled.material;
+  hanging.material.density = 1.0;
+  hanging.gravity = Vec3(0, 0, -10);
+  hanging.clamps = {FaceSelector::below(Plane::make(Vec3::UnitX(), -1.0))};
+  const std::vector<Case> cases = {{"L-prism", "Lprism.ply", 5, pulled},
+                                   {"torus", "torus.obj", 6, hanging}};
+  nlohmann::json out = nlohmann::json::array();
+  for (const Case& c : cases) {
+    MeshOptions meshing;
+    meshing.cells = c.cells;
+    MeshReport meshed;
+    const std::filesystem::path path = std::filesystem::path(o.dataDir) / c.file;
+    if (!std::filesystem::exists(path))
+      throw InputError(path.string() +
+                       " not found; pass the folder that holds polydg's bundled models "
+                       "(share/polydg of the build or installation) with --data");
+    const Model model = Model::fromSurface(readSurface(path.string()), meshing, meshed);
+    for (int p = 1; p <= (o.quick ? 1 : 3); ++p) {
+      SolveOptions so = c.options;
+      so.discretization.basis.degree = p;
+      const Stopwatch watch;
+      const ReferenceCheck r = checkAgainstReference(model.mesh(), so, 2, p);
+      all.add(r.effectivity());
+      out.push_back({{"problem", c.name},
+                     {"cells", c.cells},
+                     {"degree", p},
+                     {"elements", r.elements},
+                     {"dofs", r.dofs},
+                     {"reference_elements", r.referenceElements},
+                     {"reference_dofs", r.referenceDofs},
+                     {"estimate", r.estimate},
+                     {"error", r.error},
+                     {"effectivity", r.effectivity()},
+                     {"seconds", watch.seconds()}});
+      s.rows.push_back({{"benchmark", "estimator"},
+                        {"case", c.name + " p = " + std::to_string(p)},
+                        {"elements", r.elements},
+                        {"dofs", r.dofs},
+                        {"reference", r.referenceDofs},
+                        {"l2_error", nullptr},
+                        {"effectivity", r.effectivity()}});
+      log("estimator " + c.name + " p = " + std::to_string(p) + ": " + std::to_string(r.elements) +
+          " elements, effectivity " + shortNumber(r.effectivity()) + " against " +
+          std::to_string(r.referenceDofs) + " reference DOFs");
+    }
+  }
+  return out;
 }
 
 }  // namespace
@@ -253,18 +341,36 @@ SuiteOutput adaptivitySuite(const BenchOptions& o, bool quiet) {
       {"B11",
        "bar [0,9]x[0,2]x[0,2] of 36 unit hexahedra, E = 1000, nu = 0.3, clamped on x = 0, "
        "traction (0,0,-1) on x = 9, IP p = 1; refine where the element's mean stress has a "
-       "principal value above tau * the unrefined mesh's largest, until none does or 3 rounds"},
+       "principal value above tau * the unrefined mesh's largest, each element split once at "
+       "most (max level 1), until none does or 3 rounds"},
       {"B12",
-       "unit cube, E = 1, nu = 0.3, u = 0.01 (1,1,1) exp(-|x-c|^2/(2 w^2)), w = 0.05, IP p = 2; "
-       "uniform n^3 hex grids against solve --adapt from n = 4 (Doerfler bulk 0.5, 1-to-8)"}};
+       "unit cube, E = 1, nu = 0.3, u = 0.01 (1,1,1) exp(-|x-c|^2/(2 w^2)), w = 0.05, IP p = "
+       "1-3; uniform n^3 hex grids against solve --adapt from n = 4 (Doerfler bulk 0.5, 1-to-8)"},
+      {"estimator",
+       "L-prism sliced at 5 cells, E = 1000, nu = 0.3, clamped on y = 2, traction (0,10,0) on "
+       "x = 2; torus sliced at 6 cells, density 1, gravity (0,0,-10), clamped where x <= -1; "
+       "IP p = 1-3, error against the same degree on the mesh split twice into octants"}};
   runB11(o, s, log);
   runB13(o, s, log);
   const ManufacturedProblem problem = benchmarkB12Problem();
-  const SolveOptions base = b12Options(problem);
   SeriesSet plot;
-  std::vector<UniformPoint> uniformPoints;
-  nlohmann::json uniform = runB12Uniform(o, base, s, plot, uniformPoints, log);
-  runB12Adaptive(o, base, std::move(uniform), uniformPoints, s, plot, log);
+  EffectivityRange all;
+  nlohmann::json b12 = nlohmann::json::array();
+  for (int p = 1; p <= 3; ++p) {
+    SolveOptions base = b12Options(problem);
+    base.discretization.basis.degree = p;
+    std::vector<UniformPoint> uniformPoints;
+    nlohmann::json uniform = runB12Uniform(o, base, s, plot, uniformPoints, all, log);
+    b12.push_back(runB12Adaptive(o, base, std::move(uniform), uniformPoints, s, plot, all, log));
+  }
+  s.json["B12"] = std::move(b12);
+  s.plots.push_back({"adaptivity_b12.svg",
+                     {"B12 steep bump: L2 error against DOFs (IP, p = 1-3)",
+                      {"DOFs", AxisScale::Log},
+                      {"L2 error", AxisScale::Log},
+                      plot.series()}});
+  s.json["estimator_references"] = runReferenceChecks(o, s, all, log);
+  s.json["effectivity_range"] = {all.lowest, all.highest};
   return s;
 }
 

@@ -37,6 +37,15 @@ EnergyError energyError(const PolyMesh& mesh, const DgBasis& basis, const Moment
                         const Eigen::VectorXd& coefficients, const VectorField& exact,
                         const GradientField& exactGradient, int quadratureDegree);
 
+/// sqrt(sum_k int_k sigma(e) : eps(e)), e = u_fine - u_coarse, over the elements k of a
+/// refinement of the coarse mesh, fine element k lying inside coarse element parent[k]: the
+/// broken energy norm of a solution's error against a reference solve on a finer mesh. Both
+/// fields are polynomials on a fine element; its rule is exact to `quadratureDegree`.
+double brokenEnergyDifference(const PolyMesh& fineMesh, const DgBasis& fineBasis,
+                              const Eigen::VectorXd& fine, const DgBasis& coarseBasis,
+                              const Eigen::VectorXd& coarse, const std::vector<ElementId>& parent,
+                              const Material& material, int quadratureDegree);
+
 /// Doerfler's bulk marking: the fewest elements whose indicators sum to at least
 /// theta * sum_K indicators[K] (0 < theta <= 1), largest first (ties by element id). Empty when
 /// every indicator is 0. Throws std::invalid_argument for theta outside (0, 1].

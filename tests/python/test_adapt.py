@@ -50,13 +50,15 @@ def test_adaptive_solves_report_their_rounds():
 
 # The beam's estimate relative to its energy norm on the unrefined mesh (10 elements, p = 2),
 # and its ratio from each round to the next under bulk marking with octants, as measured
-# 2026-12-04 (10 -> 38 -> 73 -> 108 -> 185 elements).
-FIRST_RELATIVE_ESTIMATE = 0.19770
-ESTIMATE_RATIOS = [0.8276, 0.6864, 0.7453, 0.7826]
+# 2026-12-05 (10 -> 17 -> 38 -> 87 -> 157 elements). The first round refines 1 of the 10
+# elements and the estimate rises 9% (an estimate is not monotone under refinement, only close
+# to the error); each later round lowers it.
+FIRST_RELATIVE_ESTIMATE = 0.13416
+ESTIMATE_RATIOS = [1.0874, 0.7839, 0.7694, 0.7561]
 
 
 def test_an_adaptive_solve_whose_first_mesh_meets_the_target_stops_there():
-    # Target 0.2: the first solve's estimate (0.1977 of the energy norm) is already below it.
+    # Target 0.2: the first solve's estimate (0.134 of the energy norm) is already below it.
     model = beam()
     report = model.solve(degree=2, adapt={"target_error": 0.2, "max_rounds": 4}, **LOADS)
     rounds = report["adapt"]["rounds"]
@@ -67,9 +69,9 @@ def test_an_adaptive_solve_whose_first_mesh_meets_the_target_stops_there():
     assert report["estimate"]["total"] == pytest.approx(rounds[0]["estimate"])
 
 
-def test_an_adaptive_solve_lowers_the_estimate_each_round_until_the_rounds_run_out():
-    # Target 0.05: four rounds of refinement lower the estimate by the measured factors, to
-    # 0.0653 of the energy norm, still above the target: the rounds run out.
+def test_an_adaptive_solve_lowers_the_estimate_over_its_rounds_until_they_run_out():
+    # Target 0.05: four rounds of refinement change the estimate by the measured factors, to
+    # 0.0664 of the energy norm, still above the target: the rounds run out.
     model = beam()
     report = model.solve(degree=2, adapt={"target_error": 0.05, "max_rounds": 4}, **LOADS)
     rounds = report["adapt"]["rounds"]
@@ -79,8 +81,8 @@ def test_an_adaptive_solve_lowers_the_estimate_each_round_until_the_rounds_run_o
         ratio = rounds[k + 1]["estimate"] / rounds[k]["estimate"]
         assert ratio == pytest.approx(expected, rel=0.02), (k, ratio)
         assert rounds[k]["marked"] > 0 and rounds[k]["stop"] is None
-    assert [r["elements"] for r in rounds] == [10, 38, 73, 108, 185]
-    assert rounds[-1]["relative_estimate"] == pytest.approx(0.06533, rel=1e-3)
+    assert [r["elements"] for r in rounds] == [10, 17, 38, 87, 157]
+    assert rounds[-1]["relative_estimate"] == pytest.approx(0.06637, rel=1e-3)
     assert rounds[-1]["relative_estimate"] > 0.05
     assert "largest number of rounds (4)" in rounds[-1]["stop"]
     assert report["estimate"]["total"] == pytest.approx(rounds[-1]["estimate"])

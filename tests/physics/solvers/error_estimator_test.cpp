@@ -1,42 +1,45 @@
-// The residual error estimator of physics/solvers/error_estimator.h: it vanishes where the IP
-// solution is exact (polynomial solutions of degree <= p, on hexahedra and sliced polyhedra, with
-// Dirichlet and traction faces), its effectivity on a Gaussian bump (B12's field with a wider
-// bump) is the one measured (4.9 and 6.0: it misses B12's specification, 0.3 to 3; issue
-// 'adaptivity'), it falls at the error's rate under uniform refinement, and is largest where the
-// bump is; DgBasis::hessians(), which it uses; and the markings.
+// The error estimator of physics/solvers/error_estimator.h (local Neumann problems with the DG
+// flux): it vanishes where the IP solution is exact (polynomial solutions of degree <= p, on
+// hexahedra and sliced polyhedra, with Dirichlet and traction faces); its effectivity (estimate /
+// true DG energy error) lies in the specification's [0.3, 3] for p = 1-3 on B12, on a wider bump
+// near the bump and away from it, and, against a reference solve two levels finer, on a sliced
+// L-prism (its re-entrant edge a stress singularity) and the sliced torus under gravity; it
+// falls at the error's rate and is largest where the bump is; DgBasis::hessians(); the markings.
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
 
 #include "cli/bench/problems.h"
+#include "cli/bench/reference_error.h"
 #include "mesh/primitives.h"
 #include "physics/solvers/error_estimator.h"
 #include "polydg/integrate/moment_cache.h"
+#include "polydg/mesh/surface_io.h"
+#include "polydg/model/model.h"
 
 namespace polydg {
 namespace {
 
 /// The solution must make the estimate vanish to this, relative to the energy of u.
 constexpr double kExactTolerance = 1e-8;
-/// Estimate / true DG energy error of the bump tests, as measured (2026-12-04), per mesh. The
-/// specification asks for an effectivity in [0.3, 3], an estimate within 3x of the error (the
-/// guide's Known limits); this estimator MISSES it (issue 'adaptivity': its standard constants
-/// overestimate by 5-6 here, by up to 8 on B12 itself). Until that issue fixes the estimator,
-/// the test holds the figures it has, within kEffectivityChange either way, so that any change
-/// of the estimate or of the error is noticed; the fix then replaces them with the
-/// specification's window.
-struct MeasuredEffectivity {
-  int n;
-  double effectivity;
-};
-constexpr MeasuredEffectivity kBumpEffectivity[] = {{4, 6.035}, {8, 4.855}};
-constexpr double kEffectivityChange = 0.1;
-/// Least share of the squared estimate held by the elements within 2 w of the bump's centre.
-constexpr double kNearShare = 0.5;
+/// The specification's window for the effectivity, estimate / true DG energy error.
+constexpr double kLeastEffectivity = 0.3;
+constexpr double kLargestEffectivity = 3.0;
+
+void expectEffectivityInWindow(double estimate, double error, const std::string& what) {
+  ASSERT_GT(error, 0.0) << what;
+  const double effectivity = estimate / error;
+  std::printf("%s: estimate %.4e, error %.4e, effectivity %.3f\n", what.c_str(), estimate, error,
+              effectivity);
+  EXPECT_GE(effectivity, kLeastEffectivity) << what;
+  EXPECT_LE(effectivity, kLargestEffectivity) << what;
+}
+
 /// Largest difference between the rates of the estimate and of the error from n = 4 to 8.
 constexpr double kRateTolerance = 0.5;
 
@@ -136,8 +139,8 @@ void expectVanishes(const PolyMesh& mesh, const LoadCase& loads, const Quadratic
       energyOf(mesh, solver.basis(), solver.moments(), solver.roles(), solver.form(), gradient);
   ASSERT_GT(scale, 0.0);
   EXPECT_LT(estimate.total, kExactTolerance * scale)
-      << "residual " << estimate.residual << " traction " << estimate.tractionJump << " jump "
-      << estimate.displacementJump << " dirichlet " << estimate.dirichlet;
+      << "local " << estimate.local << " jump " << estimate.displacementJump << " dirichlet "
+      << estimate.dirichlet;
   ASSERT_EQ(estimate.indicators.size(), mesh.numElements());
   double sum = 0.0;
   for (double eta2 : estimate.indicators) {
@@ -240,26 +243,20 @@ EstimatedSolve solveBump(double width, int n, int quadratureDegree) {
 }
 
 // B12's field with a bump wide enough (w = 0.15) to be resolved from n = 4 on, p = 2.
-// Measured (quadrature degree 8), estimate / true DG energy error (broken part alone):
-//   n = 4: 6.04 (7.41), n = 8: 4.86 (6.57), n = 16: 4.79 (6.52);
-//   the real B12 (w = 0.05): n = 4: 8.26, 8: 7.05, 16: 5.36.
-// The residual term is ~80% of the estimate. The estimate bounds the error from above on every
-// mesh, but B12's specification [0.3, 3] is NOT met with these standard constants (see
-// physics/solvers/error_estimator.h; issue 'adaptivity').
+// Measured 2026-12-05 (quadrature degree 8): effectivity 1.59 (n = 4), 1.52 (n = 8); near the
+// bump (elements within 2 w of its centre) 1.35 and away from it 1.88 at n = 4. The residual
+// estimator before it (unit constants) gave 6.0 and 4.9.
 constexpr double kBumpWidth = 0.15;
 constexpr int kBumpQuadrature = 8;
 
-TEST(ErrorEstimator, HasTheMeasuredEffectivityOnAGaussianBumpAndIsLargestAtTheBump) {
-  for (const auto& [n, measuredEffectivity] : kBumpEffectivity) {
+TEST(ErrorEstimator, IsWithinThreeOfTheErrorOnAGaussianBumpNearItAndAwayFromIt) {
+  for (int n : {4, 8}) {
     SCOPED_TRACE("n = " + std::to_string(n));
     const EstimatedSolve s = solveBump(kBumpWidth, n, kBumpQuadrature);
-    const double effectivity = s.estimate.total / s.error.total();
-    std::printf("n = %d: %zu DOFs, estimate %.4e, error %.4e (broken %.4e), effectivity %.3f\n", n,
-                s.dofs, s.estimate.total, s.error.total(), s.error.broken, effectivity);
-    // Not the specification's [0.3, 3] (issue 'adaptivity'): the figure measured, to 10%.
-    EXPECT_NEAR(effectivity, measuredEffectivity, kEffectivityChange * measuredEffectivity);
+    expectEffectivityInWindow(s.estimate.total, s.error.total(), "n = " + std::to_string(n));
     // The largest indicator sits on one of the 8 elements around the bump's centre (a grid
-    // vertex), and the elements within 2 w of it hold most of the estimate.
+    // vertex); the elements within 2 w of it, and the rest, each hold an estimate within the
+    // window of the error they hold.
     const PolyMesh mesh = hexGridMesh(n, n, n, Box3(Vec3::Zero(), Vec3::Ones()));
     const auto& eta2 = s.estimate.indicators.raw();
     const std::size_t largest =
@@ -267,14 +264,64 @@ TEST(ErrorEstimator, HasTheMeasuredEffectivityOnAGaussianBumpAndIsLargestAtTheBu
     const double h = 1.0 / n;
     EXPECT_LE((elementBounds(mesh, ElementId(largest)).center() - kBumpCentre).norm(),
               0.5 * std::sqrt(3.0) * h * (1.0 + 1e-9));
-    double near = 0.0;
-    for (std::size_t i = 0; i < eta2.size(); ++i)
-      if ((elementBounds(mesh, ElementId(i)).center() - kBumpCentre).norm() <= 2.0 * kBumpWidth)
-        near += eta2[i];
-    std::printf("  share of the estimate within 2 w: %.3f\n",
-                near / (s.estimate.total * s.estimate.total));
-    EXPECT_GT(near, kNearShare * s.estimate.total * s.estimate.total);
+    double estimate[2] = {0.0, 0.0}, error[2] = {0.0, 0.0};
+    for (std::size_t i = 0; i < eta2.size(); ++i) {
+      const bool near =
+          (elementBounds(mesh, ElementId(i)).center() - kBumpCentre).norm() <= 2.0 * kBumpWidth;
+      estimate[near] += eta2[i];
+      error[near] += s.error.elements[ElementId(i)];
+    }
+    expectEffectivityInWindow(std::sqrt(estimate[1]), std::sqrt(error[1]), "  near the bump");
+    expectEffectivityInWindow(std::sqrt(estimate[0]), std::sqrt(error[0]), "  away from it");
   }
+}
+
+TEST(ErrorEstimator, IsWithinThreeOfTheErrorOnB12ForDegreesOneToThree) {
+  // B12 itself (w = 0.05), IP, n = 4 and 8. Measured 2026-12-05: p = 1: 0.89, 0.95; p = 2:
+  // 0.99, 1.05 (1.32 at n = 16); p = 3: 1.01, 1.05. The residual estimator gave 8.3 and 7.1
+  // at p = 2.
+  const bench::ManufacturedProblem bump = bench::benchmarkB12Problem(0.05);
+  for (int p : {1, 2, 3})
+    for (int n : {4, 8}) {
+      const PolyMesh mesh = hexGridMesh(n, n, n, Box3(Vec3::Zero(), Vec3::Ones()));
+      const EstimatedSolve s = solveAndEstimate(mesh, bump.material, bench::benchmarkB1Loads(bump),
+                                                bump.displacement, bump.gradient, p, 2 * p + 6);
+      expectEffectivityInWindow(s.estimate.total, s.error.total(),
+                                "B12 p = " + std::to_string(p) + ", n = " + std::to_string(n));
+    }
+}
+
+TEST(ErrorEstimator, IsWithinThreeOfAReferenceErrorOnAnLPrismAndTheTorus) {
+  // No closed form: the error against a solve of the same degree on the mesh split twice into
+  // octants. The L-prism ([0,2] x [0,1] u [0,1] x [0,2], 1.5 high) sliced at 5 cells puts its
+  // re-entrant edge inside cut elements; held on y = 2 and pulled along y on x = 2, the stress
+  // is singular there. The torus sliced at 6 cells (cut polyhedra only) hangs from its x <= -1
+  // part under gravity. Measured 2026-12-05: L-prism 1.09 (p = 1), 0.92 (p = 2); torus 1.33.
+  const std::string data = POLYDG_TESTDATA_DIR;
+  MeshOptions meshing;
+  MeshReport meshed;
+  meshing.cells = 5;
+  const Model prism = Model::fromSurface(readSurface(data + "/Lprism.ply"), meshing, meshed);
+  meshing.cells = 6;
+  const Model torus = Model::fromSurface(readSurface(data + "/torus.obj"), meshing, meshed);
+  SolveOptions pulled;
+  pulled.material.youngsModulus = 1000.0;
+  pulled.material.poissonRatio = 0.3;
+  pulled.clamps = {FaceSelector::inPlane(1, 2.0)};
+  pulled.tractions = {{FaceSelector::inPlane(0, 2.0), Vec3(0, 10, 0)}};
+  for (int p : {1, 2}) {
+    pulled.discretization.basis.degree = p;
+    const bench::ReferenceCheck c = bench::checkAgainstReference(prism.mesh(), pulled, 2, p);
+    expectEffectivityInWindow(c.estimate, c.error, "L-prism p = " + std::to_string(p));
+  }
+  SolveOptions hanging;
+  hanging.material = pulled.material;
+  hanging.material.density = 1.0;
+  hanging.gravity = Vec3(0, 0, -10);
+  hanging.clamps = {FaceSelector::below(Plane::make(Vec3::UnitX(), -1.0))};
+  hanging.discretization.basis.degree = 1;
+  const bench::ReferenceCheck t = bench::checkAgainstReference(torus.mesh(), hanging, 2, 1);
+  expectEffectivityInWindow(t.estimate, t.error, "torus p = 1");
 }
 
 TEST(ErrorEstimator, FallsAtTheRateOfTheErrorUnderUniformRefinement) {
