@@ -133,10 +133,11 @@ class Monomials {
 /// Ainsworth and Oden, with the DG numerical flux as the equilibrated boundary traction): phi in
 /// P_q(K)^3, L2-orthogonal to the rigid motions, with
 ///   a_K(phi, v) = int_K f.v - a_K(u_h, v) + int_dK sigma^ n . v   for every such v,
-/// returned as a_K(phi, phi). The element stiffness a_K comes from the element's moments of the
-/// scaled monomials xi = (x - c) / s; the right-hand side from quadrature (f is not a
-/// polynomial). The multipliers of the rigid-motion constraints take up what the flux leaves
-/// unbalanced (the IP form's lambda lifting term is not in it).
+/// returned as a_K(phi, phi). The element stiffness a_K, the constraints and the gravity load
+/// come from the element's moments of the scaled monomials xi = (x - c) / s, computed with
+/// sigma(u_h) : grad v by a rule exact for them; a body force (not a polynomial) by a finer rule.
+/// The multipliers of the rigid-motion constraints take up what the flux leaves unbalanced (the IP
+/// form's lambda lifting term is not in it).
 struct LocalProblem {
   const PolyMesh& mesh;
   const DgBasis& basis;
@@ -147,10 +148,12 @@ struct LocalProblem {
   const Eigen::VectorXd& u;
   Vec3 gravityForce;
   int q;                                        ///< degree of the local space, p + 1
-  int elementDegree;                            ///< exactness of the element rule
+  int elementDegree;                            ///< exactness of the body force's rule
   int faceDegree;                               ///< exactness of the face rules
   Monomials space{q};                           ///< P_q
   Monomials table{std::max(2 * q - 2, q + 1)};  ///< the moments a_K and the constraints need
+  /// Exactness of the polynomial element integrals: the moments, and sigma(u_h) : grad v.
+  int polynomialDegree = std::max(2 * q - 2, q + 1);
 
   double energy(ElementId e) const;
 };
@@ -163,18 +166,15 @@ double LocalProblem::energy(ElementId e) const {
   std::vector<double> mom(static_cast<std::size_t>(table.size()), 0.0);
   std::vector<double> phi(static_cast<std::size_t>(table.size()));
   Eigen::VectorXd b = Eigen::VectorXd::Zero(size);
-  // Element integrals: the moments, int f.v and -int sigma(u_h) : grad v.
-  for (const QuadraturePoint& qp : elementQuadrature(mesh, e, elementDegree)) {
+  // Polynomial element integrals, exact: the moments and -int sigma(u_h) : grad v.
+  for (const QuadraturePoint& qp : elementQuadrature(mesh, e, polynomialDegree)) {
     const Vec3 xi = (qp.point - c) / s;
     table.values(xi, phi.data());
     for (int i = 0; i < table.size(); ++i)
       mom[static_cast<std::size_t>(i)] += qp.weight * phi[static_cast<std::size_t>(i)];
-    Vec3 f = gravityForce;
-    if (loads.bodyForce) f += loads.bodyForce(qp.point);
     const Eigen::Matrix3d sigma = stress(displacementGradientAt(basis, u, e, qp.point), mu, lambda);
     for (int a = 0; a < m; ++a) {
       const std::array<int, 3>& ea = space.exponent(a);
-      const double value = phi[static_cast<std::size_t>(table.of(ea))];
       Vec3 grad;
       for (int k = 0; k < 3; ++k) {
         std::array<int, 3> lower = ea;
@@ -185,9 +185,21 @@ double LocalProblem::energy(ElementId e) const {
                       : 0.0;
       }
       const Vec3 sg = sigma * grad;  // row d: sum_k sigma_dk d_k phi_a
-      for (int d = 0; d < 3; ++d) b[d * m + a] += qp.weight * (f[d] * value - sg[d]);
+      for (int d = 0; d < 3; ++d) b[d * m + a] -= qp.weight * sg[d];
     }
   }
+  // int f.v: gravity from the moments, a body force (not a polynomial) by the finer rule.
+  for (int a = 0; a < m; ++a)
+    for (int d = 0; d < 3; ++d)
+      b[d * m + a] += gravityForce[d] * mom[static_cast<std::size_t>(table.of(space.exponent(a)))];
+  if (loads.bodyForce)
+    for (const QuadraturePoint& qp : elementQuadrature(mesh, e, elementDegree)) {
+      const Vec3 f = loads.bodyForce(qp.point);
+      space.values((qp.point - c) / s, phi.data());
+      for (int a = 0; a < m; ++a)
+        for (int d = 0; d < 3; ++d)
+          b[d * m + a] += qp.weight * f[d] * phi[static_cast<std::size_t>(a)];
+    }
   // Face integrals of the numerical flux out of e.
   for (const FaceUse& use : mesh.element(e).faces) {
     const FaceId f = use.face;
