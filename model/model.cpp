@@ -438,7 +438,7 @@ SolveReport Model::solve(const SolveOptions& options) {
   report.clampForces = dirichletForces(m, solver.basis(), solver.moments(), solver.roles(),
                                        options.material, *u, loads.dirichlet.size());
   if (options.estimate) {
-    report.estimate = estimateError(m, solver, options.material, loads, *u);
+    report.estimate = estimateError(m, solver, loads, *u);
     report.energyNorm = std::sqrt(std::max(0.0, u->dot(solver.stiffnessTimes(*u))));
   }
 

@@ -146,7 +146,6 @@ struct LocalProblem {
   const FormCoefficients& form;
   const LoadCase& loads;
   const Eigen::VectorXd& u;
-  Vec3 gravityForce;
   int q;                                        ///< degree of the local space, p + 1
   int elementDegree;                            ///< exactness of the body force's rule
   int faceDegree;                               ///< exactness of the face rules
@@ -188,10 +187,8 @@ double LocalProblem::energy(ElementId e) const {
       for (int d = 0; d < 3; ++d) b[d * m + a] -= qp.weight * sg[d];
     }
   }
-  // int f.v: gravity from the moments, a body force (not a polynomial) by the finer rule.
-  for (int a = 0; a < m; ++a)
-    for (int d = 0; d < 3; ++d)
-      b[d * m + a] += gravityForce[d] * mom[static_cast<std::size_t>(table.of(space.exponent(a)))];
+  // int f.v for a body force (not a polynomial) by the finer rule. Gravity, constant, does no
+  // work on fields orthogonal to the translations: it enters through the flux alone.
   if (loads.bodyForce)
     for (const QuadraturePoint& qp : elementQuadrature(mesh, e, elementDegree)) {
       const Vec3 f = loads.bodyForce(qp.point);
@@ -278,8 +275,8 @@ double LocalProblem::energy(ElementId e) const {
 
 ErrorEstimate estimateError(const PolyMesh& mesh, const DgBasis& basis, const MomentCache& moments,
                             const FaceRoles& roles, const FormCoefficients& form,
-                            const Material& material, const LoadCase& loads,
-                            const Eigen::VectorXd& coefficients, const EstimatorOptions& options) {
+                            const LoadCase& loads, const Eigen::VectorXd& coefficients,
+                            const EstimatorOptions& options) {
   if (form.method != Method::IP)
     throw std::invalid_argument("estimateError: the estimator is for the IP method");
   const std::size_t ne = mesh.numElements(), nf = mesh.numFaces();
@@ -303,7 +300,6 @@ ErrorEstimate estimateError(const PolyMesh& mesh, const DgBasis& basis, const Mo
                            form,
                            loads,
                            coefficients,
-                           material.density * loads.gravity,
                            p + 1,
                            std::max(quadrature, 2 * (p + 1)),
                            std::max(quadrature, 2 * p + 1)};
@@ -331,11 +327,10 @@ ErrorEstimate estimateError(const PolyMesh& mesh, const DgBasis& basis, const Mo
   return out;
 }
 
-ErrorEstimate estimateError(const PolyMesh& mesh, const StaticSolver& solver,
-                            const Material& material, const LoadCase& loads,
+ErrorEstimate estimateError(const PolyMesh& mesh, const StaticSolver& solver, const LoadCase& loads,
                             const Eigen::VectorXd& coefficients, const EstimatorOptions& options) {
-  return estimateError(mesh, solver.basis(), solver.moments(), solver.roles(), solver.form(),
-                       material, loads, coefficients, options);
+  return estimateError(mesh, solver.basis(), solver.moments(), solver.roles(), solver.form(), loads,
+                       coefficients, options);
 }
 
 double EnergyError::total() const { return std::hypot(broken, jump); }

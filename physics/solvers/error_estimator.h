@@ -16,17 +16,17 @@ namespace polydg {
 
 /// The estimate for the solution `coefficients` (layout of LinearSystem) of the static problem
 /// assembled with `roles`, `form` and `loads` (as by StaticSolver::assemble(): the same face
-/// roles, penalty and loads; `material` gives the density of the gravity load). IP only: throws
-/// std::invalid_argument for another method. Runs in parallel over faces and elements.
+/// roles, penalty and loads). Gravity, a constant load, does no work on the local problems'
+/// fields (orthogonal to the rigid motions): it enters through the solution's flux alone. IP
+/// only: throws std::invalid_argument for another method. Runs in parallel over faces and
+/// elements.
 ErrorEstimate estimateError(const PolyMesh& mesh, const DgBasis& basis, const MomentCache& moments,
                             const FaceRoles& roles, const FormCoefficients& form,
-                            const Material& material, const LoadCase& loads,
-                            const Eigen::VectorXd& coefficients,
+                            const LoadCase& loads, const Eigen::VectorXd& coefficients,
                             const EstimatorOptions& options = {});
 
 /// The same for a solver after assemble(loads) and solve() (`coefficients` its solution).
-ErrorEstimate estimateError(const PolyMesh& mesh, const StaticSolver& solver,
-                            const Material& material, const LoadCase& loads,
+ErrorEstimate estimateError(const PolyMesh& mesh, const StaticSolver& solver, const LoadCase& loads,
                             const Eigen::VectorXd& coefficients,
                             const EstimatorOptions& options = {});
 

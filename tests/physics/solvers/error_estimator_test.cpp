@@ -108,7 +108,7 @@ EstimatedSolve solveAndEstimate(const PolyMesh& mesh, const Material& material,
   EstimatorOptions estimator;
   estimator.quadratureDegree = quadratureDegree;
   EstimatedSolve out;
-  out.estimate = estimateError(mesh, solver, material, loads, u, estimator);
+  out.estimate = estimateError(mesh, solver, loads, u, estimator);
   out.error = energyError(mesh, solver.basis(), solver.moments(), solver.roles(), solver.form(), u,
                           exact, exactGradient, quadratureDegree);
   out.dofs = solver.report().dofs;
@@ -133,7 +133,7 @@ void expectVanishes(const PolyMesh& mesh, const LoadCase& loads, const Quadratic
   StaticSolver solver(mesh, material, options);
   solver.assemble(loads);
   const Eigen::VectorXd u = solver.solve();
-  const ErrorEstimate estimate = estimateError(mesh, solver, material, loads, u);
+  const ErrorEstimate estimate = estimateError(mesh, solver, loads, u);
   const GradientField gradient = [&](const Vec3& x) { return field.gradient(x); };
   const double scale =
       energyOf(mesh, solver.basis(), solver.moments(), solver.roles(), solver.form(), gradient);

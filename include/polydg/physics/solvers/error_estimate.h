@@ -21,12 +21,14 @@ struct EstimatorOptions {
 /// Ainsworth and Oden, with the DG numerical flux as the boundary traction): phi_K in
 /// P_{p+1}(K)^3, L2-orthogonal to the rigid motions, with
 ///   a_K(phi_K, v) = int_K f.v - a_K(u_h, v) + int_dK sigma^ n . v   for every such v,
-/// f the body force (density * gravity + LoadCase::bodyForce), a_K the element's elastic energy
-/// form, and sigma^ n the IP form's flux {sigma(u_h)} n - mu eta_F [u_h] (on a Dirichlet face
-/// with u_L = g, on a Neumann face the prescribed traction, 0 on a free one). phi_K is the error
+/// f the body force (LoadCase::bodyForce; gravity, constant, does no work on such v), a_K the
+/// element's elastic energy form, and sigma^ n the IP form's flux {sigma(u_h)} n - mu eta_F
+/// [u_h] (on a Dirichlet face with u_L = g, on a Neumann face the prescribed traction, 0 on a
+/// free one). phi_K is the error
 /// on K up to the flux's own error, so no constant is tuned: its energy is the broken part of
 /// the estimate. The flux leaves out the IP form's lambda lifting term; the rigid-motion
-/// constraints' multipliers take up what it leaves unbalanced. The jump terms are the penalty
+/// constraints' multipliers take up what it leaves unbalanced (such an imbalance is not
+/// measured). The jump terms are the penalty
 /// part of the DG energy norm itself (mu eta_F from facePenalty(), eq. 7), so they equal the
 /// jump part of energyError() exactly (the exact solution does not jump). Interior faces give
 /// half to each side, so that the sum over elements counts every face once. The estimate
