@@ -44,20 +44,6 @@ nlohmann::json roundJson(const AdaptRound& r) {
           {"refine_seconds", r.refineSeconds}};
 }
 
-/// B12's solve options on the unit cube (IP, p = 2, u = u_exact weakly on the boundary), with
-/// the exact solution for the errors.
-SolveOptions b12Options(const ManufacturedProblem& problem) {
-  SolveOptions o;
-  o.discretization.basis.degree = 2;
-  o.material = problem.material;
-  o.displacements = {{FaceSelector::allBoundary(), problem.displacement}};
-  o.bodyForce = problem.bodyForce;
-  o.exactDisplacement = problem.displacement;
-  o.exactGradient = problem.gradient;
-  o.estimate = true;
-  return o;
-}
-
 Model unitCube(int n) { return Model(hexGridMesh(n, n, n, Box3(Vec3::Zero(), Vec3::Ones()))); }
 
 /// B11: the bent bar of thesis Fig. 4.9 refined by principal stress, 1-to-8 and 1-to-2, beside
@@ -270,25 +256,8 @@ nlohmann::json runB12Adaptive(const BenchOptions& o, const SolveOptions& base,
 /// singularity) pulled round its corner, and the sliced torus hanging under gravity.
 nlohmann::json runReferenceChecks(const BenchOptions& o, SuiteOutput& s, EffectivityRange& all,
                                   const Log& log) {
-  struct Case {
-    std::string name, file;
-    int cells;
-    SolveOptions options;
-  };
-  SolveOptions pulled;
-  pulled.material.youngsModulus = 1000.0;
-  pulled.material.poissonRatio = 0.3;
-  pulled.clamps = {FaceSelector::inPlane(1, 2.0)};
-  pulled.tractions = {{FaceSelector::inPlane(0, 2.0), Vec3(0, 10, 0)}};
-  SolveOptions hanging;
-  hanging.material = pulled.material;
-  hanging.material.density = 1.0;
-  hanging.gravity = Vec3(0, 0, -10);
-  hanging.clamps = {FaceSelector::below(Plane::make(Vec3::UnitX(), -1.0))};
-  const std::vector<Case> cases = {{"L-prism", "Lprism.ply", 5, pulled},
-                                   {"torus", "torus.obj", 6, hanging}};
   nlohmann::json out = nlohmann::json::array();
-  for (const Case& c : cases) {
+  for (const ReferenceProblem& c : referenceProblems()) {
     MeshOptions meshing;
     meshing.cells = c.cells;
     MeshReport meshed;
@@ -357,8 +326,8 @@ SuiteOutput adaptivitySuite(const BenchOptions& o, bool quiet) {
   EffectivityRange all;
   nlohmann::json b12 = nlohmann::json::array();
   for (int p = 1; p <= 3; ++p) {
-    SolveOptions base = b12Options(problem);
-    base.discretization.basis.degree = p;
+    SolveOptions base = manufacturedSolveOptions(problem, p);
+    base.estimate = true;
     std::vector<UniformPoint> uniformPoints;
     nlohmann::json uniform = runB12Uniform(o, base, s, plot, uniformPoints, all, log);
     b12.push_back(runB12Adaptive(o, base, std::move(uniform), uniformPoints, s, plot, all, log));

@@ -8,6 +8,31 @@
 
 namespace polydg::bench {
 
+SolveOptions manufacturedSolveOptions(const ManufacturedProblem& problem, int degree) {
+  SolveOptions o;
+  o.discretization.basis.degree = degree;
+  o.material = problem.material;
+  o.displacements = {{FaceSelector::allBoundary(), problem.displacement}};
+  o.bodyForce = problem.bodyForce;
+  o.exactDisplacement = problem.displacement;
+  o.exactGradient = problem.gradient;
+  return o;
+}
+
+std::vector<ReferenceProblem> referenceProblems() {
+  SolveOptions pulled;
+  pulled.material.youngsModulus = 1000.0;
+  pulled.material.poissonRatio = 0.3;
+  pulled.clamps = {FaceSelector::inPlane(1, 2.0)};
+  pulled.tractions = {{FaceSelector::inPlane(0, 2.0), Vec3(0, 10, 0)}};
+  SolveOptions hanging;
+  hanging.material = pulled.material;
+  hanging.material.density = 1.0;
+  hanging.gravity = Vec3(0, 0, -10);
+  hanging.clamps = {FaceSelector::below(Plane::make(Vec3::UnitX(), -1.0))};
+  return {{"L-prism", "Lprism.ply", 5, pulled}, {"torus", "torus.obj", 6, hanging}};
+}
+
 ReferenceCheck checkAgainstReference(const PolyMesh& mesh, const SolveOptions& options, int levels,
                                      int referenceDegree) {
   ReferenceCheck out;

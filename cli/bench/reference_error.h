@@ -4,10 +4,28 @@
 #pragma once
 
 #include <cstddef>
+#include <string>
+#include <vector>
 
+#include "cli/bench/problems.h"
 #include "polydg/model/model.h"
 
 namespace polydg::bench {
+
+/// The solve options of a manufactured problem (cli/bench/problems.h) with degree `degree`:
+/// u = u_exact weakly on the whole boundary, the body force, and the exact solution for the
+/// errors.
+SolveOptions manufacturedSolveOptions(const ManufacturedProblem& problem, int degree);
+
+/// The estimator's problems without a closed form (the adaptivity suite and its tests), sliced
+/// from a bundled model: the L-prism (its re-entrant edge a stress singularity) held on y = 2
+/// and pulled along y on x = 2, and the torus hanging from its x <= -1 part under gravity.
+struct ReferenceProblem {
+  std::string name, file;  ///< file: in testdata/ and share/polydg
+  int cells = 0;           ///< slicing cells along the longest side
+  SolveOptions options;    ///< degree 1; set the degree per run
+};
+std::vector<ReferenceProblem> referenceProblems();
 
 /// A solve's estimate beside its error measured against a reference solution.
 struct ReferenceCheck {

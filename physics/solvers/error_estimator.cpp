@@ -25,6 +25,11 @@ Eigen::Matrix3d stress(const Eigen::Matrix3d& g, double mu, double lambda) {
   return 2.0 * mu * eps + lambda * eps.trace() * Eigen::Matrix3d::Identity();
 }
 
+/// sigma(g) : eps(g), the elastic energy density (times 2) of the displacement gradient g.
+double energyDensity(const Eigen::Matrix3d& g, double mu, double lambda) {
+  return stress(g, mu, lambda).cwiseProduct(0.5 * (g + g.transpose())).sum();
+}
+
 /// Largest distance between two of the points.
 template <class Range>
 double diameter(const PolyMesh& mesh, const Range& vertices) {
@@ -40,23 +45,22 @@ Vec3 outwardNormal(const MomentCache& moments, const FaceUses& uses, FaceId f, i
   return uses.reversed[s] ? Vec3(-moments.faceNormal(f)) : moments.faceNormal(f);
 }
 
-/// The jump term of a face, whole (not yet shared between its elements): mu eta_F |[u_h]|^2 on
-/// an interior face, mu eta_F |u_h - g|^2 on a Dirichlet face, 0 on a Neumann face.
-double faceJump(const MomentCache& moments, const FaceRoles& roles, const FormCoefficients& form,
-                const LoadCase& loads, const DgBasis& basis, const Eigen::VectorXd& u, FaceId f,
-                const std::vector<QuadraturePoint>& rule) {
+/// mu eta_F |u_h,K - outside|^2 over face f by `rule`, the face's penalty part of the DG energy
+/// norm: `outside` is the other element's u_h on an interior face and `boundary` (null: 0) on a
+/// Dirichlet face; 0 on a face without face terms. Whole, not yet shared between its elements.
+double penaltyJump(const MomentCache& moments, const FaceRoles& roles, const FormCoefficients& form,
+                   const DgBasis& basis, const Eigen::VectorXd& u, FaceId f,
+                   const std::vector<QuadraturePoint>& rule, const VectorField* boundary) {
   const FaceUses& uses = roles.uses[f];
   const FaceKind kind = roles.kind[f];
-  if (uses.count == 0 || (kind != FaceKind::Interior && kind != FaceKind::Dirichlet)) return 0.0;
+  if (uses.count == 0 || kind == FaceKind::Free) return 0.0;
   const ElementId k = uses.element[0];
   const ElementId l = kind == FaceKind::Interior ? uses.element[1] : ElementId();
-  const VectorField* g =
-      kind == FaceKind::Dirichlet ? &loads.dirichlet[roles.dirichlet[f]].displacement : nullptr;
   double jump = 0.0;
   for (const QuadraturePoint& q : rule) {
-    const Vec3 outside = l.valid()   ? displacementAt(basis, u, l, q.point)
-                         : (g && *g) ? (*g)(q.point)
-                                     : Vec3::Zero();
+    const Vec3 outside = l.valid()                 ? displacementAt(basis, u, l, q.point)
+                         : (boundary && *boundary) ? (*boundary)(q.point)
+                                                   : Vec3::Zero();
     jump += q.weight * (displacementAt(basis, u, k, q.point) - outside).squaredNorm();
   }
   return form.mu * facePenalty(form, moments, f, k, l) * jump;
@@ -101,6 +105,7 @@ class Monomials {
         }
   }
   int size() const { return static_cast<int>(exponents_.size()); }
+  int degree() const { return degree_; }
   const std::array<int, 3>& exponent(int i) const {
     return exponents_[static_cast<std::size_t>(i)];
   }
@@ -146,13 +151,12 @@ struct LocalProblem {
   const FormCoefficients& form;
   const LoadCase& loads;
   const Eigen::VectorXd& u;
-  int q;                                        ///< degree of the local space, p + 1
-  int elementDegree;                            ///< exactness of the body force's rule
-  int faceDegree;                               ///< exactness of the face rules
-  Monomials space{q};                           ///< P_q
-  Monomials table{std::max(2 * q - 2, q + 1)};  ///< the moments a_K and the constraints need
-  /// Exactness of the polynomial element integrals: the moments, and sigma(u_h) : grad v.
-  int polynomialDegree = std::max(2 * q - 2, q + 1);
+  int q;               ///< degree of the local space, p + 1
+  int elementDegree;   ///< exactness of the body force's rule
+  int faceDegree;      ///< exactness of the face rules
+  Monomials space{q};  ///< P_q
+  /// The moments a_K and the constraints need; sigma(u_h) : grad v is of no higher degree.
+  Monomials table{std::max(2 * q - 2, q + 1)};
 
   double energy(ElementId e) const;
 };
@@ -166,7 +170,7 @@ double LocalProblem::energy(ElementId e) const {
   std::vector<double> phi(static_cast<std::size_t>(table.size()));
   Eigen::VectorXd b = Eigen::VectorXd::Zero(size);
   // Polynomial element integrals, exact: the moments and -int sigma(u_h) : grad v.
-  for (const QuadraturePoint& qp : elementQuadrature(mesh, e, polynomialDegree)) {
+  for (const QuadraturePoint& qp : elementQuadrature(mesh, e, table.degree())) {
     const Vec3 xi = (qp.point - c) / s;
     table.values(xi, phi.data());
     for (int i = 0; i < table.size(); ++i)
@@ -288,8 +292,11 @@ ErrorEstimate estimateError(const PolyMesh& mesh, const DgBasis& basis, const Mo
   FaceData<double> jumps(nf, 0.0);
   tbb::parallel_for(std::size_t(0), nf, [&](std::size_t i) {
     const FaceId f(i);
-    jumps[f] = faceJump(moments, roles, form, loads, basis, coefficients, f,
-                        faceQuadrature(mesh, f, quadrature));
+    const VectorField* g = roles.kind[f] == FaceKind::Dirichlet
+                               ? &loads.dirichlet[roles.dirichlet[f]].displacement
+                               : nullptr;
+    jumps[f] = penaltyJump(moments, roles, form, basis, coefficients, f,
+                           faceQuadrature(mesh, f, quadrature), g);
   });
 
   const int p = basis.degree();
@@ -348,25 +355,15 @@ EnergyError energyError(const PolyMesh& mesh, const DgBasis& basis, const Moment
     for (const QuadraturePoint& q : elementQuadrature(mesh, e, quadratureDegree)) {
       const Eigen::Matrix3d g =
           exactGradient(q.point) - displacementGradientAt(basis, coefficients, e, q.point);
-      s += q.weight * stress(g, mu, lambda).cwiseProduct(0.5 * (g + g.transpose())).sum();
+      s += q.weight * energyDensity(g, mu, lambda);
     }
     elementEnergy[e] = s;
   });
   FaceData<double> faceJump(nf, 0.0);
   tbb::parallel_for(std::size_t(0), nf, [&](std::size_t i) {
     const FaceId f(i);
-    const FaceUses& uses = roles.uses[f];
-    const FaceKind kind = roles.kind[f];
-    if (uses.count == 0 || kind == FaceKind::Free) return;
-    const bool interior = kind == FaceKind::Interior;
-    const ElementId k = uses.element[0], l = interior ? uses.element[1] : ElementId();
-    double s = 0.0;
-    for (const QuadraturePoint& q : faceQuadrature(mesh, f, quadratureDegree)) {
-      const Vec3 outside =
-          interior ? displacementAt(basis, coefficients, l, q.point) : exact(q.point);
-      s += q.weight * (displacementAt(basis, coefficients, k, q.point) - outside).squaredNorm();
-    }
-    faceJump[f] = mu * facePenalty(form, moments, f, k, l) * s;
+    faceJump[f] = penaltyJump(moments, roles, form, basis, coefficients, f,
+                              faceQuadrature(mesh, f, quadratureDegree), &exact);
   });
   EnergyError out;
   out.elements = elementEnergy;
@@ -395,7 +392,7 @@ double brokenEnergyDifference(const PolyMesh& fineMesh, const DgBasis& fineBasis
     for (const QuadraturePoint& q : elementQuadrature(fineMesh, k, quadratureDegree)) {
       const Eigen::Matrix3d g = displacementGradientAt(fineBasis, fine, k, q.point) -
                                 displacementGradientAt(coarseBasis, coarse, parent[i], q.point);
-      s += q.weight * stress(g, mu, lambda).cwiseProduct(0.5 * (g + g.transpose())).sum();
+      s += q.weight * energyDensity(g, mu, lambda);
     }
     energy[i] = s;
   });

@@ -295,14 +295,7 @@ TEST(ErrorEstimator, AReferenceTwoLevelsFinerMeasuresTheErrorOfAKnownSolution) {
   // The wider bump on 4^3 hexahedra, p = 1: the error against the reference (the same degree on
   // 16^3 cells, error ~h/4) is the true error to within the reference's own, a quarter of it
   // (triangle inequality, energy error ~ h). Measured 2026-12-05: 1.03e-2 against 1.21e-2.
-  const bench::ManufacturedProblem bump = bench::benchmarkB12Problem(kBumpWidth);
-  SolveOptions o;
-  o.discretization.basis.degree = 1;
-  o.material = bump.material;
-  o.displacements = {{FaceSelector::allBoundary(), bump.displacement}};
-  o.bodyForce = bump.bodyForce;
-  o.exactDisplacement = bump.displacement;
-  o.exactGradient = bump.gradient;
+  const SolveOptions o = bench::manufacturedSolveOptions(bench::benchmarkB12Problem(kBumpWidth), 1);
   const PolyMesh mesh = hexGridMesh(4, 4, 4, Box3(Vec3::Zero(), Vec3::Ones()));
   Model exact(mesh);
   const SolveReport r = exact.solve(o);
@@ -319,31 +312,21 @@ TEST(ErrorEstimator, IsWithinThreeOfAReferenceErrorOnAnLPrismAndTheTorus) {
   // re-entrant edge inside cut elements; held on y = 2 and pulled along y on x = 2, the stress
   // is singular there. The torus sliced at 6 cells (cut polyhedra only) hangs from its x <= -1
   // part under gravity. Measured 2026-12-05: L-prism 1.09 (p = 1), 0.92 (p = 2); torus 1.33.
-  const std::string data = POLYDG_TESTDATA_DIR;
-  MeshOptions meshing;
-  MeshReport meshed;
-  meshing.cells = 5;
-  const Model prism = Model::fromSurface(readSurface(data + "/Lprism.ply"), meshing, meshed);
-  meshing.cells = 6;
-  const Model torus = Model::fromSurface(readSurface(data + "/torus.obj"), meshing, meshed);
-  SolveOptions pulled;
-  pulled.material.youngsModulus = 1000.0;
-  pulled.material.poissonRatio = 0.3;
-  pulled.clamps = {FaceSelector::inPlane(1, 2.0)};
-  pulled.tractions = {{FaceSelector::inPlane(0, 2.0), Vec3(0, 10, 0)}};
-  for (int p : {1, 2}) {
-    pulled.discretization.basis.degree = p;
-    const bench::ReferenceCheck c = bench::checkAgainstReference(prism.mesh(), pulled, 2, p);
-    expectEffectivityInWindow(c.estimate, c.error, "L-prism p = " + std::to_string(p));
+  // The problems of the adaptivity suite (bench::referenceProblems()): the L-prism at p = 1
+  // and 2, the torus at p = 1.
+  for (const bench::ReferenceProblem& problem : bench::referenceProblems()) {
+    MeshOptions meshing;
+    meshing.cells = problem.cells;
+    MeshReport meshed;
+    const Model model = Model::fromSurface(
+        readSurface(std::string(POLYDG_TESTDATA_DIR) + "/" + problem.file), meshing, meshed);
+    for (int p = 1; p <= (problem.name == "L-prism" ? 2 : 1); ++p) {
+      SolveOptions options = problem.options;
+      options.discretization.basis.degree = p;
+      const bench::ReferenceCheck c = bench::checkAgainstReference(model.mesh(), options, 2, p);
+      expectEffectivityInWindow(c.estimate, c.error, problem.name + " p = " + std::to_string(p));
+    }
   }
-  SolveOptions hanging;
-  hanging.material = pulled.material;
-  hanging.material.density = 1.0;
-  hanging.gravity = Vec3(0, 0, -10);
-  hanging.clamps = {FaceSelector::below(Plane::make(Vec3::UnitX(), -1.0))};
-  hanging.discretization.basis.degree = 1;
-  const bench::ReferenceCheck t = bench::checkAgainstReference(torus.mesh(), hanging, 2, 1);
-  expectEffectivityInWindow(t.estimate, t.error, "torus p = 1");
 }
 
 TEST(ErrorEstimator, FallsAtTheRateOfTheErrorUnderUniformRefinement) {
