@@ -341,6 +341,64 @@ TEST(ErrorEstimator, FallsAtTheRateOfTheErrorUnderUniformRefinement) {
   EXPECT_NEAR(estimateRate, errorRate, kRateTolerance);
 }
 
+TEST(ErrorEstimator, TheJumpTermsAreThePenaltyTimesTheSquaredJumpOnEachFace) {
+  // u_h = c on the centre element of a 3^3 grid of the unit cube and 0 elsewhere, held at 0 on
+  // the boundary: the centre element's 6 faces (area 1/9) jump by c, no other face jumps. Both
+  // the estimate's jump terms and the true error's jump part against u = 0 are sum over those
+  // faces of mu eta_F |F| |c|^2.
+  const PolyMesh mesh = hexGridMesh(3, 3, 3, Box3(Vec3::Zero(), Vec3::Ones()));
+  const Material material = unitMaterial();
+  LoadCase loads;
+  loads.dirichlet.push_back({FaceSelector::allBoundary(), nullptr});
+  StaticOptions options;
+  options.discretization.basis.degree = 1;
+  StaticSolver solver(mesh, material, options);
+  solver.assemble(loads);
+  const DgBasis& basis = solver.basis();
+  const int n = basis.size();
+  std::size_t centre = 0;
+  for (std::size_t e = 0; e < mesh.numElements(); ++e)
+    if ((solver.moments().centroid(ElementId(e)) - Vec3::Constant(0.5)).norm() < 1e-12) centre = e;
+  const Vec3 c(0.3, -0.2, 0.1);
+  Eigen::VectorXd u = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(mesh.numElements() * 3 * n));
+  const Eigen::Index base = static_cast<Eigen::Index>(centre * 3 * n);
+  for (int d = 0; d < 3; ++d) u[base + d * n] = 1.0;  // the constant function, value phi_0
+  const Vec3 phi0 = displacementAt(basis, u, ElementId(centre), Vec3::Constant(0.5));
+  for (int d = 0; d < 3; ++d) u[base + d * n] = c[d] / phi0[d];
+  double expected = 0.0;
+  for (const FaceUse& use : mesh.element(ElementId(centre)).faces) {
+    const Face& face = mesh.face(use.face);
+    expected += material.mu() *
+                facePenalty(solver.form(), solver.moments(), use.face, face.front, face.back) *
+                (1.0 / 9.0) * c.squaredNorm();
+  }
+  ASSERT_GT(expected, 0.0);
+  const ErrorEstimate estimate = estimateError(mesh, solver, loads, u);
+  EXPECT_NEAR(estimate.displacementJump, expected, 1e-12 * expected);
+  EXPECT_EQ(estimate.dirichlet, 0.0);
+  const VectorField zero = [](const Vec3&) -> Vec3 { return Vec3::Zero(); };
+  const GradientField still = [](const Vec3&) -> Eigen::Matrix3d {
+    return Eigen::Matrix3d::Zero();
+  };
+  const EnergyError error =
+      energyError(mesh, basis, solver.moments(), solver.roles(), solver.form(), u, zero, still, 4);
+  EXPECT_NEAR(error.jump * error.jump, expected, 1e-12 * expected);
+  EXPECT_NEAR(error.broken, 0.0, 1e-12);
+  // Against u = a (constant) the boundary faces, where u_h = 0, add mu eta_F |F| |a|^2 each.
+  const Vec3 a(-0.1, 0.05, 0.2);
+  double boundary = 0.0;
+  for (std::size_t f = 0; f < mesh.numFaces(); ++f)
+    if (!mesh.face(FaceId(f)).back.valid())
+      boundary += material.mu() *
+                  facePenalty(solver.form(), solver.moments(), FaceId(f),
+                              mesh.face(FaceId(f)).front, ElementId()) *
+                  (1.0 / 9.0) * a.squaredNorm();
+  const VectorField shifted = [a](const Vec3&) -> Vec3 { return a; };
+  const EnergyError against = energyError(mesh, basis, solver.moments(), solver.roles(),
+                                          solver.form(), u, shifted, still, 4);
+  EXPECT_NEAR(against.jump * against.jump, expected + boundary, 1e-12 * (expected + boundary));
+}
+
 TEST(ErrorEstimator, BulkMarkingTakesTheFewestLargestIndicators) {
   ElementData<double> indicators;
   for (double v : {1.0, 4.0, 0.0, 3.0, 2.0, 3.0}) indicators.push_back(v);
