@@ -35,7 +35,7 @@ void printSummary(const MeshReport& report) {
     std::cout << "  octree: " << report.levels << " levels below cells of " << report.coarseCellSize
               << "; elements per level";
     for (std::size_t n : report.elementsPerLevel) std::cout << ' ' << n;
-    std::cout << "; refinement " << report.refineSeconds << " s\n";
+    std::cout << "; octree built in " << report.refineSeconds << " s\n";
   }
   if (report.dg.local) {
     const LocalDgCheck& c = *report.dg.local;

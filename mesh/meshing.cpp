@@ -130,13 +130,24 @@ void orientAndSlice(const TriangleSurface& closed, double cellSize, const Meshin
   timer.done("orient");
 
   r.grid = Grid::covering(bounds(surface), cellSize);
-  PolyMesh sliced = sliceSurface(surface, r.grid, &r.slice, nullptr, options.progress);
+  const int levels = options.octreeLevels;
+  PolyMesh sliced = levels > 0 ? sliceSurfaceOctree(surface, r.grid, levels, &r.slice,
+                                                    &result.elementLevels, options.progress)
+                               : sliceSurface(surface, r.grid, &r.slice, nullptr, options.progress);
   timer.done("slice");
 
   if (options.sliverTau > 0) {
     SliverMergeReport merge;
-    result.mesh = mergeSlivers(std::move(sliced), options.sliverTau * r.grid.cellVolume(), &merge);
+    const double finestCell = std::ldexp(r.grid.cellVolume(), -3 * levels);
+    result.mesh = mergeSlivers(std::move(sliced), options.sliverTau * finestCell, &merge);
     r.slivers = {merge.threshold, merge.slivers, merge.merged, merge.isolated};
+    if (levels > 0) {
+      // A merged element is at the finest level of its parts.
+      std::vector<int> merged(result.mesh.numElements(), 0);
+      for (std::size_t e = 0; e < merge.group.size(); ++e)
+        merged[merge.group[e]] = std::max(merged[merge.group[e]], result.elementLevels[e]);
+      result.elementLevels = std::move(merged);
+    }
   } else {
     result.mesh = std::move(sliced);
   }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -13,6 +14,7 @@
 
 #include "mesh/flat_faces.h"
 #include "mesh/plane_split.h"
+#include "mesh/surface_octree.h"
 #include "mesh/welded_polygons.h"
 #include "polydg/mesh/merge_elements.h"
 #include "util/stopwatch.h"
@@ -53,17 +55,32 @@ namespace {
 
 class Slicer {
  public:
-  Slicer(const Grid& grid, std::vector<Vec3> points, const ProgressFn& progress)
-      : grid_(grid),
+  /// Slices with `grid`, or, given an octree, with its finest grid down to its leaves.
+  Slicer(const Grid& grid, std::vector<Vec3> points, const ProgressFn& progress,
+         const SurfaceOctree* octree = nullptr)
+      : grid_(octree ? octree->finest() : grid),
         splitter_(std::make_unique<PlaneSplitter>(std::move(points))),
-        progress_(progress) {}
+        progress_(progress),
+        octree_(octree) {}
 
   void run(Piece solid) {
     totalCells_ = static_cast<double>(grid_.cells[0]) * grid_.cells[1] * grid_.cells[2];
     recurse(std::move(solid), {0, 0, 0}, grid_.cells);
     std::size_t count = 0;
     for (const std::vector<Leaf>& list : threadLeaves_) count += list.size();
+    for (const std::vector<Leaf>& list : threadBoxes_) count += list.size();
     leaves_.reserve(count);
+    // The octree's whole cells get their faces from the octree, on points after the
+    // splitter's (build() welds them to the splitter's points at the same corners).
+    firstGenerated_ = splitter_->numPoints();
+    for (std::vector<Leaf>& list : threadBoxes_) {
+      for (Leaf& box : list) {
+        box.piece = octree_->boxFaces(box.level, box.cell,
+                                      static_cast<std::uint32_t>(firstGenerated_), generated_);
+        leaves_.push_back(std::move(box));
+      }
+      std::vector<Leaf>().swap(list);
+    }
     for (std::vector<Leaf>& list : threadLeaves_) {
       leaves_.insert(leaves_.end(), std::make_move_iterator(list.begin()),
                      std::make_move_iterator(list.end()));
@@ -83,8 +100,10 @@ class Slicer {
   /// Sizes the splitter for about `points` points.
   void reserve(std::size_t points) { splitter_->reserve(points); }
 
-  PolyMesh build(std::vector<std::array<int, 3>>* elementCell) {
-    const std::vector<Vec3> points = splitter_->points();
+  PolyMesh build(std::vector<std::array<int, 3>>* elementCell, std::vector<int>* elementLevel) {
+    std::vector<Vec3> points = splitter_->points();
+    points.insert(points.end(), generated_.begin(), generated_.end());
+    std::vector<Vec3>().swap(generated_);
     // The splitter's maps of shared points (hundreds of thousands of nodes) are not needed any
     // more: they are freed beside the build, not after it.
     tbb::task_group release;
@@ -104,6 +123,9 @@ class Slicer {
     if (elementCell)
       for (std::size_t l = 0; l < leaves_.size(); ++l)
         if (ids.elementOf[l] != kNone) elementCell->push_back(leaves_[l].cell);
+    if (elementLevel)
+      for (std::size_t l = 0; l < leaves_.size(); ++l)
+        if (ids.elementOf[l] != kNone) elementLevel->push_back(leaves_[l].level);
     freeLeaves();
     release.wait();
     PolyMesh mesh;
@@ -118,6 +140,7 @@ class Slicer {
     Piece piece;
     std::array<int, 3> cell;
     std::size_t part;  ///< index of the piece among its cell's connected pieces
+    int level = 0;     ///< its octree level (the octree's finest for a sliced cell)
   };
 
   /// For each polygon (numbered across leaves): kNone, or the number of the earlier polygon
@@ -210,14 +233,18 @@ class Slicer {
     // Points in order of first use, then welded; vertex ids follow that order.
     WeldedVertices out;
     out.rank.assign(points.size(), kNone);
+    // The octree's points come after the splitter's, so that a splitter point is never
+    // welded into one of them: only welds among the splitter's points are the slicing's
+    // (counted, and marking polygons as touched); the octree's corners repeat its points.
     std::vector<std::uint32_t> used;
-    for (const Leaf& leaf : leaves_)
-      for (const PiecePolygon& polygon : leaf.piece)
-        for (std::uint32_t v : polygon.vertices)
-          if (out.rank[v] == kNone) {
-            out.rank[v] = static_cast<std::uint32_t>(used.size());
-            used.push_back(v);
-          }
+    for (const bool generated : {false, true})
+      for (const Leaf& leaf : leaves_)
+        for (const PiecePolygon& polygon : leaf.piece)
+          for (std::uint32_t v : polygon.vertices)
+            if (out.rank[v] == kNone && (v >= firstGenerated_) == generated) {
+              out.rank[v] = static_cast<std::uint32_t>(used.size());
+              used.push_back(v);
+            }
     const std::vector<std::uint32_t> target = weldTargets(points, used, resolution);
     out.positions.raw().reserve(used.size());
     out.vertexOfRank.resize(used.size());
@@ -227,12 +254,12 @@ class Slicer {
         out.positions.push_back(points[used[i]]);
       } else {
         out.vertexOfRank[i] = out.vertexOfRank[target[i]];
-        ++stats.weldedPoints;
+        stats.weldedPoints += used[i] < firstGenerated_;
       }
     }
     out.shared.assign(out.positions.size(), 0);
     for (std::size_t i = 0; i < used.size(); ++i)
-      if (target[i] != i) out.shared[out.vertexOfRank[i]] = 1;
+      if (target[i] != i && used[i] < firstGenerated_) out.shared[out.vertexOfRank[i]] = 1;
     return out;
   }
 
@@ -431,9 +458,15 @@ class Slicer {
   /// Splits `piece` (the part of the solid in cells lo .. hi - 1) down to single cells, whose
   /// connected pieces go to this thread's list of leaves (their order is fixed by run()).
   void recurse(Piece piece, std::array<int, 3> lo, std::array<int, 3> hi) {
-    for (int axis = 0; axis < 3; ++axis) {
-      if (hi[axis] - lo[axis] <= 1) continue;
-      const int mid = (lo[axis] + hi[axis]) / 2;
+    if (octree_) {
+      const int level = octreeLevel(lo, hi);
+      if (level >= 0 && level < octree_->levels() && octree_->isLeaf(level, lo)) {
+        wholeCell(piece, lo, hi, level);
+        return;
+      }
+    }
+    if (const int axis = splitAxis(lo, hi); axis >= 0) {
+      const int mid = splitAt(lo[axis], hi[axis]);
       const auto id = static_cast<std::uint32_t>(axis * ((1 << 20) + 1) + mid);
       const SplitPlane plane = SplitPlane::axisAligned(axis, grid_.plane(axis, mid), id);
       PieceSplit s = splitter_->split(std::move(piece), plane, FaceOrigin::Interior);
@@ -466,7 +499,53 @@ class Slicer {
     std::vector<Piece> parts = PlaneSplitter::components(std::move(piece));
     if (parts.size() > 1) ++multiPieceCells_;
     std::vector<Leaf>& leaves = threadLeaves_.local();
-    for (std::size_t i = 0; i < parts.size(); ++i) leaves.push_back({std::move(parts[i]), lo, i});
+    const int level = octree_ ? octree_->levels() : 0;
+    for (std::size_t i = 0; i < parts.size(); ++i)
+      leaves.push_back({std::move(parts[i]), lo, i, level});
+    reportDone(lo, hi);
+  }
+
+  /// The axis to split cells lo .. hi - 1 across, or -1 for a single cell. On a grid, the first
+  /// axis more than a cell long. In an octree, the first more than a coarse cell long while
+  /// any is, then the longest (the first of equals), so that a cube splits into its octants.
+  int splitAxis(const std::array<int, 3>& lo, const std::array<int, 3>& hi) const {
+    const int coarse = octree_ ? 1 << octree_->levels() : 1;
+    for (int axis = 0; axis < 3; ++axis)
+      if (hi[axis] - lo[axis] > coarse) return axis;
+    if (!octree_) return -1;
+    int longest = 0;
+    for (int axis = 1; axis < 3; ++axis)
+      if (hi[axis] - lo[axis] > hi[longest] - lo[longest]) longest = axis;
+    return hi[longest] - lo[longest] > 1 ? longest : -1;
+  }
+
+  /// Where to split cells lo .. hi - 1 of an axis: the middle, on a coarse cell's plane while
+  /// the range is longer than a coarse cell.
+  int splitAt(int lo, int hi) const {
+    const int coarse = octree_ ? octree_->levels() : 0;
+    if (hi - lo > 1 << coarse) return lo + (((hi - lo) >> coarse) / 2 << coarse);
+    return (lo + hi) / 2;
+  }
+
+  /// The octree level of the node with cells lo .. hi - 1, or -1 if they are not a node.
+  int octreeLevel(const std::array<int, 3>& lo, const std::array<int, 3>& hi) const {
+    const int size = hi[0] - lo[0];
+    if (hi[1] - lo[1] != size || hi[2] - lo[2] != size || (size & (size - 1)) != 0) return -1;
+    for (int k = 0; k < 3; ++k)
+      if (lo[k] % size != 0) return -1;
+    const int level = octree_->levels() - std::countr_zero(static_cast<unsigned>(size));
+    return level >= 0 ? level : -1;
+  }
+
+  /// A leaf of the octree above its finest level: the surface does not touch it, so `piece`
+  /// (not empty) is the whole cube. Its faces are made once all leaves are known (run()).
+  void wholeCell(const Piece& piece, const std::array<int, 3>& lo, const std::array<int, 3>& hi,
+                 int level) {
+    if (std::any_of(piece.begin(), piece.end(),
+                    [](const PiecePolygon& p) { return p.origin == FaceOrigin::Surface; }))
+      throw std::logic_error("octree slicing: a cell the surface does not touch holds part of it");
+    ++leafCells_;
+    threadBoxes_.local().push_back({Piece(), lo, 0, level});
     reportDone(lo, hi);
   }
 
@@ -481,6 +560,10 @@ class Slicer {
   std::unique_ptr<PlaneSplitter> splitter_;
   tbb::enumerable_thread_specific<std::vector<Leaf>> threadLeaves_;  ///< leaves, per thread
   const ProgressFn& progress_;
+  const SurfaceOctree* octree_;
+  tbb::enumerable_thread_specific<std::vector<Leaf>> threadBoxes_;  ///< whole octree cells
+  std::vector<Vec3> generated_;                                     ///< the points of their faces
+  std::size_t firstGenerated_ = std::numeric_limits<std::size_t>::max();  ///< their first id
   std::vector<Leaf> leaves_;
   double totalCells_ = 1.0;
   double doneCells_ = 0.0;
@@ -495,8 +578,9 @@ namespace {
 /// About how many points slicing `surface` with `grid` makes, to size the splitter's tables:
 /// the surface's vertices, a grid node per cell inside, a point where a surface edge crosses a
 /// grid plane, and one where a grid line crosses the surface (the projected areas over a
-/// cell face). At most 2^22: beyond that the tables grow as they go.
-std::size_t expectedPoints(const TriangleSurface& surface, const Grid& grid) {
+/// cell face). An octree's cells inside are whole cubes: no node per finest cell there. At most
+/// 2^22: beyond that the tables grow as they go.
+std::size_t expectedPoints(const TriangleSurface& surface, const Grid& grid, bool octree) {
   const double h = grid.cellSize;
   double crossings = 0.0, lines = 0.0;
   for (const auto& t : surface.triangles) {
@@ -508,15 +592,19 @@ std::size_t expectedPoints(const TriangleSurface& surface, const Grid& grid) {
         0.5 * ((b - a).cwiseAbs().sum() + (c - b).cwiseAbs().sum() + (a - c).cwiseAbs().sum()) / h;
     lines += 0.5 * (b - a).cross(c - a).cwiseAbs().sum() / (h * h);
   }
-  const double inside = std::abs(enclosedVolume(surface)) / (h * h * h);
+  const double inside = octree ? 0.0 : std::abs(enclosedVolume(surface)) / (h * h * h);
   const double total = static_cast<double>(surface.vertices.size()) + inside + crossings + lines;
   return static_cast<std::size_t>(std::min(total, double(1 << 22)));
 }
 
 }  // namespace
 
-PolyMesh sliceSurface(const TriangleSurface& surface, const Grid& grid, SliceStats* stats,
-                      std::vector<std::array<int, 3>>* elementCell, const ProgressFn& progress) {
+namespace {
+
+/// sliceSurface() and sliceSurfaceOctree(): slices, builds, and repairs what rounding left.
+PolyMesh slice(const TriangleSurface& surface, const Grid& grid, const SurfaceOctree* octree,
+               SliceStats* stats, std::vector<std::array<int, 3>>* elementCell,
+               std::vector<int>* elementLevel, const ProgressFn& progress) {
   Piece solid;
   solid.reserve(surface.triangles.size());
   for (const auto& tri : surface.triangles) {
@@ -528,26 +616,61 @@ PolyMesh sliceSurface(const TriangleSurface& surface, const Grid& grid, SliceSta
     solid.push_back(std::move(p));
   }
   Stopwatch phase;
-  Slicer slicer(grid, surface.vertices, progress);
-  slicer.reserve(expectedPoints(surface, grid));
+  Slicer slicer(grid, surface.vertices, progress, octree);
+  slicer.reserve(expectedPoints(surface, octree ? octree->finest() : grid, octree != nullptr));
   slicer.run(std::move(solid));
   slicer.stats.secondsSplitting = phase.seconds();
   phase.restart();
-  if (elementCell) elementCell->clear();
-  PolyMesh mesh = slicer.build(elementCell);
+  std::vector<std::array<int, 3>> cells;
+  std::vector<int> levels;
+  PolyMesh mesh = slicer.build(elementCell ? &cells : nullptr, elementLevel ? &levels : nullptr);
   slicer.stats.flatFaces = dissolveFlatFaces(mesh);
   DegenerateMergeReport merge;
   mesh = mergeDegenerateElements(std::move(mesh), &merge);
   slicer.stats.mergedElements = merge.merged;
   slicer.stats.droppedElements = merge.dropped;
-  if (elementCell && (merge.merged > 0 || merge.dropped > 0)) {
-    std::vector<std::array<int, 3>> cells(mesh.numElements());
-    for (std::size_t e = merge.group.size(); e-- > 0;)  // each group's first element's cell
-      if (merge.group[e] != kDroppedElement) cells[merge.group[e]] = (*elementCell)[e];
-    *elementCell = std::move(cells);
+  if (merge.merged > 0 || merge.dropped > 0) {
+    // A merged element keeps its first part's cell and the finest of its parts' levels.
+    std::vector<std::array<int, 3>> mergedCells(elementCell ? mesh.numElements() : 0);
+    std::vector<int> mergedLevels(elementLevel ? mesh.numElements() : 0, 0);
+    for (std::size_t e = merge.group.size(); e-- > 0;) {
+      const std::uint32_t g = merge.group[e];
+      if (g == kDroppedElement) continue;
+      if (elementCell) mergedCells[g] = cells[e];
+      if (elementLevel) mergedLevels[g] = std::max(mergedLevels[g], levels[e]);
+    }
+    cells = std::move(mergedCells);
+    levels = std::move(mergedLevels);
   }
+  if (elementCell) *elementCell = std::move(cells);
+  if (elementLevel) *elementLevel = std::move(levels);
   slicer.stats.secondsBuilding = phase.seconds();
   if (stats) *stats = slicer.stats;
+  return mesh;
+}
+
+}  // namespace
+
+PolyMesh sliceSurface(const TriangleSurface& surface, const Grid& grid, SliceStats* stats,
+                      std::vector<std::array<int, 3>>* elementCell, const ProgressFn& progress) {
+  return slice(surface, grid, nullptr, stats, elementCell, nullptr, progress);
+}
+
+PolyMesh sliceSurfaceOctree(const TriangleSurface& surface, const Grid& coarse, int levels,
+                            SliceStats* stats, std::vector<int>* elementLevel,
+                            const ProgressFn& progress) {
+  if (levels < 1 || levels > 10)
+    throw std::invalid_argument("octree slicing needs 1 to 10 levels below the coarse grid");
+  for (int n : coarse.cells)
+    if (n > (1 << 20) >> levels)
+      throw std::invalid_argument(
+          "octree slicing: the finest grid would have more than 2^20 "
+          "cells per axis");
+  const Stopwatch watch;
+  const SurfaceOctree octree(surface, coarse, levels);
+  const double octreeSeconds = watch.seconds();
+  PolyMesh mesh = slice(surface, coarse, &octree, stats, nullptr, elementLevel, progress);
+  if (stats) stats->secondsOctree = octreeSeconds;
   return mesh;
 }
 

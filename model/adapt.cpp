@@ -13,7 +13,6 @@
 #include "physics/solvers/error_estimator.h"
 #include "physics/solvers/static_solver.h"
 #include "polydg/mesh/geometry.h"
-#include "polydg/mesh/slice.h"
 #include "polydg/model/model.h"
 #include "polydg/util/error.h"
 #include "util/stopwatch.h"
@@ -50,112 +49,7 @@ std::vector<ElementId> markByError(const SolveReport& report, const AdaptOptions
   return marked;
 }
 
-/// The plane of `grid` across `axis` strictly inside (lo, hi) nearest their middle, if any.
-/// Computed as Grid::plane() computes the slicing planes, so that a plane of a finer grid that
-/// a coarser one also has is the same number.
-std::optional<Plane> gridPlaneInside(const Grid& grid, int axis, double lo, double hi) {
-  const double middle = 0.5 * (lo + hi);
-  const long j = std::lround((middle - grid.plane(axis, 0)) / grid.cellSize);
-  std::optional<double> best;
-  for (long c = j - 1; c <= j + 1; ++c) {
-    const double x =
-        grid.centre[axis] + (static_cast<double>(c) - 0.5 * grid.cells[axis]) * grid.cellSize;
-    if (x > lo && x < hi && (!best || std::abs(x - middle) < std::abs(*best - middle))) best = x;
-  }
-  if (!best) return std::nullopt;
-  return Plane::axisAligned(axis, *best);
-}
-
-/// `coarse` with cells 2^level times smaller.
-Grid finerGrid(const Grid& coarse, int level) {
-  Grid g = coarse;
-  g.cellSize = std::ldexp(coarse.cellSize, -level);
-  for (int& n : g.cells) n <<= level;
-  return g;
-}
-
 }  // namespace
-
-void refineAtSurface(Model& model, const Grid& coarse, int levels, double sliverFraction,
-                     MeshReport& report) {
-  const Stopwatch watch;
-  std::vector<int> level(model.mesh().numElements(), 0);
-  // Splits `marked` into the octants of their cells (the planes of the grid one level finer
-  // than each) and carries the levels over.
-  auto split = [&](const std::vector<ElementId>& marked, int round) {
-    RefineRequest request;
-    request.sliverFraction = 0.0;  // slivers are merged once, at the finest cell's scale
-    request.checks = CheckLevel::None;
-    std::unordered_set<std::uint32_t> refined;
-    for (ElementId e : marked) {
-      const Grid grid = finerGrid(coarse, level[e.index()] + 1);
-      const Box3 box = elementBounds(model.mesh(), e);
-      std::vector<Plane> planes;
-      for (int axis = 0; axis < 3; ++axis)
-        if (auto p = gridPlaneInside(grid, axis, box.min()[axis], box.max()[axis]))
-          planes.push_back(*p);
-      // An element no plane of the finer grid crosses lies in one of its cells already: it
-      // moves to that level whole.
-      refined.insert(e.value);
-      if (planes.empty()) continue;
-      request.elements.push_back(e);
-      request.planes.push_back(std::move(planes));
-    }
-    if (request.elements.empty()) {
-      for (ElementId e : marked) level[e.index()] += 1;
-      return;
-    }
-    const RefineReport r = model.refine(request);
-    if (!r.operation.check.passed)
-      throw CheckFailure("octree round " + std::to_string(round) + " failed (" +
-                         r.operation.check.failure + ")");
-    level = levelsAfter(level, r.operation.lineage, model.mesh().numElements(), refined);
-  };
-  for (int round = 1; round <= levels; ++round) {
-    const PolyMesh& mesh = model.mesh();
-    std::vector<ElementId> marked;
-    for (std::size_t e = 0; e < mesh.numElements(); ++e) {
-      const auto& uses = mesh.element(ElementId(e)).faces;
-      if (level[e] < round && std::any_of(uses.begin(), uses.end(), [&](const FaceUse& u) {
-            return mesh.face(u.face).origin == FaceOrigin::Surface;
-          }))
-        marked.push_back(ElementId(e));
-    }
-    split(marked, round);
-    // At most one level between face neighbours: split the coarser side until it holds.
-    for (;;) {
-      const PolyMesh& m = model.mesh();
-      std::vector<ElementId> coarser;
-      for (std::size_t e = 0; e < m.numElements(); ++e)
-        for (const FaceUse& use : m.element(ElementId(e)).faces) {
-          const Face& face = m.face(use.face);
-          const ElementId other = use.reversed ? face.front : face.back;
-          if (other.valid() && level[other.index()] > level[e] + 1) {
-            coarser.push_back(ElementId(e));
-            break;
-          }
-        }
-      if (coarser.empty()) break;
-      split(coarser, round);
-    }
-  }
-  if (sliverFraction > 0.0) {
-    MergeRequest merge;
-    merge.fraction = sliverFraction;
-    merge.checks = CheckLevel::None;
-    const OperationReport r = model.mergeSlivers(merge);
-    report.meshing.slivers.slivers += r.slivers;
-    report.meshing.slivers.merged += r.sliversMerged;
-    report.meshing.slivers.isolated += r.isolatedSlivers;
-    level = levelsAfter(level, r.lineage, model.mesh().numElements(), {});
-  }
-  report.levels = levels;
-  report.coarseCellSize = coarse.cellSize;
-  report.elementsPerLevel.assign(static_cast<std::size_t>(levels) + 1, 0);
-  for (int l : level) report.elementsPerLevel[static_cast<std::size_t>(std::min(l, levels))] += 1;
-  report.elementLevels = std::move(level);
-  report.refineSeconds = watch.seconds();
-}
 
 RefineReport Model::refine(const RefineRequest& request) {
   State& s = *state_;

@@ -139,7 +139,7 @@ Model Model::fromSurface(const TriangleSurface& surface, const MeshOptions& opti
   meshing.repair = options.repair;
   meshing.sliverTau = options.sliverFraction;
   // Octree slicing: the grid 2^levels times coarser than the finest cell, with at least two
-  // cells along the longest side; its slivers are merged once, at the finest cell's scale.
+  // cells along the longest side.
   double finest = 0.0;
   int levels = 0;
   if (options.adaptive) {
@@ -152,7 +152,7 @@ Model Model::fromSurface(const TriangleSurface& surface, const MeshOptions& opti
     while (levels < 10 && std::ldexp(finest, levels + 1) * 2.0 <= longest) ++levels;
     meshing.cellSize = std::ldexp(finest, levels);
     meshing.cellsAlongLongest = 0;
-    meshing.sliverTau = 0.0;
+    meshing.octreeLevels = levels;
   }
   meshing.progress = options.progress;
   meshing.checkGeometry = false;  // below, beside the checks and the writing
@@ -167,7 +167,14 @@ Model Model::fromSurface(const TriangleSurface& surface, const MeshOptions& opti
   provenance.referenceKind = ReferenceKind::GridCell;
   provenance.sliverFraction = options.sliverFraction;
   Model model(std::move(meshed.mesh), provenance);
-  if (options.adaptive) refineAtSurface(model, grid, levels, options.sliverFraction, report);
+  if (options.adaptive) {
+    report.levels = levels;
+    report.coarseCellSize = grid.cellSize;
+    report.elementsPerLevel.assign(static_cast<std::size_t>(levels) + 1, 0);
+    for (int l : meshed.elementLevels) report.elementsPerLevel[static_cast<std::size_t>(l)] += 1;
+    report.elementLevels = std::move(meshed.elementLevels);
+    report.refineSeconds = report.meshing.slice.secondsOctree;
+  }
   const PolyMesh& mesh = model.mesh();
 
   // The mesh is validated, DG-checked and written side by side: all three only read it, and

@@ -94,14 +94,6 @@ inline void checkEditOptions(double sliverFraction, int checkDegree) {
     throw InputError("the validation degree must be 1, 2 or 3");
 }
 
-/// Octree slicing (MeshOptions::adaptive, adapt.cpp): `levels` rounds of splitting the elements
-/// of a mesh sliced with `coarse` that the surface passes, and their neighbours more than one
-/// level coarser, into the octants of their cell (planes of the grid `coarse` halved each round);
-/// then slivers below `sliverFraction` of the finest cell are merged. Fills the report's adaptive
-/// fields; throws CheckFailure if a round fails its checks.
-void refineAtSurface(Model& model, const Grid& coarse, int levels, double sliverFraction,
-                     MeshReport& report);
-
 /// Model::solve() with SolveOptions::adapt set (adapt.cpp).
 SolveReport solveAdaptively(Model& model, const SolveOptions& options);
 

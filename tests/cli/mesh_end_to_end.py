@@ -143,9 +143,8 @@ def python(polydg, work):
               report["output"]["elements"])
         equal(name + ": the meshing report's volume, Python's against the CLI's (bits)",
               model.report["output"]["volume"], report["output"]["volume"])
-        # Model.volume is the mesh editor's running sum (octree refinement adds and removes
-        # pieces), the report's the final geometry's: one ulp apart at most (measured 1 ulp on
-        # the octree, 0 on the uniform grid).
+        # Model.volume sums the element volumes, the report's volume is the validation's (its
+        # own sum): one ulp apart at most.
         close(name + ": Model.volume against the CLI's", model.volume,
               report["output"]["volume"], 4e-16)
         # The same file, byte for byte, written from Python.

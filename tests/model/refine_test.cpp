@@ -267,6 +267,11 @@ TEST(ModelRefine, OctreeSlicingFillsTheVolumeWithFewerElements) {
     ASSERT_TRUE(octree.passed()) << octree.failures().front();
     EXPECT_GE(octree.levels, 2);
     EXPECT_LT(a.mesh().numElements(), u.mesh().numElements());
+    // Slivers are measured against the finest cell, as on the uniform grid of that cell.
+    const double finest = std::ldexp(octree.coarseCellSize, -octree.levels);
+    EXPECT_DOUBLE_EQ(octree.meshing.slivers.threshold, uniform.meshing.slivers.threshold);
+    EXPECT_DOUBLE_EQ(octree.meshing.slivers.threshold,
+                     options.sliverFraction * finest * finest * finest);
     std::size_t perLevel = 0;
     for (std::size_t n : octree.elementsPerLevel) perLevel += n;
     EXPECT_EQ(perLevel, a.mesh().numElements());
@@ -291,6 +296,20 @@ TEST(ModelRefine, OctreeSlicingFillsTheVolumeWithFewerElements) {
                          std::abs(signedVolume(m, e) - v) <= 1e-12 * v;
       return whole ? s.x() : 0.0;
     };
+    // Levels as reported, slivers merged: a cube's edge is its level's, and an element at the
+    // surface (merged slivers included) is at the finest level.
+    for (std::size_t e = 0; e < m.numElements(); ++e) {
+      const int level = octree.elementLevels[e];
+      if (const double edge = cube(ElementId(e)); edge > 0.0 && level < octree.levels) {
+        EXPECT_NEAR(edge, std::ldexp(octree.coarseCellSize, -level), 1e-9 * edge);
+      }
+      bool atSurface = false;
+      for (const FaceUse& use : m.element(ElementId(e)).faces)
+        atSurface = atSurface || m.face(use.face).origin == FaceOrigin::Surface;
+      if (atSurface) {
+        EXPECT_EQ(level, octree.levels) << "element " << e;
+      }
+    }
     double worst = 1.0;
     std::size_t checked = 0;
     for (std::size_t i = 0; i < m.numFaces(); ++i) {

@@ -57,6 +57,10 @@ struct MeshingOptions {
   /// for every piece size, B4) while leaving nearly every boundary element as sliced. 0
   /// disables merging.
   double sliverTau = 0.01;
+  /// Octree slicing (sliceSurfaceOctree): 0 slices with the uniform grid of the cell size; L > 0
+  /// takes the cell size for the coarse cells and refines L levels at the surface (slivers
+  /// are then measured against the finest cell).
+  int octreeLevels = 0;
   ProgressFn progress;
   /// Validate the result and count its shapes at the end of meshSurface(). A caller that
   /// overlaps that work with something else (writing the mesh) turns this off and calls
@@ -97,6 +101,9 @@ struct MeshingReport {
 struct MeshingResult {
   PolyMesh mesh;
   MeshingReport report;
+  /// Octree slicing: each element's level (0: a coarse cell, MeshingOptions::octreeLevels: the
+  /// finest); empty for the uniform grid.
+  std::vector<int> elementLevels;
 };
 
 /// Runs the pipeline on a surface as read from a file. Throws InputError for input it refuses

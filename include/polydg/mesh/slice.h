@@ -41,6 +41,7 @@ struct SliceStats {
   std::size_t droppedElements = 0;    ///< elements rounding left flat, alone: left out
   double secondsSplitting = 0.0;      ///< wall time of the recursive plane splits
   double secondsBuilding = 0.0;       ///< wall time of welding and assembling the PolyMesh
+  double secondsOctree = 0.0;         ///< octree slicing: wall time of building the octree
 };
 
 /// Progress callback: fraction done in [0, 1].
@@ -59,5 +60,20 @@ using ProgressFn = std::function<void(double)>;
 PolyMesh sliceSurface(const TriangleSurface& surface, const Grid& grid, SliceStats* stats = nullptr,
                       std::vector<std::array<int, 3>>* elementCell = nullptr,
                       const ProgressFn& progress = {});
+
+/// Octree slicing: as sliceSurface() on the grid with cells 2^levels times smaller than
+/// `coarse`'s (levels 1 .. 10), but only where the surface is. A coarse cell is split into its
+/// octants, and they in turn, down to that finest grid, wherever a cell's closed box meets a
+/// triangle of the surface (an exact test), and wherever a face neighbour would otherwise be
+/// two levels finer (2:1 balance across faces). Cells at the surface are sliced as by
+/// sliceSurface(); the cells the surface does not touch are whole cubes (inside the solid; those
+/// outside are left out), and a cube's face that meets four finer neighbours is four faces, its
+/// edges holding the corners of the finer cells around them, so the mesh is conforming face by
+/// face and the volume is the solid's exactly as with the uniform grid. `elementLevel`
+/// (optional) receives each element's level: 0 for a coarse cell, `levels` for the finest (a
+/// merged element: the finest of its parts').
+PolyMesh sliceSurfaceOctree(const TriangleSurface& surface, const Grid& coarse, int levels,
+                            SliceStats* stats = nullptr, std::vector<int>* elementLevel = nullptr,
+                            const ProgressFn& progress = {});
 
 }  // namespace polydg
