@@ -204,6 +204,16 @@ std::vector<Eigen::Matrix3d> TetDiscretization::domainRotations(
   return out;
 }
 
+double TetDiscretization::volume(const Eigen::VectorXd& x) const {
+  double six = 0.0;
+  for (const auto& c : tets_) {
+    const Eigen::Vector3d o = x.segment<3>(3 * c[0]);
+    six += (x.segment<3>(3 * c[1]) - o)
+               .dot((x.segment<3>(3 * c[2]) - o).cross(x.segment<3>(3 * c[3]) - o));
+  }
+  return six / 6.0;
+}
+
 Eigen::VectorXd TetDiscretization::lumpedMass(double density) const {
   Eigen::VectorXd m = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(numDofs()));
   for (std::size_t t = 0; t < tets_.size(); ++t)

@@ -80,6 +80,8 @@ class TetDiscretization {
   Eigen::VectorXd lumpedMass(double density) const;
   /// The nodal load of a constant body force (force per volume): a quarter of each tet's.
   Eigen::VectorXd bodyForceLoad(const Eigen::Vector3d& force) const;
+  /// The mesh's volume at positions x (node-major): the sum of its tets' signed volumes.
+  double volume(const Eigen::VectorXd& x) const;
   /// The rest positions, node-major.
   const Eigen::VectorXd& restPositions() const { return rest_; }
 

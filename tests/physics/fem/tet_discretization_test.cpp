@@ -9,56 +9,12 @@
 #include <cmath>
 #include <iostream>
 #include <numbers>
-#include <random>
 
 #include "physics/fem/tet_static.h"
+#include "tests/physics/fem/cube_tets.h"
 
 namespace polydg {
 namespace {
-
-/// The unit cube [0, L]^3 in n^3 cubes of six tets each (Kuhn's split along the main
-/// diagonal: conforming), interior nodes moved by up to `distortion` times the spacing along each
-/// axis (seeded), boundary nodes on the boundary.
-TetMesh cubeTets(int n, double length = 1.0, double distortion = 0.0, unsigned seed = 7) {
-  TetMesh mesh;
-  const double h = length / n;
-  std::mt19937 random(seed);
-  std::uniform_real_distribution<double> shift(-distortion * h, distortion * h);
-  auto id = [&](int i, int j, int k) {
-    return static_cast<std::uint32_t>(i + (n + 1) * (j + (n + 1) * k));
-  };
-  for (int k = 0; k <= n; ++k)
-    for (int j = 0; j <= n; ++j)
-      for (int i = 0; i <= n; ++i) {
-        Vec3 p(i * h, j * h, k * h);
-        const bool interior = i > 0 && i < n && j > 0 && j < n && k > 0 && k < n;
-        if (interior && distortion > 0.0) p += Vec3(shift(random), shift(random), shift(random));
-        mesh.vertices.push_back(p);
-      }
-  // The six tets of a cube: paths from corner 0 to corner 7 through one corner of each kind.
-  static constexpr int kPaths[6][2] = {{1, 3}, {1, 5}, {2, 3}, {2, 6}, {4, 5}, {4, 6}};
-  for (int k = 0; k < n; ++k)
-    for (int j = 0; j < n; ++j)
-      for (int i = 0; i < n; ++i) {
-        auto corner = [&](int c) { return id(i + (c & 1), j + (c >> 1 & 1), k + (c >> 2)); };
-        for (const auto& path : kPaths) {
-          std::array<std::uint32_t, 4> t{corner(0), corner(path[0]), corner(path[1]), corner(7)};
-          TetMesh one{mesh.vertices, {t}};
-          if (sixVolume(one, 0) < 0) std::swap(t[2], t[3]);
-          mesh.tets.push_back(t);
-        }
-      }
-  return mesh;
-}
-
-std::vector<std::uint32_t> boundaryNodes(const TetMesh& mesh, double length) {
-  std::vector<std::uint32_t> out;
-  for (std::size_t v = 0; v < mesh.numVertices(); ++v) {
-    const Vec3& p = mesh.vertices[v];
-    if (p.minCoeff() == 0.0 || p.maxCoeff() == length) out.push_back(static_cast<std::uint32_t>(v));
-  }
-  return out;
-}
 
 constexpr TetMethod kMethods[] = {TetMethod::Fem, TetMethod::FsFem};
 const char* name(TetMethod m) { return m == TetMethod::Fem ? "FEM" : "FS-FEM"; }
