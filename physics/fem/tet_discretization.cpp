@@ -228,4 +228,23 @@ Eigen::VectorXd TetDiscretization::bodyForceLoad(const Eigen::Vector3d& force) c
   return f;
 }
 
+Eigen::VectorXd TetDiscretization::bodyForceFieldLoad(
+    const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& force) const {
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(numDofs()));
+  // The points at barycentric (a, b, b, b) and its permutations, weights a quarter each.
+  const double a = 0.5854101966249685, b = 0.1381966011250105;
+  for (std::size_t t = 0; t < tets_.size(); ++t) {
+    const auto& c = tets_[t];
+    for (int q = 0; q < 4; ++q) {
+      Eigen::Vector4d bary = Eigen::Vector4d::Constant(b);
+      bary[q] = a;
+      Eigen::Vector3d x = Eigen::Vector3d::Zero();
+      for (int k = 0; k < 4; ++k) x += bary[k] * rest_.segment<3>(3 * c[k]);
+      const Eigen::Vector3d value = force(x);
+      for (int k = 0; k < 4; ++k) f.segment<3>(3 * c[k]) += 0.25 * tetVolumes_[t] * bary[k] * value;
+    }
+  }
+  return f;
+}
+
 }  // namespace polydg

@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -80,6 +81,10 @@ class TetDiscretization {
   Eigen::VectorXd lumpedMass(double density) const;
   /// The nodal load of a constant body force (force per volume): a quarter of each tet's.
   Eigen::VectorXd bodyForceLoad(const Eigen::Vector3d& force) const;
+  /// The consistent nodal load of a body force field f(x): int f N_a over each tet by the
+  /// 4-point rule exact for quadratics (Keast's degree-2 rule).
+  Eigen::VectorXd bodyForceFieldLoad(
+      const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& force) const;
   /// The mesh's volume at positions x (node-major): the sum of its tets' signed volumes.
   double volume(const Eigen::VectorXd& x) const;
   /// The rest positions, node-major.

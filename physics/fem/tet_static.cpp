@@ -18,11 +18,13 @@ TetStaticSolution solveTetStatic(const TetDiscretization& discretization,
   // Prescribed displacements on the clamped nodes; the free DOFs numbered in order.
   Eigen::VectorXd u = Eigen::VectorXd::Zero(n);
   std::vector<char> held(static_cast<std::size_t>(n), 0);
-  const Eigen::VectorXd& rest = discretization.restPositions();
+  if (problem.prescribed.size() != 0 && problem.prescribed.size() != n)
+    throw std::invalid_argument("prescribed displacements must be given for every node");
   for (std::uint32_t v : problem.clamped) {
+    if (3 * static_cast<Eigen::Index>(v) + 2 >= n)
+      throw std::invalid_argument("a clamped node is not a node of the mesh");
     for (int c = 0; c < 3; ++c) held[3 * v + c] = 1;
-    if (problem.clampDisplacement)
-      u.segment<3>(3 * v) = problem.clampDisplacement(rest.segment<3>(3 * v));
+    if (problem.prescribed.size() == n) u.segment<3>(3 * v) = problem.prescribed.segment<3>(3 * v);
   }
   std::vector<Eigen::Index> freeIndex(static_cast<std::size_t>(n), -1);
   Eigen::Index free = 0;

@@ -3,7 +3,6 @@
 // DG solves' linear solver (CHOLMOD, or CG on large systems).
 #pragma once
 
-#include <functional>
 #include <vector>
 
 #include "physics/fem/tet_discretization.h"
@@ -17,9 +16,10 @@ struct TetStaticProblem {
   Eigen::Vector3d bodyForce = Eigen::Vector3d::Zero();
   /// Node-major nodal forces (empty: none).
   Eigen::VectorXd nodalForces;
-  /// Nodes held, and the displacement each is given (unset: zero) from its rest position.
+  /// Nodes held, and the displacements they are given (node-major, read at the held nodes;
+  /// empty: zero).
   std::vector<std::uint32_t> clamped;
-  std::function<Eigen::Vector3d(const Eigen::Vector3d&)> clampDisplacement;
+  Eigen::VectorXd prescribed;
 };
 
 struct TetStaticSolution {

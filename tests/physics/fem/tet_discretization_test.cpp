@@ -30,9 +30,9 @@ TEST(TetFem, PatchTestReproducesAnAffineDisplacementOnDistortedTets) {
     TetStaticProblem problem;
     problem.material = {1000.0, 0.3, 1.0};
     problem.clamped = boundaryNodes(mesh, 1.0);
-    problem.clampDisplacement = [&](const Eigen::Vector3d& x) -> Eigen::Vector3d {
-      return a * x + b;
-    };
+    problem.prescribed.resize(static_cast<Eigen::Index>(3 * mesh.numVertices()));
+    for (std::size_t v = 0; v < mesh.numVertices(); ++v)
+      problem.prescribed.segment<3>(3 * v) = a * mesh.vertices[v] + b;
     const TetStaticSolution s = solveTetStatic(d, problem);
     double worst = 0.0;
     for (std::size_t v = 0; v < mesh.numVertices(); ++v)
@@ -104,25 +104,6 @@ struct SmoothProblem {
   }
 };
 
-/// The consistent load of a smooth body force: each tet's four-point rule (degree 2).
-Eigen::VectorXd smoothLoad(const TetMesh& mesh, const SmoothProblem& p) {
-  Eigen::VectorXd f = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(3 * mesh.numVertices()));
-  const double a = 0.5854101966249685, b = 0.1381966011250105;
-  for (std::size_t t = 0; t < mesh.numTets(); ++t) {
-    const auto& c = mesh.tets[t];
-    const double volume = sixVolume(mesh, t) / 6.0;
-    for (int q = 0; q < 4; ++q) {
-      Eigen::Vector4d bary = Eigen::Vector4d::Constant(b);
-      bary[q] = a;
-      Eigen::Vector3d x = Eigen::Vector3d::Zero();
-      for (int k = 0; k < 4; ++k) x += bary[k] * mesh.vertices[c[k]];
-      const Eigen::Vector3d force = p.force(x);
-      for (int k = 0; k < 4; ++k) f.segment<3>(3 * c[k]) += 0.25 * volume * bary[k] * force;
-    }
-  }
-  return f;
-}
-
 TEST(TetFem, ConvergesAtSecondOrderOnASmoothSolution) {
   const SmoothProblem problem;
   double finest[2];
@@ -134,7 +115,8 @@ TEST(TetFem, ConvergesAtSecondOrderOnASmoothSolution) {
       const TetDiscretization d(mesh, method);
       TetStaticProblem p;
       p.material = problem.material;
-      p.nodalForces = smoothLoad(mesh, problem);
+      p.nodalForces =
+          d.bodyForceFieldLoad([&](const Eigen::Vector3d& x) { return problem.force(x); });
       p.clamped = boundaryNodes(mesh, 1.0);
       const TetStaticSolution s = solveTetStatic(d, p);
       // The nodal L2 error, weighted by the lumped mass.
