@@ -1,6 +1,6 @@
 // Tetrahedral meshes for the tet methods (linear and corotational FEM, face-based smoothed FEM):
-// vertices and 4-node tetrahedra, checked, and turned into a PolyMesh of tetrahedral elements for
-// the DG methods.
+// vertices and 4-node tetrahedra, read from VTU (VTK_TETRA), TetGen (.node/.ele) or Gmsh MSH 4.1,
+// checked, and turned into a PolyMesh of tetrahedral elements for the DG methods.
 #pragma once
 
 #include <array>
@@ -29,6 +29,25 @@ double sixVolume(const TetMesh& mesh, std::size_t t);
 /// normal (right-hand rule) points out of a positively oriented tet: VTK's vtkTetra faces.
 inline constexpr std::array<std::array<int, 3>, 4> kTetFaces = {
     {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}}};
+
+/// Reads a tet mesh, choosing the format by the extension (case-insensitive):
+///  - .vtu: a VTK XML UnstructuredGrid whose cells are all VTK_TETRA (type 10), in any encoding
+///    polydg's VTU reader takes (ascii, inline base64 binary, appended raw or base64; zlib
+///    compression; UInt32 or UInt64 headers; either byte order). Tets are cells in file order.
+///  - .ele: TetGen's FILE.ele with its sibling FILE.node. Indices start at the first .node
+///    index (0 or 1) and run on without gaps in both files; '#' starts a comment; 10-node tets
+///    give their first 4 nodes (the corners). Tets are in file order.
+///  - .msh: Gmsh MSH 4.1 ASCII. Tets are the elements of type 4 (4 nodes) and 11 (10 nodes; the
+///    first 4 are the corners) in file order; points, lines, triangles and quadrangles are
+///    ignored, other 3D elements refused. Binary files and other versions are refused.
+/// Vertices are the points (nodes) that some tet uses, in file order; unused ones are dropped
+/// (a vertex without a tet would leave the FEM's matrices singular). A tet the file gives with
+/// negative orientation has its last two corners swapped, so that files of either convention
+/// read alike (TetGen 1.5 and Gmsh 4.8 write positive tets, hand-made files may not); every
+/// other corner order is kept. The result has passed checkTetMesh.
+/// Throws InputError with one line "FILE[:LINE]: what is wrong; what to do" that names the
+/// element by its number in the file (a TetGen index, a Gmsh element tag, a VTU cell index).
+TetMesh readTetMesh(const std::string& path);
 
 /// Checks that `mesh` is a conforming tet mesh, and throws InputError naming the first problem
 /// ("tet T ..." with T its index in mesh.tets; first in order of the checks, then of T):
