@@ -1,6 +1,6 @@
 // Tests of polydg/mesh/tet_mesh.h: tet meshes written by small writers here (VTU in three
-// encodings, TetGen with index base 0 and 1, Gmsh MSH 4.1) read back alike; the checks and
-// conversion to a PolyMesh; and each refusal naming the element at fault.
+// encodings, TetGen with index base 0 and 1, Gmsh MSH 4.1) and by the real tools (testdata/),
+// read back alike; conversion to a PolyMesh; and each refusal naming the element at fault.
 #include "polydg/mesh/tet_mesh.h"
 
 #include <unistd.h>
@@ -572,6 +572,21 @@ TEST_F(TetMeshRead, GmshNonContiguousTagsMixedElementsAndTenNodeTets) {
     const TetMesh read = readTetMesh(file("scrambled.msh", text).string());
     EXPECT_EQ(read.vertices, cubes.vertices);
     expectSameTets(cubes, read);
+  }
+}
+
+TEST_F(TetMeshRead, ReadsFilesMadeByTetgenAndGmsh) {
+  // testdata/cube_tets.*: the unit cube meshed by TetGen 1.5 and Gmsh 4.8 (how to make them
+  // again is in cube_tets.poly and cube_tets.geo).
+  const std::string data = POLYDG_TESTDATA_DIR;
+  for (const std::string name : {"cube_tets.1.ele", "cube_tets.msh"}) {
+    SCOPED_TRACE(name);
+    const TetMesh mesh = readTetMesh(data + "/" + name);
+    EXPECT_GT(mesh.numTets(), 20u);
+    EXPECT_NEAR(volume(mesh), 1.0, kVolumeTolerance);
+    const GeometryCheck check = checkGeometry(toPolyMesh(mesh));
+    EXPECT_TRUE(check.passed) << (check.messages.empty() ? "" : check.messages[0]);
+    EXPECT_NEAR(check.volume, 1.0, kVolumeTolerance);
   }
 }
 
