@@ -263,6 +263,15 @@ TetMesh readTetgen(const std::string& elePath) {
 constexpr const char* kToMsh41 =
     "convert it with 'gmsh FILE -save -format msh41 -o OUT.msh' (ASCII unless -bin is given)";
 
+/// Reads the line that closes a section, `marker` ("$EndNodes"), which must follow `after`.
+void expectEnd(TextLines& in, const std::string& marker, const std::string& after) {
+  in.require("'" + marker + "'");
+  if (in.words()[0] != marker)
+    in.fail("expected '" + marker + "' after " + after + ", found " +
+            surface_text::quoted(in.words()[0]) +
+            "; a count in the section is wrong or the file is damaged: write it again");
+}
+
 /// Skips to the line "$End<name>" of the section `name` ("$Comments" ...).
 void skipSection(TextLines& in, std::string_view name) {
   const std::string end = "$End" + std::string(name.substr(1));
@@ -279,8 +288,7 @@ void readMeshFormat(TextLines& in) {
   if (in.words()[1] != "0")
     in.fail("a binary MSH file (file-type " + surface_text::quoted(in.words()[1]) +
             "); polydg reads MSH 4.1 ASCII only: " + kToMsh41);
-  in.require("'$EndMeshFormat'");
-  if (in.words()[0] != "$EndMeshFormat") in.fail("expected '$EndMeshFormat'");
+  expectEnd(in, "$EndMeshFormat", "the format line");
 }
 
 /// The points of $Nodes in file order, their tags, and each tag's point.
@@ -326,8 +334,7 @@ GmshNodes readNodes(TextLines& in) {
   if (nodes.tags.size() != static_cast<std::size_t>(count))
     in.fail("$Nodes announces " + std::to_string(count) + " nodes but its blocks hold " +
             std::to_string(nodes.tags.size()) + "; fix the count");
-  in.require("'$EndNodes'");
-  if (in.words()[0] != "$EndNodes") in.fail("expected '$EndNodes' after the nodes");
+  expectEnd(in, "$EndNodes", "the nodes");
   return nodes;
 }
 
@@ -376,8 +383,7 @@ void readElements(TextLines& in, const GmshNodes& nodes, std::vector<Tet>& tets,
   if (seen != count)
     in.fail("$Elements announces " + std::to_string(count) + " elements but its blocks hold " +
             std::to_string(seen) + "; fix the count");
-  in.require("'$EndElements'");
-  if (in.words()[0] != "$EndElements") in.fail("expected '$EndElements' after the elements");
+  expectEnd(in, "$EndElements", "the elements");
 }
 
 TetMesh readGmsh(const std::string& path) {

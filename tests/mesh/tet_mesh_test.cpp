@@ -731,6 +731,12 @@ TEST_F(TetMeshRead, RefusesBadFieldsAndCounts) {
   expectMentions(readError(ele), {"fields.node:3: node 2: y 'nan' is not a number; fix it"});
   fs::remove(dir_ / "fields.node");
   expectMentions(readError(ele), {"fields.node: cannot open"});
+  // One element more than the $Elements header counts.
+  std::string msh = mshText(cubes);
+  msh.insert(msh.find("$EndElements"), "49 1 2 3 4\n");
+  expectMentions(
+      readError(file("extra.msh", msh)),
+      {"extra.msh:", "expected '$EndElements' after the elements, found '49'", "write it again"});
 }
 
 TEST_F(TetMeshRead, RefusesBinaryAndOtherMshVersions) {
