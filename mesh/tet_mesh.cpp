@@ -1,3 +1,5 @@
+// TetMesh's volume and its conversion to a PolyMesh (polydg/mesh/tet_mesh.h); reading is in
+// tet_mesh_io.cpp, checking in tet_mesh_check.cpp.
 #include "polydg/mesh/tet_mesh.h"
 
 namespace polydg {
@@ -7,6 +9,23 @@ double sixVolume(const TetMesh& mesh, std::size_t t) {
   // About the first corner, so that the volume does not lose digits far from the origin.
   const Vec3& o = mesh.vertices[c[0]];
   return (mesh.vertices[c[1]] - o).dot((mesh.vertices[c[2]] - o).cross(mesh.vertices[c[3]] - o));
+}
+
+PolyMesh toPolyMesh(const TetMesh& mesh) {
+  PolyMesh out;
+  out.reserve(mesh.numVertices(), 2 * mesh.numTets() + 2, mesh.numTets());
+  for (const Vec3& p : mesh.vertices) out.addVertex(p);
+  const std::uint32_t loopEnd[1] = {3};
+  for (const auto& c : mesh.tets) {
+    FaceList uses;
+    for (const auto& f : kTetFaces) {
+      const VertexId corners[3] = {VertexId(c[f[0]]), VertexId(c[f[1]]), VertexId(c[f[2]])};
+      // A face is created as Surface and becomes Interior when the neighbour takes its back.
+      uses.push_back(out.findOrCreateFace(corners, loopEnd, FaceOrigin::Surface));
+    }
+    out.addElementFromFaces(uses);
+  }
+  return out;
 }
 
 }  // namespace polydg
