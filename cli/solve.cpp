@@ -10,13 +10,20 @@
 //       another)
 //   polydg solve bar.vtu -o bar_adapted.vtu --clamp x=0 --traction x=9:0,0,-1 --adapt
 //       --target-error 0.05 --max-dofs 200000   (solve, estimate, mark, refine; one line)
+//   polydg solve beam.msh -o beam_out.vtu --method fs-fem --clamp x=0 --gravity 0,0,-9.81
+//       (a tet mesh from Gmsh, TetGen's .ele or a VTU of tets, by the face-based smoothed FEM)
 #include <filesystem>
 #include <iostream>
+#include <optional>
 
 #include "cli/commands.h"
 #include "cli/options.h"
 #include "mesh/vtp_io.h"
 #include "model/files.h"
+#include "model/tet_solve.h"
+#include "polydg/mesh/tet_mesh.h"
+#include "polydg/mesh/vtu_io.h"
+#include "polydg/model/names.h"
 #include "polydg/model/report_json.h"
 #include "util/stopwatch.h"
 
@@ -26,8 +33,10 @@ namespace {
 
 struct SolveCommandOptions {
   std::string input, output, report;
-  std::string surfaceOutput, embed;  ///< --surface, --embed
-  bool adapt = false;                ///< --adapt
+  std::string method = "ip";             ///< --method: a DG method (methodNames) or a tet method
+  std::vector<std::string> dgOnlyGiven;  ///< DG options given with a tet method
+  std::string surfaceOutput, embed;      ///< --surface, --embed
+  bool adapt = false;                    ///< --adapt
   AdaptOptions adaptOptions;
   SolveOptions solve = [] {
     SolveOptions s;
@@ -36,13 +45,83 @@ struct SolveCommandOptions {
   }();
 };
 
-void run(const SolveCommandOptions& o, const CommonOptions& common) {
-  if (!isVolumeMeshPath(o.input))
-    throw InputError(o.input +
-                     ": solve reads simulation meshes (.vtu); make one with 'polydg mesh'");
+/// What every solve needs before it reads: a .vtu output that is not the input (nor is the
+/// report), and something that holds the body.
+void checkOutputsAndClamps(const SolveCommandOptions& o) {
   if (!isVolumeMeshPath(o.output)) throw InputError(o.output + ": the output must be a .vtu file");
   requireDistinct(o.output, o.input);
   if (!o.report.empty()) requireDistinct(o.report, o.input);
+  if (o.solve.clamps.empty())
+    throw InputError(
+        "nothing holds the body: add at least one --clamp, --clamp-plane, "
+        "--clamp-below or --clamp-box");
+}
+
+/// The tet methods' names (physics/fem/), beside methodNames()'s DG ones.
+std::optional<TetMethod> tetMethod(const std::string& name) {
+  if (name == "fem") return TetMethod::Fem;
+  if (name == "fs-fem") return TetMethod::FsFem;
+  return std::nullopt;
+}
+
+/// --method fem|fs-fem: the tet mesh solved by solveOnTets, written with its displacement.
+void runOnTets(const SolveCommandOptions& o, TetMethod method, const CommonOptions& common) {
+  if (!o.dgOnlyGiven.empty())
+    throw InputError(o.dgOnlyGiven.front() +
+                     " is an option of the DG methods (ip, bz), not of "
+                     "--method " +
+                     o.method + "; leave it out");
+  const std::string ext = std::filesystem::path(o.input).extension().string();
+  if (ext != ".vtu" && ext != ".ele" && ext != ".msh")
+    throw InputError(o.input + ": --method " + o.method +
+                     " reads tet meshes (.vtu of tets, TetGen .ele, Gmsh .msh)");
+  checkOutputsAndClamps(o);
+  const Stopwatch read;
+  const TetMesh mesh = readTetMesh(o.input);
+  const double readSeconds = read.seconds();
+  const TetSolveReport r = solveOnTets(mesh, method, o.solve);
+  const Stopwatch write;
+  PointArray displacement{
+      "displacement", 3,
+      std::vector<double>(r.displacement.data(), r.displacement.data() + r.dofs)};
+  writeVtu(toPolyMesh(mesh), o.output, {}, {}, {displacement});
+  const double writeSeconds = write.seconds();
+  if (!o.report.empty()) {
+    nlohmann::json j{{"command", "solve"},
+                     {"input", o.input},
+                     {"output", o.output},
+                     {"method", toString(method)},
+                     {"nodes", r.nodes},
+                     {"tets", r.tets},
+                     {"dofs", r.dofs},
+                     {"held_nodes", r.heldNodes},
+                     {"energy", r.energy},
+                     {"max_displacement", r.maxDisplacement},
+                     {"solver",
+                      {{"used", toString(r.solver.used)},
+                       {"iterations", r.solver.iterations},
+                       {"residual", r.solver.residual}}},
+                     {"timings_s",
+                      {{"read", readSeconds},
+                       {"assemble", r.assembleSeconds},
+                       {"solve", r.solveSeconds},
+                       {"write", writeSeconds}}}};
+    writeJsonFile(o.report, j);
+  }
+  if (!common.quiet)
+    std::cout << o.input << ": " << toString(method) << ", " << r.tets << " tets, " << r.dofs
+              << " DOFs (" << r.heldNodes << " nodes held), " << toString(r.solver.used)
+              << " (residual " << r.solver.residual << ")\n  assemble " << r.assembleSeconds
+              << " s, solve " << r.solveSeconds << " s; max |u| " << r.maxDisplacement
+              << ", energy " << r.energy << "\n  wrote " << o.output << '\n';
+}
+
+void run(const SolveCommandOptions& o, const CommonOptions& common) {
+  if (const std::optional<TetMethod> tets = tetMethod(o.method)) return runOnTets(o, *tets, common);
+  if (!isVolumeMeshPath(o.input))
+    throw InputError(o.input +
+                     ": solve reads simulation meshes (.vtu); make one with 'polydg mesh'");
+  checkOutputsAndClamps(o);
   if (!o.embed.empty() && o.surfaceOutput.empty())
     throw InputError("--embed names the surface --surface writes: add --surface OUT.vtp");
   if (!o.surfaceOutput.empty()) {
@@ -51,10 +130,6 @@ void run(const SolveCommandOptions& o, const CommonOptions& common) {
     requireDistinct(o.surfaceOutput, o.input);
     if (!o.embed.empty()) requireDistinct(o.surfaceOutput, o.embed);
   }
-  if (o.solve.clamps.empty())
-    throw InputError(
-        "nothing holds the body: add at least one --clamp, --clamp-plane, "
-        "--clamp-below or --clamp-box");
   ReadReport read;
   Model model = Model::read(o.input, &read);
   SolveOptions options = o.solve;
@@ -138,12 +213,26 @@ void addSolveCommand(CLI::App& app, const CommonOptions& common, int& exitCode) 
   auto o = std::make_shared<SolveCommandOptions>();
   SolveOptions& s = o->solve;
   CLI::App* cmd = app.add_subcommand(
-      "solve", "Static linear elasticity on a simulation mesh with DG (IP or BZ)");
-  cmd->add_option("mesh", o->input, "simulation mesh (.vtu)")->required()->check(CLI::ExistingFile);
+      "solve",
+      "Static linear elasticity on a simulation mesh with DG (IP or BZ), or on a tet mesh with "
+      "linear FEM or FS-FEM");
+  cmd->add_option("mesh", o->input,
+                  "simulation mesh (.vtu); for --method fem or fs-fem a tet mesh (.vtu, .ele, "
+                  ".msh)")
+      ->required()
+      ->check(CLI::ExistingFile);
   cmd->add_option("-o,--output", o->output, "output mesh with displacement and stress (.vtu)")
       ->required();
   DiscretizationOptions& d = s.discretization;
-  addChoice(*cmd, "--method", d.method, methodNames(), "DG method (interior penalty or BZ)");
+  std::vector<std::string> methods;
+  for (const auto& [name, method] : methodNames()) methods.push_back(name);
+  methods.insert(methods.end(), {"fem", "fs-fem"});
+  cmd->add_option("--method", o->method,
+                  "the method: DG on any simulation mesh (ip: interior penalty, bz), or on a tet "
+                  "mesh (.vtu of tets, TetGen .ele, Gmsh .msh) linear FEM (fem) or the "
+                  "face-based smoothed FEM (fs-fem)")
+      ->check(CLI::IsMember(methods))
+      ->capture_default_str();
   addChoice(*cmd, "--bz-penalty", d.bzPenalty, bzPenaltyNames(),
             "--method bz: the superpenalty ~h^-(2p+1) (super: converges at rate >= p, stiffer "
             "system) or a penalty ~1/h (fixed: cheap, but its error does not fall with h)",
@@ -218,7 +307,15 @@ void addSolveCommand(CLI::App& app, const CommonOptions& common, int& exitCode) 
   cmd->add_option("--embed", o->embed,
                   "the surface --surface carries (default: the one the mesh was sliced from)")
       ->check(CLI::ExistingFile);
-  cmd->callback([o, &common, &exitCode] {
+  cmd->callback([o, cmd, &common, &exitCode] {
+    if (tetMethod(o->method)) {
+      for (const char* name :
+           {"--degree", "--bz-penalty", "--penalty", "--eta", "--adapt", "--surface", "--embed"})
+        if (cmd->count(name) > 0) o->dgOnlyGiven.push_back(name);
+    } else {
+      for (const auto& [name, method] : methodNames())
+        if (name == o->method) o->solve.discretization.method = method;
+    }
     run(*o, common);
     exitCode = 0;
   });

@@ -102,7 +102,7 @@ TEST_F(Commands, NonFiniteAndOutOfRangeValuesNameTheirOption) {
   expectRefused(runPolydg(solve + "--clamp x=0 --gravity 0,0,nan"), "--gravity");
   expectRefused(runPolydg(solve + "--clamp x=0 --traction x=1:0,0"), "--traction");
   expectRefused(runPolydg(solve + "--clamp x=0 --eta inf"), "--eta");
-  expectRefused(runPolydg(solve + "--clamp x=0 --method fem"), "--method");
+  expectRefused(runPolydg(solve + "--clamp x=0 --method sfem"), "--method");
   // The material's and the discretization's own checks, named by the option.
   expectRefused(runPolydg(solve + "--clamp x=0 --E 0"),
                 "Young's modulus must be a positive number");

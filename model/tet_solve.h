@@ -1,0 +1,34 @@
+// A static solve on a tet mesh with the tet methods (linear FEM, FS-FEM; physics/fem/), taking
+// the same options as the DG solve: material, clamps, prescribed displacements, tractions,
+// gravity and body force. `polydg solve --method fem|fs-fem` runs it.
+#pragma once
+
+#include <Eigen/Dense>
+
+#include "physics/fem/tet_discretization.h"
+#include "polydg/model/model.h"
+
+namespace polydg {
+
+struct TetSolveReport {
+  TetMethod method = TetMethod::Fem;
+  std::size_t nodes = 0, tets = 0, dofs = 0, heldNodes = 0, nonzeros = 0;
+  Eigen::VectorXd displacement;  ///< node-major
+  double maxDisplacement = 0.0;
+  double energy = 0.0;  ///< strain energy u^T K u / 2
+  LinearSolveReport solver;
+  double assembleSeconds = 0.0, solveSeconds = 0.0;
+};
+
+/// Solves on `mesh`: a node is held by a clamp or a prescribed displacement when a selected
+/// boundary face has it as a corner (a node two conditions hold takes the last one's value); a
+/// traction adds a third of each selected face's force to each of its corners; gravity and the
+/// body force are integrated over the tets. The DG discretization options (degree, penalty, the
+/// estimate, adaptivity, an exact solution) do not apply and are refused if set away from their
+/// defaults. Throws InvalidOption for bad options, InputError when nothing is held.
+TetSolveReport solveOnTets(const TetMesh& mesh, TetMethod method, const SolveOptions& options);
+
+/// "fem", "fs-fem".
+const char* toString(TetMethod method);
+
+}  // namespace polydg
