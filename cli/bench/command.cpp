@@ -63,6 +63,7 @@ void runBench(BenchOptions o, const CommonOptions& common) {
     timed("adaptivity", [&] { return bench::adaptivitySuite(o, common.quiet); });
   if (all || o.suite == "multigrid")
     timed("multigrid", [&] { return bench::multigridSuite(o, common.quiet); });
+  if (all || o.suite == "sfem") timed("sfem", [&] { return bench::sfemSuite(o, common.quiet); });
   if (!common.quiet && all) std::cout << "all suites: " << total.seconds() << " s" << std::endl;
 }
 
@@ -75,14 +76,14 @@ void addBenchCommand(CLI::App& app, const CommonOptions& common, int& exitCode) 
       "Benchmark suites as JSON, CSV and SVG plots: accuracy (B1), table41 (B2), "
       "stability (B4), meshing, cutting, dynamics (B6, B7, time per step), contact (B9, "
       "embedding and collision speed), adaptivity (B11, B12), multigrid (CG iterations on real "
-      "models), or all");
-  cmd->add_option(
-         "--suite", o->suite,
-         "accuracy, table41, stability, meshing, cutting, dynamics, contact, adaptivity, multigrid "
-         "or all")
+      "models), sfem (the tet methods beside DG), or all");
+  cmd->add_option("--suite", o->suite,
+                  "accuracy, table41, stability, meshing, cutting, dynamics, contact, adaptivity, "
+                  "multigrid, "
+                  "sfem or all")
       ->required()
       ->check(CLI::IsMember({"accuracy", "table41", "stability", "meshing", "cutting", "dynamics",
-                             "contact", "adaptivity", "multigrid", "all"}));
+                             "contact", "adaptivity", "multigrid", "sfem", "all"}));
   cmd->add_option("--out", o->out, "folder for NAME.json, NAME.csv and NAME*.svg")->required();
   cmd->add_flag("--skip-sliced", o->skipSliced, "accuracy: hex grids only");
   cmd->add_flag("--quick", o->quick,

@@ -38,6 +38,10 @@
 //              polygon, IP at p = 1, 2, clamped at the bottom under gravity (B2's material),
 //              beside B2 on the unit cube of about as many elements: DOFs, iterations and their
 //              ratio to the cube's, setup and solve time.
+//   sfem       the tet methods beside DG (Zhang et al. 2017 section 5): the cubic cantilever under
+//              pressure on 625 tets distorted by alpha = 0 .. 0.4 (L-FEM, LFS-FEM, IP p = 1, 2
+//              on the tets; IP p = 3 on 12^3 hexahedra the reference), and the falling beam's
+//              volume (1,440 tets; L-FEM, LFS-FEM, C-FEM, CS-FEM).
 // With `quick` each runs reduced sizes (a smoke test of every output, as the tests run it).
 #pragma once
 
@@ -67,5 +71,6 @@ SuiteOutput dynamicsSuite(const BenchOptions& options, bool quiet);
 SuiteOutput contactSuite(const BenchOptions& options, bool quiet);
 SuiteOutput adaptivitySuite(const BenchOptions& options, bool quiet);
 SuiteOutput multigridSuite(const BenchOptions& options, bool quiet);
+SuiteOutput sfemSuite(const BenchOptions& options, bool quiet);
 
 }  // namespace polydg::bench

@@ -14,6 +14,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -323,6 +324,38 @@ TEST(BenchCommand, ContactSuiteDetectsContactAndKeepsEnergyFromGrowing) {
         "com_z", "weight_nonzeros", "query_seconds"})
     EXPECT_NE(header.find(column), std::string::npos) << column;
   if (files.scratch) fs::remove_all(dir);
+}
+
+TEST(BenchCommand, SfemSuiteShowsThePapersFindings) {
+  // Quick sizes: the pressure cantilever on 625 tets against IP p = 3 on 4^3 hexahedra, the
+  // falling beam on 360 tets for 0.5 s. Zhang et al.'s findings: the smoothed strain is
+  // softer and more accurate than linear FEM at every distortion, and less sensitive to it;
+  // warping keeps the falling beam's volume, linear forces inflate it.
+  const SuiteFiles files = quickSuite("sfem");
+  ASSERT_TRUE(files.ok);
+  for (const char* file : {"sfem.json", "sfem.csv", "sfem_pressure.svg"})
+    EXPECT_TRUE(fs::exists(files.dir / file)) << file;
+  std::ifstream in(files.dir / "sfem.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  std::map<std::string, std::map<double, double>> error, energy;
+  for (const auto& run : j["pressure"]["runs"]) {
+    error[run["method"]][run["alpha"]] = run["energy_error"].get<double>();
+    energy[run["method"]][run["alpha"]] = run["energy"].get<double>();
+  }
+  ASSERT_EQ(error["L-FEM"].size(), 5u);
+  const double reference = j["pressure"]["reference"]["energy"].get<double>();
+  for (const auto& [alpha, e] : error["L-FEM"]) {
+    EXPECT_LT(error["LFS-FEM"][alpha], e) << "alpha " << alpha;
+    EXPECT_GT(energy["LFS-FEM"][alpha], energy["L-FEM"][alpha]) << "alpha " << alpha;
+    EXPECT_LT(energy["L-FEM"][alpha], reference) << "alpha " << alpha;  // FEM is too stiff
+  }
+  EXPECT_LT(error["LFS-FEM"][0.4] - error["LFS-FEM"][0.0],
+            error["L-FEM"][0.4] - error["L-FEM"][0.0]);
+  std::map<std::string, double> volume;
+  for (const auto& run : j["rotation"]) volume[run["method"]] = run["largest_volume_change"];
+  for (const char* linear : {"L-FEM", "LFS-FEM"})
+    for (const char* warped : {"C-FEM", "CS-FEM"})
+      EXPECT_GT(volume[linear], 10 * volume[warped]) << linear << " against " << warped;
 }
 
 TEST(BenchCommand, AdaptivitySuiteRefinesWhereItShould) {

@@ -1,0 +1,240 @@
+// The sfem suite (Zhang et al. 2017, section 5): the tet methods (physics/fem/) side by side
+// with DG on the paper's meshes, boxes of cubes split into five tets:
+//  1. Distortion under pressure: the unit cubic cantilever (5^3 cubes: 216 nodes, 625 tets;
+//     E = 1, nu = 0.3; clamped at x = 0, pressure 1 on z = 1), interior nodes moved by up to
+//     alpha = 0 .. 0.4 of the spacing along each axis (seeded). Strain energy and the tip's
+//     deflection (the largest |u| on x = 1) for L-FEM and LFS-FEM (in a linear static solve
+//     C-FEM and CS-FEM are the same methods), and IP DG p = 1, 2 on the same tets, against IP
+//     p = 3 on a 12^3 hex grid of the cube (the reference).
+//  3. Volume under rotation: the 2 x 0.5 x 0.5 beam (18 x 4 x 4 cubes: 475 nodes, 1,440 tets),
+//     clamped at x = 0, falling under gravity (E = 1e6, nu = 0.3, density 1000) for 2 s at
+//     dt = 0.01: the largest relative volume change per method. Linear forces take the rotation
+//     for a stretch and inflate the beam; warped ones do not.
+#include <algorithm>
+#include <cmath>
+#include <iostream>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "cli/bench/suites.h"
+#include "model/tet_solve.h"
+#include "physics/fem/tet_dynamics.h"
+#include "polydg/mesh/surface_shapes.h"
+#include "polydg/model/model.h"
+#include "polydg/util/error.h"
+#include "util/stopwatch.h"
+
+namespace polydg::bench {
+
+namespace {
+
+/// A box from the origin to `size` in cells[0] x cells[1] x cells[2] cubes of five tets (the
+/// central tet and four corners, alternating with the cube's parity so that neighbours share
+/// their faces' diagonals), oriented on the regular grid; then interior nodes moved by up to
+/// `alpha` times the spacing per axis (uniform random numbers from `seed`). A draw that
+/// inverts a tet (checkTetMesh) is drawn again from the next seed; `seed` returns the one used.
+TetMesh boxOfFiveTetCubes(const Vec3& size, const std::array<int, 3>& cells, double alpha,
+                          unsigned& seed) {
+  TetMesh mesh;
+  const Vec3 h(size.x() / cells[0], size.y() / cells[1], size.z() / cells[2]);
+  auto id = [&](int i, int j, int k) {
+    return static_cast<std::uint32_t>(i + (cells[0] + 1) * (j + (cells[1] + 1) * k));
+  };
+  for (int k = 0; k <= cells[2]; ++k)
+    for (int j = 0; j <= cells[1]; ++j)
+      for (int i = 0; i <= cells[0]; ++i)
+        mesh.vertices.emplace_back(i * h.x(), j * h.y(), k * h.z());
+  // Corners by bits (x, y, z); an even cube cuts off corners 0, 3, 5, 6, an odd one 1, 2, 4, 7.
+  static constexpr int kEven[5][4] = {
+      {0, 1, 2, 4}, {3, 1, 2, 7}, {5, 1, 4, 7}, {6, 2, 4, 7}, {1, 2, 4, 7}};
+  static constexpr int kOdd[5][4] = {
+      {1, 0, 3, 5}, {2, 0, 3, 6}, {4, 0, 5, 6}, {7, 3, 5, 6}, {0, 3, 5, 6}};
+  for (int k = 0; k < cells[2]; ++k)
+    for (int j = 0; j < cells[1]; ++j)
+      for (int i = 0; i < cells[0]; ++i) {
+        const auto& split = (i + j + k) % 2 == 0 ? kEven : kOdd;
+        for (const auto& tet : split) {
+          std::array<std::uint32_t, 4> t;
+          for (int c = 0; c < 4; ++c)
+            t[c] = id(i + (tet[c] & 1), j + (tet[c] >> 1 & 1), k + (tet[c] >> 2));
+          mesh.tets.push_back(t);
+          if (sixVolume(mesh, mesh.tets.size() - 1) < 0)
+            std::swap(mesh.tets.back()[2], mesh.tets.back()[3]);
+        }
+      }
+  if (alpha == 0.0) return mesh;
+  const std::vector<Vec3> regular = mesh.vertices;
+  for (;; ++seed) {
+    std::mt19937 random(seed);
+    std::uniform_real_distribution<double> unit(-1.0, 1.0);
+    for (int k = 0; k <= cells[2]; ++k)
+      for (int j = 0; j <= cells[1]; ++j)
+        for (int i = 0; i <= cells[0]; ++i) {
+          const Vec3 shift(unit(random), unit(random), unit(random));
+          const bool interior =
+              i > 0 && i < cells[0] && j > 0 && j < cells[1] && k > 0 && k < cells[2];
+          mesh.vertices[id(i, j, k)] =
+              regular[id(i, j, k)] + (interior ? alpha : 0.0) * shift.cwiseProduct(h);
+        }
+    try {
+      checkTetMesh(mesh);
+      return mesh;
+    } catch (const InputError&) {
+      // an inverted tet: the next draw
+    }
+  }
+}
+
+constexpr double kDistortions[] = {0.0, 0.1, 0.2, 0.3, 0.4};
+
+/// The pressure cantilever's solve options, for DG and the tet methods alike (solveOnTets
+/// ignores the degree).
+SolveOptions pressureOptions(int degree) {
+  SolveOptions o;
+  o.material = {1.0, 0.3, 1.0};
+  o.discretization.basis.degree = degree;
+  o.clamps = {FaceSelector::inPlane(0, 0.0)};
+  o.tractions = {{FaceSelector::inPlane(2, 1.0), Vec3(0, 0, -1)}};
+  return o;
+}
+
+/// Experiment 1: energy and tip deflection against distortion, per method.
+void runPressure(const BenchOptions& b, SuiteOutput& s, const Log& log, SeriesSet& plot) {
+  // The reference: IP p = 3 on a hex grid of the cube.
+  const int referenceCells = b.quick ? 4 : 12;
+  MeshOptions meshing;
+  meshing.cells = referenceCells;
+  MeshReport meshed;
+  Model reference =
+      Model::fromSurface(boxSurface(Box3(Vec3::Zero(), Vec3::Ones())), meshing, meshed);
+  const Stopwatch referenceWatch;
+  const SolveReport ref = reference.solve(pressureOptions(3));
+  const double referenceEnergy = ref.solve.energy;
+  log("pressure: reference IP p = 3 on " + std::to_string(referenceCells) + "^3 hexahedra (" +
+      std::to_string(ref.solve.dofs) + " DOFs): energy " + shortNumber(referenceEnergy) +
+      ", largest |u| " + shortNumber(ref.maxDisplacement) + " (" +
+      shortNumber(referenceWatch.seconds()) + " s)");
+  nlohmann::json rows = nlohmann::json::array();
+  for (double alpha : kDistortions) {
+    unsigned seed = 2017;
+    const TetMesh mesh = boxOfFiveTetCubes(Vec3::Ones(), {5, 5, 5}, alpha, seed);
+    auto record = [&](const std::string& method, double energy, double tip, std::size_t dofs,
+                      double seconds) {
+      const double error = std::abs(energy - referenceEnergy) / referenceEnergy;
+      rows.push_back({{"alpha", alpha},
+                      {"seed", seed},
+                      {"method", method},
+                      {"dofs", dofs},
+                      {"energy", energy},
+                      {"energy_error", error},
+                      {"tip_deflection", tip},
+                      {"seconds", seconds}});
+      s.rows.push_back({{"benchmark", "sfem pressure"},
+                        {"case", method},
+                        {"alpha", alpha},
+                        {"dofs", dofs},
+                        {"energy", energy},
+                        {"energy_error", error},
+                        {"tip_deflection", tip},
+                        {"seconds", seconds}});
+      plot.add(method, alpha, error);
+      log("pressure alpha " + shortNumber(alpha) + " " + method + ": energy " +
+          shortNumber(energy) + " (error " + shortNumber(error) + "), tip " + shortNumber(tip));
+    };
+    for (TetMethod method : {TetMethod::Fem, TetMethod::FsFem}) {
+      const Stopwatch watch;
+      const TetSolveReport r = solveOnTets(mesh, method, pressureOptions(1));
+      double tip = 0.0;
+      for (std::size_t v = 0; v < mesh.numVertices(); ++v)
+        if (mesh.vertices[v].x() == 1.0)
+          tip = std::max(tip, r.displacement.segment<3>(3 * v).norm());
+      record(method == TetMethod::Fem ? "L-FEM" : "LFS-FEM", r.energy, tip, r.dofs,
+             watch.seconds());
+    }
+    for (int degree : {1, 2}) {
+      const Stopwatch watch;
+      Model dg(toPolyMesh(mesh));
+      const SolveReport r = dg.solve(pressureOptions(degree));
+      record("IP p=" + std::to_string(degree), r.solve.energy, r.maxDisplacement, r.solve.dofs,
+             watch.seconds());
+    }
+  }
+  s.json["pressure"] = {{"reference",
+                         {{"method", "IP p=3"},
+                          {"hex_cells", referenceCells},
+                          {"dofs", ref.solve.dofs},
+                          {"energy", referenceEnergy},
+                          {"max_displacement", ref.maxDisplacement}}},
+                        {"runs", rows}};
+}
+
+/// Experiment 3: the falling beam's largest volume change, per method.
+void runRotation(const BenchOptions& b, SuiteOutput& s, const Log& log) {
+  unsigned seed = 0;
+  const TetMesh mesh = boxOfFiveTetCubes(
+      Vec3(2.0, 0.5, 0.5), b.quick ? std::array{6, 2, 2} : std::array{18, 4, 4}, 0.0, seed);
+  std::vector<std::uint32_t> clamped;
+  for (std::size_t v = 0; v < mesh.numVertices(); ++v)
+    if (mesh.vertices[v].x() == 0.0) clamped.push_back(static_cast<std::uint32_t>(v));
+  nlohmann::json rows = nlohmann::json::array();
+  for (TetMethod method : {TetMethod::Fem, TetMethod::FsFem}) {
+    const TetDiscretization d(mesh, method);
+    for (bool corotational : {false, true}) {
+      const std::string name = method == TetMethod::Fem ? (corotational ? "C-FEM" : "L-FEM")
+                                                        : (corotational ? "CS-FEM" : "LFS-FEM");
+      TetDynamicsOptions o;
+      o.material = {1e6, 0.3, 1000.0};
+      o.corotational = corotational;
+      o.gravity = Vec3(0, 0, -9.81);
+      o.clamped = clamped;
+      TetDynamics beam(d, o);
+      const double rest = beam.volume();
+      double largest = 0.0, lowest = 0.0;
+      const int steps = b.quick ? 50 : 200;
+      const Stopwatch watch;
+      for (int n = 0; n < steps; ++n) {
+        beam.step(0.01);
+        largest = std::max(largest, std::abs(beam.volume() / rest - 1.0));
+        const Eigen::VectorXd u = beam.displacement();
+        for (Eigen::Index i = 2; i < u.size(); i += 3) lowest = std::min(lowest, u[i]);
+      }
+      const double perStep = watch.seconds() / steps;
+      rows.push_back({{"method", name},
+                      {"tets", mesh.numTets()},
+                      {"largest_volume_change", largest},
+                      {"lowest_displacement", lowest},
+                      {"seconds_per_step", perStep}});
+      s.rows.push_back({{"benchmark", "sfem rotation"},
+                        {"case", name},
+                        {"largest_volume_change", largest},
+                        {"lowest_displacement", lowest},
+                        {"seconds", perStep}});
+      log("rotation " + name + ": largest volume change " + shortNumber(largest) +
+          ", lowest point " + shortNumber(lowest) + " m, " + shortNumber(perStep * 1e3) +
+          " ms a step");
+    }
+  }
+  s.json["rotation"] = rows;
+}
+
+}  // namespace
+
+SuiteOutput sfemSuite(const BenchOptions& options, bool quiet) {
+  SuiteOutput s;
+  s.name = "sfem";
+  const Log log = [quiet](const std::string& line) {
+    if (!quiet) std::cout << line << std::endl;
+  };
+  SeriesSet errors;
+  runPressure(options, s, log, errors);
+  runRotation(options, s, log);
+  s.plots.push_back({"sfem_pressure.svg",
+                     {"Cubic cantilever under pressure: strain energy error against distortion",
+                      {"distortion alpha", AxisScale::Linear},
+                      {"|E - E_ref| / E_ref", AxisScale::Log},
+                      errors.series()}});
+  return s;
+}
+
+}  // namespace polydg::bench
