@@ -333,7 +333,7 @@ TEST(BenchCommand, SfemSuiteShowsThePapersFindings) {
   // warping keeps the falling beam's volume, linear forces inflate it.
   const SuiteFiles files = quickSuite("sfem");
   ASSERT_TRUE(files.ok);
-  for (const char* file : {"sfem.json", "sfem.csv", "sfem_pressure.svg"})
+  for (const char* file : {"sfem.json", "sfem.csv", "sfem_pressure.svg", "sfem_speed.svg"})
     EXPECT_TRUE(fs::exists(files.dir / file)) << file;
   std::ifstream in(files.dir / "sfem.json");
   const nlohmann::json j = nlohmann::json::parse(in);
@@ -351,6 +351,15 @@ TEST(BenchCommand, SfemSuiteShowsThePapersFindings) {
   }
   EXPECT_LT(error["LFS-FEM"][0.4] - error["LFS-FEM"][0.0],
             error["L-FEM"][0.4] - error["L-FEM"][0.0]);
+  // Speed against error (quick: n = 4, 8 for the tets, 2, 4 for IP p = 1): the error falls
+  // with h, at second order at least (a factor above 2.5 from one h to its half).
+  std::map<std::string, std::map<int, double>> l2;
+  for (const auto& run : j["speed_against_error"])
+    l2[run["method"]][run["n"].get<int>()] = run["l2_error"].get<double>();
+  for (const char* method : {"FEM", "FS-FEM", "IP p=1"}) {
+    ASSERT_EQ(l2[method].size(), 2u) << method;
+    EXPECT_GT(l2[method].begin()->second, 2.5 * l2[method].rbegin()->second) << method;
+  }
   std::map<std::string, double> volume;
   for (const auto& run : j["rotation"]) volume[run["method"]] = run["largest_volume_change"];
   for (const char* linear : {"L-FEM", "LFS-FEM"})
