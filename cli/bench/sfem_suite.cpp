@@ -1,21 +1,28 @@
 // The sfem suite (Zhang et al. 2017, section 5): the tet methods (physics/fem/) side by side
 // with DG on the paper's meshes, boxes of cubes split into five tets:
 //  1. Distortion under pressure: the unit cubic cantilever (5^3 cubes: 216 nodes, 625 tets;
-//     E = 1, nu = 0.3; clamped at x = 0, pressure 1 on z = 1), interior nodes moved by up to
-//     alpha = 0 .. 0.4 of the spacing along each axis (seeded). Strain energy and the tip's
-//     deflection (the largest |u| on x = 1) for L-FEM and LFS-FEM (in a linear static solve
-//     C-FEM and CS-FEM are the same methods), and IP DG p = 1, 2 on the same tets, against IP
-//     p = 3 on a 12^3 hex grid of the cube (the reference).
+//     E = 1, nu = 0.3; clamped at x = 0, pressure 1 on z = 1), nodes moved by up to alpha =
+//     0 .. 0.4 of the spacing along each axis (seeded; nodes on the sides within them). Strain
+//     energy and the tip's deflection (the largest |u| on x = 1) for L-FEM and LFS-FEM (in a linear
+//     static solve C-FEM and CS-FEM are the same methods), and IP DG p = 1, 2 on the same tets,
+//     against IP p = 3 on a 12^3 hex grid of the cube (the reference).
+//  2. Distortion under large rotation: the paper's 405-tet beam (below, k = 1) falling under
+//     gravity, distorted by alpha = 0 .. 0.4: node A's vertical displacement at 0.25 s and the
+//     time of its first lowest point, per method, dt = 0.0025 for 0.5 s.
 //  3. Volume under rotation: the 2 x 0.5 x 0.5 beam (18 x 4 x 4 cubes: 475 nodes, 1,440 tets),
 //     clamped at x = 0, falling under gravity (E = 1e6, nu = 0.3, density 1000) for 2 s at
 //     dt = 0.01: the largest relative volume change per method. Linear forces take the rotation
 //     for a stretch and inflate the beam; warped ones do not.
+//  4. Time per step (the paper's Table 1): the beam 0.9 x 0.3 x 0.3 m in 9k x 3k x 3k cubes
+//     (k = 1..5: 405 to 50,625 tets), clamped, under gravity, C-FEM and CS-FEM: the mean wall
+//     time of 10 backward Euler steps after 2, with assembly and solve apart.
 //  5. Speed against error: u = sin(pi x) sin(pi y) sin(pi z) (1, 2, -1) / 100 on the unit cube
 //     (its body force, u = 0 on the boundary): the relative L2 error against the solve's wall
 //     time for FEM and FS-FEM on 5-tet cubes (n = 4, 8, 16, 24) and IP p = 1, 2, 3 on hex grids.
 #include <algorithm>
 #include <cmath>
 #include <iostream>
+#include <map>
 #include <random>
 #include <string>
 #include <vector>
@@ -34,9 +41,10 @@ namespace {
 
 /// A box from the origin to `size` in cells[0] x cells[1] x cells[2] cubes of five tets (the
 /// central tet and four corners, alternating with the cube's parity so that neighbours share
-/// their faces' diagonals), oriented on the regular grid; then interior nodes moved by up to
-/// `alpha` times the spacing per axis (uniform random numbers from `seed`). A draw that
-/// inverts a tet (checkTetMesh) is drawn again from the next seed; `seed` returns the one used.
+/// their faces' diagonals), oriented on the regular grid; then nodes moved by up to `alpha`
+/// times the spacing along each axis that does not take them off the box's sides (uniform
+/// random numbers from `seed`). A draw that inverts a tet (checkTetMesh) is drawn again from
+/// the next seed; `seed` returns the one used.
 TetMesh boxOfFiveTetCubes(const Vec3& size, const std::array<int, 3>& cells, double alpha,
                           unsigned& seed) {
   TetMesh mesh;
@@ -74,11 +82,13 @@ TetMesh boxOfFiveTetCubes(const Vec3& size, const std::array<int, 3>& cells, dou
     for (int k = 0; k <= cells[2]; ++k)
       for (int j = 0; j <= cells[1]; ++j)
         for (int i = 0; i <= cells[0]; ++i) {
-          const Vec3 shift(unit(random), unit(random), unit(random));
-          const bool interior =
-              i > 0 && i < cells[0] && j > 0 && j < cells[1] && k > 0 && k < cells[2];
-          mesh.vertices[id(i, j, k)] =
-              regular[id(i, j, k)] + (interior ? alpha : 0.0) * shift.cwiseProduct(h);
+          Vec3 shift(unit(random), unit(random), unit(random));
+          // Along an axis only off the box's sides across it: nodes on a side move in its
+          // plane, on an edge along it, corners not at all, so the box keeps its shape.
+          const std::array<int, 3> index{i, j, k};
+          for (int a = 0; a < 3; ++a)
+            if (index[a] == 0 || index[a] == cells[a]) shift[a] = 0.0;
+          mesh.vertices[id(i, j, k)] = regular[id(i, j, k)] + alpha * shift.cwiseProduct(h);
         }
     try {
       checkTetMesh(mesh);
@@ -335,6 +345,135 @@ void runSpeedAgainstError(const BenchOptions& b, SuiteOutput& s, const Log& log,
   s.json["speed_against_error"] = rows;
 }
 
+/// The paper's beam under gravity at size k (its Table 1: 9k x 3k x 3k cubes of five tets, 0.9
+/// x 0.3 x 0.3 m), clamped at x = 0, E = 1e6, nu = 0.3, density 1000, distorted by `alpha`.
+struct GravityBeam {
+  TetMesh mesh;
+  std::vector<std::uint32_t> clamped;
+  std::uint32_t tipNode = 0;  ///< node A: the free end's lowest corner on y = 0
+  unsigned seed = 0;
+};
+
+GravityBeam gravityBeam(int k, double alpha) {
+  GravityBeam b;
+  b.seed = 42;
+  b.mesh = boxOfFiveTetCubes(Vec3(0.9, 0.3, 0.3), {9 * k, 3 * k, 3 * k}, alpha, b.seed);
+  for (std::size_t v = 0; v < b.mesh.numVertices(); ++v) {
+    const Vec3& p = b.mesh.vertices[v];
+    if (p.x() == 0.0) b.clamped.push_back(static_cast<std::uint32_t>(v));
+    if (p.x() == 0.9 && p.y() == 0.0 && p.z() == 0.0) b.tipNode = static_cast<std::uint32_t>(v);
+  }
+  return b;
+}
+
+TetDynamicsOptions beamDynamics(const GravityBeam& b, bool corotational) {
+  TetDynamicsOptions o;
+  o.material = {1e6, 0.3, 1000.0};
+  o.corotational = corotational;
+  o.gravity = Vec3(0, 0, -9.81);
+  o.clamped = b.clamped;
+  return o;
+}
+
+const char* methodName(TetMethod method, bool corotational) {
+  if (method == TetMethod::Fem) return corotational ? "C-FEM" : "L-FEM";
+  return corotational ? "CS-FEM" : "LFS-FEM";
+}
+
+/// Experiment 2: node A of the 405-tet beam under gravity, distorted by alpha = 0 .. 0.4: its
+/// vertical displacement at t = 0.25 s and the time of its first lowest point (half the first
+/// period), per method; the shift of that time against the regular mesh's is the frequency
+/// shift the paper plots.
+void runDistortedBeam(const BenchOptions& b, SuiteOutput& s, const Log& log) {
+  nlohmann::json rows = nlohmann::json::array();
+  const double dt = 0.0025;
+  const int steps = b.quick ? 100 : 200;  // 0.25 s, or 0.5 s
+  std::map<std::string, double> regular;  // each method's half period at alpha = 0
+  const std::vector<double> alphas =
+      b.quick ? std::vector<double>{0.0, 0.4}
+              : std::vector<double>(std::begin(kDistortions), std::end(kDistortions));
+  for (double alpha : alphas) {
+    const GravityBeam beam = gravityBeam(1, alpha);
+    for (TetMethod method : {TetMethod::Fem, TetMethod::FsFem}) {
+      const TetDiscretization d(beam.mesh, method);
+      for (bool corotational : {false, true}) {
+        TetDynamics body(d, beamDynamics(beam, corotational));
+        double atQuarter = 0.0, lowest = 0.0, lowestTime = 0.0;
+        bool rising = false;
+        for (int n = 1; n <= steps; ++n) {
+          body.step(dt);
+          const double z = body.displacement()[3 * beam.tipNode + 2];
+          if (n == 100) atQuarter = z;
+          if (!rising && z < lowest) {
+            lowest = z;
+            lowestTime = n * dt;
+          } else if (z > lowest) {
+            rising = true;  // past the first lowest point
+          }
+        }
+        const std::string name = methodName(method, corotational);
+        if (alpha == 0.0) regular[name] = lowestTime;
+        const double shift = regular[name] > 0.0 ? lowestTime / regular[name] - 1.0 : 0.0;
+        rows.push_back({{"alpha", alpha},
+                        {"seed", beam.seed},
+                        {"method", name},
+                        {"uz_A_at_0.25s", atQuarter},
+                        {"first_lowest_uz_A", lowest},
+                        {"first_lowest_time", lowestTime},
+                        {"half_period_shift", shift}});
+        s.rows.push_back({{"benchmark", "sfem distorted beam"},
+                          {"case", name},
+                          {"alpha", alpha},
+                          {"uz_A", atQuarter},
+                          {"first_lowest_time", lowestTime}});
+        log("distorted beam alpha " + shortNumber(alpha) + " " + name + ": u_z(A) at 0.25 s " +
+            shortNumber(atQuarter) + " m, first lowest " + shortNumber(lowest) + " m at " +
+            shortNumber(lowestTime) + " s (shift " + shortNumber(shift) + ")");
+      }
+    }
+  }
+  s.json["distorted_beam"] = rows;
+}
+
+/// Experiment 4 (the paper's Table 1): wall time per step against the number of tets.
+void runTimePerStep(const BenchOptions& b, SuiteOutput& s, const Log& log, SeriesSet& plot) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (int k = 1; k <= (b.quick ? 2 : 5); ++k) {
+    const GravityBeam beam = gravityBeam(k, 0.0);
+    for (TetMethod method : {TetMethod::Fem, TetMethod::FsFem}) {
+      const TetDiscretization d(beam.mesh, method);
+      TetDynamics body(d, beamDynamics(beam, true));
+      for (int n = 0; n < 2; ++n) body.step(0.01);  // warm-up: the solver's first analysis
+      const int steps = 10;
+      double assemble = 0.0, solve = 0.0;
+      const Stopwatch watch;
+      for (int n = 0; n < steps; ++n) {
+        body.step(0.01);
+        assemble += body.assembleSeconds();
+        solve += body.solveSeconds();
+      }
+      const double perStep = watch.seconds() / steps;
+      const std::string name = methodName(method, true);
+      rows.push_back({{"method", name},
+                      {"nodes", beam.mesh.numVertices()},
+                      {"tets", beam.mesh.numTets()},
+                      {"domains", d.domains().size()},
+                      {"seconds_per_step", perStep},
+                      {"assemble_seconds", assemble / steps},
+                      {"solve_seconds", solve / steps}});
+      s.rows.push_back({{"benchmark", "sfem time per step"},
+                        {"case", name},
+                        {"tets", beam.mesh.numTets()},
+                        {"seconds", perStep}});
+      plot.add(name, static_cast<double>(beam.mesh.numTets()), perStep * 1e3);
+      log("time per step " + name + ", " + std::to_string(beam.mesh.numTets()) + " tets: " +
+          shortNumber(perStep * 1e3) + " ms (assembly " + shortNumber(assemble / steps * 1e3) +
+          ", solve " + shortNumber(solve / steps * 1e3) + ")");
+    }
+  }
+  s.json["time_per_step"] = rows;
+}
+
 }  // namespace
 
 SuiteOutput sfemSuite(const BenchOptions& options, bool quiet) {
@@ -343,15 +482,22 @@ SuiteOutput sfemSuite(const BenchOptions& options, bool quiet) {
   const Log log = [quiet](const std::string& line) {
     if (!quiet) std::cout << line << std::endl;
   };
-  SeriesSet errors, speed;
+  SeriesSet errors, speed, steps;
   runPressure(options, s, log, errors);
   runRotation(options, s, log);
+  runDistortedBeam(options, s, log);
+  runTimePerStep(options, s, log, steps);
   runSpeedAgainstError(options, s, log, speed);
   s.plots.push_back({"sfem_pressure.svg",
                      {"Cubic cantilever under pressure: strain energy error against distortion",
                       {"distortion alpha", AxisScale::Linear},
                       {"|E - E_ref| / E_ref", AxisScale::Log},
                       errors.series()}});
+  s.plots.push_back({"sfem_time_per_step.svg",
+                     {"Corotated beam under gravity: wall time per backward Euler step",
+                      {"tets", AxisScale::Log},
+                      {"ms per step", AxisScale::Log},
+                      steps.series()}});
   s.plots.push_back({"sfem_speed.svg",
                      {"Sine solution on the unit cube: L2 error against wall time",
                       {"wall time of the solve [s]", AxisScale::Log},

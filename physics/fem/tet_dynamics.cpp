@@ -1,5 +1,7 @@
 #include "physics/fem/tet_dynamics.h"
 
+#include <algorithm>
+#include <array>
 #include <stdexcept>
 
 #include "physics/solvers/linear_solver.h"
@@ -13,8 +15,67 @@ struct TetDynamics::Solver {
   Eigen::SparseMatrix<double> matrix;
   LinearSolver linear;
   bool computed = false;
+  /// Each domain's stiffness for the material: constant, only its rotation changes (Zhang et
+  /// al. section 4.3: computed once, in preprocessing).
+  std::vector<Eigen::MatrixXd> domainStiffness;
+  /// Per domain, per node pair (a, b) and column c of the pair's 3 x 3 block: where the block's
+  /// first row lies in the matrix's values (its 3 rows follow), or -1 when a node is held.
+  std::vector<std::vector<int>> blockAt;
+  std::vector<int> diagonalAt;  ///< per free DOF: its diagonal entry's place in the values
   explicit Solver(const SolverOptions& options) : linear(options) {}
 };
+
+namespace {
+
+/// The place of entry (row, col) in a compressed column-major matrix, which must hold it.
+int entryAt(const Eigen::SparseMatrix<double>& m, Eigen::Index row, Eigen::Index col) {
+  const int* begin = m.innerIndexPtr() + m.outerIndexPtr()[col];
+  const int* end = m.innerIndexPtr() + m.outerIndexPtr()[col + 1];
+  const int* at = std::lower_bound(begin, end, static_cast<int>(row));
+  return static_cast<int>(at - m.innerIndexPtr());
+}
+
+}  // namespace
+
+void TetDynamics::prepareAssembly() {
+  Solver& s = *solver_;
+  const auto& domains = discretization_.domains();
+  // The pattern: every free node pair of a domain as a 3 x 3 block, and the diagonal.
+  std::vector<Eigen::Triplet<double>> pattern;
+  auto freeNode = [&](std::uint32_t v) { return freeIndex_[3 * v] >= 0 ? freeIndex_[3 * v] : -1; };
+  for (const StrainDomain& d : domains)
+    for (int a = 0; a < d.numNodes; ++a)
+      for (int b = 0; b < d.numNodes; ++b) {
+        const Eigen::Index fa = freeNode(d.nodes[a]), fb = freeNode(d.nodes[b]);
+        if (fa < 0 || fb < 0) continue;
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j)
+            pattern.emplace_back(static_cast<int>(fa + i), static_cast<int>(fb + j), 0.0);
+      }
+  for (Eigen::Index i = 0; i < numFree_; ++i)
+    pattern.emplace_back(static_cast<int>(i), static_cast<int>(i), 0.0);
+  s.matrix.resize(numFree_, numFree_);
+  s.matrix.setFromTriplets(pattern.begin(), pattern.end());
+  s.matrix.makeCompressed();
+  s.diagonalAt.resize(static_cast<std::size_t>(numFree_));
+  for (Eigen::Index i = 0; i < numFree_; ++i) s.diagonalAt[i] = entryAt(s.matrix, i, i);
+  s.domainStiffness.reserve(domains.size());
+  s.blockAt.resize(domains.size());
+  for (std::size_t i = 0; i < domains.size(); ++i) {
+    const StrainDomain& d = domains[i];
+    s.domainStiffness.push_back(discretization_.domainStiffness(d, options_.material));
+    std::vector<int>& at = s.blockAt[i];
+    at.assign(static_cast<std::size_t>(3 * d.numNodes * d.numNodes), -1);
+    for (int a = 0; a < d.numNodes; ++a)
+      for (int b = 0; b < d.numNodes; ++b) {
+        const Eigen::Index fa = freeNode(d.nodes[a]), fb = freeNode(d.nodes[b]);
+        if (fa < 0 || fb < 0) continue;
+        for (int c = 0; c < 3; ++c)
+          at[static_cast<std::size_t>(3 * (a * d.numNodes + b) + c)] =
+              entryAt(s.matrix, fa, fb + c);
+      }
+  }
+}
 
 TetDynamics::TetDynamics(const TetDiscretization& discretization, const TetDynamicsOptions& options)
     : discretization_(discretization), options_(options) {
@@ -33,10 +94,10 @@ TetDynamics::TetDynamics(const TetDiscretization& discretization, const TetDynam
   freeIndex_.assign(static_cast<std::size_t>(n), -1);
   for (Eigen::Index i = 0; i < n; ++i)
     if (!held[i]) freeIndex_[i] = numFree_++;
-  if (!options.corotational) linearK_ = discretization.stiffness(options.material);
   // The nodes' 3 x 3 blocks for CG (the p-multigrid needs the DG layout).
   options_.solver.preconditioner = CgPreconditioner::BlockJacobi;
   solver_ = std::make_unique<Solver>(options_.solver);
+  prepareAssembly();
 }
 
 TetDynamics::~TetDynamics() = default;
@@ -51,36 +112,48 @@ void TetDynamics::setRigidVelocity(const Eigen::Vector3d& linear, const Eigen::V
 void TetDynamics::step(double dt) {
   if (!(dt > 0.0)) throw std::invalid_argument("the time step must be positive");
   const Stopwatch assemble;
-  // K_R and the elastic force offset - K_R x at the current positions.
-  Eigen::SparseMatrix<double> k;
-  Eigen::VectorXd offset;
-  if (options_.corotational) {
-    discretization_.corotatedStiffness(
-        options_.material, discretization_.domainRotations(discretization_.tetRotations(x_)), k,
-        offset);
-  } else {
-    k = linearK_;
-    offset = linearK_ * discretization_.restPositions();
-  }
+  Solver& s = *solver_;
+  const auto& domains = discretization_.domains();
+  const std::vector<Eigen::Matrix3d> rotations =
+      options_.corotational
+          ? discretization_.domainRotations(discretization_.tetRotations(x_))
+          : std::vector<Eigen::Matrix3d>(domains.size(), Eigen::Matrix3d::Identity());
+  // The matrix (M (1 + dt alpha) + (dt^2 + dt beta) K_R on the free DOFs) and the elastic
+  // force f(x) = offset - K_R x, domain by domain: with R its rotation, f_a = R sum_b K_ab
+  // (X_b - R^T x_b) and the block of K_R is R K_ab R^T.
   const double alpha = options_.massDamping, beta = options_.stiffnessDamping;
   const double kScale = dt * dt + dt * beta, mScale = 1.0 + dt * alpha;
-  std::vector<Eigen::Triplet<double>> triplets;
-  triplets.reserve(static_cast<std::size_t>(k.nonZeros() + numFree_));
-  for (Eigen::Index col = 0; col < k.outerSize(); ++col)
-    for (Eigen::SparseMatrix<double>::InnerIterator it(k, col); it; ++it)
-      if (freeIndex_[it.row()] >= 0 && freeIndex_[col] >= 0)
-        triplets.emplace_back(static_cast<int>(freeIndex_[it.row()]),
-                              static_cast<int>(freeIndex_[col]), kScale * it.value());
+  double* values = s.matrix.valuePtr();
+  std::fill(values, values + s.matrix.nonZeros(), 0.0);
   for (Eigen::Index i = 0; i < x_.size(); ++i)
-    if (freeIndex_[i] >= 0)
-      triplets.emplace_back(static_cast<int>(freeIndex_[i]), static_cast<int>(freeIndex_[i]),
-                            mScale * mass_[i]);
-  Solver& s = *solver_;
-  s.matrix.resize(numFree_, numFree_);
-  s.matrix.setFromTriplets(triplets.begin(), triplets.end());
-  // M v + dt (f(x) + f_ext - beta K v): the stiffness damping's force at the old velocity moves
-  // to the left-hand side through dt beta K v'.
-  const Eigen::VectorXd full = mass_.cwiseProduct(v_) + dt * (offset - k * x_ + gravityLoad_);
+    if (freeIndex_[i] >= 0) values[s.diagonalAt[freeIndex_[i]]] = mScale * mass_[i];
+  const Eigen::VectorXd& rest = discretization_.restPositions();
+  Eigen::VectorXd force = gravityLoad_;
+  for (std::size_t i = 0; i < domains.size(); ++i) {
+    const StrainDomain& d = domains[i];
+    const Eigen::Matrix3d& r = rotations[i];
+    const Eigen::MatrixXd& kd = s.domainStiffness[i];
+    const std::vector<int>& at = s.blockAt[i];
+    std::array<Eigen::Vector3d, 5> local;  // X_b - R^T x_b
+    for (int b = 0; b < d.numNodes; ++b)
+      local[b] = rest.segment<3>(3 * d.nodes[b]) - r.transpose() * x_.segment<3>(3 * d.nodes[b]);
+    for (int a = 0; a < d.numNodes; ++a) {
+      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+      for (int b = 0; b < d.numNodes; ++b) {
+        const Eigen::Matrix3d kab = kd.block<3, 3>(3 * a, 3 * b);
+        sum += kab * local[b];
+        const int* place = &at[static_cast<std::size_t>(3 * (a * d.numNodes + b))];
+        if (place[0] < 0) continue;
+        const Eigen::Matrix3d block = kScale * (r * kab * r.transpose());
+        for (int c = 0; c < 3; ++c)
+          for (int row = 0; row < 3; ++row) values[place[c] + row] += block(row, c);
+      }
+      force.segment<3>(3 * d.nodes[a]) += r * sum;
+    }
+  }
+  // M v + dt (f(x) + f_ext): the stiffness damping's force at the new velocity is in the
+  // matrix (dt beta K v').
+  const Eigen::VectorXd full = mass_.cwiseProduct(v_) + dt * force;
   Eigen::VectorXd rhs(numFree_);
   for (Eigen::Index i = 0; i < x_.size(); ++i)
     if (freeIndex_[i] >= 0) rhs[freeIndex_[i]] = full[i];

@@ -55,8 +55,10 @@ class TetDynamics {
   Eigen::VectorXd mass_, x_, v_, gravityLoad_;
   std::vector<Eigen::Index> freeIndex_;  ///< per DOF: its index among the free DOFs, or -1
   Eigen::Index numFree_ = 0;
-  Eigen::SparseMatrix<double> linearK_;  ///< K, when not corotational
   struct Solver;
+  /// The step matrix's fixed pattern, where each domain's blocks go in it, and the domains'
+  /// stiffness matrices.
+  void prepareAssembly();
   std::unique_ptr<Solver> solver_;
   double time_ = 0.0, assembleSeconds_ = 0.0, solveSeconds_ = 0.0;
 };
