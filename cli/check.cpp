@@ -1,12 +1,15 @@
-// polydg check: validation of a simulation mesh (VTU), first geometric (closed, positive,
+// polydg check: validation of a simulation mesh (VTU, or a tet mesh from TetGen or Gmsh), first
+// geometric (closed, positive,
 // planar, properly shared elements), then the DG discretization's invariants on it (local patch
 // test and rigid modes of every element, the zero modes of the global stiffness when
 // affordable): Model::check(). Non-zero exit if any check fails.
+#include <filesystem>
 #include <iostream>
 
 #include "cli/commands.h"
 #include "cli/options.h"
 #include "model/files.h"
+#include "polydg/mesh/tet_mesh.h"
 #include "polydg/model/report_json.h"
 
 namespace polydg::cli {
@@ -38,12 +41,21 @@ void print(const std::string& input, const MeshCheck& c) {
   for (const std::string& n : c.notes) std::cout << "  " << n << '\n';
 }
 
+/// A tet mesh from TetGen (.ele) or Gmsh (.msh): read and checked as such (readTetMesh refuses
+/// what is not a conforming tet mesh, naming the element), then as a simulation mesh.
+bool isTetMeshPath(const std::string& path) {
+  const std::string ext = std::filesystem::path(path).extension().string();
+  return ext == ".ele" || ext == ".msh";
+}
+
 void run(CheckCommandOptions o, const CommonOptions& common, int& exitCode) {
-  if (!isVolumeMeshPath(o.input))
+  if (!isVolumeMeshPath(o.input) && !isTetMeshPath(o.input))
     throw InputError(o.input +
-                     ": check reads simulation meshes (.vtu); for a surface use 'polydg info'");
+                     ": check reads simulation meshes (.vtu) and tet meshes (TetGen .ele, Gmsh "
+                     ".msh); for a surface use 'polydg info'");
   if (!o.report.empty()) requireDistinct(o.report, o.input);
-  Model model = Model::read(o.input);
+  Model model =
+      isTetMeshPath(o.input) ? Model(toPolyMesh(readTetMesh(o.input))) : Model::read(o.input);
   if (o.skipDg) {
     o.check.local = false;
     o.check.rigidModes = GlobalCheck::Never;
@@ -69,7 +81,9 @@ void addCheckCommand(CLI::App& app, const CommonOptions& common, int& exitCode) 
       "check",
       "Validate a simulation mesh: closed, positive, planar, properly shared elements, and the "
       "DG patch test and rigid modes on it");
-  cmd->add_option("mesh", o->input, "simulation mesh (.vtu)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("mesh", o->input, "simulation mesh (.vtu), or a tet mesh (.vtu, .ele, .msh)")
+      ->required()
+      ->check(CLI::ExistingFile);
   cmd->add_option("--report", o->report, "write the validation as JSON to this file");
   cmd->add_option("--planarity-tolerance", o->check.geometryOptions.planarityTolerance,
                   "largest vertex distance from a face's plane, relative to the face size")

@@ -548,6 +548,21 @@ def tets(polydg, work):
               exact_energy, 1e-2)
     check(energies["fem"] < exact_energy, "FEM's energy is below the exact one: %r" % energies)
     check(energies["fs-fem"] > energies["fem"], "FS-FEM is softer than FEM: %r" % energies)
+    # polydg check takes the tet meshes as they are: valid, 192 elements, the bar's volume.
+    for kind, path in files.items():
+        report = work / "check.json"
+        run([polydg, "check", path, "--report", report, "--quiet"])
+        r = read_json(report)
+        check(r["passed"], "polydg check on the %s tets passes" % kind)
+        equal("polydg check on the %s tets: elements" % kind, r["elements"], len(cells))
+        close("polydg check on the %s tets: volume" % kind, r["volume"], L, 1e-14)
+    # A tet with a repeated corner is refused, named by its Gmsh tag (its index + 1).
+    bad = cells.copy()
+    bad[5] = [bad[5][0], bad[5][1], bad[5][2], bad[5][2]]
+    write_msh(work / "bad.msh", points, bad)
+    _, err = run([polydg, "check", work / "bad.msh"], expect=2)
+    check("element 6 " in err and "corner" in err and err.count("\n") == 1,
+          "a tet with a repeated corner is named, on one line: " + err)
     # Refusals, one line each, and no output left behind.
     out = work / "refused.vtu"
     _, err = run([polydg, "solve", files["msh"], "-o", out, "--method", "fem", "--degree", 2,
