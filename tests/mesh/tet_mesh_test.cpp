@@ -320,6 +320,25 @@ std::string number(double value) {
 
 std::string xyz(const Vec3& p) { return number(p.x()) + " " + number(p.y()) + " " + number(p.z()); }
 
+/// The nodes and tets a file lists for `mesh`: its vertices and corners, with `tenNodes` also a
+/// node at each edge's middle per tet (after the corners, in the order 01 02 03 12 13 23).
+std::pair<std::vector<Vec3>, std::vector<std::vector<std::size_t>>> fileNodes(const TetMesh& mesh,
+                                                                              bool tenNodes) {
+  std::vector<Vec3> nodes = mesh.vertices;
+  std::vector<std::vector<std::size_t>> tets;
+  for (const Tet& t : mesh.tets) {
+    std::vector<std::size_t> tet(t.begin(), t.end());
+    if (tenNodes)
+      for (int a = 0; a < 4; ++a)
+        for (int b = a + 1; b < 4; ++b) {
+          tet.push_back(nodes.size());
+          nodes.push_back(0.5 * (mesh.vertices[t[a]] + mesh.vertices[t[b]]));
+        }
+    tets.push_back(tet);
+  }
+  return {nodes, tets};
+}
+
 struct TetgenOptions {
   int base = 1;
   bool tenNodes = false;  ///< tets with 10 nodes: the corners, then 6 extra (mid-edge) nodes
@@ -328,18 +347,7 @@ struct TetgenOptions {
 
 /// Writes STEM.node and STEM.ele; returns STEM.ele.
 fs::path writeTetgen(const fs::path& stem, const TetMesh& mesh, const TetgenOptions& o = {}) {
-  std::vector<Vec3> nodes = mesh.vertices;
-  std::vector<std::vector<std::size_t>> tets;
-  for (const Tet& t : mesh.tets) {
-    std::vector<std::size_t> tet(t.begin(), t.end());
-    if (o.tenNodes)
-      for (int a = 0; a < 4; ++a)
-        for (int b = a + 1; b < 4; ++b) {
-          tet.push_back(nodes.size());
-          nodes.push_back(0.5 * (mesh.vertices[t[a]] + mesh.vertices[t[b]]));
-        }
-    tets.push_back(tet);
-  }
+  auto [nodes, tets] = fileNodes(mesh, o.tenNodes);
   const std::string comment = o.extras ? "  # a comment\n# a line of comment\n\n" : "\n";
   std::string node = std::to_string(nodes.size()) + " 3 " + (o.extras ? "1 1" : "0 0") + comment;
   for (std::size_t i = 0; i < nodes.size(); ++i)
@@ -367,18 +375,7 @@ struct MshOptions {
 
 /// A Gmsh MSH 4.1 ASCII file of `mesh`.
 std::string mshText(const TetMesh& mesh, const MshOptions& o = {}) {
-  std::vector<Vec3> nodes = mesh.vertices;
-  std::vector<std::vector<std::size_t>> tets;
-  for (const Tet& t : mesh.tets) {
-    std::vector<std::size_t> tet(t.begin(), t.end());
-    if (o.tenNodes)
-      for (int a = 0; a < 4; ++a)
-        for (int b = a + 1; b < 4; ++b) {
-          tet.push_back(nodes.size());
-          nodes.push_back(0.5 * (mesh.vertices[t[a]] + mesh.vertices[t[b]]));
-        }
-    tets.push_back(tet);
-  }
+  auto [nodes, tets] = fileNodes(mesh, o.tenNodes);
   const std::size_t extra = nodes.size();  // a node only a point element uses
   if (o.scrambled) nodes.push_back(Vec3(5, 5, 5));
   auto tag = [&](std::size_t i) {
