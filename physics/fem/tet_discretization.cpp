@@ -7,6 +7,7 @@
 
 #include <Eigen/Geometry>
 
+#include "integrate/quadrature.h"
 #include "physics/dynamics/corotation.h"
 
 namespace polydg {
@@ -231,17 +232,19 @@ Eigen::VectorXd TetDiscretization::bodyForceLoad(const Eigen::Vector3d& force) c
 Eigen::VectorXd TetDiscretization::bodyForceFieldLoad(
     const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& force) const {
   Eigen::VectorXd f = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(numDofs()));
-  // The points at barycentric (a, b, b, b) and its permutations, weights a quarter each.
-  const double a = 0.5854101966249685, b = 0.1381966011250105;
+  std::vector<QuadraturePoint> rule;
   for (std::size_t t = 0; t < tets_.size(); ++t) {
     const auto& c = tets_[t];
-    for (int q = 0; q < 4; ++q) {
-      Eigen::Vector4d bary = Eigen::Vector4d::Constant(b);
-      bary[q] = a;
-      Eigen::Vector3d x = Eigen::Vector3d::Zero();
-      for (int k = 0; k < 4; ++k) x += bary[k] * rest_.segment<3>(3 * c[k]);
-      const Eigen::Vector3d value = force(x);
-      for (int k = 0; k < 4; ++k) f.segment<3>(3 * c[k]) += 0.25 * tetVolumes_[t] * bary[k] * value;
+    const Eigen::Vector3d x0 = rest_.segment<3>(3 * c[0]);
+    rule.clear();
+    appendTetrahedronRule(x0, rest_.segment<3>(3 * c[1]), rest_.segment<3>(3 * c[2]),
+                          rest_.segment<3>(3 * c[3]), 2, rule);
+    for (const QuadraturePoint& q : rule) {
+      // The shape functions at q: its barycentric coordinates.
+      const Eigen::Vector3d xi = restEdgesInverse_[t] * (q.point - x0);
+      const Eigen::Vector4d shape(1.0 - xi.sum(), xi.x(), xi.y(), xi.z());
+      const Eigen::Vector3d value = q.weight * force(q.point);
+      for (int k = 0; k < 4; ++k) f.segment<3>(3 * c[k]) += shape[k] * value;
     }
   }
   return f;

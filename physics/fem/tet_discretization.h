@@ -81,8 +81,8 @@ class TetDiscretization {
   Eigen::VectorXd lumpedMass(double density) const;
   /// The nodal load of a constant body force (force per volume): a quarter of each tet's.
   Eigen::VectorXd bodyForceLoad(const Eigen::Vector3d& force) const;
-  /// The consistent nodal load of a body force field f(x): int f N_a over each tet by the
-  /// 4-point rule exact for quadratics (Keast's degree-2 rule).
+  /// The consistent nodal load of a body force field f(x): int f N_a over each tet by a rule
+  /// exact for quadratics (appendTetrahedronRule, integrate/quadrature.h).
   Eigen::VectorXd bodyForceFieldLoad(
       const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& force) const;
   /// The mesh's volume at positions x (node-major): the sum of its tets' signed volumes.

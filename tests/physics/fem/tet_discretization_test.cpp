@@ -104,6 +104,26 @@ struct SmoothProblem {
   }
 };
 
+TEST(TetFem, ABodyForceFieldLoadsEachNodeByItsShapeFunction) {
+  // A linear field f = sum_b f_b N_b on one tet: int f N_a = V / 20 (f_a + sum_b f_b), since
+  // int N_a N_b = V (1 + delta_ab) / 20; the rule is exact for these quadratics.
+  TetMesh mesh;
+  mesh.vertices = {Vec3(0.1, 0, 0), Vec3(1, 0.2, 0), Vec3(0, 1.3, 0.1), Vec3(0.2, 0.1, 0.9)};
+  mesh.tets = {{0, 1, 2, 3}};
+  const TetDiscretization d(mesh, TetMethod::Fem);
+  auto field = [](const Eigen::Vector3d& x) {
+    return Eigen::Vector3d(1.0 + 2.0 * x.x() - x.y(), 3.0 * x.z(), x.x() + x.y() + x.z());
+  };
+  const Eigen::VectorXd load = d.bodyForceFieldLoad(field);
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (const Vec3& x : mesh.vertices) sum += field(x);
+  const double volume = d.tetVolumes()[0];
+  for (int a = 0; a < 4; ++a) {
+    const Eigen::Vector3d exact = volume / 20.0 * (field(mesh.vertices[a]) + sum);
+    EXPECT_LT((load.segment<3>(3 * a) - exact).norm(), 1e-15) << "node " << a;
+  }
+}
+
 TEST(TetFem, ConvergesAtSecondOrderOnASmoothSolution) {
   const SmoothProblem problem;
   double finest[2];
