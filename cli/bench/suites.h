@@ -42,7 +42,7 @@
 //              pressure on 625 tets distorted by alpha = 0 .. 0.4 (L-FEM, LFS-FEM, IP p = 1, 2
 //              on the tets; IP p = 3 on 12^3 hexahedra the reference), and the falling beam's
 //              volume (1,440 tets; L-FEM, LFS-FEM, C-FEM, CS-FEM), and speed against error
-//              on a sine solution (FEM, FS-FEM on tets, IP p = 1-3 on hexahedra).
+//              on B1 (FEM, FS-FEM on tets, IP p = 1-3 on hexahedra).
 // With `quick` each runs reduced sizes (a smoke test of every output, as the tests run it).
 #pragma once
 
