@@ -43,19 +43,13 @@ void print(const std::string& input, const MeshCheck& c) {
 
 /// A tet mesh from TetGen (.ele) or Gmsh (.msh): read and checked as such (readTetMesh refuses
 /// what is not a conforming tet mesh, naming the element), then as a simulation mesh.
-bool isTetMeshPath(const std::string& path) {
-  const std::string ext = std::filesystem::path(path).extension().string();
-  return ext == ".ele" || ext == ".msh";
-}
-
 void run(CheckCommandOptions o, const CommonOptions& common, int& exitCode) {
-  if (!isVolumeMeshPath(o.input) && !isTetMeshPath(o.input))
+  if (!isVolumeMeshPath(o.input) && !isTetMeshFile(o.input))
     throw InputError(o.input +
                      ": check reads simulation meshes (.vtu) and tet meshes (TetGen .ele, Gmsh "
                      ".msh); for a surface use 'polydg info'");
   if (!o.report.empty()) requireDistinct(o.report, o.input);
-  Model model =
-      isTetMeshPath(o.input) ? Model(toPolyMesh(readTetMesh(o.input))) : Model::read(o.input);
+  Model model = Model::read(o.input);
   if (o.skipDg) {
     o.check.local = false;
     o.check.rigidModes = GlobalCheck::Never;

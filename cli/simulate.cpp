@@ -13,6 +13,8 @@
 #include "cli/options.h"
 #include "cli/progress.h"
 #include "model/files.h"
+#include "polydg/mesh/tet_mesh.h"
+#include "polydg/model/names.h"
 #include "polydg/model/report_json.h"
 #include "polydg/model/scene.h"
 
@@ -25,9 +27,10 @@ struct SimulateCommandOptions {
 };
 
 void run(const SimulateCommandOptions& o, const CommonOptions& common) {
-  if (!isVolumeMeshPath(o.input))
+  if (!isVolumeMeshPath(o.input) && !isTetMeshFile(o.input))
     throw InputError(o.input +
-                     ": simulate reads simulation meshes (.vtu); make one with 'polydg mesh'");
+                     ": simulate reads simulation meshes (.vtu; make one with 'polydg mesh') "
+                     "and, for the tet methods, tet meshes (TetGen .ele, Gmsh .msh)");
   if (!o.report.empty()) {
     requireDistinct(o.report, o.input);
     requireDistinct(o.report, o.scene);
@@ -89,8 +92,11 @@ void run(const SimulateCommandOptions& o, const CommonOptions& common) {
       stepping += s.seconds;
     }
     const double n = static_cast<double>(r.steps.size());
-    std::cout << o.input << ": " << r.elements << " elements, " << r.dofs << " DOFs, "
-              << r.steps.size() << " steps of dt " << scene.dt << " ("
+    std::cout << o.input << ": "
+              << (scene.tetMethod
+                      ? toString(*scene.tetMethod) + ", " + std::to_string(r.elements) + " tets, "
+                      : std::to_string(r.elements) + " elements, ")
+              << r.dofs << " DOFs, " << r.steps.size() << " steps of dt " << scene.dt << " ("
               << (scene.corotational ? "corotational" : "linear") << ", "
               << nameOf(integratorNames(), scene.integrator) << ")"
               << (iterations ? ", " + std::to_string(iterations) + " CG iterations" : "") << '\n'
@@ -127,7 +133,11 @@ void addSimulateCommand(CLI::App& app, const CommonOptions& common, int& exitCod
   auto o = std::make_shared<SimulateCommandOptions>();
   CLI::App* cmd = app.add_subcommand(
       "simulate", "Move a body in time (corotational DG dynamics, cuts while it moves)");
-  cmd->add_option("mesh", o->input, "simulation mesh (.vtu)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("mesh", o->input,
+                  "simulation mesh (.vtu); for \"method\": \"fem\" or \"fs-fem\" a tet mesh "
+                  "(.vtu of tets, TetGen .ele, Gmsh .msh)")
+      ->required()
+      ->check(CLI::ExistingFile);
   cmd->add_option("--scene", o->scene, "the scene (JSON; see README.md, Scenes)")
       ->required()
       ->check(CLI::ExistingFile);

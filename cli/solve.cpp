@@ -57,13 +57,6 @@ void checkOutputsAndClamps(const SolveCommandOptions& o) {
         "--clamp-below or --clamp-box");
 }
 
-/// The tet methods' names (physics/fem/), beside methodNames()'s DG ones.
-std::optional<TetMethod> tetMethod(const std::string& name) {
-  if (name == "fem") return TetMethod::Fem;
-  if (name == "fs-fem") return TetMethod::FsFem;
-  return std::nullopt;
-}
-
 /// --method fem|fs-fem: the tet mesh solved by solveOnTets, written with its displacement.
 void runOnTets(const SolveCommandOptions& o, TetMethod method, const CommonOptions& common) {
   if (!o.dgOnlyGiven.empty())
@@ -117,7 +110,8 @@ void runOnTets(const SolveCommandOptions& o, TetMethod method, const CommonOptio
 }
 
 void run(const SolveCommandOptions& o, const CommonOptions& common) {
-  if (const std::optional<TetMethod> tets = tetMethod(o.method)) return runOnTets(o, *tets, common);
+  if (const std::optional<TetMethod> tets = parseName(tetMethodNames(), o.method))
+    return runOnTets(o, *tets, common);
   if (!isVolumeMeshPath(o.input))
     throw InputError(o.input +
                      ": solve reads simulation meshes (.vtu); make one with 'polydg mesh'");
@@ -226,7 +220,7 @@ void addSolveCommand(CLI::App& app, const CommonOptions& common, int& exitCode) 
   DiscretizationOptions& d = s.discretization;
   std::vector<std::string> methods;
   for (const auto& [name, method] : methodNames()) methods.push_back(name);
-  methods.insert(methods.end(), {"fem", "fs-fem"});
+  for (const auto& [name, method] : tetMethodNames()) methods.push_back(name);
   cmd->add_option("--method", o->method,
                   "the method: DG on any simulation mesh (ip: interior penalty, bz), or on a tet "
                   "mesh (.vtu of tets, TetGen .ele, Gmsh .msh) linear FEM (fem) or the "
@@ -308,7 +302,7 @@ void addSolveCommand(CLI::App& app, const CommonOptions& common, int& exitCode) 
                   "the surface --surface carries (default: the one the mesh was sliced from)")
       ->check(CLI::ExistingFile);
   cmd->callback([o, cmd, &common, &exitCode] {
-    if (tetMethod(o->method)) {
+    if (parseName(tetMethodNames(), o->method)) {
       for (const char* name :
            {"--degree", "--bz-penalty", "--penalty", "--eta", "--adapt", "--surface", "--embed"})
         if (cmd->count(name) > 0) o->dgOnlyGiven.push_back(name);

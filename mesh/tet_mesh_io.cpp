@@ -516,10 +516,24 @@ TetMesh readVtuTets(const std::string& path) {
 
 }  // namespace
 
-TetMesh readTetMesh(const std::string& path) {
+namespace {
+
+std::string lowerExtension(const std::string& path) {
   std::string extension = std::filesystem::path(path).extension().string();
   std::transform(extension.begin(), extension.end(), extension.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return extension;
+}
+
+}  // namespace
+
+bool isTetMeshFile(const std::string& path) {
+  const std::string extension = lowerExtension(path);
+  return extension == ".ele" || extension == ".msh";
+}
+
+TetMesh readTetMesh(const std::string& path) {
+  const std::string extension = lowerExtension(path);
   try {
     if (extension == ".vtu") return readVtuTets(path);
     if (extension == ".ele") return readTetgen(path);

@@ -17,6 +17,7 @@
 #include "physics/solvers/static_solver.h"
 #include "polydg/mesh/geometry.h"
 #include "polydg/mesh/surface_io.h"
+#include "polydg/mesh/tet_mesh.h"
 #include "polydg/model/names.h"
 #include "polydg/model/provenance.h"
 #include "polydg/util/error.h"
@@ -235,7 +236,11 @@ Model Model::read(const std::string& path, ReadReport* report) {
   VtuFieldData fields;
   PolyMesh mesh;
   try {
-    mesh = readVtu(path, &fields);
+    if (isTetMeshFile(path)) {
+      mesh = toPolyMesh(readTetMesh(path));
+    } else {
+      mesh = readVtu(path, &fields);
+    }
   } catch (const InputError&) {
     throw;
   } catch (const std::exception& e) {

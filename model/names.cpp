@@ -7,6 +7,11 @@ const Names<Method>& methodNames() {
   return names;
 }
 
+const Names<TetMethod>& tetMethodNames() {
+  static const Names<TetMethod> names{{"fem", TetMethod::Fem}, {"fs-fem", TetMethod::FsFem}};
+  return names;
+}
+
 const Names<BzPenalty>& bzPenaltyNames() {
   static const Names<BzPenalty> names{{"fixed", BzPenalty::Fixed}, {"super", BzPenalty::Super}};
   return names;

@@ -396,10 +396,14 @@ json toJson(const Scene& s) {
   j["material"] = {{"E", s.material.youngsModulus},
                    {"nu", s.material.poissonRatio},
                    {"density", s.material.density}};
-  j["method"] = toString(s.discretization.method);
-  if (s.discretization.method == Method::BZ)
-    j["bz_penalty"] = toString(s.discretization.bzPenaltyInEffect());
-  j["degree"] = s.discretization.basis.degree;
+  if (s.tetMethod) {
+    j["method"] = toString(*s.tetMethod);
+  } else {
+    j["method"] = toString(s.discretization.method);
+    if (s.discretization.method == Method::BZ)
+      j["bz_penalty"] = toString(s.discretization.bzPenaltyInEffect());
+    j["degree"] = s.discretization.basis.degree;
+  }
   j["corotational"] = s.corotational;
   j["integrator"] = nameOf(integratorNames(), s.integrator);
   j["solver"] = toString(s.solver);

@@ -90,6 +90,20 @@ void readContact(JsonObjectReader& r, Scene& s) {
   }
 }
 
+/// The edits and contact of a DG body, which the tet methods do not have.
+void refuseOnTets(const Scene& s) {
+  auto refuse = [&](const char* key, const char* what) {
+    throw InvalidOption(key, std::string(what) + " is for the DG methods (ip, bz), not " +
+                                 toString(*s.tetMethod) + "; leave it out or use a DG method");
+  };
+  if (!s.cuts.empty()) refuse("cuts", "cutting while the body moves");
+  if (s.embed.enabled) refuse("embed", "an embedded surface");
+  if (!s.obstacles.empty()) refuse("obstacles", "contact with obstacles");
+  if (s.adapt.enabled) refuse("adapt", "refinement by stress");
+  if (s.discretization.basis.degree != BasisOptions{}.degree)
+    refuse("degree", "a polynomial degree");
+}
+
 }  // namespace
 
 void checkScene(const Scene& s) {
@@ -134,6 +148,7 @@ void checkScene(const Scene& s) {
   checkAtLeast(s.contact.stiffness, 0.0, "contact.stiffness", "must be a positive number");
   checkAtLeast(s.contact.friction, 0.0, "contact.friction", "must be a number >= 0");
   checkAtLeast(s.contact.slipSpeed, 0.0, "contact.slip_speed", "must be a positive speed");
+  if (s.tetMethod) refuseOnTets(s);
   if (s.adapt.enabled) {
     if (!(s.adapt.stress > 0.0 && s.adapt.stress < kHuge))
       throw InvalidOption("adapt.stress", "must be a positive stress");
@@ -150,7 +165,22 @@ Scene parseScene(const json& document, const std::string& file) {
   JsonObjectReader r(document, "", file, kHint);
   Scene s;
   s.material = readMaterial(r, s.material);  // "material" is required
-  if (r.has("method")) s.discretization.method = r.choice("method", methodNames());
+  if (r.has("method")) {
+    const std::string name = r.string("method");
+    if (const auto tets = parseName(tetMethodNames(), name)) {
+      s.tetMethod = tets;
+    } else if (const auto dg = parseName(methodNames(), name)) {
+      s.discretization.method = *dg;
+    } else {
+      r.fail(r.at("method"), "'" + name + "' is not one of " + listNames(methodNames()) + ", " +
+                                 listNames(tetMethodNames()));
+    }
+  }
+  if (s.tetMethod)
+    for (const char* key : {"degree", "bz_penalty"})
+      if (r.has(key))
+        r.fail(r.at(key), std::string("is an option of the DG methods (ip, bz), not of ") +
+                              toString(*s.tetMethod) + "; leave it out");
   if (r.has("bz_penalty")) s.discretization.bzPenalty = r.choice("bz_penalty", bzPenaltyNames());
   if (r.has("degree")) s.discretization.basis.degree = r.integer("degree");
   if (r.has("corotational")) s.corotational = r.boolean("corotational");

@@ -1,5 +1,7 @@
 #include "model/simulation.h"
 
+#include "model/tet_simulation.h"
+
 #include <cmath>
 #include <unordered_set>
 
@@ -76,7 +78,8 @@ std::vector<Obstacle> makeObstacles(const Scene& scene, double diagonal,
   return obstacles;
 }
 
-/// What the step did with its matrix, in words.
+}  // namespace
+
 std::string solverAction(const StepReport& r, SolverKind kind, bool first) {
   if (kind == SolverKind::Cholesky)
     return first            ? "cholesky: factorized"
@@ -85,6 +88,8 @@ std::string solverAction(const StepReport& r, SolverKind kind, bool first) {
   const std::string cg = "cg (" + toString(r.preconditioner) + "): ";
   return cg + (first || r.preconditionerRebuilt ? "preconditioner built" : "preconditioner reused");
 }
+
+namespace {
 
 /// Stops the run at an edit whose checks failed (the model is then broken, as after cut()).
 void requirePassed(const OperationCheck& check, const char* what, double time) {
@@ -101,6 +106,10 @@ double relativeChange(double a, double b) {
 }  // namespace
 
 SimulationReport Model::simulate(const Scene& scene, const SimulateOptions& options) {
+  if (scene.tetMethod) {
+    state_->requireUsable();
+    return simulateOnTets(toTetMesh(mesh()), scene, options);
+  }
   return Simulation(*this, *state_, scene, options).run();
 }
 

@@ -23,6 +23,10 @@
 
 namespace polydg {
 
+/// What a time step did with its matrix, in words ("cholesky: factorization reused", "cg
+/// (block-jacobi): preconditioner built"); `first`: the solver's first step.
+std::string solverAction(const StepReport& r, SolverKind kind, bool first);
+
 class Simulation {
  public:
   /// Checks the scene (checkScene()), the mesh and the scene's selections (InputError naming

@@ -1,13 +1,45 @@
 #include "model/tet_solve.h"
 
+#include <algorithm>
+
 #include "physics/fem/tet_static.h"
 #include "polydg/mesh/geometry.h"
+#include "polydg/model/names.h"
 #include "polydg/util/error.h"
 #include "util/stopwatch.h"
 
 namespace polydg {
 
-const char* toString(TetMethod method) { return method == TetMethod::Fem ? "fem" : "fs-fem"; }
+TetBoundary::TetBoundary(const TetMesh& mesh)
+    : faces_(toPolyMesh(mesh)), diagonal_(meshBounds(faces_).diagonal().norm()) {}
+
+std::vector<FaceId> TetBoundary::select(const FaceSelector& where) const {
+  std::vector<FaceId> out;
+  for (std::size_t f = 0; f < faces_.numFaces(); ++f)
+    if (!faces_.face(FaceId(f)).back.valid() && selects(where, faces_, FaceId(f), diagonal_))
+      out.push_back(FaceId(f));
+  return out;
+}
+
+std::vector<std::uint32_t> TetBoundary::nodes(const std::vector<FaceId>& faces) const {
+  std::vector<std::uint32_t> out;
+  for (FaceId f : faces)
+    for (VertexId v : faces_.face(f).vertices) out.push_back(static_cast<std::uint32_t>(v.index()));
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+Eigen::VectorXd TetBoundary::tractionLoad(const std::vector<FaceId>& faces,
+                                          const Vec3& traction) const {
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(3 * faces_.numVertices()));
+  for (FaceId face : faces) {
+    const double area = areaVector(faces_, face).norm();
+    for (VertexId v : faces_.face(face).vertices)
+      f.segment<3>(3 * static_cast<Eigen::Index>(v.index())) += traction * (area / 3.0);
+  }
+  return f;
+}
 
 TetSolveReport solveOnTets(const TetMesh& mesh, TetMethod method, const SolveOptions& options) {
   options.check();
@@ -23,9 +55,7 @@ TetSolveReport solveOnTets(const TetMesh& mesh, TetMethod method, const SolveOpt
   r.dofs = 3 * r.nodes;
   const TetDiscretization discretization(mesh, method);
 
-  // Boundary faces as a PolyMesh's, for the face selectors.
-  const PolyMesh faces = toPolyMesh(mesh);
-  const double diagonal = meshBounds(faces).diagonal().norm();
+  const TetBoundary boundary(mesh);
   TetStaticProblem problem;
   problem.material = options.material;
   problem.bodyForce = options.material.density * options.gravity;
@@ -35,26 +65,15 @@ TetSolveReport solveOnTets(const TetMesh& mesh, TetMethod method, const SolveOpt
     problem.nodalForces += discretization.bodyForceFieldLoad(options.bodyForce);
   std::vector<char> held(r.nodes, 0);
   auto hold = [&](const FaceSelector& where, const VectorField& value) {
-    for (std::size_t f = 0; f < faces.numFaces(); ++f) {
-      const Face& face = faces.face(FaceId(f));
-      if (face.back.valid() || !selects(where, faces, FaceId(f), diagonal)) continue;
-      for (VertexId v : face.vertices) {
-        held[v.index()] = 1;
-        problem.prescribed.segment<3>(3 * v.index()) =
-            value ? value(faces.position(v)) : Vec3::Zero();
-      }
+    for (std::uint32_t v : boundary.nodes(boundary.select(where))) {
+      held[v] = 1;
+      problem.prescribed.segment<3>(3 * v) = value ? value(mesh.vertices[v]) : Vec3::Zero();
     }
   };
   for (const FaceSelector& clamp : options.clamps) hold(clamp, {});
   for (const DirichletCondition& d : options.displacements) hold(d.where, d.displacement);
   for (const TractionLoad& t : options.tractions)
-    for (std::size_t f = 0; f < faces.numFaces(); ++f) {
-      const Face& face = faces.face(FaceId(f));
-      if (face.back.valid() || !selects(t.where, faces, FaceId(f), diagonal)) continue;
-      const double area = areaVector(faces, FaceId(f)).norm();
-      for (VertexId v : face.vertices)
-        problem.nodalForces.segment<3>(3 * v.index()) += t.traction * (area / 3.0);
-    }
+    problem.nodalForces += boundary.tractionLoad(boundary.select(t.where), t.traction);
   for (std::size_t v = 0; v < r.nodes; ++v)
     if (held[v]) problem.clamped.push_back(static_cast<std::uint32_t>(v));
   r.heldNodes = problem.clamped.size();

@@ -10,6 +10,24 @@
 
 namespace polydg {
 
+/// A tet mesh's boundary faces (as toPolyMesh's Surface faces) and what face selectors pick on
+/// them: the nodes a region holds, the nodal forces of a traction.
+class TetBoundary {
+ public:
+  explicit TetBoundary(const TetMesh& mesh);
+  /// The boundary faces `where` selects.
+  std::vector<FaceId> select(const FaceSelector& where) const;
+  /// The corners of `faces`, each once, in increasing order.
+  std::vector<std::uint32_t> nodes(const std::vector<FaceId>& faces) const;
+  /// A traction's nodal forces (node-major): a third of each face's force on each corner.
+  Eigen::VectorXd tractionLoad(const std::vector<FaceId>& faces, const Vec3& traction) const;
+  const PolyMesh& mesh() const { return faces_; }
+
+ private:
+  PolyMesh faces_;
+  double diagonal_ = 0.0;
+};
+
 struct TetSolveReport {
   TetMethod method = TetMethod::Fem;
   std::size_t nodes = 0, tets = 0, dofs = 0, heldNodes = 0, nonzeros = 0;
@@ -27,8 +45,5 @@ struct TetSolveReport {
 /// estimate, adaptivity, an exact solution) do not apply and are refused if set away from their
 /// defaults. Throws InvalidOption for bad options, InputError when nothing is held.
 TetSolveReport solveOnTets(const TetMesh& mesh, TetMethod method, const SolveOptions& options);
-
-/// "fem", "fs-fem".
-const char* toString(TetMethod method);
 
 }  // namespace polydg

@@ -23,23 +23,12 @@ TimeSeries::TimeSeries(const fs::path& folder, VtuEncoding encoding)
 SimulationFrame TimeSeries::write(const PolyMesh& mesh, const DynamicSolver& solver, int step,
                                   const TriangleSurface* surface,
                                   const Eigen::Matrix<double, Eigen::Dynamic, 3>* displacement) {
-  SimulationFrame frame;
-  frame.step = step;
-  frame.t = solver.time();
+  const CornerValues moved = cornerDisplacements(mesh, solver.basis(), solver.displacement());
+  const CornerValues moving = cornerDisplacements(mesh, solver.basis(), solver.velocity());
+  SimulationFrame frame =
+      writeMesh(mesh, step, solver.time(), {CellArray{"von_mises", 1, solver.vonMises()}}, {},
+                {displacementPointData(moved), displacementPointData(moving, "velocity")});
   char name[32];
-  std::snprintf(name, sizeof name, "scene_%06d.vtu", step);
-  frame.file = name;
-  const CornerValues u = cornerDisplacements(mesh, solver.basis(), solver.displacement());
-  const CornerValues v = cornerDisplacements(mesh, solver.basis(), solver.velocity());
-  const std::vector<double> vonMises = solver.vonMises();
-  VtuWriteOptions options;
-  options.encoding = encoding_;
-  try {
-    writeVtu(mesh, (folder_ / name).string(), options, {CellArray{"von_mises", 1, vonMises}}, {},
-             {displacementPointData(u), displacementPointData(v, "velocity")});
-  } catch (const std::runtime_error& e) {
-    throw InputError(e.what());
-  }
   if (surface) {
     std::snprintf(name, sizeof name, "scene_%06d.vtp", step);
     frame.surfaceFile = name;
@@ -59,6 +48,35 @@ SimulationFrame TimeSeries::write(const PolyMesh& mesh, const DynamicSolver& sol
   }
   frames_.push_back(frame);
   writeCollection();
+  return frame;
+}
+
+SimulationFrame TimeSeries::write(const PolyMesh& mesh, int step, double t,
+                                  const std::vector<CellArray>& cells,
+                                  const std::vector<PointArray>& points) {
+  SimulationFrame frame = writeMesh(mesh, step, t, cells, points, {});
+  frames_.push_back(frame);
+  writeCollection();
+  return frame;
+}
+
+SimulationFrame TimeSeries::writeMesh(const PolyMesh& mesh, int step, double t,
+                                      const std::vector<CellArray>& cells,
+                                      const std::vector<PointArray>& points,
+                                      const std::vector<CornerArray>& corners) const {
+  SimulationFrame frame;
+  frame.step = step;
+  frame.t = t;
+  char name[32];
+  std::snprintf(name, sizeof name, "scene_%06d.vtu", step);
+  frame.file = name;
+  VtuWriteOptions options;
+  options.encoding = encoding_;
+  try {
+    writeVtu(mesh, (folder_ / name).string(), options, cells, points, corners);
+  } catch (const std::runtime_error& e) {
+    throw InputError(e.what());
+  }
   return frame;
 }
 

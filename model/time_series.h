@@ -27,8 +27,17 @@ class TimeSeries {
   SimulationFrame write(const PolyMesh& mesh, const DynamicSolver& solver, int step,
                         const TriangleSurface* surface,
                         const Eigen::Matrix<double, Eigen::Dynamic, 3>* displacement);
+  /// A frame with the given point and cell data on `mesh` (the tet methods' frames: point
+  /// displacement and velocity).
+  SimulationFrame write(const PolyMesh& mesh, int step, double t,
+                        const std::vector<CellArray>& cells, const std::vector<PointArray>& points);
 
  private:
+  /// Writes the frame's VTU (scene_NNNNNN.vtu) and returns the frame, not yet listed.
+  SimulationFrame writeMesh(const PolyMesh& mesh, int step, double t,
+                            const std::vector<CellArray>& cells,
+                            const std::vector<PointArray>& points,
+                            const std::vector<CornerArray>& corners) const;
   void writeCollection() const;
 
   std::filesystem::path folder_;

@@ -1,6 +1,7 @@
 #include "physics/fem/tet_discretization.h"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 #include <tuple>
@@ -201,6 +202,26 @@ std::vector<Eigen::Matrix3d> TetDiscretization::domainRotations(
     }
     const Eigen::Quaterniond q0(tetRotations[d.tets[0]]), q1(tetRotations[d.tets[1]]);
     out[i] = q0.slerp(d.tetVolume[1] / d.volume, q1).toRotationMatrix();
+  }
+  return out;
+}
+
+std::vector<double> TetDiscretization::tetVonMises(const Eigen::VectorXd& x,
+                                                   const Material& material,
+                                                   bool corotational) const {
+  std::vector<double> out(tets_.size());
+  const double lambda = material.lambda(), mu = material.mu();
+  for (std::size_t t = 0; t < tets_.size(); ++t) {
+    const auto& c = tets_[t];
+    Eigen::Matrix3d edges;
+    for (int k = 0; k < 3; ++k) edges.col(k) = x.segment<3>(3 * c[k + 1]) - x.segment<3>(3 * c[0]);
+    Eigen::Matrix3d f = edges * restEdgesInverse_[t];
+    if (corotational) f = polarRotation(f).transpose() * f;
+    const Eigen::Matrix3d strain = 0.5 * (f + f.transpose()) - Eigen::Matrix3d::Identity();
+    const Eigen::Matrix3d stress =
+        lambda * strain.trace() * Eigen::Matrix3d::Identity() + 2.0 * mu * strain;
+    const Eigen::Matrix3d deviator = stress - stress.trace() / 3.0 * Eigen::Matrix3d::Identity();
+    out[t] = std::sqrt(1.5 * deviator.squaredNorm());
   }
   return out;
 }

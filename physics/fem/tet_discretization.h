@@ -15,14 +15,9 @@
 
 #include "polydg/mesh/tet_mesh.h"
 #include "polydg/physics/dg/material.h"
+#include "polydg/physics/fem/tet_method.h"
 
 namespace polydg {
-
-/// The method on a tet mesh.
-enum class TetMethod {
-  Fem,    ///< linear FEM: one domain per tet, its constant strain
-  FsFem,  ///< FS-FEM: one domain per face (the face and its tets' centroids), smoothed strain
-};
 
 /// Where strain is constant and integrated: a tet (FEM), or the smoothing domain of a face
 /// (FS-FEM), the union of the pyramids from the face to the centroids of its one or two tets.
@@ -85,6 +80,11 @@ class TetDiscretization {
   /// exact for quadratics (appendTetrahedronRule, integrate/quadrature.h).
   Eigen::VectorXd bodyForceFieldLoad(
       const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& force) const;
+  /// Each tet's von Mises stress at positions x: of its own strain, sym(F) - I (linear), or
+  /// sym(R^T F) - I with R the polar rotation of F (corotational). For FS-FEM this is the
+  /// tet's strain, not its faces' smoothed ones: a picture of the stress, not the method's.
+  std::vector<double> tetVonMises(const Eigen::VectorXd& x, const Material& material,
+                                  bool corotational) const;
   /// The mesh's volume at positions x (node-major): the sum of its tets' signed volumes.
   double volume(const Eigen::VectorXd& x) const;
   /// The rest positions, node-major.

@@ -293,6 +293,7 @@ Eigen::VectorXd TetDynamics::System::solve(const ImplicitStep& step, StepReport&
   const bool ok = computed ? linear.update(matrix, true) : linear.compute(matrix, 3);
   computed = true;
   report.refactorized = linear.kind() == SolverKind::Cholesky;
+  report.preconditionerRebuilt = !report.refactorized;
   if (!ok) throw std::runtime_error("the tet time step's matrix is not positive definite");
   report.solves = 1;
   Eigen::VectorXd x = solveFree(step.rhs - step.forceScale * startForce, step.guess, report);
@@ -355,6 +356,7 @@ Eigen::VectorXd TetDynamics::positions() const {
 const Eigen::VectorXd& TetDynamics::velocities() const { return system_->state.v; }
 const Eigen::VectorXd& TetDynamics::displacement() const { return system_->state.u; }
 double TetDynamics::volume() const { return system_->discretization.volume(positions()); }
+SolverKind TetDynamics::solverKind() const { return system_->linear.kind(); }
 double TetDynamics::mass() const { return system_->totalMass; }
 const Eigen::Vector3d& TetDynamics::referencePoint() const { return system_->centre; }
 

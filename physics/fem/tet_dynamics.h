@@ -69,6 +69,8 @@ class TetDynamics {
   double mass() const;
   /// The rest centre of mass.
   const Eigen::Vector3d& referencePoint() const;
+  /// The solver the steps use (Cholesky or CG, once Auto has chosen at the first step).
+  SolverKind solverKind() const;
   /// Seconds of the last step: rotations and assembly, and the solve.
   double assembleSeconds() const { return last_.rotationSeconds + last_.assemblySeconds; }
   double solveSeconds() const { return last_.solveSeconds; }

@@ -7,7 +7,11 @@ a moving obstacle that reaches the body at the step the kinematics say.
 The body is a bar [0, 4] x [0, 1] x [0, 1] sliced by `polydg mesh --cells 8` (32 elements), with
 density 2: mass m = 8, inertia about its centre I = m/12 diag(1 + 1, 16 + 1, 16 + 1).
 
-Groups (one ctest each): initial, integrators, frames, phases, obstacle.
+The tet methods ("method": "fem", "fs-fem", group tets) move the same bar as 96 distorted tets
+read from Gmsh's MSH (tests/cli/solve_end_to_end.py makes them), with lumped masses computed
+here from the file's points.
+
+Groups (one ctest each): initial, integrators, frames, phases, obstacle, tets.
 Usage: simulate_end_to_end.py GROUP POLYDG WORKDIR
 """
 import json
@@ -263,8 +267,156 @@ def obstacle(polydg, work):
                   "%.3g" % p for p in pushed))
 
 
+# --- tets ----------------------------------------------------------------------------------
+
+def lumped_masses(points, cells):
+    """Each node's lumped mass: a quarter of each of its tets' mass."""
+    e = points[cells[:, 1:]] - points[cells[:, :1]]
+    volumes = np.einsum("ij,ij->i", e[:, 0], np.cross(e[:, 1], e[:, 2])) / 6.0
+    m = np.zeros(len(points))
+    np.add.at(m, cells.ravel(), np.repeat(DENSITY * volumes / 4.0, 4))
+    return m
+
+
+def tets_free(polydg, work, mesh, points, m):
+    """Free bodies: each method falls as each integrator's recurrence, undeformed; an initial
+    velocity v and angular velocity w give momentum m v and angular momentum J w with J the
+    lumped masses' inertia about their centre, and (no force) the momentum stays."""
+    dt, steps = 0.01, 12
+    bdf2_u, bdf2_v = bdf2_fall(G, dt, steps)
+    laws = {"euler": lambda n: (-G * dt * dt * n * (n + 1) / 2, -G * dt * n),
+            "newmark": lambda n: (-G * (n * dt) ** 2 / 2, -G * n * dt),
+            "bdf2": lambda n: (bdf2_u[n], bdf2_v[n])}
+    for method in ("fem", "fs-fem"):
+        for integrator, law in laws.items():
+            name = "%s, %s" % (method, integrator)
+            scene = {"material": MATERIAL, "method": method, "dt": dt, "steps": steps,
+                     "fixed": [], "integrator": integrator, "gravity": [0, 0, -G],
+                     "solver": "cholesky"}
+            r, _ = simulate(polydg, work, mesh, "tet_fall", scene)
+            equal(name + ": the report's method", r["scene"]["method"], method)
+            z0 = r["initial"]["centre_of_mass"][2]
+            worst_z = worst_p = 0.0
+            for n, s in enumerate(r["steps"], start=1):
+                z, vz = law(n)
+                worst_z = max(worst_z, abs(s["centre_of_mass"][2] - z0 - z) / abs(z))
+                worst_p = max(worst_p, abs(s["momentum"][2] - MASS * vz) / abs(MASS * vz))
+            # Measured 2026-12-05: at most 6e-14 and 1e-15; bounds 20x and more.
+            close(name + ": the fall against the recurrence, worst relative", worst_z, 0.0,
+                  1e-12, relative=False)
+            close(name + ": momentum m v_n, worst relative", worst_p, 0.0, 1e-13,
+                  relative=False)
+            close(name + ": elastic energy (no deformation), largest",
+                  max(abs(s["elastic"]) for s in r["steps"]), 0.0, 1e-12, relative=False)
+    centre = (m[:, None] * points).sum(axis=0) / m.sum()
+    q = points - centre
+    inertia = (m[:, None, None] * (np.einsum("ij,ij->i", q, q)[:, None, None] * np.eye(3) -
+                                   q[:, :, None] * q[:, None, :])).sum(axis=0)
+    v, w = np.array([0.3, -0.2, 0.5]), np.array([0.4, 1.0, -0.7])
+    for method in ("fem", "fs-fem"):
+        scene = {"material": MATERIAL, "method": method, "dt": 0.01, "steps": 20, "fixed": [],
+                 "integrator": "bdf2", "solver": "cholesky",
+                 "initial": {"velocity": v.tolist(), "angular_velocity": w.tolist()}}
+        r, _ = simulate(polydg, work, mesh, "tet_spin", scene)
+        start = r["initial"]
+        vector_close(method + ": initial momentum against m v", start["momentum"], MASS * v,
+                     1e-14, np.abs(MASS * v).max())
+        vector_close(method + ": initial angular momentum against J w (lumped masses)",
+                     start["angular_momentum"], inertia @ w, 1e-13, np.abs(inertia @ w).max())
+        vector_close(method + ": centre of mass against the lumped masses'",
+                     start["centre_of_mass"], centre, 1e-14, 4.0)
+        vector_close(method + ": momentum kept over 20 steps, worst",
+                     max((np.abs(np.asarray(s["momentum"]) - MASS * v).max(), s["momentum"])
+                         for s in r["steps"])[1], MASS * v, 1e-12, np.abs(MASS * v).max())
+
+
+def tets_frames(polydg, work, mesh, points, cells):
+    """The frames of a backward Euler fall read back with VTK: the tets' points, each point's
+    displacement (0, 0, -g dt^2 n (n+1) / 2) and velocity, von_mises per tet."""
+    dt, steps = 0.02, 5
+    scene = {"material": MATERIAL, "method": "fs-fem", "dt": dt, "steps": steps, "fixed": [],
+             "gravity": [0, 0, -G], "output": {"every": 2}, "solver": "cholesky"}
+    r, out = simulate(polydg, work, mesh, "tet_frames", scene)
+    collection = read_pvd(out / "scene.pvd")
+    equal("tet frames in the report", [f["step"] for f in r["frames"]], [0, 2, 4, 5])
+    for (t, _, name), n in zip(collection, [0, 2, 4, 5]):
+        close("tet frame %s: time n dt" % name, t, n * dt, 1e-14, relative=False)
+        vtu = Vtu(out / name)
+        check(np.array_equal(vtu.points, points), "tet frame %s: the points are the file's" % name)
+        equal("tet frame %s: cells" % name, len(vtu.cells), len(cells))
+        u, v = vtu.point_data["displacement"], vtu.point_data["velocity"]
+        z, vz = -G * dt * dt * n * (n + 1) / 2, -G * n * dt
+        close("tet frame %s: worst point's displacement against the fall" % name,
+              np.abs(u - [0, 0, z]).max(), 0.0, 1e-13 * max(abs(z), 1e-300), relative=False)
+        close("tet frame %s: worst point's velocity against the fall" % name,
+              np.abs(v - [0, 0, vz]).max(), 0.0, 1e-12 * max(abs(vz), 1e-300), relative=False)
+        close("tet frame %s: largest von Mises (no deformation)" % name,
+              float(np.abs(vtu.cell_data["von_mises"]).max()), 0.0, 1e-9, relative=False)
+
+
+def tets_settle(polydg, work, mesh):
+    """Clamped at x = 0, pulled by a traction 10 on x = 4, with nu = 0 and mass damping: the
+    bar settles on the uniaxial field u = (10 x / E, 0, 0), which both methods reproduce exactly
+    on any tets, linear or corotated (a stretch: every polar rotation is the identity)."""
+    for method in ("fem", "fs-fem"):
+        for corotational in (False, True):
+            name = "%s%s" % ("corotational " if corotational else "", method)
+            scene = {"material": {"E": 1000, "nu": 0, "density": DENSITY}, "method": method,
+                     "corotational": corotational, "dt": 0.1, "steps": 400,
+                     "damping": {"mass": 3}, "fixed": [{"axis": "x", "value": 0}],
+                     "loads": [{"traction": [10, 0, 0], "on": {"axis": "x", "value": 4}}],
+                     "output": {"every": 400}}
+            r, out = simulate(polydg, work, mesh, "tet_settle", scene)
+            equal(name + ": fixed and loaded boundary faces", [r["fixed_faces"], r["load_faces"]],
+                  [[8], [8]])
+            last = Vtu(out / r["frames"][-1]["file"])
+            exact = np.zeros_like(last.points)
+            exact[:, 0] = 10.0 * last.points[:, 0] / 1000.0
+            # Measured 2026-12-05: at most 6.8e-16 (of the end's 0.04): bound 50x.
+            close(name + ": worst point against u = (sigma x / E, 0, 0)",
+                  np.abs(last.point_data["displacement"] - exact).max(), 0.0, 1e-12 * 0.04,
+                  relative=False)
+            close(name + ": kinetic energy at rest", r["steps"][-1]["kinetic"], 0.0, 1e-20,
+                  relative=False)
+
+
+def tets_refused(polydg, work, mesh):
+    """What the tet methods do not have is refused with one line, before anything runs."""
+    base = {"material": MATERIAL, "method": "fem", "dt": 0.01, "steps": 2, "fixed": []}
+    cases = [({"cuts": [{"time": 0.01, "plane": [1, 0, 0, 2]}]}, "cuts"),
+             ({"degree": 2}, "degree"),
+             ({"fixed": [{"axis": "x", "value": 7}]}, "selects no boundary face"),
+             ({"method": "fs-femm"}, "is not one of ip, bz, fem, fs-fem")]
+    for extra, words in cases:
+        path = work / "bad_scene.json"
+        path.write_text(json.dumps(dict(base, **extra)))
+        _, err = run([polydg, "simulate", mesh, "--scene", path, "-o", work / "bad"], expect=2)
+        check(words in err and len(err.strip().splitlines()) == 1,
+              "%s refused in one line: %s" % (json.dumps(extra), err.strip()))
+    path = work / "bad_scene.json"
+    path.write_text(json.dumps(base))
+    _, err = run([polydg, "simulate", bar_mesh(polydg, work), "--scene", path, "-o",
+                  work / "bad"], expect=2)
+    check("is not a tetrahedron" in err, "a hexahedral mesh refused: " + err.strip())
+
+
+def tets(polydg, work):
+    """The tet methods through `polydg simulate` (issue 33): free bodies, frames, a loaded
+    bar settling on the closed form, refusals."""
+    from solve_end_to_end import bar_tets, write_msh
+    points, cells = bar_tets()
+    mesh = work / "bar.msh"
+    write_msh(mesh, points, cells)
+    m = lumped_masses(points, cells)
+    close("the lumped masses sum to the bar's mass", m.sum(), MASS, 1e-14)
+    tets_free(polydg, work, mesh, points, m)
+    tets_frames(polydg, work, mesh, points, cells)
+    tets_settle(polydg, work, mesh)
+    tets_refused(polydg, work, mesh)
+
+
 GROUPS = {"initial": initial, "integrators": integrators, "frames": frames,
-          "phases": phases, "obstacle": obstacle}
+          "phases": phases, "obstacle": obstacle, "tets": tets}
 
 if __name__ == "__main__":
     main(GROUPS, sys.argv)

@@ -19,6 +19,7 @@
 
 #include <gtest/gtest.h>
 
+#include "mesh/primitives.h"
 #include "mesh/vtk_format.h"
 #include "polydg/mesh/geometry_checks.h"
 #include "polydg/util/error.h"
@@ -290,6 +291,33 @@ TEST(TetMeshToPolyMesh, SharesFacesAndPassesCheckGeometry) {
         for (VertexId v : poly.face(element.faces[k].face).vertices)
           EXPECT_NE(v.value, c.mesh.tets[t][k]);
     }
+  }
+}
+
+TEST(TetMeshFromPolyMesh, GivesBackToPolyMeshsTetsAndRefusesOtherElements) {
+  for (const TetMesh& mesh : {oriented(kuhnCubes()), oriented(fiveTetCubes(true))}) {
+    PolyMesh poly = toPolyMesh(mesh);
+    poly.addVertex(Vec3(9.0, 9.0, 9.0));  // used by no element: dropped
+    const TetMesh back = toTetMesh(poly);
+    ASSERT_EQ(back.numTets(), mesh.numTets());
+    EXPECT_EQ(back.vertices, mesh.vertices);
+    for (std::size_t t = 0; t < mesh.numTets(); ++t) {
+      // The same apex, and the opposite face's corners in the same cyclic order.
+      const auto& a = mesh.tets[t];
+      const auto& b = back.tets[t];
+      EXPECT_EQ(b[0], a[0]);
+      const int shift = static_cast<int>(std::find(b.begin() + 1, b.end(), a[1]) - b.begin()) - 1;
+      ASSERT_LT(shift, 3);
+      for (int k = 0; k < 3; ++k) EXPECT_EQ(b[1 + (shift + k) % 3], a[1 + k]) << "tet " << t;
+    }
+  }
+  try {
+    toTetMesh(boxMesh(Box3(Vec3::Zero(), Vec3::Ones())));
+    ADD_FAILURE() << "a hexahedron was taken for a tet";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("element 0 (6 faces, 8 corners) is not a tetrahedron"),
+              std::string::npos)
+        << e.what();
   }
 }
 

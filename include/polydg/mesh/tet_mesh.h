@@ -49,6 +49,10 @@ inline constexpr std::array<std::array<int, 3>, 4> kTetFaces = {
 /// element by its number in the file (a TetGen index, a Gmsh element tag, a VTU cell index).
 TetMesh readTetMesh(const std::string& path);
 
+/// Whether `path` names a tet mesh file by its extension: .ele or .msh (case-insensitive). A
+/// .vtu may hold tets too; readVtu reads those as polyhedra and toTetMesh turns them back.
+bool isTetMeshFile(const std::string& path);
+
 /// Checks that `mesh` is a conforming tet mesh, and throws InputError naming the first problem
 /// ("tet T ..." with T its index in mesh.tets; first in order of the checks, then of T):
 ///  1. each tet: corner indices in range, four distinct corners, positive orientation by
@@ -69,5 +73,13 @@ void checkTetMesh(const TetMesh& mesh);
 /// checkTetMesh: a triangle of three tets, or of two on one side, gives faces that
 /// checkGeometry reports as duplicates; a corner index out of range throws std::out_of_range.
 PolyMesh toPolyMesh(const TetMesh& mesh);
+
+/// A PolyMesh whose elements are all tetrahedra (4 triangular faces without holes on 4
+/// corners; e.g. read from a VTU of VTK_TETRA cells, or toPolyMesh's) as a TetMesh: tet t is
+/// element t, its corners the apex opposite the element's first face and that face's corners
+/// in outward order (so toPolyMesh's tets come back with their corners); vertices no element
+/// uses are dropped, the others keep their order. Throws InputError naming the first element
+/// that is not a tetrahedron, or what checkTetMesh finds.
+TetMesh toTetMesh(const PolyMesh& mesh);
 
 }  // namespace polydg

@@ -327,8 +327,9 @@ class Model {
   static Model fromSurface(const TriangleSurface& surface, const MeshOptions& options,
                            MeshReport& report, const std::string& source = "");
 
-  /// Reads a VTU file (mesh/vtu_io.h) with its provenance if polydg wrote it. Throws InputError
-  /// for a file it cannot read.
+  /// Reads a VTU file (mesh/vtu_io.h) with its provenance if polydg wrote it, or a tet mesh
+  /// (TetGen .ele, Gmsh .msh: readTetMesh, its tets as elements). Throws InputError for a file
+  /// it cannot read.
   static Model read(const std::string& path, ReadReport* report = nullptr);
 
   const PolyMesh& mesh() const;
@@ -378,6 +379,9 @@ class Model {
   /// its validation (the model is then broken, as after cut()), or a step's solve fails.
   /// If it stops early (an error, or an exception from the progress callback), the cuts made
   /// so far stay and the solution is the one before the simulation (none after a cut).
+  /// With a tet method (scene.tetMethod: "fem", "fs-fem") the mesh must be all tetrahedra
+  /// (toTetMesh; InputError naming the first element that is not) and simulateOnTets
+  /// (model/tet_simulation.h) moves it; the model keeps its mesh and solution.
   SimulationReport simulate(const Scene& scene, const SimulateOptions& options);
 
   /// Reads `file` (or, if "", the surface the mesh was sliced from: the provenance's source)

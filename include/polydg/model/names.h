@@ -12,6 +12,7 @@
 #include "polydg/mesh/meshing.h"
 #include "polydg/model/model.h"
 #include "polydg/physics/dg/discretization.h"
+#include "polydg/physics/fem/tet_method.h"
 #include "polydg/physics/solvers/solver_options.h"
 
 namespace polydg {
@@ -21,6 +22,7 @@ template <class E>
 using Names = std::vector<std::pair<std::string, E>>;
 
 const Names<Method>& methodNames();                    ///< ip, bz
+const Names<TetMethod>& tetMethodNames();              ///< fem, fs-fem
 const Names<BzPenalty>& bzPenaltyNames();              ///< fixed, super
 const Names<SolverKind>& solverNames();                ///< auto, cholesky, cg
 const Names<PenaltyRule>& penaltyNames();              ///< bound, doubling, fixed
@@ -64,6 +66,7 @@ std::string listNames(const Names<E>& names) {
 }
 
 inline std::string toString(Method m) { return nameOf(methodNames(), m); }
+inline std::string toString(TetMethod m) { return nameOf(tetMethodNames(), m); }
 inline std::string toString(BzPenalty b) { return nameOf(bzPenaltyNames(), b); }
 inline std::string toString(SolverKind k) { return nameOf(solverNames(), k); }
 inline std::string toString(PenaltyRule r) { return nameOf(penaltyNames(), r); }

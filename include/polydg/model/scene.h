@@ -78,6 +78,10 @@ struct Scene {
   Material material;
   /// Method, BZ penalty and basis degree (a scene keeps the default penalty rule).
   DiscretizationOptions discretization;
+  /// "method": "fem" or "fs-fem": the body is a tet mesh moved by a tet method (physics/fem/)
+  /// instead of DG; unset: DG with discretization.method. The DG-only keys ("degree",
+  /// "bz_penalty", "cuts", "embed", "obstacles", "contact", "adapt") are refused with it.
+  std::optional<TetMethod> tetMethod;
   bool corotational = true;
   Integrator integrator = Integrator::BackwardEuler;
   /// The time step: required (0 until given), checked by checkScene(), the one place, and the
