@@ -29,8 +29,8 @@ struct SimulateCommandOptions {
 void run(const SimulateCommandOptions& o, const CommonOptions& common) {
   if (!isVolumeMeshPath(o.input) && !isTetMeshFile(o.input))
     throw InputError(o.input +
-                     ": simulate reads simulation meshes (.vtu; make one with 'polydg mesh') "
-                     "and, for the tet methods, tet meshes (TetGen .ele, Gmsh .msh)");
+                     ": simulate reads simulation meshes (.vtu), and tet meshes (TetGen .ele, "
+                     "Gmsh .msh) for the tet methods; make a simulation mesh with 'polydg mesh'");
   if (!o.report.empty()) {
     requireDistinct(o.report, o.input);
     requireDistinct(o.report, o.scene);

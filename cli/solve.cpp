@@ -20,7 +20,6 @@
 #include "cli/options.h"
 #include "mesh/vtp_io.h"
 #include "model/files.h"
-#include "model/tet_solve.h"
 #include "polydg/mesh/tet_mesh.h"
 #include "polydg/mesh/vtu_io.h"
 #include "polydg/model/names.h"
@@ -57,64 +56,26 @@ void checkOutputsAndClamps(const SolveCommandOptions& o) {
         "--clamp-below or --clamp-box");
 }
 
-/// --method fem|fs-fem: the tet mesh solved by solveOnTets, written with its displacement.
-void runOnTets(const SolveCommandOptions& o, TetMethod method, const CommonOptions& common) {
+/// --method fem|fs-fem: the DG-only options refused, the input a tet mesh.
+void refuseForTets(const SolveCommandOptions& o) {
   if (!o.dgOnlyGiven.empty())
     throw InputError(o.dgOnlyGiven.front() +
                      " is an option of the DG methods (ip, bz), not of "
                      "--method " +
                      o.method + "; leave it out");
-  const std::string ext = std::filesystem::path(o.input).extension().string();
-  if (ext != ".vtu" && ext != ".ele" && ext != ".msh")
+  if (!isVolumeMeshPath(o.input) && !isTetMeshFile(o.input))
     throw InputError(o.input + ": --method " + o.method +
                      " reads tet meshes (.vtu of tets, TetGen .ele, Gmsh .msh)");
-  checkOutputsAndClamps(o);
-  const Stopwatch read;
-  const TetMesh mesh = readTetMesh(o.input);
-  const double readSeconds = read.seconds();
-  const TetSolveReport r = solveOnTets(mesh, method, o.solve);
-  const Stopwatch write;
-  PointArray displacement{
-      "displacement", 3,
-      std::vector<double>(r.displacement.data(), r.displacement.data() + r.dofs)};
-  writeVtu(toPolyMesh(mesh), o.output, {}, {}, {displacement});
-  const double writeSeconds = write.seconds();
-  if (!o.report.empty()) {
-    nlohmann::json j{{"command", "solve"},
-                     {"input", o.input},
-                     {"output", o.output},
-                     {"method", toString(method)},
-                     {"nodes", r.nodes},
-                     {"tets", r.tets},
-                     {"dofs", r.dofs},
-                     {"held_nodes", r.heldNodes},
-                     {"energy", r.energy},
-                     {"max_displacement", r.maxDisplacement},
-                     {"solver",
-                      {{"used", toString(r.solver.used)},
-                       {"iterations", r.solver.iterations},
-                       {"residual", r.solver.residual}}},
-                     {"timings_s",
-                      {{"read", readSeconds},
-                       {"assemble", r.assembleSeconds},
-                       {"solve", r.solveSeconds},
-                       {"write", writeSeconds}}}};
-    writeJsonFile(o.report, j);
-  }
-  if (!common.quiet)
-    std::cout << o.input << ": " << toString(method) << ", " << r.tets << " tets, " << r.dofs
-              << " DOFs (" << r.heldNodes << " nodes held), " << toString(r.solver.used)
-              << " (residual " << r.solver.residual << ")\n  assemble " << r.assembleSeconds
-              << " s, solve " << r.solveSeconds << " s; max |u| " << r.maxDisplacement
-              << ", energy " << r.energy << "\n  wrote " << o.output << '\n';
 }
 
 void run(const SolveCommandOptions& o, const CommonOptions& common) {
-  if (const std::optional<TetMethod> tets = parseName(tetMethodNames(), o.method))
-    return runOnTets(o, *tets, common);
-  if (!isVolumeMeshPath(o.input))
+  const std::optional<TetMethod> tets = parseName(tetMethodNames(), o.method);
+  if (tets) {
+    refuseForTets(o);
+  } else if (!isVolumeMeshPath(o.input)) {
     throw InputError(o.input +
                      ": solve reads simulation meshes (.vtu); make one with 'polydg mesh'");
+  }
   checkOutputsAndClamps(o);
   if (!o.embed.empty() && o.surfaceOutput.empty())
     throw InputError("--embed names the surface --surface writes: add --surface OUT.vtp");
@@ -128,6 +89,10 @@ void run(const SolveCommandOptions& o, const CommonOptions& common) {
   Model model = Model::read(o.input, &read);
   SolveOptions options = o.solve;
   if (o.adapt) options.adapt = o.adaptOptions;
+  if (tets) {
+    options.tetMethod = tets;
+    options.discretization = DiscretizationOptions{};  // the command's degree 2 is DG's
+  }
   const SolveReport r = model.solve(options);
   for (const std::string& w : r.warnings) std::cerr << "polydg: warning: " << w << '\n';
   const WriteReport written = model.write(o.output);
@@ -171,10 +136,14 @@ void run(const SolveCommandOptions& o, const CommonOptions& common) {
   }
   if (!common.quiet) {
     const StaticReport& s = r.solve;
-    std::cout << o.input << ": " << toString(o.solve.discretization.method)
-              << " p=" << o.solve.discretization.basis.degree << ", " << s.dofs << " DOFs, "
-              << s.nonzeros << " nonzeros, eta " << s.eta << ", " << toString(s.solver.used)
-              << " (residual " << s.solver.residual
+    if (r.tets)
+      std::cout << o.input << ": " << o.method << ", " << r.tets->tets << " tets, " << s.dofs
+                << " DOFs (" << r.tets->heldNodes << " nodes held), ";
+    else
+      std::cout << o.input << ": " << toString(o.solve.discretization.method)
+                << " p=" << o.solve.discretization.basis.degree << ", " << s.dofs << " DOFs, "
+                << s.nonzeros << " nonzeros, eta " << s.eta << ", ";
+    std::cout << toString(s.solver.used) << " (residual " << s.solver.residual
               << (s.solver.iterations ? ", " + std::to_string(s.solver.iterations) + " iterations"
                                       : std::string())
               << ")\n  integrate " << s.integrateSeconds << " s, assemble " << s.assembleSeconds

@@ -97,5 +97,9 @@ nlohmann::json readJsonDocument(const std::string& file, const std::string& what
 CutRequest readCutRequest(JsonObjectReader& r);
 /// The object under "material" of `r` ("E", "nu", "density"), over `defaults`.
 Material readMaterial(JsonObjectReader& r, Material defaults);
+/// "method" of `r`, if given: a DG method (methodNames) into `dg`, or a tet method
+/// (tetMethodNames) into `tets`; with a tet method, the DG keys "degree" and "bz_penalty" are
+/// refused.
+void readMethod(JsonObjectReader& r, Method& dg, std::optional<TetMethod>& tets);
 
 }  // namespace polydg

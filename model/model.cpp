@@ -10,6 +10,7 @@
 #include <tbb/parallel_invoke.h>
 #include <unistd.h>
 
+#include "model/tet_solve.h"
 #include "model_state.h"
 #include "physics/checks/mesh_checks.h"
 #include "physics/dg/reactions.h"
@@ -378,6 +379,18 @@ void Model::State::adoptSolution(std::unique_ptr<DgBasis> basis, Eigen::VectorXd
   solution = std::move(u);
 }
 
+namespace {
+
+/// The solution's largest displacement, jump and von Mises stress in its report.
+SolveReport summarize(const Solution& solution, SolveReport report) {
+  report.maxDisplacement = solution.corners.largestNorm();
+  for (double j : solution.fields.largestJump) report.maxJump = std::max(report.maxJump, j);
+  for (double v : solution.fields.vonMises) report.maxVonMises = std::max(report.maxVonMises, v);
+  return report;
+}
+
+}  // namespace
+
 void SolveOptions::check() const {
   try {
     material.check();
@@ -396,10 +409,19 @@ void SolveOptions::check() const {
     throw InvalidOption("exact", "an exact solution needs both its displacement and its gradient");
   if (estimate && discretization.method != Method::IP)
     throw InvalidOption("estimate", "the error estimate is for the IP method: use method ip");
+  if (tetMethod) {
+    const std::string dgOnly = " is for the DG methods (ip, bz), not " + toString(*tetMethod) +
+                               " (linear on each tet); leave it out";
+    if (adapt) throw InvalidOption("adapt", "adaptivity" + dgOnly);
+    if (estimate) throw InvalidOption("estimate", "the error estimate" + dgOnly);
+    if (exactDisplacement) throw InvalidOption("exact", "an exact solution" + dgOnly);
+    if (discretization.basis.degree != BasisOptions{}.degree)
+      throw InvalidOption("degree", "a degree" + dgOnly);
+  }
 }
 
 SolveReport Model::solve(const SolveOptions& options) {
-  if (options.adapt) return solveAdaptively(*this, options);
+  if (options.adapt && !options.tetMethod) return solveAdaptively(*this, options);
   State& s = *state_;
   s.requireUsable();
   refuseInvalid([&] { options.check(); });
@@ -407,6 +429,30 @@ SolveReport Model::solve(const SolveOptions& options) {
   s.requireValid();
   SolveReport report;
   report.options = options;
+  if (options.tetMethod) {
+    // The tet methods (physics/fem/): their nodal displacement, linear on each tet, is the
+    // model's solution as DG degree-1 polynomials, exactly.
+    std::vector<const FaceSelector*> tractions;
+    for (const TractionLoad& t : options.tractions) tractions.push_back(&t.where);
+    std::vector<FaceSelector> held = options.clamps;
+    for (const DirichletCondition& d : options.displacements) held.push_back(d.where);
+    s.checkSelections(held, tractions, report.clampFaces, report.tractionFaces);
+    const TetMesh tets = toTetMesh(m);
+    TetSolveReport solved;
+    try {
+      solved = solveOnTets(tets, *options.tetMethod, options);
+    } catch (const InvalidOption& e) {
+      throw InputError(e.what());
+    } catch (const std::runtime_error& e) {
+      throw CheckFailure(e.what());
+    }
+    fillSolveReport(solved, report);
+    const MomentCache& moments = this->moments(2);
+    auto basis = std::make_unique<DgBasis>(m, moments, BasisOptions{});
+    Eigen::VectorXd coefficients = tetCoefficients(tets, solved.displacement, *basis);
+    s.adoptSolution(std::move(basis), std::move(coefficients), options.material, moments);
+    return summarize(*s.solution, std::move(report));
+  }
   if (options.discretization.method == Method::BZ &&
       options.discretization.bzPenaltyInEffect() == BzPenalty::Fixed)
     report.warnings.push_back(
@@ -466,11 +512,7 @@ SolveReport Model::solve(const SolveOptions& options) {
   StaticSolution solved = solver.release();
   s.adoptSolution(std::move(solved.basis), std::move(solved.coefficients), options.material,
                   moments);
-  const Solution& solution = *s.solution;
-  report.maxDisplacement = solution.corners.largestNorm();
-  for (double j : solution.fields.largestJump) report.maxJump = std::max(report.maxJump, j);
-  for (double v : solution.fields.vonMises) report.maxVonMises = std::max(report.maxVonMises, v);
-  return report;
+  return summarize(*s.solution, std::move(report));
 }
 
 const Solution* Model::solution() const { return state_->solution ? &*state_->solution : nullptr; }

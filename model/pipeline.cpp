@@ -78,6 +78,25 @@ Material readMaterial(JsonObjectReader& r, Material material) {
   return material;
 }
 
+void readMethod(JsonObjectReader& r, Method& dg, std::optional<TetMethod>& tets) {
+  if (r.has("method")) {
+    const std::string name = r.string("method");
+    if (const auto tet = parseName(tetMethodNames(), name)) {
+      tets = tet;
+    } else if (const auto method = parseName(methodNames(), name)) {
+      dg = *method;
+    } else {
+      r.fail(r.at("method"), "'" + name + "' is not one of " + listNames(methodNames()) + ", " +
+                                 listNames(tetMethodNames()));
+    }
+  }
+  if (tets)
+    for (const char* key : {"degree", "bz_penalty"})
+      if (r.has(key))
+        r.fail(r.at(key), std::string("is an option of the DG methods (ip, bz), not of ") +
+                              toString(*tets) + "; leave it out");
+}
+
 namespace {
 
 constexpr const char* kHint = "see the pipeline format in docs/guide.md";
@@ -150,7 +169,7 @@ SolveStep solveStep(JsonObjectReader& r) {
   SolveStep s;
   SolveOptions& o = s.options;
   DiscretizationOptions& d = o.discretization;
-  if (r.has("method")) d.method = r.choice("method", methodNames());
+  readMethod(r, d.method, o.tetMethod);
   if (r.has("bz_penalty")) d.bzPenalty = r.choice("bz_penalty", bzPenaltyNames());
   if (r.has("degree")) d.basis.degree = r.integer("degree");
   if (r.has("material")) o.material = readMaterial(r, o.material);

@@ -350,7 +350,18 @@ json toJson(const SolveReport& report) {
                               {"dirichlet", std::sqrt(report.estimate->dirichlet)}}
                        : json(nullptr)},
       {"adapt", adaptJson(report)}};
-  if (o.discretization.method == Method::BZ) {
+  if (o.tetMethod) {
+    // No penalty and no jumps: the tet methods are continuous.
+    j["method"] = toString(*o.tetMethod);
+    for (const char* dgOnly : {"penalty_rule", "eta", "eta_threshold", "penalty_attempts",
+                               "basis_fallbacks", "max_jump", "estimate", "adapt"})
+      j.erase(dgOnly);
+    if (report.tets) {
+      j["nodes"] = report.tets->nodes;
+      j["tets"] = report.tets->tets;
+      j["held_nodes"] = report.tets->heldNodes;
+    }
+  } else if (o.discretization.method == Method::BZ) {
     j["bz_penalty"] = toString(o.discretization.bzPenaltyInEffect());
     j["bz_factor"] = r.bzFactor;
   }

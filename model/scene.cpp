@@ -165,22 +165,7 @@ Scene parseScene(const json& document, const std::string& file) {
   JsonObjectReader r(document, "", file, kHint);
   Scene s;
   s.material = readMaterial(r, s.material);  // "material" is required
-  if (r.has("method")) {
-    const std::string name = r.string("method");
-    if (const auto tets = parseName(tetMethodNames(), name)) {
-      s.tetMethod = tets;
-    } else if (const auto dg = parseName(methodNames(), name)) {
-      s.discretization.method = *dg;
-    } else {
-      r.fail(r.at("method"), "'" + name + "' is not one of " + listNames(methodNames()) + ", " +
-                                 listNames(tetMethodNames()));
-    }
-  }
-  if (s.tetMethod)
-    for (const char* key : {"degree", "bz_penalty"})
-      if (r.has(key))
-        r.fail(r.at(key), std::string("is an option of the DG methods (ip, bz), not of ") +
-                              toString(*s.tetMethod) + "; leave it out");
+  readMethod(r, s.discretization.method, s.tetMethod);
   if (r.has("bz_penalty")) s.discretization.bzPenalty = r.choice("bz_penalty", bzPenaltyNames());
   if (r.has("degree")) s.discretization.basis.degree = r.integer("degree");
   if (r.has("corotational")) s.corotational = r.boolean("corotational");

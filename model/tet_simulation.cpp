@@ -57,7 +57,8 @@ PointArray pointArray(const char* name, const Eigen::VectorXd& values) {
 }  // namespace
 
 SimulationReport simulateOnTets(const TetMesh& mesh, const Scene& scene,
-                                const SimulateOptions& options) {
+                                const SimulateOptions& options,
+                                Eigen::VectorXd* finalDisplacement) {
   const Stopwatch wall;
   refuseInvalid([&] { checkScene(scene); });
   if (!scene.tetMethod) throw std::logic_error("simulateOnTets needs a scene with a tet method");
@@ -110,6 +111,7 @@ SimulationReport simulateOnTets(const TetMesh& mesh, const Scene& scene,
     if (k % scene.outputEvery == 0 || k == scene.steps) writeFrame(k);
     if (options.progress) options.progress({k, scene.steps, body.time()});
   }
+  if (finalDisplacement) *finalDisplacement = body.displacement();
   report.wallSeconds = wall.seconds();
   return report;
 }

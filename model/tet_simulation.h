@@ -12,8 +12,10 @@ namespace polydg {
 /// Runs `scene` (its tetMethod set) on `mesh`. A fixed region holds every corner of the
 /// boundary faces it selects; a load puts a third of each selected face's force on each
 /// corner. Throws InputError for a bad scene or a region that selects no boundary face,
-/// CheckFailure if a step's solve fails.
+/// CheckFailure if a step's solve fails. `finalDisplacement`, if given, takes the nodes'
+/// displacement at the end (node-major).
 SimulationReport simulateOnTets(const TetMesh& mesh, const Scene& scene,
-                                const SimulateOptions& options);
+                                const SimulateOptions& options,
+                                Eigen::VectorXd* finalDisplacement = nullptr);
 
 }  // namespace polydg

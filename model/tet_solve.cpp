@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "physics/checks/linear_field.h"
 #include "physics/fem/tet_static.h"
 #include "polydg/mesh/geometry.h"
 #include "polydg/model/names.h"
@@ -42,11 +43,9 @@ Eigen::VectorXd TetBoundary::tractionLoad(const std::vector<FaceId>& faces,
 }
 
 TetSolveReport solveOnTets(const TetMesh& mesh, TetMethod method, const SolveOptions& options) {
-  options.check();
-  if (options.adapt || options.estimate || options.exactDisplacement)
-    throw InvalidOption("method", std::string("adaptivity, the error estimate and an exact "
-                                              "solution are for the DG methods, not ") +
-                                      toString(method));
+  SolveOptions checked = options;
+  checked.tetMethod = method;
+  checked.check();
   const Stopwatch assemble;
   TetSolveReport r;
   r.method = method;
@@ -90,10 +89,48 @@ TetSolveReport solveOnTets(const TetMesh& mesh, TetMethod method, const SolveOpt
   r.solveSeconds = solve.seconds();
   r.solver = s.solve;
   r.energy = s.strainEnergy;
+  r.nonzeros = s.nonzeros;
   for (std::size_t v = 0; v < r.nodes; ++v)
     r.maxDisplacement = std::max(r.maxDisplacement, s.displacement.segment<3>(3 * v).norm());
   r.displacement = std::move(s.displacement);
   return r;
+}
+
+Eigen::VectorXd tetCoefficients(const TetMesh& mesh, const Eigen::VectorXd& displacement,
+                                const DgBasis& basis) {
+  const auto bs = static_cast<Eigen::Index>(3 * basis.size());
+  Eigen::VectorXd out(bs * static_cast<Eigen::Index>(mesh.numTets()));
+  for (std::size_t t = 0; t < mesh.numTets(); ++t) {
+    const auto& c = mesh.tets[t];
+    // u(x) = u_0 + A (x - x_0) with A (x_k - x_0) = u_k - u_0 for the three other corners.
+    Eigen::Matrix3d edges, du;
+    for (int k = 0; k < 3; ++k) {
+      edges.col(k) = mesh.vertices[c[k + 1]] - mesh.vertices[c[0]];
+      du.col(k) = displacement.segment<3>(3 * c[k + 1]) - displacement.segment<3>(3 * c[0]);
+    }
+    LinearField field;
+    field.a = du * edges.inverse();
+    field.b = displacement.segment<3>(3 * c[0]);
+    field.x0 = mesh.vertices[c[0]];
+    linearFieldCoefficients(basis, ElementId(t), field,
+                            std::span<double>(out.data() + static_cast<Eigen::Index>(t) * bs,
+                                              static_cast<std::size_t>(bs)));
+  }
+  return out;
+}
+
+void fillSolveReport(const TetSolveReport& t, SolveReport& report) {
+  StaticReport& s = report.solve;
+  s.elements = t.tets;
+  s.dofs = t.dofs;
+  s.nonzeros = t.nonzeros;
+  s.solver = t.solver;
+  s.energy = t.energy;
+  s.assembleSeconds = t.assembleSeconds;
+  s.solveSeconds = t.solveSeconds;
+  for (std::size_t n : report.clampFaces) s.dirichletFaces += n;
+  for (std::size_t n : report.tractionFaces) s.tractionFaces += n;
+  report.tets = SolveReport::TetCounts{t.nodes, t.tets, t.heldNodes};
 }
 
 }  // namespace polydg

@@ -7,6 +7,7 @@
 
 #include "physics/fem/tet_discretization.h"
 #include "polydg/model/model.h"
+#include "polydg/physics/dg/dg_basis.h"
 
 namespace polydg {
 
@@ -45,5 +46,14 @@ struct TetSolveReport {
 /// estimate, adaptivity, an exact solution) do not apply and are refused if set away from their
 /// defaults. Throws InvalidOption for bad options, InputError when nothing is held.
 TetSolveReport solveOnTets(const TetMesh& mesh, TetMethod method, const SolveOptions& options);
+
+/// The nodal displacement (node-major) of a tet solve as DG coefficients in `basis` (degree 1
+/// or more, on toPolyMesh(mesh)'s elements or any PolyMesh whose element t is tet t): exact,
+/// since the displacement is linear on each tet (linearFieldCoefficients).
+Eigen::VectorXd tetCoefficients(const TetMesh& mesh, const Eigen::VectorXd& displacement,
+                                const DgBasis& basis);
+
+/// The figures of a tet solve in Model::solve()'s report: counts, solver, energy, times.
+void fillSolveReport(const TetSolveReport& t, SolveReport& report);
 
 }  // namespace polydg

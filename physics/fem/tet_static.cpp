@@ -45,6 +45,7 @@ TetStaticSolution solveTetStatic(const TetDiscretization& discretization,
     if (freeIndex[i] >= 0) rhs[freeIndex[i]] = load[i];
 
   TetStaticSolution out;
+  out.nonzeros = static_cast<std::size_t>(kf.nonZeros());
   // The p-multigrid needs the DG basis's layout: CG on nodes takes block Jacobi on the nodes'
   // 3 x 3 blocks (a node is held or free as a whole).
   SolverOptions solver = options;

@@ -25,6 +25,7 @@ struct TetStaticProblem {
 struct TetStaticSolution {
   Eigen::VectorXd displacement;  ///< node-major
   double strainEnergy = 0.0;     ///< u^T K u / 2
+  std::size_t nonzeros = 0;      ///< stored entries of the free DOFs' matrix
   LinearSolveReport solve;
 };
 

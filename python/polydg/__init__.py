@@ -105,8 +105,10 @@ def mesh(surface, cells=None, cell=None, repair="none", merge_slivers=None, dg_c
 
 
 def read(path):
-    """Reads a simulation mesh (VTU) into a ``Model``, with its provenance if polydg wrote it.
-    Raises ``Error`` for a file it cannot read."""
+    """Reads a simulation mesh (VTU) into a ``Model``, with its provenance if polydg wrote it;
+    or a tet mesh (TetGen .ele with its .node, Gmsh MSH 4.1 .msh), each tet an element, for
+    the tet methods ("fem", "fs-fem" in ``solve`` and in scenes). Raises ``Error`` for a file it
+    cannot read (a tet mesh's bad tet named)."""
     model, report = _polydg.read(_os.fspath(path))
     model.report = report
     return model
@@ -167,13 +169,17 @@ def _check(self, degree=1):
     return self._check(degree=degree)
 
 
-def _solve(self, method="ip", degree=1, E=None, nu=None, density=None, gravity=None,
+def _solve(self, method="ip", degree=None, E=None, nu=None, density=None, gravity=None,
            clamp=None, traction=None, solver=None, penalty=None, eta=None, adapt=None,
            estimate=None, bz_penalty=None):
-    """Static linear elasticity with DG (``polydg solve``) on the model; keeps the solution for
+    """Static linear elasticity (``polydg solve``) on the model; keeps the solution for
     ``write``.
 
-    method: "ip" (interior penalty) or "bz" (Babuska-Zlamal); degree: 1-3.
+    method: DG, "ip" (interior penalty) or "bz" (Babuska-Zlamal), with degree 1-3 (default 1);
+    or on a model of tetrahedra (``read`` of a .msh, .ele or a VTU of tets) "fem" (linear FEM)
+    or "fs-fem" (the face-based smoothed FEM), which clamp every corner of a clamp's faces and
+    take no DG option (degree, bz_penalty, penalty, eta, adapt, estimate). Their solution,
+    linear on each tet, is the model's as DG degree 1.
     bz_penalty: with method="bz", "super" (the default: the superpenalty ~h^-(2p+1), converges
     at rate >= p, with a stiffer system) or "fixed" (penalty ~1/h, cheap, but its error does not
     fall under refinement: the report's "warnings" says so).
@@ -234,6 +240,8 @@ def _simulate(self, scene, output=None, progress=None):
     """Moves the body in time (``polydg simulate``): dynamic DG elasticity through the steps of
     ``scene``, with its cuts made at their times on this model. Afterwards the model holds the
     cut mesh and, as its solution, the final displacement (``element_displacements``, ``write``).
+    With "method": "fem" or "fs-fem" a model of tetrahedra moves by the tet method instead
+    (no cuts, embedding, obstacles or adaptivity).
 
     scene: a dict in the scene format of docs/guide.md (material, dt, steps or duration, gravity,
     fixed, loads, initial, cuts, embed, obstacles, contact, ...), or the path (str or

@@ -19,6 +19,7 @@
 #include "polydg/physics/contact/embedding.h"
 #include "polydg/physics/dg/loads.h"
 #include "polydg/physics/dg/post_process.h"
+#include "polydg/physics/fem/tet_method.h"
 #include "polydg/physics/solvers/error_estimate.h"
 #include "polydg/physics/solvers/static_report.h"
 
@@ -226,6 +227,11 @@ struct SolveOptions {
   GradientField exactGradient;
   /// Solve adaptively (the model is refined in place); unset: one solve.
   std::optional<AdaptOptions> adapt;
+  /// A tet method ("fem", "fs-fem") instead of DG: the model must be all tetrahedra, and the
+  /// DG options (degree, penalty, the estimate, adaptivity, an exact solution) keep their
+  /// defaults. A clamp holds every corner of the faces it selects (strongly); a traction puts a
+  /// third of each face's force on each corner.
+  std::optional<TetMethod> tetMethod;
 
   /// The one check of a solve's options (material, discretization, finite loads, something
   /// that holds the body, the estimate's method): throws InvalidOption naming the key.
@@ -271,6 +277,11 @@ struct SolveReport {
   std::vector<Vec3> clampForces;
   /// What the user should know about the result, a sentence each (BZ's fixed penalty).
   std::vector<std::string> warnings;
+  /// A tet method's counts (SolveOptions::tetMethod), unset for DG.
+  struct TetCounts {
+    std::size_t nodes = 0, tets = 0, heldNodes = 0;
+  };
+  std::optional<TetCounts> tets;
 };
 
 /// The solution of the model's last solve, until the mesh changes.
@@ -381,7 +392,8 @@ class Model {
   /// so far stay and the solution is the one before the simulation (none after a cut).
   /// With a tet method (scene.tetMethod: "fem", "fs-fem") the mesh must be all tetrahedra
   /// (toTetMesh; InputError naming the first element that is not) and simulateOnTets
-  /// (model/tet_simulation.h) moves it; the model keeps its mesh and solution.
+  /// (model/tet_simulation.h) moves it; the model's solution is then the final displacement
+  /// (linear on each tet, as DG degree 1).
   SimulationReport simulate(const Scene& scene, const SimulateOptions& options);
 
   /// Reads `file` (or, if "", the surface the mesh was sliced from: the provenance's source)

@@ -365,6 +365,19 @@ TEST(BenchCommand, SfemSuiteShowsThePapersFindings) {
   for (const char* linear : {"L-FEM", "LFS-FEM"})
     for (const char* warped : {"C-FEM", "CS-FEM"})
       EXPECT_GT(volume[linear], 10 * volume[warped]) << linear << " against " << warped;
+  // Time per step: each size's C-FEM and CS-FEM rows, then DG at about the same DOFs (an
+  // n x m x m grid at 12 DOFs an element: within 10% of the tets' 3 per node).
+  const nlohmann::json& steps = j["time_per_step"];
+  ASSERT_EQ(steps.size(), 6u);  // quick: k = 1, 2
+  for (std::size_t i = 0; i < steps.size(); i += 3) {
+    EXPECT_EQ(steps[i]["method"], "C-FEM");
+    EXPECT_EQ(steps[i + 1]["method"], "CS-FEM");
+    ASSERT_EQ(steps[i + 2]["method"], "IP p = 1");
+    const double tetDofs = 3.0 * steps[i]["nodes"].get<double>();
+    const double ratio = steps[i + 2]["dofs"].get<double>() / tetDofs;
+    EXPECT_NEAR(ratio, 1.0, 0.1) << "size " << i / 3 + 1;
+    EXPECT_GT(steps[i + 2]["seconds_per_step"].get<double>(), 0.0);
+  }
 }
 
 TEST(BenchCommand, AdaptivitySuiteRefinesWhereItShould) {
