@@ -230,6 +230,39 @@ TEST(TetDynamics, NewmarkKeepsTheLinearBodysEnergy) {
   }
 }
 
+TEST(TetDynamics, NewmarkCorrectsTheCorotatedForceOfASpinningBody) {
+  // A free cube spun at one turn a second for one turn, corotated, Newmark: no force acts, so
+  // kinetic + elastic energy and the angular momentum stay. Linearized once per step the
+  // warped force gains energy in the rotation; the step's corrections (several solves a step)
+  // keep it.
+  const TetMesh mesh = cubeTets(3, 1.0, 0.2);
+  const TetDiscretization d(mesh, TetMethod::FsFem);
+  TetDynamicsOptions o;
+  o.material = {1e4, 0.3, 1.0};
+  o.integrator = Integrator::Newmark;
+  o.solver.kind = SolverKind::Cholesky;
+  TetDynamics body(d, o);
+  body.setRigidVelocity(Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, 2 * std::numbers::pi),
+                        body.referencePoint());
+  const BodyState start = body.state();
+  double energy = 0.0, angular = 0.0;
+  int solves = 0;
+  for (int n = 0; n < 100; ++n) {
+    solves += body.step(0.01).solves;
+    const BodyState s = body.state();
+    energy = std::max(energy, std::abs(s.kinetic + s.elastic - start.kinetic) / start.kinetic);
+    angular = std::max(angular, (s.angularMomentum - start.angularMomentum).norm() /
+                                    start.angularMomentum.norm());
+  }
+  std::cout << "energy drift " << energy << ", angular momentum drift " << angular << ", "
+            << solves / 100.0 << " solves a step\n";
+  // Measured 2026-12-05: 0.0030 and 0.0015 with the corrections (10 solves a step), 3.6 and
+  // 1.06 without them.
+  EXPECT_GT(solves, 200);
+  EXPECT_LT(energy, 0.01);
+  EXPECT_LT(angular, 0.01);
+}
+
 TEST(TetDynamics, ALoadGivesItsImpulseAndStopsAtItsTime) {
   // A free body, no gravity, a load of total force F on its nodes until t = 0.05: the elastic
   // forces sum to zero, so the momentum after the steps ending at 0.01 ... 0.05 is 5 dt F and
