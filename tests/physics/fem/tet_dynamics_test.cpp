@@ -251,8 +251,8 @@ TEST(TetDynamics, NewmarkCorrectsTheCorotatedForceOfASpinningBody) {
     solves += body.step(0.01).solves;
     const BodyState s = body.state();
     energy = std::max(energy, std::abs(s.kinetic + s.elastic - start.kinetic) / start.kinetic);
-    angular = std::max(angular, (s.angularMomentum - start.angularMomentum).norm() /
-                                    start.angularMomentum.norm());
+    angular = std::max(
+        angular, (s.angularMomentum - start.angularMomentum).norm() / start.angularMomentum.norm());
   }
   std::cout << "energy drift " << energy << ", angular momentum drift " << angular << ", "
             << solves / 100.0 << " solves a step\n";
