@@ -423,17 +423,20 @@ nlohmann::json dgStepRow(std::size_t dofs, const Log& log, SeriesSet& plot) {
   for (int n = 0; n < 2; ++n) body.step(0.01);
   const int steps = 10;
   double assemble = 0.0, solve = 0.0;
+  int iterations = 0;
   const Stopwatch watch;
   for (int n = 0; n < steps; ++n) {
     const StepReport r = body.step(0.01);
     assemble += r.rotationSeconds + r.assemblySeconds;
     solve += r.solveSeconds;
+    iterations += r.iterations;
   }
   const double perStep = watch.seconds() / steps;
   plot.add("IP p = 1 (hexahedra)", static_cast<double>(body.dofs()) / 3.0, perStep * 1e3);
   log("time per step IP p = 1, " + std::to_string(hex.numElements()) + " hexahedra (" +
       std::to_string(body.dofs()) + " DOFs): " + shortNumber(perStep * 1e3) + " ms (assembly " +
-      shortNumber(assemble / steps * 1e3) + ", solve " + shortNumber(solve / steps * 1e3) + ")");
+      shortNumber(assemble / steps * 1e3) + ", solve " + shortNumber(solve / steps * 1e3) + ", " +
+      shortNumber(static_cast<double>(iterations) / steps) + " CG iterations)");
   return {{"method", "IP p = 1"},
           {"elements", hex.numElements()},
           {"dofs", body.dofs()},
@@ -454,9 +457,10 @@ void runTimePerStep(const BenchOptions& b, SuiteOutput& s, const Log& log, Serie
       for (int n = 0; n < 2; ++n) body.step(0.01);  // warm-up: the solver's first analysis
       const int steps = 10;
       double assemble = 0.0, solve = 0.0;
+      int iterations = 0;
       const Stopwatch watch;
       for (int n = 0; n < steps; ++n) {
-        body.step(0.01);
+        iterations += body.step(0.01).iterations;
         assemble += body.assembleSeconds();
         solve += body.solveSeconds();
       }
@@ -468,15 +472,17 @@ void runTimePerStep(const BenchOptions& b, SuiteOutput& s, const Log& log, Serie
                       {"domains", d.domains().size()},
                       {"seconds_per_step", perStep},
                       {"assemble_seconds", assemble / steps},
-                      {"solve_seconds", solve / steps}});
+                      {"solve_seconds", solve / steps},
+                      {"cg_iterations", static_cast<double>(iterations) / steps}});
       s.rows.push_back({{"benchmark", "sfem time per step"},
                         {"case", name},
                         {"tets", beam.mesh.numTets()},
                         {"seconds", perStep}});
       plot.add(name, static_cast<double>(beam.mesh.numVertices()), perStep * 1e3);
-      log("time per step " + name + ", " + std::to_string(beam.mesh.numTets()) + " tets: " +
-          shortNumber(perStep * 1e3) + " ms (assembly " + shortNumber(assemble / steps * 1e3) +
-          ", solve " + shortNumber(solve / steps * 1e3) + ")");
+      log("time per step " + name + ", " + std::to_string(beam.mesh.numTets()) +
+          " tets: " + shortNumber(perStep * 1e3) + " ms (assembly " +
+          shortNumber(assemble / steps * 1e3) + ", solve " + shortNumber(solve / steps * 1e3) +
+          ", " + shortNumber(static_cast<double>(iterations) / steps) + " CG iterations)");
     }
     nlohmann::json dg = dgStepRow(3 * beam.mesh.numVertices(), log, plot);
     s.rows.push_back({{"benchmark", "sfem time per step"},

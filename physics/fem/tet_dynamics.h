@@ -37,7 +37,13 @@ struct TetDynamicsOptions {
   /// at the step's matrix) until the relative change of the solution is below this; backward
   /// Euler solves once, as the paper.
   double correctionTolerance = 1e-6;
-  SolverOptions solver;
+  /// The step's solver; CG's tolerance 1e-8 of the right-hand side (which the momentum M v
+  /// dominates), as for the DG body (DynamicsOptions::solver), not the static 1e-10.
+  SolverOptions solver = [] {
+    SolverOptions s;
+    s.tolerance = 1e-8;
+    return s;
+  }();
 };
 
 class TetDynamics {
