@@ -48,7 +48,7 @@ bool positive(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
          sixVolume(a, b, c, d) > 0.0;
 }
 
-/// "origin of element E": where a boundary face comes from and the element it bounds.
+/// "cut face of element 3": where a boundary face comes from and the element it bounds.
 std::string faceName(const PolyMesh& mesh, FaceId f) {
   const Face& face = mesh.face(f);
   return std::string(toString(face.origin)) + " face of element " +
@@ -242,8 +242,10 @@ void tetgenElement(const PolyMesh& mesh, const std::vector<Triangle>& boundary, 
   tetgenio in, result;
   fillTetgenInput(mesh, boundary, vertices, in);
   // p: the input is a boundary (a PLC); z: indices from 0; Y: no Steiner point on the
-  // boundary; Q: quiet.
-  char switches[] = "pzYQ";
+  // boundary; Q: quiet; T1e-16: TetGen's tolerance (default 1e-8 of the element's size, below
+  // which it merges two vertices) as small as it goes, since welding leaves the vertices of a
+  // sliced mesh as little as a few ulps apart (0 makes TetGen 1.5 fail).
+  char switches[] = "pzYQT1e-16";
   try {
     const std::lock_guard<std::mutex> lock(tetgenMutex);
     ::tetrahedralize(switches, &in, &result);
@@ -252,10 +254,10 @@ void tetgenElement(const PolyMesh& mesh, const std::vector<Triangle>& boundary, 
     return;
   }
   const std::size_t n = vertices.size();
-  if (result.numberofcorners != 4 || result.numberofpoints < static_cast<int>(n) ||
-      result.numberoftetrahedra < 1 ||
+  // TetGen's output starts with its input points, unless it merged some.
+  if (result.numberofpoints < static_cast<int>(n) ||
       !std::equal(in.pointlist, in.pointlist + 3 * n, result.pointlist)) {
-    out.error = "TetGen changed its vertices or gave no 4-node tets";
+    out.error = "TetGen merged or moved some of its vertices";
     return;
   }
   // TetGen's point i: the element's vertex i, then new point i - n.

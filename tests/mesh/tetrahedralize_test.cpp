@@ -214,6 +214,20 @@ TEST(Tetrahedralize, MeshAfterAPlaneCutIsExactAndItsCutFacesAreBoundary) {
   expectExactConformingSplit(editor.mesh());
 }
 
+TEST(Tetrahedralize, LShapedElementIsTheConeFromItsCentroid) {
+  // The prism over the L (0,0) (2,0) (2,1) (1,1) (1,2) (0,2): the mean of its vertices lies on
+  // the reflex edge x = y = 1, which sees the two faces through it edge-on; the centroid
+  // (5/6, 5/6, 1/2) sees every face from inside.
+  Polygon2 l;
+  l.outer = {{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}};
+  const PolyMesh mesh = prismMesh(l, 0.0, 1.0);
+  const TetrahedralizeReport r = expectExactConformingSplit(mesh);
+  EXPECT_EQ(r.coneElements, 1u);
+  EXPECT_EQ(r.steinerPoints, 1u);
+  const Vec3 apex = tetrahedralize(mesh).vertices.back();
+  EXPECT_NEAR((apex - Vec3(5.0 / 6.0, 5.0 / 6.0, 0.5)).norm(), 0.0, 1e-15);
+}
+
 TEST(Tetrahedralize, ElementWithTunnelsAndHoledFacesGoesToTetGen) {
   // One element: the prism over a U with two holes (a tunnel through its base and one through
   // its arm), its top and bottom faces with holes. Not star-shaped.
@@ -240,6 +254,27 @@ TEST(Tetrahedralize, NonStarShapedElementBesideConesConforms) {
   const TetrahedralizeReport r = expectExactConformingSplit(mesh);
   EXPECT_EQ(r.tetgenElements, 1u);
   EXPECT_EQ(r.coneElements, 11u);
+}
+
+TEST(Tetrahedralize, NonStarShapedElementWithVerticesUlpsApartGoesToTetGen) {
+  // A U-shaped prism with a vertex three ulps from its corner (3, 0, 0) on the edge to (0, 0, 0),
+  // in both faces through that edge, as welding leaves vertices of a sliced mesh a few ulps
+  // apart: TetGen keeps the two vertices apart only with a tolerance below its default 1e-8.
+  Polygon2 u;
+  u.outer = {{0, 0}, {3, 0}, {3, 3}, {2, 3}, {2, 1}, {1, 1}, {1, 3}, {0, 3}};
+  PolyMesh mesh = prismMesh(u, 0.0, 1.0);
+  VertexId origin, corner;
+  for (std::size_t v = 0; v < mesh.numVertices(); ++v) {
+    if (mesh.position(VertexId(v)) == Vec3(0, 0, 0)) origin = VertexId(v);
+    if (mesh.position(VertexId(v)) == Vec3(3, 0, 0)) corner = VertexId(v);
+  }
+  ASSERT_TRUE(origin.valid() && corner.valid());
+  const VertexId close = mesh.addVertex(Vec3(3.0 - 3 * 0x1p-51, 0, 0));  // 3 ulps of 3 below it
+  std::size_t split = 0;
+  for (std::size_t f = 0; f < mesh.numFaces(); ++f)
+    split += mesh.splitEdge(FaceId(f), origin, corner, close);
+  ASSERT_EQ(split, 2u);
+  EXPECT_EQ(expectExactConformingSplit(mesh).tetgenElements, 1u);
 }
 
 TEST(Tetrahedralize, FarFromTheOriginAndAtSmallScaleStaysExact) {

@@ -34,12 +34,12 @@ struct TetrahedralizeReport {
 /// is strictly star-shaped from it) and every cone tet's sixVolume() is positive in double
 /// precision too (the two conditions checkTetMesh() asks of each tet). Any other element (a
 /// non-convex piece of a cell, an element with a tunnel) is tetrahedralized by TetGen 1.5 with
-/// switches "pzYQ": its boundary triangles kept exactly as given (no Steiner point on the
-/// boundary), new points only inside; TetGen's result is accepted only if its boundary
-/// triangles are exactly the element's and its tets are positive by the same two conditions.
-/// Nothing is perturbed and no tolerance is used, so the tets' volumes sum, in exact
-/// arithmetic, to the polyhedral mesh's volume (the divergence theorem over its triangulated
-/// faces).
+/// switches "pzYQT1e-16": its boundary triangles kept exactly as given (no Steiner point on the
+/// boundary), new points only inside, vertices a few ulps apart kept apart; TetGen's result is
+/// accepted only if its boundary triangles are exactly the element's and its tets are positive by
+/// the same two conditions. Nothing is perturbed and no tolerance is used, so the tets' volumes
+/// sum, in exact arithmetic, to the polyhedral mesh's volume (the divergence theorem over its
+/// triangulated faces).
 ///
 /// Vertices: the mesh's vertices first, at the same indices (a point field maps one to one),
 /// then the new points element by element. Tets: element by element in element order, every
