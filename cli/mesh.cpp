@@ -1,5 +1,6 @@
 // polydg mesh: a surface file in, a polyhedral DG simulation mesh (VTU) out, checked
-// geometrically and by the element-local DG checks (degree 1): Model::fromSurface().
+// geometrically and by the element-local DG checks (degree 1): Model::fromSurface(); with --tets
+// the file holds that mesh split into tets (tetrahedralize()) for the tet methods.
 #include <iostream>
 
 #include "cli/commands.h"
@@ -20,6 +21,14 @@ struct MeshCommandOptions {
   bool skipDg = false;
 };
 
+void printTets(const TetOutputReport& t) {
+  std::cout << "  written as tets: " << t.split.tets << " tets, " << t.vertices << " vertices ("
+            << t.split.steinerPoints << " Steiner points); " << t.split.coneElements
+            << " elements as cones, " << t.split.tetgenElements << " by TetGen; volume " << t.volume
+            << " (relative difference " << t.volumeRelDifference << " from the polyhedral mesh's), "
+            << t.split.seconds << " s\n";
+}
+
 void printSummary(const MeshReport& report) {
   const MeshingReport& r = report.meshing;
   std::cout << (report.output.empty() ? std::string("(not written)") : report.output) << ": "
@@ -31,6 +40,7 @@ void printSummary(const MeshReport& report) {
             << r.volumeRelError << "), slivers merged " << r.slivers.merged << ", validation "
             << (r.geometry.passed ? "passed" : "FAILED") << "\n";
   for (const std::string& repair : r.repairs) std::cout << "  repair: " << repair << "\n";
+  if (report.tets) printTets(*report.tets);
   if (report.coarseCellSize > 0.0) {
     std::cout << "  octree: " << report.levels << " levels below cells of " << report.coarseCellSize
               << "; elements per level";
@@ -125,6 +135,11 @@ void addMeshCommand(CLI::App& app, const CommonOptions& common, int& exitCode) {
                 "octree slicing: --cell/--cells give the finest cells, used where the surface "
                 "passes; inside, cells as coarse as one level between face neighbours allows");
   cmd->add_flag("--no-dg", o->skipDg, "skip the DG checks (patch test, rigid modes) of the result");
+  cmd->add_flag("--tets", o->mesh.tets,
+                "write the output as tets (VTK_TETRA) for --method fem and fs-fem: each checked "
+                "polyhedral element split into tets of exactly its volume (a cone from an "
+                "interior point, or TetGen's tets where it is not star-shaped), conforming, the "
+                "polyhedral mesh's vertices first");
   cmd->callback([o, &common, &exitCode] { run(*o, common, exitCode); });
 }
 

@@ -9,11 +9,14 @@
 
 namespace polydg {
 
+double sixVolume(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  return (b - a).dot((c - a).cross(d - a));
+}
+
 double sixVolume(const TetMesh& mesh, std::size_t t) {
   const auto& c = mesh.tets[t];
-  // About the first corner, so that the volume does not lose digits far from the origin.
-  const Vec3& o = mesh.vertices[c[0]];
-  return (mesh.vertices[c[1]] - o).dot((mesh.vertices[c[2]] - o).cross(mesh.vertices[c[3]] - o));
+  return sixVolume(mesh.vertices[c[0]], mesh.vertices[c[1]], mesh.vertices[c[2]],
+                   mesh.vertices[c[3]]);
 }
 
 PolyMesh toPolyMesh(const TetMesh& mesh) {

@@ -19,6 +19,7 @@
 
 #include "mesh/surface_text_reading.h"
 #include "mesh/tet_mesh_check.h"
+#include "mesh/vtk_cell_types.h"
 #include "mesh/vtk_format.h"
 #include "polydg/mesh/tet_mesh.h"
 #include "polydg/util/error.h"
@@ -423,8 +424,6 @@ TetMesh readGmsh(const std::string& path) {
 // VTU
 // ============================================================================================
 
-constexpr std::int64_t kVtkTetra = 10;
-
 /// One Piece's points and tets, appended to `points`, `tets` and `naming.tetNumbers` (cells
 /// are numbered across pieces, as ParaView shows them). Throws FormatError for a damaged file,
 /// InputError for a cell polydg refuses.
@@ -460,7 +459,7 @@ void readVtuPiece(pugi::xml_node piece, const vtk_format::FileLayout& layout,
   std::int64_t begin = 0;
   for (std::size_t c = 0; c < numCells; ++c) {
     const std::string cell = naming.file + ": cell " + std::to_string(cellBase + c);
-    if (types[c] != kVtkTetra)
+    if (types[c] != vtk_format::kVtkTetra)
       throw InputError(cell + " has VTK type " + std::to_string(types[c]) +
                        ", but a tet mesh holds only VTK_TETRA (10) cells; export the tets only");
     if (offsets[c] != begin + 4 || offsets[c] > static_cast<std::int64_t>(connectivity.size()))

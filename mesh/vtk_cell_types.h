@@ -8,6 +8,9 @@
 
 namespace polydg::vtk_format {
 
+/// VTK_TETRA: four points, positive when (p1 - p0) . ((p2 - p0) x (p3 - p0)) > 0.
+constexpr std::int64_t kVtkTetra = 10;
+
 /// VTK_POLYHEDRON: a cell given by its faces (Cells/faces and Cells/faceoffsets).
 constexpr std::int64_t kVtkPolyhedron = 42;
 

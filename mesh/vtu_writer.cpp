@@ -1,4 +1,5 @@
-// writeVtu (polydg/mesh/vtu_io.h): a PolyMesh as VTK polyhedra, with polydg's restore arrays.
+// writeVtu (polydg/mesh/vtu_io.h): a PolyMesh as VTK polyhedra, with polydg's restore arrays;
+// writeTetVtu (polydg/mesh/tet_mesh.h): a TetMesh as VTK_TETRA cells, through the same document.
 #include <algorithm>
 #include <array>
 #include <cerrno>
@@ -25,6 +26,7 @@
 #include "mesh/vtk_format.h"
 #include "mesh/vtu_restore_arrays.h"
 #include "polydg/mesh/geometry.h"
+#include "polydg/mesh/tet_mesh.h"
 #include "polydg/mesh/vtu_io.h"
 
 namespace polydg {
@@ -309,49 +311,45 @@ FileValues fileValues(const PolyMesh& mesh, const CellStreams& s,
   return v;
 }
 
-void writeContents(std::ostream& os, const PolyMesh& mesh, const CellStreams& s,
-                   const FileValues& values, const std::vector<CellArray>& cellData,
-                   const std::vector<PointArray>& pointData,
-                   const std::vector<CornerArray>& cornerData, const VtuFieldData& fieldData,
-                   VtuEncoding enc) {
-  const std::string_view field = "      ", inner = "        ";
-  std::vector<ArrayOut> restoreArrays{intArray(field, kFaceGroupArray, s.faceGroup, true),
-                                      intArray(field, kFaceReversedArray, s.faceReversed, true),
-                                      intArray(field, kFaceOriginArray, s.faceOrigin, true),
-                                      intArray(field, kElementArray, s.element, true)};
-  if (s.pointVertex.size() != mesh.numVertices())
-    restoreArrays.push_back(intArray(field, kPointVertexArray, s.pointVertex, true));
-  // The caller's field data: numbers, then text as its bytes (0 .. 255, which intArray stores as
-  // UInt8).
-  std::vector<std::string> textNames;
-  std::vector<std::vector<std::int64_t>> textBytes;
-  for (const auto& [name, text] : fieldData.strings) {
-    textNames.push_back(name + std::string(kVtuTextSuffix));
-    textBytes.emplace_back(reinterpret_cast<const unsigned char*>(text.data()),
-                           reinterpret_cast<const unsigned char*>(text.data()) + text.size());
-  }
-  std::vector<ArrayOut> callerArrays;
-  for (const auto& [name, values] : fieldData.numbers)
-    callerArrays.push_back(floatArray(field, name, 1, values, true));
-  for (std::size_t i = 0; i < textNames.size(); ++i)
-    callerArrays.push_back(intArray(field, textNames[i], textBytes[i], true));
-  std::vector<ArrayOut> pointArrays, cellArrays;
-  for (std::size_t i = 0; i < pointData.size(); ++i)
-    pointArrays.push_back(
-        floatArray(inner, pointData[i].name, pointData[i].components, values.pointArrays[i]));
-  for (std::size_t i = 0; i < cornerData.size(); ++i)
-    pointArrays.push_back(
-        floatArray(inner, cornerData[i].name, cornerData[i].components, values.cornerArrays[i]));
-  cellArrays.push_back(floatArray(inner, "volume", 1, values.volume));
-  for (std::size_t i = 0; i < cellData.size(); ++i)
-    cellArrays.push_back(
-        floatArray(inner, cellData[i].name, cellData[i].components, values.cellArrays[i]));
-  const ArrayOut points = floatArray(inner, "Points", 3, values.points);
-  const std::vector<ArrayOut> cells{
-      intArray(inner, "connectivity", s.connectivity), intArray(inner, "offsets", s.offsets),
-      intArray(inner, "types", s.types), intArray(inner, "faces", s.faces),
-      intArray(inner, "faceoffsets", s.faceOffsets)};
+constexpr std::string_view kFieldIndent = "      ", kArrayIndent = "        ";
 
+/// The caller's field data as arrays: numbers, then texts as their bytes (0 .. 255, which
+/// intArray stores as UInt8). The arrays view this object's own storage, so it is never copied.
+class CallerArrays {
+ public:
+  explicit CallerArrays(const VtuFieldData& fieldData) {
+    // Every name and byte string first: the arrays view them, so the vectors must not grow after.
+    for (const auto& [name, text] : fieldData.strings) {
+      textNames_.push_back(name + std::string(kVtuTextSuffix));
+      textBytes_.emplace_back(reinterpret_cast<const unsigned char*>(text.data()),
+                              reinterpret_cast<const unsigned char*>(text.data()) + text.size());
+    }
+    for (const auto& [name, values] : fieldData.numbers)
+      arrays.push_back(floatArray(kFieldIndent, name, 1, values, true));
+    for (std::size_t i = 0; i < textNames_.size(); ++i)
+      arrays.push_back(intArray(kFieldIndent, textNames_[i], textBytes_[i], true));
+  }
+  CallerArrays(const CallerArrays&) = delete;
+  CallerArrays& operator=(const CallerArrays&) = delete;
+
+  std::vector<ArrayOut> arrays;
+
+ private:
+  std::vector<std::string> textNames_;
+  std::vector<std::vector<std::int64_t>> textBytes_;
+};
+
+/// The arrays of one file, section by section in document order, and the piece's size.
+struct Document {
+  std::vector<ArrayOut> restore;  ///< polydg's field data (restore arrays)
+  std::vector<ArrayOut> caller;   ///< the caller's field data
+  std::vector<ArrayOut> pointData, cellData;
+  ArrayOut points;
+  std::vector<ArrayOut> cells;  ///< connectivity, offsets, types, and any face arrays
+  std::size_t numPoints = 0, numCells = 0;
+};
+
+void writeDocument(std::ostream& os, const Document& d, VtuEncoding enc) {
   // The appended data: polydg's arrays in document order, then the caller's field data in
   // reverse order. meshio 7 reads raw appended data array by array, finding each <DataArray> by
   // its offset attribute while it rewrites the attributes of the arrays already read to
@@ -364,12 +362,12 @@ void writeContents(std::ostream& os, const PolyMesh& mesh, const CellStreams& s,
   // mesh, where the caller's arrays begin. polydg's own arrays keep the offsets they have in a
   // file without field data.
   std::vector<const ArrayOut*> appended;
-  for (const ArrayOut& a : restoreArrays) appended.push_back(&a);
-  for (const ArrayOut& a : pointArrays) appended.push_back(&a);
-  for (const ArrayOut& a : cellArrays) appended.push_back(&a);
-  appended.push_back(&points);
-  for (const ArrayOut& a : cells) appended.push_back(&a);
-  for (auto a = callerArrays.rbegin(); a != callerArrays.rend(); ++a) appended.push_back(&*a);
+  for (const ArrayOut& a : d.restore) appended.push_back(&a);
+  for (const ArrayOut& a : d.pointData) appended.push_back(&a);
+  for (const ArrayOut& a : d.cellData) appended.push_back(&a);
+  appended.push_back(&d.points);
+  for (const ArrayOut& a : d.cells) appended.push_back(&a);
+  for (auto a = d.caller.rbegin(); a != d.caller.rend(); ++a) appended.push_back(&*a);
   std::unordered_map<const ArrayOut*, std::size_t> offsets;
   std::size_t offset = 0;
   for (const ArrayOut* a : appended) {
@@ -383,19 +381,19 @@ void writeContents(std::ostream& os, const PolyMesh& mesh, const CellStreams& s,
         " header_type=\"UInt64\">\n"
      << "  <UnstructuredGrid>\n"
      << "    <FieldData>\n";
-  for (const ArrayOut& a : restoreArrays) put(a);
-  for (const ArrayOut& a : callerArrays) put(a);
+  for (const ArrayOut& a : d.restore) put(a);
+  for (const ArrayOut& a : d.caller) put(a);
   os << "    </FieldData>\n"
-     << "    <Piece NumberOfPoints=\"" << s.points.numPoints() << "\" NumberOfCells=\""
-     << mesh.numElements() << "\">\n";
+     << "    <Piece NumberOfPoints=\"" << d.numPoints << "\" NumberOfCells=\"" << d.numCells
+     << "\">\n";
   os << "      <PointData>\n";
-  for (const ArrayOut& a : pointArrays) put(a);
+  for (const ArrayOut& a : d.pointData) put(a);
   os << "      </PointData>\n      <CellData>\n";
-  for (const ArrayOut& a : cellArrays) put(a);
+  for (const ArrayOut& a : d.cellData) put(a);
   os << "      </CellData>\n      <Points>\n";
-  put(points);
+  put(d.points);
   os << "      </Points>\n      <Cells>\n";
-  for (const ArrayOut& a : cells) put(a);
+  for (const ArrayOut& a : d.cells) put(a);
   os << "      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n";
   if (enc == VtuEncoding::Appended) {
     // Raw bytes after '_'; the newline before the closing tag is where meshio 5 ends the data.
@@ -404,6 +402,40 @@ void writeContents(std::ostream& os, const PolyMesh& mesh, const CellStreams& s,
     os << "\n  </AppendedData>\n";
   }
   os << "</VTKFile>\n";
+}
+
+void writeContents(std::ostream& os, const PolyMesh& mesh, const CellStreams& s,
+                   const FileValues& values, const std::vector<CellArray>& cellData,
+                   const std::vector<PointArray>& pointData,
+                   const std::vector<CornerArray>& cornerData, const VtuFieldData& fieldData,
+                   VtuEncoding enc) {
+  const CallerArrays caller(fieldData);
+  Document d;
+  d.restore = {intArray(kFieldIndent, kFaceGroupArray, s.faceGroup, true),
+               intArray(kFieldIndent, kFaceReversedArray, s.faceReversed, true),
+               intArray(kFieldIndent, kFaceOriginArray, s.faceOrigin, true),
+               intArray(kFieldIndent, kElementArray, s.element, true)};
+  if (s.pointVertex.size() != mesh.numVertices())
+    d.restore.push_back(intArray(kFieldIndent, kPointVertexArray, s.pointVertex, true));
+  d.caller = caller.arrays;
+  for (std::size_t i = 0; i < pointData.size(); ++i)
+    d.pointData.push_back(floatArray(kArrayIndent, pointData[i].name, pointData[i].components,
+                                     values.pointArrays[i]));
+  for (std::size_t i = 0; i < cornerData.size(); ++i)
+    d.pointData.push_back(floatArray(kArrayIndent, cornerData[i].name, cornerData[i].components,
+                                     values.cornerArrays[i]));
+  d.cellData.push_back(floatArray(kArrayIndent, "volume", 1, values.volume));
+  for (std::size_t i = 0; i < cellData.size(); ++i)
+    d.cellData.push_back(
+        floatArray(kArrayIndent, cellData[i].name, cellData[i].components, values.cellArrays[i]));
+  d.points = floatArray(kArrayIndent, "Points", 3, values.points);
+  d.cells = {intArray(kArrayIndent, "connectivity", s.connectivity),
+             intArray(kArrayIndent, "offsets", s.offsets), intArray(kArrayIndent, "types", s.types),
+             intArray(kArrayIndent, "faces", s.faces),
+             intArray(kArrayIndent, "faceoffsets", s.faceOffsets)};
+  d.numPoints = s.points.numPoints();
+  d.numCells = mesh.numElements();
+  writeDocument(os, d, enc);
 }
 
 }  // namespace
@@ -428,6 +460,38 @@ void writeVtu(const PolyMesh& mesh, const std::string& path, const VtuWriteOptio
     writeContents(os, mesh, streams, values, cellData, pointData, cornerData, fieldData,
                   options.encoding);
   });
+}
+
+void writeTetVtu(const TetMesh& mesh, const std::string& path, const VtuWriteOptions& options,
+                 const VtuFieldData& fieldData) {
+  checkFieldData(fieldData);
+  const std::size_t nv = mesh.numVertices(), nt = mesh.numTets();
+  std::vector<double> points(3 * nv), volume(nt);
+  for (std::size_t v = 0; v < nv; ++v)
+    for (std::size_t k = 0; k < 3; ++k) points[3 * v + k] = mesh.vertices[v][static_cast<int>(k)];
+  std::vector<std::int64_t> connectivity(4 * nt), offsets(nt), types(nt, vtk_format::kVtkTetra);
+  for (std::size_t t = 0; t < nt; ++t) {
+    for (std::size_t k = 0; k < 4; ++k) {
+      if (mesh.tets[t][k] >= nv)
+        throw std::invalid_argument("writeTetVtu: tet " + std::to_string(t) + " has corner " +
+                                    std::to_string(mesh.tets[t][k]) + ", but the mesh has " +
+                                    std::to_string(nv) + " vertices");
+      connectivity[4 * t + k] = mesh.tets[t][k];
+    }
+    offsets[t] = static_cast<std::int64_t>(4 * (t + 1));
+    volume[t] = sixVolume(mesh, t) / 6.0;
+  }
+  const CallerArrays caller(fieldData);
+  Document d;
+  d.caller = caller.arrays;
+  d.cellData = {floatArray(kArrayIndent, "volume", 1, volume)};
+  d.points = floatArray(kArrayIndent, "Points", 3, points);
+  d.cells = {intArray(kArrayIndent, "connectivity", connectivity),
+             intArray(kArrayIndent, "offsets", offsets), intArray(kArrayIndent, "types", types)};
+  d.numPoints = nv;
+  d.numCells = nt;
+  vtk_format::writeReplacing(path,
+                             [&](std::ostream& os) { writeDocument(os, d, options.encoding); });
 }
 
 }  // namespace polydg

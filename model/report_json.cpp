@@ -142,6 +142,19 @@ json toJson(const MeshCheck& c) {
   return v;
 }
 
+json toJson(const TetOutputReport& r) {
+  return {{"tets", r.split.tets},
+          {"vertices", r.vertices},
+          {"steiner_points", r.split.steinerPoints},
+          {"cone_elements", r.split.coneElements},
+          {"tetgen_elements", r.split.tetgenElements},
+          {"volume", r.volume},
+          {"polyhedral_volume", r.polyhedralVolume},
+          {"volume_rel_difference", r.volumeRelDifference},
+          {"seconds", r.split.seconds},
+          {"write_seconds", r.writeSeconds}};
+}
+
 json toJson(const MeshReport& report) {
   const MeshingReport& r = report.meshing;
   json timings = timingsJson(r.timings);
@@ -208,6 +221,7 @@ json toJson(const MeshReport& report) {
         {"sliver_threshold", r.slivers.threshold},
         {"cells_with_several_pieces", r.slice.multiPieceCells}}},
       {"volume_rel_error", r.volumeRelError},
+      {"tets", report.tets ? toJson(*report.tets) : json(nullptr)},
       {"validation", checks},
       {"faces_integrated", report.dg.facesIntegrated},
       {"timings_s", timings}};

@@ -8,7 +8,7 @@ packages=(
   libcgal-dev libeigen3-dev libpugixml-dev zlib1g-dev libassimp-dev
   libopenvdb-dev libboost-iostreams-dev
   libsuitesparse-dev libopenblas0-pthread libopenblas-pthread-dev
-  libtbb-dev libjemalloc-dev libcli11-dev nlohmann-json3-dev
+  libtbb-dev libjemalloc-dev libcli11-dev nlohmann-json3-dev libtet1.5-dev
   libgtest-dev libgmock-dev libbenchmark-dev libspectra-dev clang-format universal-ctags
   python3-vtk9 python3-meshio python3-numpy assimp-testmodels
   pybind11-dev python3-pybind11 python3-dev python3-pytest python3-dask python3-distributed

@@ -21,6 +21,7 @@
 #include "polydg/mesh/surface_io.h"
 #include "polydg/mesh/surface_shapes.h"
 #include "polydg/mesh/tet_mesh.h"
+#include "polydg/mesh/tetrahedralize.h"
 #include "polydg/mesh/vtu_io.h"
 
 #include "polydg/model/info.h"

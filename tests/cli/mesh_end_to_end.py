@@ -1,10 +1,11 @@
 #!/usr/bin/env python3
 """`polydg mesh` end to end through the binary: octree slicing (--adaptive) against the
 surface's enclosed volume and the uniform grid, the determinism docs/guide.md claims (the same
-VTU bytes run after run, on one thread or two), and the Python module giving the CLI's results
-to the last digit.
+VTU bytes run after run, on one thread or two), the Python module giving the CLI's results
+to the last digit, and --tets (the mesh written as tets of the same volume, solved by the tet
+methods).
 
-Groups (one ctest each): adaptive, determinism, python.
+Groups (one ctest each): adaptive, determinism, python, tets.
 Usage: mesh_end_to_end.py GROUP POLYDG WORKDIR (python: with the module on PYTHONPATH)
 """
 import filecmp
@@ -179,7 +180,128 @@ def python(polydg, work):
           (cli["energy"], cli["max_displacement"], cli["dofs"]))
 
 
-GROUPS = {"adaptive": adaptive, "determinism": determinism, "python": python}
+# --- tets ----------------------------------------------------------------------------------
+
+def tet_volumes(points, tets):
+    """Each tet's signed volume, about its first corner."""
+    a = points[tets[:, 0]]
+    return np.einsum("ij,ij->i", points[tets[:, 1]] - a,
+                     np.cross(points[tets[:, 2]] - a, points[tets[:, 3]] - a)) / 6.0
+
+
+def u_obj(path):
+    """A U-shaped prism: the outline (0,0) (3,0) (3,3) (2,3) (2,1) (1,1) (1,3) (0,3) extruded over
+    z in [0, 1] (volume 7), its top and bottom cut into triangles along y = 1; outward."""
+    outline = [(0, 0), (3, 0), (3, 1), (3, 3), (2, 3), (2, 1), (1, 1), (1, 3), (0, 3), (0, 1)]
+    k = {p: i + 1 for i, p in enumerate(outline)}  # OBJ's 1-based index at z = 0
+    n = len(outline)
+    # Counter-clockwise seen from +z: the base (a hexagon with collinear corners), then the arms.
+    caps = [((0, 0), (3, 0), (3, 1)), ((0, 0), (3, 1), (2, 1)), ((0, 0), (2, 1), (1, 1)),
+            ((0, 0), (1, 1), (0, 1)), ((0, 1), (1, 1), (1, 3)), ((0, 1), (1, 3), (0, 3)),
+            ((2, 1), (3, 1), (3, 3)), ((2, 1), (3, 3), (2, 3))]
+    with open(path, "w") as out:
+        for z in (0, 1):
+            out.writelines("v %d %d %d\n" % (x, y, z) for x, y in outline)
+        for a, b, c in caps:
+            out.write("f %d %d %d\n" % (k[a], k[c], k[b]))  # the bottom, facing -z
+            out.write("f %d %d %d\n" % (k[a] + n, k[b] + n, k[c] + n))
+        for i in range(1, n + 1):
+            j = i % n + 1
+            out.write("f %d %d %d\nf %d %d %d\n" % (i, j, j + n, i, j + n, i + n))
+
+
+def tets(polydg, work):
+    """`polydg mesh --tets`: the torus (non-convex pieces), a U-shaped prism (one element that
+    is not star-shaped) and the beam written as tets. meshio reads VTK_TETRA cells only, the
+    polyhedral mesh's points first and in order; the tets' volumes (computed here) are positive
+    and sum to the polyhedral mesh's; polydg check accepts the files; the tets solve, the beam's
+    uniaxial tension with --method fem and fs-fem to round-off; one thread and two write the
+    same bytes."""
+    try:
+        import meshio
+    except ImportError as error:
+        raise CheckFailed("cannot import meshio (%s): install Debian's python3-meshio" % error)
+    torus = TESTDATA / "torus.obj"
+    poly, poly_vtu = mesh(polydg, work, torus, "torus_poly", "--cells", 12)
+    report, out = mesh(polydg, work, torus, "torus_tets", "--cells", 12, "--tets")
+    t = report["tets"]
+    check(poly["tets"] is None, "without --tets the report's tets is null")
+    check(t is not None, "with --tets the report has its tets object")
+    check(report["validation"]["passed"] is True, "the polyhedral mesh's checks passed")
+    equal("elements: the polyhedral mesh's, with --tets or without",
+          report["output"]["elements"], poly["output"]["elements"])
+    equal("elements as cones and by TetGen add up", t["cone_elements"] + t["tetgen_elements"],
+          report["output"]["elements"])
+    close("the report's tet volume against the polyhedral mesh's", t["volume"],
+          report["output"]["volume"], 1e-12)
+    close("the report's relative difference", t["volume_rel_difference"], 0.0, 1e-12,
+          relative=False)
+    written = meshio.read(str(out))
+    equal("meshio: cell blocks", [block.type for block in written.cells], ["tetra"])
+    cells = written.cells[0].data
+    equal("meshio: tets", len(cells), t["tets"])
+    equal("meshio: points", len(written.points), t["vertices"])
+    polyhedral = Vtu(poly_vtu).points
+    n = t["vertices"] - t["steiner_points"]
+    equal("the polyhedral mesh's points (no copies in a sliced mesh)", len(polyhedral), n)
+    check(np.array_equal(written.points[:n], polyhedral),
+          "the first %d points are the polyhedral mesh's, in order, bit for bit" % n)
+    volumes = tet_volumes(written.points, cells)
+    check(volumes.min() > 0, "every tet is positive (smallest volume %.3g)" % volumes.min())
+    close("the tets' volumes, summed here, against the polyhedral mesh's", volumes.sum(),
+          report["output"]["volume"], 1e-12)
+    close("against the surface's enclosed volume", volumes.sum(), obj_volume(torus), 1e-12)
+    check_report = work / "check.json"
+    run([polydg, "check", out, "--report", check_report, "--quiet"])
+    checked = read_json(check_report)
+    check(checked["passed"], "polydg check accepts the tets")
+    equal("polydg check: elements", checked["elements"], t["tets"])
+    close("polydg check: volume", checked["volume"], report["output"]["volume"], 1e-12)
+    stdout, _ = run([polydg, "mesh", torus, "-o", work / "printed.vtu", "--cells", 12, "--tets"])
+    line = [x for x in stdout.splitlines() if "written as tets" in x]
+    check(len(line) == 1 and ("%d tets" % t["tets"]) in line[0],
+          "the summary's tets line: %s" % line)
+    # One thread and two: the same file (taskset: TBB takes its threads from the affinity).
+    cpus = sorted(os.sched_getaffinity(0))
+    check(len(cpus) >= 2 and shutil.which("taskset") is not None, "two CPUs and taskset")
+    one = work / "one_thread.vtu"
+    run(["taskset", "-c", cpus[0], polydg, "mesh", torus, "-o", one, "--cells", 12, "--tets",
+         "--quiet"])
+    check(filecmp.cmp(one, out, shallow=False), "one thread writes the same %d bytes as two" %
+          out.stat().st_size)
+
+    # A U-shaped prism in one grid cell: one element, not star-shaped, split by TetGen; the
+    # tets fill its volume, 7, and solve.
+    u = work / "u.obj"
+    u_obj(u)
+    report, out = mesh(polydg, work, u, "u_tets", "--cells", 1, "--tets")
+    t = report["tets"]
+    equal("U: one element, split by TetGen", (report["output"]["elements"], t["tetgen_elements"],
+                                              t["cone_elements"]), (1, 1, 0))
+    written = meshio.read(str(out))
+    volumes = tet_volumes(written.points, written.cells[0].data)
+    check(volumes.min() > 0, "U: every tet is positive (smallest volume %.3g)" % volumes.min())
+    close("U: the tets' volumes, summed here", volumes.sum(), 7.0, 1e-15)
+    run([polydg, "check", out, "--quiet"])
+    run([polydg, "solve", out, "-o", work / "u_solved.vtu", "--method", "fem", "--clamp", "y=0",
+         "--traction", "y=3:0,1,0", "--quiet"])
+
+    # The beam [0, 10] x [0, 1] x [0, 1] in tets, pulled along x at x = 10 and clamped at x = 0
+    # (nu = 0): u = (T x / E, 0, 0) is linear, which both tet methods reproduce exactly.
+    beam = TESTDATA / "beam.obj"
+    report, out = mesh(polydg, work, beam, "beam_tets", "--cells", 20, "--tets")
+    close("beam: the tets' volume", report["tets"]["volume"], 10.0, 1e-14)
+    for method in ("fem", "fs-fem"):
+        solved = work / ("beam_%s.json" % method)
+        run([polydg, "solve", out, "-o", work / ("beam_%s.vtu" % method), "--method", method,
+             "--E", 1000, "--nu", 0, "--clamp", "x=0", "--traction", "x=10:10,0,0", "--report",
+             solved, "--quiet"])
+        r = read_json(solved)
+        equal("beam, %s: tets solved" % method, r["tets"], report["tets"]["tets"])
+        close("beam, %s: end displacement T L / E" % method, r["max_displacement"], 0.1, 1e-9)
+
+
+GROUPS = {"adaptive": adaptive, "determinism": determinism, "python": python, "tets": tets}
 
 if __name__ == "__main__":
     main(GROUPS, sys.argv)

@@ -1,6 +1,7 @@
 // Tests of polydg/mesh/tet_mesh.h: tet meshes written by small writers here (VTU in three
-// encodings, TetGen with index base 0 and 1, Gmsh MSH 4.1) and by the real tools (testdata/),
-// read back alike; conversion to a PolyMesh; and each refusal naming the element at fault.
+// encodings, TetGen with index base 0 and 1, Gmsh MSH 4.1), by writeTetVtu and by the real tools
+// (testdata/), read back alike; conversion to a PolyMesh; and each refusal naming the element at
+// fault.
 #include "polydg/mesh/tet_mesh.h"
 
 #include <unistd.h>
@@ -551,6 +552,29 @@ TEST_F(TetMeshRead, CubesReadAlikeFromEveryFormat) {
     expectSameTets(cubes, read);
     EXPECT_NEAR(volume(read), 8.0, kVolumeTolerance);
   }
+}
+
+TEST_F(TetMeshRead, WrittenVtuReadsBackBitForBit) {
+  // writeTetVtu's file in each encoding: the same vertices (coordinates that are no short
+  // decimals, far from the origin) and the same tets, corner for corner.
+  TetMesh cubes = oriented(kuhnCubes());
+  for (Vec3& p : cubes.vertices) p = p * (1.0 / 3.0) + Vec3(1e6 / 7.0, -0.1, 1e-7);
+  // polydg::VtuEncoding, the writer's (VtuEncoding here is this file's writer's).
+  for (const polydg::VtuEncoding encoding :
+       {polydg::VtuEncoding::Ascii, polydg::VtuEncoding::Binary, polydg::VtuEncoding::Appended}) {
+    const fs::path path = dir_ / ("written" + std::to_string(static_cast<int>(encoding)) + ".vtu");
+    VtuFieldData fields;
+    fields.numbers["cell"] = {0.5};
+    writeTetVtu(cubes, path.string(), {.encoding = encoding}, fields);
+    const TetMesh read = readTetMesh(path.string());
+    EXPECT_EQ(read.vertices, cubes.vertices);
+    EXPECT_EQ(read.tets, cubes.tets);
+    EXPECT_FALSE(fs::exists(path.string() + ".tmp"));
+  }
+  TetMesh broken = cubes;
+  broken.tets[3][2] = 27;
+  EXPECT_THROW(writeTetVtu(broken, (dir_ / "broken.vtu").string()), std::invalid_argument);
+  EXPECT_FALSE(fs::exists(dir_ / "broken.vtu"));
 }
 
 TEST_F(TetMeshRead, InvertedTetsAreReoriented) {

@@ -1,6 +1,6 @@
 // Tetrahedral meshes for the tet methods (linear and corotational FEM, face-based smoothed FEM):
 // vertices and 4-node tetrahedra, read from VTU (VTK_TETRA), TetGen (.node/.ele) or Gmsh MSH 4.1,
-// checked, and turned into a PolyMesh of tetrahedral elements for the DG methods.
+// written as VTU, checked, and turned into a PolyMesh of tetrahedral elements for the DG methods.
 #pragma once
 
 #include <array>
@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "polydg/mesh/poly_mesh.h"
+#include "polydg/mesh/vtu_io.h"
 
 namespace polydg {
 
@@ -21,6 +22,10 @@ struct TetMesh {
   std::size_t numVertices() const { return vertices.size(); }
   std::size_t numTets() const { return tets.size(); }
 };
+
+/// Six times the signed volume of the tet (a, b, c, d): (b - a) . ((c - a) x (d - a)), computed
+/// about `a` so that it loses no digits far from the origin.
+double sixVolume(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d);
 
 /// Six times tet t's signed volume (positive when it is positively oriented).
 double sixVolume(const TetMesh& mesh, std::size_t t);
@@ -65,6 +70,18 @@ bool isTetMeshFile(const std::string& path);
 ///     boundary faces in one plane overlap (neighbours that split a quadrilateral by different
 ///     diagonals). Decided with CGAL's exact predicates.
 void checkTetMesh(const TetMesh& mesh);
+
+/// Writes `mesh` to `path` as a VTK XML UnstructuredGrid (version 1.0, UInt64 headers) of
+/// VTK_TETRA (10) cells, in `options`' encoding: points (Float64) are the vertices in order,
+/// cells the tets in order with their corners as given, cell data `volume` (sixVolume() / 6),
+/// field data `fieldData` (as writeVtu() writes it; VtuFieldData's rules apply). readTetMesh()
+/// reads the file back with the same vertices and tets, bit for bit, provided every vertex is a
+/// corner of some tet (it drops the others); VTK and meshio read it as tetra cells. Written to
+/// `path + ".tmp"` and renamed over `path`. Throws std::invalid_argument for a corner index out
+/// of range or field data that breaks VtuFieldData's rules, std::runtime_error("cannot write
+/// PATH: reason") if the file cannot be written.
+void writeTetVtu(const TetMesh& mesh, const std::string& path, const VtuWriteOptions& options = {},
+                 const VtuFieldData& fieldData = {});
 
 /// The tets as a PolyMesh: element t is tet t, bounded by its 4 triangles in kTetFaces order.
 /// A triangle of two tets is one Interior face whose front is the tet that uses it first (its

@@ -14,6 +14,7 @@
 #include "polydg/cut/cut.h"
 #include "polydg/mesh/meshing.h"
 #include "polydg/mesh/surface.h"
+#include "polydg/mesh/tetrahedralize.h"
 #include "polydg/mesh/vtu_io.h"
 #include "polydg/physics/checks/check_reports.h"
 #include "polydg/physics/contact/embedding.h"
@@ -71,7 +72,21 @@ struct MeshOptions {
   /// If not empty, the mesh is written to this VTU while it is validated and checked (the three
   /// overlap); the file appears only if every check passed.
   std::string output;
+  /// Write `output` as the tets of the new mesh (tetrahedralize(): VTK_TETRA cells, the
+  /// polyhedral mesh's vertices first, its provenance as field data) instead of the polyhedral
+  /// mesh, once every check of the polyhedral mesh has passed. Needs `output`.
+  bool tets = false;
   ProgressFn progress;  ///< slicing progress in [0, 1]
+};
+
+/// MeshOptions::tets: the tet mesh written in place of the polyhedral mesh.
+struct TetOutputReport {
+  TetrahedralizeReport split;     ///< tets, Steiner points, cones and TetGen's elements, seconds
+  std::size_t vertices = 0;       ///< the tet mesh's: the polyhedral mesh's and the Steiner points
+  double volume = 0.0;            ///< the sum of the tets' volumes (sixVolume() / 6, in double)
+  double polyhedralVolume = 0.0;  ///< the polyhedral mesh's (MeshingReport::outputVolume)
+  double volumeRelDifference = 0.0;  ///< (volume - polyhedralVolume) / polyhedralVolume
+  double writeSeconds = 0.0;
 };
 
 struct MeshReport {
@@ -86,10 +101,11 @@ struct MeshReport {
   std::vector<std::size_t> elementsPerLevel;
   std::vector<int> elementLevels;  ///< each element's level (0: a coarse grid cell or its piece)
   double refineSeconds = 0.0;
-  std::string output;         ///< the file written, "" if none
-  double readSeconds = 0.0;   ///< set by callers that read the surface (fromFile)
-  double writeSeconds = 0.0;  ///< overlapped with the checks
-  double wallSeconds = 0.0;   ///< the whole operation, read to write
+  std::string output;                   ///< the file written, "" if none
+  std::optional<TetOutputReport> tets;  ///< MeshOptions::tets: set when the tets were written
+  double readSeconds = 0.0;             ///< set by callers that read the surface (fromFile)
+  double writeSeconds = 0.0;            ///< overlapped with the checks
+  double wallSeconds = 0.0;             ///< the whole operation, read to write
 
   bool passed() const { return meshing.geometry.passed && dg.passed(); }
   /// One line per failed check (empty when passed).

@@ -26,8 +26,11 @@ nlohmann::json toJson(const LocalDgCheck& c, double seconds);
 /// rigid_modes_expected / rigid_modes_seconds, global_patch_test_error when run, dofs,
 /// faces_integrated, messages (failures) and dg_note (why a check did not run).
 nlohmann::json toJson(const MeshCheck& c);
-/// `polydg mesh`: input, grid, output, volume_rel_error, validation (geometry and DG checks),
-/// provenance, timings_s.
+/// `polydg mesh --tets`: tets, vertices, steiner_points, cone_elements, tetgen_elements, volume
+/// (the tets'), polyhedral_volume, volume_rel_difference, seconds (the split), write_seconds.
+nlohmann::json toJson(const TetOutputReport& r);
+/// `polydg mesh`: input, grid, output, volume_rel_error, tets (toJson(TetOutputReport); null
+/// without --tets), validation (geometry and DG checks), provenance, timings_s.
 nlohmann::json toJson(const MeshReport& r);
 /// One cut or merge: op, elements_split, pieces_created, elements_removed, volume_removed,
 /// sliver_threshold, slivers, slivers_merged, isolated_slivers, faces_reintegrated,
