@@ -426,6 +426,9 @@ def tets(polydg, work):
     fall = r["steps"][-1]["centre_of_mass"][2] - r["initial"]["centre_of_mass"][2]
     close("the sliced bar's tets: fall after %d steps against -g dt^2 n (n+1) / 2" % steps,
           fall, -G * dt * dt * steps * (steps + 1) / 2, 1e-12)
+    t = r["timings_s"]
+    close("the tets' phases against the wall time", sum(t[k] for k in PHASES), t["wall"], 0.05)
+    check(t["rotation"] > 0.0, "the tets' rotations are timed (%.3g s)" % t["rotation"])
 
 
 GROUPS = {"initial": initial, "integrators": integrators, "frames": frames,
