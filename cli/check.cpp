@@ -1,9 +1,7 @@
 // polydg check: validation of a simulation mesh (VTU, or a tet mesh from TetGen or Gmsh), first
-// geometric (closed, positive,
-// planar, properly shared elements), then the DG discretization's invariants on it (local patch
-// test and rigid modes of every element, the zero modes of the global stiffness when
-// affordable): Model::check(). Non-zero exit if any check fails.
-#include <filesystem>
+// geometric (closed, positive, planar, properly shared elements), then the DG discretization's
+// invariants on it (local patch test and rigid modes of every element, the zero modes of the
+// global stiffness when affordable): Model::check(). Non-zero exit if any check fails.
 #include <iostream>
 
 #include "cli/commands.h"

@@ -407,6 +407,13 @@ void Model::State::adoptSolution(std::unique_ptr<DgBasis> basis, Eigen::VectorXd
   solution = std::move(u);
 }
 
+void Model::State::adoptTetSolution(const TetMesh& tets, const Eigen::VectorXd& displacement,
+                                    const Material& material, const MomentCache& moments) {
+  auto basis = std::make_unique<DgBasis>(currentMesh(), moments, BasisOptions{});
+  Eigen::VectorXd coefficients = tetCoefficients(tets, displacement, *basis);
+  adoptSolution(std::move(basis), std::move(coefficients), material, moments);
+}
+
 namespace {
 
 /// The solution's largest displacement, jump and von Mises stress in its report.
@@ -457,14 +464,14 @@ SolveReport Model::solve(const SolveOptions& options) {
   s.requireValid();
   SolveReport report;
   report.options = options;
+  std::vector<const FaceSelector*> tractions;
+  for (const TractionLoad& t : options.tractions) tractions.push_back(&t.where);
+  std::vector<FaceSelector> held = options.clamps;
+  for (const DirichletCondition& d : options.displacements) held.push_back(d.where);
+  s.checkSelections(held, tractions, report.clampFaces, report.tractionFaces);
   if (options.tetMethod) {
     // The tet methods (physics/fem/): their nodal displacement, linear on each tet, is the
     // model's solution as DG degree-1 polynomials, exactly.
-    std::vector<const FaceSelector*> tractions;
-    for (const TractionLoad& t : options.tractions) tractions.push_back(&t.where);
-    std::vector<FaceSelector> held = options.clamps;
-    for (const DirichletCondition& d : options.displacements) held.push_back(d.where);
-    s.checkSelections(held, tractions, report.clampFaces, report.tractionFaces);
     const TetMesh tets = toTetMesh(m);
     TetSolveReport solved;
     try {
@@ -475,10 +482,7 @@ SolveReport Model::solve(const SolveOptions& options) {
       throw CheckFailure(e.what());
     }
     fillSolveReport(solved, report);
-    const MomentCache& moments = this->moments(2);
-    auto basis = std::make_unique<DgBasis>(m, moments, BasisOptions{});
-    Eigen::VectorXd coefficients = tetCoefficients(tets, solved.displacement, *basis);
-    s.adoptSolution(std::move(basis), std::move(coefficients), options.material, moments);
+    s.adoptTetSolution(tets, solved.displacement, options.material, moments(2));
     return summarize(*s.solution, std::move(report));
   }
   if (options.discretization.method == Method::BZ &&
@@ -487,11 +491,6 @@ SolveReport Model::solve(const SolveOptions& options) {
         "BZ with the fixed penalty does not converge: its error stays whatever the mesh (a "
         "uniaxial bar's displacement 87% too large at degree 1); use the superpenalty (the "
         "default) or the IP method");
-  std::vector<const FaceSelector*> tractions;
-  for (const TractionLoad& t : options.tractions) tractions.push_back(&t.where);
-  std::vector<FaceSelector> held = options.clamps;
-  for (const DirichletCondition& d : options.displacements) held.push_back(d.where);
-  s.checkSelections(held, tractions, report.clampFaces, report.tractionFaces);
 
   LoadCase loads;
   for (const FaceSelector& c : options.clamps) loads.dirichlet.push_back({c, {}});

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "cut/mesh_editor.h"
+#include "polydg/mesh/tet_mesh.h"
 #include "polydg/model/model.h"
 #include "polydg/util/error.h"
 
@@ -59,6 +60,10 @@ struct Model::State {
   /// Makes `coefficients` in `basis` the model's solution (corner values and element fields).
   void adoptSolution(std::unique_ptr<DgBasis> basis, Eigen::VectorXd coefficients,
                      const Material& material, const MomentCache& moments);
+  /// Makes a tet method's nodal displacement (node-major) on `tets`, whose tet t is element t,
+  /// the model's solution: linear on each tet, so exactly DG degree 1 (tetCoefficients).
+  void adoptTetSolution(const TetMesh& tets, const Eigen::VectorXd& displacement,
+                        const Material& material, const MomentCache& moments);
   /// What follows every edit (cut or merge): the solution no longer fits the mesh; an edit that
   /// left no element fails; a failed one breaks the model; an unvalidated one leaves its
   /// validity unknown.

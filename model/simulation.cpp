@@ -1,7 +1,6 @@
 #include "model/simulation.h"
 
 #include "model/tet_simulation.h"
-#include "model/tet_solve.h"
 
 #include <cmath>
 #include <unordered_set>
@@ -112,12 +111,9 @@ SimulationReport Model::simulate(const Scene& scene, const SimulateOptions& opti
     const TetMesh tets = toTetMesh(mesh());
     Eigen::VectorXd u;
     SimulationReport report = simulateOnTets(tets, scene, options, &u);
-    // The final displacement as the model's solution: DG degree 1 on the tets, exactly.
+    // The final displacement as the model's solution.
     const Stopwatch finish;
-    const MomentCache& moments = this->moments(2);
-    auto basis = std::make_unique<DgBasis>(mesh(), moments, BasisOptions{});
-    Eigen::VectorXd coefficients = tetCoefficients(tets, u, *basis);
-    state_->adoptSolution(std::move(basis), std::move(coefficients), scene.material, moments);
+    state_->adoptTetSolution(tets, u, scene.material, moments(2));
     report.finishSeconds = finish.seconds();
     report.wallSeconds += report.finishSeconds;
     return report;

@@ -1,6 +1,6 @@
 #include "model/tet_simulation.h"
 
-#include <algorithm>
+#include <memory>
 
 #include "model/model_state.h"
 #include "model/simulation.h"
