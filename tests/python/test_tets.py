@@ -73,6 +73,15 @@ def test_dg_options_are_refused_with_a_tet_method():
             model.solve(method="fem", clamp=CLAMP, **extra)
 
 
+def test_a_clamp_that_selects_nothing_is_named():
+    model = polydg.read(FILES[0])
+    with pytest.raises(polydg.Error, match="the clamp .* selects no boundary face"):
+        model.solve(method="fs-fem", clamp={"axis": "x", "value": 7})
+    report = model.solve(method="fs-fem", clamp=CLAMP, traction=TRACTION)
+    # Gmsh split each side of the cube in 4 triangles about its centre (14 nodes: 8 + 6).
+    assert report["clamps"][0]["faces"] == 4 and report["tractions"][0]["faces"] == 4
+
+
 def test_simulate_moves_the_tets_as_the_command_line_does(tmp_path):
     scene = {"material": {"E": E, "nu": 0.3, "density": 2}, "method": "fs-fem",
              "integrator": "newmark", "dt": 0.01, "steps": 15, "gravity": [0, 0, -9.81],
