@@ -22,6 +22,8 @@ void addCutCommand(CLI::App& app, const CommonOptions& common, int& exitCode);
 void addRunCommand(CLI::App& app, const CommonOptions& common, int& exitCode);
 /// `polydg simulate MESH.vtu --scene SCENE.json -o OUTDIR`: dynamics (model/scene.h).
 void addSimulateCommand(CLI::App& app, const CommonOptions& common, int& exitCode);
+/// `polydg export MESH --format openfoam -o CASE`: the mesh as an OpenFOAM case.
+void addExportCommand(CLI::App& app, const CommonOptions& common, int& exitCode);
 void addBenchCommand(CLI::App& app, const CommonOptions& common, int& exitCode);
 
 }  // namespace polydg::cli

@@ -79,6 +79,7 @@ int main(int argc, char** argv) {
   polydg::cli::addSimulateCommand(app, common, exitCode);
   polydg::cli::addCutCommand(app, common, exitCode);
   polydg::cli::addRunCommand(app, common, exitCode);
+  polydg::cli::addExportCommand(app, common, exitCode);
   polydg::cli::addBenchCommand(app, common, exitCode);
   // CLI11 would answer an unknown command with "A subcommand is required".
   if (const char* command = requestedCommand(argc, argv)) {
