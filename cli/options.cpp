@@ -187,6 +187,17 @@ const RegionForm kRegionForms[] = {
 
 }  // namespace
 
+FaceSelector parseRegion(const std::string& text, const std::string& option) {
+  const auto colon = text.find(':');
+  if (colon == std::string::npos) return kRegionForms[0].parse(text, option);
+  const std::string suffix = "-" + text.substr(0, colon);
+  for (const RegionForm& form : kRegionForms)
+    if (suffix == form.suffix) return form.parse(text.substr(colon + 1), option);
+  throw CLI::ValidationError(option, "'" + text.substr(0, colon) +
+                                         "' is not a region; use x=V, plane:NX,NY,NZ,D, "
+                                         "below:NX,NY,NZ,D or box:X0,Y0,Z0,X1,Y1,Z1");
+}
+
 void addRegionOptions(CLI::App& cmd, const std::string& prefix, std::vector<FaceSelector>& regions,
                       const std::string& what) {
   for (const RegionForm& form : kRegionForms) {

@@ -38,6 +38,9 @@ Plane parsePlane(const std::string& text, const std::string& option);  ///< "nx,
 Box3 parseBox(const std::string& text, const std::string& option);     ///< "x0,y0,z0,x1,y1,z1"
 /// "x=0.5": the plane x = 0.5 (axis x, y or z).
 Plane parseAxisPlane(const std::string& text, const std::string& option);
+/// A region in one word, the clamps' forms with the form before a colon: "x=0.5" (the faces in
+/// that plane), "plane:NX,NY,NZ,D", "below:NX,NY,NZ,D", "box:X0,Y0,Z0,X1,Y1,Z1".
+FaceSelector parseRegion(const std::string& text, const std::string& option);
 /// "x1,y1,z1;x2,y2,z2;...": a convex planar polygon blade.
 Blade parsePolygon(const std::string& text, const std::string& option);
 

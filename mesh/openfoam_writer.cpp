@@ -1,14 +1,18 @@
-#include "polydg/mesh/openfoam.h"
-
 #include <unistd.h>
 
 #include <algorithm>
 #include <array>
+#include <cctype>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
+#include <set>
 #include <tuple>
 
 #include "mesh/face_triangulation.h"
+#include "mesh/openfoam_quality.h"
+#include "polydg/mesh/openfoam.h"
 #include "polydg/util/error.h"
 
 namespace polydg {
@@ -16,8 +20,6 @@ namespace polydg {
 namespace {
 
 namespace fs = std::filesystem;
-
-constexpr std::array<const char*, 2> kPatches = {"wall", "cut"};
 
 /// One face as written: its corners (outward from the owner), owner, neighbour (-1 on the
 /// boundary) and patch (-1 inside).
@@ -27,16 +29,40 @@ struct FoamFace {
   int patch = -1;
 };
 
-int patchOf(FaceOrigin origin) { return origin == FaceOrigin::Cut ? 1 : 0; }
+/// The patches in order: the caller's, then wall and cut.
+std::vector<std::string> patchNames(const OpenFoamOptions& options) {
+  std::vector<std::string> names;
+  std::set<std::string> seen;
+  for (const OpenFoamPatch& p : options.patches) {
+    // An OpenFOAM word: no whitespace, quotes, braces, parentheses or semicolons.
+    const bool word = !p.name.empty() && std::none_of(p.name.begin(), p.name.end(), [](char c) {
+      return std::isspace(static_cast<unsigned char>(c)) || std::strchr("\"'(){};/\\", c) ||
+             static_cast<unsigned char>(c) < 0x20;
+    });
+    if (!word)
+      throw InputError("patch name '" + p.name +
+                       "' is not an OpenFOAM word; use letters, digits and _ only");
+    if (!seen.insert(p.name).second)
+      throw InputError("patch name '" + p.name + "' is given twice; give each patch one name");
+    names.push_back(p.name);
+  }
+  for (const char* name : {"wall", "cut"})
+    if (!seen.count(name)) names.push_back(name);
+  return names;
+}
 
-std::string header(const char* cls, const char* object, const char* location) {
-  return std::string("FoamFile\n{\n    version     2.0;\n    format      ascii;\n    class       ") +
-         cls + ";\n    location    \"" + location + "\";\n    object      " + object + ";\n}\n\n";
+int patchOf(const Face& face, FaceId f, const OpenFoamOptions& options,
+            const std::vector<std::string>& names) {
+  for (std::size_t p = 0; p < options.patches.size(); ++p)
+    if (options.patches[p].selects(f)) return static_cast<int>(p);
+  const char* fallback = face.origin == FaceOrigin::Cut ? "cut" : "wall";
+  return static_cast<int>(std::find(names.begin(), names.end(), fallback) - names.begin());
 }
 
 /// The mesh's faces as OpenFOAM's: split where they have holes, oriented out of the owner,
 /// internal ones in upper-triangular order, then the boundary by patch.
-std::vector<FoamFace> foamFaces(const PolyMesh& mesh, std::size_t& splitFaces) {
+std::vector<FoamFace> foamFaces(const PolyMesh& mesh, const OpenFoamOptions& options,
+                                const std::vector<std::string>& names, std::size_t& splitFaces) {
   std::vector<FoamFace> out;
   out.reserve(mesh.numFaces());
   for (std::size_t f = 0; f < mesh.numFaces(); ++f) {
@@ -53,22 +79,24 @@ std::vector<FoamFace> foamFaces(const PolyMesh& mesh, std::size_t& splitFaces) {
       try {
         triangles = triangulateFace(mesh, FaceId(f));
       } catch (const std::runtime_error& e) {
-        throw InputError("face " + std::to_string(f) + " (with holes) cannot be split into simple "
-                         "polygons for OpenFOAM: " + e.what());
+        throw InputError(
+            "face " + std::to_string(f) + " of element " + std::to_string(face.front.value) +
+            " (with holes) cannot be split into simple polygons for OpenFOAM: " + e.what() +
+            "; run polydg check on the mesh");
       }
       for (const auto& t : triangles) polygons.push_back({t[0].value, t[1].value, t[2].value});
     }
+    const int patch = face.back.valid() ? -1 : patchOf(face, FaceId(f), options, names);
     for (std::vector<std::uint32_t>& corners : polygons) {
       FoamFace foam;
       foam.owner = face.front.value;
+      foam.patch = patch;
       if (face.back.valid()) {
         foam.neighbour = face.back.value;
         if (foam.neighbour < foam.owner) {
           std::swap(foam.owner, foam.neighbour);
           std::reverse(corners.begin(), corners.end());
         }
-      } else {
-        foam.patch = patchOf(face.origin);
       }
       foam.corners = std::move(corners);
       out.push_back(std::move(foam));
@@ -83,74 +111,189 @@ std::vector<FoamFace> foamFaces(const PolyMesh& mesh, std::size_t& splitFaces) {
   return out;
 }
 
-void writeFile(const fs::path& path, const std::string& text) {
-  std::ofstream os(path, std::ios::binary);
-  os << text;
+/// Writes OpenFOAM files in one format: the FoamFile header, then lists of labels, vectors or
+/// faces, as text or as raw little-endian bytes between the parentheses.
+class FoamWriter {
+ public:
+  FoamWriter(const fs::path& dir, bool binary) : dir_(dir), binary_(binary) {}
+
+  void labels(const char* object, const std::vector<std::uint32_t>& values,
+              const std::string& note = "") {
+    std::string text = header("labelList", object, note);
+    appendLabels(text, values);
+    write(object, text);
+  }
+
+  void points(const std::vector<Vec3>& points) {
+    std::string text = header("vectorField", "points");
+    text += std::to_string(points.size()) + "\n(";
+    if (binary_) {
+      if (!points.empty()) {
+        std::vector<double> raw;
+        raw.reserve(3 * points.size());
+        for (const Vec3& p : points) raw.insert(raw.end(), {p.x(), p.y(), p.z()});
+        text.append(reinterpret_cast<const char*>(raw.data()), raw.size() * sizeof(double));
+      }
+    } else {
+      text += "\n";
+      char line[96];
+      for (const Vec3& p : points) {
+        std::snprintf(line, sizeof line, "(%.17g %.17g %.17g)\n", p.x(), p.y(), p.z());
+        text += line;
+      }
+    }
+    text += ")\n";
+    write("points", text);
+  }
+
+  /// Faces: a faceList in ASCII, a faceCompactList (offsets, then all corners) in binary.
+  void faces(const std::vector<std::vector<std::uint32_t>>& faces) {
+    std::string text = header(binary_ ? "faceCompactList" : "faceList", "faces");
+    if (binary_) {
+      std::vector<std::uint32_t> offsets{0}, corners;
+      for (const auto& f : faces) {
+        corners.insert(corners.end(), f.begin(), f.end());
+        offsets.push_back(static_cast<std::uint32_t>(corners.size()));
+      }
+      appendLabels(text, offsets);
+      appendLabels(text, corners);
+    } else {
+      text += std::to_string(faces.size()) + "\n(\n";
+      for (const auto& f : faces) {
+        text += std::to_string(f.size()) + "(";
+        for (std::size_t k = 0; k < f.size(); ++k) text += (k ? " " : "") + std::to_string(f[k]);
+        text += ")\n";
+      }
+      text += ")\n";
+    }
+    write("faces", text);
+  }
+
+  void text(const char* cls, const char* object, const std::string& body) {
+    write(object, header(cls, object) + body);
+  }
+
+ private:
+  std::string header(const char* cls, const char* object, const std::string& note = "") const {
+    std::string h = "FoamFile\n{\n    version     2.0;\n    format      ";
+    h += binary_ ? "binary;\n    arch        \"LSB;label=32;scalar=64\";\n" : "ascii;\n";
+    h += std::string("    class       ") + cls + ";\n";
+    if (!note.empty()) h += "    note        \"" + note + "\";\n";
+    h += std::string("    location    \"constant/polyMesh\";\n    object      ") + object +
+         ";\n}\n\n";
+    return h;
+  }
+
+  void appendLabels(std::string& text, const std::vector<std::uint32_t>& values) const {
+    text += std::to_string(values.size());
+    if (binary_) {
+      // OpenFOAM reads no parentheses around an empty binary list.
+      if (!values.empty()) {
+        text += "\n(";
+        text.append(reinterpret_cast<const char*>(values.data()),
+                    values.size() * sizeof(std::uint32_t));
+        text += ")";
+      }
+      text += "\n";
+      return;
+    }
+    text += "\n(\n";
+    for (std::uint32_t v : values) text += std::to_string(v) + "\n";
+    text += ")\n";
+  }
+
+  void write(const char* object, const std::string& text) const {
+    const fs::path path = dir_ / object;
+    std::ofstream os(path, std::ios::binary);
+    os << text;
+    os.close();
+    if (!os) throw InputError("cannot write " + path.string() + "; check the folder");
+  }
+
+  fs::path dir_;
+  bool binary_;
+};
+
+void writeTextFile(const fs::path& path, const std::string& object, const std::string& body) {
+  std::ofstream os(path / object, std::ios::binary);
+  os << "FoamFile\n{\n    version     2.0;\n    format      ascii;\n    class       "
+        "dictionary;\n    location    \"system\";\n    object      "
+     << object << ";\n}\n\n"
+     << body;
   os.close();
-  if (!os) throw InputError("cannot write " + path.string() + "; check the folder");
+  if (!os) throw InputError("cannot write " + (path / object).string() + "; check the folder");
 }
 
 void writeSystem(const fs::path& dir) {
-  writeFile(dir / "controlDict",
-            header("dictionary", "controlDict", "system") +
+  writeTextFile(dir, "controlDict",
                 "application     none;\nstartFrom       startTime;\nstartTime       0;\n"
                 "stopAt          endTime;\nendTime         1;\ndeltaT          1;\n"
-                "writeControl    timeStep;\nwriteInterval   1;\n");
-  writeFile(dir / "fvSchemes",
-            header("dictionary", "fvSchemes", "system") +
+                "writeControl    timeStep;\nwriteInterval   1;\nwritePrecision  17;\n");
+  writeTextFile(dir, "fvSchemes",
                 "ddtSchemes { default Euler; }\ngradSchemes { default Gauss linear; }\n"
                 "divSchemes { default none; }\nlaplacianSchemes { default Gauss linear "
                 "corrected; }\ninterpolationSchemes { default linear; }\nsnGradSchemes { "
                 "default corrected; }\n");
-  writeFile(dir / "fvSolution", header("dictionary", "fvSolution", "system") + "solvers { }\n");
+  writeTextFile(dir, "fvSolution", "solvers { }\n");
 }
 
 }  // namespace
 
-OpenFoamReport writeOpenFoamCase(const PolyMesh& mesh, const std::string& caseDir) {
+OpenFoamReport writeOpenFoamCase(const PolyMesh& mesh, const std::string& caseDir,
+                                 const OpenFoamOptions& options) {
   OpenFoamReport report;
-  const std::vector<FoamFace> faces = foamFaces(mesh, report.splitFaces);
+  report.binary = options.binary;
+  const std::vector<std::string> names = patchNames(options);
+  const std::vector<FoamFace> faces = foamFaces(mesh, options, names, report.splitFaces);
+  constexpr std::size_t kMaxLabel = std::numeric_limits<std::int32_t>::max();
+  if (mesh.numElements() > kMaxLabel || faces.size() > kMaxLabel || mesh.numVertices() > kMaxLabel)
+    throw InputError(
+        "the mesh has more cells, faces or points than OpenFOAM's 32-bit labels "
+        "hold; split it or mesh it coarser");
+
   // Points: those the faces use, in order.
+  OpenFoamFaces foam;
+  foam.cells = mesh.numElements();
   std::vector<std::int64_t> index(mesh.numVertices(), -1);
   for (const FoamFace& f : faces)
     for (std::uint32_t v : f.corners) index[v] = 0;
-  std::string points;
   for (std::size_t v = 0; v < mesh.numVertices(); ++v) {
     if (index[v] < 0) continue;
-    index[v] = static_cast<std::int64_t>(report.points++);
-    char line[96];
-    const Vec3& p = mesh.position(VertexId(v));
-    std::snprintf(line, sizeof line, "(%.17g %.17g %.17g)\n", p.x(), p.y(), p.z());
-    points += line;
+    index[v] = static_cast<std::int64_t>(foam.points.size());
+    foam.points.push_back(mesh.position(VertexId(v)));
   }
-  std::string faceText, owner, neighbour;
-  std::array<std::size_t, kPatches.size()> patchFaces{};
+  std::vector<std::size_t> patchFaces(names.size(), 0);
   for (const FoamFace& f : faces) {
-    faceText += std::to_string(f.corners.size()) + "(";
-    for (std::size_t k = 0; k < f.corners.size(); ++k)
-      faceText += (k ? " " : "") + std::to_string(index[f.corners[k]]);
-    faceText += ")\n";
-    owner += std::to_string(f.owner) + "\n";
+    std::vector<std::uint32_t> corners;
+    corners.reserve(f.corners.size());
+    for (std::uint32_t v : f.corners) corners.push_back(static_cast<std::uint32_t>(index[v]));
+    foam.corners.push_back(std::move(corners));
+    foam.owner.push_back(static_cast<std::uint32_t>(f.owner));
     if (f.neighbour >= 0) {
-      neighbour += std::to_string(f.neighbour) + "\n";
-      ++report.internalFaces;
+      foam.neighbour.push_back(static_cast<std::uint32_t>(f.neighbour));
     } else {
       ++patchFaces[static_cast<std::size_t>(f.patch)];
+      foam.patch.push_back(names[static_cast<std::size_t>(f.patch)]);
     }
   }
-  report.cells = mesh.numElements();
+  report.cells = foam.cells;
+  report.points = foam.points.size();
   report.faces = faces.size();
+  report.internalFaces = foam.neighbour.size();
+
   std::string boundary;
   std::size_t start = report.internalFaces, nonEmpty = 0;
-  for (std::size_t p = 0; p < kPatches.size(); ++p) {
+  for (std::size_t p = 0; p < names.size(); ++p) {
     if (patchFaces[p] == 0) continue;
     ++nonEmpty;
-    boundary += std::string(kPatches[p]) + "\n{\n    type            wall;\n    inGroups        1(wall);\n    nFaces          " +
-                std::to_string(patchFaces[p]) + ";\n    startFace       " + std::to_string(start) +
-                ";\n}\n";
-    report.patches.push_back({kPatches[p], patchFaces[p]});
+    boundary += names[p] + "\n{\n    type            wall;\n    inGroups        1(wall);\n" +
+                "    nFaces          " + std::to_string(patchFaces[p]) + ";\n    startFace       " +
+                std::to_string(start) + ";\n}\n";
+    report.patches.push_back({names[p], patchFaces[p]});
     start += patchFaces[p];
   }
+  report.quality = openFoamQuality(foam);
+
   const fs::path target(caseDir);
   const fs::path staging = target.string() + ".tmp-" + std::to_string(::getpid());
   std::error_code ec;
@@ -160,22 +303,29 @@ OpenFoamReport writeOpenFoamCase(const PolyMesh& mesh, const std::string& caseDi
   fs::create_directories(staging / "constant" / "polyMesh", ec);
   fs::create_directories(staging / "system", ec);
   if (ec) throw InputError("cannot create " + staging.string() + ": " + ec.message());
-  const fs::path poly = staging / "constant" / "polyMesh";
-  writeFile(poly / "points", header("vectorField", "points", "constant/polyMesh") +
-                                 std::to_string(report.points) + "\n(\n" + points + ")\n");
-  writeFile(poly / "faces", header("faceList", "faces", "constant/polyMesh") +
-                                std::to_string(report.faces) + "\n(\n" + faceText + ")\n");
-  writeFile(poly / "owner", header("labelList", "owner", "constant/polyMesh") +
-                                std::to_string(report.faces) + "\n(\n" + owner + ")\n");
-  writeFile(poly / "neighbour", header("labelList", "neighbour", "constant/polyMesh") +
-                                    std::to_string(report.internalFaces) + "\n(\n" + neighbour +
-                                    ")\n");
-  writeFile(poly / "boundary", header("polyBoundaryMesh", "boundary", "constant/polyMesh") +
-                                   std::to_string(nonEmpty) + "\n(\n" + boundary + ")\n");
-  writeSystem(staging / "system");
+  try {
+    FoamWriter w(staging / "constant" / "polyMesh", options.binary);
+    w.points(foam.points);
+    w.faces(foam.corners);
+    const std::string note = "nPoints:" + std::to_string(report.points) +
+                             "  nCells:" + std::to_string(report.cells) +
+                             "  nFaces:" + std::to_string(report.faces) +
+                             "  nInternalFaces:" + std::to_string(report.internalFaces);
+    w.labels("owner", foam.owner, note);
+    w.labels("neighbour", foam.neighbour, note);
+    w.text("polyBoundaryMesh", "boundary", std::to_string(nonEmpty) + "\n(\n" + boundary + ")\n");
+    writeSystem(staging / "system");
+  } catch (...) {
+    fs::remove_all(staging, ec);
+    throw;
+  }
   fs::remove_all(target, ec);
   fs::rename(staging, target, ec);
-  if (ec) throw InputError("cannot rename " + staging.string() + " to " + caseDir + ": " + ec.message());
+  if (ec) {
+    const std::string why = ec.message();
+    fs::remove_all(staging, ec);
+    throw InputError("cannot rename " + staging.string() + " to " + caseDir + ": " + why);
+  }
   return report;
 }
 

@@ -593,6 +593,34 @@ VtuArray<Tag> vectorArray(const std::string& name, const IndexedData<Tag, Vec3>&
 
 }  // namespace
 
+ExportReport Model::exportOpenFoam(const std::string& folder, const ExportOptions& options) const {
+  const State& s = *state_;
+  s.requireUsable();
+  const Stopwatch watch;
+  const PolyMesh& m = mesh();
+  const double diagonal = meshBounds(m).diagonal().norm();
+  OpenFoamOptions foam;
+  foam.binary = options.binary;
+  for (const ExportPatch& p : options.patches) {
+    auto selected = [&m, diagonal, where = p.where](FaceId f) {
+      return m.face(f).isBoundary() && selects(where, m, f, diagonal);
+    };
+    bool any = false;
+    for (std::size_t f = 0; f < m.numFaces() && !any; ++f)
+      any = m.face(FaceId(f)).front.valid() && selected(FaceId(f));
+    if (!any)
+      throw InputError("patch '" + p.name + "' (" + p.where.describe() +
+                       ") selects no boundary face (the mesh spans " + boxText(meshBounds(m)) +
+                       "); use a region that meets the boundary");
+    foam.patches.push_back({p.name, selected});
+  }
+  ExportReport r;
+  r.folder = folder;
+  r.foam = writeOpenFoamCase(m, folder, foam);
+  r.seconds = watch.seconds();
+  return r;
+}
+
 WriteReport Model::write(const std::string& path, const WriteOptions& options) const {
   const State& s = *state_;
   s.requireUsable();

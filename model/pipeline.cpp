@@ -23,7 +23,7 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 
 const char* stepName(const PipelineStep& step) {
-  static const char* names[] = {"mesh", "cut", "merge", "check", "solve", "write"};
+  static const char* names[] = {"mesh", "cut", "merge", "check", "solve", "write", "export"};
   return names[step.index()];
 }
 
@@ -101,16 +101,16 @@ namespace {
 
 constexpr const char* kHint = "see the pipeline format in docs/guide.md";
 
-/// A relative path inside the input's folder, ending in .vtu, with {stem} the only
-/// substitution.
-std::string outputPath(JsonObjectReader& r, const std::string& key) {
+/// A relative path inside the input's folder, ending in .vtu unless `folder`, with {stem} the
+/// only substitution.
+std::string outputPath(JsonObjectReader& r, const std::string& key, bool folder = false) {
   const std::string s = r.string(key);
   const fs::path p(s);
   if (s.empty() || p.is_absolute())
     r.fail(r.at(key), "expected a relative path (inside the input's output folder)");
   for (const fs::path& part : p)
     if (part == "..") r.fail(r.at(key), "'..' would leave the input's output folder");
-  if (p.extension() != ".vtu") r.fail(r.at(key), "the output must be a .vtu file");
+  if (!folder && p.extension() != ".vtu") r.fail(r.at(key), "the output must be a .vtu file");
   for (std::size_t at = s.find('{'); at != std::string::npos; at = s.find('{', at + 1))
     if (s.compare(at, 6, "{stem}") != 0) r.fail(r.at(key), "the only substitution is {stem}");
   return s;
@@ -198,15 +198,35 @@ SolveStep solveStep(JsonObjectReader& r) {
   return s;
 }
 
+/// {"step": "export", "path": "{stem}_case", "format": "openfoam", "binary": false,
+///  "patches": [{"name": "inlet", "x": 0}, ...]} (each patch a name and region keys).
+ExportStep exportStep(JsonObjectReader& r) {
+  ExportStep s;
+  s.path = outputPath(r, "path", true);
+  if (r.has("format")) r.choice("format", Names<int>{{"openfoam", 0}});
+  if (r.has("binary")) s.options.binary = r.boolean("binary");
+  if (r.has("patches")) {
+    const json& list = r.list("patches", "expected a list of patches, each a name and a region");
+    for (std::size_t k = 0; k < list.size(); ++k) {
+      JsonObjectReader item = r.element(list, r.at("patches"), k);
+      const std::string name = item.string("name");
+      s.options.patches.push_back({name, item.selection()});
+      item.finish();
+    }
+  }
+  return s;
+}
+
 PipelineStep parseStep(JsonObjectReader& r) {
-  static const Names<int> kinds{{"mesh", 0},  {"cut", 1},   {"merge", 2},
-                                {"check", 3}, {"solve", 4}, {"write", 5}};
+  static const Names<int> kinds{{"mesh", 0},  {"cut", 1},   {"merge", 2}, {"check", 3},
+                                {"solve", 4}, {"write", 5}, {"export", 6}};
   switch (r.choice("step", kinds)) {
     case 0: return meshStep(r);
     case 1: return cutStep(r);
     case 2: return mergeStep(r);
     case 3: return checkStep(r);
     case 4: return solveStep(r);
+    case 6: return exportStep(r);
     default: return WriteStep{outputPath(r, "path")};
   }
 }
@@ -416,6 +436,17 @@ class InputRun {
     result["path"] = relative;
     result["elements"] = current().mesh().numElements();
     log("wrote " + relative);
+  }
+
+  void apply(const ExportStep& s, json& result) {
+    const std::string relative = substituteStem(s.path, stem_);
+    const fs::path folder = folder_ / relative;
+    if (folder.has_parent_path()) fs::create_directories(folder.parent_path());
+    const ExportReport r = current().exportOpenFoam(folder.string(), s.options);
+    result.update(toJson(r));
+    result["folder"] = relative;
+    log("export: " + relative + ", " + std::to_string(r.foam.cells) + " cells, checkMesh " +
+        (r.foam.quality.failedChecks().empty() ? "OK" : "would fail"));
   }
 
   const Pipeline& pipeline_;

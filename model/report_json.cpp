@@ -402,6 +402,51 @@ json toJson(const WriteReport& r) {
   return {{"file", r.file}, {"with_solution", r.withSolution}, {"time_s", r.seconds}};
 }
 
+json toJson(const OpenFoamQuality& q) {
+  json worst = json::array();
+  for (const OpenFoamFlaggedFace& f : q.worst) {
+    json face = {{"face", f.face},         {"cell", f.cell},     {"kind", f.kind},
+                 {"skewness", f.skewness}, {"offset", f.offset}, {"width", f.width}};
+    if (f.kind == "internal")
+      face["non_orthogonality"] = f.nonOrthogonality;
+    else
+      face["depth"] = f.depth;
+    if (f.wrongOriented) face["wrong_oriented"] = true;
+    worst.push_back(std::move(face));
+  }
+  return {{"check_mesh", q.failedChecks().empty() ? "Mesh OK" : "failed"},
+          {"failed_checks", q.failedChecks()},
+          {"total_volume", q.totalVolume},
+          {"min_volume", q.minVolume},
+          {"max_volume", q.maxVolume},
+          {"max_non_orthogonality", q.maxNonOrthogonality},
+          {"average_non_orthogonality", q.averageNonOrthogonality},
+          {"severely_non_orthogonal_faces", q.severelyNonOrthogonal},
+          {"non_orthogonality_errors", q.nonOrthogonalityErrors},
+          {"max_skewness", q.maxSkewness},
+          {"skew_faces", q.skewFaces},
+          {"skew_boundary_faces", q.skewBoundaryFaces},
+          {"max_aspect_ratio", q.maxAspectRatio},
+          {"wrong_oriented_faces", q.wrongOrientedFaces},
+          {"worst_faces", worst}};
+}
+
+json toJson(const ExportReport& r) {
+  json patches = json::array();
+  for (const OpenFoamPatchReport& p : r.foam.patches)
+    patches.push_back({{"name", p.name}, {"faces", p.faces}});
+  return {{"folder", r.folder},
+          {"format", r.foam.binary ? "binary" : "ascii"},
+          {"cells", r.foam.cells},
+          {"points", r.foam.points},
+          {"faces", r.foam.faces},
+          {"internal_faces", r.foam.internalFaces},
+          {"split_faces", r.foam.splitFaces},
+          {"patches", patches},
+          {"quality", toJson(r.foam.quality)},
+          {"time_s", r.seconds}};
+}
+
 namespace {
 
 json stateJson(const BodyState& s) {

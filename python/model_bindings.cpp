@@ -226,6 +226,17 @@ void bindOperations(ModelClass& c) {
                  model, "solve", "Model.solve()", kwargs,
                  [](Model& m, const SolveStep& s) { return toJson(m.solve(s.options)); });
            })
+      .def("_export",
+           [](Model& model, const std::string& folder, const py::kwargs& kwargs) {
+             // The step's own path must be relative (a pipeline's); Python's folder is any path.
+             py::dict step(kwargs);
+             step["path"] = "case";
+             return operate<ExportStep>(
+                 model, "export", "Model.export()", step, [&folder](Model& m, const ExportStep& s) {
+                   nlohmann::json r = toJson(m.exportOpenFoam(folder, s.options));
+                   return r;
+                 });
+           })
       .def(
           "_write",
           [](const Model& model, const std::string& path, bool solution) {

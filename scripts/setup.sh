@@ -12,6 +12,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev libspectra-dev clang-format universal-ctags
   python3-vtk9 python3-meshio python3-numpy assimp-testmodels
   pybind11-dev python3-pybind11 python3-dev python3-pytest python3-dask python3-distributed
+  openfoam  # polydg export's tests and bench: checkMesh, foamToVTK, postProcess, snappyHexMesh
   xvfb xauth  # scripts/render_images.py: Debian's VTK 9.1 renders only through an X server
 )
 

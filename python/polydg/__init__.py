@@ -307,6 +307,20 @@ def _write(self, path, solution=True):
     return self._write(_os.fspath(path), solution)
 
 
+def _export(self, folder, format="openfoam", binary=None, patches=None):
+    """Writes the mesh as an OpenFOAM case folder (``polydg export --format openfoam``):
+    constant/polyMesh and the system/ dictionaries checkMesh needs, never half-written.
+    binary: OpenFOAM's binary format instead of ASCII. patches: boundary patches before the
+    default ``wall`` and ``cut``, a dict ``{name: region}`` (a region as in ``solve``'s clamp,
+    e.g. ``{"below": [0, 0, 1, 0.1]}``). Returns the report: counts, patches and, under
+    ``quality``, the figures OpenFOAM's checkMesh computes (``quality["check_mesh"]`` is
+    "Mesh OK" or "failed", with ``failed_checks`` and the worst faces)."""
+    if patches is not None:
+        patches = [dict(region, name=name) for name, region in patches.items()]
+    return self._export(_os.fspath(folder), **_given(format=format, binary=binary, patches=patches))
+
+
+Model.export = _export
 Model.cut = _cut
 Model.write = _write
 Model.merge_slivers = _merge_slivers

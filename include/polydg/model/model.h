@@ -13,6 +13,7 @@
 
 #include "polydg/cut/cut.h"
 #include "polydg/mesh/meshing.h"
+#include "polydg/mesh/openfoam.h"
 #include "polydg/mesh/surface.h"
 #include "polydg/mesh/tetrahedralize.h"
 #include "polydg/mesh/vtu_io.h"
@@ -334,6 +335,26 @@ struct WriteReport {
   double seconds = 0.0;
 };
 
+/// A named boundary patch of an export: the boundary faces `where` selects.
+struct ExportPatch {
+  std::string name;
+  FaceSelector where;
+};
+
+/// How exportOpenFoam() writes the case.
+struct ExportOptions {
+  /// Patches before the default ones (wall: the input surface, cut: faces made by cuts); a
+  /// face selected by several goes to the first.
+  std::vector<ExportPatch> patches;
+  bool binary = false;  ///< OpenFOAM's binary format instead of ASCII
+};
+
+struct ExportReport {
+  std::string folder;
+  OpenFoamReport foam;  ///< counts, patches and checkMesh's figures
+  double seconds = 0.0;
+};
+
 /// A polyhedral mesh with its cached integrals, editor and provenance. Operations keep the
 /// moment cache up to date: every face is integrated once (to the highest degree asked for so
 /// far) and again only when an edit changes it; facesIntegrated() counts every integration.
@@ -423,6 +444,11 @@ class Model {
   /// Writes the model as a VTU file with its provenance (and the solution's fields, see
   /// WriteOptions), atomically: `path` is never left half-written.
   WriteReport write(const std::string& path, const WriteOptions& options = {}) const;
+
+  /// Writes the mesh as an OpenFOAM case folder (writeOpenFoamCase, mesh/openfoam.h), never
+  /// half-written, with OpenFOAM's checkMesh figures in the report. Throws InputError naming a
+  /// patch whose region selects no boundary face, or what writeOpenFoamCase refuses.
+  ExportReport exportOpenFoam(const std::string& folder, const ExportOptions& options = {}) const;
 
  private:
   struct State;

@@ -37,9 +37,14 @@ struct SolveStep {
 struct WriteStep {
   std::string path;  ///< relative to the input's folder; "{stem}" is the input's stem
 };
-using PipelineStep = std::variant<MeshStep, CutStep, MergeStep, CheckStep, SolveStep, WriteStep>;
+struct ExportStep {
+  std::string path;  ///< the case folder, relative to the input's folder; "{stem}" as above
+  ExportOptions options;
+};
+using PipelineStep =
+    std::variant<MeshStep, CutStep, MergeStep, CheckStep, SolveStep, WriteStep, ExportStep>;
 
-/// "mesh", "cut", "merge", "check", "solve" or "write".
+/// "mesh", "cut", "merge", "check", "solve", "write" or "export".
 const char* stepName(const PipelineStep& step);
 
 struct Pipeline {

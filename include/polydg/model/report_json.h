@@ -48,6 +48,8 @@ nlohmann::json toJson(const RefineReport& r);
 nlohmann::json toJson(const SolveReport& r);
 nlohmann::json toJson(const ReadReport& r);
 nlohmann::json toJson(const WriteReport& r);
+nlohmann::json toJson(const OpenFoamQuality& q);
+nlohmann::json toJson(const ExportReport& r);
 
 /// A scene in its own format, every key explicit.
 nlohmann::json toJson(const Scene& scene);
