@@ -53,6 +53,7 @@ void run(const ExportCommandOptions& o, const CommonOptions& common) {
             << " of them on the boundary; " << q.nonOrthogonalityErrors
             << " faces at 90 degrees or more; " << q.wrongOrientedFaces
             << " wrongly oriented face pyramids); --report lists the worst\n";
+  for (const std::string& a : q.advice()) std::cout << "  " << a << "\n";
 }
 
 }  // namespace

@@ -71,6 +71,23 @@ std::vector<std::string> OpenFoamQuality::failedChecks() const {
   return out;
 }
 
+std::vector<std::string> OpenFoamQuality::advice() const {
+  std::vector<std::string> out;
+  if (wrongOrientedFaces > 0 || nonOrthogonalityErrors > 0)
+    out.push_back(
+        "some cells are non-convex so that their centre sees a face from behind or edge-on, as "
+        "merged slivers can be: mesh with --merge-slivers 0 for OpenFOAM (finite volumes take "
+        "small cells)");
+  if (skewBoundaryFaces > 0)
+    out.push_back(
+        "boundary faces that are small pieces of the input's triangles lie far to the side of "
+        "their cell's centre (exact boundaries of finely triangulated curved surfaces in cut "
+        "cells); OpenFOAM runs on such meshes, with less accurate boundary gradients");
+  if (skewFaces > skewBoundaryFaces)
+    out.push_back("internal faces are skewed between cells of very different shapes");
+  return out;
+}
+
 OpenFoamQuality openFoamQuality(const OpenFoamFaces& m) {
   OpenFoamQuality q;
   const std::size_t nFaces = m.corners.size(), nInternal = m.neighbour.size();

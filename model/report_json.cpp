@@ -416,6 +416,7 @@ json toJson(const OpenFoamQuality& q) {
   }
   return {{"check_mesh", q.failedChecks().empty() ? "Mesh OK" : "failed"},
           {"failed_checks", q.failedChecks()},
+          {"advice", q.advice()},
           {"total_volume", q.totalVolume},
           {"min_volume", q.minVolume},
           {"max_volume", q.maxVolume},

@@ -59,10 +59,12 @@ def check_mesh(case):
     return figures
 
 
-def mesh(polydg, work, surface, cells, name, *cuts):
-    """polydg mesh at `cells` (no DG checks), then the cut planes given; the VTU's path."""
+def mesh(polydg, work, surface, cells, name, *cuts, merge=None):
+    """polydg mesh at `cells` (no DG checks; --merge-slivers `merge` if given), then the cut
+    planes given; the VTU's path."""
     out = work / (name + ".vtu")
-    run([polydg, "mesh", TESTDATA / surface, "--cells", cells, "--no-dg", "-o", out, "--quiet"])
+    run([polydg, "mesh", TESTDATA / surface, "--cells", cells, "--no-dg", "-o", out, "--quiet",
+         *(["--merge-slivers", merge] if merge is not None else [])])
     if cuts:
         sliced, out = out, work / (name + "_cut.vtu")
         args = [polydg, "cut", sliced, "-o", out, "--quiet"]
@@ -89,6 +91,12 @@ def checkmesh(polydg, work):
     """Bundled models sliced, and cut by planes, in ASCII and binary: checkMesh says "Mesh OK"
     with no failed check, and polydg's report said so before."""
     cases = [(m, n, ()) for m, n in MODELS_OK]
+    # Without sliver merging, whose non-convex unions checkMesh can refuse (see quality).
+    for model, cells in [("octahedron.stl", 16), ("tetra.off", 8)]:
+        vtu = mesh(polydg, work, model, cells, "unmerged_" + model.split(".")[0], merge=0)
+        case, report = export(polydg, work, vtu, "unmerged_" + model.split(".")[0] + "_case")
+        check(check_mesh(case)["ok"] and report["quality"]["check_mesh"] == "Mesh OK",
+              "%s at %d cells, --merge-slivers 0: checkMesh says Mesh OK" % (model, cells))
     cases += [("cube.obj", 8, ("0,0,1,0.45",)), ("Lprism.ply", 8, ("1,0,0,0.3", "0,1,0,0.7")),
               ("beam.obj", 8, ("1,0,0,2.05",))]
     for k, (model, cells, cuts) in enumerate(cases):
@@ -138,6 +146,11 @@ def quality(polydg, work):
               len(worst) == 20, what + ": the report lists the worst faces")
         check(max(w["skewness"] for w in worst) == q["max_skewness"],
               what + ": the worst faces include the most skewed")
+        check(any("small pieces of the input's triangles" in a for a in q["advice"]) ==
+              (q["skew_boundary_faces"] > 0), what + ": the advice names the skewed pieces")
+        check(any("--merge-slivers 0" in a for a in q["advice"]) ==
+              (q["wrong_oriented_faces"] + q["non_orthogonality_errors"] > 0),
+              what + ": the advice names non-convex merged cells where they are")
 
 
 # --- roundtrip -----------------------------------------------------------------------------

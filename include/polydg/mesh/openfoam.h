@@ -66,6 +66,8 @@ struct OpenFoamQuality {
   /// The checks checkMesh fails ("skewness", "non-orthogonality", "face pyramids", "aspect
   /// ratio"); empty: checkMesh says "Mesh OK".
   std::vector<std::string> failedChecks() const;
+  /// Why the flagged faces are as they are and what would help, one sentence per cause.
+  std::vector<std::string> advice() const;
 };
 
 struct OpenFoamReport {
