@@ -13,6 +13,7 @@ packages=(
   python3-vtk9 python3-meshio python3-numpy assimp-testmodels
   pybind11-dev python3-pybind11 python3-dev python3-pytest python3-dask python3-distributed
   xvfb xauth  # scripts/render_images.py: Debian's VTK 9.1 renders only through an X server
+  openfoam  # polydg bench --suite openfoam: snappyHexMesh, the peer mesher, and checkMesh
 )
 
 missing=()
