@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # Fetches the real models the benchmarks use beyond the bundled testdata/, from Debian's
 # packages (the project does not ship them): the Stanford bunny as a closed 75,408-triangle
-# surface (bunny00.off of CGAL's data, package libcgal-demo) and tetgen, the reference mesher
-# `polydg bench --suite meshing` times polydg against.
+# surface (bunny00.off of CGAL's data, package libcgal-demo), tetgen, the reference mesher
+# `polydg bench --suite meshing` times polydg against, and OpenFOAM (snappyHexMesh and
+# checkMesh, package openfoam; scripts/setup.sh installs it too), the peer of `polydg bench
+# --suite openfoam`.
 # Usage: scripts/get-models.sh [DIR]   (default build/share/polydg/models, where polydg bench
 # looks for them; `polydg bench --data DIR` reads DIR/models instead).
 set -euo pipefail
@@ -12,9 +14,12 @@ mkdir -p "$dest"
 SUDO=""
 if [[ $(id -u) -ne 0 ]]; then SUDO="sudo"; fi
 export DEBIAN_FRONTEND=noninteractive
-if ! command -v tetgen >/dev/null 2>&1; then
+tools=()
+command -v tetgen >/dev/null 2>&1 || tools+=(tetgen)
+command -v snappyHexMesh >/dev/null 2>&1 || tools+=(openfoam)
+if ((${#tools[@]})); then
   $SUDO apt-get update -qq
-  $SUDO apt-get install -y -qq --no-install-recommends tetgen >/dev/null
+  $SUDO apt-get install -y -qq --no-install-recommends "${tools[@]}" >/dev/null
 fi
 if [[ ! -f "$dest/bunny.off" ]]; then
   work=$(mktemp -d)

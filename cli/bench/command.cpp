@@ -11,6 +11,8 @@
 //                                                   the error estimate)
 //   polydg bench --suite multigrid --out bench/    (CG iterations on the bunny and the torus,
 //                                                   sliced and cut, beside the unit cube)
+//   polydg bench --suite openfoam --out bench/     (polydg against OpenFOAM's snappyHexMesh on
+//                                                   the torus and the bunny, checkMesh on both)
 //   polydg bench --suite meshing --out b/ --data DIR  (torus.obj from DIR instead of the
 //                                                      share/polydg folder beside the binary)
 #include <filesystem>
@@ -64,6 +66,8 @@ void runBench(BenchOptions o, const CommonOptions& common) {
   if (all || o.suite == "multigrid")
     timed("multigrid", [&] { return bench::multigridSuite(o, common.quiet); });
   if (all || o.suite == "sfem") timed("sfem", [&] { return bench::sfemSuite(o, common.quiet); });
+  if (all || o.suite == "openfoam")
+    timed("openfoam", [&] { return bench::openfoamSuite(o, common.quiet); });
   if (!common.quiet && all) std::cout << "all suites: " << total.seconds() << " s" << std::endl;
 }
 
@@ -76,22 +80,22 @@ void addBenchCommand(CLI::App& app, const CommonOptions& common, int& exitCode) 
       "Benchmark suites as JSON, CSV and SVG plots: accuracy (B1), table41 (B2), "
       "stability (B4), meshing, cutting, dynamics (B6, B7, time per step), contact (B9, "
       "embedding and collision speed), adaptivity (B11, B12), multigrid (CG iterations on real "
-      "models), sfem (the tet methods beside DG), or all");
+      "models), sfem (the tet methods beside DG), openfoam (polydg beside OpenFOAM's "
+      "snappyHexMesh), or all");
   cmd->add_option("--suite", o->suite,
                   "accuracy, table41, stability, meshing, cutting, dynamics, contact, adaptivity, "
-                  "multigrid, "
-                  "sfem or all")
+                  "multigrid, sfem, openfoam or all")
       ->required()
       ->check(CLI::IsMember({"accuracy", "table41", "stability", "meshing", "cutting", "dynamics",
-                             "contact", "adaptivity", "multigrid", "sfem", "all"}));
+                             "contact", "adaptivity", "multigrid", "sfem", "openfoam", "all"}));
   cmd->add_option("--out", o->out, "folder for NAME.json, NAME.csv and NAME*.svg")->required();
   cmd->add_flag("--skip-sliced", o->skipSliced, "accuracy: hex grids only");
   cmd->add_flag("--quick", o->quick,
                 "reduced sizes (a smoke test of every output; the figures are not the "
                 "benchmark's)");
   cmd->add_option("--data", o->dataDir,
-                  "folder of the bundled models (torus.obj); default: share/polydg beside the "
-                  "folder of the polydg binary")
+                  "folder of the bundled models (torus.obj, models/bunny.off); default: "
+                  "share/polydg beside the folder of the polydg binary")
       ->check(CLI::ExistingDirectory);
   cmd->callback([o, &common, &exitCode] {
     runBench(*o, common);

@@ -3,15 +3,15 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <chrono>
-#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <limits>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "cli/bench/external_commands.h"
 #include "cli/bench/meshing_benchmark.h"
 #include "model/files.h"
 #include "polydg/mesh/surface_io.h"
@@ -21,20 +21,6 @@ namespace polydg::bench {
 namespace fs = std::filesystem;
 
 namespace {
-
-/// Wall time of a shell command, or -1 if it failed.
-double commandSeconds(const std::string& command) {
-  const auto start = std::chrono::steady_clock::now();
-  const int status = std::system(command.c_str());
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return status == 0 ? seconds : -1.0;
-}
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
 
 /// polydg's whole `polydg mesh` command (read, checks, slicing, validation, DG checks, the
 /// VTU written) against Debian's `tetgen -pQ` on the same closed 75k-triangle surface (the
@@ -49,17 +35,18 @@ nlohmann::json againstTetgen(const BenchOptions& o, int rounds, bool quiet) {
   };
   if (!fs::exists(bunny))
     return skipped(bunny.string() + " not found; scripts/get-models.sh fetches it");
-  if (std::system("command -v tetgen > /dev/null 2>&1") != 0)
+  if (!commandExists("tetgen"))
     return skipped("tetgen not installed; scripts/get-models.sh installs it (Debian's tetgen)");
-  std::error_code ec;
-  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
-  if (ec) return skipped("cannot find the polydg executable through /proc/self/exe");
+  const std::optional<fs::path> self = polydgExecutable();
+  if (!self) return skipped("cannot find the polydg executable through /proc/self/exe");
   const fs::path dir = fs::temp_directory_path() / ("polydg-tetgen-" + std::to_string(::getpid()));
   fs::create_directories(dir);
   fs::copy_file(bunny, dir / "bunny.off", fs::copy_options::overwrite_existing);
-  const std::string polydg = "'" + self.string() + "' mesh '" + (dir / "bunny.off").string() +
-                             "' --cells 64 -o '" + (dir / "bunny.vtu").string() + "' --quiet";
-  const std::string tetgen = "tetgen -pQ '" + (dir / "bunny.off").string() + "' > /dev/null";
+  const std::string polydg = shellQuoted(self->string()) + " mesh " +
+                             shellQuoted((dir / "bunny.off").string()) + " --cells 64 -o " +
+                             shellQuoted((dir / "bunny.vtu").string()) + " --quiet";
+  const std::string tetgen =
+      "tetgen -pQ " + shellQuoted((dir / "bunny.off").string()) + " > /dev/null";
   std::vector<double> ours, theirs;
   for (int r = 0; r < rounds; ++r) {
     ours.push_back(commandSeconds(polydg));

@@ -43,6 +43,13 @@
 //              on the tets; IP p = 3 on 12^3 hexahedra the reference), and the falling beam's
 //              volume (1,440 tets; L-FEM, LFS-FEM, C-FEM, CS-FEM), and speed against error
 //              on B1 (FEM, FS-FEM on tets, IP p = 1-3 on hexahedra).
+//   openfoam   polydg beside OpenFOAM's snappyHexMesh (issue 34) on the bundled torus (12 and 24
+//              cells) and the bunny (32 and 64; skipped with a note if absent): the whole
+//              commands timed alternately (polydg mesh + export against blockMesh +
+//              surfaceFeatureExtract + snappyHexMesh on the same background cells), checkMesh's
+//              verdict and figures on both cases, their cells, volume error and the largest
+//              distance of their boundary from the surface. Skipped, with one line, without
+//              OpenFOAM's tools.
 // With `quick` each runs reduced sizes (a smoke test of every output, as the tests run it).
 #pragma once
 
@@ -53,11 +60,12 @@
 namespace polydg::bench {
 
 struct BenchOptions {
-  std::string suite;        ///< accuracy, ..., adaptivity, multigrid or all
+  std::string suite;        ///< accuracy, ..., multigrid, sfem, openfoam or all
   std::string out;          ///< the folder the files go to
   bool skipSliced = false;  ///< accuracy: hex grids only
   bool quick = false;
-  /// The folder of the bundled models the meshing suite reads (torus.obj); `polydg bench` uses
+  /// The folder of the bundled models the meshing and openfoam suites read (torus.obj, and
+  /// models/bunny.off of scripts/get-models.sh); `polydg bench` uses
   /// dataDirectory() (cli/bench/data_files.h) unless --data names another.
   std::string dataDir;
 };
@@ -73,5 +81,7 @@ SuiteOutput contactSuite(const BenchOptions& options, bool quiet);
 SuiteOutput adaptivitySuite(const BenchOptions& options, bool quiet);
 SuiteOutput multigridSuite(const BenchOptions& options, bool quiet);
 SuiteOutput sfemSuite(const BenchOptions& options, bool quiet);
+/// Throws InputError if DATA_DIR/torus.obj does not exist.
+SuiteOutput openfoamSuite(const BenchOptions& options, bool quiet);
 
 }  // namespace polydg::bench

@@ -26,9 +26,13 @@ class TempDir {
   TempDir(const TempDir&) = delete;
   TempDir& operator=(const TempDir&) = delete;
 
-  /// Writes `text` (bytes as given) to the file `name` in the folder; returns its path.
+  const std::filesystem::path& path() const { return path_; }
+
+  /// Writes `text` (bytes as given) to the file `name` in the folder (a relative path: its
+  /// folders are created); returns its path.
   std::string write(const std::string& name, const std::string& text) const {
     const std::filesystem::path file = path_ / name;
+    std::filesystem::create_directories(file.parent_path());
     std::ofstream(file, std::ios::binary) << text;
     return file.string();
   }

@@ -1,11 +1,12 @@
 // `polydg bench` end to end through the binary, as a user runs it: the stability, cutting,
-// dynamics, contact and adaptivity suites with --quick (under ctest, all but cutting from the
-// one `--suite all --quick` run of tests/cli/bench_end_to_end.py; every file written, the B4 JSON
-// keys and findings, incremental cuts, B6's energy and period, B7's volume with and without
-// corotation, the speed rows, B9's contacts, penetration and energy, the embedding's and the
-// queries' figures), the meshing suite finding its model in share/polydg beside the binary (build
-// tree and an installation's layout) or in --data, the multigrid suite saying in one line how to
-// get the bunny and still running the torus, and an unknown suite refused with one line.
+// dynamics, contact, adaptivity and openfoam suites with --quick (under ctest, all but cutting
+// from the one `--suite all --quick` run of tests/cli/bench_end_to_end.py; every file written,
+// the B4 JSON keys and findings, incremental cuts, B6's energy and period, B7's volume with and
+// without corotation, the speed rows, B9's contacts, penetration and energy, the embedding's and
+// the queries' figures, both meshers' rows beside OpenFOAM's), the meshing suite finding its
+// model in share/polydg beside the binary (build tree and an installation's layout) or in
+// --data, the multigrid suite saying in one line how to get the bunny and still running the
+// torus, and an unknown suite refused with one line.
 #include <gtest/gtest.h>
 
 #include <unistd.h>
@@ -378,6 +379,56 @@ TEST(BenchCommand, SfemSuiteShowsThePapersFindings) {
     EXPECT_NEAR(ratio, 1.0, 0.1) << "size " << i / 3 + 1;
     EXPECT_GT(steps[i + 2]["seconds_per_step"].get<double>(), 0.0);
   }
+}
+
+TEST(BenchCommand, OpenfoamSuiteSetsBothMeshersSideBySide) {
+  // Quick: the torus at 12 cells, one round. polydg's boundary is the surface exactly and its
+  // volume the surface's; snappyHexMesh's is snapped to within a cell, and checkMesh gives both
+  // a verdict. Without OpenFOAM the suite says so in one line and writes no rows and no plots.
+  const SuiteFiles files = quickSuite("openfoam");
+  ASSERT_TRUE(files.ok);
+  for (const char* file : {"openfoam.json", "openfoam.csv"})
+    EXPECT_TRUE(fs::exists(files.dir / file)) << file;
+  std::ifstream in(files.dir / "openfoam.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  if (j.contains("skipped")) {
+    EXPECT_NE(j["skipped"].get<std::string>().find("not installed"), std::string::npos) << j;
+    EXPECT_FALSE(j.contains("rows"));
+    if (files.scratch) fs::remove_all(files.dir);
+    return;
+  }
+  for (const char* file :
+       {"openfoam_time.svg", "openfoam_volume_error.svg", "openfoam_distance.svg"})
+    EXPECT_TRUE(fs::exists(files.dir / file)) << file;
+  ASSERT_EQ(j["rows"].size(), 2u) << j;
+  const nlohmann::json &polydg = j["rows"][0], &snappy = j["rows"][1];
+  ASSERT_EQ(polydg["mesher"], "polydg");
+  ASSERT_EQ(snappy["mesher"], "snappyHexMesh");
+  const nlohmann::json& setup = j["snappy_setup"][0];
+  EXPECT_EQ(setup["block_cells"], nlohmann::json({14, 14, 6}));  // polydg's 12 x 12 x 4, + 2
+  EXPECT_EQ(setup["surface_level"], 0);
+  for (const nlohmann::json& row : {polydg, snappy}) {
+    ASSERT_FALSE(row.contains("error")) << row;
+    EXPECT_EQ(row["model"], "torus");
+    EXPECT_EQ(row["n"], 12);
+    EXPECT_GT(row["cells"].get<std::size_t>(), 0u) << row;
+    EXPECT_NE(row["checkmesh_verdict"], "no verdict") << row;
+    EXPECT_GT(row["wall_seconds"].get<double>(), 0.0);
+    EXPECT_GT(row["max_skewness"].get<double>(), 0.0);
+  }
+  EXPECT_LT(polydg["max_boundary_distance_rel"].get<double>(), 1e-14) << polydg;
+  EXPECT_LT(polydg["volume_rel_error"].get<double>(), 1e-12) << polydg;
+  EXPECT_GT(snappy["max_boundary_distance"].get<double>(), 1e-6) << snappy;
+  EXPECT_LT(snappy["max_boundary_distance"].get<double>(), setup["cell_size"].get<double>());
+  EXPECT_LT(snappy["volume_rel_error"].get<double>(), 0.2) << snappy;
+  std::ifstream csv(files.dir / "openfoam.csv");
+  std::string header;
+  std::getline(csv, header);
+  for (const char* column : {"model", "n", "mesher", "wall_seconds", "cells", "volume_rel_error",
+                             "max_boundary_distance_rel", "checkmesh_verdict",
+                             "checkmesh_failed_checks", "max_non_orthogonality"})
+    EXPECT_NE(header.find(column), std::string::npos) << column;
+  if (files.scratch) fs::remove_all(files.dir);
 }
 
 TEST(BenchCommand, AdaptivitySuiteRefinesWhereItShould) {
