@@ -75,9 +75,9 @@ std::vector<std::string> OpenFoamQuality::advice() const {
   std::vector<std::string> out;
   if (wrongOrientedFaces > 0 || nonOrthogonalityErrors > 0)
     out.push_back(
-        "some cells are non-convex so that their centre sees a face from behind or edge-on, as "
-        "merged slivers can be: mesh with --merge-slivers 0 for OpenFOAM (finite volumes take "
-        "small cells)");
+        "some cells are non-convex so that their centre sees a face from behind or edge-on: "
+        "cells the surface cuts into non-convex pieces, or slivers merged into a neighbour "
+        "(polydg mesh --merge-slivers 0 avoids the latter; finite volumes take small cells)");
   if (skewBoundaryFaces > 0)
     out.push_back(
         "boundary faces that are small pieces of the input's triangles lie far to the side of "

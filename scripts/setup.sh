@@ -14,7 +14,6 @@ packages=(
   pybind11-dev python3-pybind11 python3-dev python3-pytest python3-dask python3-distributed
   openfoam  # polydg export's tests and bench: checkMesh, foamToVTK, postProcess, snappyHexMesh
   xvfb xauth  # scripts/render_images.py: Debian's VTK 9.1 renders only through an X server
-  openfoam  # polydg bench --suite openfoam: snappyHexMesh, the peer mesher, and checkMesh
 )
 
 missing=()
