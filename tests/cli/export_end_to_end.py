@@ -331,6 +331,8 @@ def pipeline(polydg, work):
         check(len(found) == 1, stem + ": the export step wrote its case")
         figures = check_mesh(found[0])
         check(figures["ok"], stem + ": checkMesh says Mesh OK")
+        points = (found[0] / "constant" / "polyMesh" / "points").read_bytes()
+        check(b"format      binary;" in points[:400], stem + ": written in binary, as asked")
         boundary = (found[0] / "constant" / "polyMesh" / "boundary").read_text()
         check(boundary.index("bottom") < boundary.index("wall") < boundary.index("cut"),
               stem + ": patches bottom, wall, cut in that order")
