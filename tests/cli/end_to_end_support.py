@@ -109,8 +109,8 @@ def sphere_obj(path, centre, radius, rings=8, segments=12):
     return np.array(vertices)
 
 
-def obj_volume(path):
-    """Enclosed volume of an OBJ of triangles (divergence theorem), independent of polydg."""
+def read_obj(path):
+    """The vertices (n x 3) and triangles (m x 3, 0-based) of an OBJ of triangles."""
     vertices, triangles = [], []
     with open(path) as f:
         for line in f:
@@ -119,9 +119,20 @@ def obj_volume(path):
                 vertices.append([float(x) for x in parts[1:4]])
             elif parts and parts[0] == "f":
                 triangles.append([int(x.split("/")[0]) - 1 for x in parts[1:4]])
-    v = np.array(vertices)
-    t = np.array(triangles)
+    return np.array(vertices), np.array(triangles)
+
+
+def obj_volume(path):
+    """Enclosed volume of an OBJ of triangles (divergence theorem), independent of polydg."""
+    v, t = read_obj(path)
     return np.einsum("ij,ij->", v[t[:, 0]], np.cross(v[t[:, 1]], v[t[:, 2]])) / 6.0
+
+
+def obj_area(path):
+    """Surface area of an OBJ of triangles, independent of polydg."""
+    v, t = read_obj(path)
+    return 0.5 * np.linalg.norm(np.cross(v[t[:, 1]] - v[t[:, 0]], v[t[:, 2]] - v[t[:, 0]]),
+                                axis=1).sum()
 
 
 def read_xml(reader_type, path, size):

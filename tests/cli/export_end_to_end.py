@@ -19,7 +19,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from end_to_end_support import (CheckFailed, Vtu, check, close, equal, main, np,  # noqa: E402
-                                obj_volume, read_json, read_xml, run)
+                                obj_area, obj_volume, read_json, read_xml, run)
 from vtkmodules.util.numpy_support import vtk_to_numpy  # noqa: E402
 from vtkmodules.vtkIOXML import (vtkXMLPolyDataReader,  # noqa: E402
                                  vtkXMLUnstructuredGridReader)
@@ -182,33 +182,6 @@ def foam_vtk(case):
             total += 0.5 * np.linalg.norm(np.cross(f[1:-1] - f[0], f[2:] - f[0]).sum(axis=0))
         areas[vtp.stem] = total
     return points, cells, areas
-
-
-def volumes(points, cells):
-    out = []
-    for faces in cells:
-        centre = points[[f[0] for f in faces]].mean(axis=0)
-        v = 0.0
-        for f in faces:
-            p = points[f] - centre
-            v += np.einsum("ij,ij->", np.repeat(p[:1], len(f) - 2, axis=0),
-                           np.cross(p[1:-1], p[2:]))
-        out.append(v / 6.0)
-    return np.array(out)
-
-
-def obj_area(path):
-    vertices, triangles = [], []
-    with open(path) as f:
-        for line in f:
-            parts = line.split()
-            if parts and parts[0] == "v":
-                vertices.append([float(x) for x in parts[1:4]])
-            elif parts and parts[0] == "f":
-                triangles.append([int(x.split("/")[0]) - 1 for x in parts[1:4]])
-    v, t = np.array(vertices), np.array(triangles)
-    return 0.5 * np.linalg.norm(np.cross(v[t[:, 1]] - v[t[:, 0]], v[t[:, 2]] - v[t[:, 0]]),
-                                axis=1).sum()
 
 
 def foam_volumes(case):
