@@ -60,10 +60,11 @@ def check_mesh(case):
 
 
 def mesh(polydg, work, surface, cells, name, *cuts, merge=None):
-    """polydg mesh at `cells` (no DG checks; --merge-slivers `merge` if given), then the cut
-    planes given; the VTU's path."""
+    """polydg mesh at `cells` (--cell if a float; no DG checks; --merge-slivers `merge` if
+    given), then the cut planes given; the VTU's path. `surface`: in testdata/, or a path."""
     out = work / (name + ".vtu")
-    run([polydg, "mesh", TESTDATA / surface, "--cells", cells, "--no-dg", "-o", out, "--quiet",
+    size = ["--cell", cells] if isinstance(cells, float) else ["--cells", cells]
+    run([polydg, "mesh", TESTDATA / surface, *size, "--no-dg", "-o", out, "--quiet",
          *(["--merge-slivers", merge] if merge is not None else [])])
     if cuts:
         sliced, out = out, work / (name + "_cut.vtu")
@@ -72,6 +73,44 @@ def mesh(polydg, work, surface, cells, name, *cuts, merge=None):
             args += ["--plane", plane]
         run(args)
     return out
+
+
+def holed_block(path, nx=9, ny=9, nz=4):
+    """A block of nx x ny x nz unit voxels without the columns at odd (i, j): 16 square
+    through-holes along z, volume 260 for the defaults. Its boundary, as outward quads split
+    into triangles on shared vertices; the block's volume."""
+    full = {(i, j, k) for i in range(nx) for j in range(ny) for k in range(nz)
+            if not (i % 2 == 1 and j % 2 == 1)}
+    index, vertices, triangles = {}, [], []
+
+    def vertex(p):
+        if p not in index:
+            index[p] = len(vertices) + 1
+            vertices.append(p)
+        return index[p]
+
+    for voxel in sorted(full):
+        for axis in range(3):
+            u, w = [(1, 2), (2, 0), (0, 1)][axis]
+            for side in (0, 1):
+                beyond = list(voxel)
+                beyond[axis] += 1 if side else -1
+                if tuple(beyond) in full:
+                    continue
+                base = list(voxel)
+                base[axis] += side
+                corners = []
+                for du, dw in ((0, 0), (1, 0), (1, 1), (0, 1)):
+                    p = list(base)
+                    p[u] += du
+                    p[w] += dw
+                    corners.append(tuple(p))
+                a, b, c, d = (vertex(p) for p in (corners if side else corners[::-1]))
+                triangles += [(a, b, c), (a, c, d)]
+    with open(path, "w") as f:
+        f.writelines("v %d %d %d\n" % p for p in vertices)
+        f.writelines("f %d %d %d\n" % t for t in triangles)
+    return float(len(full))
 
 
 def export(polydg, work, vtu, name, *options):
@@ -88,8 +127,9 @@ MODELS_OK = [("cube.obj", 8), ("Lprism.ply", 8), ("beam.obj", 8), ("two_cubes.ob
 
 
 def checkmesh(polydg, work):
-    """Bundled models sliced, and cut by planes, in ASCII and binary: checkMesh says "Mesh OK"
-    with no failed check, and polydg's report said so before."""
+    """Bundled models sliced, and cut by planes, and a block with 16 square through-holes at
+    cells half the holes' side, in ASCII and binary: checkMesh says "Mesh OK" with no failed
+    check, and polydg's report said so before."""
     cases = [(m, n, ()) for m, n in MODELS_OK]
     # Without sliver merging, whose non-convex unions checkMesh can refuse (see quality).
     for model, cells in [("octahedron.stl", 16), ("tetra.off", 8)]:
@@ -99,12 +139,15 @@ def checkmesh(polydg, work):
               "%s at %d cells, --merge-slivers 0: checkMesh says Mesh OK" % (model, cells))
     cases += [("cube.obj", 8, ("0,0,1,0.45",)), ("Lprism.ply", 8, ("1,0,0,0.3", "0,1,0,0.7")),
               ("beam.obj", 8, ("1,0,0,2.05",))]
+    holes = work / "holes.obj"
+    holed_block(holes)
+    cases += [(holes, 0.5, ())]
     for k, (model, cells, cuts) in enumerate(cases):
         vtu = mesh(polydg, work, model, cells, "m%d" % k, *cuts)
         for binary in (False, True):
             case, report = export(polydg, work, vtu, "c%d%s" % (k, "b" if binary else ""),
                                   *(["--binary"] if binary else []))
-            what = "%s at %d cells%s%s" % (model, cells, " cut " + ";".join(cuts) if cuts else "",
+            what = "%s at %s cells%s%s" % (Path(model).name, cells, " cut " + ";".join(cuts) if cuts else "",
                                            ", binary" if binary else "")
             figures = check_mesh(case)
             check(figures["ok"] and figures["failed"] == 0,
@@ -202,7 +245,22 @@ def roundtrip(polydg, work):
     polydg's VTU, computed here) to 1e-12 of each cell, in polydg's element order, and sum to
     the surface's enclosed volume (its triangles, computed here) to 1e-12; foamToVTK gives back
     as many cells, and the wall's area is the input surface's to foamToVTK's float32
-    round-off (1e-6)."""
+    round-off (1e-6). The same for a block with 16 through-holes at cells larger than the
+    holes, whose faces with holes are written as triangles."""
+    holes = work / "holes.obj"
+    volume = holed_block(holes)
+    vtu = mesh(polydg, work, holes, 2.7, "holes")
+    ours = Vtu(vtu)
+    reference = np.empty(len(ours.cells))
+    reference[ours.field_data["polydg_element"].astype(np.int64)] = ours.cell_volumes()
+    case, report = export(polydg, work, vtu, "holes_case", "--binary")
+    check(report["split_faces"] > 0, "the holed block at cell 2.7: %d faces with holes written as "
+          "triangles" % report["split_faces"])
+    got = foam_volumes(case)
+    worst = np.max(np.abs(got - reference) / np.abs(reference))
+    check(len(got) == len(reference) and worst <= 1e-12,
+          "holed block: OpenFOAM's volume of each cell the element's, worst %.3g" % worst)
+    close("holed block: total volume", got.sum(), volume, 1e-12)
     torus = TESTDATA / "torus.obj"
     enclosed, area = obj_volume(torus), obj_area(torus)
     for cuts in [(), ("0,1,0,0.3",)]:
