@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cctype>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -29,7 +30,7 @@ struct FoamFace {
   int patch = -1;
 };
 
-/// The patches in order: the caller's, then wall and cut.
+/// The patches in order: the caller's, then wall, cut0, cut1, ... (one per cut plane) and cut.
 std::vector<std::string> patchNames(const OpenFoamOptions& options) {
   std::vector<std::string> names;
   std::set<std::string> seen;
@@ -46,17 +47,39 @@ std::vector<std::string> patchNames(const OpenFoamOptions& options) {
       throw InputError("patch name '" + p.name + "' is given twice; give each patch one name");
     names.push_back(p.name);
   }
-  for (const char* name : {"wall", "cut"})
-    if (!seen.count(name)) names.push_back(name);
+  std::vector<std::string> defaults{"wall"};
+  for (std::size_t k = 0; k < options.cuts.size(); ++k)
+    defaults.push_back("cut" + std::to_string(k));
+  defaults.push_back("cut");
+  for (const std::string& name : defaults) {
+    if (seen.count(name))
+      throw InputError("patch name '" + name +
+                       "' is one of the default patches (wall, cut0, "
+                       "cut1, ..., cut); choose another");
+    names.push_back(name);
+  }
   return names;
 }
 
-int patchOf(const Face& face, FaceId f, const OpenFoamOptions& options,
-            const std::vector<std::string>& names) {
+/// Which patch a boundary face goes to (an index into `names`): the first caller's patch that
+/// selects it; else wall, or for a cut face the first cut whose plane it lies on (its vertices
+/// within `tolerance` of it), else cut.
+int patchOf(const PolyMesh& mesh, FaceId f, const OpenFoamOptions& options,
+            const std::vector<std::string>& names, double tolerance) {
   for (std::size_t p = 0; p < options.patches.size(); ++p)
     if (options.patches[p].selects(f)) return static_cast<int>(p);
-  const char* fallback = face.origin == FaceOrigin::Cut ? "cut" : "wall";
-  return static_cast<int>(std::find(names.begin(), names.end(), fallback) - names.begin());
+  const std::size_t wall = options.patches.size();
+  const Face& face = mesh.face(f);
+  if (face.origin != FaceOrigin::Cut) return static_cast<int>(wall);
+  for (std::size_t k = 0; k < options.cuts.size(); ++k) {
+    const Plane& c = options.cuts[k];
+    const double norm = c.normal.norm();
+    const bool on = std::all_of(face.vertices.begin(), face.vertices.end(), [&](VertexId v) {
+      return std::abs(c.normal.dot(mesh.position(v)) - c.offset) <= tolerance * norm;
+    });
+    if (on) return static_cast<int>(wall + 1 + k);
+  }
+  return static_cast<int>(names.size() - 1);
 }
 
 /// The mesh's faces as OpenFOAM's: split where they have holes, oriented out of the owner,
@@ -65,6 +88,13 @@ std::vector<FoamFace> foamFaces(const PolyMesh& mesh, const OpenFoamOptions& opt
                                 const std::vector<std::string>& names, std::size_t& splitFaces) {
   std::vector<FoamFace> out;
   out.reserve(mesh.numFaces());
+  // A cut's points are its exact intersections rounded, possibly welded: within a few ulps of
+  // the largest coordinate of its plane (see OpenFoamOptions::cuts).
+  double largest = 0.0;
+  for (std::size_t v = 0; v < mesh.numVertices(); ++v)
+    largest = std::max(largest, mesh.position(VertexId(v)).cwiseAbs().maxCoeff());
+  const double tolerance =
+      32.0 * (std::nextafter(largest, std::numeric_limits<double>::infinity()) - largest);
   for (std::size_t f = 0; f < mesh.numFaces(); ++f) {
     const Face& face = mesh.face(FaceId(f));
     if (!face.front.valid()) continue;  // used by no element
@@ -86,7 +116,7 @@ std::vector<FoamFace> foamFaces(const PolyMesh& mesh, const OpenFoamOptions& opt
       }
       for (const auto& t : triangles) polygons.push_back({t[0].value, t[1].value, t[2].value});
     }
-    const int patch = face.back.valid() ? -1 : patchOf(face, FaceId(f), options, names);
+    const int patch = face.back.valid() ? -1 : patchOf(mesh, FaceId(f), options, names, tolerance);
     for (std::vector<std::uint32_t>& corners : polygons) {
       FoamFace foam;
       foam.owner = face.front.value;

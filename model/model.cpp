@@ -311,6 +311,7 @@ OperationReport Model::cut(const CutRequest& request) {
   checkEditOptions(options.sliverFraction, options.checkDegree);
   OperationReport report = s.edit().cut(request.blade, options);
   s.finishEdit(report, request.checks);
+  s.provenance.cuts.push_back(request.blade);
   return report;
 }
 
@@ -601,6 +602,7 @@ ExportReport Model::exportOpenFoam(const std::string& folder, const ExportOption
   const double diagonal = meshBounds(m).diagonal().norm();
   OpenFoamOptions foam;
   foam.binary = options.binary;
+  foam.cuts = s.provenance.cuts;
   for (const ExportPatch& p : options.patches) {
     auto selected = [&m, diagonal, where = p.where](FaceId f) {
       return m.face(f).isBoundary() && selects(where, m, f, diagonal);

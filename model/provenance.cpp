@@ -10,6 +10,7 @@ constexpr const char* kReferenceVolume = "polydg_reference_volume";
 constexpr const char* kSliverFraction = "polydg_sliver_fraction";
 constexpr const char* kReference = "polydg_reference";
 constexpr const char* kSource = "polydg_source";
+constexpr const char* kCutPlanes = "polydg_cut_planes";  // nx, ny, nz, d per cut
 
 /// The single number stored under `name`, if there is one.
 std::optional<double> number(const VtuFieldData& data, const char* name) {
@@ -27,6 +28,11 @@ VtuFieldData provenanceFieldData(const Provenance& p) {
   data.strings[kReference] =
       p.referenceKind == ReferenceKind::GridCell ? "grid_cell" : "median_element";
   data.strings[kSource] = p.source;
+  if (!p.cuts.empty()) {
+    std::vector<double>& planes = data.numbers[kCutPlanes];
+    for (const Plane& c : p.cuts)
+      planes.insert(planes.end(), {c.normal.x(), c.normal.y(), c.normal.z(), c.offset});
+  }
   return data;
 }
 
@@ -51,6 +57,18 @@ std::optional<Provenance> provenanceFromFieldData(const VtuFieldData& data) {
   p.sliverFraction = *fraction;
   const auto source = data.strings.find(kSource);
   if (source != data.strings.end()) p.source = source->second;
+  // The cuts are labels for export's patches: a malformed list is dropped, not refused.
+  const auto planes = data.numbers.find(kCutPlanes);
+  if (planes != data.numbers.end() && planes->second.size() % 4 == 0) {
+    try {
+      for (std::size_t k = 0; k < planes->second.size(); k += 4) {
+        const double* c = planes->second.data() + k;
+        p.cuts.push_back(Plane::make(Vec3(c[0], c[1], c[2]), c[3]));
+      }
+    } catch (const std::invalid_argument&) {
+      p.cuts.clear();
+    }
+  }
   return p;
 }
 

@@ -57,13 +57,20 @@ json toJson(const Box3& box) {
 }
 
 json toJson(const Provenance& p) {
-  return {
+  json out = {
       {"source", p.source},
       {"cell_size", p.cellSize > 0.0 ? json(p.cellSize) : json(nullptr)},
       {"reference_volume", p.referenceVolume},
       {"reference", p.referenceKind == ReferenceKind::GridCell ? "grid_cell" : "median_element"},
       {"sliver_fraction", p.sliverFraction},
       {"sliver_threshold", p.sliverFraction * p.referenceVolume}};
+  if (!p.cuts.empty()) {
+    json cuts = json::array();
+    for (const Plane& c : p.cuts)
+      cuts.push_back({c.normal.x(), c.normal.y(), c.normal.z(), c.offset});
+    out["cuts"] = cuts;
+  }
+  return out;
 }
 
 json toJson(const GeometryCheck& r) {

@@ -157,7 +157,7 @@ def checkmesh(polydg, work):
             equal(what + ": checkMesh's cells", int(figures["cells"]), report["cells"])
             if cuts:
                 names = [p["name"] for p in report["patches"]]
-                equal(what + ": patches", names, ["wall", "cut"])
+                equal(what + ": patches", names, ["wall"] + ["cut%d" % i for i in range(len(cuts))])
 
 
 # --- quality -------------------------------------------------------------------------------
@@ -283,8 +283,8 @@ def roundtrip(polydg, work):
                 close(what + ": total volume", got.sum(), enclosed, 1e-12)
                 close(what + ": wall area (foamToVTK, float32)", areas["wall"], area, 1e-6)
             else:
-                check(set(areas) == {"wall", "cut"}, what + ": patches wall and cut")
-                check(areas["wall"] < area and areas["cut"] > 0,
+                check(set(areas) == {"wall", "cut0"}, what + ": patches wall and cut0")
+                check(areas["wall"] < area and areas["cut0"] > 0,
                       what + ": the cut's faces are patch cut")
 
 
@@ -307,6 +307,19 @@ def patches(polydg, work):
     check(check_mesh(case)["ok"], "checkMesh says Mesh OK with named patches")
     boundary = (case / "constant" / "polyMesh" / "boundary").read_text()
     check("bottom\n{\n    type            wall;" in boundary, "the boundary file names bottom")
+    # Two cuts by two commands (the cuts travel in the VTU): each its own patch, both sides.
+    once = mesh(polydg, work, "cube.obj", 8, "cube8", "0,0,1,0.45")
+    twice = work / "cube8_twice.vtu"
+    run([polydg, "cut", once, "-o", twice, "--plane", "1,0,0,0.3", "--quiet"])
+    out, _ = run([polydg, "info", twice, "--report", work / "info.json", "--quiet"])
+    equal("the cuts in the VTU's provenance", read_json(work / "info.json")["provenance"]["cuts"],
+          [[0, 0, 1, 0.45], [1, 0, 0, 0.3]])
+    case, report = export(polydg, work, twice, "cube_cuts")
+    equal("patches of two cuts", [p["name"] for p in report["patches"]], ["wall", "cut0", "cut1"])
+    _, _, areas = foam_vtk(case)
+    for name, a in [("wall", 6.0), ("cut0", 2.0), ("cut1", 2.0)]:
+        close("area of " + name + " (foamToVTK, float32)", areas[name], a, 1e-6)
+    check(check_mesh(case)["ok"], "checkMesh says Mesh OK with two cuts' patches")
 
 
 # --- refusals ------------------------------------------------------------------------------
@@ -321,7 +334,8 @@ def refusals(polydg, work):
                          "boundary face"),
                         (["--patch", "a b=x=0"], "is not an OpenFOAM word"),
                         (["--patch", "a=x=0", "--patch", "a=x=1"], "is given twice"),
-                        (["--patch", "a=side:1,2"], "is not a region")]:
+                        (["--patch", "a=side:1,2"], "is not a region"),
+                        (["--patch", "wall=x=0"], "is one of the default patches")]:
         case = work / "refused"
         _, err = run([polydg, "export", vtu, "-o", case, *args], expect=2)
         lines = [line for line in err.strip().splitlines() if line]
@@ -365,8 +379,8 @@ def pipeline(polydg, work):
         points = (found[0] / "constant" / "polyMesh" / "points").read_bytes()
         check(b"format      binary;" in points[:400], stem + ": written in binary, as asked")
         boundary = (found[0] / "constant" / "polyMesh" / "boundary").read_text()
-        check(boundary.index("bottom") < boundary.index("wall") < boundary.index("cut"),
-              stem + ": patches bottom, wall, cut in that order")
+        check(boundary.index("bottom") < boundary.index("wall") < boundary.index("cut0"),
+              stem + ": patches bottom, wall, cut0 in that order")
 
 
 # --- python --------------------------------------------------------------------------------

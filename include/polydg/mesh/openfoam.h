@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "polydg/mesh/plane.h"
 #include "polydg/mesh/poly_mesh.h"
 
 namespace polydg {
@@ -26,6 +27,11 @@ struct OpenFoamOptions {
   std::vector<OpenFoamPatch> patches;
   /// OpenFOAM's binary format (32-bit labels, 64-bit scalars, little-endian) instead of ASCII.
   bool binary = false;
+  /// The planes of the cuts that made the mesh's cut faces, in order: a cut face whose
+  /// vertices all lie on cut k's plane (within 32 ulps of the mesh's largest coordinate, the
+  /// bound of rounding a cut's intersection points and of welding) goes to patch "cut<k>", the
+  /// first such k; other cut faces to "cut".
+  std::vector<Plane> cuts;
 };
 
 struct OpenFoamPatchReport {

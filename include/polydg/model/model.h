@@ -46,6 +46,9 @@ struct Provenance {
   /// The sliver rule: pieces below this fraction of the reference volume are slivers. Meshing
   /// sets it (MeshOptions::sliverFraction); later cuts and merges use it unless told otherwise.
   double sliverFraction = kDefaultSliverFraction;
+  /// The planes of the cuts made so far, in order (a polygon blade's plane): the export names
+  /// each one's faces as a patch (cut0, cut1, ...).
+  std::vector<Plane> cuts;
 };
 
 // --- creation ------------------------------------------------------------------------------
