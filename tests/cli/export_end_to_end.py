@@ -320,6 +320,10 @@ def patches(polydg, work):
     for name, a in [("wall", 6.0), ("cut0", 2.0), ("cut1", 2.0)]:
         close("area of " + name + " (foamToVTK, float32)", areas[name], a, 1e-6)
     check(check_mesh(case)["ok"], "checkMesh says Mesh OK with two cuts' patches")
+    # An oblique cut: its points are its exact intersections rounded, all still on its patch.
+    oblique = mesh(polydg, work, "torus.obj", 12, "torus_oblique", "1,1,3,0.25")
+    case, report = export(polydg, work, oblique, "torus_oblique_case")
+    equal("patches of an oblique cut", [p["name"] for p in report["patches"]], ["wall", "cut0"])
 
 
 # --- refusals ------------------------------------------------------------------------------
