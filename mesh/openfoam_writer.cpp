@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <set>
 #include <tuple>
 
@@ -82,6 +83,66 @@ int patchOf(const PolyMesh& mesh, FaceId f, const OpenFoamOptions& options,
   return static_cast<int>(names.size() - 1);
 }
 
+/// The axis (0-2) and value of the axis-aligned plane holding all `corners`, or axis -1.
+std::pair<int, double> axisPlaneOf(const PolyMesh& mesh,
+                                   const std::vector<std::uint32_t>& corners) {
+  for (int axis = 0; axis < 3; ++axis) {
+    const double value = mesh.position(VertexId(corners[0]))[axis];
+    if (std::all_of(corners.begin(), corners.end(),
+                    [&](std::uint32_t v) { return mesh.position(VertexId(v))[axis] == value; }))
+      return {axis, value};
+  }
+  return {-1, 0.0};
+}
+
+/// Boundary faces of one cell and patch on one axis-aligned plane (exactly: equal coordinates)
+/// become one face where their union is one simple loop: the union of their directed edges
+/// without the edges two of them share. A flat wall split into triangles then reaches OpenFOAM
+/// as one polygon, whose centre its cell sees head-on, not as pieces off to the side.
+void mergeCoplanarBoundaryFaces(const PolyMesh& mesh, std::vector<FoamFace>& faces) {
+  std::map<std::tuple<std::int64_t, int, int, double>, std::vector<std::size_t>> groups;
+  for (std::size_t i = 0; i < faces.size(); ++i) {
+    if (faces[i].neighbour >= 0) continue;
+    const auto [axis, value] = axisPlaneOf(mesh, faces[i].corners);
+    if (axis >= 0) groups[{faces[i].owner, faces[i].patch, axis, value}].push_back(i);
+  }
+  std::vector<bool> dropped(faces.size(), false);
+  for (const auto& [key, members] : groups) {
+    if (members.size() < 2) continue;
+    std::map<std::pair<std::uint32_t, std::uint32_t>, int> edges;
+    for (std::size_t i : members) {
+      const auto& c = faces[i].corners;
+      for (std::size_t k = 0; k < c.size(); ++k) ++edges[{c[k], c[(k + 1) % c.size()]}];
+    }
+    std::map<std::uint32_t, std::uint32_t> next;
+    bool simple = true;
+    for (const auto& [edge, count] : edges) {
+      const int twin =
+          edges.count({edge.second, edge.first}) ? edges.at({edge.second, edge.first}) : 0;
+      if (count > 1 || twin > 1) simple = false;
+      if (twin == 1) continue;
+      if (!next.emplace(edge.first, edge.second).second) simple = false;
+    }
+    if (!simple || next.empty()) continue;
+    std::vector<std::uint32_t> loop{next.begin()->first};
+    while (loop.size() <= next.size()) {
+      const auto it = next.find(loop.back());
+      if (it == next.end() || it->second == loop.front()) break;
+      loop.push_back(it->second);
+    }
+    if (loop.size() != next.size() || next.at(loop.back()) != loop.front()) continue;
+    faces[members[0]].corners = std::move(loop);
+    for (std::size_t k = 1; k < members.size(); ++k) dropped[members[k]] = true;
+  }
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < faces.size(); ++i)
+    if (!dropped[i]) {
+      if (kept != i) faces[kept] = std::move(faces[i]);
+      ++kept;
+    }
+  faces.resize(kept);
+}
+
 /// The mesh's faces as OpenFOAM's: split where they have holes, oriented out of the owner,
 /// internal ones in upper-triangular order, then the boundary by patch.
 std::vector<FoamFace> foamFaces(const PolyMesh& mesh, const OpenFoamOptions& options,
@@ -132,6 +193,7 @@ std::vector<FoamFace> foamFaces(const PolyMesh& mesh, const OpenFoamOptions& opt
       out.push_back(std::move(foam));
     }
   }
+  mergeCoplanarBoundaryFaces(mesh, out);
   std::stable_sort(out.begin(), out.end(), [](const FoamFace& a, const FoamFace& b) {
     const bool ai = a.neighbour >= 0, bi = b.neighbour >= 0;
     if (ai != bi) return ai;

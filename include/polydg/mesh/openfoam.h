@@ -90,8 +90,10 @@ struct OpenFoamReport {
 ///  - Cells are the elements, in order; points the vertices some face uses, in order.
 ///  - Faces: every face with one loop as it is; a face with holes as the triangles of
 ///    triangulateFace() (simple polygons on the face's own vertices: the cells' volumes and
-///    closedness do not change). Each face's normal points out of its owner, the lower of its
-///    two cells (owner < neighbour).
+///    closedness do not change). The boundary faces of one cell and patch on one axis-aligned
+///    plane (equal coordinates, decided exactly) whose union is one simple loop are written as
+///    that one polygon. Each face's normal points out of its owner, the lower of its two cells
+///    (owner < neighbour).
 ///  - Internal faces first, ordered by owner and then neighbour (OpenFOAM's upper-triangular
 ///    order); then the boundary faces grouped by patch: the caller's patches in order, then
 ///    `wall` (faces on the input surface, a generated box, or read from a file) and `cut`
