@@ -81,8 +81,8 @@ void addExportCommand(CLI::App& app, const CommonOptions& common, int& exitCode)
            }
          },
          "a boundary patch NAME=REGION (REGION: x=V, plane:NX,NY,NZ,D, below:NX,NY,NZ,D or "
-         "box:X0,Y0,Z0,X1,Y1,Z1, as the clamps'); before the default patches wall and cut; "
-         "repeatable")
+         "box:X0,Y0,Z0,X1,Y1,Z1, as the clamps'); before the default patches wall, cut0, cut1, "
+         "... (one per cut) and cut; repeatable")
       ->type_name("NAME=REGION")
       ->allow_extra_args(false);
   cmd->add_flag("--binary", o->exporting.binary, "OpenFOAM's binary format instead of ASCII");

@@ -52,9 +52,9 @@ void faceGeometry(const OpenFoamFaces& m, std::size_t f, Vec3& centre, Vec3& are
   area = 0.5 * sumN;
 }
 
-/// The face's extent from its centre along the unit vector `along`, at least `least`.
-double extent(const OpenFoamFaces& m, std::size_t f, const Vec3& centre, const Vec3& along,
-              double least) {
+/// The face's extent from its centre along the unit vector `along`.
+double extent(const OpenFoamFaces& m, std::size_t f, const Vec3& centre, const Vec3& along) {
+  double least = 0.0;
   for (std::uint32_t v : m.corners[f])
     least = std::max(least, std::abs(along.dot(m.points[v] - centre)));
   return least;
@@ -137,7 +137,6 @@ OpenFoamQuality openFoamQuality(const OpenFoamFaces& m) {
     OpenFoamFlaggedFace r;
     r.face = f;
     r.cell = m.owner[f];
-    r.kind = f < nInternal ? "internal" : m.patch[f - nInternal];
     const Vec3 cpf = fc[f] - own;
     Vec3 d;
     double least;
@@ -166,7 +165,7 @@ OpenFoamQuality openFoamQuality(const OpenFoamFaces& m) {
     const Vec3 sv = cpf - (fa[f].dot(cpf) / (fa[f].dot(d) + kRootVSmall)) * d;
     const Vec3 svHat = sv / (sv.norm() + kRootVSmall);
     r.offset = sv.norm();
-    r.width = extent(m, f, fc[f], svHat, 0.0);
+    r.width = extent(m, f, fc[f], svHat);
     r.skewness = r.offset / (std::max(least, r.width) + kRootVSmall);
     q.maxSkewness = std::max(q.maxSkewness, r.skewness);
     if (r.wrongOriented) ++q.wrongOrientedFaces;
@@ -175,7 +174,10 @@ OpenFoamQuality openFoamQuality(const OpenFoamFaces& m) {
       ++q.skewFaces;
       if (f >= nInternal) ++q.skewBoundaryFaces;
     }
-    if (skew || r.wrongOriented || (f < nInternal && cosineError)) flagged.push_back(std::move(r));
+    if (skew || r.wrongOriented || cosineError) {
+      r.kind = f < nInternal ? "internal" : m.patch[f - nInternal];  // only the flagged need it
+      flagged.push_back(std::move(r));
+    }
   }
   if (nInternal) {
     q.maxNonOrthogonality = degrees(minCos);

@@ -14,6 +14,7 @@
 
 #include "mesh/face_triangulation.h"
 #include "mesh/openfoam_quality.h"
+#include "polydg/mesh/geometry.h"
 #include "polydg/mesh/openfoam.h"
 #include "polydg/util/error.h"
 
@@ -151,9 +152,10 @@ std::vector<FoamFace> foamFaces(const PolyMesh& mesh, const OpenFoamOptions& opt
   out.reserve(mesh.numFaces());
   // A cut's points are its exact intersections rounded, possibly welded: within a few ulps of
   // the largest coordinate of its plane (see OpenFoamOptions::cuts).
-  double largest = 0.0;
-  for (std::size_t v = 0; v < mesh.numVertices(); ++v)
-    largest = std::max(largest, mesh.position(VertexId(v)).cwiseAbs().maxCoeff());
+  const Box3 bounds = meshBounds(mesh);
+  const double largest = mesh.numVertices() ? std::max(bounds.min().cwiseAbs().maxCoeff(),
+                                                       bounds.max().cwiseAbs().maxCoeff())
+                                            : 0.0;
   const double tolerance =
       32.0 * (std::nextafter(largest, std::numeric_limits<double>::infinity()) - largest);
   for (std::size_t f = 0; f < mesh.numFaces(); ++f) {
@@ -207,7 +209,9 @@ std::vector<FoamFace> foamFaces(const PolyMesh& mesh, const OpenFoamOptions& opt
 /// faces, as text or as raw little-endian bytes between the parentheses.
 class FoamWriter {
  public:
-  FoamWriter(const fs::path& dir, bool binary) : dir_(dir), binary_(binary) {}
+  /// Files in `dir`, which OpenFOAM knows as `location` (constant/polyMesh, system).
+  FoamWriter(const fs::path& dir, bool binary, std::string location)
+      : dir_(dir), binary_(binary), location_(std::move(location)) {}
 
   void labels(const char* object, const std::vector<std::uint32_t>& values,
               const std::string& note = "") {
@@ -271,8 +275,7 @@ class FoamWriter {
     h += binary_ ? "binary;\n    arch        \"LSB;label=32;scalar=64\";\n" : "ascii;\n";
     h += std::string("    class       ") + cls + ";\n";
     if (!note.empty()) h += "    note        \"" + note + "\";\n";
-    h += std::string("    location    \"constant/polyMesh\";\n    object      ") + object +
-         ";\n}\n\n";
+    h += "    location    \"" + location_ + "\";\n    object      " + object + ";\n}\n\n";
     return h;
   }
 
@@ -304,29 +307,22 @@ class FoamWriter {
 
   fs::path dir_;
   bool binary_;
+  std::string location_;
 };
 
-void writeTextFile(const fs::path& path, const std::string& object, const std::string& body) {
-  std::ofstream os(path / object, std::ios::binary);
-  os << "FoamFile\n{\n    version     2.0;\n    format      ascii;\n    class       "
-        "dictionary;\n    location    \"system\";\n    object      "
-     << object << ";\n}\n\n"
-     << body;
-  os.close();
-  if (!os) throw InputError("cannot write " + (path / object).string() + "; check the folder");
-}
-
+/// The dictionaries OpenFOAM's tools read before they open a mesh (always ASCII).
 void writeSystem(const fs::path& dir) {
-  writeTextFile(dir, "controlDict",
-                "application     none;\nstartFrom       startTime;\nstartTime       0;\n"
-                "stopAt          endTime;\nendTime         1;\ndeltaT          1;\n"
-                "writeControl    timeStep;\nwriteInterval   1;\nwritePrecision  17;\n");
-  writeTextFile(dir, "fvSchemes",
-                "ddtSchemes { default Euler; }\ngradSchemes { default Gauss linear; }\n"
-                "divSchemes { default none; }\nlaplacianSchemes { default Gauss linear "
-                "corrected; }\ninterpolationSchemes { default linear; }\nsnGradSchemes { "
-                "default corrected; }\n");
-  writeTextFile(dir, "fvSolution", "solvers { }\n");
+  FoamWriter w(dir, false, "system");
+  w.text("dictionary", "controlDict",
+         "application     none;\nstartFrom       startTime;\nstartTime       0;\n"
+         "stopAt          endTime;\nendTime         1;\ndeltaT          1;\n"
+         "writeControl    timeStep;\nwriteInterval   1;\nwritePrecision  17;\n");
+  w.text("dictionary", "fvSchemes",
+         "ddtSchemes { default Euler; }\ngradSchemes { default Gauss linear; }\n"
+         "divSchemes { default none; }\nlaplacianSchemes { default Gauss linear "
+         "corrected; }\ninterpolationSchemes { default linear; }\nsnGradSchemes { "
+         "default corrected; }\n");
+  w.text("dictionary", "fvSolution", "solvers { }\n");
 }
 
 }  // namespace
@@ -396,7 +392,7 @@ OpenFoamReport writeOpenFoamCase(const PolyMesh& mesh, const std::string& caseDi
   fs::create_directories(staging / "system", ec);
   if (ec) throw InputError("cannot create " + staging.string() + ": " + ec.message());
   try {
-    FoamWriter w(staging / "constant" / "polyMesh", options.binary);
+    FoamWriter w(staging / "constant" / "polyMesh", options.binary, "constant/polyMesh");
     w.points(foam.points);
     w.faces(foam.corners);
     const std::string note = "nPoints:" + std::to_string(report.points) +

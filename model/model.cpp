@@ -603,18 +603,18 @@ ExportReport Model::exportOpenFoam(const std::string& folder, const ExportOption
   OpenFoamOptions foam;
   foam.binary = options.binary;
   foam.cuts = s.provenance.cuts;
-  for (const ExportPatch& p : options.patches) {
-    auto selected = [&m, diagonal, where = p.where](FaceId f) {
-      return m.face(f).isBoundary() && selects(where, m, f, diagonal);
-    };
-    bool any = false;
-    for (std::size_t f = 0; f < m.numFaces() && !any; ++f)
-      any = m.face(FaceId(f)).front.valid() && selected(FaceId(f));
-    if (!any)
+  std::vector<const FaceSelector*> regions;
+  for (const ExportPatch& p : options.patches) regions.push_back(&p.where);
+  const std::vector<std::size_t> counts = countSelected(m, regions);
+  for (std::size_t i = 0; i < options.patches.size(); ++i) {
+    const ExportPatch& p = options.patches[i];
+    if (counts[i] == 0)
       throw InputError("patch '" + p.name + "' (" + p.where.describe() +
                        ") selects no boundary face (the mesh spans " + boxText(meshBounds(m)) +
                        "); use a region that meets the boundary");
-    foam.patches.push_back({p.name, selected});
+    foam.patches.push_back({p.name, [&m, diagonal, where = p.where](FaceId f) {
+                              return m.face(f).isBoundary() && selects(where, m, f, diagonal);
+                            }});
   }
   ExportReport r;
   r.folder = folder;

@@ -346,8 +346,8 @@ struct ExportPatch {
 
 /// How exportOpenFoam() writes the case.
 struct ExportOptions {
-  /// Patches before the default ones (wall: the input surface, cut: faces made by cuts); a
-  /// face selected by several goes to the first.
+  /// Patches before the default ones (wall: the input surface; cut0, cut1, ...: the faces of
+  /// each recorded cut; cut: other cut faces); a face selected by several goes to the first.
   std::vector<ExportPatch> patches;
   bool binary = false;  ///< OpenFOAM's binary format instead of ASCII
 };
