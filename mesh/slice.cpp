@@ -14,8 +14,10 @@
 
 #include "mesh/flat_faces.h"
 #include "mesh/plane_split.h"
+#include "mesh/slice_reference.h"
 #include "mesh/surface_octree.h"
 #include "mesh/welded_polygons.h"
+#include "mesh/whole_cells.h"
 #include "polydg/mesh/merge_elements.h"
 #include "util/stopwatch.h"
 
@@ -55,13 +57,17 @@ namespace {
 
 class Slicer {
  public:
-  /// Slices with `grid`, or, given an octree, with its finest grid down to its leaves.
+  /// Slices with `grid`, or, given an octree, with its finest grid down to its leaves. On the
+  /// uniform grid, boxes of whole cells are found as they appear and not split further, unless
+  /// `splitEveryCell` (a reference for tests).
   Slicer(const Grid& grid, std::vector<Vec3> points, const ProgressFn& progress,
-         const SurfaceOctree* octree = nullptr)
+         const SurfaceOctree* octree = nullptr, bool splitEveryCell = false)
       : grid_(octree ? octree->finest() : grid),
         splitter_(std::make_unique<PlaneSplitter>(std::move(points))),
         progress_(progress),
-        octree_(octree) {}
+        octree_(octree),
+        findWholeCells_(!octree && !splitEveryCell),
+        whole_(grid_) {}
 
   void run(Piece solid) {
     totalCells_ = static_cast<double>(grid_.cells[0]) * grid_.cells[1] * grid_.cells[2];
@@ -69,7 +75,8 @@ class Slicer {
     std::size_t count = 0;
     for (const std::vector<Leaf>& list : threadLeaves_) count += list.size();
     for (const std::vector<Leaf>& list : threadBoxes_) count += list.size();
-    leaves_.reserve(count);
+    stats.wholeCells = whole_.count();
+    leaves_.reserve(count + stats.wholeCells);
     // The octree's whole cells get their faces from the octree, on points after the
     // splitter's (build() welds them to the splitter's points at the same corners).
     firstGenerated_ = splitter_->numPoints();
@@ -81,6 +88,9 @@ class Slicer {
       }
       std::vector<Leaf>().swap(list);
     }
+    for (const std::array<int, 3>& cell :
+         whole_.finish(static_cast<std::uint32_t>(firstGenerated_), generated_))
+      leaves_.push_back({Piece(), cell, 0, 0, true});
     for (std::vector<Leaf>& list : threadLeaves_) {
       leaves_.insert(leaves_.end(), std::make_move_iterator(list.begin()),
                      std::make_move_iterator(list.end()));
@@ -141,64 +151,16 @@ class Slicer {
     std::array<int, 3> cell;
     std::size_t part;  ///< index of the piece among its cell's connected pieces
     int level = 0;     ///< its octree level (the octree's finest for a sliced cell)
+    /// A whole cell of the uniform grid: `piece` is empty, its sides are made when they are
+    /// read (pieceOf).
+    bool whole = false;
   };
 
-  /// For each polygon (numbered across leaves): kNone, or the number of the earlier polygon
-  /// whose face it shares. Caps are shared with the neighbouring cell's leaf. So are the
-  /// polygons on the surface that rounding made the reverse of one in another leaf (`touched`:
-  /// they have a vertex that several points were welded into): two elements whose parts on
-  /// either side of a gap thinner than the coordinates resolve now touch there. Candidates are
-  /// grouped by vertex-set key (sorted in parallel); within a group, in leaf order, each takes
-  /// the first earlier open one of its kind (cap or surface) that is its reverse, which is then
-  /// closed.
-  static std::vector<std::uint32_t> matchSides(const WeldedPolygons& welded,
-                                               const std::vector<FaceOrigin>& origin,
-                                               const std::vector<char>& kept,
-                                               const std::vector<char>& touched,
-                                               const std::vector<std::uint64_t>& keys) {
-    const std::size_t np = kept.size();
-    auto isCap = [&](std::size_t p) { return origin[p] == FaceOrigin::Interior; };
-    auto candidate = [&](std::size_t p) { return kept[p] && (isCap(p) || touched[p]); };
-    // Candidates in polygon order (that is, leaf order), gathered in parallel blocks.
-    constexpr std::size_t kBlock = 16384;
-    const std::size_t blocks = (np + kBlock - 1) / kBlock;
-    std::vector<std::size_t> blockBase(blocks + 1, 0);
-    tbb::parallel_for(std::size_t(0), blocks, [&](std::size_t b) {
-      std::size_t count = 0;
-      for (std::size_t p = b * kBlock; p < std::min(np, (b + 1) * kBlock); ++p)
-        count += candidate(p);
-      blockBase[b + 1] = count;
-    });
-    for (std::size_t b = 0; b < blocks; ++b) blockBase[b + 1] += blockBase[b];
-    std::vector<std::pair<std::uint64_t, std::uint32_t>> sides(blockBase[blocks]);  // (key, p)
-    tbb::parallel_for(std::size_t(0), blocks, [&](std::size_t b) {
-      std::size_t next = blockBase[b];
-      for (std::size_t p = b * kBlock; p < std::min(np, (b + 1) * kBlock); ++p)
-        if (candidate(p)) sides[next++] = {keys[p], static_cast<std::uint32_t>(p)};
-    });
-    tbb::parallel_sort(sides.begin(), sides.end());
-    std::vector<std::uint32_t> groupStart;
-    for (std::size_t c = 0; c < sides.size(); ++c)
-      if (c == 0 || sides[c].first != sides[c - 1].first)
-        groupStart.push_back(static_cast<std::uint32_t>(c));
-    groupStart.push_back(static_cast<std::uint32_t>(sides.size()));
-    std::vector<std::uint32_t> shares(np, kNone);
-    tbb::parallel_for(std::size_t(0), groupStart.size() - 1, [&](std::size_t g) {
-      boost::container::small_vector<std::uint32_t, 4> open;
-      for (std::size_t c = groupStart[g]; c < groupStart[g + 1]; ++c) {
-        const std::uint32_t p = sides[c].second;
-        auto match = std::find_if(open.begin(), open.end(), [&](std::uint32_t o) {
-          return isCap(o) == isCap(p) && welded.isReversed(o, p);
-        });
-        if (match != open.end()) {
-          shares[p] = *match;
-          open.erase(match);
-        } else {
-          open.push_back(p);
-        }
-      }
-    });
-    return shares;
+  /// The polygons of `leaf`: its piece, or a whole cell's sides made in `scratch`.
+  const Piece& pieceOf(const Leaf& leaf, Piece& scratch) const {
+    if (!leaf.whole) return leaf.piece;
+    whole_.sides(leaf.cell, scratch);
+    return scratch;
   }
 
   /// No point, polygon, element or face.
@@ -235,13 +197,16 @@ class Slicer {
     out.rank.assign(points.size(), kNone);
     // The octree's points come after the splitter's, so that a splitter point is never
     // welded into one of them: only welds among the splitter's points are the slicing's
-    // (counted, and marking polygons as touched); the octree's corners repeat its points.
+    // (counted, and marking polygons as touched); the octree's corners repeat its points. The
+    // uniform grid's whole cells take their turn in leaf order, as the splitter's points at
+    // their corners did when they were split, so that a weld keeps the same position.
     std::vector<std::uint32_t> used;
+    Piece scratch;
     for (const bool generated : {false, true})
       for (const Leaf& leaf : leaves_)
-        for (const PiecePolygon& polygon : leaf.piece)
+        for (const PiecePolygon& polygon : pieceOf(leaf, scratch))
           for (std::uint32_t v : polygon.vertices)
-            if (out.rank[v] == kNone && (v >= firstGenerated_) == generated) {
+            if (out.rank[v] == kNone && (!octree_ || (v >= firstGenerated_) == generated)) {
               out.rank[v] = static_cast<std::uint32_t>(used.size());
               used.push_back(v);
             }
@@ -254,12 +219,37 @@ class Slicer {
         out.positions.push_back(points[used[i]]);
       } else {
         out.vertexOfRank[i] = out.vertexOfRank[target[i]];
-        stats.weldedPoints += used[i] < firstGenerated_;
+        if (octree_) stats.weldedPoints += used[i] < firstGenerated_;
       }
     }
     out.shared.assign(out.positions.size(), 0);
+    if (octree_) {
+      for (std::size_t i = 0; i < used.size(); ++i)
+        if (target[i] != i && used[i] < firstGenerated_) out.shared[out.vertexOfRank[i]] = 1;
+      return out;
+    }
+    // Uniform grid: a vertex is shared if two distinct points were welded into it; a grid node
+    // made for whole cells is the same point as the splitter's at its position.
+    std::vector<std::uint32_t> node(out.positions.size(), kNone), distinct(out.positions.size(), 0);
     for (std::size_t i = 0; i < used.size(); ++i)
-      if (target[i] != i && used[i] < firstGenerated_) out.shared[out.vertexOfRank[i]] = 1;
+      if (used[i] >= firstGenerated_ && node[out.vertexOfRank[i]] == kNone) {
+        node[out.vertexOfRank[i]] = used[i];
+        distinct[out.vertexOfRank[i]] = 1;
+      }
+    std::vector<char> standsFor(out.positions.size(), 0);
+    for (std::size_t i = 0; i < used.size(); ++i) {
+      if (used[i] >= firstGenerated_) continue;
+      const std::uint32_t v = out.vertexOfRank[i];
+      if (node[v] != kNone && !standsFor[v] && points[used[i]] == points[node[v]])
+        standsFor[v] = 1;
+      else
+        ++distinct[v];
+    }
+    for (std::size_t v = 0; v < distinct.size(); ++v)
+      if (distinct[v] >= 2) {
+        out.shared[v] = 1;
+        stats.weldedPoints += distinct[v] - 1;
+      }
     return out;
   }
 
@@ -276,6 +266,12 @@ class Slicer {
     LeafOffsets at{std::vector<std::uint32_t>(nl + 1, 0), std::vector<std::size_t>(nl + 1, 0),
                    std::vector<std::size_t>(nl + 1, 0)};
     tbb::parallel_for(std::size_t(0), nl, [&](std::size_t l) {
+      if (leaves_[l].whole) {  // six quadrilaterals
+        at.polygon[l + 1] = 6;
+        at.corner[l + 1] = 24;
+        at.loop[l + 1] = 6;
+        return;
+      }
       std::size_t corners = 0, loops = 0;
       for (const PiecePolygon& polygon : leaves_[l].piece) {
         corners += polygon.vertices.size();
@@ -314,8 +310,9 @@ class Slicer {
     std::atomic<std::size_t> collapsed{0};
     tbb::parallel_for(
         tbb::blocked_range<std::size_t>(0, nl, 64), [&](const tbb::blocked_range<std::size_t>& r) {
+          Piece scratch;
           for (std::size_t l = r.begin(); l != r.end(); ++l) {
-            const Piece& piece = leaves_[l].piece;
+            const Piece& piece = pieceOf(leaves_[l], scratch);
             std::size_t corner = at.corner[l], loop = at.loop[l];
             for (std::size_t i = 0; i < piece.size(); ++i) {
               const std::size_t p = at.polygon[l] + i;
@@ -383,7 +380,7 @@ class Slicer {
       std::uint32_t created = 0, any = 0;
       for (std::size_t p = at.polygon[l]; p < at.polygon[l + 1]; ++p) {
         any += polygons.kept[p];
-        created += polygons.kept[p] && sharesEarlier[p] == kNone;
+        created += polygons.kept[p] && sharesEarlier[p] == kNoSide;
       }
       ids.faceBase[l + 1] = created;
       ids.elementOf[l] = any ? 0 : kNone;
@@ -408,7 +405,7 @@ class Slicer {
           for (std::size_t l = r.begin(); l != r.end(); ++l) {
             std::uint32_t next = ids.faceBase[l];
             for (std::size_t p = at.polygon[l]; p < at.polygon[l + 1]; ++p) {
-              if (!polygons.kept[p] || sharesEarlier[p] != kNone) continue;
+              if (!polygons.kept[p] || sharesEarlier[p] != kNoSide) continue;
               faceId[p] = next;
               Face& f = meshFaces[FaceId(std::size_t(next++))];
               polygons.welded.copyTo(p, f);
@@ -429,7 +426,7 @@ class Slicer {
                           for (std::size_t p = at.polygon[l]; p < at.polygon[l + 1]; ++p) {
                             if (!polygons.kept[p]) continue;
                             const std::uint32_t s = sharesEarlier[p];
-                            if (s == kNone) {
+                            if (s == kNoSide) {
                               uses.push_back({FaceId(std::size_t(faceId[p])), false});
                               continue;
                             }
@@ -458,6 +455,10 @@ class Slicer {
   /// Splits `piece` (the part of the solid in cells lo .. hi - 1) down to single cells, whose
   /// connected pieces go to this thread's list of leaves (their order is fixed by run()).
   void recurse(Piece piece, std::array<int, 3> lo, std::array<int, 3> hi) {
+    if (findWholeCells_ && WholeCells::isWholeBox(piece)) {
+      wholeRun(lo, hi);
+      return;
+    }
     if (octree_) {
       const int level = octreeLevel(lo, hi);
       if (level >= 0 && level < octree_->levels() && octree_->isLeaf(level, lo)) {
@@ -502,6 +503,14 @@ class Slicer {
     const int level = octree_ ? octree_->levels() : 0;
     for (std::size_t i = 0; i < parts.size(); ++i)
       leaves.push_back({std::move(parts[i]), lo, i, level});
+    reportDone(lo, hi);
+  }
+
+  /// Cells lo .. hi - 1 of the uniform grid are whole: they are not split; their faces are made
+  /// from the grid once all leaves are known (run()).
+  void wholeRun(const std::array<int, 3>& lo, const std::array<int, 3>& hi) {
+    whole_.add(lo, hi);
+    leafCells_ += static_cast<std::size_t>(hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]);
     reportDone(lo, hi);
   }
 
@@ -561,6 +570,8 @@ class Slicer {
   tbb::enumerable_thread_specific<std::vector<Leaf>> threadLeaves_;  ///< leaves, per thread
   const ProgressFn& progress_;
   const SurfaceOctree* octree_;
+  const bool findWholeCells_;
+  WholeCells whole_;
   tbb::enumerable_thread_specific<std::vector<Leaf>> threadBoxes_;  ///< whole octree cells
   std::vector<Vec3> generated_;                                     ///< the points of their faces
   std::size_t firstGenerated_ = std::numeric_limits<std::size_t>::max();  ///< their first id
@@ -604,7 +615,8 @@ namespace {
 /// sliceSurface() and sliceSurfaceOctree(): slices, builds, and repairs what rounding left.
 PolyMesh slice(const TriangleSurface& surface, const Grid& grid, const SurfaceOctree* octree,
                SliceStats* stats, std::vector<std::array<int, 3>>* elementCell,
-               std::vector<int>* elementLevel, const ProgressFn& progress) {
+               std::vector<int>* elementLevel, const ProgressFn& progress,
+               bool splitEveryCell = false) {
   Piece solid;
   solid.reserve(surface.triangles.size());
   for (const auto& tri : surface.triangles) {
@@ -616,7 +628,7 @@ PolyMesh slice(const TriangleSurface& surface, const Grid& grid, const SurfaceOc
     solid.push_back(std::move(p));
   }
   Stopwatch phase;
-  Slicer slicer(grid, surface.vertices, progress, octree);
+  Slicer slicer(grid, surface.vertices, progress, octree, splitEveryCell);
   slicer.reserve(expectedPoints(surface, octree ? octree->finest() : grid, octree != nullptr));
   slicer.run(std::move(solid));
   slicer.stats.secondsSplitting = phase.seconds();
@@ -654,6 +666,11 @@ PolyMesh slice(const TriangleSurface& surface, const Grid& grid, const SurfaceOc
 PolyMesh sliceSurface(const TriangleSurface& surface, const Grid& grid, SliceStats* stats,
                       std::vector<std::array<int, 3>>* elementCell, const ProgressFn& progress) {
   return slice(surface, grid, nullptr, stats, elementCell, nullptr, progress);
+}
+
+PolyMesh sliceSurfaceSplittingEveryCell(const TriangleSurface& surface, const Grid& grid,
+                                        SliceStats* stats) {
+  return slice(surface, grid, nullptr, stats, nullptr, nullptr, {}, true);
 }
 
 PolyMesh sliceSurfaceOctree(const TriangleSurface& surface, const Grid& coarse, int levels,

@@ -117,4 +117,53 @@ bool WeldedPolygons::isReversed(std::size_t a, std::size_t b) const {
   return false;
 }
 
+std::vector<std::uint32_t> matchSides(const WeldedPolygons& welded,
+                                      const std::vector<FaceOrigin>& origin,
+                                      const std::vector<char>& kept,
+                                      const std::vector<char>& touched,
+                                      const std::vector<std::uint64_t>& keys) {
+  const std::size_t np = kept.size();
+  auto isCap = [&](std::size_t p) { return origin[p] == FaceOrigin::Interior; };
+  auto candidate = [&](std::size_t p) { return kept[p] && (isCap(p) || touched[p]); };
+  // Candidates in polygon order (that is, leaf order), gathered in parallel blocks.
+  constexpr std::size_t kBlock = 16384;
+  const std::size_t blocks = (np + kBlock - 1) / kBlock;
+  std::vector<std::size_t> blockBase(blocks + 1, 0);
+  tbb::parallel_for(std::size_t(0), blocks, [&](std::size_t b) {
+    std::size_t count = 0;
+    for (std::size_t p = b * kBlock; p < std::min(np, (b + 1) * kBlock); ++p) count += candidate(p);
+    blockBase[b + 1] = count;
+  });
+  for (std::size_t b = 0; b < blocks; ++b) blockBase[b + 1] += blockBase[b];
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> sides(blockBase[blocks]);  // (key, p)
+  tbb::parallel_for(std::size_t(0), blocks, [&](std::size_t b) {
+    std::size_t next = blockBase[b];
+    for (std::size_t p = b * kBlock; p < std::min(np, (b + 1) * kBlock); ++p)
+      if (candidate(p)) sides[next++] = {keys[p], static_cast<std::uint32_t>(p)};
+  });
+  tbb::parallel_sort(sides.begin(), sides.end());
+  std::vector<std::uint32_t> groupStart;
+  for (std::size_t c = 0; c < sides.size(); ++c)
+    if (c == 0 || sides[c].first != sides[c - 1].first)
+      groupStart.push_back(static_cast<std::uint32_t>(c));
+  groupStart.push_back(static_cast<std::uint32_t>(sides.size()));
+  std::vector<std::uint32_t> shares(np, kNoSide);
+  tbb::parallel_for(std::size_t(0), groupStart.size() - 1, [&](std::size_t g) {
+    boost::container::small_vector<std::uint32_t, 4> open;
+    for (std::size_t c = groupStart[g]; c < groupStart[g + 1]; ++c) {
+      const std::uint32_t p = sides[c].second;
+      auto match = std::find_if(open.begin(), open.end(), [&](std::uint32_t o) {
+        return isCap(o) == isCap(p) && welded.isReversed(o, p);
+      });
+      if (match != open.end()) {
+        shares[p] = *match;
+        open.erase(match);
+      } else {
+        open.push_back(p);
+      }
+    }
+  });
+  return shares;
+}
+
 }  // namespace polydg

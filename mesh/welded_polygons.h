@@ -103,4 +103,21 @@ class WeldedPolygons {
   std::vector<std::uint32_t> loopEnds_;
 };
 
+/// No earlier side: the polygon makes a face of its own (matchSides).
+inline constexpr std::uint32_t kNoSide = 0xffffffffu;
+
+/// For each polygon (numbered across leaves): kNoSide, or the number of the earlier polygon
+/// whose face it shares. Caps are shared with the neighbouring cell's leaf. So are the
+/// polygons on the surface that rounding made the reverse of one in another leaf (`touched`:
+/// they have a vertex that several points were welded into): two elements whose parts on
+/// either side of a gap thinner than the coordinates resolve now touch there. Candidates are
+/// grouped by vertex-set key (sorted in parallel); within a group, in leaf order, each takes
+/// the first earlier open one of its kind (cap or surface) that is its reverse, which is then
+/// closed.
+std::vector<std::uint32_t> matchSides(const WeldedPolygons& welded,
+                                      const std::vector<FaceOrigin>& origin,
+                                      const std::vector<char>& kept,
+                                      const std::vector<char>& touched,
+                                      const std::vector<std::uint64_t>& keys);
+
 }  // namespace polydg

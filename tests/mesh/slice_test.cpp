@@ -5,13 +5,19 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <iomanip>
 #include <iostream>
 #include <limits>
+#include <string>
+#include <vector>
 
+#include "mesh/slice_reference.h"
 #include "polydg/integrate/moment_cache.h"
 #include "polydg/mesh/geometry.h"
 #include "polydg/mesh/geometry_checks.h"
+#include "polydg/mesh/surface_io.h"
 #include "polydg/mesh/surface_shapes.h"
 
 namespace polydg {
@@ -230,6 +236,112 @@ TEST(Slice, ManyThinTwistedSlices) {
               << std::setprecision(17) << s.volume << " (enclosed " << exact << ")\n";
   }
   EXPECT_GT(repairs, 0u);  // what rounding flattens was there to repair
+}
+
+/// A mesh's elements in order, each as its faces as it uses them (outward): each loop the
+/// cycle of its corners' positions from the smallest, the holes sorted, the faces sorted. Two
+/// meshes with the same elements, faces and orientations give the same list, whatever the
+/// order of an element's faces and the first corner of each loop.
+using CanonicalLoop = std::vector<std::array<double, 3>>;
+using CanonicalFace = std::vector<CanonicalLoop>;
+std::vector<std::vector<CanonicalFace>> canonicalElements(const PolyMesh& mesh) {
+  std::vector<std::vector<CanonicalFace>> elements;
+  for (std::size_t e = 0; e < mesh.numElements(); ++e) {
+    std::vector<CanonicalFace> faces;
+    for (const FaceUse& use : mesh.element(ElementId(e)).faces) {
+      const Face& f = mesh.face(use.face);
+      CanonicalFace face;
+      for (std::size_t k = 0; k < f.numLoops(); ++k) {
+        CanonicalLoop loop;
+        for (VertexId v : f.loop(k)) {
+          const Vec3& p = mesh.position(v);
+          loop.push_back({p.x(), p.y(), p.z()});
+        }
+        if (use.reversed) std::reverse(loop.begin(), loop.end());
+        std::rotate(loop.begin(), std::min_element(loop.begin(), loop.end()), loop.end());
+        face.push_back(std::move(loop));
+      }
+      std::sort(face.begin() + 1, face.end());
+      faces.push_back(std::move(face));
+    }
+    std::sort(faces.begin(), faces.end());
+    elements.push_back(std::move(faces));
+  }
+  return elements;
+}
+
+/// The octahedron with corners centre +- d[k], outward.
+TriangleSurface octahedron(const Vec3& centre, const std::array<Vec3, 3>& d) {
+  TriangleSurface s;
+  for (const Vec3& v : d) {
+    s.vertices.push_back(centre + v);
+    s.vertices.push_back(centre - v);
+  }
+  for (std::uint32_t a = 0; a < 2; ++a)
+    for (std::uint32_t b = 2; b < 4; ++b)
+      for (std::uint32_t c = 4; c < 6; ++c) {
+        const Vec3 n = (s.vertices[b] - s.vertices[a]).cross(s.vertices[c] - s.vertices[a]);
+        if (n.dot(s.vertices[a] + s.vertices[b] + s.vertices[c] - 3 * centre) > 0)
+          s.triangles.push_back({a, b, c});
+        else
+          s.triangles.push_back({a, c, b});
+      }
+  return s;
+}
+
+TEST(Slice, WholeCellsMadeFromTheGridAreThoseSplittingGives) {
+  // Boxes of cells the surface does not enter are made from the grid instead of being split
+  // cell by cell; the mesh must be the one splitting gives, element by element and face by
+  // face. The cases put surfaces on grid planes, within round-off of them (whose slivers
+  // welding collapses next to whole cells), through many holes, and 1e6 from the origin.
+  struct Case {
+    std::string name;
+    TriangleSurface surface;
+    int cells;
+  };
+  const TriangleSurface torus = readSurface(std::string(POLYDG_TESTDATA_DIR) + "/torus.obj");
+  TriangleSurface parts = twistedTaperedPrism(Vec3::Zero(), 20, 10, 40, 200, 1.0);
+  parts = combine(parts, boxSurface(Box3(Vec3(20, -5, 0), Vec3(30, 5, 10))));
+  parts = combine(parts, boxSurface(Box3(Vec3(-30, -5, 0), Vec3(-20, 5, 20))));
+  parts = combine(parts, boxSurface(Box3(Vec3(-5, 20, 0), Vec3(5, 30, 5))));
+  const std::vector<Case> cases = {
+      {"torus.obj at 14 cells", torus, 14},
+      {"torus.obj at 24 cells", torus, 24},
+      {"twist and boxes at 58 cells", parts, 58},
+      {"twist and boxes 1e6 away at 48 cells", transformed(parts, 1.0, Vec3(1e6, 0, 0)), 48},
+      {"grid-aligned box", boxSurface(Box3(Vec3(0, 0, 0), Vec3(4, 3, 2))), 8},
+      {"sphere", icosphere(Vec3(0.1, 0.2, 0.3), 1.0, 3), 20},
+      {"holed block", swissCheeseBlock(Box3(Vec3(0, 0, 0), Vec3(9, 9, 9)), {9, 9, 9}), 18},
+      // A cavity whose corner (2, 2, 2.5) lies on the grid line x = 2, y = 2, the cavity on
+      // its y < 2 side: the cells beyond y = 2 are whole, but a side of theirs has that corner
+      // on its edge, so they are split, not made from the grid.
+      {"cavity touching a grid line",
+       combine(boxSurface(Box3(Vec3(0, 0, 0), Vec3(4, 4, 4))),
+               reversedSurface(octahedron(
+                   Vec3(2, 1.5, 2.5), {Vec3(0, 0.5, 0), Vec3(0.375, 0, 0), Vec3(0, 0, 0.375)}))),
+       8},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    const Grid grid = Grid::withCellsAlongLongest(bounds(c.surface), c.cells);
+    SliceStats shortcut, reference;
+    const PolyMesh fast = sliceSurface(c.surface, grid, &shortcut);
+    const PolyMesh split = sliceSurfaceSplittingEveryCell(c.surface, grid, &reference);
+    EXPECT_GT(shortcut.wholeCells, 0u);
+    EXPECT_EQ(reference.wholeCells, 0u);
+    EXPECT_LE(shortcut.splits, reference.splits);
+    EXPECT_EQ(shortcut.leafCells, reference.leafCells);
+    EXPECT_EQ(shortcut.weldedPoints, reference.weldedPoints);
+    EXPECT_EQ(shortcut.mergedElements, reference.mergedElements);
+    EXPECT_EQ(fast.numVertices(), split.numVertices());
+    EXPECT_EQ(fast.numFaces(), split.numFaces());
+    ASSERT_EQ(fast.numElements(), split.numElements());
+    const auto a = canonicalElements(fast), b = canonicalElements(split);
+    std::size_t differing = 0;
+    for (std::size_t e = 0; e < a.size(); ++e) differing += a[e] != b[e];
+    EXPECT_EQ(differing, 0u);
+    EXPECT_TRUE(checkGeometry(fast).passed);
+  }
 }
 
 }  // namespace

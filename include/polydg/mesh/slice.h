@@ -30,10 +30,11 @@ struct Grid {
 };
 
 struct SliceStats {
-  std::size_t splits = 0;             ///< plane splits of a piece
-  std::size_t polygonsSplit = 0;      ///< polygons cut in two or more
-  std::size_t leafCells = 0;          ///< cells that hold part of the solid
-  std::size_t multiPieceCells = 0;    ///< cells holding two or more disconnected pieces
+  std::size_t splits = 0;           ///< plane splits of a piece
+  std::size_t polygonsSplit = 0;    ///< polygons cut in two or more
+  std::size_t leafCells = 0;        ///< cells that hold part of the solid
+  std::size_t multiPieceCells = 0;  ///< cells holding two or more disconnected pieces
+  std::size_t wholeCells = 0;  ///< uniform grid: leaf cells found whole in a box of them, not split
   std::size_t collapsedPolygons = 0;  ///< polygons removed when rounding made points equal
   std::size_t weldedPoints = 0;       ///< points at the same rounded position as another
   std::size_t flatFaces = 0;          ///< faces rounding left flat, dissolved into their edges
