@@ -31,28 +31,6 @@
 
 namespace polydg {
 
-Grid Grid::covering(const Box3& bounds, double cellSize) {
-  if (!(cellSize > 0.0) || !std::isfinite(cellSize))
-    throw std::invalid_argument("grid cell size must be positive and finite");
-  if (bounds.isEmpty()) throw std::invalid_argument("cannot build a grid around an empty box");
-  Grid g;
-  g.cellSize = cellSize;
-  const Vec3 extent = bounds.diagonal();
-  const Vec3 centre = 0.5 * (bounds.min() + bounds.max());
-  for (int a = 0; a < 3; ++a) {
-    const double n = std::max(1.0, std::ceil(extent[a] / cellSize));
-    if (n > 1 << 20) throw std::invalid_argument("grid would have more than 2^20 cells per axis");
-    g.cells[a] = static_cast<int>(n);
-  }
-  g.centre = centre;
-  return g;
-}
-
-Grid Grid::withCellsAlongLongest(const Box3& bounds, int cellsAlongLongest) {
-  if (cellsAlongLongest < 1) throw std::invalid_argument("need at least one cell");
-  return covering(bounds, bounds.diagonal().maxCoeff() / cellsAlongLongest);
-}
-
 namespace {
 
 class Slicer {
@@ -124,8 +102,9 @@ class Slicer {
     // Caps meet their other side: the later of two reversed, equal polygons uses the earlier's
     // face (reversed), as findOrCreateFace would in leaf order; so do two polygons on the
     // surface that rounding made reversed and equal.
-    const std::vector<std::uint32_t> sharesEarlier = matchSides(
-        polygons.welded, polygons.origin, polygons.kept, polygons.touched, polygons.keys);
+    const std::vector<std::uint32_t> sharesEarlier =
+        matchSides(polygons.welded, polygons.origin, polygons.kept, polygons.touched, polygons.keys,
+                   pairWholeSides(at, polygons));
     const MeshIds ids = numberMesh(at, polygons, sharesEarlier);
     FaceData<Face> meshFaces(ids.faceBase[leaves_.size()]);
     ElementData<Element> meshElements(ids.elements);
@@ -361,6 +340,20 @@ class Slicer {
         }
     });
     stats.collapsedPolygons += cancelled;
+  }
+
+  /// For matchSides: the sides two whole cells share (WholeCells::pairSides), unless welding
+  /// touched or collapsed one.
+  std::vector<std::uint32_t> pairWholeSides(const LeafOffsets& at,
+                                            const LeafPolygons& polygons) const {
+    std::vector<std::pair<std::array<int, 3>, std::uint32_t>> firstSide;
+    firstSide.reserve(stats.wholeCells);
+    for (std::size_t l = 0; l < leaves_.size(); ++l)
+      if (leaves_[l].whole) firstSide.emplace_back(leaves_[l].cell, at.polygon[l]);
+    auto free = [&](std::uint32_t p) { return polygons.kept[p] && !polygons.touched[p]; };
+    return whole_.pairSides(firstSide, at.polygon.back(), [&](std::uint32_t p, std::uint32_t q) {
+      return free(p) && free(q) && polygons.welded.isReversed(p, q);
+    });
   }
 
   /// The mesh's ids, in leaf order: an element for each leaf that kept a polygon, a face for

@@ -121,10 +121,14 @@ std::vector<std::uint32_t> matchSides(const WeldedPolygons& welded,
                                       const std::vector<FaceOrigin>& origin,
                                       const std::vector<char>& kept,
                                       const std::vector<char>& touched,
-                                      const std::vector<std::uint64_t>& keys) {
+                                      const std::vector<std::uint64_t>& keys,
+                                      std::vector<std::uint32_t> paired) {
   const std::size_t np = kept.size();
+  if (paired.empty()) paired.assign(np, kNoSide);
   auto isCap = [&](std::size_t p) { return origin[p] == FaceOrigin::Interior; };
-  auto candidate = [&](std::size_t p) { return kept[p] && (isCap(p) || touched[p]); };
+  auto candidate = [&](std::size_t p) {
+    return kept[p] && (isCap(p) || touched[p]) && paired[p] == kNoSide;
+  };
   // Candidates in polygon order (that is, leaf order), gathered in parallel blocks.
   constexpr std::size_t kBlock = 16384;
   const std::size_t blocks = (np + kBlock - 1) / kBlock;
@@ -147,7 +151,10 @@ std::vector<std::uint32_t> matchSides(const WeldedPolygons& welded,
     if (c == 0 || sides[c].first != sides[c - 1].first)
       groupStart.push_back(static_cast<std::uint32_t>(c));
   groupStart.push_back(static_cast<std::uint32_t>(sides.size()));
-  std::vector<std::uint32_t> shares(np, kNoSide);
+  std::vector<std::uint32_t>& shares = paired;  // the pairs given, then those found
+  tbb::parallel_for(std::size_t(0), np, [&](std::size_t p) {
+    if (shares[p] == p) shares[p] = kNoSide;
+  });
   tbb::parallel_for(std::size_t(0), groupStart.size() - 1, [&](std::size_t g) {
     boost::container::small_vector<std::uint32_t, 4> open;
     for (std::size_t c = groupStart[g]; c < groupStart[g + 1]; ++c) {

@@ -113,11 +113,14 @@ inline constexpr std::uint32_t kNoSide = 0xffffffffu;
 /// either side of a gap thinner than the coordinates resolve now touch there. Candidates are
 /// grouped by vertex-set key (sorted in parallel); within a group, in leaf order, each takes
 /// the first earlier open one of its kind (cap or surface) that is its reverse, which is then
-/// closed.
+/// closed. `paired` (empty, or one entry per polygon) gives pairs known beforehand: for the
+/// later side, the earlier one; for the earlier side, itself; kNoSide for the others. Those
+/// are the result's pairs, and their polygons are no candidates.
 std::vector<std::uint32_t> matchSides(const WeldedPolygons& welded,
                                       const std::vector<FaceOrigin>& origin,
                                       const std::vector<char>& kept,
                                       const std::vector<char>& touched,
-                                      const std::vector<std::uint64_t>& keys);
+                                      const std::vector<std::uint64_t>& keys,
+                                      std::vector<std::uint32_t> paired = {});
 
 }  // namespace polydg

@@ -3,6 +3,10 @@
 #include <algorithm>
 #include <tuple>
 
+#include <tbb/parallel_for.h>
+
+#include "mesh/welded_polygons.h"
+
 namespace polydg {
 
 bool WholeCells::isWholeBox(const Piece& piece) {
@@ -82,6 +86,38 @@ void WholeCells::sides(const std::array<int, 3>& cell, Piece& piece) const {
       polygon.vertices.assign(loop.begin(), loop.end());
       polygon.loopEnd.assign(1, 4);
     }
+}
+
+std::vector<std::uint32_t> WholeCells::pairSides(
+    const std::vector<std::pair<std::array<int, 3>, std::uint32_t>>& firstSide,
+    std::size_t polygons, const std::function<bool(std::uint32_t, std::uint32_t)>& canPair) const {
+  const std::array<std::size_t, 3> n{std::size_t(grid_.cells[0]), std::size_t(grid_.cells[1]),
+                                     std::size_t(grid_.cells[2])};
+  const std::size_t cells = n[0] * n[1] * n[2];
+  if (firstSide.empty() || cells > 8 * firstSide.size() + (std::size_t(1) << 20)) return {};
+  auto index = [&](const std::array<int, 3>& c) {
+    return (std::size_t(c[2]) * n[1] + std::size_t(c[1])) * n[0] + std::size_t(c[0]);
+  };
+  constexpr std::uint32_t kNone = 0xffffffffu;
+  std::vector<std::uint32_t> at(cells, kNone);  // each whole cell's entry in firstSide
+  tbb::parallel_for(std::size_t(0), firstSide.size(), [&](std::size_t w) {
+    at[index(firstSide[w].first)] = static_cast<std::uint32_t>(w);
+  });
+  std::vector<std::uint32_t> paired(polygons, kNoSide);
+  tbb::parallel_for(std::size_t(0), firstSide.size(), [&](std::size_t w) {
+    for (int axis = 0; axis < 3; ++axis) {
+      std::array<int, 3> next = firstSide[w].first;
+      if (++next[axis] == grid_.cells[axis]) continue;
+      const std::uint32_t m = at[index(next)];
+      if (m == kNone) continue;
+      const std::uint32_t p = firstSide[w].second + 2 * axis + 1,
+                          q = firstSide[m].second + 2 * axis;
+      if (!canPair(p, q)) continue;
+      paired[q] = p;  // the next cell's sides come later
+      paired[p] = p;
+    }
+  });
+  return paired;
 }
 
 }  // namespace polydg

@@ -5,7 +5,9 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include <tbb/enumerable_thread_specific.h>
@@ -38,6 +40,15 @@ class WholeCells {
   /// The six sides of whole cell `cell` into `piece`, outward, on the points finish() made:
   /// those of SurfaceOctree::boxFaces for a leaf without a finer neighbour.
   void sides(const std::array<int, 3>& cell, Piece& piece) const;
+
+  /// For matchSides: the sides two whole cells share, paired by the grid, each cell's side
+  /// towards +axis (its sides' index 2 axis + 1) with the next cell's towards -axis (2 axis),
+  /// where `canPair` agrees. `firstSide`: each whole cell with the number of its first side, in
+  /// the order of the numbers; `polygons`: the number of all. Empty where a table of the
+  /// grid's cells would be much larger than the whole cells.
+  std::vector<std::uint32_t> pairSides(
+      const std::vector<std::pair<std::array<int, 3>, std::uint32_t>>& firstSide,
+      std::size_t polygons, const std::function<bool(std::uint32_t, std::uint32_t)>& canPair) const;
 
  private:
   struct Box {
