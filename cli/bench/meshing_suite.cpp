@@ -154,7 +154,7 @@ std::string summary(const nlohmann::json& r) {
   if (r.contains("error")) return mesher + ": " + r["error"].get<std::string>();
   return mesher + " " + std::to_string(r["elements"].get<std::size_t>()) + " cells, " +
          shortNumber(r["wall_seconds"].get<double>()) + " s, peak " +
-         shortNumber(r["peak_rss_bytes"].get<double>() / 1e6) + " MB, " +
+         std::to_string(std::llround(r["peak_rss_bytes"].get<double>() / 1e6)) + " MB, " +
          std::to_string(std::llround(r["elements_per_second"].get<double>())) + " cells/s, " +
          std::to_string(std::llround(r["bytes_per_element"].get<double>())) + " B/cell";
 }
