@@ -68,15 +68,6 @@ std::string readText(const fs::path& file) {
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
-/// The last line of `file` that is not blank, to say why a tool failed.
-std::string lastLine(const fs::path& file) {
-  std::ifstream in(file);
-  std::string last;
-  for (std::string line; std::getline(in, line);)
-    if (line.find_first_not_of(" \t\r") != std::string::npos) last = line;
-  return last;
-}
-
 /// Runs `run.command` once, timed; after a failure (the error set) it is not run again.
 void runRound(MesherRun& run, const std::function<void()>& clean,
               const std::vector<fs::path>& logs) {

@@ -7,6 +7,7 @@
 #include <tuple>
 #include <utility>
 
+#include "cli/bench/stl_file.h"
 #include "model/files.h"
 #include "polydg/mesh/slice.h"
 #include "polydg/util/error.h"
@@ -118,24 +119,6 @@ std::string snappyHexMeshDict(const SnappySetup& s) {
          "mergeTolerance 1e-6;\n";
 }
 
-void writeStl(const fs::path& file, const TriangleSurface& surface, const std::string& name) {
-  writeFileAtomically(file, [&](std::ostream& os) {
-    os << "solid " << name << "\n";
-    for (const auto& t : surface.triangles) {
-      const Vec3 &a = surface.vertices[t[0]], &b = surface.vertices[t[1]],
-                 &c = surface.vertices[t[2]];
-      const Vec3 n = (b - a).cross(c - a).normalized();
-      os << " facet normal " << number(n.x()) << ' ' << number(n.y()) << ' ' << number(n.z())
-         << "\n  outer loop\n";
-      for (const Vec3* v : {&a, &b, &c})
-        os << "   vertex " << number(v->x()) << ' ' << number(v->y()) << ' ' << number(v->z())
-           << "\n";
-      os << "  endloop\n endfacet\n";
-    }
-    os << "endsolid " << name << "\n";
-  });
-}
-
 }  // namespace
 
 SnappySetup snappySetup(const TriangleSurface& surface, const SurfaceDistance& distance, int cells,
@@ -182,7 +165,7 @@ void writeSnappyCase(const fs::path& dir, const TriangleSurface& surface, const 
             ".stl\n{\n    extractionMethod extractFromSurface;\n    includedAngle " +
             number(s.includedAngle) + ";\n    writeObj no;\n}\n");
   write(system / "snappyHexMeshDict", snappyHexMeshDict(s));
-  writeStl(dir / "constant" / "triSurface" / (s.surface + ".stl"), surface, s.surface);
+  writeAsciiStl(dir / "constant" / "triSurface" / (s.surface + ".stl"), surface, s.surface);
 }
 
 }  // namespace polydg::bench

@@ -12,7 +12,12 @@
 //              scale and position (B1 and B3 scaled by 1e-6, 1, 1e6, offsets 0 and
 //              (1e6, -1e6, 1e6), p = 2).
 //   meshing    the meshing pipeline and its validation (geometric, DG checks) for the bundled
-//              torus.obj and the generated sphere and torus knot at 16 .. 128 cells.
+//              torus.obj and the generated sphere and torus knot at 16 .. 128 cells; the whole
+//              `polydg mesh` command on the bunny (DATA/models/bunny.off) beside Debian's
+//              `tetgen -pQ` (64 cells) and beside Gmsh's HXT (`gmsh -3 -nt 2`, 64, 128 and 200
+//              cells, Gmsh's largest mesh size polydg's cell edge): wall time, peak memory,
+//              cells per second and bytes per cell, and plots of both against the cells. Each
+//              comparison is skipped, with one line, without the bunny or its program.
 //   cutting    plane cuts of growing size on a 47^3 hex grid (103,823 elements): time per cut
 //              against elements split, validation none and local, beside a full moment rebuild.
 //   dynamics   B6 (linear, p = 2, 10 periods of dt = T/200: energy against time and the first
