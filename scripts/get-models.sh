@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Fetches the real models the benchmarks use beyond the bundled testdata/, from Debian's
 # packages (the project does not ship them): the Stanford bunny as a closed 75,408-triangle
-# surface (bunny00.off of CGAL's data, package libcgal-demo), tetgen, the reference mesher
-# `polydg bench --suite meshing` times polydg against, and OpenFOAM (snappyHexMesh and
+# surface (bunny00.off of CGAL's data, package libcgal-demo), tetgen and Gmsh (HXT), the
+# reference meshers `polydg bench --suite meshing` times polydg against, and OpenFOAM (snappyHexMesh and
 # checkMesh, package openfoam; scripts/setup.sh installs it too), the peer of `polydg bench
 # --suite openfoam`.
 # Usage: scripts/get-models.sh [DIR]   (default build/share/polydg/models, where polydg bench
@@ -16,6 +16,7 @@ if [[ $(id -u) -ne 0 ]]; then SUDO="sudo"; fi
 export DEBIAN_FRONTEND=noninteractive
 tools=()
 command -v tetgen >/dev/null 2>&1 || tools+=(tetgen)
+command -v gmsh >/dev/null 2>&1 || tools+=(gmsh)
 command -v snappyHexMesh >/dev/null 2>&1 || tools+=(openfoam)
 if ((${#tools[@]})); then
   $SUDO apt-get update -qq

@@ -26,7 +26,8 @@ std::string gmshCommand(const std::filesystem::path& geo, const std::filesystem:
   char size[32];
   std::snprintf(size, sizeof size, "%.17g", options.meshSizeMax);
   return "gmsh " + shellQuoted(geo.string()) + " -3 -nt " + std::to_string(options.threads) +
-         " -clmax " + size + " -format msh41 -o " + shellQuoted(msh.string());
+         (options.meshSizeMax > 0 ? std::string(" -clmax ") + size : std::string()) +
+         " -format msh41 -o " + shellQuoted(msh.string());
 }
 
 }  // namespace polydg::bench

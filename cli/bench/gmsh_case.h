@@ -24,12 +24,15 @@ std::string gmshGeo(const std::string& stl);
 
 /// How Gmsh is run on a .geo of gmshGeo().
 struct GmshOptions {
-  double meshSizeMax = 0.0;  ///< Mesh.MeshSizeMax (-clmax), in the surface's units
-  int threads = 2;           ///< -nt
+  /// Mesh.MeshSizeMax (-clmax), in the surface's units; 0: none, Gmsh's own sizes (from the
+  /// surface's triangles), as issue 35 measured it.
+  double meshSizeMax = 0.0;
+  int threads = 2;  ///< -nt
 };
 
 /// `gmsh GEO -3 -nt THREADS -clmax SIZE -format msh41 -o MSH` (SIZE with 17 significant digits,
-/// the paths quoted for /bin/sh): the volume meshed and written as MSH 4.1 ASCII.
+/// left out for a size of 0; the paths quoted for /bin/sh): the volume meshed and written as
+/// MSH 4.1 ASCII.
 std::string gmshCommand(const std::filesystem::path& geo, const std::filesystem::path& msh,
                         const GmshOptions& options);
 

@@ -160,13 +160,15 @@ std::string summary(const nlohmann::json& r) {
 }
 
 /// polydg's and Gmsh's runs at `cells` cells, alternately for `rounds` rounds in `dir` (which
-/// holds bunny.geo and bunny.stl): their two rows.
+/// holds bunny.geo and bunny.stl): their two rows. Gmsh's mesh size is limited to polydg's cell
+/// edge, unless `gmshOwnSizes` (its sizes from the surface's triangles, as issue 35 ran it).
 std::pair<nlohmann::json, nlohmann::json> compareWithGmsh(const fs::path& self,
                                                           const fs::path& bunny,
                                                           const TriangleSurface& surface, int cells,
-                                                          int rounds, const fs::path& dir) {
+                                                          int rounds, const fs::path& dir,
+                                                          bool gmshOwnSizes = false) {
   const double h = polydgCellSize(surface, cells);
-  const std::string n = std::to_string(cells);
+  const std::string n = std::to_string(cells) + (gmshOwnSizes ? "_own" : "");
   ComparedMesher polydg, gmsh;
   polydg.mesher = "polydg";
   polydg.output = dir / ("polydg_" + n + ".vtu");
@@ -175,11 +177,12 @@ std::pair<nlohmann::json, nlohmann::json> compareWithGmsh(const fs::path& self,
                    " --cells " + n + " -o " + shellQuoted(polydg.output.string()) +
                    " --no-dg --quiet > " + shellQuoted(polydg.log.string()) + " 2>&1";
   polydg.countCells = [](const fs::path& file) { return vtuCells(file); };
-  gmsh.mesher = kGmshComparison;
+  gmsh.mesher = gmshOwnSizes ? std::string(kGmshComparison) + " (own sizes)" : kGmshComparison;
   gmsh.output = dir / ("gmsh_" + n + ".msh");
   gmsh.log = dir / ("gmsh_" + n + ".log");
-  gmsh.command = gmshCommand(dir / "bunny.geo", gmsh.output, {h, kGmshThreads}) + " > " +
-                 shellQuoted(gmsh.log.string()) + " 2>&1";
+  gmsh.command =
+      gmshCommand(dir / "bunny.geo", gmsh.output, {gmshOwnSizes ? 0.0 : h, kGmshThreads}) + " > " +
+      shellQuoted(gmsh.log.string()) + " 2>&1";
   gmsh.countCells = [](const fs::path& file) { return mshTetrahedra(file); };
   for (int r = 0; r < rounds; ++r) {
     measureRound(polydg);
@@ -229,8 +232,13 @@ nlohmann::json againstGmsh(const BenchOptions& o, bool quiet) {
     fs::create_directories(dir);
     writeAsciiStl(dir / "bunny.stl", surface, "bunny");
     writeFileAtomically(dir / "bunny.geo", [](std::ostream& os) { os << gmshGeo("bunny.stl"); });
-    for (int cells : resolutions) {
-      auto [ours, theirs] = compareWithGmsh(*self, bunny, surface, cells, rounds, dir);
+    // The last run: Gmsh with its own sizes, the configuration issue 35 quotes, beside the
+    // finest grid.
+    for (std::size_t run = 0; run <= resolutions.size(); ++run) {
+      const bool own = run == resolutions.size();
+      if (own && o.quick) break;
+      const int cells = own ? resolutions.back() : resolutions[run];
+      auto [ours, theirs] = compareWithGmsh(*self, bunny, surface, cells, rounds, dir, own);
       if (!quiet)
         std::cout << "bunny (" << surface.triangles.size() << " triangles), N = " << cells
                   << " (h = " << shortNumber(ours["cell_size"].get<double>())
@@ -254,6 +262,7 @@ nlohmann::json againstGmsh(const BenchOptions& o, bool quiet) {
             {"gmsh", "gmsh bunny.geo -3 -nt " + std::to_string(kGmshThreads) +
                          " -clmax H -format msh41 -o bunny.msh"},
             {"H", "the longest side of the bunny's bounding box / N (polydg's cell edge)"},
+            {"gmsh_own_sizes", "the same without -clmax, beside polydg at the finest N"},
             {"bunny.stl", "bunny.off as ASCII STL, 17 significant digits"}}},
           {"geo", gmshGeo("bunny.stl")},
           {"rows", rows}};

@@ -54,6 +54,9 @@ TEST(GmshCase, CommandLine) {
   const std::size_t at = command.find("-clmax ") + 7;
   EXPECT_EQ(std::stod(command.substr(at, command.find(' ', at) - at)), 0.1 / 3);
   EXPECT_NE(command.find(" -nt 4 "), std::string::npos);
+  // No limit: Gmsh's own sizes.
+  EXPECT_EQ(gmshCommand("x.geo", "x.msh", {0.0, 2}),
+            "gmsh 'x.geo' -3 -nt 2 -format msh41 -o 'x.msh'");
 }
 
 TEST(GmshCase, GmshFillsABoxWithTets) {
