@@ -181,7 +181,8 @@ class Slicer {
     // their corners did when they were split, so that a weld keeps the same position.
     std::vector<std::uint32_t> used;
     Piece scratch;
-    for (const bool generated : {false, true})
+    for (const bool generated : {false, true}) {
+      if (generated && !octree_) break;  // one pass ranks every point
       for (const Leaf& leaf : leaves_)
         for (const PiecePolygon& polygon : pieceOf(leaf, scratch))
           for (std::uint32_t v : polygon.vertices)
@@ -189,6 +190,7 @@ class Slicer {
               out.rank[v] = static_cast<std::uint32_t>(used.size());
               used.push_back(v);
             }
+    }
     const std::vector<std::uint32_t> target = weldTargets(points, used, resolution);
     out.positions.raw().reserve(used.size());
     out.vertexOfRank.resize(used.size());
@@ -502,8 +504,7 @@ class Slicer {
   /// Cells lo .. hi - 1 of the uniform grid are whole: they are not split; their faces are made
   /// from the grid once all leaves are known (run()).
   void wholeRun(const std::array<int, 3>& lo, const std::array<int, 3>& hi) {
-    whole_.add(lo, hi);
-    leafCells_ += static_cast<std::size_t>(hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]);
+    leafCells_ += whole_.add(lo, hi);
     reportDone(lo, hi);
   }
 

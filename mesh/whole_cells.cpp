@@ -15,8 +15,9 @@ bool WholeCells::isWholeBox(const Piece& piece) {
          });
 }
 
-void WholeCells::add(const std::array<int, 3>& lo, const std::array<int, 3>& hi) {
+std::size_t WholeCells::add(const std::array<int, 3>& lo, const std::array<int, 3>& hi) {
   boxes_.local().push_back({lo, hi});
+  return boxes_.local().back().cells();
 }
 
 std::size_t WholeCells::count() const {
@@ -24,11 +25,6 @@ std::size_t WholeCells::count() const {
   for (const std::vector<Box>& list : boxes_)
     for (const Box& box : list) cells += box.cells();
   return cells;
-}
-
-std::size_t WholeCells::nodeIndex(const std::array<int, 3>& c) const {
-  const std::size_t nx = std::size_t(grid_.cells[0]) + 1, ny = std::size_t(grid_.cells[1]) + 1;
-  return (std::size_t(c[2]) * ny + std::size_t(c[1])) * nx + std::size_t(c[0]);
 }
 
 std::uint32_t WholeCells::node(const std::array<int, 3>& c) const {
@@ -48,7 +44,6 @@ std::vector<std::array<int, 3>> WholeCells::finish(std::uint32_t firstPoint,
   std::size_t cells = 0;
   for (const Box& box : boxes) cells += box.cells();
   if (cells == 0) return {};
-  constexpr std::uint32_t kNone = 0xffffffffu;
   const std::size_t nodes = nodeIndex(grid_.cells) + 1;
   if (nodes <= 8 * cells + (std::size_t(1) << 20)) table_.assign(nodes, kNone);
   std::vector<std::array<int, 3>> out;
@@ -91,14 +86,12 @@ void WholeCells::sides(const std::array<int, 3>& cell, Piece& piece) const {
 std::vector<std::uint32_t> WholeCells::pairSides(
     const std::vector<std::pair<std::array<int, 3>, std::uint32_t>>& firstSide,
     std::size_t polygons, const std::function<bool(std::uint32_t, std::uint32_t)>& canPair) const {
-  const std::array<std::size_t, 3> n{std::size_t(grid_.cells[0]), std::size_t(grid_.cells[1]),
-                                     std::size_t(grid_.cells[2])};
-  const std::size_t cells = n[0] * n[1] * n[2];
+  const std::size_t cells =
+      std::size_t(grid_.cells[0]) * std::size_t(grid_.cells[1]) * std::size_t(grid_.cells[2]);
   if (firstSide.empty() || cells > 8 * firstSide.size() + (std::size_t(1) << 20)) return {};
   auto index = [&](const std::array<int, 3>& c) {
-    return (std::size_t(c[2]) * n[1] + std::size_t(c[1])) * n[0] + std::size_t(c[0]);
+    return linearIndex(c, grid_.cells[0], grid_.cells[1]);
   };
-  constexpr std::uint32_t kNone = 0xffffffffu;
   std::vector<std::uint32_t> at(cells, kNone);  // each whole cell's entry in firstSide
   tbb::parallel_for(std::size_t(0), firstSide.size(), [&](std::size_t w) {
     at[index(firstSide[w].first)] = static_cast<std::uint32_t>(w);

@@ -27,8 +27,8 @@ class WholeCells {
   /// other than the box's would be where the surface touches a side.)
   static bool isWholeBox(const Piece& piece);
 
-  /// Records cells lo .. hi - 1 as whole. May be called concurrently.
-  void add(const std::array<int, 3>& lo, const std::array<int, 3>& hi);
+  /// Records cells lo .. hi - 1 as whole and returns their number. May be called concurrently.
+  std::size_t add(const std::array<int, 3>& lo, const std::array<int, 3>& hi);
   /// The number of cells recorded.
   std::size_t count() const;
 
@@ -58,7 +58,16 @@ class WholeCells {
     }
   };
   /// Grid node c's index (i fastest, then j, then k).
-  std::size_t nodeIndex(const std::array<int, 3>& c) const;
+  std::size_t nodeIndex(const std::array<int, 3>& c) const {
+    return linearIndex(c, grid_.cells[0] + 1, grid_.cells[1] + 1);
+  }
+  /// The index of c in an array nx by ny by any, i fastest.
+  static std::size_t linearIndex(const std::array<int, 3>& c, int nx, int ny) {
+    return (std::size_t(c[2]) * std::size_t(ny) + std::size_t(c[1])) * std::size_t(nx) +
+           std::size_t(c[0]);
+  }
+  /// No point, no cell.
+  static constexpr std::uint32_t kNone = 0xffffffffu;
   std::uint32_t node(const std::array<int, 3>& c) const;
 
   const Grid& grid_;
