@@ -29,6 +29,16 @@ namespace fs = std::filesystem;
 
 namespace {
 
+/// Why a comparison on `bunny` with `program` cannot run (`install`: how to get the program),
+/// or nothing: the bunny, the program and polydg's own executable are there.
+std::optional<std::string> missingForComparison(const fs::path& bunny, const std::string& program,
+                                                const std::string& install) {
+  if (!fs::exists(bunny)) return bunny.string() + " not found; scripts/get-models.sh fetches it";
+  if (!commandExists(program)) return program + " not installed; " + install;
+  if (!polydgExecutable()) return "cannot find the polydg executable through /proc/self/exe";
+  return std::nullopt;
+}
+
 /// polydg's whole `polydg mesh` command (read, checks, slicing, validation, DG checks, the
 /// VTU written) against Debian's `tetgen -pQ` on the same closed 75k-triangle surface (the
 /// bunny of scripts/get-models.sh), run alternately `rounds` times in one run. The project
@@ -40,16 +50,14 @@ nlohmann::json againstTetgen(const BenchOptions& o, int rounds, bool quiet) {
     if (!quiet) std::cout << "meshing against tetgen skipped: " << why << std::endl;
     return nlohmann::json{{"comparison", "tetgen -pQ"}, {"skipped", why}};
   };
-  if (!fs::exists(bunny))
-    return skipped(bunny.string() + " not found; scripts/get-models.sh fetches it");
-  if (!commandExists("tetgen"))
-    return skipped("tetgen not installed; scripts/get-models.sh installs it (Debian's tetgen)");
-  const std::optional<fs::path> self = polydgExecutable();
-  if (!self) return skipped("cannot find the polydg executable through /proc/self/exe");
+  if (const std::optional<std::string> why = missingForComparison(
+          bunny, "tetgen", "scripts/get-models.sh installs it (Debian's tetgen)"))
+    return skipped(*why);
+  const fs::path self = *polydgExecutable();
   const fs::path dir = fs::temp_directory_path() / ("polydg-tetgen-" + std::to_string(::getpid()));
   fs::create_directories(dir);
   fs::copy_file(bunny, dir / "bunny.off", fs::copy_options::overwrite_existing);
-  const std::string polydg = shellQuoted(self->string()) + " mesh " +
+  const std::string polydg = shellQuoted(self.string()) + " mesh " +
                              shellQuoted((dir / "bunny.off").string()) + " --cells 64 -o " +
                              shellQuoted((dir / "bunny.vtu").string()) + " --quiet";
   const std::string tetgen =
@@ -208,12 +216,10 @@ nlohmann::json againstGmsh(const BenchOptions& o, bool quiet) {
     if (!quiet) std::cout << "meshing against gmsh skipped: " << why << std::endl;
     return nlohmann::json{{"comparison", kGmshComparison}, {"skipped", why}};
   };
-  if (!fs::exists(bunny))
-    return skipped(bunny.string() + " not found; scripts/get-models.sh fetches it");
-  if (!commandExists("gmsh"))
-    return skipped("gmsh not installed; Debian's gmsh package has it (apt-get install gmsh)");
-  const std::optional<fs::path> self = polydgExecutable();
-  if (!self) return skipped("cannot find the polydg executable through /proc/self/exe");
+  if (const std::optional<std::string> why = missingForComparison(
+          bunny, "gmsh", "Debian's gmsh package has it (apt-get install gmsh)"))
+    return skipped(*why);
+  const fs::path self = *polydgExecutable();
   TriangleSurface surface;
   try {
     surface = readSurface(bunny.string());
@@ -238,7 +244,7 @@ nlohmann::json againstGmsh(const BenchOptions& o, bool quiet) {
       const bool own = run == resolutions.size();
       if (own && o.quick) break;
       const int cells = own ? resolutions.back() : resolutions[run];
-      auto [ours, theirs] = compareWithGmsh(*self, bunny, surface, cells, rounds, dir, own);
+      auto [ours, theirs] = compareWithGmsh(self, bunny, surface, cells, rounds, dir, own);
       if (!quiet)
         std::cout << "bunny (" << surface.triangles.size() << " triangles), N = " << cells
                   << " (h = " << shortNumber(ours["cell_size"].get<double>())
