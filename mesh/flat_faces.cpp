@@ -117,16 +117,20 @@ std::vector<VertexId> between(const Lines& lines, VertexId u, VertexId w) {
 }  // namespace
 
 std::size_t dissolveFlatFaces(PolyMesh& mesh) {
-  std::vector<std::vector<VertexId>> corners(mesh.numFaces());
-  tbb::parallel_for(std::size_t(0), mesh.numFaces(),
-                    [&](std::size_t f) { corners[f] = flatCorners(mesh, FaceId(f)); });
+  // A byte per face, not a list: flat faces are rare, and a mesh has millions of faces.
+  std::vector<char> zeroArea(mesh.numFaces());
+  tbb::parallel_for(std::size_t(0), mesh.numFaces(), [&](std::size_t f) {
+    zeroArea[f] = areaVector(mesh, FaceId(f)).squaredNorm() == 0.0;
+  });
   std::vector<FaceId> flat;
   std::vector<std::vector<VertexId>> flatCornerSets;
-  for (std::size_t f = 0; f < mesh.numFaces(); ++f)
-    if (!corners[f].empty()) {
-      flat.push_back(FaceId(f));
-      flatCornerSets.push_back(std::move(corners[f]));
-    }
+  for (std::size_t f = 0; f < mesh.numFaces(); ++f) {
+    if (!zeroArea[f]) continue;
+    std::vector<VertexId> corners = flatCorners(mesh, FaceId(f));
+    if (corners.empty()) continue;
+    flat.push_back(FaceId(f));
+    flatCornerSets.push_back(std::move(corners));
+  }
   if (flat.empty()) return 0;
   const Lines lines = linesOf(mesh, flatCornerSets);
   // Every edge between two corners of a line gets the corners between them, in every face.

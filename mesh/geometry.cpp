@@ -74,11 +74,10 @@ double signedConeVolume(const PolyMesh& mesh, ElementId e, Area&& area, Bounds&&
 }
 }  // namespace
 
-double signedVolume(const PolyMesh& mesh, ElementId e, const FaceData<Vec3>& areaVectors,
-                    const FaceData<Box3>& faceBoxes) {
+double signedVolume(const PolyMesh& mesh, ElementId e, const FaceData<Vec3>& areaVectors) {
   return signedConeVolume(
       mesh, e, [&](FaceId f) -> const Vec3& { return areaVectors[f]; },
-      [&](FaceId f) -> const Box3& { return faceBoxes[f]; });
+      [&](FaceId f) { return faceBounds(mesh, f); });
 }
 
 double signedVolume(const PolyMesh& mesh, ElementId e) {

@@ -204,21 +204,18 @@ struct FaceCheck {
   std::uint64_t key = 0;   ///< hash of the sorted vertex ids
 };
 
-/// Every face's FaceCheck, with its area vector and bounds, computed once: the elements'
-/// volumes reuse them.
+/// Every face's FaceCheck, with its area vector, computed once: the elements' volumes reuse it.
 struct FaceMeasures {
   std::vector<FaceCheck> checks;
   FaceData<Vec3> areaVectors;
-  FaceData<Box3> boxes;
 };
 
 /// Shape and planarity of every face, in parallel (the costly part of the face checks).
 FaceMeasures measureFaces(const PolyMesh& mesh, const GeometryCheckOptions& options) {
   FaceMeasures m{std::vector<FaceCheck>(mesh.numFaces()),
-                 FaceData<Vec3>(mesh.numFaces(), Vec3::Zero()), FaceData<Box3>(mesh.numFaces())};
+                 FaceData<Vec3>(mesh.numFaces(), Vec3::Zero())};
   std::vector<FaceCheck>& checks = m.checks;
   FaceData<Vec3>& areaVectors = m.areaVectors;
-  FaceData<Box3>& faceBoxes = m.boxes;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.numFaces(), 1024),
                     [&](const tbb::blocked_range<std::size_t>& r) {
                       for (std::size_t i = r.begin(); i != r.end(); ++i) {
@@ -227,10 +224,9 @@ FaceMeasures measureFaces(const PolyMesh& mesh, const GeometryCheckOptions& opti
                         const Face& face = mesh.face(f);
                         c.key = vertexSetKey({face.vertices.data(), face.vertices.size()});
                         areaVectors[f] = areaVector(mesh, f);
-                        faceBoxes[f] = faceBounds(mesh, f);
                         c.degenerate = isDegenerateFace(mesh, f, areaVectors[f]);
                         if (c.degenerate) continue;
-                        const Box3& box = faceBoxes[f];
+                        const Box3 box = faceBounds(mesh, f);
                         const double deviation = planarityDeviation(mesh, f, areaVectors[f]);
                         const double resolution = 16.0 * std::numeric_limits<double>::epsilon() *
                                                   std::max(box.min().cwiseAbs().maxCoeff(),
@@ -311,8 +307,7 @@ void reportElements(const PolyMesh& mesh, const FaceMeasures& faces, Problems& p
                     [&](const tbb::blocked_range<std::size_t>& r) {
                       for (std::size_t i = r.begin(); i != r.end(); ++i) {
                         closed[i] = isClosed(mesh, ElementId(i));
-                        volumes[i] =
-                            signedVolume(mesh, ElementId(i), faces.areaVectors, faces.boxes);
+                        volumes[i] = signedVolume(mesh, ElementId(i), faces.areaVectors);
                       }
                     });
   bool first = true;

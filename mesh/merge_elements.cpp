@@ -18,46 +18,8 @@ PolyMesh mergeElements(const PolyMesh& mesh, const std::vector<std::uint32_t>& g
                        std::size_t groups) {
   if (group.size() != mesh.numElements())
     throw std::invalid_argument("mergeElements: one group per element is needed");
-  const std::size_t nf = mesh.numFaces();
-  auto dropped = [&](ElementId e) { return e.valid() && group[e.index()] == kDroppedElement; };
-  auto inside = [&](const Face& face) {
-    return (face.front.valid() && face.back.valid() &&
-            group[face.front.index()] == group[face.back.index()]) ||
-           dropped(face.front) || dropped(face.back);
-  };
-  // Kept faces numbered in order: counts per block, running starts, then ids (in parallel).
-  constexpr std::size_t kBlock = 8192;
-  const std::size_t blocks = (nf + kBlock - 1) / kBlock;
-  std::vector<std::size_t> blockStart(blocks + 1, 0);
-  tbb::parallel_for(std::size_t(0), blocks, [&](std::size_t b) {
-    for (std::size_t f = b * kBlock; f < std::min(nf, (b + 1) * kBlock); ++f)
-      blockStart[b + 1] += !inside(mesh.face(FaceId(f)));
-  });
-  for (std::size_t b = 0; b < blocks; ++b) blockStart[b + 1] += blockStart[b];
-  std::vector<FaceId> newId(nf);
-  FaceData<Face> faces(blockStart[blocks]);
-  auto regrouped = [&](ElementId e) { return e.valid() ? ElementId(group[e.index()]) : e; };
-  tbb::parallel_for(std::size_t(0), blocks, [&](std::size_t b) {
-    std::size_t next = blockStart[b];
-    for (std::size_t f = b * kBlock; f < std::min(nf, (b + 1) * kBlock); ++f) {
-      const Face& face = mesh.face(FaceId(f));
-      if (inside(face)) continue;
-      newId[f] = FaceId(next);
-      Face& kept = faces[FaceId(next++)];
-      kept = face;
-      kept.front = regrouped(face.front);
-      kept.back = regrouped(face.back);
-    }
-  });
-  // Each group's face uses: its members' in element order (a short serial pass).
-  ElementData<Element> elements(groups);
-  for (std::size_t e = 0; e < mesh.numElements(); ++e)
-    if (group[e] != kDroppedElement)
-      for (const FaceUse& use : mesh.element(ElementId(e)).faces)
-        if (newId[use.face.index()].valid())
-          elements[ElementId(group[e])].faces.push_back({newId[use.face.index()], use.reversed});
-  PolyMesh out;
-  out.assign(mesh.positions(), std::move(faces), std::move(elements));
+  PolyMesh out = mesh;
+  out.mergeElementGroups(group, groups);
   return out;
 }
 
@@ -157,9 +119,9 @@ PolyMesh mergeSlivers(PolyMesh mesh, double volumeThreshold, SliverMergeReport* 
   r.isolated = counts.isolated;
   // Number the groups in order of their first element.
   const std::size_t count = groups.labels(r.group);
-  PolyMesh out = count == n ? std::move(mesh) : mergeElements(mesh, r.group, count);
+  if (count != n) mesh.mergeElementGroups(r.group, count);
   if (report) *report = std::move(r);
-  return out;
+  return mesh;
 }
 
 namespace {
@@ -267,9 +229,9 @@ PolyMesh mergeDegenerateElements(PolyMesh mesh, DegenerateMergeReport* report) {
     if (label[g] == kDroppedElement) label[g] = count++;
     r.group[e] = label[g];
   }
-  PolyMesh out = mergeElements(mesh, r.group, count);
+  mesh.mergeElementGroups(r.group, count);
   if (report) *report = std::move(r);
-  return out;
+  return mesh;
 }
 
 }  // namespace polydg

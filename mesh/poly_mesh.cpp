@@ -171,25 +171,44 @@ ElementId PolyMesh::addElement(const std::vector<std::vector<Loop>>& boundary,
 void PolyMesh::mergeElementGroups(const std::vector<std::uint32_t>& group, std::size_t groups) {
   if (group.size() != elements_.size())
     throw std::invalid_argument("mergeElementGroups: one group per element is needed");
+  auto dropped = [&](ElementId e) { return e.valid() && group[e.index()] == kDroppedElement; };
+  auto regrouped = [&](ElementId e) { return e.valid() ? ElementId(group[e.index()]) : e; };
+  // Faces are compacted in place: a kept face only moves towards the front.
   std::vector<FaceId> newId(faces_.size());
-  FaceData<Face> kept;
+  std::size_t next = 0;
   for (std::size_t i = 0; i < faces_.size(); ++i) {
     Face& face = faces_[FaceId(i)];
-    if (face.front.valid() && face.back.valid() &&
-        group[face.front.index()] == group[face.back.index()])
-      continue;  // inside a group
-    if (face.front.valid()) face.front = ElementId(group[face.front.index()]);
-    if (face.back.valid()) face.back = ElementId(group[face.back.index()]);
-    newId[i] = FaceId(kept.size());
-    kept.push_back(std::move(face));
+    const bool inside = (face.front.valid() && face.back.valid() &&
+                         group[face.front.index()] == group[face.back.index()]) ||
+                        dropped(face.front) || dropped(face.back);
+    if (inside) continue;
+    face.front = regrouped(face.front);
+    face.back = regrouped(face.back);
+    newId[i] = FaceId(next);
+    if (next != i) faces_[FaceId(next)] = std::move(face);
+    ++next;
   }
-  ElementData<Element> merged(groups);
-  for (std::size_t e = 0; e < elements_.size(); ++e)
-    for (const FaceUse& use : elements_[ElementId(e)].faces)
-      if (newId[use.face.index()].valid())
-        merged[ElementId(group[e])].faces.push_back({newId[use.face.index()], use.reversed});
-  faces_ = std::move(kept);
-  elements_ = std::move(merged);
+  faces_.raw().resize(next);
+  // Groups numbered in order of their first element (as the merges here number them) take
+  // their members' faces in place: group g's slot is never read again once g's members start
+  // arriving. Any other numbering fills a new list.
+  bool inPlace = true;
+  for (std::size_t e = 0; e < group.size() && inPlace; ++e)
+    inPlace = group[e] == kDroppedElement || group[e] <= e;
+  ElementData<Element> fresh(inPlace ? 0 : groups);
+  ElementData<Element>& merged = inPlace ? elements_ : fresh;
+  for (std::size_t e = 0; e < elements_.size(); ++e) {
+    const FaceList uses = std::move(elements_[ElementId(e)].faces);
+    elements_[ElementId(e)].faces.clear();
+    if (group[e] == kDroppedElement) continue;
+    FaceList& into = merged[ElementId(group[e])].faces;
+    for (const FaceUse& use : uses)
+      if (newId[use.face.index()].valid()) into.push_back({newId[use.face.index()], use.reversed});
+  }
+  if (inPlace)
+    elements_.raw().resize(groups);
+  else
+    elements_ = std::move(fresh);
   openFacesStale_ = true;
 }
 

@@ -15,15 +15,11 @@
 
 namespace polydg {
 
-/// A group for mergeElements(): the element is left out, with its faces (it may share faces only
-/// with elements also left out).
-inline constexpr std::uint32_t kDroppedElement = 0xffffffffu;
-
 /// A new mesh in which the elements of each group form one element: `group[e]` is element e's
 /// group, 0 .. groups-1, or kDroppedElement, and new element g is group g. Faces between members
 /// of a group, and faces of dropped elements, are removed; all other faces are kept as they are,
-/// in their order. Vertices are kept (same ids). Without dropped elements, the same mesh as
-/// PolyMesh::mergeElementGroups on a copy, built in parallel.
+/// in their order. Vertices are kept (same ids). PolyMesh::mergeElementGroups on a copy; a
+/// caller that owns the mesh merges in place instead.
 PolyMesh mergeElements(const PolyMesh& mesh, const std::vector<std::uint32_t>& group,
                        std::size_t groups);
 

@@ -64,6 +64,9 @@ struct Element {
   FaceList faces;
 };
 
+/// The group of an element left out by PolyMesh::mergeElementGroups.
+inline constexpr std::uint32_t kDroppedElement = 0xffffffffu;
+
 /// A loop of vertex ids; used to describe faces to the mesh.
 using Loop = std::vector<VertexId>;
 
@@ -149,10 +152,12 @@ class PolyMesh {
   FaceUse findOrCreateFace(std::span<const VertexId> vertices,
                            std::span<const std::uint32_t> loopEnd, FaceOrigin origin);
 
-  /// Merges elements in place: `group[e]` (0 .. groups-1) is element e's new element. Faces
-  /// between two members of one group disappear, the others keep their vertices, orientation
-  /// and origin; element and face ids are renumbered (new element g is group g; faces keep
-  /// their relative order). Vertices are unchanged.
+  /// Merges elements in place: `group[e]` (0 .. groups-1) is element e's new element, or
+  /// kDroppedElement to leave e out with its faces (it may share faces only with elements also
+  /// left out). Faces between two members of one group disappear, the others keep their
+  /// vertices, orientation and origin; element and face ids are renumbered (new element g is
+  /// group g; faces keep their relative order). Vertices are unchanged. Groups numbered in order
+  /// of their first element need no second element list.
   void mergeElementGroups(const std::vector<std::uint32_t>& group, std::size_t groups);
 
   // --- in-place editing (cut/): each operation costs O(faces touched), never O(mesh) -------

@@ -1,0 +1,466 @@
+#include "mesh/slice_build.h"
+
+#include <algorithm>
+#include <atomic>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <span>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <boost/container/small_vector.hpp>
+
+#include "mesh/welded_polygons.h"
+
+namespace polydg {
+
+namespace {
+
+class SliceBuilder {
+ public:
+  SliceBuilder(std::vector<SliceLeaf>& leaves, const WholeCells& whole, bool octree,
+               std::size_t firstGenerated, SliceStats& stats)
+      : leaves_(leaves),
+        whole_(whole),
+        octree_(octree),
+        firstGenerated_(firstGenerated),
+        stats_(stats) {}
+
+  PolyMesh build(const std::vector<Vec3>& points, std::vector<std::array<int, 3>>* elementCell,
+                 std::vector<int>* elementLevel) {
+    WeldedVertices vertices = weldPoints(points);
+    findFreeSides(vertices);
+    const LeafOffsets at = leafOffsets();
+    const LeafPolygons polygons = weldPolygons(at, vertices);
+    // Caps meet their other side: the later of two reversed, equal polygons uses the earlier's
+    // face (reversed), as findOrCreateFace would in leaf order; so do two polygons on the
+    // surface that rounding made reversed and equal.
+    const std::vector<std::uint32_t> sharesEarlier =
+        matchSides(polygons.welded, polygons.origin, polygons.kept, polygons.touched, polygons.keys);
+    const MeshIds ids = numberMesh(at, polygons, sharesEarlier);
+    FaceData<Face> meshFaces(ids.faceBase[leaves_.size()]);
+    ElementData<Element> meshElements(ids.elements);
+    makeFacesAndElements(at, polygons, sharesEarlier, ids, vertices, meshFaces, meshElements);
+    if (elementCell)
+      for (std::size_t l = 0; l < leaves_.size(); ++l)
+        if (ids.elementOf[l] != kNone) elementCell->push_back(leaves_[l].cell);
+    if (elementLevel)
+      for (std::size_t l = 0; l < leaves_.size(); ++l)
+        if (ids.elementOf[l] != kNone) elementLevel->push_back(leaves_[l].level);
+    freeLeaves();
+    PolyMesh mesh;
+    mesh.assign(std::move(vertices.positions), std::move(meshFaces), std::move(meshElements));
+    return mesh;
+  }
+
+ private:
+  using Leaf = SliceLeaf;
+
+
+  /// The polygons of `leaf`: its piece, or a whole cell's sides made in `scratch` (without
+  /// those in `skip`).
+  const Piece& pieceOf(const Leaf& leaf, Piece& scratch, unsigned skip = 0) const {
+    if (!leaf.whole) return leaf.piece;
+    whole_.sides(leaf.cell, scratch, skip);
+    return scratch;
+  }
+
+  /// No point, polygon, element or face.
+  static constexpr std::uint32_t kNone = 0xffffffffu;
+
+  /// The points the leaves use, welded: each point's vertex, and the vertices' positions.
+  struct WeldedVertices {
+    std::vector<std::uint32_t> rank;          ///< point -> its order of first use, or kNone
+    std::vector<std::uint32_t> vertexOfRank;  ///< order of first use -> vertex id
+    VertexData<Vec3> positions;
+    std::vector<char> shared;  ///< per vertex: two or more points were welded into it
+    VertexId operator()(std::uint32_t v) const { return VertexId(vertexOfRank[rank[v]]); }
+  };
+
+  /// Welds the points the leaves use; vertex ids follow their order of first use.
+  WeldedVertices weldPoints(const std::vector<Vec3>& points) {
+    // Points closer than the resolution of the coordinates are one vertex: 8 units in the last
+    // place of the largest coordinate, in every coordinate. The slicing is exact, and such
+    // points are distinct exact points where a part of the solid is thinner than the coordinates
+    // resolve (a surface vertex within round-off of a grid plane, a grid line within round-off
+    // of a surface edge); kept apart they would leave edges of round-off length, which VTK's
+    // polygon triangulation rejects. Welding moves geometry by at most that resolution. What it
+    // collapses goes alike on both sides of a shared polygon (WeldedPolygons::weld,
+    // cancelReversedPairs, matchSides); after the build, faces it leaves flat are dissolved
+    // into their edges (dissolveFlatFaces) and elements it leaves flat are merged into a
+    // neighbour (mergeDegenerateElements). Only points that elements use are kept, in order of
+    // first use (deterministic).
+    double largest = 0.0;
+    for (const Vec3& p : points) largest = std::max(largest, p.cwiseAbs().maxCoeff());
+    const double resolution = 8.0 * std::numeric_limits<double>::epsilon() * largest;
+
+    // Points in order of first use, then welded; vertex ids follow that order.
+    WeldedVertices out;
+    out.rank.assign(points.size(), kNone);
+    // The octree's points come after the splitter's, so that a splitter point is never
+    // welded into one of them: only welds among the splitter's points are the slicing's
+    // (counted, and marking polygons as touched); the octree's corners repeat its points. The
+    // uniform grid's whole cells take their turn in leaf order, as the splitter's points at
+    // their corners did when they were split, so that a weld keeps the same position.
+    std::vector<std::uint32_t> used;
+    Piece scratch;
+    for (const bool generated : {false, true}) {
+      if (generated && !octree_) break;  // one pass ranks every point
+      for (const Leaf& leaf : leaves_)
+        for (const PiecePolygon& polygon : pieceOf(leaf, scratch))
+          for (std::uint32_t v : polygon.vertices)
+            if (out.rank[v] == kNone && (!octree_ || (v >= firstGenerated_) == generated)) {
+              out.rank[v] = static_cast<std::uint32_t>(used.size());
+              used.push_back(v);
+            }
+    }
+    const std::vector<std::uint32_t> target = weldTargets(points, used, resolution);
+    out.positions.raw().reserve(used.size());
+    out.vertexOfRank.resize(used.size());
+    for (std::size_t i = 0; i < used.size(); ++i) {
+      if (target[i] == i) {
+        out.vertexOfRank[i] = static_cast<std::uint32_t>(out.positions.size());
+        out.positions.push_back(points[used[i]]);
+      } else {
+        out.vertexOfRank[i] = out.vertexOfRank[target[i]];
+        if (octree_) stats_.weldedPoints += used[i] < firstGenerated_;
+      }
+    }
+    out.shared.assign(out.positions.size(), 0);
+    if (octree_) {
+      for (std::size_t i = 0; i < used.size(); ++i)
+        if (target[i] != i && used[i] < firstGenerated_) out.shared[out.vertexOfRank[i]] = 1;
+      return out;
+    }
+    // Uniform grid: a vertex is shared if two distinct points were welded into it; a grid node
+    // made for whole cells is the same point as the splitter's at its position.
+    std::vector<std::uint32_t> node(out.positions.size(), kNone), distinct(out.positions.size(), 0);
+    for (std::size_t i = 0; i < used.size(); ++i)
+      if (used[i] >= firstGenerated_ && node[out.vertexOfRank[i]] == kNone) {
+        node[out.vertexOfRank[i]] = used[i];
+        distinct[out.vertexOfRank[i]] = 1;
+      }
+    std::vector<char> standsFor(out.positions.size(), 0);
+    for (std::size_t i = 0; i < used.size(); ++i) {
+      if (used[i] >= firstGenerated_) continue;
+      const std::uint32_t v = out.vertexOfRank[i];
+      if (node[v] != kNone && !standsFor[v] && points[used[i]] == points[node[v]])
+        standsFor[v] = 1;
+      else
+        ++distinct[v];
+    }
+    for (std::size_t v = 0; v < distinct.size(); ++v)
+      if (distinct[v] >= 2) {
+        out.shared[v] = 1;
+        stats_.weldedPoints += distinct[v] - 1;
+      }
+    return out;
+  }
+
+  /// Where each leaf's polygons, corners and loops start when they are numbered across all
+  /// leaves (polygon i of leaf l is polygon[l] + i); the last entries are the totals.
+  struct LeafOffsets {
+    std::vector<std::uint32_t> polygon;
+    std::vector<std::size_t> corner, loop;
+  };
+
+  /// Counts the leaves' polygons, corners and loops (in parallel) and sums them up.
+  LeafOffsets leafOffsets() const {
+    const std::size_t nl = leaves_.size();
+    LeafOffsets at{std::vector<std::uint32_t>(nl + 1, 0), std::vector<std::size_t>(nl + 1, 0),
+                   std::vector<std::size_t>(nl + 1, 0)};
+    tbb::parallel_for(std::size_t(0), nl, [&](std::size_t l) {
+      if (leaves_[l].whole) {  // quadrilaterals, but for the free sides
+        const auto sides = static_cast<std::uint32_t>(6 - std::popcount(freeSides_[l]));
+        at.polygon[l + 1] = sides;
+        at.corner[l + 1] = 4 * sides;
+        at.loop[l + 1] = sides;
+        return;
+      }
+      std::size_t corners = 0, loops = 0;
+      for (const PiecePolygon& polygon : leaves_[l].piece) {
+        corners += polygon.vertices.size();
+        loops += polygon.numLoops();
+      }
+      at.polygon[l + 1] = static_cast<std::uint32_t>(leaves_[l].piece.size());
+      at.corner[l + 1] = corners;
+      at.loop[l + 1] = loops;
+    });
+    for (std::size_t l = 0; l < nl; ++l) {
+      at.polygon[l + 1] += at.polygon[l];
+      at.corner[l + 1] += at.corner[l];
+      at.loop[l + 1] += at.loop[l];
+    }
+    return at;
+  }
+
+  /// The leaves' polygons on the welded vertices, numbered across leaves (LeafOffsets), with
+  /// the vertex-set key of those that may share a face with another leaf's (matchSides).
+  struct LeafPolygons {
+    WeldedPolygons welded;
+    std::vector<char> kept;           ///< the polygon did not collapse
+    std::vector<char> touched;        ///< it has a vertex that several points were welded into
+    std::vector<std::uint64_t> keys;  ///< a kept cap's or touched polygon's vertex-set key
+    std::vector<FaceOrigin> origin;
+  };
+
+  /// Each leaf's polygons on the welded vertices (in parallel), kept in flat arrays
+  /// (WeldedPolygons): a Face is made only for each face of the mesh.
+  LeafPolygons weldPolygons(const LeafOffsets& at, const WeldedVertices& vertexOf) {
+    const std::size_t nl = leaves_.size();
+    const std::size_t np = at.polygon[nl];
+    LeafPolygons out{WeldedPolygons(np, at.corner[nl], at.loop[nl]), std::vector<char>(np, 0),
+                     std::vector<char>(np, 0), std::vector<std::uint64_t>(np, 0),
+                     std::vector<FaceOrigin>(np)};
+    std::atomic<std::size_t> collapsed{0};
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, nl, 64), [&](const tbb::blocked_range<std::size_t>& r) {
+          Piece scratch;
+          for (std::size_t l = r.begin(); l != r.end(); ++l) {
+            const Piece& piece = pieceOf(leaves_[l], scratch, freeSides_[l]);
+            std::size_t corner = at.corner[l], loop = at.loop[l];
+            for (std::size_t i = 0; i < piece.size(); ++i) {
+              const std::size_t p = at.polygon[l] + i;
+              out.origin[p] = piece[i].origin;
+              if (!out.welded.weld(p, corner, loop, piece[i], vertexOf)) {
+                ++collapsed;
+              } else {
+                out.kept[p] = 1;
+                const auto corners = out.welded.corners(p);
+                out.touched[p] = std::any_of(corners.begin(), corners.end(), [&](VertexId v) {
+                  return vertexOf.shared[v.index()];
+                });
+                if (out.origin[p] == FaceOrigin::Interior || out.touched[p])
+                  out.keys[p] = vertexSetKey(corners);
+              }
+              corner += piece[i].vertices.size();
+              loop += piece[i].numLoops();
+            }
+          }
+        });
+    stats_.collapsedPolygons = collapsed;
+    cancelReversedPairs(at, out);
+    return out;
+  }
+
+  /// Within each leaf, two kept polygons that are each other's reverse on the welded vertices
+  /// (the two sides of a part of the solid thinner than the coordinates resolve, rounded onto
+  /// one polygon) bound nothing between them: both are dropped, so the leaf stays closed. Only
+  /// polygons with a vertex that several points were welded into can be such a pair (the exact
+  /// polygons of a leaf are distinct). A dropped cap leaves its other side (in the neighbouring
+  /// leaf) unmatched: it becomes a face on the surface (makeFacesAndElements). A leaf left
+  /// without polygons has no element.
+  void cancelReversedPairs(const LeafOffsets& at, LeafPolygons& out) {
+    std::atomic<std::size_t> cancelled{0};
+    tbb::parallel_for(std::size_t(0), leaves_.size(), [&](std::size_t l) {
+      boost::container::small_vector<std::pair<std::uint64_t, std::uint32_t>, 16> keyed;
+      for (std::uint32_t p = at.polygon[l]; p < at.polygon[l + 1]; ++p)
+        if (out.kept[p] && out.touched[p]) keyed.emplace_back(out.keys[p], p);
+      std::sort(keyed.begin(), keyed.end());
+      for (std::size_t i = 0; i < keyed.size(); ++i)
+        for (std::size_t j = i + 1; j < keyed.size() && keyed[j].first == keyed[i].first; ++j) {
+          const std::uint32_t a = keyed[i].second, b = keyed[j].second;
+          if (!out.kept[a] || !out.kept[b] || !out.welded.isReversed(a, b)) continue;
+          out.kept[a] = out.kept[b] = 0;
+          cancelled += 2;
+        }
+    });
+    stats_.collapsedPolygons += cancelled;
+  }
+
+  /// Marks the free sides (freeSides_): those two whole cells share, with no corner that
+  /// several points were welded into. The grid pairs them, so they are no polygons.
+  void findFreeSides(const WeldedVertices& vertexOf) {
+    freeSides_.assign(leaves_.size(), 0);
+    wholeLeafAt_ = whole_.cellTable();
+    if (wholeLeafAt_.empty()) return;
+    tbb::parallel_for(std::size_t(0), leaves_.size(), [&](std::size_t l) {
+      if (leaves_[l].whole) wholeLeafAt_[whole_.cellIndex(leaves_[l].cell)] = std::uint32_t(l);
+    });
+    tbb::parallel_for(std::size_t(0), leaves_.size(), [&](std::size_t l) {
+      if (!leaves_[l].whole) return;
+      for (int s = 0; s < 6; ++s) {
+        const auto next = whole_.beside(leaves_[l].cell, s);
+        if (!next || wholeLeafAt_[whole_.cellIndex(*next)] == kNone) continue;
+        const std::array<std::uint32_t, 4> corners = whole_.side(leaves_[l].cell, s);
+        if (std::none_of(corners.begin(), corners.end(),
+                         [&](std::uint32_t p) { return vertexOf.shared[vertexOf(p).index()]; }))
+          freeSides_[l] |= std::uint8_t(1u << s);
+      }
+    });
+  }
+
+  /// Whole leaf l's side s: the number of its polygon, or kNone for a free side.
+  std::uint32_t sidePolygon(const LeafOffsets& at, std::size_t l, int s) const {
+    const unsigned free = freeSides_[l];
+    if (free >> s & 1) return kNone;
+    return at.polygon[l] + static_cast<std::uint32_t>(std::popcount(~free & ((1u << s) - 1)));
+  }
+
+  /// The mesh's ids, in leaf order: an element for each leaf that kept a polygon, a face for
+  /// each kept polygon that is not a later side.
+  struct MeshIds {
+    std::vector<std::uint32_t> elementOf;  ///< each leaf's element, or kNone
+    std::vector<std::uint32_t> faceBase;   ///< each leaf's first new face; the last: the total
+    std::uint32_t elements = 0;
+  };
+
+  /// Numbers the elements and the new faces (counted per leaf in parallel).
+  MeshIds numberMesh(const LeafOffsets& at, const LeafPolygons& polygons,
+                     const std::vector<std::uint32_t>& sharesEarlier) const {
+    const std::size_t nl = leaves_.size();
+    MeshIds ids{std::vector<std::uint32_t>(nl, kNone), std::vector<std::uint32_t>(nl + 1, 0)};
+    tbb::parallel_for(std::size_t(0), nl, [&](std::size_t l) {
+      // A whole leaf makes the faces of its free sides towards +axis (bits 1, 3, 5).
+      std::uint32_t created = static_cast<std::uint32_t>(std::popcount(freeSides_[l] & 0x2au));
+      std::uint32_t any = created;
+      for (std::size_t p = at.polygon[l]; p < at.polygon[l + 1]; ++p) {
+        any += polygons.kept[p];
+        created += polygons.kept[p] && sharesEarlier[p] == kNoSide;
+      }
+      ids.faceBase[l + 1] = created;
+      ids.elementOf[l] = any ? 0 : kNone;
+    });
+    for (std::size_t l = 0; l < nl; ++l) {
+      ids.faceBase[l + 1] += ids.faceBase[l];
+      if (ids.elementOf[l] != kNone) ids.elementOf[l] = ids.elements++;
+    }
+    return ids;
+  }
+
+  /// The face of whole leaf l's side s, which l makes: the faces l makes before it, in order,
+  /// are its free sides towards +axis and its polygons that share no earlier face.
+  std::uint32_t wholeSideFace(const LeafOffsets& at, const LeafPolygons& polygons,
+                              const std::vector<std::uint32_t>& sharesEarlier, const MeshIds& ids,
+                              std::size_t l, int s) const {
+    std::uint32_t face = ids.faceBase[l];
+    for (int t = 0; t < s; ++t) {
+      const std::uint32_t p = sidePolygon(at, l, t);
+      face += p == kNone ? t % 2 : polygons.kept[p] && sharesEarlier[p] == kNoSide;
+    }
+    return face;
+  }
+
+  /// Fills `meshFaces` and `meshElements` (sized by `ids`) in parallel: the new faces first
+  /// (their ids are known per leaf), then the later sides, which take the earlier side's face
+  /// as its back (an interior face, whatever the earlier side was).
+  void makeFacesAndElements(const LeafOffsets& at, const LeafPolygons& polygons,
+                            const std::vector<std::uint32_t>& sharesEarlier, const MeshIds& ids,
+                            const WeldedVertices& vertexOf, FaceData<Face>& meshFaces,
+                            ElementData<Element>& meshElements) const {
+    const std::size_t nl = leaves_.size();
+    std::vector<std::uint32_t> faceId(at.polygon[nl], kNone);
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, nl, 64), [&](const tbb::blocked_range<std::size_t>& r) {
+          for (std::size_t l = r.begin(); l != r.end(); ++l) {
+            const ElementId e{std::size_t(ids.elementOf[l])};
+            std::uint32_t next = ids.faceBase[l];
+            auto polygonFace = [&](std::size_t p) {
+              if (!polygons.kept[p] || sharesEarlier[p] != kNoSide) return;
+              faceId[p] = next;
+              Face& f = meshFaces[FaceId(std::size_t(next++))];
+              polygons.welded.copyTo(p, f);
+              // A cap is interior once its other side uses it (below); one whose
+              // other side was cancelled lies on the surface.
+              f.origin = polygons.origin[p] == FaceOrigin::Interior ? FaceOrigin::Surface
+                                                                    : polygons.origin[p];
+              f.front = e;
+            };
+            if (!leaves_[l].whole) {
+              for (std::size_t p = at.polygon[l]; p < at.polygon[l + 1]; ++p) polygonFace(p);
+              continue;
+            }
+            // A whole cell's faces in the order of its sides, those of free sides towards
+            // +axis made from the grid (the cell beyond uses them).
+            for (int s = 0; s < 6; ++s) {
+              const std::uint32_t p = sidePolygon(at, l, s);
+              if (p != kNone) {
+                polygonFace(p);
+              } else if (s % 2 == 1) {
+                Face& f = meshFaces[FaceId(std::size_t(next++))];
+                for (std::uint32_t corner : whole_.side(leaves_[l].cell, s))
+                  f.vertices.push_back(vertexOf(corner));
+                f.loopEnd.assign(1, 4);
+                f.front = e;
+              }
+            }
+          }
+        });
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, nl, 64), [&](const tbb::blocked_range<std::size_t>& r) {
+          for (std::size_t l = r.begin(); l != r.end(); ++l) {
+            if (ids.elementOf[l] == kNone) continue;
+            const ElementId e{std::size_t(ids.elementOf[l])};
+            FaceList& uses = meshElements[e].faces;
+            auto useBack = [&](FaceId f) {
+              meshFaces[f].back = e;
+              meshFaces[f].origin = FaceOrigin::Interior;
+              uses.push_back({f, true});
+            };
+            auto usePolygon = [&](std::size_t p) {
+              if (!polygons.kept[p]) return;
+              const std::uint32_t s = sharesEarlier[p];
+              if (s == kNoSide)
+                uses.push_back({FaceId(std::size_t(faceId[p])), false});
+              else
+                useBack(FaceId(std::size_t(faceId[s])));
+            };
+            if (!leaves_[l].whole) {
+              for (std::size_t p = at.polygon[l]; p < at.polygon[l + 1]; ++p) usePolygon(p);
+              continue;
+            }
+            for (int s = 0; s < 6; ++s) {
+              const std::uint32_t p = sidePolygon(at, l, s);
+              if (p != kNone) {
+                usePolygon(p);
+              } else if (s % 2 == 1) {
+                uses.push_back(
+                    {FaceId(std::size_t(wholeSideFace(at, polygons, sharesEarlier, ids, l, s))),
+                     false});
+              } else {
+                const std::size_t before =
+                    wholeLeafAt_[whole_.cellIndex(*whole_.beside(leaves_[l].cell, s))];
+                useBack(FaceId(
+                    std::size_t(wholeSideFace(at, polygons, sharesEarlier, ids, before, s + 1))));
+              }
+            }
+          }
+        });
+  }
+
+  /// The leaves are spent: their many small buffers are freed in parallel, not one by one
+  /// when the slicer goes.
+  void freeLeaves() {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves_.size(), 256),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        for (std::size_t l = r.begin(); l != r.end(); ++l)
+                          Piece().swap(leaves_[l].piece);
+                      });
+  }
+
+  std::vector<SliceLeaf>& leaves_;
+  const WholeCells& whole_;
+  const bool octree_;
+  const std::size_t firstGenerated_;
+  SliceStats& stats_;
+  /// Per leaf, the sides (bit s, as WholeCells::sides numbers them) a whole cell shares with
+  /// another whole cell where welding moved no corner: the grid pairs them, so they are made
+  /// into faces directly (by the earlier cell, towards +axis), not into polygons.
+  std::vector<std::uint8_t> freeSides_;
+  /// Each grid cell's whole leaf, or kNone (empty for a grid much larger than its whole cells).
+  std::vector<std::uint32_t> wholeLeafAt_;
+};
+
+}  // namespace
+
+PolyMesh buildSliceMesh(std::vector<SliceLeaf>& leaves, const WholeCells& whole, bool octree,
+                        std::size_t firstGenerated, const std::vector<Vec3>& points,
+                        SliceStats& stats, std::vector<std::array<int, 3>>* elementCell,
+                        std::vector<int>* elementLevel) {
+  return SliceBuilder(leaves, whole, octree, firstGenerated, stats)
+      .build(points, elementCell, elementLevel);
+}
+
+}  // namespace polydg

@@ -1,0 +1,37 @@
+// Building the mesh of slicing (mesh/slice.cpp) from its leaves: the exact points rounded to
+// doubles and welded, each leaf's polygons on the welded vertices, the sides two leaves share
+// matched, and the faces and elements made, all in leaf order.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <vector>
+
+#include "mesh/plane_split.h"
+#include "mesh/whole_cells.h"
+#include "polydg/mesh/poly_mesh.h"
+#include "polydg/mesh/slice.h"
+
+namespace polydg {
+
+/// A connected piece of the solid in one cell, as slicing leaves it.
+struct SliceLeaf {
+  Piece piece;
+  std::array<int, 3> cell;
+  std::size_t part;  ///< index of the piece among its cell's connected pieces
+  int level = 0;     ///< its octree level (the octree's finest for a sliced cell)
+  /// A whole cell of the uniform grid: `piece` is empty, its sides are made when they are read
+  /// (from `whole`, below).
+  bool whole = false;
+};
+
+/// The mesh of `leaves` (sorted by cell, then part), whose polygons use `points`: the
+/// splitter's, then, from `firstGenerated` on, those made for whole cells (the octree's boxes,
+/// or `whole`'s grid nodes). Counts what rounding did in `stats`, frees the leaves' pieces, and
+/// gives each element's leaf's cell and level to `elementCell` and `elementLevel` (optional).
+PolyMesh buildSliceMesh(std::vector<SliceLeaf>& leaves, const WholeCells& whole, bool octree,
+                        std::size_t firstGenerated, const std::vector<Vec3>& points,
+                        SliceStats& stats, std::vector<std::array<int, 3>>* elementCell,
+                        std::vector<int>* elementLevel);
+
+}  // namespace polydg
