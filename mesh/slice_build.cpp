@@ -37,8 +37,8 @@ class SliceBuilder {
     // Caps meet their other side: the later of two reversed, equal polygons uses the earlier's
     // face (reversed), as findOrCreateFace would in leaf order; so do two polygons on the
     // surface that rounding made reversed and equal.
-    const std::vector<std::uint32_t> sharesEarlier =
-        matchSides(polygons.welded, polygons.origin, polygons.kept, polygons.touched, polygons.keys);
+    const std::vector<std::uint32_t> sharesEarlier = matchSides(
+        polygons.welded, polygons.origin, polygons.kept, polygons.touched, polygons.keys);
     const MeshIds ids = numberMesh(at, polygons, sharesEarlier);
     FaceData<Face> meshFaces(ids.faceBase[leaves_.size()]);
     ElementData<Element> meshElements(ids.elements);
@@ -57,7 +57,6 @@ class SliceBuilder {
 
  private:
   using Leaf = SliceLeaf;
-
 
   /// The polygons of `leaf`: its piece, or a whole cell's sides made in `scratch` (without
   /// those in `skip`).

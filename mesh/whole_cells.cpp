@@ -3,10 +3,6 @@
 #include <algorithm>
 #include <tuple>
 
-#include <tbb/parallel_for.h>
-
-#include "mesh/welded_polygons.h"
-
 namespace polydg {
 
 bool WholeCells::isWholeBox(const Piece& piece) {
@@ -21,7 +17,7 @@ std::size_t WholeCells::add(const std::array<int, 3>& lo, const std::array<int, 
 }
 
 std::size_t WholeCells::count() const {
-  std::size_t cells = 0;
+  std::size_t cells = finished_;
   for (const std::vector<Box>& list : boxes_)
     for (const Box& box : list) cells += box.cells();
   return cells;
@@ -43,6 +39,7 @@ std::vector<std::array<int, 3>> WholeCells::finish(std::uint32_t firstPoint,
   });
   std::size_t cells = 0;
   for (const Box& box : boxes) cells += box.cells();
+  finished_ += cells;
   if (cells == 0) return {};
   const std::size_t nodes = nodeIndex(grid_.cells) + 1;
   if (nodes <= 8 * cells + (std::size_t(1) << 20)) table_.assign(nodes, kNone);
@@ -65,52 +62,37 @@ std::vector<std::array<int, 3>> WholeCells::finish(std::uint32_t firstPoint,
   return out;
 }
 
-void WholeCells::sides(const std::array<int, 3>& cell, Piece& piece) const {
-  std::array<std::uint32_t, 8> corner;  // bit a of the index: +1 along axis a
-  for (int b = 0; b < 8; ++b)
-    corner[b] = node({cell[0] + (b & 1), cell[1] + (b >> 1 & 1), cell[2] + (b >> 2 & 1)});
-  piece.resize(6);
-  for (int axis = 0; axis < 3; ++axis)
-    for (int side = 0; side < 2; ++side) {
-      const int u = 1 << (axis + 1) % 3, w = 1 << (axis + 2) % 3, a = side << axis;
-      // Counter-clockwise about +axis (u, w, axis are right-handed); the low side faces -axis.
-      std::array<std::uint32_t, 4> loop{corner[a], corner[a | u], corner[a | u | w], corner[a | w]};
-      if (side == 0) std::reverse(loop.begin(), loop.end());
-      PiecePolygon& polygon = piece[2 * axis + side];
-      polygon.origin = FaceOrigin::Interior;
-      polygon.vertices.assign(loop.begin(), loop.end());
-      polygon.loopEnd.assign(1, 4);
-    }
+std::array<std::uint32_t, 4> WholeCells::side(const std::array<int, 3>& cell, int s) const {
+  const int axis = s / 2;
+  // Corner b of the cell: bit a of b is +1 along axis a.
+  auto corner = [&](int b) {
+    return node({cell[0] + (b & 1), cell[1] + (b >> 1 & 1), cell[2] + (b >> 2 & 1)});
+  };
+  const int u = 1 << (axis + 1) % 3, w = 1 << (axis + 2) % 3, a = (s % 2) << axis;
+  // Counter-clockwise about +axis (u, w, axis are right-handed); the low side faces -axis.
+  std::array<std::uint32_t, 4> loop{corner(a), corner(a | u), corner(a | u | w), corner(a | w)};
+  if (s % 2 == 0) std::reverse(loop.begin(), loop.end());
+  return loop;
 }
 
-std::vector<std::uint32_t> WholeCells::pairSides(
-    const std::vector<std::pair<std::array<int, 3>, std::uint32_t>>& firstSide,
-    std::size_t polygons, const std::function<bool(std::uint32_t, std::uint32_t)>& canPair) const {
+void WholeCells::sides(const std::array<int, 3>& cell, Piece& piece, unsigned skip) const {
+  piece.clear();
+  for (int s = 0; s < 6; ++s) {
+    if (skip >> s & 1) continue;
+    const std::array<std::uint32_t, 4> loop = side(cell, s);
+    PiecePolygon& polygon = piece.emplace_back();
+    polygon.origin = FaceOrigin::Interior;
+    polygon.vertices.assign(loop.begin(), loop.end());
+    polygon.loopEnd.assign(1, 4);
+  }
+}
+
+std::vector<std::uint32_t> WholeCells::cellTable() const {
   const std::size_t cells =
       std::size_t(grid_.cells[0]) * std::size_t(grid_.cells[1]) * std::size_t(grid_.cells[2]);
-  if (firstSide.empty() || cells > 8 * firstSide.size() + (std::size_t(1) << 20)) return {};
-  auto index = [&](const std::array<int, 3>& c) {
-    return linearIndex(c, grid_.cells[0], grid_.cells[1]);
-  };
-  std::vector<std::uint32_t> at(cells, kNone);  // each whole cell's entry in firstSide
-  tbb::parallel_for(std::size_t(0), firstSide.size(), [&](std::size_t w) {
-    at[index(firstSide[w].first)] = static_cast<std::uint32_t>(w);
-  });
-  std::vector<std::uint32_t> paired(polygons, kNoSide);
-  tbb::parallel_for(std::size_t(0), firstSide.size(), [&](std::size_t w) {
-    for (int axis = 0; axis < 3; ++axis) {
-      std::array<int, 3> next = firstSide[w].first;
-      if (++next[axis] == grid_.cells[axis]) continue;
-      const std::uint32_t m = at[index(next)];
-      if (m == kNone) continue;
-      const std::uint32_t p = firstSide[w].second + 2 * axis + 1,
-                          q = firstSide[m].second + 2 * axis;
-      if (!canPair(p, q)) continue;
-      paired[q] = p;  // the next cell's sides come later
-      paired[p] = p;
-    }
-  });
-  return paired;
+  const std::size_t whole = count();
+  if (whole == 0 || cells > 8 * whole + (std::size_t(1) << 20)) return {};
+  return std::vector<std::uint32_t>(cells, kNone);
 }
 
 }  // namespace polydg

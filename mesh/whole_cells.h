@@ -5,7 +5,7 @@
 
 #include <array>
 #include <cstdint>
-#include <functional>
+#include <optional>
 #include <unordered_map>
 #include <utility>
 #include <vector>
@@ -29,7 +29,7 @@ class WholeCells {
 
   /// Records cells lo .. hi - 1 as whole and returns their number. May be called concurrently.
   std::size_t add(const std::array<int, 3>& lo, const std::array<int, 3>& hi);
-  /// The number of cells recorded.
+  /// The number of cells recorded (before and after finish()).
   std::size_t count() const;
 
   /// Ends the recording: returns the whole cells, box by box, after making a
@@ -37,18 +37,29 @@ class WholeCells {
   /// on (the grid's plane coordinates, exactly as slicing makes the same points).
   std::vector<std::array<int, 3>> finish(std::uint32_t firstPoint, std::vector<Vec3>& points);
 
-  /// The six sides of whole cell `cell` into `piece`, outward, on the points finish() made:
-  /// those of SurfaceOctree::boxFaces for a leaf without a finer neighbour.
-  void sides(const std::array<int, 3>& cell, Piece& piece) const;
+  /// The sides of whole cell `cell` into `piece`, outward, on the points finish() made: those
+  /// of SurfaceOctree::boxFaces for a leaf without a finer neighbour. Side s (2 axis, towards
+  /// -axis, or 2 axis + 1, towards +axis) comes at its place in that order, unless bit s of
+  /// `skip` leaves it out.
+  void sides(const std::array<int, 3>& cell, Piece& piece, unsigned skip = 0) const;
+  /// The corners of side s of `cell`, as sides() gives them.
+  std::array<std::uint32_t, 4> side(const std::array<int, 3>& cell, int s) const;
 
-  /// For matchSides: the sides two whole cells share, paired by the grid, each cell's side
-  /// towards +axis (its sides' index 2 axis + 1) with the next cell's towards -axis (2 axis),
-  /// where `canPair` agrees. `firstSide`: each whole cell with the number of its first side, in
-  /// the order of the numbers; `polygons`: the number of all. Empty where a table of the
-  /// grid's cells would be much larger than the whole cells.
-  std::vector<std::uint32_t> pairSides(
-      const std::vector<std::pair<std::array<int, 3>, std::uint32_t>>& firstSide,
-      std::size_t polygons, const std::function<bool(std::uint32_t, std::uint32_t)>& canPair) const;
+  /// A table of the grid's cells (cellIndex()) holding kNone, for the caller to mark the whole
+  /// ones in; empty where it would be much larger than the whole cells.
+  std::vector<std::uint32_t> cellTable() const;
+  std::size_t cellIndex(const std::array<int, 3>& c) const {
+    return linearIndex(c, grid_.cells[0], grid_.cells[1]);
+  }
+  /// The cell beside `cell` across side s (see sides()), if the grid has it.
+  std::optional<std::array<int, 3>> beside(std::array<int, 3> cell, int s) const {
+    cell[s / 2] += s % 2 ? 1 : -1;
+    if (cell[s / 2] < 0 || cell[s / 2] >= grid_.cells[s / 2]) return std::nullopt;
+    return cell;
+  }
+
+  /// No point, no cell.
+  static constexpr std::uint32_t kNone = 0xffffffffu;
 
  private:
   struct Box {
@@ -66,8 +77,6 @@ class WholeCells {
     return (std::size_t(c[2]) * std::size_t(ny) + std::size_t(c[1])) * std::size_t(nx) +
            std::size_t(c[0]);
   }
-  /// No point, no cell.
-  static constexpr std::uint32_t kNone = 0xffffffffu;
   std::uint32_t node(const std::array<int, 3>& c) const;
 
   const Grid& grid_;
@@ -76,6 +85,7 @@ class WholeCells {
   /// times the whole cells' number, a map of the nodes used otherwise.
   std::vector<std::uint32_t> table_;
   std::unordered_map<std::size_t, std::uint32_t> map_;
+  std::size_t finished_ = 0;  ///< the cells finish() took from the boxes
 };
 
 }  // namespace polydg
