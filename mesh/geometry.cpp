@@ -56,34 +56,16 @@ Vec3 elementReferencePoint(const PolyMesh& mesh, ElementId e) {
   return 0.5 * (box.min() + box.max());
 }
 
-namespace {
-/// The sum of signed cones from the centre of the element's bounding box to its faces, with
-/// each face's area vector and bounds from `area(f)` and `bounds(f)`.
-template <class Area, class Bounds>
-double signedConeVolume(const PolyMesh& mesh, ElementId e, Area&& area, Bounds&& bounds) {
-  Box3 box;
-  for (const FaceUse& use : mesh.element(e).faces) box.extend(bounds(use.face));
-  const Vec3 o = 0.5 * (box.min() + box.max());  // elementReferencePoint()
-  // Cone volume = height * area / 3, and a.dot(c - o) = area * height.
+double signedVolume(const PolyMesh& mesh, ElementId e) {
+  // Signed cones from the centre of the element's bounding box (elementReferencePoint()):
+  // cone volume = height * area / 3, and a.dot(c - o) = area * height.
+  const Vec3 o = elementReferencePoint(mesh, e);
   double threeVolume = 0.0;
   for (const FaceUse& use : mesh.element(e).faces) {
-    const double h = area(use.face).dot(faceReferencePoint(mesh, use.face) - o);
+    const double h = areaVector(mesh, use.face).dot(faceReferencePoint(mesh, use.face) - o);
     threeVolume += use.reversed ? -h : h;
   }
   return threeVolume / 3.0;
-}
-}  // namespace
-
-double signedVolume(const PolyMesh& mesh, ElementId e, const FaceData<Vec3>& areaVectors) {
-  return signedConeVolume(
-      mesh, e, [&](FaceId f) -> const Vec3& { return areaVectors[f]; },
-      [&](FaceId f) { return faceBounds(mesh, f); });
-}
-
-double signedVolume(const PolyMesh& mesh, ElementId e) {
-  return signedConeVolume(
-      mesh, e, [&](FaceId f) { return areaVector(mesh, f); },
-      [&](FaceId f) { return faceBounds(mesh, f); });
 }
 
 double planarityDeviation(const PolyMesh& mesh, FaceId f) {

@@ -204,18 +204,16 @@ struct FaceCheck {
   std::uint64_t key = 0;   ///< hash of the sorted vertex ids
 };
 
-/// Every face's FaceCheck, with its area vector, computed once: the elements' volumes reuse it.
+/// Every face's FaceCheck. (Area vectors are not kept for the elements' volumes: computing
+/// them again costs less than holding one per face beside the mesh, for millions of faces.)
 struct FaceMeasures {
   std::vector<FaceCheck> checks;
-  FaceData<Vec3> areaVectors;
 };
 
 /// Shape and planarity of every face, in parallel (the costly part of the face checks).
 FaceMeasures measureFaces(const PolyMesh& mesh, const GeometryCheckOptions& options) {
-  FaceMeasures m{std::vector<FaceCheck>(mesh.numFaces()),
-                 FaceData<Vec3>(mesh.numFaces(), Vec3::Zero())};
+  FaceMeasures m{std::vector<FaceCheck>(mesh.numFaces())};
   std::vector<FaceCheck>& checks = m.checks;
-  FaceData<Vec3>& areaVectors = m.areaVectors;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.numFaces(), 1024),
                     [&](const tbb::blocked_range<std::size_t>& r) {
                       for (std::size_t i = r.begin(); i != r.end(); ++i) {
@@ -223,11 +221,11 @@ FaceMeasures measureFaces(const PolyMesh& mesh, const GeometryCheckOptions& opti
                         FaceCheck& c = checks[i];
                         const Face& face = mesh.face(f);
                         c.key = vertexSetKey({face.vertices.data(), face.vertices.size()});
-                        areaVectors[f] = areaVector(mesh, f);
-                        c.degenerate = isDegenerateFace(mesh, f, areaVectors[f]);
+                        const Vec3 area = areaVector(mesh, f);
+                        c.degenerate = isDegenerateFace(mesh, f, area);
                         if (c.degenerate) continue;
                         const Box3 box = faceBounds(mesh, f);
-                        const double deviation = planarityDeviation(mesh, f, areaVectors[f]);
+                        const double deviation = planarityDeviation(mesh, f, area);
                         const double resolution = 16.0 * std::numeric_limits<double>::epsilon() *
                                                   std::max(box.min().cwiseAbs().maxCoeff(),
                                                            box.max().cwiseAbs().maxCoeff());
@@ -307,7 +305,7 @@ void reportElements(const PolyMesh& mesh, const FaceMeasures& faces, Problems& p
                     [&](const tbb::blocked_range<std::size_t>& r) {
                       for (std::size_t i = r.begin(); i != r.end(); ++i) {
                         closed[i] = isClosed(mesh, ElementId(i));
-                        volumes[i] = signedVolume(mesh, ElementId(i), faces.areaVectors);
+                        volumes[i] = signedVolume(mesh, ElementId(i));
                       }
                     });
   bool first = true;

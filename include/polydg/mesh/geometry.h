@@ -42,10 +42,6 @@ Vec3 elementReferencePoint(const PolyMesh& mesh, ElementId e);
 /// cones from the element's reference point to its faces.
 double signedVolume(const PolyMesh& mesh, ElementId e);
 
-/// signedVolume() from every face's areaVector(), computed once by the caller (each face serves
-/// two elements): the same operations, the same result.
-double signedVolume(const PolyMesh& mesh, ElementId e, const FaceData<Vec3>& areaVectors);
-
 /// Largest distance of a face vertex from the face's plane (through the vertex mean, with the
 /// Newell normal).
 double planarityDeviation(const PolyMesh& mesh, FaceId f);
