@@ -16,6 +16,7 @@
 #include <pugixml.hpp>
 
 #include "mesh/vtk_cell_types.h"
+#include "tests/support/vtu_encodings.h"
 
 namespace polydg::vtk_format {
 namespace {
@@ -173,17 +174,8 @@ TEST(VtkDataArray, GeneratedArraysKnowTheirSizeWithoutMakingValues) {
   EXPECT_EQ(generatedIntArray("", "a", {1, std::int64_t{1} << 31, {}}).stored, StoredType::Int64);
 }
 
-INSTANTIATE_TEST_SUITE_P(Encodings, VtkDataArrayEncoding,
-                         ::testing::Values(VtuEncoding::Ascii, VtuEncoding::Binary,
-                                           VtuEncoding::Appended),
-                         [](const auto& info) {
-                           switch (info.param) {
-                             case VtuEncoding::Ascii: return "Ascii";
-                             case VtuEncoding::Binary: return "Binary";
-                             case VtuEncoding::Appended: return "Appended";
-                           }
-                           return "Unknown";
-                         });
+INSTANTIATE_TEST_SUITE_P(Encodings, VtkDataArrayEncoding, polydg::testing::allEncodings(),
+                         polydg::testing::encodingName);
 
 TEST(VtkDataArray, IdsMustBeIntegers) {
   const std::vector<double> reals{1.0, 2.5};
