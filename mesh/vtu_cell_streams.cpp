@@ -21,29 +21,44 @@ namespace {
 
 using vtk_format::GeneratedInts;
 
-/// Each element's distinct vertices in order of first use by its records.
+/// Calls f(v) for each vertex of element e's records, in file order.
+template <class F>
+void forEachRecordVertex(const PolyMesh& mesh, const FaceRecords& records, ElementId e, F&& f) {
+  for (const FaceUse& use : mesh.element(e).faces)
+    for (std::size_t k = 0; k < records.count(use.face); ++k)
+      for (VertexId v : records.record(use.face, k)) f(v);
+}
+
+/// Each element's distinct vertices in order of first use by its records: counted first, then
+/// written in place, so that no list per element is held between the two passes.
 ElementCorners elementCorners(const PolyMesh& mesh, const FaceRecords& records) {
   const std::size_t ne = mesh.numElements();
-  std::vector<boost::container::small_vector<VertexId, 16>> perElement(ne);
+  ElementCorners corners;
+  corners.begin.assign(ne + 1, 0);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ne, 512),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      boost::container::small_vector<VertexId, 32> seen;
+                      for (std::size_t e = r.begin(); e != r.end(); ++e) {
+                        seen.clear();
+                        forEachRecordVertex(mesh, records, ElementId(e), [&](VertexId v) {
+                          if (std::find(seen.begin(), seen.end(), v) == seen.end())
+                            seen.push_back(v);
+                        });
+                        corners.begin[e + 1] = seen.size();
+                      }
+                    });
+  std::inclusive_scan(corners.begin.begin() + 1, corners.begin.end(), corners.begin.begin() + 1);
+  corners.vertices.resize(corners.begin[ne]);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ne, 512),
                     [&](const tbb::blocked_range<std::size_t>& r) {
                       for (std::size_t e = r.begin(); e != r.end(); ++e) {
-                        auto& vs = perElement[e];
-                        for (const FaceUse& use : mesh.element(ElementId(e)).faces)
-                          for (std::size_t k = 0; k < records.count(use.face); ++k)
-                            for (VertexId v : records.record(use.face, k))
-                              if (std::find(vs.begin(), vs.end(), v) == vs.end()) vs.push_back(v);
+                        VertexId* const first = corners.vertices.data() + corners.begin[e];
+                        VertexId* last = first;
+                        forEachRecordVertex(mesh, records, ElementId(e), [&](VertexId v) {
+                          if (std::find(first, last, v) == last) *last++ = v;
+                        });
                       }
                     });
-  ElementCorners corners;
-  corners.begin.resize(ne + 1, 0);
-  for (std::size_t e = 0; e < ne; ++e)
-    corners.begin[e + 1] = corners.begin[e] + perElement[e].size();
-  corners.vertices.resize(corners.begin[ne]);
-  tbb::parallel_for(std::size_t(0), ne, [&](std::size_t e) {
-    std::copy(perElement[e].begin(), perElement[e].end(),
-              corners.vertices.begin() + corners.begin[e]);
-  });
   return corners;
 }
 
