@@ -110,9 +110,12 @@ GeneratedInts eachOf(std::size_t size, std::int64_t largest, ValueOf valueOf) {
 
 }  // namespace
 
-FaceRecords::FaceRecords(const PolyMesh& mesh) : mesh_(mesh) {
+FaceRecords::FaceRecords(const PolyMesh& mesh) : mesh_(mesh), isHoled_(mesh.numFaces(), false) {
   for (std::size_t f = 0; f < mesh.numFaces(); ++f)
-    if (mesh.face(FaceId(f)).numLoops() != 1) holed_.push_back(FaceId(f));
+    if (mesh.face(FaceId(f)).numLoops() != 1) {
+      isHoled_[f] = true;
+      holed_.push_back(FaceId(f));
+    }
   std::vector<std::vector<std::array<VertexId, 3>>> triangles(holed_.size());
   tbb::parallel_for(std::size_t(0), holed_.size(), [&](std::size_t i) {
     if (mesh.face(holed_[i]).numLoops() > 1) triangles[i] = triangulateFace(mesh, holed_[i]);

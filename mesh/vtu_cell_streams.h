@@ -23,14 +23,13 @@ class FaceRecords {
   explicit FaceRecords(const PolyMesh& mesh);
 
   std::size_t count(FaceId f) const {
-    if (mesh_.face(f).numLoops() == 1) return 1;
+    if (!isHoled_[f.index()]) return 1;
     const std::size_t i = holed(f);
     return holedBegin_[i + 1] - holedBegin_[i];
   }
   /// Record k (< count(f)) of face f.
   std::span<const VertexId> record(FaceId f, std::size_t k) const {
-    const Face& face = mesh_.face(f);
-    if (face.numLoops() == 1) return {face.vertices.data(), face.vertices.size()};
+    if (!isHoled_[f.index()]) return {mesh_.face(f).vertices.data(), mesh_.face(f).vertices.size()};
     return {triangles_[holedBegin_[holed(f)] + k].data(), 3};
   }
 
@@ -39,6 +38,9 @@ class FaceRecords {
   std::size_t holed(FaceId f) const;
 
   const PolyMesh& mesh_;
+  /// Per face, whether it has other than one loop: a bit per face, so that counting records
+  /// reads no face.
+  std::vector<bool> isHoled_;
   std::vector<FaceId> holed_;            ///< the faces of other than one loop, in id order
   std::vector<std::size_t> holedBegin_;  ///< holed_[i]'s: triangles_[holedBegin_[i] .. [i + 1])
   std::vector<std::array<VertexId, 3>> triangles_;
