@@ -1,6 +1,7 @@
 #include "mesh/vtu_cell_streams.h"
 
 #include <algorithm>
+#include <bit>
 #include <functional>
 #include <limits>
 #include <numeric>
@@ -21,45 +22,73 @@ namespace {
 
 using vtk_format::GeneratedInts;
 
-/// Calls f(v) for each vertex of element e's records, in file order.
-template <class F>
-void forEachRecordVertex(const PolyMesh& mesh, const FaceRecords& records, ElementId e, F&& f) {
-  for (const FaceUse& use : mesh.element(e).faces)
-    for (std::size_t k = 0; k < records.count(use.face); ++k)
-      for (VertexId v : records.record(use.face, k)) f(v);
-}
+/// The distinct vertices of one element at a time, numbered in order of first use: a linear
+/// search while there are few (a grid cell has 8), a hash table once there are more (a cut cell
+/// has tens, and searching them all for every use made numbering quadratic).
+class CornerNumbers {
+ public:
+  void clear() {
+    vertices_.clear();
+    table_.clear();
+  }
+  /// The number of v, the next one if v is new.
+  std::uint32_t number(VertexId v) {
+    if (table_.empty()) {
+      for (std::size_t i = 0; i < vertices_.size(); ++i)
+        if (vertices_[i] == v) return static_cast<std::uint32_t>(i);
+      return add(v);
+    }
+    std::size_t slot = hash(v);
+    for (; table_[slot] != kEmpty; slot = (slot + 1) & (table_.size() - 1))
+      if (vertices_[table_[slot]] == v) return table_[slot];
+    table_[slot] = static_cast<std::uint32_t>(vertices_.size());
+    return add(v);
+  }
+  std::span<const VertexId> vertices() const { return {vertices_.data(), vertices_.size()}; }
 
-/// Each element's distinct vertices in order of first use by its records: counted first, then
-/// written in place, so that no list per element is held between the two passes.
-ElementCorners elementCorners(const PolyMesh& mesh, const FaceRecords& records) {
-  const std::size_t ne = mesh.numElements();
-  ElementCorners corners;
-  corners.begin.assign(ne + 1, 0);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ne, 512),
-                    [&](const tbb::blocked_range<std::size_t>& r) {
-                      boost::container::small_vector<VertexId, 32> seen;
-                      for (std::size_t e = r.begin(); e != r.end(); ++e) {
-                        seen.clear();
-                        forEachRecordVertex(mesh, records, ElementId(e), [&](VertexId v) {
-                          if (std::find(seen.begin(), seen.end(), v) == seen.end())
-                            seen.push_back(v);
-                        });
-                        corners.begin[e + 1] = seen.size();
-                      }
-                    });
-  std::inclusive_scan(corners.begin.begin() + 1, corners.begin.end(), corners.begin.begin() + 1);
-  corners.vertices.resize(corners.begin[ne]);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ne, 512),
-                    [&](const tbb::blocked_range<std::size_t>& r) {
-                      for (std::size_t e = r.begin(); e != r.end(); ++e) {
-                        VertexId* const first = corners.vertices.data() + corners.begin[e];
-                        VertexId* last = first;
-                        forEachRecordVertex(mesh, records, ElementId(e), [&](VertexId v) {
-                          if (std::find(first, last, v) == last) *last++ = v;
-                        });
-                      }
-                    });
-  return corners;
+ private:
+  static constexpr std::uint32_t kEmpty = std::numeric_limits<std::uint32_t>::max();
+  static constexpr std::size_t kLinear = 16;  ///< vertices searched linearly at most
+
+  std::uint32_t add(VertexId v) {
+    vertices_.push_back(v);
+    // Rebuilt at a quarter full, so that probes stay short.
+    if (vertices_.size() > kLinear && 4 * vertices_.size() > table_.size()) {
+      table_.assign(std::bit_ceil(8 * vertices_.size()), kEmpty);
+      shift_ = 64 - std::countr_zero(table_.size());
+      for (std::size_t i = 0; i < vertices_.size(); ++i) {
+        std::size_t slot = hash(vertices_[i]);
+        while (table_[slot] != kEmpty) slot = (slot + 1) & (table_.size() - 1);
+        table_[slot] = static_cast<std::uint32_t>(i);
+      }
+    }
+    return static_cast<std::uint32_t>(vertices_.size() - 1);
+  }
+  /// Fibonacci hashing: the top bits of v times 2^64 / golden ratio.
+  std::size_t hash(VertexId v) const {
+    return static_cast<std::size_t>((v.value * 0x9e3779b97f4a7c15ull) >> shift_);
+  }
+
+  boost::container::small_vector<VertexId, 32> vertices_;
+  std::vector<std::uint32_t> table_;  ///< indices into vertices_, or kEmpty
+  int shift_ = 0;                     ///< 64 - log2(table_.size())
+};
+
+/// Numbers the vertices of element e's records in file order (so `numbers` ends with its
+/// corners in order of first use) and calls f(use, record, corner) for each record, corner[i]
+/// being the number of record[i].
+template <class F>
+void forEachRecord(const PolyMesh& mesh, const FaceRecords& records, ElementId e,
+                   CornerNumbers& numbers, F&& f) {
+  numbers.clear();
+  boost::container::small_vector<std::uint32_t, 16> corner;
+  for (const FaceUse& use : mesh.element(e).faces)
+    for (std::size_t k = 0; k < records.count(use.face); ++k) {
+      const auto record = records.record(use.face, k);
+      corner.resize(record.size());
+      for (std::size_t i = 0; i < record.size(); ++i) corner[i] = numbers.number(record[i]);
+      f(use, record, std::span<const std::uint32_t>(corner.data(), corner.size()));
+    }
 }
 
 /// A count of one cell, which RunningEnds keeps in 32 bits.
@@ -151,18 +180,22 @@ std::size_t RunningEnds::cellAt(std::uint64_t at) const {
   return static_cast<std::size_t>(std::upper_bound(wide_.begin(), wide_.end(), at) - wide_.begin());
 }
 
-CellStreams::CellStreams(const PolyMesh& mesh)
-    : mesh_(mesh),
-      records_(mesh),
-      corners_(elementCorners(mesh, records_)),
-      points_(groupPoints(mesh, corners_)) {
+CellStreams::CellStreams(const PolyMesh& mesh) : mesh_(mesh), records_(mesh) {
+  std::vector<std::uint32_t> recordCount, streamCount;
+  findCorners(recordCount, streamCount);
+  points_ = groupPoints(mesh, corners_);
   order_.resize(mesh.numElements());
   for (std::size_t e = 0; e < order_.size(); ++e) order_[e] = ElementId(e);
   // Cells in increasing order of their point count (stable), see kElementArray.
   std::stable_sort(order_.begin(), order_.end(), [&](ElementId a, ElementId b) {
     return corners_.of(a).size() < corners_.of(b).size();
   });
-  sizeCells();
+  std::vector<std::uint32_t> cornerCount(order_.size());
+  for (std::size_t c = 0; c < order_.size(); ++c)
+    cornerCount[c] = cellCount(corners_.of(order_[c]).size());
+  connectivityEnd_ = RunningEnds(std::move(cornerCount));
+  recordEnd_ = RunningEnds(inCellOrder(recordCount));
+  faceEnd_ = RunningEnds(inCellOrder(streamCount));
   for (std::uint32_t p : points_.cornerPoint)
     largest_.point = std::max<std::int64_t>(largest_.point, p);
   for (const Face& face : mesh.faces())
@@ -171,11 +204,12 @@ CellStreams::CellStreams(const PolyMesh& mesh)
     largest_.vertex = std::max<std::int64_t>(largest_.vertex, v.value);
 }
 
-/// The running ends of each cell's corners, records and `faces` run, and the largest record
-/// count, record size, face id and reversal among the records.
-void CellStreams::sizeCells() {
-  const std::size_t ne = order_.size();
-  std::vector<std::uint32_t> cornerCount(ne), recordCount(ne), streamCount(ne);
+void CellStreams::findCorners(std::vector<std::uint32_t>& recordCount,
+                              std::vector<std::uint32_t>& streamCount) {
+  const std::size_t ne = mesh_.numElements();
+  recordCount.resize(ne);
+  streamCount.resize(ne);
+  corners_.begin.assign(ne + 1, 0);
   auto most = [](Largest a, const Largest& b) {
     a.recordsPerCell = std::max(a.recordsPerCell, b.recordsPerCell);
     a.recordSize = std::max(a.recordSize, b.recordSize);
@@ -183,33 +217,49 @@ void CellStreams::sizeCells() {
     a.reversed = std::max(a.reversed, b.reversed);
     return a;
   };
-  const Largest cells = tbb::parallel_reduce(
-      tbb::blocked_range<std::size_t>(0, ne, 1024), Largest{},
+  const Largest counted = tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, ne, 512), Largest{},
       [&](const tbb::blocked_range<std::size_t>& r, Largest largest) {
-        for (std::size_t c = r.begin(); c != r.end(); ++c) {
-          std::size_t recordsOfCell = 0, stream = 1;
-          for (const FaceUse& use : mesh_.element(order_[c]).faces)
-            for (std::size_t k = 0; k < records_.count(use.face); ++k) {
-              const auto n = static_cast<std::int64_t>(records_.record(use.face, k).size());
-              ++recordsOfCell;
-              stream += 1 + static_cast<std::size_t>(n);
-              largest.recordSize = std::max(largest.recordSize, n);
-              largest.face = std::max<std::int64_t>(largest.face, use.face.value);
-              largest.reversed = std::max<std::int64_t>(largest.reversed, use.reversed ? 1 : 0);
-            }
+        CornerNumbers numbers;
+        for (std::size_t e = r.begin(); e != r.end(); ++e) {
+          std::size_t records = 0, stream = 1;
+          forEachRecord(mesh_, records_, ElementId(e), numbers,
+                        [&](const FaceUse& use, std::span<const VertexId> record, auto) {
+                          ++records;
+                          stream += 1 + record.size();
+                          largest.recordSize = std::max(largest.recordSize,
+                                                        static_cast<std::int64_t>(record.size()));
+                          largest.face = std::max<std::int64_t>(largest.face, use.face.value);
+                          largest.reversed = std::max<std::int64_t>(largest.reversed, use.reversed);
+                        });
           largest.recordsPerCell =
-              std::max(largest.recordsPerCell, static_cast<std::int64_t>(recordsOfCell));
-          cornerCount[c] = cellCount(corners_.of(order_[c]).size());
-          recordCount[c] = cellCount(recordsOfCell);
-          streamCount[c] = cellCount(stream);
+              std::max(largest.recordsPerCell, static_cast<std::int64_t>(records));
+          corners_.begin[e + 1] = numbers.vertices().size();
+          recordCount[e] = cellCount(records);
+          streamCount[e] = cellCount(stream);
         }
         return largest;
       },
       most);
-  largest_ = most(largest_, cells);
-  connectivityEnd_ = RunningEnds(std::move(cornerCount));
-  recordEnd_ = RunningEnds(std::move(recordCount));
-  faceEnd_ = RunningEnds(std::move(streamCount));
+  largest_ = most(largest_, counted);
+  std::inclusive_scan(corners_.begin.begin() + 1, corners_.begin.end(), corners_.begin.begin() + 1);
+  corners_.vertices.resize(corners_.begin[ne]);
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, ne, 512), [&](const tbb::blocked_range<std::size_t>& r) {
+        CornerNumbers numbers;
+        for (std::size_t e = r.begin(); e != r.end(); ++e) {
+          forEachRecord(mesh_, records_, ElementId(e), numbers, [](const FaceUse&, auto, auto) {});
+          const auto found = numbers.vertices();
+          std::copy(found.begin(), found.end(), corners_.vertices.begin() + corners_.begin[e]);
+        }
+      });
+}
+
+std::vector<std::uint32_t> CellStreams::inCellOrder(
+    const std::vector<std::uint32_t>& perElement) const {
+  std::vector<std::uint32_t> perCell(order_.size());
+  for (std::size_t c = 0; c < order_.size(); ++c) perCell[c] = perElement[order_[c].index()];
+  return perCell;
 }
 
 GeneratedInts CellStreams::connectivity() const {
@@ -234,24 +284,25 @@ GeneratedInts CellStreams::types() const {
 }
 
 GeneratedInts CellStreams::faces() const {
-  return {faceEnd_.total(),
-          std::max({largest_.point, largest_.recordsPerCell, largest_.recordSize}),
-          [this](std::size_t begin, std::size_t end, std::int64_t* out) {
-            fillByCell(faceEnd_, begin, end, out, [&](std::size_t c, Window& window) {
-              const ElementId e = order_[c];
-              window.put(static_cast<std::int64_t>(recordEnd_.end(c) - recordEnd_.begin(c)));
-              for (const FaceUse& use : mesh_.element(e).faces)
-                for (std::size_t k = 0; k < records_.count(use.face); ++k) {
-                  const auto record = records_.record(use.face, k);
-                  const std::size_t n = record.size();
-                  window.put(static_cast<std::int64_t>(n));
-                  // Backwards keeps the first vertex first: v0, v(n-1), ..., v1.
-                  for (std::size_t i = 0; i < n; ++i)
-                    window.put(points_.cornerPoint[corners_.find(
-                        e, use.reversed ? record[(n - i) % n] : record[i])]);
-                }
-            });
-          }};
+  return {
+      faceEnd_.total(), std::max({largest_.point, largest_.recordsPerCell, largest_.recordSize}),
+      [this](std::size_t begin, std::size_t end, std::int64_t* out) {
+        CornerNumbers numbers;
+        fillByCell(faceEnd_, begin, end, out, [&](std::size_t c, Window& window) {
+          const ElementId e = order_[c];
+          const std::uint32_t* const point = points_.cornerPoint.data() + corners_.begin[e.index()];
+          window.put(static_cast<std::int64_t>(recordEnd_.end(c) - recordEnd_.begin(c)));
+          // The records' vertices are numbered as elementCorners numbered them.
+          forEachRecord(mesh_, records_, e, numbers,
+                        [&](const FaceUse& use, auto, std::span<const std::uint32_t> corner) {
+                          const std::size_t n = corner.size();
+                          window.put(static_cast<std::int64_t>(n));
+                          // Backwards keeps the first vertex first: v0, v(n-1), ..., v1.
+                          for (std::size_t i = 0; i < n; ++i)
+                            window.put(point[corner[use.reversed ? (n - i) % n : i]]);
+                        });
+        });
+      }};
 }
 
 GeneratedInts CellStreams::faceOffsets() const {

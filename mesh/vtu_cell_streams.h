@@ -110,7 +110,13 @@ class CellStreams {
     std::int64_t origin = 0, vertex = 0;
   };
 
-  void sizeCells();
+  /// Each element's corners, counted in a first pass and written in place in a second, so that
+  /// no list per element is held between them; the first pass also counts each element's
+  /// records and `faces` values (in element order) and finds the largest values of its records.
+  void findCorners(std::vector<std::uint32_t>& recordCount,
+                   std::vector<std::uint32_t>& streamCount);
+  /// Counts per element as counts per cell.
+  std::vector<std::uint32_t> inCellOrder(const std::vector<std::uint32_t>& perElement) const;
   /// One value per face record, value(use) for each record of the face use `use`.
   template <class Value>
   vtk_format::GeneratedInts perRecord(std::int64_t largest, Value value) const;
