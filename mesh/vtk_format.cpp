@@ -13,7 +13,10 @@
 #include <optional>
 #include <sstream>
 #include <type_traits>
+#include <utility>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 #include <zlib.h>
 #include <pugixml.hpp>
 
@@ -160,11 +163,11 @@ std::size_t storedSize(StoredType t) {
   }
 }
 
-/// Appends values [begin, end) of `a`, as stored little-endian, to `out`.
-void storeValues(const ArrayOut& a, std::size_t begin, std::size_t end, std::vector<char>& out) {
+/// Appends `values`, stored as `stored` (little-endian), to `out`.
+template <class T>
+void storeValues(StoredType stored, std::span<const T> values, std::vector<char>& out) {
   const std::size_t at = out.size();
-  const std::size_t width = storedSize(a.stored);
-  out.resize(at + (end - begin) * width);
+  out.resize(at + values.size() * storedSize(stored));
   char* p = out.data() + at;
   auto put = [&](auto value) {
     auto bytes = std::bit_cast<std::array<char, sizeof value>>(value);
@@ -172,29 +175,77 @@ void storeValues(const ArrayOut& a, std::size_t begin, std::size_t end, std::vec
     std::memcpy(p, bytes.data(), bytes.size());
     p += bytes.size();
   };
-  for (std::size_t i = begin; i < end; ++i) {
-    switch (a.stored) {
-      case StoredType::Float64: put(a.doubles[i]); break;
-      case StoredType::UInt8: put(static_cast<std::uint8_t>(a.integers[i])); break;
-      case StoredType::Int32: put(static_cast<std::int32_t>(a.integers[i])); break;
-      case StoredType::Int64: put(a.integers[i]); break;
+  for (const T value : values) {
+    if constexpr (std::is_same_v<T, double>) {
+      put(value);
+    } else {
+      switch (stored) {
+        case StoredType::UInt8: put(static_cast<std::uint8_t>(value)); break;
+        case StoredType::Int32: put(static_cast<std::int32_t>(value)); break;
+        default: put(value); break;
+      }
     }
+  }
+}
+
+/// Values of a generated array that one task makes: a chunk is split into ranges of this many.
+constexpr std::size_t kFillGrain = 1 << 14;
+
+/// Hands the values of `a` to f(first, values), values[i] being value first + i: a held array
+/// in one run, a generated one chunk by chunk, each chunk filled by ranges on all cores (every
+/// position gets its value whatever the range, so the bytes never depend on the schedule).
+template <class F>
+void forEachRun(const ArrayOut& a, F&& f) {
+  if (!a.isGenerated()) {
+    if (a.stored == StoredType::Float64)
+      f(std::size_t{0}, a.doubles);
+    else
+      f(std::size_t{0}, a.integers);
+    return;
+  }
+  const std::size_t chunk = std::max<std::size_t>(a.chunk, 1);
+  std::vector<std::int64_t> run(std::min(a.size(), chunk));
+  for (std::size_t begin = 0; begin < a.size(); begin += chunk) {
+    const std::size_t end = std::min(a.size(), begin + chunk);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(begin, end, kFillGrain),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        a.generated.fill(r.begin(), r.end(), run.data() + (r.begin() - begin));
+                      });
+    f(begin, std::span<const std::int64_t>(run.data(), end - begin));
   }
 }
 
 /// Writes the UInt64 byte count and the values of `a` as raw bytes to `sink`.
 template <class Sink>
 void writeBinary(const ArrayOut& a, Sink&& sink) {
-  constexpr std::size_t kChunk = 1 << 16;
+  constexpr std::size_t kPiece = 1 << 16;
   std::vector<char> buffer;
   auto count = std::bit_cast<std::array<char, 8>>(std::uint64_t{a.bytes()});
   if constexpr (std::endian::native == std::endian::big) std::reverse(count.begin(), count.end());
   sink(count.data(), count.size());
-  for (std::size_t begin = 0; begin < a.size(); begin += kChunk) {
-    buffer.clear();
-    storeValues(a, begin, std::min(a.size(), begin + kChunk), buffer);
-    sink(buffer.data(), buffer.size());
-  }
+  forEachRun(a, [&](std::size_t, auto values) {
+    for (std::size_t begin = 0; begin < values.size(); begin += kPiece) {
+      buffer.clear();
+      storeValues(a.stored, values.subspan(begin, std::min(kPiece, values.size() - begin)), buffer);
+      sink(buffer.data(), buffer.size());
+    }
+  });
+}
+
+/// The smallest of UInt8, Int32 and Int64 that holds non-negative values up to `largest`.
+StoredType intType(std::int64_t largest) {
+  return largest < 256                                         ? StoredType::UInt8
+         : largest <= std::numeric_limits<std::int32_t>::max() ? StoredType::Int32
+                                                               : StoredType::Int64;
+}
+
+/// An array with no values yet: its place, name and whether it has NumberOfTuples.
+ArrayOut namedArray(std::string_view indent, std::string_view name, bool withTuples) {
+  ArrayOut a;
+  a.indent = indent;
+  a.name = name;
+  a.withTuples = withTuples;
+  return a;
 }
 
 }  // namespace
@@ -203,16 +254,27 @@ std::size_t ArrayOut::bytes() const { return size() * storedSize(stored); }
 
 ArrayOut floatArray(std::string_view indent, std::string_view name, int components,
                     std::span<const double> values, bool withTuples) {
-  return {indent, name, components, withTuples, values, {}, StoredType::Float64};
+  ArrayOut a = namedArray(indent, name, withTuples);
+  a.components = components;
+  a.doubles = values;
+  return a;
 }
 
 ArrayOut intArray(std::string_view indent, std::string_view name,
                   std::span<const std::int64_t> values, bool withTuples) {
   const std::int64_t largest = values.empty() ? 0 : *std::max_element(values.begin(), values.end());
-  const StoredType t = largest < 256                                         ? StoredType::UInt8
-                       : largest <= std::numeric_limits<std::int32_t>::max() ? StoredType::Int32
-                                                                             : StoredType::Int64;
-  return {indent, name, 1, withTuples, {}, values, t};
+  ArrayOut a = namedArray(indent, name, withTuples);
+  a.integers = values;
+  a.stored = intType(largest);
+  return a;
+}
+
+ArrayOut generatedIntArray(std::string_view indent, std::string_view name, GeneratedInts values,
+                           bool withTuples) {
+  ArrayOut a = namedArray(indent, name, withTuples);
+  a.stored = intType(values.largest);
+  a.generated = std::move(values);
+  return a;
 }
 
 void writeDataArray(std::ostream& os, const ArrayOut& a, VtuEncoding encoding, std::size_t offset) {
@@ -230,16 +292,17 @@ void writeDataArray(std::ostream& os, const ArrayOut& a, VtuEncoding encoding, s
      << a.indent << "  ";
   if (encoding == VtuEncoding::Ascii) {
     char buffer[64];
-    for (std::size_t i = 0; i < a.size(); ++i) {
-      if (i > 0 && i % 12 == 0)
-        os << '\n' << a.indent << "  ";
-      else if (i > 0)
-        os << ' ';
-      const auto result = a.stored == StoredType::Float64
-                              ? std::to_chars(buffer, buffer + sizeof buffer, a.doubles[i])
-                              : std::to_chars(buffer, buffer + sizeof buffer, a.integers[i]);
-      os.write(buffer, result.ptr - buffer);
-    }
+    forEachRun(a, [&](std::size_t first, auto values) {
+      for (std::size_t j = 0; j < values.size(); ++j) {
+        const std::size_t i = first + j;
+        if (i > 0 && i % 12 == 0)
+          os << '\n' << a.indent << "  ";
+        else if (i > 0)
+          os << ' ';
+        const auto result = std::to_chars(buffer, buffer + sizeof buffer, values[j]);
+        os.write(buffer, result.ptr - buffer);
+      }
+    });
   } else {
     Base64Writer out(os);
     writeBinary(a, [&](const char* data, std::size_t n) { out.write(data, n); });

@@ -86,8 +86,25 @@ bool isXmlSpace(char c);
 /// smallest of UInt8, Int32 and Int64 that holds them (VTK and meshio convert on reading).
 enum class StoredType { Float64, UInt8, Int32, Int64 };
 
+/// Produces values [begin, end) of a generated array into out[0 .. end - begin).
+using FillValues = std::function<void(std::size_t begin, std::size_t end, std::int64_t* out)>;
+
+/// Non-negative integers made on demand instead of held: how many, the largest (which picks the
+/// stored type before any value is made) and `fill`, which the writer calls from several
+/// threads at once for disjoint ranges, so it must give each position the same value whatever
+/// the range it falls in.
+struct GeneratedInts {
+  std::size_t size = 0;
+  std::int64_t largest = 0;
+  FillValues fill;
+};
+
+/// How many values of a generated array are made and written at a time (8 MB as Int64).
+inline constexpr std::size_t kChunkValues = std::size_t{1} << 20;
+
 /// One <DataArray> to write: its values (doubles or integers, entity by entity with
-/// `components` values each) and how to store them. The spans must outlive the writing.
+/// `components` values each) and how to store them. The spans, and what a generated array's
+/// fill refers to, must outlive the writing.
 struct ArrayOut {
   std::string_view indent, name;
   int components = 1;
@@ -95,8 +112,13 @@ struct ArrayOut {
   std::span<const double> doubles;
   std::span<const std::int64_t> integers;
   StoredType stored = StoredType::Float64;
+  /// Integers generated `chunk` values at a time (then `integers` is unused), if its fill is set.
+  GeneratedInts generated;
+  std::size_t chunk = kChunkValues;  ///< at least 1
 
+  bool isGenerated() const { return static_cast<bool>(generated.fill); }
   std::size_t size() const {
+    if (isGenerated()) return generated.size;
     return stored == StoredType::Float64 ? doubles.size() : integers.size();
   }
   /// Bytes of the stored values, without the header.
@@ -113,10 +135,15 @@ ArrayOut floatArray(std::string_view indent, std::string_view name, int componen
 ArrayOut intArray(std::string_view indent, std::string_view name,
                   std::span<const std::int64_t> values, bool withTuples = false);
 
+/// `values` generated when written, stored as intArray would store them all.
+ArrayOut generatedIntArray(std::string_view indent, std::string_view name, GeneratedInts values,
+                           bool withTuples = false);
+
 /// Writes one <DataArray> (header_type UInt64, little-endian, uncompressed): ascii text (12
 /// values a line, shortest round-trip form), inline base64 of the binary form, or, for
 /// VtuEncoding::Appended, only the tag with `offset` (bytes into the appended data; see
-/// writeAppendedBytes).
+/// writeAppendedBytes). A generated array is made chunk by chunk, each chunk on all cores; the
+/// bytes are those of its values held whole.
 void writeDataArray(std::ostream& os, const ArrayOut& a, VtuEncoding encoding, std::size_t offset);
 
 /// Writes the binary form of `a` (binaryBytes() bytes) raw, for the AppendedData section.

@@ -1,14 +1,12 @@
 // writeVtu (polydg/mesh/vtu_io.h): a PolyMesh as VTK polyhedra, with polydg's restore arrays;
 // writeTetVtu (polydg/mesh/tet_mesh.h): a TetMesh as VTK_TETRA cells, through the same document.
 #include <algorithm>
-#include <array>
 #include <cerrno>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
-#include <numeric>
 #include <ostream>
 #include <span>
 #include <stdexcept>
@@ -18,12 +16,11 @@
 #include <unordered_set>
 
 #include <tbb/parallel_for.h>
-#include <boost/container/small_vector.hpp>
 
-#include "mesh/face_triangulation.h"
 #include "mesh/point_groups.h"
 #include "mesh/vtk_cell_types.h"
 #include "mesh/vtk_format.h"
+#include "mesh/vtu_cell_streams.h"
 #include "mesh/vtu_restore_arrays.h"
 #include "polydg/mesh/geometry.h"
 #include "polydg/mesh/tet_mesh.h"
@@ -35,142 +32,8 @@ namespace {
 
 using vtk_format::ArrayOut;
 using vtk_format::floatArray;
+using vtk_format::generatedIntArray;
 using vtk_format::intArray;
-
-/// The cell arrays of the file, with the polydg field data that goes with them. Point ids are
-/// VTU points (see PointGroups), not mesh vertices.
-struct CellStreams {
-  std::vector<std::int64_t> connectivity, offsets, types, faces, faceOffsets;
-  std::vector<std::int64_t> faceGroup, faceReversed, faceOrigin;
-  std::vector<std::int64_t> element;  ///< the element written as each cell, in file order
-  /// The mesh vertex of each VTU point (PointGroups::pointVertex as integers).
-  std::vector<std::int64_t> pointVertex;
-  /// Each element's corners in order of first use by its records, and their points.
-  ElementCorners corners;
-  PointGroups points;
-};
-
-/// The records (simple polygons) that stand for each face in the file, in the face's own
-/// orientation: the face's one loop, or the triangles of a face with holes.
-class FaceRecords {
- public:
-  explicit FaceRecords(const PolyMesh& mesh) : mesh_(mesh), triangles_(mesh.numFaces()) {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.numFaces(), 1024),
-                      [&](const tbb::blocked_range<std::size_t>& r) {
-                        for (std::size_t f = r.begin(); f != r.end(); ++f)
-                          if (mesh.face(FaceId(f)).numLoops() > 1)
-                            triangles_[FaceId(f)] = triangulateFace(mesh, FaceId(f));
-                      });
-  }
-  std::size_t count(FaceId f) const {
-    return mesh_.face(f).numLoops() == 1 ? 1 : triangles_[f].size();
-  }
-  std::span<const VertexId> record(FaceId f, std::size_t k) const {
-    const Face& face = mesh_.face(f);
-    if (face.numLoops() == 1) return {face.vertices.data(), face.vertices.size()};
-    return {triangles_[f][k].data(), 3};
-  }
-
- private:
-  const PolyMesh& mesh_;
-  FaceData<std::vector<std::array<VertexId, 3>>> triangles_;
-};
-
-/// Each element's distinct vertices in order of first use by its records.
-ElementCorners elementCorners(const PolyMesh& mesh, const FaceRecords& records) {
-  const std::size_t ne = mesh.numElements();
-  std::vector<boost::container::small_vector<VertexId, 16>> perElement(ne);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ne, 512),
-                    [&](const tbb::blocked_range<std::size_t>& r) {
-                      for (std::size_t e = r.begin(); e != r.end(); ++e) {
-                        auto& vs = perElement[e];
-                        for (const FaceUse& use : mesh.element(ElementId(e)).faces)
-                          for (std::size_t k = 0; k < records.count(use.face); ++k)
-                            for (VertexId v : records.record(use.face, k))
-                              if (std::find(vs.begin(), vs.end(), v) == vs.end()) vs.push_back(v);
-                      }
-                    });
-  ElementCorners corners;
-  corners.begin.resize(ne + 1, 0);
-  for (std::size_t e = 0; e < ne; ++e)
-    corners.begin[e + 1] = corners.begin[e] + perElement[e].size();
-  corners.vertices.resize(corners.begin[ne]);
-  tbb::parallel_for(std::size_t(0), ne, [&](std::size_t e) {
-    std::copy(perElement[e].begin(), perElement[e].end(),
-              corners.vertices.begin() + corners.begin[e]);
-  });
-  return corners;
-}
-
-CellStreams buildCellStreams(const PolyMesh& mesh) {
-  const std::size_t ne = mesh.numElements();
-  const FaceRecords records(mesh);
-  CellStreams s;
-  s.corners = elementCorners(mesh, records);
-  s.points = groupPoints(mesh, s.corners);
-  const ElementCorners& inc = s.corners;
-  const std::vector<std::uint32_t>& point = s.points.cornerPoint;
-  s.pointVertex.resize(s.points.numPoints());
-  for (std::size_t p = 0; p < s.pointVertex.size(); ++p)
-    s.pointVertex[p] = s.points.pointVertex[p].value;
-
-  // Cells in increasing order of their point count (stable), see kElementArray.
-  std::vector<std::size_t> order(ne);
-  std::iota(order.begin(), order.end(), 0);
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-    return inc.begin[a + 1] - inc.begin[a] < inc.begin[b + 1] - inc.begin[b];
-  });
-  // Sizes per cell, then running ends, then the streams filled in parallel.
-  std::vector<std::size_t> recordEnd(ne + 1, 0), faceEnd(ne + 1, 0);
-  for (std::size_t c = 0; c < ne; ++c) {
-    std::size_t recordsOfCell = 0, stream = 1;
-    for (const FaceUse& use : mesh.element(ElementId(order[c])).faces)
-      for (std::size_t k = 0; k < records.count(use.face); ++k) {
-        ++recordsOfCell;
-        stream += 1 + records.record(use.face, k).size();
-      }
-    recordEnd[c + 1] = recordEnd[c] + recordsOfCell;
-    faceEnd[c + 1] = faceEnd[c] + stream;
-  }
-  s.element.assign(order.begin(), order.end());
-  s.types.assign(ne, vtk_format::kVtkPolyhedron);
-  s.offsets.resize(ne);
-  s.faceOffsets.resize(ne);
-  s.connectivity.resize(inc.vertices.size());
-  s.faces.resize(faceEnd[ne]);
-  s.faceGroup.resize(recordEnd[ne]);
-  s.faceReversed.resize(recordEnd[ne]);
-  std::vector<std::size_t> connectivityEnd(ne + 1, 0);
-  for (std::size_t c = 0; c < ne; ++c)
-    connectivityEnd[c + 1] = connectivityEnd[c] + inc.begin[order[c] + 1] - inc.begin[order[c]];
-  tbb::parallel_for(
-      tbb::blocked_range<std::size_t>(0, ne, 256), [&](const tbb::blocked_range<std::size_t>& r) {
-        for (std::size_t c = r.begin(); c != r.end(); ++c) {
-          const ElementId e(order[c]);
-          const std::size_t first = inc.begin[e.index()];
-          for (std::size_t i = first; i < inc.begin[e.index() + 1]; ++i)
-            s.connectivity[connectivityEnd[c] + i - first] = point[i];
-          s.offsets[c] = static_cast<std::int64_t>(connectivityEnd[c + 1]);
-          std::size_t at = faceEnd[c], rec = recordEnd[c];
-          s.faces[at++] = static_cast<std::int64_t>(recordEnd[c + 1] - recordEnd[c]);
-          for (const FaceUse& use : mesh.element(e).faces)
-            for (std::size_t k = 0; k < records.count(use.face); ++k) {
-              const auto record = records.record(use.face, k);
-              const std::size_t n = record.size();
-              s.faces[at++] = static_cast<std::int64_t>(n);
-              // Backwards keeps the first vertex first: v0, v(n-1), ..., v1.
-              for (std::size_t i = 0; i < n; ++i)
-                s.faces[at++] = point[inc.find(e, use.reversed ? record[(n - i) % n] : record[i])];
-              s.faceGroup[rec] = use.face.value;
-              s.faceReversed[rec++] = use.reversed ? 1 : 0;
-            }
-          s.faceOffsets[c] = static_cast<std::int64_t>(faceEnd[c + 1]);
-        }
-      });
-  for (const Face& face : mesh.faces())
-    s.faceOrigin.push_back(static_cast<std::int64_t>(face.origin));
-  return s;
-}
 
 /// An array's name (non-empty, unused so far among `names`, then recorded) and component count
 /// (1 or 3).
@@ -251,20 +114,21 @@ struct FileValues {
 
 /// The rows of `values` (`components` values per row) in the order `rows` lists them: an
 /// array per mesh entity becomes one per file entity (VTU point or cell).
+template <class Tag>
 std::vector<double> gatherRows(const std::vector<double>& values, int components,
-                               const std::vector<std::int64_t>& rows) {
+                               std::span<const Id<Tag>> rows) {
   const auto k = static_cast<std::size_t>(components);
   std::vector<double> out(rows.size() * k);
   for (std::size_t r = 0; r < rows.size(); ++r)
-    for (std::size_t i = 0; i < k; ++i)
-      out[r * k + i] = values[static_cast<std::size_t>(rows[r]) * k + i];
+    for (std::size_t i = 0; i < k; ++i) out[r * k + i] = values[rows[r].index() * k + i];
   return out;
 }
 
 /// The mean of `a`'s corner values over the corners written as each VTU point.
 std::vector<double> cornerMeans(const CellStreams& s, const CornerArray& a) {
   const auto k = static_cast<std::size_t>(a.components);
-  const ElementCorners& corners = s.corners;
+  const ElementCorners& corners = s.corners();
+  const PointGroups& points = s.points();
   const std::size_t ne = corners.begin.size() - 1;
   std::vector<double> corner(corners.vertices.size() * k);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ne, 256),
@@ -273,10 +137,10 @@ std::vector<double> cornerMeans(const CellStreams& s, const CornerArray& a) {
                         for (std::size_t i = corners.begin[e]; i < corners.begin[e + 1]; ++i)
                           a.value(ElementId(e), corners.vertices[i], corner.data() + i * k);
                     });
-  std::vector<double> mean(s.points.numPoints() * k, 0.0);
-  std::vector<std::uint32_t> count(s.points.numPoints(), 0);
-  for (std::size_t i = 0; i < s.points.cornerPoint.size(); ++i) {
-    const std::size_t p = s.points.cornerPoint[i];
+  std::vector<double> mean(points.numPoints() * k, 0.0);
+  std::vector<std::uint32_t> count(points.numPoints(), 0);
+  for (std::size_t i = 0; i < points.cornerPoint.size(); ++i) {
+    const std::size_t p = points.cornerPoint[i];
     ++count[p];
     for (std::size_t c = 0; c < k; ++c) mean[p * k + c] += corner[i * k + c];
   }
@@ -291,23 +155,24 @@ FileValues fileValues(const PolyMesh& mesh, const CellStreams& s,
                       const std::vector<PointArray>& pointData,
                       const std::vector<CornerArray>& cornerData) {
   FileValues v;
-  const std::size_t np = s.points.numPoints(), ne = s.element.size();
-  v.points.resize(3 * np);
-  v.volume.resize(ne);
-  tbb::parallel_for(std::size_t(0), np, [&](std::size_t p) {
-    const Vec3& x = mesh.position(s.points.pointVertex[p]);
+  const std::span<const VertexId> pointVertex = s.points().pointVertex;
+  const std::span<const ElementId> cells = s.elements();
+  v.points.resize(3 * pointVertex.size());
+  v.volume.resize(cells.size());
+  tbb::parallel_for(std::size_t(0), pointVertex.size(), [&](std::size_t p) {
+    const Vec3& x = mesh.position(pointVertex[p]);
     for (int i = 0; i < 3; ++i) v.points[3 * p + i] = x[i];
   });
-  tbb::parallel_for(
-      tbb::blocked_range<std::size_t>(0, ne, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
-        for (std::size_t c = r.begin(); c != r.end(); ++c)
-          v.volume[c] = signedVolume(mesh, ElementId(static_cast<std::size_t>(s.element[c])));
-      });
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells.size(), 1024),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t c = r.begin(); c != r.end(); ++c)
+                        v.volume[c] = signedVolume(mesh, cells[c]);
+                    });
   for (const PointArray& a : pointData)
-    v.pointArrays.push_back(gatherRows(a.values, a.components, s.pointVertex));
+    v.pointArrays.push_back(gatherRows(a.values, a.components, pointVertex));
   for (const CornerArray& a : cornerData) v.cornerArrays.push_back(cornerMeans(s, a));
   for (const CellArray& a : cellData)
-    v.cellArrays.push_back(gatherRows(a.values, a.components, s.element));
+    v.cellArrays.push_back(gatherRows(a.values, a.components, cells));
   return v;
 }
 
@@ -411,12 +276,12 @@ void writeContents(std::ostream& os, const PolyMesh& mesh, const CellStreams& s,
                    VtuEncoding enc) {
   const CallerArrays caller(fieldData);
   Document d;
-  d.restore = {intArray(kFieldIndent, kFaceGroupArray, s.faceGroup, true),
-               intArray(kFieldIndent, kFaceReversedArray, s.faceReversed, true),
-               intArray(kFieldIndent, kFaceOriginArray, s.faceOrigin, true),
-               intArray(kFieldIndent, kElementArray, s.element, true)};
-  if (s.pointVertex.size() != mesh.numVertices())
-    d.restore.push_back(intArray(kFieldIndent, kPointVertexArray, s.pointVertex, true));
+  d.restore = {generatedIntArray(kFieldIndent, kFaceGroupArray, s.faceGroup(), true),
+               generatedIntArray(kFieldIndent, kFaceReversedArray, s.faceReversed(), true),
+               generatedIntArray(kFieldIndent, kFaceOriginArray, s.faceOrigin(), true),
+               generatedIntArray(kFieldIndent, kElementArray, s.element(), true)};
+  if (s.points().numPoints() != mesh.numVertices())
+    d.restore.push_back(generatedIntArray(kFieldIndent, kPointVertexArray, s.pointVertex(), true));
   d.caller = caller.arrays;
   for (std::size_t i = 0; i < pointData.size(); ++i)
     d.pointData.push_back(floatArray(kArrayIndent, pointData[i].name, pointData[i].components,
@@ -429,11 +294,12 @@ void writeContents(std::ostream& os, const PolyMesh& mesh, const CellStreams& s,
     d.cellData.push_back(
         floatArray(kArrayIndent, cellData[i].name, cellData[i].components, values.cellArrays[i]));
   d.points = floatArray(kArrayIndent, "Points", 3, values.points);
-  d.cells = {intArray(kArrayIndent, "connectivity", s.connectivity),
-             intArray(kArrayIndent, "offsets", s.offsets), intArray(kArrayIndent, "types", s.types),
-             intArray(kArrayIndent, "faces", s.faces),
-             intArray(kArrayIndent, "faceoffsets", s.faceOffsets)};
-  d.numPoints = s.points.numPoints();
+  d.cells = {generatedIntArray(kArrayIndent, "connectivity", s.connectivity()),
+             generatedIntArray(kArrayIndent, "offsets", s.offsets()),
+             generatedIntArray(kArrayIndent, "types", s.types()),
+             generatedIntArray(kArrayIndent, "faces", s.faces()),
+             generatedIntArray(kArrayIndent, "faceoffsets", s.faceOffsets())};
+  d.numPoints = s.points().numPoints();
   d.numCells = mesh.numElements();
   writeDocument(os, d, enc);
 }
@@ -453,7 +319,7 @@ void writeVtu(const PolyMesh& mesh, const std::string& path, const VtuWriteOptio
   }
   checkFieldData(fieldData);
   // Everything that can fail for reasons other than I/O happens before the file is opened.
-  const CellStreams streams = buildCellStreams(mesh);
+  const CellStreams streams(mesh);
   const FileValues values = fileValues(mesh, streams, cellData, pointData, cornerData);
 
   vtk_format::writeReplacing(path, [&](std::ostream& os) {

@@ -2,6 +2,7 @@
 // mesh/vtk_cell_types.h (the faces of VTK's linear cells).
 #include "mesh/vtk_format.h"
 
+#include <algorithm>
 #include <bit>
 #include <cstdint>
 #include <limits>
@@ -15,6 +16,7 @@
 #include <pugixml.hpp>
 
 #include "mesh/vtk_cell_types.h"
+#include "tests/support/vtu_encodings.h"
 
 namespace polydg::vtk_format {
 namespace {
@@ -131,17 +133,49 @@ TEST_P(VtkDataArrayEncoding, ValuesComeBackBitForBit) {
             std::string::npos);
 }
 
-INSTANTIATE_TEST_SUITE_P(Encodings, VtkDataArrayEncoding,
-                         ::testing::Values(VtuEncoding::Ascii, VtuEncoding::Binary,
-                                           VtuEncoding::Appended),
-                         [](const auto& info) {
-                           switch (info.param) {
-                             case VtuEncoding::Ascii: return "Ascii";
-                             case VtuEncoding::Binary: return "Binary";
-                             case VtuEncoding::Appended: return "Appended";
-                           }
-                           return "Unknown";
-                         });
+TEST_P(VtkDataArrayEncoding, GeneratedArraysWriteTheBytesOfTheirValuesHeldWhole) {
+  // 30 values (two and a half ascii lines of 12) in each stored type, made in chunks of every
+  // size from one value to all of them, so chunk ends fall anywhere in a line and in base64's
+  // groups of three bytes.
+  for (const std::int64_t largest :
+       {std::int64_t{200}, std::int64_t{70000}, std::int64_t{1} << 40}) {
+    std::vector<std::int64_t> values(30);
+    for (std::size_t i = 0; i < values.size(); ++i)
+      values[i] = static_cast<std::int64_t>(i * 7919) % (largest + 1);
+    values[17] = largest;
+    const GeneratedInts generated{values.size(), largest,
+                                  [&](std::size_t begin, std::size_t end, std::int64_t* out) {
+                                    std::copy(values.begin() + begin, values.begin() + end, out);
+                                  }};
+    const ArrayOut held = intArray("  ", "a", values, /*withTuples=*/true);
+    const std::string expected = fileWith({held}, GetParam());
+    for (std::size_t chunk = 1; chunk <= values.size(); ++chunk) {
+      ArrayOut a = generatedIntArray("  ", "a", generated, /*withTuples=*/true);
+      a.chunk = chunk;
+      EXPECT_EQ(a.stored, held.stored);
+      EXPECT_EQ(fileWith({a}, GetParam()), expected)
+          << "largest " << largest << ", chunk " << chunk;
+    }
+  }
+}
+
+TEST(VtkDataArray, GeneratedArraysKnowTheirSizeWithoutMakingValues) {
+  int calls = 0;
+  const ArrayOut a = generatedIntArray(
+      "", "a", {1000, 70000, [&](std::size_t, std::size_t, std::int64_t*) { ++calls; }});
+  EXPECT_EQ(a.stored, StoredType::Int32);
+  EXPECT_EQ(a.size(), 1000u);
+  EXPECT_EQ(a.bytes(), 4000u);
+  EXPECT_EQ(a.binaryBytes(), 4008u);
+  std::ostringstream os;
+  writeDataArray(os, a, VtuEncoding::Appended, 0);
+  EXPECT_EQ(calls, 0);
+  EXPECT_EQ(generatedIntArray("", "a", {0, 0, {}}).stored, StoredType::UInt8);
+  EXPECT_EQ(generatedIntArray("", "a", {1, std::int64_t{1} << 31, {}}).stored, StoredType::Int64);
+}
+
+INSTANTIATE_TEST_SUITE_P(Encodings, VtkDataArrayEncoding, polydg::testing::allEncodings(),
+                         polydg::testing::encodingName);
 
 TEST(VtkDataArray, IdsMustBeIntegers) {
   const std::vector<double> reals{1.0, 2.5};

@@ -108,6 +108,10 @@ inline constexpr std::string_view kVtuTextSuffix = ".utf8";
 /// meshio 7 from mistaking one array for another (see mesh/vtu_writer.cpp) and leaves polydg's
 /// arrays where they are without field data.
 ///
+/// Writing holds the points, each element's corners and a few integers per cell; the cell and
+/// restore arrays are made a chunk at a time as they are written (mesh/vtu_cell_streams.h), so
+/// the memory it takes does not grow with the size of the file.
+///
 /// The file is written to `path + ".tmp"` and renamed over `path`, so `path` is never left
 /// half-written. Throws std::invalid_argument if an array has the wrong size, a component count
 /// other than 1 or 3, an empty name, or a name already used (`volume` is taken), or if a field
