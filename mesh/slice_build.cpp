@@ -342,6 +342,24 @@ class SliceBuilder {
     return face;
   }
 
+  /// Calls polygon(p) for each polygon of leaf l and freeSide(s) for each free side of a whole
+  /// leaf, in the order of the leaf's faces (a whole cell's sides in order).
+  template <class Polygon, class FreeSide>
+  void forEachSide(const LeafOffsets& at, std::size_t l, Polygon&& polygon,
+                   FreeSide&& freeSide) const {
+    if (!leaves_[l].whole) {
+      for (std::size_t p = at.polygon[l]; p < at.polygon[l + 1]; ++p) polygon(p);
+      return;
+    }
+    for (int s = 0; s < 6; ++s) {
+      const std::uint32_t p = sidePolygon(at, l, s);
+      if (p != kNone)
+        polygon(p);
+      else
+        freeSide(s);
+    }
+  }
+
   /// Fills `meshFaces` and `meshElements` (sized by `ids`) in parallel: the new faces first
   /// (their ids are known per leaf), then the later sides, which take the earlier side's face
   /// as its back (an interior face, whatever the earlier side was).
@@ -367,24 +385,15 @@ class SliceBuilder {
                                                                     : polygons.origin[p];
               f.front = e;
             };
-            if (!leaves_[l].whole) {
-              for (std::size_t p = at.polygon[l]; p < at.polygon[l + 1]; ++p) polygonFace(p);
-              continue;
-            }
-            // A whole cell's faces in the order of its sides, those of free sides towards
-            // +axis made from the grid (the cell beyond uses them).
-            for (int s = 0; s < 6; ++s) {
-              const std::uint32_t p = sidePolygon(at, l, s);
-              if (p != kNone) {
-                polygonFace(p);
-              } else if (s % 2 == 1) {
-                Face& f = meshFaces[FaceId(std::size_t(next++))];
-                for (std::uint32_t corner : whole_.side(leaves_[l].cell, s))
-                  f.vertices.push_back(vertexOf(corner));
-                f.loopEnd.assign(1, 4);
-                f.front = e;
-              }
-            }
+            // A free side towards +axis is made from the grid (the cell beyond uses it).
+            forEachSide(at, l, polygonFace, [&](int s) {
+              if (s % 2 == 0) return;
+              Face& f = meshFaces[FaceId(std::size_t(next++))];
+              for (std::uint32_t corner : whole_.side(leaves_[l].cell, s))
+                f.vertices.push_back(vertexOf(corner));
+              f.loopEnd.assign(1, 4);
+              f.front = e;
+            });
           }
         });
     tbb::parallel_for(
@@ -406,25 +415,18 @@ class SliceBuilder {
               else
                 useBack(FaceId(std::size_t(faceId[s])));
             };
-            if (!leaves_[l].whole) {
-              for (std::size_t p = at.polygon[l]; p < at.polygon[l + 1]; ++p) usePolygon(p);
-              continue;
-            }
-            for (int s = 0; s < 6; ++s) {
-              const std::uint32_t p = sidePolygon(at, l, s);
-              if (p != kNone) {
-                usePolygon(p);
-              } else if (s % 2 == 1) {
+            forEachSide(at, l, usePolygon, [&](int s) {
+              if (s % 2 == 1) {
                 uses.push_back(
                     {FaceId(std::size_t(wholeSideFace(at, polygons, sharesEarlier, ids, l, s))),
                      false});
-              } else {
-                const std::size_t before =
-                    wholeLeafAt_[whole_.cellIndex(*whole_.beside(leaves_[l].cell, s))];
-                useBack(FaceId(
-                    std::size_t(wholeSideFace(at, polygons, sharesEarlier, ids, before, s + 1))));
+                return;
               }
-            }
+              const std::size_t before =
+                  wholeLeafAt_[whole_.cellIndex(*whole_.beside(leaves_[l].cell, s))];
+              useBack(FaceId(
+                  std::size_t(wholeSideFace(at, polygons, sharesEarlier, ids, before, s + 1))));
+            });
           }
         });
   }
