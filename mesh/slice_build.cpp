@@ -13,6 +13,7 @@
 #include <boost/container/small_vector.hpp>
 
 #include "mesh/welded_polygons.h"
+#include "util/resident.h"
 
 namespace polydg {
 
@@ -40,8 +41,11 @@ class SliceBuilder {
     const std::vector<std::uint32_t> sharesEarlier = matchSides(
         polygons.welded, polygons.origin, polygons.kept, polygons.touched, polygons.keys);
     const MeshIds ids = numberMesh(at, polygons, sharesEarlier);
-    FaceData<Face> meshFaces(ids.faceBase[leaves_.size()]);
-    ElementData<Element> meshElements(ids.elements);
+    // The largest arrays of slicing: their pages are faulted in on both cores.
+    FaceData<Face> meshFaces;
+    meshFaces.raw() = residentVector<Face>(ids.faceBase[leaves_.size()]);
+    ElementData<Element> meshElements;
+    meshElements.raw() = residentVector<Element>(ids.elements);
     makeFacesAndElements(at, polygons, sharesEarlier, ids, vertices, meshFaces, meshElements);
     if (elementCell)
       for (std::size_t l = 0; l < leaves_.size(); ++l)
