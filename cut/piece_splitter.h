@@ -12,6 +12,8 @@
 #include <unordered_map>
 #include <vector>
 
+#include <boost/container/small_vector.hpp>
+
 #include "edit.h"
 #include "mesh/plane_split.h"
 #include "polydg/cut/cut.h"

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include <boost/container/small_vector.hpp>
+
 #include "mesh/loop_tracing.h"
 #include "util/union_find.h"
 

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include <boost/container/small_vector.hpp>
+
 namespace polydg {
 
 std::string_view toString(FaceOrigin origin) {

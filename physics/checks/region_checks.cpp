@@ -7,6 +7,7 @@
 #include <unordered_map>
 
 #include <Eigen/Dense>
+#include <boost/container/small_vector.hpp>
 
 #include "physics/checks/dg_checks.h"
 #include "physics/dg/assembly.h"

@@ -10,9 +10,8 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
-#include <boost/container/small_vector.hpp>
-
 #include "polydg/mesh/ids.h"
+#include "polydg/util/small_vector.h"
 
 namespace polydg {
 
@@ -42,8 +41,8 @@ struct FaceUse {
 /// `back` the element it points into (invalid for a boundary face).
 struct Face {
   /// All loops, concatenated; up to 6 corners are stored inline (no allocation).
-  boost::container::small_vector<VertexId, 6> vertices;
-  boost::container::small_vector<std::uint32_t, 1> loopEnd;  ///< loop k ends at loopEnd[k]
+  SmallVector<VertexId, 6> vertices;
+  SmallVector<std::uint32_t, 2> loopEnd;  ///< loop k ends at loopEnd[k]
   ElementId front;
   ElementId back;
   FaceOrigin origin = FaceOrigin::Interior;
@@ -58,7 +57,7 @@ struct Face {
 
 /// An element: the faces that bound it, each with its orientation.
 /// The faces of an element; up to 7 are stored inline.
-using FaceList = boost::container::small_vector<FaceUse, 7>;
+using FaceList = SmallVector<FaceUse, 7>;
 
 struct Element {
   FaceList faces;
