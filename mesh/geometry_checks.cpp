@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "polydg/mesh/geometry.h"
+#include "util/resident.h"
 #include "util/union_find.h"
 
 namespace polydg {
@@ -199,9 +200,10 @@ namespace {
 
 /// What checkGeometry() finds about one face in parallel.
 struct FaceCheck {
+  std::uint64_t key = 0;  ///< hash of the sorted vertex ids
+  float planarity =
+      0.0f;  ///< relative deviation (for the message), if beyond the tolerance; else 0
   bool degenerate = false;
-  double planarity = 0.0;  ///< relative deviation, if beyond the tolerance; else 0
-  std::uint64_t key = 0;   ///< hash of the sorted vertex ids
 };
 
 /// Every face's FaceCheck. (Area vectors are not kept for the elements' volumes: computing
@@ -212,7 +214,7 @@ struct FaceMeasures {
 
 /// Shape and planarity of every face, in parallel (the costly part of the face checks).
 FaceMeasures measureFaces(const PolyMesh& mesh, const GeometryCheckOptions& options) {
-  FaceMeasures m{std::vector<FaceCheck>(mesh.numFaces())};
+  FaceMeasures m{residentVector<FaceCheck>(mesh.numFaces())};
   std::vector<FaceCheck>& checks = m.checks;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.numFaces(), 1024),
                     [&](const tbb::blocked_range<std::size_t>& r) {
@@ -231,7 +233,7 @@ FaceMeasures measureFaces(const PolyMesh& mesh, const GeometryCheckOptions& opti
                                                            box.max().cwiseAbs().maxCoeff());
                         const double diameter = box.diagonal().norm();
                         if (deviation > options.planarityTolerance * diameter + resolution)
-                          c.planarity = deviation / diameter;
+                          c.planarity = static_cast<float>(deviation / diameter);
                       }
                     });
   return m;
@@ -268,7 +270,8 @@ void reportFaces(const PolyMesh& mesh, const std::vector<FaceCheck>& checks, Pro
 void reportDuplicateFaces(const PolyMesh& mesh, const std::vector<FaceCheck>& checks,
                           Problems& problems, GeometryCheck& report) {
   // (key, face) pairs sorted in parallel: faces with equal keys end up adjacent, by id.
-  std::vector<std::pair<std::uint64_t, std::size_t>> keyed(mesh.numFaces());
+  std::vector<std::pair<std::uint64_t, std::size_t>> keyed =
+      residentVector<std::pair<std::uint64_t, std::size_t>>(mesh.numFaces());
   tbb::parallel_for(std::size_t(0), mesh.numFaces(), [&](std::size_t i) {
     keyed[i] = {checks[i].key, i};
   });

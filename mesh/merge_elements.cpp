@@ -8,6 +8,7 @@
 
 #include "polydg/mesh/geometry.h"
 #include "polydg/mesh/geometry_checks.h"
+#include "util/resident.h"
 #include "util/union_find.h"
 
 #include <tbb/parallel_for.h>
@@ -36,7 +37,7 @@ PolyMesh mergeSlivers(PolyMesh mesh, double volumeThreshold, SliverMergeReport* 
   const std::size_t n = mesh.numElements();
   // Each face's area vector once; element volumes from them (signed cones from the element's
   // reference point) and element surface areas.
-  std::vector<Vec3> areaVectors(mesh.numFaces());
+  std::vector<Vec3> areaVectors = residentVector<Vec3>(mesh.numFaces());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.numFaces(), 1024),
                     [&](const tbb::blocked_range<std::size_t>& r) {
                       for (std::size_t f = r.begin(); f != r.end(); ++f)
