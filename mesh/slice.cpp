@@ -95,8 +95,8 @@ class Slicer {
     // more: they are freed beside the build, not after it.
     tbb::task_group release;
     release.run([this] { splitter_.reset(); });
-    PolyMesh mesh = buildSliceMesh(leaves_, whole_, octree_ != nullptr, firstGenerated_, points,
-                                   stats, elementCell, elementLevel);
+    PolyMesh mesh = buildSliceMesh(leaves_, whole_, octree_ != nullptr, firstGenerated_,
+                                   std::move(points), stats, elementCell, elementLevel);
     release.wait();
     return mesh;
   }

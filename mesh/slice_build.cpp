@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <limits>
 #include <span>
+#include <utility>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -29,12 +30,15 @@ class SliceBuilder {
         firstGenerated_(firstGenerated),
         stats_(stats) {}
 
-  PolyMesh build(const std::vector<Vec3>& points, std::vector<std::array<int, 3>>* elementCell,
+  PolyMesh build(std::vector<Vec3> points, std::vector<std::array<int, 3>>* elementCell,
                  std::vector<int>* elementLevel) {
     WeldedVertices vertices = weldPoints(points);
+    std::vector<Vec3>().swap(points);
     findFreeSides(vertices);
     const LeafOffsets at = leafOffsets();
     const LeafPolygons polygons = weldPolygons(at, vertices);
+    // The pieces are copied into `polygons`: freed before the mesh's arrays take their place.
+    freeLeaves();
     // Caps meet their other side: the later of two reversed, equal polygons uses the earlier's
     // face (reversed), as findOrCreateFace would in leaf order; so do two polygons on the
     // surface that rounding made reversed and equal.
@@ -53,7 +57,6 @@ class SliceBuilder {
     if (elementLevel)
       for (std::size_t l = 0; l < leaves_.size(); ++l)
         if (ids.elementOf[l] != kNone) elementLevel->push_back(leaves_[l].level);
-    freeLeaves();
     PolyMesh mesh;
     mesh.assign(std::move(vertices.positions), std::move(meshFaces), std::move(meshElements));
     return mesh;
@@ -461,11 +464,11 @@ class SliceBuilder {
 }  // namespace
 
 PolyMesh buildSliceMesh(std::vector<SliceLeaf>& leaves, const WholeCells& whole, bool octree,
-                        std::size_t firstGenerated, const std::vector<Vec3>& points,
-                        SliceStats& stats, std::vector<std::array<int, 3>>* elementCell,
+                        std::size_t firstGenerated, std::vector<Vec3> points, SliceStats& stats,
+                        std::vector<std::array<int, 3>>* elementCell,
                         std::vector<int>* elementLevel) {
   return SliceBuilder(leaves, whole, octree, firstGenerated, stats)
-      .build(points, elementCell, elementLevel);
+      .build(std::move(points), elementCell, elementLevel);
 }
 
 }  // namespace polydg
