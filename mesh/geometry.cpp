@@ -9,14 +9,19 @@ Vec3 areaVector(const PolyMesh& mesh, FaceId f) {
   const Face& face = mesh.face(f);
   const Vec3& c = faceReferencePoint(mesh, f);
   Vec3 twiceArea = Vec3::Zero();
+  // Each corner's offset is taken once and serves the two edges it ends; the sum runs over the
+  // edges in loop order, closing edge last.
   for (std::size_t k = 0; k < face.numLoops(); ++k) {
     const auto loop = face.loop(k);
-    const std::size_t n = loop.size();
-    for (std::size_t i = 0; i < n; ++i) {
-      const Vec3 a = mesh.position(loop[i]) - c;
-      const Vec3 b = mesh.position(loop[(i + 1) % n]) - c;
+    if (loop.empty()) continue;
+    const Vec3 first = mesh.position(loop[0]) - c;
+    Vec3 a = first;
+    for (std::size_t i = 1; i < loop.size(); ++i) {
+      const Vec3 b = mesh.position(loop[i]) - c;
       twiceArea += a.cross(b);
+      a = b;
     }
+    twiceArea += a.cross(first);
   }
   return 0.5 * twiceArea;
 }
@@ -38,7 +43,8 @@ Box3 faceBounds(const PolyMesh& mesh, FaceId f) {
 
 Box3 elementBounds(const PolyMesh& mesh, ElementId e) {
   Box3 box;
-  for (const FaceUse& use : mesh.element(e).faces) box.extend(faceBounds(mesh, use.face));
+  for (const FaceUse& use : mesh.element(e).faces)
+    for (VertexId v : mesh.face(use.face).vertices) box.extend(mesh.position(v));
   return box;
 }
 

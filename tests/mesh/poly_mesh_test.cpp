@@ -3,8 +3,12 @@
 
 #include <gtest/gtest.h>
 
+#include <random>
+
 #include "mesh/primitives.h"
+#include "polydg/mesh/geometry.h"
 #include "polydg/mesh/surface.h"
+#include "tests/support/shapes.h"
 
 namespace polydg {
 namespace {
@@ -82,6 +86,34 @@ TEST(PolyMesh, SingleElementFromClosedSurface) {
   EXPECT_EQ(mesh.numFaces(), 4u);
   EXPECT_DOUBLE_EQ(signedVolume(mesh, ElementId(0)), 1.0 / 6.0);
   for (const Face& face : mesh.faces()) EXPECT_EQ(face.origin, FaceOrigin::Surface);
+}
+
+TEST(Geometry, BoundsAndAreaVectorsOfShearedStarPrisms) {
+  // Independent references: the box of the element's distinct vertices, and Newell's area
+  // vector of each loop taken about the origin (the same vector, with other round-off).
+  std::mt19937 rng(35);
+  for (int trial = 0; trial < 20; ++trial) {
+    const PolyMesh mesh = testing::randomStarPrism(5 + trial % 7, rng);
+    for (std::size_t e = 0; e < mesh.numElements(); ++e) {
+      Box3 box;
+      for (VertexId v : elementVertices(mesh, ElementId(e))) box.extend(mesh.position(v));
+      const Box3 bounds = elementBounds(mesh, ElementId(e));
+      EXPECT_EQ(bounds.min(), box.min());
+      EXPECT_EQ(bounds.max(), box.max());
+    }
+    for (std::size_t f = 0; f < mesh.numFaces(); ++f) {
+      const Face& face = mesh.face(FaceId(f));
+      Vec3 newell = Vec3::Zero();
+      for (std::size_t k = 0; k < face.numLoops(); ++k) {
+        const auto loop = face.loop(k);
+        for (std::size_t i = 0; i < loop.size(); ++i)
+          newell += mesh.position(loop[i]).cross(mesh.position(loop[(i + 1) % loop.size()]));
+      }
+      const Vec3 area = areaVector(mesh, FaceId(f));
+      EXPECT_LE((area - 0.5 * newell).norm(), 1e-13 * area.norm()) << "face " << f;
+      EXPECT_GT(area.norm(), 0.0);
+    }
+  }
 }
 
 TEST(SurfaceTopology, CountsBoundaryNonManifoldAndMisorientedEdges) {
