@@ -136,15 +136,20 @@ class DegenerateGroups {
 
   UnionFind& sets() { return sets_; }
 
-  /// Starts the volumes and members from the elements' volumes and the current sets.
+  /// Starts the volumes from the elements' volumes and the current sets, and the members where
+  /// a group will have to join others (its volume is not positive): usually none, and a list per
+  /// element would be a million small allocations for nothing.
   void gather(const std::vector<double>& elementVolume) {
     const std::size_t n = elementVolume.size();
     volume_.assign(n, 0.0);
+    for (std::uint32_t e = 0; e < n; ++e) volume_[sets_.find(e)] += elementVolume[e];
+    bool joining = false;
+    for (std::uint32_t e = 0; e < n && !joining; ++e)
+      joining = sets_.find(e) == e && !(volume_[e] > 0.0);
+    members_.clear();
+    if (!joining) return;
     members_.assign(n, {});
-    for (std::uint32_t e = 0; e < n; ++e) {
-      volume_[sets_.find(e)] += elementVolume[e];
-      members_[sets_.find(e)].push_back(e);
-    }
+    for (std::uint32_t e = 0; e < n; ++e) members_[sets_.find(e)].push_back(e);
   }
 
   /// Joins group g (a representative) to its neighbours until its volume is positive; false if
