@@ -201,8 +201,8 @@ namespace {
 /// What checkGeometry() finds about one face in parallel.
 struct FaceCheck {
   std::uint64_t key = 0;  ///< hash of the sorted vertex ids
-  float planarity =
-      0.0f;  ///< relative deviation (for the message), if beyond the tolerance; else 0
+  /// Relative deviation, if beyond the tolerance, else 0 (single precision: for the message).
+  float planarity = 0.0f;
   bool degenerate = false;
 };
 

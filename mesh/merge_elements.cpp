@@ -136,25 +136,17 @@ class DegenerateGroups {
 
   UnionFind& sets() { return sets_; }
 
-  /// Starts the volumes from the elements' volumes and the current sets, and the members where
-  /// a group will have to join others (its volume is not positive): usually none, and a list per
-  /// element would be a million small allocations for nothing.
+  /// Starts the volumes from the elements' volumes and the current sets.
   void gather(const std::vector<double>& elementVolume) {
-    const std::size_t n = elementVolume.size();
-    volume_.assign(n, 0.0);
-    for (std::uint32_t e = 0; e < n; ++e) volume_[sets_.find(e)] += elementVolume[e];
-    bool joining = false;
-    for (std::uint32_t e = 0; e < n && !joining; ++e)
-      joining = sets_.find(e) == e && !(volume_[e] > 0.0);
-    members_.clear();
-    if (!joining) return;
-    members_.assign(n, {});
-    for (std::uint32_t e = 0; e < n; ++e) members_[sets_.find(e)].push_back(e);
+    volume_.assign(elementVolume.size(), 0.0);
+    for (std::uint32_t e = 0; e < elementVolume.size(); ++e)
+      volume_[sets_.find(e)] += elementVolume[e];
   }
 
   /// Joins group g (a representative) to its neighbours until its volume is positive; false if
   /// it has no neighbour left before that.
   bool joinUntilPositive(std::uint32_t g, std::size_t& merges) {
+    listMembers();
     std::map<std::uint32_t, double> shared;
     while (!(volume_[g] > 0.0)) {
       shared.clear();
@@ -182,6 +174,14 @@ class DegenerateGroups {
   double volume(std::uint32_t g) const { return volume_[g]; }
 
  private:
+  /// Lists each group's members, the first time a group has to join others: usually no group
+  /// does, and a list per element would be a million small allocations for nothing.
+  void listMembers() {
+    if (!members_.empty()) return;
+    members_.resize(volume_.size());
+    for (std::uint32_t e = 0; e < volume_.size(); ++e) members_[sets_.find(e)].push_back(e);
+  }
+
   const PolyMesh& mesh_;
   const std::vector<double>& faceArea_;
   UnionFind sets_;
