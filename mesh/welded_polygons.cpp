@@ -1,6 +1,7 @@
 #include "mesh/welded_polygons.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include <tbb/concurrent_vector.h>
@@ -17,11 +18,19 @@ std::vector<std::uint32_t> weldTargets(const std::vector<Vec3>& points,
   auto cellIndex = [&](double x) {
     return cellSize > 0 ? static_cast<std::int64_t>(std::floor(x / cellSize + 0.5)) : 0;
   };
-  std::vector<std::pair<Cell, std::uint32_t>> sorted(used.size());
+  auto cellOf = [&](const Vec3& p) {
+    return Cell{cellIndex(p.x()), cellIndex(p.y()), cellIndex(p.z())};
+  };
+  // Points are sorted by a hash of their cell, not the cell itself (16 bytes to sort instead of
+  // 32): cells whose hashes collide only share a run, whose points the distance test filters.
+  auto key = [](const Cell& c) {
+    std::uint64_t h = 0;
+    for (const std::int64_t x : c) h = (h ^ static_cast<std::uint64_t>(x)) * 0x9E3779B97F4A7C15ull;
+    return h ^ (h >> 29);
+  };
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> sorted(used.size());
   tbb::parallel_for(std::size_t(0), used.size(), [&](std::size_t i) {
-    const Vec3& p = points[used[i]];
-    sorted[i] = {{cellIndex(p.x()), cellIndex(p.y()), cellIndex(p.z())},
-                 static_cast<std::uint32_t>(i)};
+    sorted[i] = {key(cellOf(points[used[i]])), static_cast<std::uint32_t>(i)};
   });
   tbb::parallel_sort(sorted.begin(), sorted.end());
   std::vector<std::uint32_t> position(used.size());
@@ -38,24 +47,30 @@ std::vector<std::uint32_t> weldTargets(const std::vector<Vec3>& points,
                       for (std::size_t i = r.begin(); i != r.end(); ++i) {
                         const Vec3& p = points[used[i]];
                         const std::size_t at = position[i];
-                        const Cell& own = sorted[at].first;
+                        const std::uint64_t own = sorted[at].first;
                         // Earlier points of the own cell: just before i in the sorted order.
                         for (std::size_t s = at; s > 0 && sorted[s - 1].first == own; --s)
                           nearPoint(i, sorted[s - 1].second);
+                        const Cell centre = cellOf(p);
                         Cell lo, hi;
                         for (int a = 0; a < 3; ++a) {
                           lo[a] = cellIndex(p[a] - resolution);
                           hi[a] = cellIndex(p[a] + resolution);
                         }
-                        if (lo == own && hi == own) continue;
+                        if (lo == centre && hi == centre) continue;
+                        // The other cells' runs, each once (a run shared by colliding cells
+                        // is searched with the first of them).
+                        boost::container::small_vector<std::uint64_t, 8> searched{own};
                         for (std::int64_t x = lo[0]; x <= hi[0]; ++x)
                           for (std::int64_t y = lo[1]; y <= hi[1]; ++y)
                             for (std::int64_t z = lo[2]; z <= hi[2]; ++z) {
-                              const Cell c{x, y, z};
-                              if (c == own) continue;
+                              const std::uint64_t k = key({x, y, z});
+                              if (std::find(searched.begin(), searched.end(), k) != searched.end())
+                                continue;
+                              searched.push_back(k);
                               auto it = std::lower_bound(sorted.begin(), sorted.end(),
-                                                         std::make_pair(c, 0u));
-                              for (; it != sorted.end() && it->first == c && it->second < i; ++it)
+                                                         std::make_pair(k, 0u));
+                              for (; it != sorted.end() && it->first == k && it->second < i; ++it)
                                 nearPoint(i, it->second);
                             }
                       }
