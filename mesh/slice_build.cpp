@@ -10,6 +10,7 @@
 #include <utility>
 
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <boost/container/small_vector.hpp>
 
@@ -85,6 +86,59 @@ class SliceBuilder {
     VertexId operator()(std::uint32_t v) const { return VertexId(vertexOfRank[rank[v]]); }
   };
 
+  /// Calls f(v) for each corner v of leaf l's polygons, in order (a whole cell's sides as
+  /// WholeCells::sides makes them, without making them).
+  template <class F>
+  void forEachCorner(const Leaf& leaf, F&& f) const {
+    if (leaf.whole) {
+      for (int s = 0; s < 6; ++s)
+        for (const std::uint32_t v : whole_.side(leaf.cell, s)) f(v);
+      return;
+    }
+    for (const PiecePolygon& polygon : leaf.piece)
+      for (const std::uint32_t v : polygon.vertices) f(v);
+  }
+
+  /// The points the leaves use, in order of first use, and each one's place in that order
+  /// (`rank`, kNone for the others). The octree's points come after the splitter's, so that a
+  /// splitter point is never welded into one of them: only welds among the splitter's points
+  /// are the slicing's (counted, and marking polygons as touched); the octree's corners repeat
+  /// its points. The uniform grid's whole cells take their turn in leaf order, as the
+  /// splitter's points at their corners did when they were split, so that a weld keeps the
+  /// same position. Runs of leaves list their first uses in parallel; the lists, joined in
+  /// order, keep each point's first.
+  std::vector<std::uint32_t> pointsInOrderOfUse(std::vector<std::uint32_t>& rank) const {
+    constexpr std::size_t kRun = 4096;  // leaves
+    const std::size_t nl = leaves_.size(), runs = (nl + kRun - 1) / kRun;
+    const std::size_t passes = octree_ ? 2 : 1;  // the octree's points in a second pass
+    std::vector<std::vector<std::uint32_t>> firstUses(runs * passes);
+    // Per thread, the run (plus one) that last listed each point.
+    tbb::enumerable_thread_specific<std::vector<std::uint32_t>> listedIn(
+        [&] { return std::vector<std::uint32_t>(rank.size(), 0); });
+    tbb::parallel_for(std::size_t(0), runs * passes, [&](std::size_t t) {
+      std::vector<std::uint32_t>& listed = listedIn.local();
+      const bool generated = t >= runs;
+      const auto mark = static_cast<std::uint32_t>(t + 1);
+      std::vector<std::uint32_t>& list = firstUses[t];
+      const std::size_t begin = (t % runs) * kRun, end = std::min(nl, begin + kRun);
+      for (std::size_t l = begin; l < end; ++l)
+        forEachCorner(leaves_[l], [&](std::uint32_t v) {
+          if (listed[v] != mark && (!octree_ || (v >= firstGenerated_) == generated)) {
+            listed[v] = mark;
+            list.push_back(v);
+          }
+        });
+    });
+    std::vector<std::uint32_t> used;
+    for (const std::vector<std::uint32_t>& list : firstUses)
+      for (const std::uint32_t v : list)
+        if (rank[v] == kNone) {
+          rank[v] = static_cast<std::uint32_t>(used.size());
+          used.push_back(v);
+        }
+    return used;
+  }
+
   /// Welds the points the leaves use; vertex ids follow their order of first use.
   WeldedVertices weldPoints(const std::vector<Vec3>& points) {
     // Points closer than the resolution of the coordinates are one vertex: 8 units in the last
@@ -105,23 +159,7 @@ class SliceBuilder {
     // Points in order of first use, then welded; vertex ids follow that order.
     WeldedVertices out;
     out.rank.assign(points.size(), kNone);
-    // The octree's points come after the splitter's, so that a splitter point is never
-    // welded into one of them: only welds among the splitter's points are the slicing's
-    // (counted, and marking polygons as touched); the octree's corners repeat its points. The
-    // uniform grid's whole cells take their turn in leaf order, as the splitter's points at
-    // their corners did when they were split, so that a weld keeps the same position.
-    std::vector<std::uint32_t> used;
-    Piece scratch;
-    for (const bool generated : {false, true}) {
-      if (generated && !octree_) break;  // one pass ranks every point
-      for (const Leaf& leaf : leaves_)
-        for (const PiecePolygon& polygon : pieceOf(leaf, scratch))
-          for (std::uint32_t v : polygon.vertices)
-            if (out.rank[v] == kNone && (!octree_ || (v >= firstGenerated_) == generated)) {
-              out.rank[v] = static_cast<std::uint32_t>(used.size());
-              used.push_back(v);
-            }
-    }
+    const std::vector<std::uint32_t> used = pointsInOrderOfUse(out.rank);
     const std::vector<std::uint32_t> target = weldTargets(points, used, resolution);
     out.positions.raw().reserve(used.size());
     out.vertexOfRank.resize(used.size());

@@ -289,6 +289,36 @@ TriangleSurface octahedron(const Vec3& centre, const std::array<Vec3, 3>& d) {
   return s;
 }
 
+TEST(Slice, VerticesAreNumberedInOrderOfFirstUse) {
+  // Vertex ids follow the order in which the elements (in order, face by face, corner by
+  // corner) first use them, whichever thread made which point: the torus at two sizes, and
+  // twisted parts beside a box 1e6 from the origin.
+  const TriangleSurface torus = readSurface(std::string(POLYDG_TESTDATA_DIR) + "/torus.obj");
+  const TriangleSurface parts =
+      transformed(combine(twistedTaperedPrism(Vec3::Zero(), 20, 10, 40, 200, 1.0),
+                          boxSurface(Box3(Vec3(20, -5, 0), Vec3(30, 5, 10)))),
+                  1.0, Vec3(1e6, 0, 0));
+  for (const auto& [surface, cells] :
+       {std::pair{&torus, 14}, std::pair{&torus, 40}, std::pair{&parts, 48}}) {
+    SCOPED_TRACE(cells);
+    const PolyMesh mesh =
+        sliceSurface(*surface, Grid::withCellsAlongLongest(bounds(*surface), cells));
+    ASSERT_GT(mesh.numElements(), 500u);
+    std::uint32_t next = 0;
+    std::size_t outOfOrder = 0;
+    for (const Element& element : mesh.elements())
+      for (const FaceUse& use : element.faces)
+        for (const VertexId v : mesh.face(use.face).vertices) {
+          if (v.value == next)
+            ++next;
+          else if (v.value > next)
+            ++outOfOrder;
+        }
+    EXPECT_EQ(outOfOrder, 0u);
+    EXPECT_EQ(next, mesh.numVertices());
+  }
+}
+
 TEST(Slice, WholeCellsMadeFromTheGridAreThoseSplittingGives) {
   // Boxes of cells the surface does not enter are made from the grid instead of being split
   // cell by cell; the mesh must be the one splitting gives, element by element and face by
