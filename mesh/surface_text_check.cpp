@@ -95,7 +95,7 @@ OffHeader parseOffHeader(std::string_view text) {
 }
 
 void checkOffText(const std::string& path, std::string_view text, const OffHeader& header,
-                  ReadWarnings& warnings) {
+                  ReadWarnings& warnings, OffRecords* values) {
   if (header.counts.size() < 3)
     failAtLine(path, header.dataLine,
                "the header has " + std::to_string(header.counts.size()) +
@@ -117,10 +117,15 @@ void checkOffText(const std::string& path, std::string_view text, const OffHeade
   std::vector<std::string_view> w;
   std::uint64_t records = 0, extra = 0;
   std::size_t firstExtraLine = 0;
+  OffRecords unused;
+  OffRecords& out = values ? *values : unused;
+  out.plain = values != nullptr && header.keyword == "OFF";
   while (lines.next(line)) {
+    if (out.plain && line.find('#') != std::string_view::npos) out.plain = false;
     splitWords(uncommented(line), w);
     if (w.empty()) continue;
     const std::size_t number = lines.number();
+    if (number == header.dataLine) out.plain = false;
     if (records < vertices) {
       for (std::size_t k = 0; k < std::min(w.size(), coordinates); ++k)
         if (const std::string problem = coordinateProblem(w[k]); !problem.empty())
@@ -136,6 +141,11 @@ void checkOffText(const std::string& path, std::string_view text, const OffHeade
                        quoted(w[k]) + " after the vertex's coordinates is not a number; ignored");
           break;
         }
+      if (out.plain && w.size() == 3)
+        out.vertices.push_back(
+            {realValue<double>(w[0]), realValue<double>(w[1]), realValue<double>(w[2])});
+      else
+        out.plain = false;
     } else if (records < vertices + faces) {
       const std::optional<long long> size =
           isIntegerNumber(w[0]) ? integerValue(w[0]) : std::nullopt;
@@ -166,10 +176,19 @@ void checkOffText(const std::string& path, std::string_view text, const OffHeade
           warnings.add(number, quoted(w[k]) + " after the face's indices is not a number; ignored");
           break;
         }
-    } else if (extra++ == 0) {
-      firstExtraLine = number;
+      if (out.plain && corners >= 3 && w.size() == corners + 1) {
+        std::vector<std::size_t>& face = out.faces.emplace_back(corners);
+        for (std::size_t k = 0; k < corners; ++k)
+          face[k] = static_cast<std::size_t>(*integerValue(w[k + 1]));
+      } else {
+        out.plain = false;
+      }
+    } else {
+      out.plain = false;
+      if (extra++ == 0) firstExtraLine = number;
     }
     ++records;
+    if (!out.plain && !out.vertices.empty()) out = OffRecords{false, {}, {}};
   }
   if (records < vertices + faces)
     failAtLine(path, lines.number(),

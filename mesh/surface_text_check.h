@@ -5,6 +5,7 @@
 // format, is documented with readSurface.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <set>
 #include <string>
@@ -76,12 +77,25 @@ struct OffHeader {
 };
 OffHeader parseOffHeader(std::string_view text);
 
+/// The records of a plain OFF file, read while checkOffText checks them.
+struct OffRecords {
+  /// The file is plain: keyword "OFF", no comment in its records, no record on the counts'
+  /// line, each vertex record exactly x y z, each face record exactly its size (3 or more)
+  /// and that many indices, nothing after the last face. Then the values below are what
+  /// CGAL's reader would make of it (numbers rounded correctly, as streams read them), and
+  /// nothing else is.
+  bool plain = true;
+  std::vector<std::array<double, 3>> vertices;
+  std::vector<std::vector<std::size_t>> faces;
+};
+
 /// Checks the counts and records of an ASCII OFF file whose header keyword is one of CGAL's
 /// forms: three counts on one line (a missing edge count is an error: CGAL and assimp would both
 /// read it from the first vertex line), then vertex records, the comment-free, non-blank lines
-/// after the counts (the rest of the counts line is one, if not blank, as CGAL reads it).
+/// after the counts (the rest of the counts line is one, if not blank, as CGAL reads it). If
+/// `values` is given, also reads the records of a plain file into it (see OffRecords).
 void checkOffText(const std::string& path, std::string_view text, const OffHeader& header,
-                  ReadWarnings& warnings);
+                  ReadWarnings& warnings, OffRecords* values = nullptr);
 
 /// One property of a PLY element as its header declares it.
 struct PlyProperty {

@@ -25,6 +25,7 @@
 #include <fstream>
 #include <iostream>
 #include <iterator>
+#include <limits>
 #include <map>
 #include <set>
 #include <sstream>
@@ -491,6 +492,46 @@ TEST(ReadSurfaceDouble, ObjVariantsCgalReads) {
       EXPECT_TRUE(info.warnings.empty()) << name << ": " << info.warnings.front();
     }
   }
+}
+
+TEST(ReadSurfaceDouble, PlainOffReadsWhatCgalsReaderReads) {
+  // A plain OFF file's records are read while its text is checked, not by CGAL's stream
+  // parser; a comment anywhere sends the same records to CGAL. Both must give the same
+  // surface, bit for bit: signs, a leading '+', 17 and 30 significant digits, a subnormal,
+  // exponents, forms without a digit before or after the point, quads and a pentagon.
+  const std::array<std::array<std::string, 2>, 3> text = {{
+      {"-0", "0.30000000000000004441"},
+      {"+1.5", "1.500000000000000222044604925031308"},
+      {"4.9406564584124654e-324", "1E5"},
+  }};
+  std::string records;
+  for (int corner = 0; corner < 8; ++corner)
+    records += text[0][corner & 1] + " " + text[1][(corner >> 1) & 1] + "\t" +
+               text[2][(corner >> 2) & 1] + "\n";
+  // The box's sides, outward; -z as a pentagon with a repeated corner's neighbour in line.
+  records += "4 0 2 3 1\n4 4 5 7 6\n4 0 1 5 4\n4 2 6 7 3\n4 0 4 6 2\n4 1 3 7 5\n";
+  const std::string header = "OFF\n8 6 0\n";
+  const TempDir dir("plain_off");
+  const std::string plain = dir.write("plain.off", header + records);
+  const std::string commented = dir.write("commented.off", header + "# to CGAL\n" + records);
+  SurfaceReadInfo plainInfo, cgalInfo;
+  const TriangleSurface a = readSurface(plain, &plainInfo);
+  const TriangleSurface b = readSurface(commented, &cgalInfo);
+  ASSERT_EQ(a.vertices.size(), 8u);
+  ASSERT_EQ(b.vertices.size(), a.vertices.size());
+  for (std::size_t v = 0; v < a.vertices.size(); ++v)
+    EXPECT_EQ(std::memcmp(a.vertices[v].data(), b.vertices[v].data(), 3 * sizeof(double)), 0)
+        << v << ": " << a.vertices[v].transpose() << " vs " << b.vertices[v].transpose();
+  EXPECT_EQ(a.triangles, b.triangles);
+  EXPECT_EQ(plainInfo.inputVertices, cgalInfo.inputVertices);
+  EXPECT_EQ(plainInfo.polygons, 6u);
+  EXPECT_EQ(cgalInfo.polygons, 6u);
+  // The values are the text's, correctly rounded (the subnormal kept; -0 is welded as 0).
+  EXPECT_EQ(a.vertices[0].x(), 0.0);
+  EXPECT_EQ(a.vertices[0].z(), std::numeric_limits<double>::denorm_min());
+  EXPECT_EQ(a.vertices[1].x(), 0.30000000000000004);
+  EXPECT_EQ(a.vertices[3].y(), std::nextafter(1.5, 2.0));
+  EXPECT_TRUE(analyzeTopology(a).closed());
 }
 
 TEST(ReadSurfaceDouble, FallsBackToAssimpForWhatCgalDoesNotRead) {
