@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <unordered_map>
 
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_sort.h>
 #include <boost/container/small_vector.hpp>
@@ -266,51 +267,84 @@ void reportFaces(const PolyMesh& mesh, const std::vector<FaceCheck>& checks, Pro
   }
 }
 
-/// Duplicates: faces with equal vertex-set hashes, confirmed by comparing the sets.
+/// Duplicates: faces with the same vertex set. Such faces share their smallest vertex, so the
+/// faces are placed by it (a counting sort, in face order within each vertex) and compared only
+/// with those of the same smallest vertex, by their vertex-set hash and then their sorted
+/// vertices. The pairs found are reported in order of their faces.
 void reportDuplicateFaces(const PolyMesh& mesh, const std::vector<FaceCheck>& checks,
                           Problems& problems, GeometryCheck& report) {
-  // (key, face) pairs sorted in parallel: faces with equal keys end up adjacent, by id.
-  std::vector<std::pair<std::uint64_t, std::size_t>> keyed =
-      residentVector<std::pair<std::uint64_t, std::size_t>>(mesh.numFaces());
-  tbb::parallel_for(std::size_t(0), mesh.numFaces(), [&](std::size_t i) {
-    keyed[i] = {checks[i].key, i};
+  const std::size_t nf = mesh.numFaces();
+  // Each face's smallest vertex; faces without vertices all go to the last place.
+  const auto none = static_cast<std::uint32_t>(mesh.numVertices());
+  std::vector<std::uint32_t> smallest(nf);
+  tbb::parallel_for(std::size_t(0), nf, [&](std::size_t f) {
+    std::uint32_t m = none;
+    for (const VertexId v : mesh.face(FaceId(f)).vertices) m = std::min(m, v.value);
+    smallest[f] = m;
   });
-  tbb::parallel_sort(keyed.begin(), keyed.end());
+  std::vector<std::size_t> start(std::size_t(none) + 2, 0);
+  for (const std::uint32_t m : smallest) ++start[m + 1];
+  std::partial_sum(start.begin(), start.end(), start.begin());
+  std::vector<std::uint32_t> byVertex(nf);
+  {
+    std::vector<std::size_t> next(start.begin(), start.end() - 1);
+    for (std::size_t f = 0; f < nf; ++f)
+      byVertex[next[smallest[f]]++] = static_cast<std::uint32_t>(f);
+  }
+  std::vector<std::uint32_t>().swap(smallest);
   auto sortedIds = [&](std::size_t f) {
     boost::container::small_vector<VertexId, 8> ids(mesh.face(FaceId(f)).vertices.begin(),
                                                     mesh.face(FaceId(f)).vertices.end());
     std::sort(ids.begin(), ids.end());
     return ids;
   };
-  for (std::size_t a = 0; a < keyed.size();) {
-    std::size_t b = a + 1;
-    while (b < keyed.size() && keyed[b].first == keyed[a].first) ++b;
-    for (std::size_t x = a; x < b; ++x)
-      for (std::size_t y = x + 1; y < b; ++y)
-        if (sortedIds(keyed[x].second) == sortedIds(keyed[y].second) &&
-            !areCutSides(mesh, FaceId(keyed[x].second), FaceId(keyed[y].second)))
-          problems.add(report.duplicateFaces,
-                       "faces " + std::to_string(keyed[x].second) + " and " +
-                           std::to_string(keyed[y].second) +
-                           " are the same polygon but not shared (a face used by more than two "
-                           "elements, or twice with the same orientation)");
-    a = b;
-  }
+  tbb::enumerable_thread_specific<std::vector<std::pair<std::uint32_t, std::uint32_t>>> found;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, start.size() - 1, 4096),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t v = r.begin(); v != r.end(); ++v)
+                        for (std::size_t x = start[v]; x < start[v + 1]; ++x)
+                          for (std::size_t y = x + 1; y < start[v + 1]; ++y) {
+                            const std::uint32_t a = byVertex[x], b = byVertex[y];
+                            if (checks[a].key == checks[b].key && sortedIds(a) == sortedIds(b) &&
+                                !areCutSides(mesh, FaceId(a), FaceId(b)))
+                              found.local().emplace_back(a, b);
+                          }
+                    });
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
+  for (const auto& list : found) pairs.insert(pairs.end(), list.begin(), list.end());
+  std::sort(pairs.begin(), pairs.end());
+  for (const auto& [a, b] : pairs)
+    problems.add(report.duplicateFaces,
+                 "faces " + std::to_string(a) + " and " + std::to_string(b) +
+                     " are the same polygon but not shared (a face used by more than two "
+                     "elements, or twice with the same orientation)");
 }
 
 /// Elements: closure and volume in parallel (they are the costly part), then links back to
 /// faces and the report in order.
 void reportElements(const PolyMesh& mesh, const FaceMeasures& faces, Problems& problems,
                     GeometryCheck& report) {
-  std::vector<char> closed(mesh.numElements());
+  // Per element, in parallel: closed, linked (each face it uses lists it on that side), volume.
+  enum : char { kClosed = 1, kLinked = 2 };
+  std::vector<char> state(mesh.numElements());
   std::vector<double> volumes(mesh.numElements());
+  auto linked = [&](ElementId e) {
+    const auto& uses = mesh.element(e).faces;
+    return std::all_of(uses.begin(), uses.end(), [&](const FaceUse& use) {
+      const Face& face = mesh.face(use.face);
+      return (use.reversed ? face.back : face.front) == e;
+    });
+  };
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.numElements(), 512),
                     [&](const tbb::blocked_range<std::size_t>& r) {
                       for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                        closed[i] = isClosed(mesh, ElementId(i));
-                        volumes[i] = signedVolume(mesh, ElementId(i));
+                        const ElementId e(i);
+                        state[i] = static_cast<char>((isClosed(mesh, e) ? kClosed : 0) |
+                                                     (linked(e) ? kLinked : 0));
+                        volumes[i] = signedVolume(mesh, e);
                       }
                     });
+  // The report in element order, reading the mesh again only where a link is wrong.
   bool first = true;
   for (std::size_t i = 0; i < mesh.numElements(); ++i) {
     const ElementId e(i);
@@ -319,14 +353,15 @@ void reportElements(const PolyMesh& mesh, const FaceMeasures& faces, Problems& p
       problems.add(report.emptyElements, describe("element without faces:", i));
       continue;
     }
-    for (const FaceUse& use : element.faces) {
-      const Face& face = mesh.face(use.face);
-      if ((use.reversed ? face.back : face.front) != e)
-        problems.add(report.inconsistentFaces, "element " + std::to_string(i) + " uses face " +
-                                                   std::to_string(use.face.value) +
-                                                   " but the face does not list it");
-    }
-    if (!closed[i])
+    if (!(state[i] & kLinked))
+      for (const FaceUse& use : element.faces) {
+        const Face& face = mesh.face(use.face);
+        if ((use.reversed ? face.back : face.front) != e)
+          problems.add(report.inconsistentFaces, "element " + std::to_string(i) + " uses face " +
+                                                     std::to_string(use.face.value) +
+                                                     " but the face does not list it");
+      }
+    if (!(state[i] & kClosed))
       problems.add(report.openElements, describe("element", i) +
                                             " is not closed (an edge of its faces is not "
                                             "matched by the reverse edge of another)");

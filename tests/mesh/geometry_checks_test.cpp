@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "mesh/primitives.h"
 #include "polydg/mesh/geometry.h"
 #include "polydg/mesh/surface.h"
@@ -99,6 +101,47 @@ TEST(GeometryChecks, RejectsInvertedElement) {
   // The shared face now has the same orientation in both: it is duplicated, not shared.
   EXPECT_EQ(r.duplicateFaces, 1u);
   EXPECT_EQ(r.components, 2u);
+}
+
+TEST(GeometryChecks, FindsEveryDuplicatedFace) {
+  // A 4 x 3 x 2 grid with the elements of one colour of a checkerboard turned inside out:
+  // every interior face (18 across x, 16 across y, 12 across z) then has the same orientation
+  // in both its elements, and is a duplicate; corners are rotated so that no two copies list
+  // their vertices alike. Each vertex is the smallest of up to a dozen faces.
+  const PolyMesh grid = hexGridMesh(4, 3, 2, Box3(Vec3(0, 0, 0), Vec3(4, 3, 2)));
+  const PolyMesh flipped = rebuild(grid, [](std::size_t e, FaceId, std::vector<Loop>& loops) {
+    const std::size_t i = e % 4, j = e / 4 % 3, k = e / 12;
+    if ((i + j + k) % 2 == 1)
+      for (Loop& loop : loops) std::reverse(loop.begin(), loop.end());
+    for (Loop& loop : loops) std::rotate(loop.begin(), loop.begin() + e % loop.size(), loop.end());
+    return true;
+  });
+  const GeometryCheck r = checkGeometry(flipped);
+  EXPECT_EQ(r.duplicateFaces, 46u);
+  EXPECT_EQ(r.nonPositiveElements, 12u);
+  EXPECT_EQ(r.openElements, 0u);
+}
+
+TEST(GeometryChecks, RejectsFaceLinksThatDisagree) {
+  // Two cells whose shared face names its elements the wrong way round: each element uses
+  // the face from a side that lists the other one.
+  const PolyMesh grid = hexGridMesh(1, 1, 2, Box3(Vec3(0, 0, 0), Vec3(1, 1, 2)));
+  FaceData<Face> faces = grid.faces();
+  std::size_t interior = 0;
+  for (Face& face : faces.raw())
+    if (face.back.valid()) {
+      std::swap(face.front, face.back);
+      ++interior;
+    }
+  ASSERT_EQ(interior, 1u);
+  PolyMesh swapped;
+  swapped.assign(grid.positions(), std::move(faces), grid.elements());
+  const GeometryCheck r = checkGeometry(swapped);
+  EXPECT_FALSE(r.passed);
+  EXPECT_EQ(r.inconsistentFaces, 2u);
+  ASSERT_FALSE(r.messages.empty());
+  EXPECT_NE(r.messages.front().find("but the face does not list it"), std::string::npos)
+      << r.messages.front();
 }
 
 TEST(GeometryChecks, RejectsNonPlanarFace) {
