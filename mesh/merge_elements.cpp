@@ -2,15 +2,18 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <numeric>
 #include <stdexcept>
+#include <tuple>
 
 #include "polydg/mesh/geometry.h"
 #include "polydg/mesh/geometry_checks.h"
 #include "util/resident.h"
 #include "util/union_find.h"
 
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 namespace polydg {
@@ -33,58 +36,70 @@ bool isSliver(double volume, double area, double volumeThreshold) {
   return size * size * size < volumeThreshold;
 }
 
-PolyMesh mergeSlivers(PolyMesh mesh, double volumeThreshold, SliverMergeReport* report) {
+namespace {
+
+/// Element e's volume (signedVolume, to the bit) and surface area (its faces' area norms), in
+/// one pass over its faces.
+std::pair<double, double> volumeAndArea(const PolyMesh& mesh, ElementId e) {
+  const Vec3 o = elementReferencePoint(mesh, e);
+  double threeVolume = 0.0, surface = 0.0;
+  for (const FaceUse& use : mesh.element(e).faces) {
+    const Vec3 a = areaVector(mesh, use.face);
+    const double h = a.dot(faceReferencePoint(mesh, use.face) - o);
+    threeVolume += use.reversed ? -h : h;
+    surface += a.norm();
+  }
+  return {threeVolume / 3.0, surface};
+}
+
+bool flagged(const std::vector<char>& flags, std::size_t e) { return !flags.empty() && flags[e]; }
+
+}  // namespace
+
+PolyMesh mergeSlivers(PolyMesh mesh, double volumeThreshold, SliverMergeReport* report,
+                      const std::vector<char>& wholeCells) {
   const std::size_t n = mesh.numElements();
-  // Each face's area vector once; element volumes from them (signed cones from the element's
-  // reference point) and element surface areas.
-  std::vector<Vec3> areaVectors = residentVector<Vec3>(mesh.numFaces());
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.numFaces(), 1024),
+  if (!wholeCells.empty() && wholeCells.size() != n)
+    throw std::invalid_argument("mergeSlivers: one whole-cell flag per element is needed");
+  // Volumes and areas of the elements that may be slivers; a whole cell's are measured when a
+  // sliver joins it. (Face areas are measured where they are read: most faces never are.)
+  constexpr double kUnmeasured = std::numeric_limits<double>::quiet_NaN();
+  std::vector<double> volume(n, kUnmeasured), area(n, kUnmeasured);
+  std::vector<std::uint32_t> candidates;
+  candidates.reserve(n);
+  for (std::uint32_t e = 0; e < n; ++e)
+    if (!flagged(wholeCells, e)) candidates.push_back(e);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, candidates.size(), 512),
                     [&](const tbb::blocked_range<std::size_t>& r) {
-                      for (std::size_t f = r.begin(); f != r.end(); ++f)
-                        areaVectors[f] = areaVector(mesh, FaceId(f));
+                      for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                        const std::uint32_t e = candidates[i];
+                        std::tie(volume[e], area[e]) = volumeAndArea(mesh, ElementId(e));
+                      }
                     });
-  auto faceArea = [&](std::size_t f) { return areaVectors[f].norm(); };
-  std::vector<double> volume(n), area(n);
-  tbb::parallel_for(
-      tbb::blocked_range<std::size_t>(0, n, 512), [&](const tbb::blocked_range<std::size_t>& r) {
-        for (std::size_t e = r.begin(); e != r.end(); ++e) {
-          const Vec3 o = elementReferencePoint(mesh, ElementId(e));
-          double threeVolume = 0.0, surface = 0.0;
-          for (const FaceUse& use : mesh.element(ElementId(e)).faces) {
-            const double h =
-                areaVectors[use.face.index()].dot(faceReferencePoint(mesh, use.face) - o);
-            threeVolume += use.reversed ? -h : h;
-            surface += faceArea(use.face.index());
-          }
-          volume[e] = threeVolume / 3.0;
-          area[e] = surface;
-        }
-      });
 
   // Groups of elements by union-find; a group's volume and area are kept at its representative.
   class Groups {
    public:
-    Groups(const PolyMesh& mesh, const std::vector<Vec3>& areaVectors, std::vector<double> volume,
-           std::vector<double> area)
+    Groups(const PolyMesh& mesh, std::vector<double> volume, std::vector<double> area)
         : mesh_(mesh),
-          areaVectors_(areaVectors),
           volume_(std::move(volume)),
           area_(std::move(area)),
           sets_(volume_.size()),
           members_(volume_.size()) {}
     std::optional<std::uint32_t> group(std::uint32_t e) { return sets_.find(e); }
-    double volume(std::uint32_t g) const { return volume_[g]; }
-    double area(std::uint32_t g) const { return area_[g]; }
+    double volume(std::uint32_t g) { return measured(g).first; }
+    double area(std::uint32_t g) { return measured(g).second; }
     void sharedAreas(std::uint32_t g, std::map<std::uint32_t, double>& shared) {
       for (std::uint32_t m : membersOf(g))
         for (const FaceUse& use : mesh_.element(ElementId(m)).faces) {
           const Face& face = mesh_.face(use.face);
           if (!face.front.valid() || !face.back.valid()) continue;
           const std::uint32_t other = sets_.find((use.reversed ? face.front : face.back).value);
-          if (other != g) shared[other] += areaVectors_[use.face.index()].norm();
+          if (other != g) shared[other] += areaVector(mesh_, use.face).norm();
         }
     }
     std::uint32_t merge(std::uint32_t g, std::uint32_t target, double sharedArea) {
+      measured(target);
       sets_.unite(g, target);  // target stays the representative
       volume_[target] += volume_[g];
       area_[target] += area_[g] - 2.0 * sharedArea;
@@ -97,21 +112,24 @@ PolyMesh mergeSlivers(PolyMesh mesh, double volumeThreshold, SliverMergeReport* 
     std::size_t labels(std::vector<std::uint32_t>& out) { return sets_.labels(out); }
 
    private:
+    /// Group g's volume and area, measured first if g is a whole cell no sliver joined yet.
+    std::pair<double, double> measured(std::uint32_t g) {
+      if (std::isnan(volume_[g]))
+        std::tie(volume_[g], area_[g]) = volumeAndArea(mesh_, ElementId(g));
+      return {volume_[g], area_[g]};
+    }
     // Members of each group that took in another (a group never merged is its element alone).
     std::vector<std::uint32_t>& membersOf(std::uint32_t g) {
       if (members_[g].empty()) members_[g].push_back(g);
       return members_[g];
     }
     const PolyMesh& mesh_;
-    const std::vector<Vec3>& areaVectors_;
     std::vector<double> volume_, area_;
     UnionFind sets_;
     std::vector<std::vector<std::uint32_t>> members_;
   };
-  Groups groups(mesh, areaVectors, std::move(volume), std::move(area));
-  std::vector<std::uint32_t> all(n);
-  std::iota(all.begin(), all.end(), std::uint32_t(0));
-  const SliverMergeSummary counts = mergeSliverGroups(all, volumeThreshold, groups);
+  Groups groups(mesh, std::move(volume), std::move(area));
+  const SliverMergeSummary counts = mergeSliverGroups(candidates, volumeThreshold, groups);
 
   SliverMergeReport r;
   r.threshold = counts.threshold;
@@ -128,11 +146,11 @@ PolyMesh mergeSlivers(PolyMesh mesh, double volumeThreshold, SliverMergeReport* 
 namespace {
 
 /// Groups of elements joined by mergeDegenerateElements(): each group's volume and members at
-/// its representative.
+/// its representative. A volume of +infinity stands for a whole cell's, measured when another
+/// group joins it.
 class DegenerateGroups {
  public:
-  DegenerateGroups(const PolyMesh& mesh, const std::vector<double>& faceArea)
-      : mesh_(mesh), faceArea_(faceArea), sets_(mesh.numElements()) {}
+  explicit DegenerateGroups(const PolyMesh& mesh) : mesh_(mesh), sets_(mesh.numElements()) {}
 
   UnionFind& sets() { return sets_; }
 
@@ -155,12 +173,14 @@ class DegenerateGroups {
           const Face& face = mesh_.face(use.face);
           if (!face.front.valid() || !face.back.valid()) continue;
           const std::uint32_t other = sets_.find((use.reversed ? face.front : face.back).value);
-          if (other != g) shared[other] += faceArea_[use.face.index()];
+          if (other != g) shared[other] += areaVector(mesh_, use.face).norm();
         }
       if (shared.empty()) return false;
       const auto best = std::max_element(shared.begin(), shared.end(),
                                          [](auto& a, auto& b) { return a.second < b.second; });
       const std::uint32_t target = best->first;
+      // A whole cell (alone in its group until now) is measured.
+      if (std::isinf(volume_[target])) volume_[target] = signedVolume(mesh_, ElementId(target));
       sets_.unite(g, target);  // target stays the representative
       volume_[target] += volume_[g];
       members_[target].insert(members_[target].end(), members_[g].begin(), members_[g].end());
@@ -183,7 +203,6 @@ class DegenerateGroups {
   }
 
   const PolyMesh& mesh_;
-  const std::vector<double>& faceArea_;
   UnionFind sets_;
   std::vector<double> volume_;
   std::vector<std::vector<std::uint32_t>> members_;
@@ -191,20 +210,31 @@ class DegenerateGroups {
 
 }  // namespace
 
-PolyMesh mergeDegenerateElements(PolyMesh mesh, DegenerateMergeReport* report) {
+PolyMesh mergeDegenerateElements(PolyMesh mesh, DegenerateMergeReport* report,
+                                 const std::vector<char>& wholeCells) {
   const std::size_t n = mesh.numElements(), nf = mesh.numFaces();
-  std::vector<double> faceArea(nf);
+  if (!wholeCells.empty() && wholeCells.size() != n)
+    throw std::invalid_argument(
+        "mergeDegenerateElements: one whole-cell flag per element is needed");
+  // A whole cell's faces are grid quadrilaterals and its volume is positive: neither is
+  // measured.
+  auto whole = [&](ElementId e) { return e.valid() && flagged(wholeCells, e.index()); };
   std::vector<char> degenerate(nf);
-  tbb::parallel_for(std::size_t(0), nf, [&](std::size_t f) {
-    const Vec3 a = areaVector(mesh, FaceId(f));
-    faceArea[f] = a.norm();
-    degenerate[f] = isDegenerateFace(mesh, FaceId(f), a);
-  });
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, nf, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t f = r.begin(); f != r.end(); ++f) {
+          const Face& face = mesh.face(FaceId(f));
+          degenerate[f] =
+              !whole(face.front) && !whole(face.back) && isDegenerateFace(mesh, FaceId(f));
+        }
+      });
   std::vector<double> volume(n);
-  tbb::parallel_for(std::size_t(0), n,
-                    [&](std::size_t e) { volume[e] = signedVolume(mesh, ElementId(e)); });
+  tbb::parallel_for(std::size_t(0), n, [&](std::size_t e) {
+    volume[e] = whole(ElementId(e)) ? std::numeric_limits<double>::infinity()
+                                    : signedVolume(mesh, ElementId(e));
+  });
   DegenerateMergeReport r;
-  DegenerateGroups groups(mesh, faceArea);
+  DegenerateGroups groups(mesh);
   UnionFind& sets = groups.sets();
   for (std::size_t f = 0; f < nf; ++f) {
     const Face& face = mesh.face(FaceId(f));

@@ -133,14 +133,27 @@ void orientAndSlice(const TriangleSurface& closed, double cellSize, const Meshin
   const int levels = options.octreeLevels;
   PolyMesh sliced = levels > 0 ? sliceSurfaceOctree(surface, r.grid, levels, &r.slice,
                                                     &result.elementLevels, options.progress)
-                               : sliceSurface(surface, r.grid, &r.slice, nullptr, options.progress);
+                               : sliceSurface(surface, r.grid, &r.slice, nullptr, options.progress,
+                                              &result.wholeCells);
   timer.done("slice");
 
   if (options.sliverTau > 0) {
     SliverMergeReport merge;
     const double finestCell = std::ldexp(r.grid.cellVolume(), -3 * levels);
-    result.mesh = mergeSlivers(std::move(sliced), options.sliverTau * finestCell, &merge);
+    // A whole cell is no sliver while the threshold is well below its volume (its computed
+    // volume and area are the cell's to round-off).
+    if (options.sliverTau > 0.5) result.wholeCells.clear();
+    result.mesh =
+        mergeSlivers(std::move(sliced), options.sliverTau * finestCell, &merge, result.wholeCells);
     r.slivers = {merge.threshold, merge.slivers, merge.merged, merge.isolated};
+    if (!result.wholeCells.empty() && result.mesh.numElements() != merge.group.size()) {
+      // A merged element is a whole cell only if all its parts are, that is, if it is one
+      // alone (no sliver is a whole cell).
+      std::vector<char> whole(result.mesh.numElements(), 1);
+      for (std::size_t e = 0; e < merge.group.size(); ++e)
+        whole[merge.group[e]] &= result.wholeCells[e];
+      result.wholeCells = std::move(whole);
+    }
     if (levels > 0) {
       // A merged element is at the finest level of its parts.
       std::vector<int> merged(result.mesh.numElements(), 0);
@@ -271,9 +284,11 @@ MeshingResult meshSurface(const TriangleSurface& input, const MeshingOptions& op
   return result;
 }
 
-void checkMeshing(MeshingResult& result) { checkMeshing(result.mesh, result.report); }
+void checkMeshing(MeshingResult& result) {
+  checkMeshing(result.mesh, result.report, result.wholeCells);
+}
 
-void checkMeshing(const PolyMesh& mesh, MeshingReport& r) {
+void checkMeshing(const PolyMesh& mesh, MeshingReport& r, const std::vector<char>& wholeCells) {
   const Stopwatch start;
   r.geometry = checkGeometry(mesh);
   r.elements = mesh.numElements();
@@ -288,7 +303,8 @@ void checkMeshing(const PolyMesh& mesh, MeshingReport& r) {
       tbb::blocked_range<std::size_t>(0, mesh.numElements(), 1024), Counts{0, 0},
       [&](const tbb::blocked_range<std::size_t>& range, Counts c) {
         for (std::size_t e = range.begin(); e != range.end(); ++e) {
-          const bool hex = isGridHexahedron(mesh, ElementId(e));
+          const bool hex =
+              (!wholeCells.empty() && wholeCells[e]) || isGridHexahedron(mesh, ElementId(e));
           c.first += hex;
           if (!hex && !isConvex(mesh, ElementId(e))) ++c.second;
         }

@@ -87,7 +87,8 @@ class Slicer {
   /// Sizes the splitter for about `points` points.
   void reserve(std::size_t points) { splitter_->reserve(points); }
 
-  PolyMesh build(std::vector<std::array<int, 3>>* elementCell, std::vector<int>* elementLevel) {
+  PolyMesh build(std::vector<std::array<int, 3>>* elementCell, std::vector<int>* elementLevel,
+                 std::vector<char>* elementWhole) {
     std::vector<Vec3> points = splitter_->points();
     points.insert(points.end(), generated_.begin(), generated_.end());
     std::vector<Vec3>().swap(generated_);
@@ -95,8 +96,9 @@ class Slicer {
     // more: they are freed beside the build, not after it.
     tbb::task_group release;
     release.run([this] { splitter_.reset(); });
-    PolyMesh mesh = buildSliceMesh(leaves_, whole_, octree_ != nullptr, firstGenerated_,
-                                   std::move(points), stats, elementCell, elementLevel);
+    PolyMesh mesh =
+        buildSliceMesh(leaves_, whole_, octree_ != nullptr, firstGenerated_, std::move(points),
+                       stats, elementCell, elementLevel, elementWhole);
     release.wait();
     return mesh;
   }
@@ -271,11 +273,20 @@ std::size_t expectedPoints(const TriangleSurface& surface, const Grid& grid, boo
 
 namespace {
 
+/// Whether the grid's planes are strictly increasing along every axis (they round onto each
+/// other only for cells of a few ulps of their coordinates).
+bool planesIncrease(const Grid& grid) {
+  for (int axis = 0; axis < 3; ++axis)
+    for (int i = 0; i < grid.cells[axis]; ++i)
+      if (!(grid.plane(axis, i) < grid.plane(axis, i + 1))) return false;
+  return true;
+}
+
 /// sliceSurface() and sliceSurfaceOctree(): slices, builds, and repairs what rounding left.
 PolyMesh slice(const TriangleSurface& surface, const Grid& grid, const SurfaceOctree* octree,
                SliceStats* stats, std::vector<std::array<int, 3>>* elementCell,
                std::vector<int>* elementLevel, const ProgressFn& progress,
-               bool splitEveryCell = false) {
+               bool splitEveryCell = false, std::vector<char>* wholeCells = nullptr) {
   Piece solid;
   solid.reserve(surface.triangles.size());
   for (const auto& tri : surface.triangles) {
@@ -294,27 +305,38 @@ PolyMesh slice(const TriangleSurface& surface, const Grid& grid, const SurfaceOc
   phase.restart();
   std::vector<std::array<int, 3>> cells;
   std::vector<int> levels;
-  PolyMesh mesh = slicer.build(elementCell ? &cells : nullptr, elementLevel ? &levels : nullptr);
+  std::vector<char> whole;  // the uniform grid's whole cells that rounding left alone
+  PolyMesh mesh = slicer.build(elementCell ? &cells : nullptr, elementLevel ? &levels : nullptr,
+                               octree ? nullptr : &whole);
   slicer.stats.flatFaces = dissolveFlatFaces(mesh);
+  // Flags only for boxes that are boxes: a dissolved face may have split their edges, and a
+  // grid whose planes round onto each other has flat cells.
+  if (slicer.stats.flatFaces > 0 || !planesIncrease(grid)) whole.clear();
   DegenerateMergeReport merge;
-  mesh = mergeDegenerateElements(std::move(mesh), &merge);
+  mesh = mergeDegenerateElements(std::move(mesh), &merge, whole);
   slicer.stats.mergedElements = merge.merged;
   slicer.stats.droppedElements = merge.dropped;
   if (merge.merged > 0 || merge.dropped > 0) {
-    // A merged element keeps its first part's cell and the finest of its parts' levels.
+    // A merged element keeps its first part's cell and the finest of its parts' levels; it is
+    // a whole cell only if all its parts are, that is, if it is one alone (a degenerate
+    // element is none).
     std::vector<std::array<int, 3>> mergedCells(elementCell ? mesh.numElements() : 0);
     std::vector<int> mergedLevels(elementLevel ? mesh.numElements() : 0, 0);
+    std::vector<char> mergedWhole(whole.empty() ? 0 : mesh.numElements(), 1);
     for (std::size_t e = merge.group.size(); e-- > 0;) {
       const std::uint32_t g = merge.group[e];
       if (g == kDroppedElement) continue;
       if (elementCell) mergedCells[g] = cells[e];
       if (elementLevel) mergedLevels[g] = std::max(mergedLevels[g], levels[e]);
+      if (!whole.empty()) mergedWhole[g] &= whole[e];
     }
     cells = std::move(mergedCells);
     levels = std::move(mergedLevels);
+    whole = std::move(mergedWhole);
   }
   if (elementCell) *elementCell = std::move(cells);
   if (elementLevel) *elementLevel = std::move(levels);
+  if (wholeCells) *wholeCells = std::move(whole);
   slicer.stats.secondsBuilding = phase.seconds();
   if (stats) *stats = slicer.stats;
   return mesh;
@@ -323,8 +345,9 @@ PolyMesh slice(const TriangleSurface& surface, const Grid& grid, const SurfaceOc
 }  // namespace
 
 PolyMesh sliceSurface(const TriangleSurface& surface, const Grid& grid, SliceStats* stats,
-                      std::vector<std::array<int, 3>>* elementCell, const ProgressFn& progress) {
-  return slice(surface, grid, nullptr, stats, elementCell, nullptr, progress);
+                      std::vector<std::array<int, 3>>* elementCell, const ProgressFn& progress,
+                      std::vector<char>* wholeCells) {
+  return slice(surface, grid, nullptr, stats, elementCell, nullptr, progress, false, wholeCells);
 }
 
 PolyMesh sliceSurfaceSplittingEveryCell(const TriangleSurface& surface, const Grid& grid,

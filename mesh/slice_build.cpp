@@ -32,7 +32,7 @@ class SliceBuilder {
         stats_(stats) {}
 
   PolyMesh build(std::vector<Vec3> points, std::vector<std::array<int, 3>>* elementCell,
-                 std::vector<int>* elementLevel) {
+                 std::vector<int>* elementLevel, std::vector<char>* elementWhole) {
     WeldedVertices vertices = weldPoints(points);
     std::vector<Vec3>().swap(points);
     findFreeSides(vertices);
@@ -58,6 +58,13 @@ class SliceBuilder {
     if (elementLevel)
       for (std::size_t l = 0; l < leaves_.size(); ++l)
         if (ids.elementOf[l] != kNone) elementLevel->push_back(leaves_[l].level);
+    if (elementWhole) {
+      elementWhole->assign(ids.elements, 0);
+      tbb::parallel_for(std::size_t(0), leaves_.size(), [&](std::size_t l) {
+        if (ids.elementOf[l] != kNone && leaves_[l].whole)
+          (*elementWhole)[ids.elementOf[l]] = !weldedCorner(leaves_[l].cell, vertices);
+      });
+    }
     PolyMesh mesh;
     mesh.assign(std::move(vertices.positions), std::move(meshFaces), std::move(meshElements));
     return mesh;
@@ -336,6 +343,14 @@ class SliceBuilder {
     });
   }
 
+  /// Whether a corner of whole cell `cell` is a vertex that several points were welded into.
+  bool weldedCorner(const std::array<int, 3>& cell, const WeldedVertices& vertexOf) const {
+    for (const int s : {0, 1})  // the cell's low and high sides hold its eight corners
+      for (const std::uint32_t p : whole_.side(cell, s))
+        if (vertexOf.shared[vertexOf(p).index()]) return true;
+    return false;
+  }
+
   /// Whole leaf l's side s: the number of its polygon, or kNone for a free side.
   std::uint32_t sidePolygon(const LeafOffsets& at, std::size_t l, int s) const {
     const unsigned free = freeSides_[l];
@@ -504,9 +519,9 @@ class SliceBuilder {
 PolyMesh buildSliceMesh(std::vector<SliceLeaf>& leaves, const WholeCells& whole, bool octree,
                         std::size_t firstGenerated, std::vector<Vec3> points, SliceStats& stats,
                         std::vector<std::array<int, 3>>* elementCell,
-                        std::vector<int>* elementLevel) {
+                        std::vector<int>* elementLevel, std::vector<char>* elementWhole) {
   return SliceBuilder(leaves, whole, octree, firstGenerated, stats)
-      .build(std::move(points), elementCell, elementLevel);
+      .build(std::move(points), elementCell, elementLevel, elementWhole);
 }
 
 }  // namespace polydg

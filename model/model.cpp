@@ -212,7 +212,7 @@ Model Model::fromSurface(const TriangleSurface& surface, const MeshOptions& opti
   std::exception_ptr writeFailure, dgFailure;
   MeshCheck dg;
   tbb::parallel_invoke(
-      [&] { checkMeshing(mesh, report.meshing); },
+      [&] { checkMeshing(mesh, report.meshing, meshed.wholeCells); },
       [&] {
         if (!options.dgChecks) return;
         try {

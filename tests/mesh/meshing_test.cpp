@@ -5,6 +5,8 @@
 // or underflow double precision downstream are refused as such, on both sides of the limits.
 #include "polydg/mesh/meshing.h"
 
+#include "polydg/mesh/geometry.h"
+
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
@@ -140,6 +142,38 @@ TEST(Meshing, GeometryChecksCanBeLeftToTheCaller) {
   EXPECT_EQ(m.report.elements, m.mesh.numElements());
   EXPECT_EQ(m.report.hexahedra + m.report.polyhedra, m.report.elements);
   EXPECT_LT(m.report.volumeRelError, kVolumeTolerance);
+}
+
+TEST(Meshing, WholeCellsAreHexahedraAndCountAsWhatTheShapesSay) {
+  // The whole cells slicing and sliver merging left alone are flagged, so that validation
+  // need not measure their shapes: each is a grid hexahedron, an element that took in a sliver
+  // is not flagged, and the counts are those of measuring every element. The grid is the unit
+  // cells of [0, 4]^3 (two small cubes in its corners make the bounds); the block's side at
+  // x = 3.05 leaves slabs 0.05 thick beyond x = 3, slivers that merge into whole cells.
+  TriangleSurface blocks = boxSurface(Box3(Vec3(0.5, 0.5, 0.5), Vec3(3.05, 3.5, 3.5)));
+  blocks = combine(blocks, boxSurface(Box3(Vec3(0, 0, 0), Vec3(0.1, 0.1, 0.1))));
+  blocks = combine(blocks, boxSurface(Box3(Vec3(3.9, 3.9, 3.9), Vec3(4, 4, 4))));
+  MeshingOptions options;
+  options.cellSize = 1.0;
+  options.sliverTau = 0.1;
+  const MeshingResult m = meshSurface(blocks, options);
+  ASSERT_EQ(m.report.grid.cells, (std::array<int, 3>{4, 4, 4}));
+  ASSERT_EQ(m.wholeCells.size(), m.mesh.numElements());
+  std::size_t flagged = 0, notHexahedra = 0;
+  for (std::size_t e = 0; e < m.mesh.numElements(); ++e)
+    if (m.wholeCells[e]) {
+      ++flagged;
+      notHexahedra += !isGridHexahedron(m.mesh, ElementId(e));
+    }
+  EXPECT_GT(flagged, 0u);
+  EXPECT_EQ(notHexahedra, 0u);
+  EXPECT_GE(m.report.slivers.merged, 4u);
+  MeshingReport measured;
+  measured.inputVolume = m.report.inputVolume;
+  checkMeshing(m.mesh, measured);
+  EXPECT_EQ(m.report.hexahedra, measured.hexahedra);
+  EXPECT_EQ(m.report.nonconvex, measured.nonconvex);
+  EXPECT_GE(m.report.hexahedra, flagged);
 }
 
 // --- scale: overflow and underflow ------------------------------------------------------------

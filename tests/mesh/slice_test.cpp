@@ -17,6 +17,7 @@
 #include "polydg/integrate/moment_cache.h"
 #include "polydg/mesh/geometry.h"
 #include "polydg/mesh/geometry_checks.h"
+#include "polydg/mesh/merge_elements.h"
 #include "polydg/mesh/surface_io.h"
 #include "polydg/mesh/surface_shapes.h"
 
@@ -289,15 +290,23 @@ TriangleSurface octahedron(const Vec3& centre, const std::array<Vec3, 3>& d) {
   return s;
 }
 
+/// testdata/torus.obj.
+TriangleSurface bundledTorus() {
+  return readSurface(std::string(POLYDG_TESTDATA_DIR) + "/torus.obj");
+}
+
+/// Twisted parts tapered to a point beside a box, 1e6 from the origin.
+TriangleSurface twistBesideABoxFarAway() {
+  return transformed(combine(twistedTaperedPrism(Vec3::Zero(), 20, 10, 40, 200, 1.0),
+                             boxSurface(Box3(Vec3(20, -5, 0), Vec3(30, 5, 10)))),
+                     1.0, Vec3(1e6, 0, 0));
+}
+
 TEST(Slice, VerticesAreNumberedInOrderOfFirstUse) {
   // Vertex ids follow the order in which the elements (in order, face by face, corner by
   // corner) first use them, whichever thread made which point: the torus at two sizes, and
   // twisted parts beside a box 1e6 from the origin.
-  const TriangleSurface torus = readSurface(std::string(POLYDG_TESTDATA_DIR) + "/torus.obj");
-  const TriangleSurface parts =
-      transformed(combine(twistedTaperedPrism(Vec3::Zero(), 20, 10, 40, 200, 1.0),
-                          boxSurface(Box3(Vec3(20, -5, 0), Vec3(30, 5, 10)))),
-                  1.0, Vec3(1e6, 0, 0));
+  const TriangleSurface torus = bundledTorus(), parts = twistBesideABoxFarAway();
   for (const auto& [surface, cells] :
        {std::pair{&torus, 14}, std::pair{&torus, 40}, std::pair{&parts, 48}}) {
     SCOPED_TRACE(cells);
@@ -316,6 +325,72 @@ TEST(Slice, VerticesAreNumberedInOrderOfFirstUse) {
         }
     EXPECT_EQ(outOfOrder, 0u);
     EXPECT_EQ(next, mesh.numVertices());
+  }
+}
+
+TEST(Slice, WholeCellFlagsMarkExactGridBoxesAndMergeSliversAlike) {
+  // sliceSurface flags the whole cells rounding left alone: each is its cell's box, on the
+  // grid's exact node coordinates, six quadrilaterals; merging slivers with the flags (whole
+  // cells measured only when a sliver joins them) gives what merging without them gives.
+  const TriangleSurface torus = bundledTorus(), parts = twistBesideABoxFarAway();
+  const TriangleSurface sphere = icosphere(Vec3(0.1, 0.2, 0.3), 1.0, 3);
+  // A box whose side lies one ulp before the grid plane x = 0.25: the slab of that ulp welds
+  // onto the plane, moving corners of whole cells beside it, which are then no whole cells.
+  const TriangleSurface ulpBeyond =
+      boxSurface(Box3(Vec3(std::nextafter(0.25, 0.0), 0.1, 0.1), Vec3(1.1, 1.2, 1.2)));
+  Grid quarters;
+  quarters.centre = Vec3(0.75, 0.75, 0.75);
+  quarters.cellSize = 0.25;
+  quarters.cells = {6, 6, 6};
+  for (const auto& [surface, cells] : {std::pair{&torus, 24}, std::pair{&parts, 48},
+                                       std::pair{&sphere, 20}, std::pair{&ulpBeyond, 0}}) {
+    SCOPED_TRACE(cells);
+    const Grid grid = cells == 0 ? quarters : Grid::withCellsAlongLongest(bounds(*surface), cells);
+    SliceStats stats;
+    std::vector<std::array<int, 3>> cell;
+    std::vector<char> whole;
+    const PolyMesh mesh = sliceSurface(*surface, grid, &stats, &cell, {}, &whole);
+    ASSERT_EQ(whole.size(), mesh.numElements());
+    std::size_t flagged = 0, notBoxes = 0;
+    for (std::size_t e = 0; e < mesh.numElements(); ++e) {
+      if (!whole[e]) continue;
+      ++flagged;
+      const Element& element = mesh.element(ElementId(e));
+      bool box = element.faces.size() == 6 && isGridHexahedron(mesh, ElementId(e));
+      for (const FaceUse& use : element.faces)
+        for (const VertexId v : mesh.face(use.face).vertices)
+          for (int a = 0; a < 3; ++a) {
+            const double x = mesh.position(v)[a];
+            box = box && (x == grid.plane(a, cell[e][a]) || x == grid.plane(a, cell[e][a] + 1));
+          }
+      box = box && elementVertices(mesh, ElementId(e)).size() == 8;
+      notBoxes += !box;
+    }
+    EXPECT_EQ(notBoxes, 0u);
+    EXPECT_GT(flagged, 0u);
+    EXPECT_LE(flagged, stats.wholeCells);
+
+    const double threshold = 0.2 * grid.cellVolume();
+    SliverMergeReport plain, flags;
+    const PolyMesh a = mergeSlivers(mesh, threshold, &plain);
+    const PolyMesh b = mergeSlivers(mesh, threshold, &flags, whole);
+    if (cells != 0) {  // the box has none
+      EXPECT_GT(plain.merged, 0u);
+    }
+    EXPECT_EQ(flags.slivers, plain.slivers);
+    EXPECT_EQ(flags.merged, plain.merged);
+    EXPECT_EQ(flags.isolated, plain.isolated);
+    EXPECT_EQ(flags.group, plain.group);
+    ASSERT_EQ(a.numFaces(), b.numFaces());
+    std::size_t differing = 0;
+    for (std::size_t f = 0; f < a.numFaces(); ++f) {
+      const Face& x = a.face(FaceId(f));
+      const Face& y = b.face(FaceId(f));
+      differing +=
+          x.front != y.front || x.back != y.back ||
+          !std::equal(x.vertices.begin(), x.vertices.end(), y.vertices.begin(), y.vertices.end());
+    }
+    EXPECT_EQ(differing, 0u);
   }
 }
 

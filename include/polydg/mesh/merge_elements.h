@@ -101,8 +101,12 @@ SliverMergeSummary mergeSliverGroups(const std::vector<std::uint32_t>& candidate
 
 /// Merges the slivers of `mesh` (isSliver with `volumeThreshold`, the sliver fraction times the
 /// grid cell's volume) by mergeSliverGroups: every element that is a sliver, until none with a
-/// neighbour is left. Deterministic.
-PolyMesh mergeSlivers(PolyMesh mesh, double volumeThreshold, SliverMergeReport* report = nullptr);
+/// neighbour is left. Deterministic. `wholeCells` (empty, or one flag per element) marks whole
+/// cells of a grid (sliceSurface): the caller knows they are no slivers (the threshold is well
+/// below a cell's volume), so they are not measured unless a sliver joins them; the result is
+/// the same as without the flags.
+PolyMesh mergeSlivers(PolyMesh mesh, double volumeThreshold, SliverMergeReport* report = nullptr,
+                      const std::vector<char>& wholeCells = {});
 
 /// What mergeDegenerateElements() did.
 struct DegenerateMergeReport {
@@ -118,7 +122,11 @@ struct DegenerateMergeReport {
 /// neighbouring group it shares the most face area with, until it is positive. A group with no
 /// neighbour left is dropped, with its faces (all on the boundary). The groups are numbered in
 /// order of their first element. Deterministic; the mesh is returned as it is when nothing is
-/// degenerate (the usual case).
-PolyMesh mergeDegenerateElements(PolyMesh mesh, DegenerateMergeReport* report = nullptr);
+/// degenerate (the usual case). `wholeCells` (empty, or one flag per element) marks whole grid
+/// cells that rounding left alone (sliceSurface): boxes of positive volume whose faces are not
+/// degenerate, which are measured only if a group joins them; the result is the same as
+/// without the flags.
+PolyMesh mergeDegenerateElements(PolyMesh mesh, DegenerateMergeReport* report = nullptr,
+                                 const std::vector<char>& wholeCells = {});
 
 }  // namespace polydg

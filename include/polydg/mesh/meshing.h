@@ -104,6 +104,9 @@ struct MeshingResult {
   /// Octree slicing: each element's level (0: a coarse cell, MeshingOptions::octreeLevels: the
   /// finest); empty for the uniform grid.
   std::vector<int> elementLevels;
+  /// Uniform grid: per element, 1 for a whole cell that rounding and merging left alone (see
+  /// sliceSurface); may be empty.
+  std::vector<char> wholeCells;
 };
 
 /// Runs the pipeline on a surface as read from a file. Throws InputError for input it refuses
@@ -117,6 +120,9 @@ MeshingResult meshSurface(const TriangleSurface& surface, const MeshingOptions& 
 /// meshSurface() ends with it unless MeshingOptions::validate is false.
 void checkMeshing(MeshingResult& result);
 /// The same for a mesh kept apart from its report (moved into a model before validation).
-void checkMeshing(const PolyMesh& mesh, MeshingReport& report);
+/// `wholeCells` (empty, or MeshingResult::wholeCells) spares measuring the shapes of the whole
+/// cells, which are grid hexahedra.
+void checkMeshing(const PolyMesh& mesh, MeshingReport& report,
+                  const std::vector<char>& wholeCells = {});
 
 }  // namespace polydg

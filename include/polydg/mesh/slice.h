@@ -57,10 +57,12 @@ using ProgressFn = std::function<void(double)>;
 /// face, a face left flat is dissolved into the edges it lies on, and an element left flat (or
 /// with a degenerate face between it and a neighbour) is merged into a neighbour
 /// (mergeDegenerateElements; its cell is then that of its first part), so the mesh passes
-/// checkGeometry().
+/// checkGeometry(). `wholeCells` (optional) receives per element 1 for a whole cell of the grid
+/// that rounding left alone (the grid's box on six quadrilaterals of grid nodes), else 0; for
+/// mergeSlivers and checkMeshing, which need not measure them.
 PolyMesh sliceSurface(const TriangleSurface& surface, const Grid& grid, SliceStats* stats = nullptr,
                       std::vector<std::array<int, 3>>* elementCell = nullptr,
-                      const ProgressFn& progress = {});
+                      const ProgressFn& progress = {}, std::vector<char>* wholeCells = nullptr);
 
 /// Octree slicing: as sliceSurface() on the grid with cells 2^levels times smaller than
 /// `coarse`'s (levels 1 .. 10), but only where the surface is. A coarse cell is split into its
