@@ -10,7 +10,6 @@
 
 #include "polydg/mesh/geometry.h"
 #include "polydg/mesh/geometry_checks.h"
-#include "util/resident.h"
 #include "util/union_find.h"
 
 #include <tbb/blocked_range.h>
