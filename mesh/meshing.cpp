@@ -12,6 +12,7 @@
 
 #include "mesh/surface_repair.h"
 #include "util/format.h"
+#include "util/held_memory.h"
 #include "util/stopwatch.h"
 
 namespace polydg {
@@ -164,6 +165,8 @@ void orientAndSlice(const TriangleSurface& closed, double cellSize, const Meshin
   } else {
     result.mesh = std::move(sliced);
   }
+  // What slicing freed is returned before the arrays of validation and writing are made.
+  releaseFreedMemory();
   timer.done("merge_slivers");
 }
 

@@ -15,6 +15,7 @@
 #include <boost/container/small_vector.hpp>
 
 #include "mesh/welded_polygons.h"
+#include "util/held_memory.h"
 #include "util/resident.h"
 
 namespace polydg {
@@ -38,8 +39,10 @@ class SliceBuilder {
     findFreeSides(vertices);
     const LeafOffsets at = leafOffsets();
     const LeafPolygons polygons = weldPolygons(at, vertices);
-    // The pieces are copied into `polygons`: freed before the mesh's arrays take their place.
+    // The pieces are copied into `polygons`: freed, and their memory returned, before the
+    // mesh's arrays take their place.
     freeLeaves();
+    releaseFreedMemory();
     // Caps meet their other side: the later of two reversed, equal polygons uses the earlier's
     // face (reversed), as findOrCreateFace would in leaf order; so do two polygons on the
     // surface that rounding made reversed and equal.
