@@ -157,6 +157,9 @@ void checkOffText(const std::string& path, std::string_view text, const OffHeade
         failAtLine(path, number,
                    "a face of " + std::to_string(corners) + " vertices lists only " +
                        std::to_string(w.size() - 1) + " indices; complete it");
+      // A plain file's face takes the indices as they are checked.
+      if (!(corners >= 3 && w.size() == corners + 1)) out.plain = false;
+      std::vector<std::size_t>* face = out.plain ? &out.faces.emplace_back(corners) : nullptr;
       for (std::size_t k = 1; k <= corners; ++k) {
         if (!isIntegerNumber(w[k]))
           failAtLine(path, number,
@@ -166,6 +169,7 @@ void checkOffText(const std::string& path, std::string_view text, const OffHeade
           failAtLine(path, number,
                      "face index " + std::string(w[k]) + " names no vertex (OFF counts from 0, " +
                          std::to_string(vertices) + " vertices); correct the face");
+        if (face) (*face)[k - 1] = static_cast<std::size_t>(*index);
       }
       if (corners < 3)
         warnings.add(number, corners == 0   ? "face without vertices; skipped"
@@ -176,13 +180,6 @@ void checkOffText(const std::string& path, std::string_view text, const OffHeade
           warnings.add(number, quoted(w[k]) + " after the face's indices is not a number; ignored");
           break;
         }
-      if (out.plain && corners >= 3 && w.size() == corners + 1) {
-        std::vector<std::size_t>& face = out.faces.emplace_back(corners);
-        for (std::size_t k = 0; k < corners; ++k)
-          face[k] = static_cast<std::size_t>(*integerValue(w[k + 1]));
-      } else {
-        out.plain = false;
-      }
     } else {
       out.plain = false;
       if (extra++ == 0) firstExtraLine = number;
