@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <numeric>
+#include <utility>
 #include <vector>
 
 namespace polydg {
@@ -25,6 +26,13 @@ class UnionFind {
 
   /// Joins the sets of a and b; the representative of b's set represents the union.
   void unite(std::uint32_t a, std::uint32_t b) { parent_[find(a)] = find(b); }
+
+  /// Every index's representative, in a vector taken from the forest, which is left empty: for
+  /// a caller that relabels the sets in that storage instead of allocating another array.
+  std::vector<std::uint32_t> takeRepresentatives() {
+    for (std::uint32_t i = 0; i < parent_.size(); ++i) parent_[i] = find(i);
+    return std::move(parent_);
+  }
 
   /// One label per index, 0 .. count-1, numbering the sets in order of their smallest index;
   /// returns the number of sets.

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <map>
+#include <random>
 #include <set>
 #include <vector>
 
@@ -165,6 +166,77 @@ TEST(PointGroups, AVertexOfNoElementKeepsItsOwnPoint) {
   expectConsistent(mesh, corners, groups);
   EXPECT_EQ(groups.numPoints(), 9u);
   EXPECT_EQ(groups.pointVertex[loose.index()], loose);
+}
+
+/// groupPoints() as its documentation says it, element by element: the elements at a vertex
+/// joined by chains of interior faces that contain it, found by a search from each corner; a
+/// group's point is decided at its first corner.
+PointGroups referenceGroups(const PolyMesh& mesh, const ElementCorners& corners) {
+  PointGroups out;
+  for (std::size_t v = 0; v < mesh.numVertices(); ++v) out.pointVertex.push_back(VertexId(v));
+  std::vector<bool> taken(mesh.numVertices(), false);
+  std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> pointOf;  // (element, vertex)
+  const std::size_t ne = corners.begin.size() - 1;
+  for (std::size_t e = 0; e < ne; ++e)
+    for (VertexId v : corners.of(ElementId(e))) {
+      if (pointOf.contains({std::uint32_t(e), v.value})) {
+        out.cornerPoint.push_back(pointOf.at({std::uint32_t(e), v.value}));
+        continue;
+      }
+      std::uint32_t point = v.value;
+      if (taken[v.index()]) {
+        point = static_cast<std::uint32_t>(out.pointVertex.size());
+        out.pointVertex.push_back(v);
+      }
+      taken[v.index()] = true;
+      std::vector<ElementId> stack{ElementId(e)};
+      pointOf[{std::uint32_t(e), v.value}] = point;
+      while (!stack.empty()) {
+        const ElementId x = stack.back();
+        stack.pop_back();
+        for (const FaceUse& use : mesh.element(x).faces) {
+          const Face& face = mesh.face(use.face);
+          if (face.isBoundary() ||
+              std::find(face.vertices.begin(), face.vertices.end(), v) == face.vertices.end())
+            continue;
+          const ElementId y = use.reversed ? face.front : face.back;
+          if (pointOf.try_emplace({y.value, v.value}, point).second) stack.push_back(y);
+        }
+      }
+      out.cornerPoint.push_back(point);
+    }
+  return out;
+}
+
+TEST(PointGroups, AsDocumentedOnCubesWithRandomCutsAndGaps) {
+  // Cubes of a 4 x 4 x 3 block with a fifth left out (so that some touch only at an edge or a
+  // vertex) and a third of the faces between them cut, added in a shuffled order: many vertices
+  // have several groups, whose first corners come in every order.
+  std::mt19937 random(7);
+  for (int round = 0; round < 20; ++round) {
+    std::vector<CubeBuilder::Cell> cells;
+    for (int x = 0; x < 4; ++x)
+      for (int y = 0; y < 4; ++y)
+        for (int z = 0; z < 3; ++z)
+          if (random() % 5 != 0) cells.push_back({x, y, z});
+    std::shuffle(cells.begin(), cells.end(), random);
+    std::set<std::pair<CubeBuilder::Cell, CubeBuilder::Cell>> cuts;
+    for (const CubeBuilder::Cell& c : cells)
+      for (int axis = 0; axis < 3; ++axis) {
+        CubeBuilder::Cell n = c;
+        ++n[axis];
+        if (random() % 3 == 0) cuts.insert({c, n});
+      }
+    CubeBuilder builder(cuts);
+    const PolyMesh mesh = builder.build(cells);
+    const ElementCorners corners = cornersOf(mesh);
+    const PointGroups groups = groupPoints(mesh, corners);
+    expectConsistent(mesh, corners, groups);
+    const PointGroups reference = referenceGroups(mesh, corners);
+    EXPECT_GT(reference.numPoints(), mesh.numVertices() + 10);
+    EXPECT_EQ(groups.pointVertex, reference.pointVertex) << "round " << round;
+    EXPECT_EQ(groups.cornerPoint, reference.cornerPoint) << "round " << round;
+  }
 }
 
 }  // namespace
