@@ -6,6 +6,8 @@
 
 #include <tbb/parallel_for.h>
 
+#include "util/resident.h"
+
 namespace polydg {
 
 namespace {
@@ -33,14 +35,25 @@ MomentCache::MomentCache(const PolyMesh& mesh, int degree)
   sync();
 }
 
+namespace {
+/// v resized to n, the pages of a growth made resident on all cores first (a cache of a mesh
+/// of millions of faces is hundreds of MB, which one thread would fault in alone).
+template <class T>
+void growResident(std::vector<T>& v, std::size_t n, const T& value) {
+  if (n > v.capacity()) v.reserve(std::max(n, 2 * v.capacity()));
+  if (n > v.size()) makeResident(v.data() + v.size(), (n - v.size()) * sizeof(T));
+  v.resize(n, value);
+}
+}  // namespace
+
 void MomentCache::sync() {
   const std::size_t nf = mesh_->numFaces(), ne = mesh_->numElements();
   const std::size_t oldFaces = std::min(faceNormals_.size(), nf);
   const std::size_t oldElements = std::min(elementOrigins_.size(), ne);
-  faceMoments_.resize(nf * stride_, 0.0);
-  elementMoments_.resize(ne * stride_, 0.0);
-  faceNormals_.resize(nf, Vec3::Zero());
-  elementOrigins_.resize(ne, Vec3::Zero());
+  growResident(faceMoments_, nf * stride_, 0.0);
+  growResident(elementMoments_, ne * stride_, 0.0);
+  growResident(faceNormals_.raw(), nf, Vec3(Vec3::Zero()));
+  growResident(elementOrigins_.raw(), ne, Vec3(Vec3::Zero()));
   faceDirty_.resize(nf, 0);
   elementDirty_.resize(ne, 0);
   for (std::size_t f = oldFaces; f < nf; ++f) invalidateFace(FaceId(f));
