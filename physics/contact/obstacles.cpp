@@ -10,17 +10,10 @@
 #include <string>
 #include <vector>
 
-// OpenVDB is included here only: it takes long to compile. The library instantiates
-// meshToVolume() for QuadAndTriangleDataAdapter<Vec3s, Vec3I> and gradient() for FloatGrid
-// itself (OPENVDB_USE_EXPLICIT_INSTANTIATION), so this file compiles neither.
-#include <openvdb/math/Proximity.h>
-#include <openvdb/openvdb.h>
-#include <openvdb/tools/GridOperators.h>
-#include <openvdb/tools/Interpolation.h>
-#include <openvdb/tools/MeshToVolume.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "physics/contact/distance_grids.h"
 #include "util/format.h"
 #include "util/stopwatch.h"
 
@@ -87,157 +80,29 @@ void checkSurface(const TriangleSurface& s) {
                                 ": it must be oriented outward (reverse it)");
 }
 
-/// The surface in the grid's index space (double precision): vertices and triangles.
-struct IndexSpaceMesh {
-  std::vector<openvdb::Vec3d> points;
-  std::vector<openvdb::Vec3I> triangles;
-
-  /// Distance, in voxels, from the voxel centre ijk to triangle t.
-  double distance(const openvdb::Coord& ijk, std::int32_t t) const {
-    const openvdb::Vec3d centre(ijk.x(), ijk.y(), ijk.z());
-    const openvdb::Vec3I& v = triangles[static_cast<std::size_t>(t)];
-    openvdb::Vec3d uvw;
-    return (centre - openvdb::math::closestPointOnTriangleToPoint(points[v[0]], points[v[1]],
-                                                                  points[v[2]], centre, uvw))
-        .length();
-  }
-};
-
-/// A voxel's distance and nearest triangle, replacing what OpenVDB found.
-struct NearerTriangle {
-  openvdb::Coord ijk;
-  float distance;  ///< world units, signed
-  std::int32_t triangle;
-};
-
-/// Reads the band's distances and nearest triangles; one per thread.
-class BandReader {
- public:
-  BandReader(const openvdb::FloatTree& distance, const openvdb::Int32Tree& nearest,
-             const IndexSpaceMesh& mesh, double voxel)
-      : distance_(distance), nearest_(nearest), mesh_(mesh), voxel_(voxel) {}
-
-  /// The voxel's distance to the nearest of the triangles nearest to it and its 26 neighbours,
-  /// if nearer than its own triangle; nothing for a voxel out of the band or voxelized exactly
-  /// (within sqrt(3)/2 voxel of the surface, which OpenVDB's voxelization computes exactly).
-  std::optional<NearerTriangle> nearer(const openvdb::Coord& ijk) const {
-    constexpr double kExactWithin = 0.8660254037844386;
-    constexpr double kImprovement = 1e-5;  // voxels: a nearer triangle, not float rounding
-    float value;
-    std::int32_t own;
-    if (!distance_.probeValue(ijk, value) || !nearest_.probeValue(ijk, own)) return {};
-    const double current = std::abs(value) / voxel_;
-    if (current <= kExactWithin) return {};
-    double best = current - kImprovement;
-    std::int32_t bestTriangle = own;
-    std::array<std::int32_t, 27> seen;
-    seen[0] = own;
-    int numSeen = 1;
-    for (const openvdb::Coord& offset : openvdb::util::COORD_OFFSETS) {
-      std::int32_t t;
-      if (!nearest_.probeValue(ijk + offset, t) ||
-          std::find(seen.begin(), seen.begin() + numSeen, t) != seen.begin() + numSeen)
-        continue;
-      seen[numSeen++] = t;
-      const double d = mesh_.distance(ijk, t);
-      if (d < best) {
-        best = d;
-        bestTriangle = t;
-      }
-    }
-    if (bestTriangle == own) return {};
-    const auto refined = static_cast<float>(best * voxel_);
-    return NearerTriangle{ijk, value < 0 ? -refined : refined, bestTriangle};
-  }
-
- private:
-  openvdb::tree::ValueAccessor<const openvdb::FloatTree, false> distance_;
-  openvdb::tree::ValueAccessor<const openvdb::Int32Tree, false> nearest_;
-  const IndexSpaceMesh& mesh_;
-  double voxel_;
-};
-
-/// Makes the band's distances exact. OpenVDB's voxelization gives every voxel within
-/// sqrt(3)/2 voxel of the surface its exact distance; it widens the band from there with the
-/// triangle nearest a nearby voxel, which is not always the one nearest the voxel, so values a
-/// few voxels out can be too large by a good part of a voxel (OpenVDB's optional
-/// renormalization smooths them, but costs the exactness near the surface). The first sweep
-/// gives each voxel the distance to the nearest of the triangles nearest to it and its 26
-/// neighbours (BandReader::nearer()); a nearer triangle spreads one voxel per sweep, so the next
-/// sweeps visit the neighbours of the voxels that changed, until none changes or after
-/// `maxSweeps`. Every value is the distance to some triangle, so values only decrease; the sign
-/// (inside or outside) is OpenVDB's.
-void refineDistances(openvdb::FloatTree& distance, openvdb::Int32Tree& nearest,
-                     const IndexSpaceMesh& mesh, double voxel, int maxSweeps) {
-  using Leaf = openvdb::FloatTree::LeafNodeType;
-  std::vector<const Leaf*> leaves;
-  distance.getNodes(leaves);
-  std::vector<std::vector<NearerTriangle>> perLeaf(leaves.size());
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size()),
-                    [&](const tbb::blocked_range<std::size_t>& range) {
-                      const BandReader reader(distance, nearest, mesh, voxel);
-                      for (std::size_t l = range.begin(); l != range.end(); ++l)
-                        for (auto it = leaves[l]->cbeginValueOn(); it; ++it)
-                          if (auto u = reader.nearer(it.getCoord())) perLeaf[l].push_back(*u);
-                    });
-  std::vector<NearerTriangle> updates;
-  for (const auto& u : perLeaf) updates.insert(updates.end(), u.begin(), u.end());
-  openvdb::tree::ValueAccessor<openvdb::FloatTree, false> distances(distance);
-  openvdb::tree::ValueAccessor<openvdb::Int32Tree, false> nearests(nearest);
-  for (int sweep = 1; !updates.empty(); ++sweep) {
-    std::vector<openvdb::Coord> next;
-    for (const NearerTriangle& u : updates) {
-      distances.setValueOnly(u.ijk, u.distance);
-      nearests.setValueOnly(u.ijk, u.triangle);
-      for (const openvdb::Coord& offset : openvdb::util::COORD_OFFSETS)
-        next.push_back(u.ijk + offset);
-    }
-    if (sweep == maxSweeps) return;
-    std::sort(next.begin(), next.end());
-    next.erase(std::unique(next.begin(), next.end()), next.end());
-    std::vector<std::optional<NearerTriangle>> found(next.size());
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, next.size()),
-                      [&](const tbb::blocked_range<std::size_t>& range) {
-                        const BandReader reader(distance, nearest, mesh, voxel);
-                        for (std::size_t i = range.begin(); i != range.end(); ++i)
-                          found[i] = reader.nearer(next[i]);
-                      });
-    updates.clear();
-    for (const auto& u : found)
-      if (u) updates.push_back(*u);
-  }
-}
-
 }  // namespace
 
-/// The distance field and its gradient, in the index space of voxels of edge `voxel` centred at
-/// origin + voxel * (i, j, k). The origin is the surface's bounding-box centre, so index
-/// coordinates stay small wherever the surface is; world points are taken to index space here,
-/// in double precision (the grids' own transforms say the same, for anyone reading them).
+/// The distance field and its gradient (built by the OpenVDB module: distance_grids.h), in the
+/// index space of voxels of edge `voxel` centred at origin + voxel * (i, j, k). The origin is the
+/// surface's bounding-box centre, so index coordinates stay small wherever the surface is; world
+/// points are taken to index space here, in double precision.
 struct Obstacle::Field {
-  openvdb::FloatGrid::ConstPtr distance;  ///< world units; background +exterior, -interior band
-  openvdb::Vec3SGrid::ConstPtr gradient;  ///< world units; background zero
+  std::shared_ptr<const DistanceGrids> grids;
   Vec3 origin = Vec3::Zero();
   double voxel = 0.0;
-  openvdb::CoordBBox activeBox;  ///< of the distance grid's active voxels
 
-  /// Samples the grids through accessors of its own: one reader per thread. The accessors are
-  /// not registered with the trees (they never change after fromSurface()).
+  /// Samples the grids through a reader of its own: one per thread.
   class Reader {
    public:
     Reader(const Field& field, const DistanceFieldOptions& options)
-        : field_(field),
-          options_(options),
-          distance_(field.distance->getConstUnsafeAccessor()),
-          gradient_(field.gradient->getConstUnsafeAccessor()) {}
+        : field_(field), options_(options), grids_(field.grids->reader()) {}
 
     /// Distance and normal at the world point x of the field at rest (time 0).
     ObstacleQuery at(const Vec3& x) const {
       const Vec3 index = (x - field_.origin) / field_.voxel;
-      const openvdb::Vec3d ijk(index.x(), index.y(), index.z());
       float d = 0.0f;
       // No active voxel among the eight around x: outside the band, or deeper in.
-      if (!openvdb::tools::BoxSampler::sample(distance_, ijk, d))
+      if (!grids_->distance(index, d))
         return {d < 0 ? -options_.interiorBand : options_.exteriorBand, Vec3::Zero()};
       // The outermost voxel layer of a band interpolates with the background: no normal there,
       // as beyond the band.
@@ -245,8 +110,7 @@ struct Obstacle::Field {
       if (d <= -options_.interiorBand + field_.voxel) return {-options_.interiorBand, Vec3::Zero()};
       ObstacleQuery q;
       q.distance = d;
-      const openvdb::Vec3s g = openvdb::tools::BoxSampler::sample(gradient_, ijk);
-      const Vec3 gradient(g.x(), g.y(), g.z());
+      const Vec3 gradient = grids_->gradient(index);
       const double length = gradient.norm();
       if (length >= kMinGradientLength) q.normal = gradient / length;
       return q;
@@ -255,8 +119,7 @@ struct Obstacle::Field {
    private:
     const Field& field_;
     const DistanceFieldOptions& options_;
-    openvdb::FloatGrid::ConstUnsafeAccessor distance_;
-    openvdb::Vec3SGrid::ConstUnsafeAccessor gradient_;
+    std::unique_ptr<DistanceGrids::Reader> grids_;
   };
 };
 
@@ -288,41 +151,21 @@ Obstacle Obstacle::fromSurface(const TriangleSurface& surface, const DistanceFie
     throw std::invalid_argument("Obstacle::fromSurface: the surface is " + formatNumber(across) +
                                 " voxels across, more than " + formatNumber(kMaxVoxelsAcross) +
                                 ": use a larger voxel");
-  openvdb::initialize();  // idempotent; registers OpenVDB's types
-
   auto field = std::make_shared<Field>();
   field->origin = box.center();
   field->voxel = options.voxel;
-  IndexSpaceMesh mesh;
-  std::vector<openvdb::Vec3s> points;  // OpenVDB's adapter takes floats
-  mesh.points.reserve(surface.vertices.size());
-  points.reserve(surface.vertices.size());
-  for (const Vec3& p : surface.vertices) {
-    const Vec3 index = (p - field->origin) / options.voxel;  // small: about the centre
-    mesh.points.emplace_back(index.x(), index.y(), index.z());
-    points.emplace_back(static_cast<float>(index.x()), static_cast<float>(index.y()),
-                        static_cast<float>(index.z()));
-  }
-  mesh.triangles.reserve(surface.triangles.size());
-  for (const auto& t : surface.triangles) mesh.triangles.emplace_back(t[0], t[1], t[2]);
-
-  openvdb::math::Transform::Ptr transform =
-      openvdb::math::Transform::createLinearTransform(options.voxel);
-  transform->postTranslate(openvdb::Vec3d(field->origin.x(), field->origin.y(), field->origin.z()));
-  const openvdb::tools::QuadAndTriangleDataAdapter<openvdb::Vec3s, openvdb::Vec3I> adapter(
-      points, mesh.triangles);
-  // Without renormalization: refineDistances() makes the values exact instead.
-  openvdb::Int32Grid::Ptr nearest = openvdb::Int32Grid::create();
-  openvdb::FloatGrid::Ptr distance = openvdb::tools::meshToVolume<openvdb::FloatGrid>(
-      adapter, *transform, static_cast<float>(options.exteriorBand / options.voxel),
-      static_cast<float>(options.interiorBand / options.voxel),
-      openvdb::tools::DISABLE_RENORMALIZATION, nearest.get());
-  const int sweeps =
+  IndexSpaceSurface index;
+  index.origin = field->origin;
+  index.voxel = options.voxel;
+  index.points.reserve(surface.vertices.size());
+  for (const Vec3& p : surface.vertices)
+    index.points.push_back((p - field->origin) / options.voxel);  // small: about the centre
+  index.triangles.assign(surface.triangles.begin(), surface.triangles.end());
+  index.exteriorVoxels = options.exteriorBand / options.voxel;
+  index.interiorVoxels = options.interiorBand / options.voxel;
+  index.sweeps =
       static_cast<int>(std::ceil((options.exteriorBand + options.interiorBand) / options.voxel));
-  refineDistances(distance->tree(), nearest->tree(), mesh, options.voxel, sweeps);
-  field->activeBox = distance->evalActiveVoxelBoundingBox();
-  field->gradient = openvdb::tools::gradient(*distance);
-  field->distance = distance;
+  field->grids = buildDistanceGrids(index);
 
   Obstacle o;
   o.velocity_ = velocity;
@@ -362,14 +205,13 @@ Box3 Obstacle::bounds(double t) const {
     return Box3(Vec3::Constant(-inf), Vec3::Constant(inf));
   }
   // Trilinear samples reach one voxel beyond the active voxels.
-  const openvdb::Coord lo = field_->activeBox.min(), hi = field_->activeBox.max();
+  const std::array<int, 6> active = field_->grids->activeBox();
+  const Vec3 lo(active[0], active[1], active[2]), hi(active[3], active[4], active[5]);
   const Vec3 shift = field_->origin + velocity_ * t;
-  return Box3(shift + field_->voxel * Vec3(lo.x() - 1, lo.y() - 1, lo.z() - 1),
-              shift + field_->voxel * Vec3(hi.x() + 1, hi.y() + 1, hi.z() + 1));
+  return Box3(shift + field_->voxel * (lo - Vec3::Ones()),
+              shift + field_->voxel * (hi + Vec3::Ones()));
 }
 
-std::size_t Obstacle::activeVoxels() const {
-  return field_ ? static_cast<std::size_t>(field_->distance->activeVoxelCount()) : 0;
-}
+std::size_t Obstacle::activeVoxels() const { return field_ ? field_->grids->activeVoxels() : 0; }
 
 }  // namespace polydg
