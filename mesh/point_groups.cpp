@@ -43,6 +43,8 @@ PointGroups groupPoints(const PolyMesh& mesh, const ElementCorners& corners) {
     }
     slot[i] = slot[root];
   }
+  // Without a second point for any vertex, every corner's point is its vertex: no list needed.
+  if (out.numPoints() == nv) return out;
   for (std::uint32_t& s : slot) s &= ~kKnown;
   out.cornerPoint = std::move(slot);
   return out;

@@ -33,7 +33,9 @@ struct ElementCorners {
 
 /// The points of a file and which corners use them.
 struct PointGroups {
-  /// Per corner (index into ElementCorners::vertices), its point.
+  /// Per corner (index into ElementCorners::vertices), its point; empty where every corner's
+  /// point is its vertex (no vertex has a second point, as in a mesh fresh from slicing), which
+  /// spares an entry per corner (54 MB for the bunny at 200 cells).
   std::vector<std::uint32_t> cornerPoint;
   /// Per point, the vertex it is a copy of. Points 0 .. numVertices()-1 are the vertices
   /// themselves (pointVertex[p] = p); later points are further copies, in order of their first
@@ -41,6 +43,10 @@ struct PointGroups {
   std::vector<VertexId> pointVertex;
 
   std::size_t numPoints() const { return pointVertex.size(); }
+  /// Corner i's point.
+  std::uint32_t point(const ElementCorners& corners, std::size_t i) const {
+    return cornerPoint.empty() ? corners.vertices[i].value : cornerPoint[i];
+  }
 };
 
 /// Groups the corners of each vertex: two elements' corners at vertex v are in one group when

@@ -196,8 +196,13 @@ CellStreams::CellStreams(const PolyMesh& mesh) : mesh_(mesh), records_(mesh) {
   connectivityEnd_ = RunningEnds(std::move(cornerCount));
   recordEnd_ = RunningEnds(inCellOrder(recordCount));
   faceEnd_ = RunningEnds(inCellOrder(streamCount));
-  for (std::uint32_t p : points_.cornerPoint)
-    largest_.point = std::max<std::int64_t>(largest_.point, p);
+  if (points_.cornerPoint.empty()) {
+    for (VertexId v : corners_.vertices)
+      largest_.point = std::max<std::int64_t>(largest_.point, v.value);
+  } else {
+    for (std::uint32_t p : points_.cornerPoint)
+      largest_.point = std::max<std::int64_t>(largest_.point, p);
+  }
   for (const Face& face : mesh.faces())
     largest_.origin = std::max(largest_.origin, static_cast<std::int64_t>(face.origin));
   for (VertexId v : points_.pointVertex)
@@ -268,7 +273,7 @@ GeneratedInts CellStreams::connectivity() const {
             fillByCell(connectivityEnd_, begin, end, out, [&](std::size_t c, Window& window) {
               const std::size_t e = order_[c].index();
               for (std::size_t i = corners_.begin[e]; i < corners_.begin[e + 1]; ++i)
-                window.put(points_.cornerPoint[i]);
+                window.put(points_.point(corners_, i));
             });
           }};
 }
@@ -284,25 +289,26 @@ GeneratedInts CellStreams::types() const {
 }
 
 GeneratedInts CellStreams::faces() const {
-  return {
-      faceEnd_.total(), std::max({largest_.point, largest_.recordsPerCell, largest_.recordSize}),
-      [this](std::size_t begin, std::size_t end, std::int64_t* out) {
-        CornerNumbers numbers;
-        fillByCell(faceEnd_, begin, end, out, [&](std::size_t c, Window& window) {
-          const ElementId e = order_[c];
-          const std::uint32_t* const point = points_.cornerPoint.data() + corners_.begin[e.index()];
-          window.put(static_cast<std::int64_t>(recordEnd_.end(c) - recordEnd_.begin(c)));
-          // The records' vertices are numbered as elementCorners numbered them.
-          forEachRecord(mesh_, records_, e, numbers,
-                        [&](const FaceUse& use, auto, std::span<const std::uint32_t> corner) {
-                          const std::size_t n = corner.size();
-                          window.put(static_cast<std::int64_t>(n));
-                          // Backwards keeps the first vertex first: v0, v(n-1), ..., v1.
-                          for (std::size_t i = 0; i < n; ++i)
-                            window.put(point[corner[use.reversed ? (n - i) % n : i]]);
-                        });
-        });
-      }};
+  return {faceEnd_.total(),
+          std::max({largest_.point, largest_.recordsPerCell, largest_.recordSize}),
+          [this](std::size_t begin, std::size_t end, std::int64_t* out) {
+            CornerNumbers numbers;
+            fillByCell(faceEnd_, begin, end, out, [&](std::size_t c, Window& window) {
+              const ElementId e = order_[c];
+              const std::size_t first = corners_.begin[e.index()];
+              window.put(static_cast<std::int64_t>(recordEnd_.end(c) - recordEnd_.begin(c)));
+              // The records' vertices are numbered as elementCorners numbered them.
+              forEachRecord(mesh_, records_, e, numbers,
+                            [&](const FaceUse& use, auto, std::span<const std::uint32_t> corner) {
+                              const std::size_t n = corner.size();
+                              window.put(static_cast<std::int64_t>(n));
+                              // Backwards keeps the first vertex first: v0, v(n-1), ..., v1.
+                              for (std::size_t i = 0; i < n; ++i)
+                                window.put(points_.point(
+                                    corners_, first + corner[use.reversed ? (n - i) % n : i]));
+                            });
+            });
+          }};
 }
 
 GeneratedInts CellStreams::faceOffsets() const {

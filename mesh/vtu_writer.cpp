@@ -139,8 +139,8 @@ std::vector<double> cornerMeans(const CellStreams& s, const CornerArray& a) {
                     });
   std::vector<double> mean(points.numPoints() * k, 0.0);
   std::vector<std::uint32_t> count(points.numPoints(), 0);
-  for (std::size_t i = 0; i < points.cornerPoint.size(); ++i) {
-    const std::size_t p = points.cornerPoint[i];
+  for (std::size_t i = 0; i < corners.vertices.size(); ++i) {
+    const std::size_t p = points.point(corners, i);
     ++count[p];
     for (std::size_t c = 0; c < k; ++c) mean[p * k + c] += corner[i * k + c];
   }

@@ -103,7 +103,8 @@ WholeArrays wholeArrays(const PolyMesh& mesh, const PointGroups& points) {
   auto pointOf = [&](ElementId e, VertexId v) {
     const auto& corners = w.corners[e.index()];
     const std::size_t i = std::find(corners.begin(), corners.end(), v) - corners.begin();
-    return static_cast<std::int64_t>(points.cornerPoint[cornerBegin[e.index()] + i]);
+    return static_cast<std::int64_t>(
+        points.cornerPoint.empty() ? v.value : points.cornerPoint[cornerBegin[e.index()] + i]);
   };
   for (ElementId e : w.order) {
     for (VertexId v : w.corners[e.index()]) w.connectivity.push_back(pointOf(e, v));
