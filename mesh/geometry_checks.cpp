@@ -199,63 +199,77 @@ ElementData<std::uint32_t> connectedComponents(const PolyMesh& mesh, std::size_t
 
 namespace {
 
-/// What checkGeometry() finds about one face in parallel.
-struct FaceCheck {
-  std::uint64_t key = 0;  ///< hash of the sorted vertex ids
+/// A face whose shape checkGeometry() reports.
+struct FaceProblem {
+  std::uint32_t face = 0;
   /// Relative deviation, if beyond the tolerance, else 0 (single precision: for the message).
   float planarity = 0.0f;
   bool degenerate = false;
 };
 
-/// Every face's FaceCheck. (Area vectors are not kept for the elements' volumes: computing
-/// them again costs less than holding one per face beside the mesh, for millions of faces.)
+/// What checkGeometry() measures of the faces in parallel: each face's vertex-set hash, and the
+/// faces with a shape problem, in face order (there are seldom any, so none of the rest is kept
+/// per face; nor are area vectors for the elements' volumes: computing them again costs less
+/// than holding one per face beside the mesh, for millions of faces).
 struct FaceMeasures {
-  std::vector<FaceCheck> checks;
+  std::vector<std::uint64_t> keys;  ///< hash of the sorted vertex ids
+  std::vector<FaceProblem> problems;
 };
 
 /// Shape and planarity of every face, in parallel (the costly part of the face checks).
 FaceMeasures measureFaces(const PolyMesh& mesh, const GeometryCheckOptions& options) {
-  FaceMeasures m{residentVector<FaceCheck>(mesh.numFaces())};
-  std::vector<FaceCheck>& checks = m.checks;
+  FaceMeasures m{residentVector<std::uint64_t>(mesh.numFaces()), {}};
+  tbb::enumerable_thread_specific<std::vector<FaceProblem>> found;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.numFaces(), 1024),
                     [&](const tbb::blocked_range<std::size_t>& r) {
                       for (std::size_t i = r.begin(); i != r.end(); ++i) {
                         const FaceId f(i);
-                        FaceCheck& c = checks[i];
                         const Face& face = mesh.face(f);
-                        c.key = vertexSetKey({face.vertices.data(), face.vertices.size()});
+                        m.keys[i] = vertexSetKey({face.vertices.data(), face.vertices.size()});
                         const Vec3 area = areaVector(mesh, f);
-                        c.degenerate = isDegenerateFace(mesh, f, area);
-                        if (c.degenerate) continue;
-                        const Box3 box = faceBounds(mesh, f);
-                        const double deviation = planarityDeviation(mesh, f, area);
-                        const double resolution = 16.0 * std::numeric_limits<double>::epsilon() *
-                                                  std::max(box.min().cwiseAbs().maxCoeff(),
-                                                           box.max().cwiseAbs().maxCoeff());
-                        const double diameter = box.diagonal().norm();
-                        if (deviation > options.planarityTolerance * diameter + resolution)
-                          c.planarity = static_cast<float>(deviation / diameter);
+                        FaceProblem problem{static_cast<std::uint32_t>(i)};
+                        problem.degenerate = isDegenerateFace(mesh, f, area);
+                        if (!problem.degenerate) {
+                          const Box3 box = faceBounds(mesh, f);
+                          const double deviation = planarityDeviation(mesh, f, area);
+                          const double resolution = 16.0 * std::numeric_limits<double>::epsilon() *
+                                                    std::max(box.min().cwiseAbs().maxCoeff(),
+                                                             box.max().cwiseAbs().maxCoeff());
+                          const double diameter = box.diagonal().norm();
+                          if (deviation > options.planarityTolerance * diameter + resolution)
+                            problem.planarity = static_cast<float>(deviation / diameter);
+                        }
+                        if (problem.degenerate || problem.planarity > 0)
+                          found.local().push_back(problem);
                       }
                     });
+  for (const std::vector<FaceProblem>& list : found)
+    m.problems.insert(m.problems.end(), list.begin(), list.end());
+  std::sort(m.problems.begin(), m.problems.end(),
+            [](const FaceProblem& x, const FaceProblem& y) { return x.face < y.face; });
   return m;
 }
 
 /// Counts interior and boundary faces and reports, face by face in order, shape, planarity
 /// and links to elements.
-void reportFaces(const PolyMesh& mesh, const std::vector<FaceCheck>& checks, Problems& problems,
+void reportFaces(const PolyMesh& mesh, const std::vector<FaceProblem>& shapes, Problems& problems,
                  GeometryCheck& report) {
+  auto shape = shapes.begin();
   for (std::size_t i = 0; i < mesh.numFaces(); ++i) {
     const Face& face = mesh.face(FaceId(i));
     if (face.front.valid() && face.back.valid())
       ++report.interiorFaces;
     else if (face.front.valid() || face.back.valid())
       ++report.boundaryFaces;
-    if (checks[i].degenerate) {
-      problems.add(report.degenerateFaces, describe("degenerate face", i));
-    } else if (checks[i].planarity > 0) {
-      std::ostringstream msg;
-      msg << "face " << i << " is not planar (relative error " << checks[i].planarity << ")";
-      problems.add(report.nonPlanarFaces, msg.str());
+    if (shape != shapes.end() && shape->face == i) {
+      if (shape->degenerate) {
+        problems.add(report.degenerateFaces, describe("degenerate face", i));
+      } else {
+        std::ostringstream msg;
+        msg << "face " << i << " is not planar (relative error " << shape->planarity << ")";
+        problems.add(report.nonPlanarFaces, msg.str());
+      }
+      ++shape;
     }
     if (!face.front.valid() && !face.back.valid()) {
       problems.add(report.inconsistentFaces, describe("face not used by any element:", i));
@@ -271,7 +285,7 @@ void reportFaces(const PolyMesh& mesh, const std::vector<FaceCheck>& checks, Pro
 /// faces are placed by it (a counting sort, in face order within each vertex) and compared only
 /// with those of the same smallest vertex, by their vertex-set hash and then their sorted
 /// vertices. The pairs found are reported in order of their faces.
-void reportDuplicateFaces(const PolyMesh& mesh, const std::vector<FaceCheck>& checks,
+void reportDuplicateFaces(const PolyMesh& mesh, const std::vector<std::uint64_t>& keys,
                           Problems& problems, GeometryCheck& report) {
   const std::size_t nf = mesh.numFaces();
   // Each face's smallest vertex; faces without vertices all go to the last place.
@@ -305,7 +319,7 @@ void reportDuplicateFaces(const PolyMesh& mesh, const std::vector<FaceCheck>& ch
                         for (std::size_t x = start[v]; x < start[v + 1]; ++x)
                           for (std::size_t y = x + 1; y < start[v + 1]; ++y) {
                             const std::uint32_t a = byVertex[x], b = byVertex[y];
-                            if (checks[a].key == checks[b].key && sortedIds(a) == sortedIds(b) &&
+                            if (keys[a] == keys[b] && sortedIds(a) == sortedIds(b) &&
                                 !areCutSides(mesh, FaceId(a), FaceId(b)))
                               found.local().emplace_back(a, b);
                           }
@@ -322,8 +336,7 @@ void reportDuplicateFaces(const PolyMesh& mesh, const std::vector<FaceCheck>& ch
 
 /// Elements: closure and volume in parallel (they are the costly part), then links back to
 /// faces and the report in order.
-void reportElements(const PolyMesh& mesh, const FaceMeasures& faces, Problems& problems,
-                    GeometryCheck& report) {
+void reportElements(const PolyMesh& mesh, Problems& problems, GeometryCheck& report) {
   // Per element, in parallel: closed, linked (each face it uses lists it on that side), volume.
   enum : char { kClosed = 1, kLinked = 2 };
   std::vector<char> state(mesh.numElements());
@@ -387,10 +400,12 @@ GeometryCheck checkGeometry(const PolyMesh& mesh, const GeometryCheckOptions& op
   report.elements = mesh.numElements();
   report.faces = mesh.numFaces();
   // Faces: shape and planarity in parallel, then links, duplicates and the report in order.
-  const FaceMeasures faces = measureFaces(mesh, options);
-  reportFaces(mesh, faces.checks, problems, report);
-  reportDuplicateFaces(mesh, faces.checks, problems, report);
-  reportElements(mesh, faces, problems, report);
+  {
+    const FaceMeasures faces = measureFaces(mesh, options);
+    reportFaces(mesh, faces.problems, problems, report);
+    reportDuplicateFaces(mesh, faces.keys, problems, report);
+  }  // the keys are freed before the elements' arrays are made
+  reportElements(mesh, problems, report);
 
   connectedComponents(mesh, report.components);
   report.passed = report.openElements == 0 && report.nonPositiveElements == 0 &&

@@ -2,6 +2,8 @@
 // and names each kind of defect: open, inverted, non-planar, duplicated, disconnected.
 #include "polydg/mesh/geometry_checks.h"
 
+#include <set>
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -152,6 +154,32 @@ TEST(GeometryChecks, RejectsNonPlanarFace) {
   EXPECT_EQ(r.nonPlanarFaces, 3u);  // the three faces meeting at the moved corner
   ASSERT_FALSE(r.messages.empty());
   EXPECT_NE(r.messages[0].find("not planar"), std::string::npos);
+}
+
+TEST(GeometryChecks, ReportsShapeProblemsInFaceOrderOnALargeMesh) {
+  // Faces measured on both cores, in many ranges: the faces at scattered moved corners are
+  // counted once each and named in face order.
+  PolyMesh mesh = hexGridMesh(40, 40, 40, Box3(Vec3(0, 0, 0), Vec3(1, 1, 1)));
+  std::set<VertexId> moved;
+  for (std::size_t v = 977; v < mesh.numVertices(); v += 2203) moved.insert(VertexId(v));
+  ASSERT_GT(moved.size(), 25u);
+  for (VertexId v : moved) mesh.positions()[v] += Vec3(0.001, 0.001, 0.001);
+  std::vector<std::size_t> expected;  // the faces with a moved corner: off their plane
+  for (std::size_t f = 0; f < mesh.numFaces(); ++f) {
+    const auto& vs = mesh.face(FaceId(f)).vertices;
+    if (std::any_of(vs.begin(), vs.end(), [&](VertexId v) { return moved.contains(v); }))
+      expected.push_back(f);
+  }
+  GeometryCheckOptions options;
+  options.maxMessages = expected.size();
+  const GeometryCheck r = checkGeometry(mesh, options);
+  EXPECT_FALSE(r.passed);
+  EXPECT_EQ(r.nonPlanarFaces, expected.size());
+  EXPECT_EQ(r.degenerateFaces, 0u);
+  ASSERT_EQ(r.messages.size(), expected.size());
+  for (std::size_t i = 0; i < expected.size(); ++i)
+    EXPECT_EQ(r.messages[i].rfind("face " + std::to_string(expected[i]) + " is not planar", 0), 0u)
+        << r.messages[i];
 }
 
 TEST(GeometryChecks, RejectsDegenerateFaceAndEmptyMesh) {
