@@ -1,7 +1,7 @@
 // Solids a moving body collides with (the ground, a bowl, any closed surface), asked for the
 // signed distance and the outward normal at points of the body: the geometry of collision
-// handling. A surface becomes a narrow-band signed distance field (OpenVDB, kept inside
-// obstacles.cpp); a half-space is exact.
+// handling. A surface becomes a narrow-band signed distance field (OpenVDB, in a module of its
+// own that is loaded when the first one is built: distance_grids.h); a half-space is exact.
 #pragma once
 
 #include <cstddef>
@@ -54,10 +54,10 @@ class Obstacle {
   /// The inside of a closed, consistently and outward oriented triangle surface (several
   /// disjoint shells allowed), as a narrow-band signed distance field: OpenVDB's
   /// tools::meshToVolume() for the band and the sign, its values then made exact distances to
-  /// the triangles (obstacles.cpp: refineDistances()). Distances are sampled trilinearly from
-  /// the voxels; the normal is the normalized trilinear sample of the field's gradient
-  /// (tools::gradient(), central differences), so it varies continuously. Accuracy, on a unit
-  /// icosphere (levels 5) with voxel 0.02: distances within 3e-4 of the sphere's (about the
+  /// the triangles (distance_grids_openvdb.cpp: refineDistances()). Distances are sampled
+  /// trilinearly from the voxels; the normal is the normalized trilinear sample of the field's
+  /// gradient (tools::gradient(), central differences), so it varies continuously. Accuracy, on a
+  /// unit icosphere (levels 5) with voxel 0.02: distances within 3e-4 of the sphere's (about the
   /// mesh's own deviation from it), normals within half a degree. The field is built about the
   /// surface's bounding-box centre, so far from the origin it is as accurate as at it. Throws
   /// std::invalid_argument, naming what is wrong, for an empty or open surface
