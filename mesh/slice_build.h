@@ -27,11 +27,11 @@ struct SliceLeaf {
 
 /// The mesh of `leaves` (sorted by cell, then part), whose polygons use `points`: the
 /// splitter's, then, from `firstGenerated` on, those made for whole cells (the octree's boxes,
-/// or `whole`'s grid nodes). Counts what rounding did in `stats`, frees the leaves' pieces and
-/// the points as soon as they are read (before the mesh's arrays are made), and gives each
-/// element's leaf's cell and level to `elementCell` and `elementLevel` (optional), and to
-/// `elementWhole` (optional) 1 for a whole cell none of whose corners welding moved (the
-/// grid's box on six quadrilaterals of grid nodes), else 0.
+/// or `whole`'s grid nodes). Counts what rounding did in `stats`, frees the leaves (`leaves`
+/// is left empty) and the points as soon as they are read (before the mesh's arrays are made), and
+/// gives each element's leaf's cell and level to `elementCell` and `elementLevel` (optional), and
+/// to `elementWhole` (optional) 1 for a whole cell none of whose corners welding moved (the grid's
+/// box on six quadrilaterals of grid nodes), else 0.
 PolyMesh buildSliceMesh(std::vector<SliceLeaf>& leaves, const WholeCells& whole, bool octree,
                         std::size_t firstGenerated, std::vector<Vec3> points, SliceStats& stats,
                         std::vector<std::array<int, 3>>* elementCell,
