@@ -20,6 +20,7 @@
 #include "polydg/mesh/merge_elements.h"
 #include "polydg/mesh/surface_io.h"
 #include "polydg/mesh/surface_shapes.h"
+#include "tests/support/identical_meshes.h"
 
 namespace polydg {
 namespace {
@@ -381,16 +382,7 @@ TEST(Slice, WholeCellFlagsMarkExactGridBoxesAndMergeSliversAlike) {
     EXPECT_EQ(flags.merged, plain.merged);
     EXPECT_EQ(flags.isolated, plain.isolated);
     EXPECT_EQ(flags.group, plain.group);
-    ASSERT_EQ(a.numFaces(), b.numFaces());
-    std::size_t differing = 0;
-    for (std::size_t f = 0; f < a.numFaces(); ++f) {
-      const Face& x = a.face(FaceId(f));
-      const Face& y = b.face(FaceId(f));
-      differing +=
-          x.front != y.front || x.back != y.back ||
-          !std::equal(x.vertices.begin(), x.vertices.end(), y.vertices.begin(), y.vertices.end());
-    }
-    EXPECT_EQ(differing, 0u);
+    testing::expectIdenticalMeshes(a, b);
   }
 }
 
