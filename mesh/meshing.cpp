@@ -11,6 +11,7 @@
 #include <string>
 
 #include "mesh/surface_repair.h"
+#include "mesh/whole_cells.h"
 #include "util/format.h"
 #include "util/held_memory.h"
 #include "util/stopwatch.h"
@@ -147,14 +148,9 @@ void orientAndSlice(const TriangleSurface& closed, double cellSize, const Meshin
     result.mesh =
         mergeSlivers(std::move(sliced), options.sliverTau * finestCell, &merge, result.wholeCells);
     r.slivers = {merge.threshold, merge.slivers, merge.merged, merge.isolated};
-    if (!result.wholeCells.empty() && result.mesh.numElements() != merge.group.size()) {
-      // A merged element is a whole cell only if all its parts are, that is, if it is one
-      // alone (no sliver is a whole cell).
-      std::vector<char> whole(result.mesh.numElements(), 1);
-      for (std::size_t e = 0; e < merge.group.size(); ++e)
-        whole[merge.group[e]] &= result.wholeCells[e];
-      result.wholeCells = std::move(whole);
-    }
+    if (result.mesh.numElements() != merge.group.size())
+      result.wholeCells =
+          mergeWholeFlags(result.wholeCells, merge.group, result.mesh.numElements());
     if (levels > 0) {
       // A merged element is at the finest level of its parts.
       std::vector<int> merged(result.mesh.numElements(), 0);

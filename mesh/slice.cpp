@@ -317,22 +317,18 @@ PolyMesh slice(const TriangleSurface& surface, const Grid& grid, const SurfaceOc
   slicer.stats.mergedElements = merge.merged;
   slicer.stats.droppedElements = merge.dropped;
   if (merge.merged > 0 || merge.dropped > 0) {
-    // A merged element keeps its first part's cell and the finest of its parts' levels; it is
-    // a whole cell only if all its parts are, that is, if it is one alone (a degenerate
-    // element is none).
+    // A merged element keeps its first part's cell and the finest of its parts' levels.
     std::vector<std::array<int, 3>> mergedCells(elementCell ? mesh.numElements() : 0);
     std::vector<int> mergedLevels(elementLevel ? mesh.numElements() : 0, 0);
-    std::vector<char> mergedWhole(whole.empty() ? 0 : mesh.numElements(), 1);
     for (std::size_t e = merge.group.size(); e-- > 0;) {
       const std::uint32_t g = merge.group[e];
       if (g == kDroppedElement) continue;
       if (elementCell) mergedCells[g] = cells[e];
       if (elementLevel) mergedLevels[g] = std::max(mergedLevels[g], levels[e]);
-      if (!whole.empty()) mergedWhole[g] &= whole[e];
     }
     cells = std::move(mergedCells);
     levels = std::move(mergedLevels);
-    whole = std::move(mergedWhole);
+    whole = mergeWholeFlags(whole, merge.group, mesh.numElements());
   }
   if (elementCell) *elementCell = std::move(cells);
   if (elementLevel) *elementLevel = std::move(levels);

@@ -5,6 +5,15 @@
 
 namespace polydg {
 
+std::vector<char> mergeWholeFlags(const std::vector<char>& whole,
+                                  const std::vector<std::uint32_t>& group, std::size_t elements) {
+  if (whole.empty()) return {};
+  std::vector<char> merged(elements, 1);
+  for (std::size_t e = 0; e < group.size(); ++e)
+    if (group[e] != kDroppedElement) merged[group[e]] &= whole[e];
+  return merged;
+}
+
 bool WholeCells::isWholeBox(const Piece& piece) {
   return piece.size() == 6 && std::all_of(piece.begin(), piece.end(), [](const PiecePolygon& p) {
            return p.origin == FaceOrigin::Interior && p.vertices.size() == 4 && p.numLoops() == 1;

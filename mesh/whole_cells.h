@@ -17,6 +17,12 @@
 
 namespace polydg {
 
+/// Whole-cell flags (one per element, or none) after elements are merged: `group[e]` is element
+/// e's new element (of `elements`), or kDroppedElement. A merged element is a whole cell only if
+/// all its parts are, that is, if it is one alone (no element a merge joins is one).
+std::vector<char> mergeWholeFlags(const std::vector<char>& whole,
+                                  const std::vector<std::uint32_t>& group, std::size_t elements);
+
 class WholeCells {
  public:
   explicit WholeCells(const Grid& grid) : grid_(grid) {}
