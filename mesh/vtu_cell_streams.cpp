@@ -196,13 +196,8 @@ CellStreams::CellStreams(const PolyMesh& mesh) : mesh_(mesh), records_(mesh) {
   connectivityEnd_ = RunningEnds(std::move(cornerCount));
   recordEnd_ = RunningEnds(inCellOrder(recordCount));
   faceEnd_ = RunningEnds(inCellOrder(streamCount));
-  if (points_.cornerPoint.empty()) {
-    for (VertexId v : corners_.vertices)
-      largest_.point = std::max<std::int64_t>(largest_.point, v.value);
-  } else {
-    for (std::uint32_t p : points_.cornerPoint)
-      largest_.point = std::max<std::int64_t>(largest_.point, p);
-  }
+  for (std::size_t i = 0; i < corners_.vertices.size(); ++i)
+    largest_.point = std::max<std::int64_t>(largest_.point, points_.point(corners_, i));
   for (const Face& face : mesh.faces())
     largest_.origin = std::max(largest_.origin, static_cast<std::int64_t>(face.origin));
   for (VertexId v : points_.pointVertex)
