@@ -35,21 +35,11 @@ MomentCache::MomentCache(const PolyMesh& mesh, int degree)
   sync();
 }
 
-namespace {
-/// v resized to n, the pages of a growth made resident on all cores first (a cache of a mesh
-/// of millions of faces is hundreds of MB, which one thread would fault in alone).
-template <class T>
-void growResident(std::vector<T>& v, std::size_t n, const T& value) {
-  if (n > v.capacity()) v.reserve(std::max(n, 2 * v.capacity()));
-  if (n > v.size()) makeResident(v.data() + v.size(), (n - v.size()) * sizeof(T));
-  v.resize(n, value);
-}
-}  // namespace
-
 void MomentCache::sync() {
   const std::size_t nf = mesh_->numFaces(), ne = mesh_->numElements();
   const std::size_t oldFaces = std::min(faceNormals_.size(), nf);
   const std::size_t oldElements = std::min(elementOrigins_.size(), ne);
+  // A cache of millions of faces is hundreds of MB, which one thread would fault in alone.
   growResident(faceMoments_, nf * stride_, 0.0);
   growResident(elementMoments_, ne * stride_, 0.0);
   growResident(faceNormals_.raw(), nf, Vec3(Vec3::Zero()));

@@ -6,6 +6,7 @@
 
 #include <sys/mman.h>
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -46,14 +47,22 @@ inline void makeResident(void* data, std::size_t bytes) {
 #endif
 }
 
-/// `size` value-initialized T in a vector whose pages were made resident first (makeResident):
-/// the constructing pass is then a plain serial write.
+/// Resizes `v` to n, the pages of a growth made resident first (makeResident), so that the
+/// constructing pass is a plain serial write; new elements are copies of `value`, or
+/// value-initialized without it. Grows geometrically, as std::vector does.
+template <class T, class... Value>
+void growResident(std::vector<T>& v, std::size_t n, const Value&... value) {
+  static_assert(sizeof...(Value) <= 1);
+  if (n > v.capacity()) v.reserve(std::max(n, 2 * v.capacity()));
+  if (n > v.size()) makeResident(v.data() + v.size(), (n - v.size()) * sizeof(T));
+  v.resize(n, value...);
+}
+
+/// `size` value-initialized T in a vector whose pages were made resident first.
 template <class T>
 std::vector<T> residentVector(std::size_t size) {
   std::vector<T> v;
-  v.reserve(size);
-  makeResident(v.data(), size * sizeof(T));
-  v.resize(size);
+  growResident(v, size);
   return v;
 }
 
