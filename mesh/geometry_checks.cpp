@@ -1,6 +1,7 @@
 #include "polydg/mesh/geometry_checks.h"
 
 #include <algorithm>
+#include <atomic>
 #include <unordered_map>
 
 #include <tbb/enumerable_thread_specific.h>
@@ -13,9 +14,9 @@
 #include <numeric>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 
 #include "polydg/mesh/geometry.h"
-#include "util/resident.h"
 #include "util/union_find.h"
 
 namespace polydg {
@@ -207,25 +208,17 @@ struct FaceProblem {
   bool degenerate = false;
 };
 
-/// What checkGeometry() measures of the faces in parallel: each face's vertex-set hash, and the
-/// faces with a shape problem, in face order (there are seldom any, so none of the rest is kept
-/// per face; nor are area vectors for the elements' volumes: computing them again costs less
-/// than holding one per face beside the mesh, for millions of faces).
-struct FaceMeasures {
-  std::vector<std::uint64_t> keys;  ///< hash of the sorted vertex ids
-  std::vector<FaceProblem> problems;
-};
-
-/// Shape and planarity of every face, in parallel (the costly part of the face checks).
-FaceMeasures measureFaces(const PolyMesh& mesh, const GeometryCheckOptions& options) {
-  FaceMeasures m{residentVector<std::uint64_t>(mesh.numFaces()), {}};
+/// The faces with a shape problem (degenerate, or not planar enough), found in parallel and
+/// listed in face order. There are seldom any, so nothing is kept for the other faces: not their
+/// area vectors (the elements' volumes compute them again, which costs less than holding one
+/// per face beside the mesh), nor their vertex-set hashes (the duplicate search makes them
+/// where it compares faces).
+std::vector<FaceProblem> measureFaces(const PolyMesh& mesh, const GeometryCheckOptions& options) {
   tbb::enumerable_thread_specific<std::vector<FaceProblem>> found;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.numFaces(), 1024),
                     [&](const tbb::blocked_range<std::size_t>& r) {
                       for (std::size_t i = r.begin(); i != r.end(); ++i) {
                         const FaceId f(i);
-                        const Face& face = mesh.face(f);
-                        m.keys[i] = vertexSetKey({face.vertices.data(), face.vertices.size()});
                         const Vec3 area = areaVector(mesh, f);
                         FaceProblem problem{static_cast<std::uint32_t>(i)};
                         problem.degenerate = isDegenerateFace(mesh, f, area);
@@ -243,11 +236,12 @@ FaceMeasures measureFaces(const PolyMesh& mesh, const GeometryCheckOptions& opti
                           found.local().push_back(problem);
                       }
                     });
+  std::vector<FaceProblem> problems;
   for (const std::vector<FaceProblem>& list : found)
-    m.problems.insert(m.problems.end(), list.begin(), list.end());
-  std::sort(m.problems.begin(), m.problems.end(),
+    problems.insert(problems.end(), list.begin(), list.end());
+  std::sort(problems.begin(), problems.end(),
             [](const FaceProblem& x, const FaceProblem& y) { return x.face < y.face; });
-  return m;
+  return problems;
 }
 
 /// Counts interior and boundary faces and reports, face by face in order, shape, planarity
@@ -284,28 +278,34 @@ void reportFaces(const PolyMesh& mesh, const std::vector<FaceProblem>& shapes, P
 /// Duplicates: faces with the same vertex set. Such faces share their smallest vertex, so the
 /// faces are placed by it (a counting sort, in face order within each vertex) and compared only
 /// with those of the same smallest vertex, by their vertex-set hash and then their sorted
-/// vertices. The pairs found are reported in order of their faces.
-void reportDuplicateFaces(const PolyMesh& mesh, const std::vector<std::uint64_t>& keys,
-                          Problems& problems, GeometryCheck& report) {
+/// vertices. The pairs found are reported in order of their faces. Besides the mesh this holds
+/// one 32-bit id per face and one count per vertex: the smallest vertex is found again where the
+/// faces are placed rather than kept per face.
+void reportDuplicateFaces(const PolyMesh& mesh, Problems& problems, GeometryCheck& report) {
   const std::size_t nf = mesh.numFaces();
-  // Each face's smallest vertex; faces without vertices all go to the last place.
+  // Faces without vertices all go to the place after the last vertex.
   const auto none = static_cast<std::uint32_t>(mesh.numVertices());
-  std::vector<std::uint32_t> smallest(nf);
-  tbb::parallel_for(std::size_t(0), nf, [&](std::size_t f) {
+  auto smallest = [&](std::size_t f) {
     std::uint32_t m = none;
     for (const VertexId v : mesh.face(FaceId(f)).vertices) m = std::min(m, v.value);
-    smallest[f] = m;
-  });
-  std::vector<std::size_t> start(std::size_t(none) + 2, 0);
-  for (const std::uint32_t m : smallest) ++start[m + 1];
-  std::partial_sum(start.begin(), start.end(), start.begin());
+    return m;
+  };
+  if (nf > std::numeric_limits<std::uint32_t>::max())
+    throw std::length_error("checkGeometry: more than 2^32 - 1 faces");
+  // end[m + 1] counts the faces of smallest vertex m, then (summed) is where m's faces end;
+  // placing the faces from the last down moves it to where they begin, so that m's faces are
+  // byVertex[end[m + 1] .. end[m + 2]), in increasing order.
+  std::vector<std::uint32_t> end(std::size_t(none) + 3, 0);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nf, 4096),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t f = r.begin(); f != r.end(); ++f)
+                        std::atomic_ref<std::uint32_t>(end[smallest(f) + 1])
+                            .fetch_add(1, std::memory_order_relaxed);
+                    });
+  std::inclusive_scan(end.begin(), end.end(), end.begin());
   std::vector<std::uint32_t> byVertex(nf);
-  {
-    std::vector<std::size_t> next(start.begin(), start.end() - 1);
-    for (std::size_t f = 0; f < nf; ++f)
-      byVertex[next[smallest[f]]++] = static_cast<std::uint32_t>(f);
-  }
-  std::vector<std::uint32_t>().swap(smallest);
+  for (std::size_t f = nf; f-- > 0;)
+    byVertex[--end[smallest(f) + 1]] = static_cast<std::uint32_t>(f);
   auto sortedIds = [&](std::size_t f) {
     boost::container::small_vector<VertexId, 8> ids(mesh.face(FaceId(f)).vertices.begin(),
                                                     mesh.face(FaceId(f)).vertices.end());
@@ -313,17 +313,27 @@ void reportDuplicateFaces(const PolyMesh& mesh, const std::vector<std::uint64_t>
     return ids;
   };
   tbb::enumerable_thread_specific<std::vector<std::pair<std::uint32_t, std::uint32_t>>> found;
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, start.size() - 1, 4096),
-                    [&](const tbb::blocked_range<std::size_t>& r) {
-                      for (std::size_t v = r.begin(); v != r.end(); ++v)
-                        for (std::size_t x = start[v]; x < start[v + 1]; ++x)
-                          for (std::size_t y = x + 1; y < start[v + 1]; ++y) {
-                            const std::uint32_t a = byVertex[x], b = byVertex[y];
-                            if (keys[a] == keys[b] && sortedIds(a) == sortedIds(b) &&
-                                !areCutSides(mesh, FaceId(a), FaceId(b)))
-                              found.local().emplace_back(a, b);
-                          }
-                    });
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, std::size_t(none) + 1, 4096),
+      [&](const tbb::blocked_range<std::size_t>& r) {
+        boost::container::small_vector<std::uint64_t, 16> keys;
+        for (std::size_t v = r.begin(); v != r.end(); ++v) {
+          const std::uint32_t first = end[v + 1], last = end[v + 2];
+          if (last - first < 2) continue;
+          keys.clear();
+          for (std::uint32_t x = first; x < last; ++x) {
+            const Face& face = mesh.face(FaceId(std::size_t(byVertex[x])));
+            keys.push_back(vertexSetKey({face.vertices.data(), face.vertices.size()}));
+          }
+          for (std::uint32_t x = first; x < last; ++x)
+            for (std::uint32_t y = x + 1; y < last; ++y) {
+              const std::uint32_t a = byVertex[x], b = byVertex[y];
+              if (keys[x - first] == keys[y - first] && sortedIds(a) == sortedIds(b) &&
+                  !areCutSides(mesh, FaceId(std::size_t(a)), FaceId(std::size_t(b))))
+                found.local().emplace_back(a, b);
+            }
+        }
+      });
   std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
   for (const auto& list : found) pairs.insert(pairs.end(), list.begin(), list.end());
   std::sort(pairs.begin(), pairs.end());
@@ -400,11 +410,8 @@ GeometryCheck checkGeometry(const PolyMesh& mesh, const GeometryCheckOptions& op
   report.elements = mesh.numElements();
   report.faces = mesh.numFaces();
   // Faces: shape and planarity in parallel, then links, duplicates and the report in order.
-  {
-    const FaceMeasures faces = measureFaces(mesh, options);
-    reportFaces(mesh, faces.problems, problems, report);
-    reportDuplicateFaces(mesh, faces.keys, problems, report);
-  }  // the keys are freed before the elements' arrays are made
+  reportFaces(mesh, measureFaces(mesh, options), problems, report);
+  reportDuplicateFaces(mesh, problems, report);
   reportElements(mesh, problems, report);
 
   connectedComponents(mesh, report.components);

@@ -7,6 +7,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdio>
+#include <string>
 
 #include "mesh/primitives.h"
 #include "polydg/mesh/geometry.h"
@@ -122,6 +124,40 @@ TEST(GeometryChecks, FindsEveryDuplicatedFace) {
   EXPECT_EQ(r.duplicateFaces, 46u);
   EXPECT_EQ(r.nonPositiveElements, 12u);
   EXPECT_EQ(r.openElements, 0u);
+}
+
+TEST(GeometryChecks, FindsADuplicateFaceAloneAtItsSmallestVertex) {
+  // Two stacked cells, the lower turned inside out, with the corners of the face they share
+  // numbered last: that face's two copies are then the only faces whose smallest vertex is one
+  // of those corners (every other face has a corner off the shared plane, numbered lower).
+  const PolyMesh grid = hexGridMesh(1, 1, 2, Box3(Vec3(0, 0, 0), Vec3(1, 1, 2)));
+  std::vector<VertexId> renumbered(grid.numVertices());
+  PolyMesh mesh;
+  for (const bool shared : {false, true})
+    for (std::size_t v = 0; v < grid.numVertices(); ++v)
+      if ((grid.position(VertexId(v)).z() == 1.0) == shared)
+        renumbered[v] = mesh.addVertex(grid.position(VertexId(v)));
+  for (std::size_t e = 0; e < grid.numElements(); ++e) {
+    std::vector<std::vector<Loop>> boundary;
+    for (const FaceUse& use : grid.element(ElementId(e)).faces) {
+      Loop loop;
+      for (const VertexId v : grid.face(use.face).vertices) loop.push_back(renumbered[v.index()]);
+      if (use.reversed != (e == 0)) std::reverse(loop.begin(), loop.end());
+      boundary.push_back({loop});
+    }
+    mesh.addElement(boundary, FaceOrigin::Box);
+  }
+  const GeometryCheck r = checkGeometry(mesh);
+  EXPECT_EQ(r.duplicateFaces, 1u);
+  EXPECT_EQ(r.nonPositiveElements, 1u);
+  EXPECT_EQ(r.openElements, 0u);
+  // Reported with the lower face first.
+  const auto message = std::find_if(r.messages.begin(), r.messages.end(),
+                                    [](const std::string& m) { return m.rfind("faces ", 0) == 0; });
+  ASSERT_NE(message, r.messages.end());
+  unsigned first = 0, second = 0;
+  ASSERT_EQ(std::sscanf(message->c_str(), "faces %u and %u", &first, &second), 2);
+  EXPECT_LT(first, second);
 }
 
 TEST(GeometryChecks, RejectsFaceLinksThatDisagree) {
