@@ -37,17 +37,21 @@ class SliceBuilder {
     WeldedVertices vertices = weldPoints(points);
     std::vector<Vec3>().swap(points);
     findFreeSides(vertices);
-    const LeafOffsets at = leafOffsets();
-    const LeafPolygons polygons = weldPolygons(at, vertices);
+    LeafOffsets at = leafOffsets();
+    LeafPolygons polygons = weldPolygons(at, vertices);
     // The pieces are copied into `polygons`: freed, and their memory returned, before the
-    // mesh's arrays take their place.
+    // mesh's arrays take their place; so are the offsets only welding reads.
     freeLeaves();
+    std::vector<std::size_t>().swap(at.corner);
+    std::vector<std::size_t>().swap(at.loop);
     releaseFreedMemory();
     // Caps meet their other side: the later of two reversed, equal polygons uses the earlier's
     // face (reversed), as findOrCreateFace would in leaf order; so do two polygons on the
     // surface that rounding made reversed and equal.
     const std::vector<std::uint32_t> sharesEarlier = matchSides(
         polygons.welded, polygons.origin, polygons.kept, polygons.touched, polygons.keys);
+    std::vector<char>().swap(polygons.touched);  // matching was the last to read these two
+    std::vector<std::uint64_t>().swap(polygons.keys);
     const MeshIds ids = numberMesh(at, polygons, sharesEarlier);
     // The largest arrays of slicing: their pages are faulted in on both cores.
     FaceData<Face> meshFaces;
@@ -217,7 +221,7 @@ class SliceBuilder {
   /// leaves (polygon i of leaf l is polygon[l] + i); the last entries are the totals.
   struct LeafOffsets {
     std::vector<std::uint32_t> polygon;
-    std::vector<std::size_t> corner, loop;
+    std::vector<std::size_t> corner, loop;  ///< for welding only (freed after it)
   };
 
   /// Counts the leaves' polygons, corners and loops (in parallel) and sums them up.
@@ -254,9 +258,10 @@ class SliceBuilder {
   /// the vertex-set key of those that may share a face with another leaf's (matchSides).
   struct LeafPolygons {
     WeldedPolygons welded;
-    std::vector<char> kept;           ///< the polygon did not collapse
-    std::vector<char> touched;        ///< it has a vertex that several points were welded into
-    std::vector<std::uint64_t> keys;  ///< a kept cap's or touched polygon's vertex-set key
+    std::vector<char> kept;  ///< the polygon did not collapse
+    /// It has a vertex that several points were welded into (freed once sides are matched).
+    std::vector<char> touched;
+    std::vector<std::uint64_t> keys;  ///< a kept cap's or touched polygon's vertex-set key (same)
     std::vector<FaceOrigin> origin;
   };
 

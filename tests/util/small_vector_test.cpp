@@ -111,9 +111,9 @@ TEST(SmallVector, MovesLeaveTheSourceEmptyAndSwapExchanges) {
 
 // What the mesh holds per face and per element (5.4 million faces and 1.6 million elements at
 // the bunny's 200 cells): the inline room shares its place with the heap pointer.
-static_assert(sizeof(SmallVector<VertexId, 6>) == 32);
-static_assert(sizeof(Face) == 64);
-static_assert(sizeof(Element) == 64);
+static_assert(sizeof(SmallVector<VertexId, 4>) == 24);
+static_assert(sizeof(Face) == 56);
+static_assert(sizeof(Element) == 56);
 
 }  // namespace
 }  // namespace polydg

@@ -40,8 +40,9 @@ struct FaceUse {
 /// Newell normal of all loops together. `front` is the element the normal points out of,
 /// `back` the element it points into (invalid for a boundary face).
 struct Face {
-  /// All loops, concatenated; up to 6 corners are stored inline (no allocation).
-  SmallVector<VertexId, 6> vertices;
+  /// All loops, concatenated; up to 4 corners are stored inline (no allocation): nearly every
+  /// face of a sliced mesh is a grid cell's side (95% of the bunny's at 200 cells have 3 or 4).
+  SmallVector<VertexId, 4> vertices;
   SmallVector<std::uint32_t, 2> loopEnd;  ///< loop k ends at loopEnd[k]
   ElementId front;
   ElementId back;
@@ -55,9 +56,9 @@ struct Face {
   bool isBoundary() const { return !back.valid(); }
 };
 
-/// An element: the faces that bound it, each with its orientation.
-/// The faces of an element; up to 7 are stored inline.
-using FaceList = SmallVector<FaceUse, 7>;
+/// The faces of an element, each with its orientation; up to 6 are stored inline (a grid
+/// cell's).
+using FaceList = SmallVector<FaceUse, 6>;
 
 struct Element {
   FaceList faces;
