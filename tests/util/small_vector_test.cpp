@@ -109,10 +109,41 @@ TEST(SmallVector, MovesLeaveTheSourceEmptyAndSwapExchanges) {
   EXPECT_NE(a, (Small{1, 2, 3, 4, 6}));
 }
 
+TEST(SmallVector, SixteenBitCountsStopAtTheirLargest) {
+  SmallVector<std::uint32_t, 2, std::uint16_t> v;
+  v.resize(65535, 3);
+  EXPECT_EQ(v.size(), 65535u);
+  EXPECT_EQ(v.back(), 3u);
+  EXPECT_THROW(v.push_back(1), std::length_error);
+  EXPECT_THROW(v.insert(v.begin(), 2, 1), std::length_error);
+  EXPECT_EQ(v.size(), 65535u);
+}
+
+TEST(SmallVector, AFacesLoopEndsLeaveTheMembersInTheirPaddingAlone) {
+  // Face::loopEnd lends the padding after its 16-bit counts to `front`: growing, copying,
+  // moving and clearing it must leave `front`, `back` and `origin` as they are.
+  Face f;
+  f.front = ElementId(std::size_t(7));
+  f.back = ElementId(std::size_t(9));
+  f.origin = FaceOrigin::Cut;
+  f.loopEnd = {4, 8};
+  f.loopEnd.push_back(12);  // onto the heap
+  Face g = f;
+  g.loopEnd.assign(1, 4);  // its heap room kept
+  Face h = std::move(g);
+  f.loopEnd = std::move(h.loopEnd);
+  for (const Face* x : {&f, &g, &h}) {
+    EXPECT_EQ(x->front.value, 7u);
+    EXPECT_EQ(x->back.value, 9u);
+    EXPECT_EQ(x->origin, FaceOrigin::Cut);
+  }
+  EXPECT_EQ(f.loopEnd, (SmallVector<std::uint32_t, 2, std::uint16_t>{4}));
+}
+
 // What the mesh holds per face and per element (5.4 million faces and 1.6 million elements at
 // the bunny's 200 cells): the inline room shares its place with the heap pointer.
 static_assert(sizeof(SmallVector<VertexId, 4>) == 24);
-static_assert(sizeof(Face) == 56);
+static_assert(sizeof(Face) == 48);
 static_assert(sizeof(Element) == 56);
 
 }  // namespace

@@ -1,5 +1,6 @@
-// A vector of trivially copyable values that keeps up to N of them inline, with 32-bit size and
-// capacity sharing one word and the inline values sharing their room with the heap pointer.
+// A vector of trivially copyable values that keeps up to N of them inline, with 32-bit (or
+// 16-bit) size and capacity after the inline values, which share their room with the heap
+// pointer.
 //
 // Written here because Boost 1.74's small_vector (Debian 12) keeps a pointer, a 64-bit size and
 // a 64-bit capacity beside the inline values (48 bytes for six 32-bit ids where this takes 32),
@@ -13,16 +14,23 @@
 #include <cstring>
 #include <initializer_list>
 #include <iterator>
+#include <limits>
 #include <new>
 #include <stdexcept>
+#include <string>
 #include <type_traits>
 
 namespace polydg {
 
-template <class T, std::uint32_t N>
+/// `Size` (std::uint32_t or std::uint16_t) bounds the number of values; growing beyond it throws
+/// std::length_error. With 16-bit counts the last 4 bytes of the object are padding, which a
+/// member declared [[no_unique_address]] leaves to the members after it.
+template <class T, std::uint32_t N, class Size = std::uint32_t>
 class SmallVector {
   static_assert(std::is_trivially_copyable_v<T>, "SmallVector holds trivially copyable values");
   static_assert(N > 0, "SmallVector keeps at least one value inline");
+  static_assert(std::is_same_v<Size, std::uint32_t> || std::is_same_v<Size, std::uint16_t>);
+  static_assert(N <= std::numeric_limits<Size>::max());
 
  public:
   using value_type = T;
@@ -108,7 +116,7 @@ class SmallVector {
       reserve(n);
       std::fill(data() + size_, data() + n, copy);
     }
-    size_ = static_cast<std::uint32_t>(n);
+    size_ = static_cast<Size>(n);
   }
   void assign(size_type n, const T& value) {
     const T copy = value;
@@ -172,7 +180,7 @@ class SmallVector {
     const auto from = static_cast<size_type>(first - b), to = static_cast<size_type>(last - b);
     if (from != to) {
       std::memmove(static_cast<void*>(b + from), b + to, (size_ - to) * sizeof(T));
-      size_ -= static_cast<std::uint32_t>(to - from);
+      size_ -= static_cast<Size>(to - from);
     }
     return b + from;
   }
@@ -195,7 +203,7 @@ class SmallVector {
     reserve(size_type(size_) + n);
     T* b = data();
     std::memmove(static_cast<void*>(b + at + n), b + at, (size_ - at) * sizeof(T));
-    size_ += static_cast<std::uint32_t>(n);
+    size_ += static_cast<Size>(n);
     return b + at;
   }
 
@@ -211,14 +219,16 @@ class SmallVector {
   }
 
   void grow(size_type needed) {
-    if (needed > UINT32_MAX) throw std::length_error("SmallVector: more than 2^32 - 1 values");
+    constexpr size_type kMost = std::numeric_limits<Size>::max();
+    if (needed > kMost)
+      throw std::length_error("SmallVector: more than " + std::to_string(kMost) + " values");
     const size_type capacity =
-        std::min<size_type>(UINT32_MAX, std::max<size_type>(needed, 2 * size_type(capacity_)));
+        std::min<size_type>(kMost, std::max<size_type>(needed, 2 * size_type(capacity_)));
     T* fresh = static_cast<T*>(::operator new(capacity * sizeof(T)));
     std::memcpy(static_cast<void*>(fresh), data(), size_ * sizeof(T));
     release();
     heap_ = fresh;
-    capacity_ = static_cast<std::uint32_t>(capacity);
+    capacity_ = static_cast<Size>(capacity);
   }
 
   void release() noexcept {
@@ -238,12 +248,12 @@ class SmallVector {
     other.capacity_ = N;
   }
 
-  std::uint32_t size_ = 0;
-  std::uint32_t capacity_ = N;
   union {
     T inline_[N];
     T* heap_;
   };
+  Size size_ = 0;
+  Size capacity_ = N;
 };
 
 }  // namespace polydg
