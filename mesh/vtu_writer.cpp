@@ -103,8 +103,14 @@ void checkFieldData(const VtuFieldData& fieldData) {
     checkName(name, name + std::string(kVtuTextSuffix), "text");
 }
 
-/// The point and cell values the file holds, in file order.
+/// The point and cell values the file holds, in file order. Not copied: `points` may view its
+/// own `pointCopies`.
 struct FileValues {
+  FileValues() = default;
+  FileValues(const FileValues&) = delete;
+  FileValues& operator=(const FileValues&) = delete;
+  FileValues(FileValues&&) = default;
+
   /// 3 per VTU point: the mesh's positions themselves where the points are the vertices (a
   /// mesh fresh from slicing; 42 MB not copied for the bunny at 200 cells), else `pointCopies`.
   std::span<const double> points;
