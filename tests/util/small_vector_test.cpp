@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cstdint>
 #include <random>
 #include <vector>
@@ -121,23 +122,37 @@ TEST(SmallVector, SixteenBitCountsStopAtTheirLargest) {
 
 TEST(SmallVector, AFacesLoopEndsLeaveTheMembersInTheirPaddingAlone) {
   // Face::loopEnd lends the padding after its 16-bit counts to `front`: growing, copying,
-  // moving and clearing it must leave `front`, `back` and `origin` as they are.
-  Face f;
-  f.front = ElementId(std::size_t(7));
-  f.back = ElementId(std::size_t(9));
-  f.origin = FaceOrigin::Cut;
+  // moving and clearing it must leave each face's `front`, `back` and `origin` as they are.
+  auto face = [](std::size_t front, std::size_t back, FaceOrigin origin) {
+    Face f;
+    f.front = ElementId(front);
+    f.back = ElementId(back);
+    f.origin = origin;
+    return f;
+  };
+  Face f = face(7, 9, FaceOrigin::Cut), g = face(5, 6, FaceOrigin::Surface);
   f.loopEnd = {4, 8};
   f.loopEnd.push_back(12);  // onto the heap
-  Face g = f;
-  g.loopEnd.assign(1, 4);  // its heap room kept
-  Face h = std::move(g);
-  f.loopEnd = std::move(h.loopEnd);
-  for (const Face* x : {&f, &g, &h}) {
-    EXPECT_EQ(x->front.value, 7u);
-    EXPECT_EQ(x->back.value, 9u);
-    EXPECT_EQ(x->origin, FaceOrigin::Cut);
+  g.loopEnd = {3};
+  g.loopEnd = f.loopEnd;
+  Face h = f;
+  h.front = ElementId(std::size_t(3));
+  h.loopEnd = std::move(g.loopEnd);
+  g.loopEnd = std::move(f.loopEnd);
+  f.loopEnd.assign(1, 4);
+  g.loopEnd.swap(h.loopEnd);
+  const std::array<std::array<std::uint32_t, 2>, 3> links{{{7, 9}, {5, 6}, {3, 9}}};
+  const std::array<FaceOrigin, 3> origins{FaceOrigin::Cut, FaceOrigin::Surface, FaceOrigin::Cut};
+  const std::array<const Face*, 3> faces{&f, &g, &h};
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(faces[i]->front.value, links[i][0]) << "face " << i;
+    EXPECT_EQ(faces[i]->back.value, links[i][1]) << "face " << i;
+    EXPECT_EQ(faces[i]->origin, origins[i]) << "face " << i;
   }
-  EXPECT_EQ(f.loopEnd, (SmallVector<std::uint32_t, 2, std::uint16_t>{4}));
+  using LoopEnds = SmallVector<std::uint32_t, 2, std::uint16_t>;
+  EXPECT_EQ(f.loopEnd, (LoopEnds{4}));
+  EXPECT_EQ(g.loopEnd, (LoopEnds{4, 8, 12}));
+  EXPECT_EQ(h.loopEnd, (LoopEnds{4, 8, 12}));
 }
 
 // What the mesh holds per face and per element (5.4 million faces and 1.6 million elements at
