@@ -43,9 +43,12 @@ struct PointGroups {
   std::vector<VertexId> pointVertex;
 
   std::size_t numPoints() const { return pointVertex.size(); }
+  /// Whether the points are the vertices (point p is vertex p), so that every corner's point is
+  /// its vertex and nothing is stored per corner.
+  bool pointsAreVertices() const { return cornerPoint.empty(); }
   /// Corner i's point.
   std::uint32_t point(const ElementCorners& corners, std::size_t i) const {
-    return cornerPoint.empty() ? corners.vertices[i].value : cornerPoint[i];
+    return pointsAreVertices() ? corners.vertices[i].value : cornerPoint[i];
   }
 };
 

@@ -167,8 +167,7 @@ FileValues fileValues(const PolyMesh& mesh, const CellStreams& s,
   const std::span<const VertexId> pointVertex = s.points().pointVertex;
   const std::span<const ElementId> cells = s.elements();
   static_assert(sizeof(Vec3) == 3 * sizeof(double), "positions are packed coordinates");
-  if (!pointVertex.empty() && pointVertex.size() == mesh.numVertices()) {
-    // Point p is vertex p (PointGroups).
+  if (s.points().pointsAreVertices() && !pointVertex.empty()) {
     v.points = {mesh.position(VertexId(std::size_t(0))).data(), 3 * pointVertex.size()};
   } else {
     v.pointCopies.resize(3 * pointVertex.size());
@@ -296,7 +295,7 @@ void writeContents(std::ostream& os, const PolyMesh& mesh, const CellStreams& s,
                generatedIntArray(kFieldIndent, kFaceReversedArray, s.faceReversed(), true),
                generatedIntArray(kFieldIndent, kFaceOriginArray, s.faceOrigin(), true),
                generatedIntArray(kFieldIndent, kElementArray, s.element(), true)};
-  if (s.points().numPoints() != mesh.numVertices())
+  if (!s.points().pointsAreVertices())
     d.restore.push_back(generatedIntArray(kFieldIndent, kPointVertexArray, s.pointVertex(), true));
   d.caller = caller.arrays;
   for (std::size_t i = 0; i < pointData.size(); ++i)
