@@ -207,7 +207,7 @@ class Splitter {
       const std::vector<Part>& parts = side < 0 ? minus : plus;
       for (const std::vector<std::size_t>& component : components(parts)) {
         if (component.size() < 2) continue;  // a lone polygon bounds no volume
-        FaceList faces;
+        std::vector<FaceUse> faces;
         for (std::size_t i : component) {
           const FaceUse use = faceFor(parts[i], side);
           if (use.face.valid()) faces.push_back(use);

@@ -221,8 +221,8 @@ void PolyMesh::detachFace(ElementId e, FaceId f) {
   if (it == uses.end())
     throw std::invalid_argument("detachFace: the element does not use the face");
   Face& face = faces_[f];
-  (it->reversed ? face.back : face.front) = ElementId();
-  uses.erase(it);
+  ((*it).reversed ? face.back : face.front) = ElementId();
+  uses.erase(static_cast<std::size_t>(it - uses.begin()));
   openFacesStale_ = true;
 }
 
@@ -245,8 +245,9 @@ void PolyMesh::reverseFace(FaceId f) {
   std::swap(face.front, face.back);
   for (ElementId e : {face.front, face.back}) {
     if (!e.valid()) continue;
-    for (FaceUse& use : elements_[e].faces)
-      if (use.face == f) use.reversed = !use.reversed;
+    FaceList& uses = elements_[e].faces;
+    for (std::size_t i = 0; i < uses.size(); ++i)
+      if (uses[i].face == f) uses.set(i, {f, !uses[i].reversed});
   }
   openFacesStale_ = true;
 }
@@ -264,8 +265,9 @@ FaceId PolyMesh::removeFace(FaceId f) {
   faces_.raw().pop_back();
   for (ElementId e : {faces_[f].front, faces_[f].back}) {
     if (!e.valid()) continue;
-    for (FaceUse& use : elements_[e].faces)
-      if (use.face == last) use.face = f;
+    FaceList& uses = elements_[e].faces;
+    for (std::size_t i = 0; i < uses.size(); ++i)
+      if (uses[i].face == last) uses.set(i, {f, uses[i].reversed});
   }
   return last;
 }

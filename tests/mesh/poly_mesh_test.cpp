@@ -1,9 +1,13 @@
-// Face sharing and orientation in PolyMesh, and the generated shapes of mesh/primitives.h.
+// Face sharing and orientation in PolyMesh, packed face lists, and the generated shapes of
+// mesh/primitives.h.
 #include "polydg/mesh/poly_mesh.h"
 
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <random>
+#include <stdexcept>
+#include <vector>
 
 #include "mesh/primitives.h"
 #include "polydg/mesh/geometry.h"
@@ -12,6 +16,46 @@
 
 namespace polydg {
 namespace {
+
+TEST(FaceList, PacksEachUseIn32BitsAndGivesItBack) {
+  const FaceId largest(std::uint32_t(0x7ffffffe));  // the largest face id a list holds
+  FaceList uses{{FaceId(0u), false}, {FaceId(7u), true}, {largest, true}, {FaceId(), true}};
+  ASSERT_EQ(uses.size(), 4u);
+  EXPECT_EQ(uses[0].face, FaceId(0u));
+  EXPECT_FALSE(uses[0].reversed);
+  EXPECT_EQ(uses[1].face, FaceId(7u));
+  EXPECT_TRUE(uses[1].reversed);
+  EXPECT_EQ(uses[2].face, largest);
+  EXPECT_TRUE(uses[2].reversed);
+  EXPECT_FALSE(uses[3].face.valid());  // an invalid id stays invalid, whatever its side
+  EXPECT_TRUE(uses[3].reversed);
+  EXPECT_THROW(uses.push_back({FaceId(std::uint32_t(0x7fffffff)), false}), std::length_error);
+  EXPECT_EQ(uses.size(), 4u);
+
+  uses.set(1, {FaceId(9u), false});
+  uses.erase(0);
+  std::vector<std::uint32_t> faces;
+  std::vector<bool> reversed;
+  for (const FaceUse& use : uses) {
+    faces.push_back(use.face.value);
+    reversed.push_back(use.reversed);
+  }
+  EXPECT_EQ(faces, (std::vector<std::uint32_t>{9, 0x7ffffffe, FaceId::kInvalid}));
+  EXPECT_EQ(reversed, (std::vector<bool>{false, true, true}));
+  // Beyond the six inline uses the list moves to the heap and keeps its values.
+  for (std::uint32_t f = 10; f < 20; ++f) uses.push_back({FaceId(f), f % 2 == 1});
+  ASSERT_EQ(uses.size(), 13u);
+  for (std::uint32_t f = 10; f < 20; ++f) {
+    EXPECT_EQ(uses[f - 7].face, FaceId(f));
+    EXPECT_EQ(uses[f - 7].reversed, f % 2 == 1);
+  }
+  const FaceList copy = uses;
+  EXPECT_TRUE(copy == uses);
+  uses.set(5, {FaceId(12u), true});  // (12, false) on the heap
+  EXPECT_FALSE(copy == uses);
+  EXPECT_EQ(uses[5].face, FaceId(12u));
+  EXPECT_TRUE(uses[5].reversed);
+}
 
 TEST(PolyMesh, HexGridSharesInteriorFaces) {
   const PolyMesh mesh = hexGridMesh(2, 2, 2, Box3(Vec3(0, 0, 0), Vec3(1, 1, 1)));

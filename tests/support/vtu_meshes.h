@@ -93,8 +93,8 @@ inline PolyMesh cutAcross(const PolyMesh& mesh, FaceId cut) {
   const FaceId backSide = out.addFace(loopsOf(mesh.face(cut), true), FaceOrigin::Cut);
   for (const Element& element : mesh.elements()) {
     FaceList uses = element.faces;
-    for (FaceUse& use : uses)
-      if (use.face == cut && use.reversed) use = {backSide, false};
+    for (std::size_t k = 0; k < uses.size(); ++k)
+      if (uses[k].face == cut && uses[k].reversed) uses.set(k, {backSide, false});
     out.addElementFromFaces(uses);
   }
   return out;

@@ -159,7 +159,7 @@ TEST(SmallVector, AFacesLoopEndsLeaveTheMembersInTheirPaddingAlone) {
 // the bunny's 200 cells): the inline room shares its place with the heap pointer.
 static_assert(sizeof(SmallVector<VertexId, 4>) == 24);
 static_assert(sizeof(Face) == 48);
-static_assert(sizeof(Element) == 56);
+static_assert(sizeof(Element) == 32);
 
 }  // namespace
 }  // namespace polydg
