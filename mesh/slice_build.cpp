@@ -36,6 +36,8 @@ class SliceBuilder {
                  std::vector<int>* elementLevel, std::vector<char>* elementWhole) {
     WeldedVertices vertices = weldPoints(points);
     std::vector<Vec3>().swap(points);
+    keepCells();
+    findRows();
     findFreeSides(vertices);
     LeafOffsets at = leafOffsets();
     LeafPolygons polygons = weldPolygons(at, vertices);
@@ -332,23 +334,73 @@ class SliceBuilder {
   /// Marks the free sides (freeSides_): those two whole cells share, with no corner that
   /// several points were welded into. The grid pairs them, so they are no polygons.
   void findFreeSides(const WeldedVertices& vertexOf) {
-    freeSides_.assign(leaves_.size(), 0);
-    wholeLeafAt_ = whole_.cellTable();
-    if (wholeLeafAt_.empty()) return;
-    tbb::parallel_for(std::size_t(0), leaves_.size(), [&](std::size_t l) {
-      if (leaves_[l].whole) wholeLeafAt_[whole_.cellIndex(leaves_[l].cell)] = std::uint32_t(l);
-    });
-    tbb::parallel_for(std::size_t(0), leaves_.size(), [&](std::size_t l) {
-      if (!leaves_[l].whole) return;
-      for (int s = 0; s < 6; ++s) {
-        const auto next = whole_.beside(leaves_[l].cell, s);
-        if (!next || wholeLeafAt_[whole_.cellIndex(*next)] == kNone) continue;
-        const std::array<std::uint32_t, 4> corners = whole_.side(leaves_[l].cell, s);
-        if (std::none_of(corners.begin(), corners.end(),
-                         [&](std::uint32_t p) { return vertexOf.shared[vertexOf(p).index()]; }))
-          freeSides_[l] |= std::uint8_t(1u << s);
+    freeSides_.assign(cells_.size(), 0);
+    if (whole_.count() == 0) return;
+    forEachRow([&](std::size_t row) {
+      std::array<RowCursor, 6> beside;
+      for (int s = 2; s < 6; ++s) beside[s] = cursorBeside(row, s);
+      for (std::uint32_t l = rowStart_[row]; l < rowStart_[row + 1]; ++l) {
+        if (!cells_[l].whole) continue;
+        for (int s = 0; s < 6; ++s) {
+          if (wholeLeafBeside(l, s, beside[s]) == kNone) continue;
+          const std::array<std::uint32_t, 4> corners = whole_.side(cells_[l].cell, s);
+          if (std::none_of(corners.begin(), corners.end(),
+                           [&](std::uint32_t p) { return vertexOf.shared[vertexOf(p).index()]; }))
+            freeSides_[l] |= std::uint8_t(1u << s);
+        }
       }
     });
+  }
+
+  /// The leaves row by row: leaves are sorted by cell (z, y, x) and part, so each row of grid
+  /// cells along x (one per y and z) is a run of them. A whole leaf finds the whole leaf beside
+  /// it by walking the neighbouring row alongside its own, which spares a table of the grid's
+  /// cells (25 MB for the bunny at 200 cells).
+  void findRows() {
+    rowStart_.assign(whole_.numRows() + 1, 0);
+    for (const LeafCell& c : cells_) ++rowStart_[whole_.rowIndex(c.cell) + 1];
+    for (std::size_t r = 0; r + 1 < rowStart_.size(); ++r) rowStart_[r + 1] += rowStart_[r];
+  }
+
+  /// Calls f(row) for each row of leaves, in parallel.
+  template <class F>
+  void forEachRow(F&& f) const {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rowStart_.size() - 1, 16),
+                      [&](const tbb::blocked_range<std::size_t>& rows) {
+                        for (std::size_t r = rows.begin(); r != rows.end(); ++r) f(r);
+                      });
+  }
+
+  /// A walk along a row of leaves in increasing x.
+  struct RowCursor {
+    std::uint32_t at = 0, end = 0;
+  };
+
+  /// A cursor on the row beside `row` across side s (2 .. 5: y and z), empty if the grid has
+  /// no such row.
+  RowCursor cursorBeside(std::size_t row, int s) const {
+    const std::array<int, 3> cell = {0, int(row % whole_.rowsAlongY()),
+                                     int(row / whole_.rowsAlongY())};
+    const auto next = whole_.beside(cell, s);
+    if (!next) return {};
+    const std::size_t r = whole_.rowIndex(*next);
+    return {rowStart_[r], rowStart_[r + 1]};
+  }
+
+  /// The whole leaf in the cell beside whole leaf l's across side s, or kNone; sides 2 .. 5 walk
+  /// `cursor` (beside l's row across s), which the leaves of l's row must ask in order.
+  std::uint32_t wholeLeafBeside(std::uint32_t l, int s, RowCursor& cursor) const {
+    const std::array<int, 3>& cell = cells_[l].cell;
+    if (s < 2) {  // along the row: the next leaf, or the one before
+      const auto next = whole_.beside(cell, s);
+      if (!next || (s == 0 ? l == 0 : l + std::size_t(1) == cells_.size())) return kNone;
+      const std::uint32_t m = s == 0 ? l - 1 : l + 1;
+      return cells_[m].whole && cells_[m].cell == *next ? m : kNone;
+    }
+    while (cursor.at < cursor.end && cells_[cursor.at].cell[0] < cell[0]) ++cursor.at;
+    if (cursor.at == cursor.end) return kNone;
+    const LeafCell& c = cells_[cursor.at];
+    return c.whole && c.cell[0] == cell[0] ? cursor.at : kNone;
   }
 
   /// Whether a corner of whole cell `cell` is a vertex that several points were welded into.
@@ -464,56 +516,59 @@ class SliceBuilder {
             });
           }
         });
-    tbb::parallel_for(
-        tbb::blocked_range<std::size_t>(0, nl, 64), [&](const tbb::blocked_range<std::size_t>& r) {
-          for (std::size_t l = r.begin(); l != r.end(); ++l) {
-            if (ids.elementOf[l] == kNone) continue;
-            const ElementId e{std::size_t(ids.elementOf[l])};
-            FaceList& uses = meshElements[e].faces;
-            auto useBack = [&](FaceId f) {
-              meshFaces[f].back = e;
-              meshFaces[f].origin = FaceOrigin::Interior;
-              uses.push_back({f, true});
-            };
-            auto usePolygon = [&](std::size_t p) {
-              if (!polygons.kept[p]) return;
-              const std::uint32_t s = sharesEarlier[p];
-              if (s == kNoSide)
-                uses.push_back({FaceId(std::size_t(faceId[p])), false});
-              else
-                useBack(FaceId(std::size_t(faceId[s])));
-            };
-            forEachSide(at, l, usePolygon, [&](int s) {
-              if (s % 2 == 1) {
-                uses.push_back(
-                    {FaceId(std::size_t(wholeSideFace(at, polygons, sharesEarlier, ids, l, s))),
-                     false});
-                return;
-              }
-              const std::size_t before =
-                  wholeLeafAt_[whole_.cellIndex(*whole_.beside(cells_[l].cell, s))];
-              useBack(FaceId(
-                  std::size_t(wholeSideFace(at, polygons, sharesEarlier, ids, before, s + 1))));
-            });
+    forEachRow([&](std::size_t row) {
+      std::array<RowCursor, 6> beside;
+      for (const int s : {2, 4}) beside[s] = cursorBeside(row, s);
+      for (std::uint32_t l = rowStart_[row]; l < rowStart_[row + 1]; ++l) {
+        if (ids.elementOf[l] == kNone) continue;
+        const ElementId e{std::size_t(ids.elementOf[l])};
+        FaceList& uses = meshElements[e].faces;
+        auto useBack = [&](FaceId f) {
+          meshFaces[f].back = e;
+          meshFaces[f].origin = FaceOrigin::Interior;
+          uses.push_back({f, true});
+        };
+        auto usePolygon = [&](std::size_t p) {
+          if (!polygons.kept[p]) return;
+          const std::uint32_t s = sharesEarlier[p];
+          if (s == kNoSide)
+            uses.push_back({FaceId(std::size_t(faceId[p])), false});
+          else
+            useBack(FaceId(std::size_t(faceId[s])));
+        };
+        forEachSide(at, l, usePolygon, [&](int s) {
+          if (s % 2 == 1) {
+            uses.push_back(
+                {FaceId(std::size_t(wholeSideFace(at, polygons, sharesEarlier, ids, l, s))),
+                 false});
+            return;
           }
+          const std::uint32_t before = wholeLeafBeside(l, s, beside[s]);
+          useBack(
+              FaceId(std::size_t(wholeSideFace(at, polygons, sharesEarlier, ids, before, s + 1))));
         });
+      }
+    });
   }
 
   /// The leaves are spent: their many small buffers are freed in parallel, not one by one
-  /// when the slicer goes, and what the rest of the build reads of them is kept in `cells_`,
-  /// so that the leaves themselves (56 bytes each, 92 MB for the bunny at 200 cells) go before
-  /// the mesh's arrays are made.
+  /// when the slicer goes, and the leaves themselves (56 bytes each, 92 MB for the bunny at 200
+  /// cells) go before the mesh's arrays are made; the rest of the build reads `cells_`.
   void freeLeaves() {
-    cells_.resize(leaves_.size());
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves_.size(), 256),
                       [&](const tbb::blocked_range<std::size_t>& r) {
-                        for (std::size_t l = r.begin(); l != r.end(); ++l) {
+                        for (std::size_t l = r.begin(); l != r.end(); ++l)
                           Piece().swap(leaves_[l].piece);
-                          cells_[l] = {leaves_[l].cell, static_cast<std::int16_t>(leaves_[l].level),
-                                       leaves_[l].whole};
-                        }
                       });
     std::vector<SliceLeaf>().swap(leaves_);
+  }
+
+  /// What the build reads of each leaf besides its piece (cells_).
+  void keepCells() {
+    cells_.resize(leaves_.size());
+    tbb::parallel_for(std::size_t(0), leaves_.size(), [&](std::size_t l) {
+      cells_[l] = {leaves_[l].cell, static_cast<std::int16_t>(leaves_[l].level), leaves_[l].whole};
+    });
   }
 
   /// What the build reads of a leaf once its piece is spent.
@@ -524,7 +579,7 @@ class SliceBuilder {
   };
 
   std::vector<SliceLeaf>& leaves_;
-  std::vector<LeafCell> cells_;  ///< per leaf, once the leaves are freed (freeLeaves())
+  std::vector<LeafCell> cells_;  ///< per leaf (keepCells()), read after the leaves are freed
   const WholeCells& whole_;
   const bool octree_;
   const std::size_t firstGenerated_;
@@ -533,8 +588,8 @@ class SliceBuilder {
   /// another whole cell where welding moved no corner: the grid pairs them, so they are made
   /// into faces directly (by the earlier cell, towards +axis), not into polygons.
   std::vector<std::uint8_t> freeSides_;
-  /// Each grid cell's whole leaf, or kNone (empty for a grid much larger than its whole cells).
-  std::vector<std::uint32_t> wholeLeafAt_;
+  /// Row r of leaves (findRows()) is [rowStart_[r], rowStart_[r + 1]).
+  std::vector<std::uint32_t> rowStart_;
 };
 
 }  // namespace

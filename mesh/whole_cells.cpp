@@ -96,12 +96,4 @@ void WholeCells::sides(const std::array<int, 3>& cell, Piece& piece, unsigned sk
   }
 }
 
-std::vector<std::uint32_t> WholeCells::cellTable() const {
-  const std::size_t cells =
-      std::size_t(grid_.cells[0]) * std::size_t(grid_.cells[1]) * std::size_t(grid_.cells[2]);
-  const std::size_t whole = count();
-  if (whole == 0 || cells > 8 * whole + (std::size_t(1) << 20)) return {};
-  return std::vector<std::uint32_t>(cells, kNone);
-}
-
 }  // namespace polydg

@@ -51,11 +51,12 @@ class WholeCells {
   /// The corners of side s of `cell`, as sides() gives them.
   std::array<std::uint32_t, 4> side(const std::array<int, 3>& cell, int s) const;
 
-  /// A table of the grid's cells (cellIndex()) holding kNone, for the caller to mark the whole
-  /// ones in; empty where it would be much larger than the whole cells.
-  std::vector<std::uint32_t> cellTable() const;
-  std::size_t cellIndex(const std::array<int, 3>& c) const {
-    return linearIndex(c, grid_.cells[0], grid_.cells[1]);
+  /// The rows of the grid's cells along x, one per (y, z): their number, how many share a z,
+  /// and cell c's (y fastest).
+  std::size_t numRows() const { return std::size_t(grid_.cells[1]) * std::size_t(grid_.cells[2]); }
+  std::size_t rowsAlongY() const { return std::size_t(grid_.cells[1]); }
+  std::size_t rowIndex(const std::array<int, 3>& c) const {
+    return std::size_t(c[2]) * std::size_t(grid_.cells[1]) + std::size_t(c[1]);
   }
   /// The cell beside `cell` across side s (see sides()), if the grid has it.
   std::optional<std::array<int, 3>> beside(std::array<int, 3> cell, int s) const {
