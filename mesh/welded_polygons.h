@@ -4,8 +4,12 @@
 // taken out the same way on both sides of every shared polygon.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <span>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "mesh/plane_split.h"
@@ -37,13 +41,14 @@ std::size_t simplifyWalk(std::span<VertexId> walk, std::uint32_t& size);
 /// corners and loops), given by the caller.
 class WeldedPolygons {
  public:
+  /// Throws std::length_error for 2^32 corners or loops or more.
   WeldedPolygons(std::size_t polygons, std::size_t corners, std::size_t loops)
       : cornerStart_(polygons),
         cornerCount_(polygons, 0),
         loopStart_(polygons),
         loopCount_(polygons, 0),
-        corners_(corners),
-        loopEnds_(loops) {}
+        corners_(checked(corners)),
+        loopEnds_(checked(loops)) {}
 
   /// `polygon` on welded vertices as polygon p, with room from `corner` and `loop` on:
   /// consecutive repeats dropped, spikes taken out (simplifyWalk), loops of fewer than 3
@@ -51,8 +56,8 @@ class WeldedPolygons {
   template <class VertexOf>
   bool weld(std::size_t p, std::size_t corner, std::size_t loop, const PiecePolygon& polygon,
             const VertexOf& vertexOf) {
-    cornerStart_[p] = corner;
-    loopStart_[p] = loop;
+    cornerStart_[p] = static_cast<std::uint32_t>(corner);
+    loopStart_[p] = static_cast<std::uint32_t>(loop);
     VertexId* out = corners_.data() + corner;
     std::uint32_t n = 0, loops = 0;
     for (std::size_t k = 0; k < polygon.numLoops(); ++k) {
@@ -95,9 +100,17 @@ class WeldedPolygons {
   bool isReversed(std::size_t a, std::size_t b) const;
 
  private:
-  std::vector<std::size_t> cornerStart_;
+  static std::size_t checked(std::size_t n) {
+    if (n > std::numeric_limits<std::uint32_t>::max())
+      throw std::length_error("slicing made " + std::to_string(n) +
+                              " polygon corners or loops, more than 2^32 - 1; use fewer cells");
+    return n;
+  }
+
+  // Starts in 32 bits: 8 bytes less per polygon (1.5 million for the bunny at 200 cells).
+  std::vector<std::uint32_t> cornerStart_;
   std::vector<std::uint32_t> cornerCount_;
-  std::vector<std::size_t> loopStart_;
+  std::vector<std::uint32_t> loopStart_;
   std::vector<std::uint32_t> loopCount_;
   std::vector<VertexId> corners_;
   std::vector<std::uint32_t> loopEnds_;
