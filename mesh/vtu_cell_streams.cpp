@@ -288,10 +288,22 @@ GeneratedInts CellStreams::faces() const {
           std::max({largest_.point, largest_.recordsPerCell, largest_.recordSize}),
           [this](std::size_t begin, std::size_t end, std::int64_t* out) {
             CornerNumbers numbers;
+            const bool vertexIds = points_.pointsAreVertices();
             fillByCell(faceEnd_, begin, end, out, [&](std::size_t c, Window& window) {
               const ElementId e = order_[c];
               const std::size_t first = corners_.begin[e.index()];
               window.put(static_cast<std::int64_t>(recordEnd_.end(c) - recordEnd_.begin(c)));
+              if (vertexIds) {  // a corner's point is its vertex: the records' ids as they are
+                for (const FaceUse& use : mesh_.element(e).faces)
+                  for (std::size_t k = 0; k < records_.count(use.face); ++k) {
+                    const auto record = records_.record(use.face, k);
+                    const std::size_t n = record.size();
+                    window.put(static_cast<std::int64_t>(n));
+                    for (std::size_t i = 0; i < n; ++i)
+                      window.put(record[use.reversed ? (n - i) % n : i].value);
+                  }
+                return;
+              }
               // The records' vertices are numbered as elementCorners numbered them.
               forEachRecord(mesh_, records_, e, numbers,
                             [&](const FaceUse& use, auto, std::span<const std::uint32_t> corner) {
