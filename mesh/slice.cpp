@@ -53,7 +53,7 @@ class Slicer {
     for (const std::vector<Leaf>& list : threadLeaves_) count += list.size();
     for (const std::vector<Leaf>& list : threadBoxes_) count += list.size();
     stats.wholeCells = whole_.count();
-    leaves_.reserve(count + stats.wholeCells);
+    leaves_.reserve(count);
     // The octree's whole cells get their faces from the octree, on points after the
     // splitter's (build() welds them to the splitter's points at the same corners).
     firstGenerated_ = splitter_->numPoints();
@@ -65,19 +65,26 @@ class Slicer {
       }
       std::vector<Leaf>().swap(list);
     }
-    for (const std::array<int, 3>& cell :
-         whole_.finish(static_cast<std::uint32_t>(firstGenerated_), generated_))
-      leaves_.push_back({Piece(), cell, 0, 0, true});
+    wholeCells_ = whole_.finish(static_cast<std::uint32_t>(firstGenerated_), generated_);
     for (std::vector<Leaf>& list : threadLeaves_) {
       leaves_.insert(leaves_.end(), std::make_move_iterator(list.begin()),
                      std::make_move_iterator(list.end()));
       std::vector<Leaf>().swap(list);
     }
     // Deterministic order whatever the schedule: by cell, then by piece within the cell.
-    tbb::parallel_sort(leaves_.begin(), leaves_.end(), [](const Leaf& a, const Leaf& b) {
-      return std::tie(a.cell[2], a.cell[1], a.cell[0], a.part) <
-             std::tie(b.cell[2], b.cell[1], b.cell[0], b.part);
-    });
+    tbb::parallel_invoke(
+        [&] {
+          tbb::parallel_sort(leaves_.begin(), leaves_.end(), [](const Leaf& a, const Leaf& b) {
+            return std::tie(a.cell[2], a.cell[1], a.cell[0], a.part) <
+                   std::tie(b.cell[2], b.cell[1], b.cell[0], b.part);
+          });
+        },
+        [&] {
+          tbb::parallel_sort(wholeCells_.begin(), wholeCells_.end(),
+                             [](const std::array<int, 3>& a, const std::array<int, 3>& b) {
+                               return std::tie(a[2], a[1], a[0]) < std::tie(b[2], b[1], b[0]);
+                             });
+        });
     stats.splits = splits_;
     stats.polygonsSplit = polygonsSplit_;
     stats.leafCells = leafCells_;
@@ -97,8 +104,8 @@ class Slicer {
     tbb::task_group release;
     release.run([this] { splitter_.reset(); });
     PolyMesh mesh =
-        buildSliceMesh(leaves_, whole_, octree_ != nullptr, firstGenerated_, std::move(points),
-                       stats, elementCell, elementLevel, elementWhole);
+        buildSliceMesh(leaves_, wholeCells_, whole_, octree_ != nullptr, firstGenerated_,
+                       std::move(points), stats, elementCell, elementLevel, elementWhole);
     release.wait();
     return mesh;
   }
@@ -236,7 +243,9 @@ class Slicer {
   tbb::enumerable_thread_specific<std::vector<Leaf>> threadBoxes_;  ///< whole octree cells
   std::vector<Vec3> generated_;                                     ///< the points of their faces
   std::size_t firstGenerated_ = std::numeric_limits<std::size_t>::max();  ///< their first id
-  std::vector<Leaf> leaves_;
+  std::vector<Leaf> leaves_;  ///< the sliced cells' pieces (and the octree's whole boxes)
+  /// The uniform grid's whole cells, not split: no pieces, their sides come from the grid.
+  std::vector<std::array<int, 3>> wholeCells_;
   double totalCells_ = 1.0;
   double doneCells_ = 0.0;
   std::mutex progressMutex_;

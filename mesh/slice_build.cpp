@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <limits>
 #include <span>
+#include <tuple>
 #include <utility>
 
 #include <tbb/blocked_range.h>
@@ -24,9 +25,10 @@ namespace {
 
 class SliceBuilder {
  public:
-  SliceBuilder(std::vector<SliceLeaf>& leaves, const WholeCells& whole, bool octree,
-               std::size_t firstGenerated, SliceStats& stats)
+  SliceBuilder(std::vector<SliceLeaf>& leaves, std::vector<std::array<int, 3>>& wholeCells,
+               const WholeCells& whole, bool octree, std::size_t firstGenerated, SliceStats& stats)
       : leaves_(leaves),
+        wholeCells_(wholeCells),
         whole_(whole),
         octree_(octree),
         firstGenerated_(firstGenerated),
@@ -34,9 +36,9 @@ class SliceBuilder {
 
   PolyMesh build(std::vector<Vec3> points, std::vector<std::array<int, 3>>* elementCell,
                  std::vector<int>* elementLevel, std::vector<char>* elementWhole) {
+    mergeCells();
     WeldedVertices vertices = weldPoints(points);
     std::vector<Vec3>().swap(points);
-    keepCells();
     findRows();
     findFreeSides(vertices);
     LeafOffsets at = leafOffsets();
@@ -82,11 +84,11 @@ class SliceBuilder {
  private:
   using Leaf = SliceLeaf;
 
-  /// The polygons of `leaf`: its piece, or a whole cell's sides made in `scratch` (without
+  /// The polygons of leaf l: its piece, or a whole cell's sides made in `scratch` (without
   /// those in `skip`).
-  const Piece& pieceOf(const Leaf& leaf, Piece& scratch, unsigned skip = 0) const {
-    if (!leaf.whole) return leaf.piece;
-    whole_.sides(leaf.cell, scratch, skip);
+  const Piece& pieceOf(std::size_t l, Piece& scratch, unsigned skip = 0) const {
+    if (!cells_[l].whole) return leaves_[cells_[l].piece].piece;
+    whole_.sides(cells_[l].cell, scratch, skip);
     return scratch;
   }
 
@@ -105,13 +107,13 @@ class SliceBuilder {
   /// Calls f(v) for each corner v of leaf l's polygons, in order (a whole cell's sides as
   /// WholeCells::sides makes them, without making them).
   template <class F>
-  void forEachCorner(const Leaf& leaf, F&& f) const {
-    if (leaf.whole) {
+  void forEachCorner(std::size_t l, F&& f) const {
+    if (cells_[l].whole) {
       for (int s = 0; s < 6; ++s)
-        for (const std::uint32_t v : whole_.side(leaf.cell, s)) f(v);
+        for (const std::uint32_t v : whole_.side(cells_[l].cell, s)) f(v);
       return;
     }
-    for (const PiecePolygon& polygon : leaf.piece)
+    for (const PiecePolygon& polygon : leaves_[cells_[l].piece].piece)
       for (const std::uint32_t v : polygon.vertices) f(v);
   }
 
@@ -125,7 +127,7 @@ class SliceBuilder {
   /// order, keep each point's first.
   std::vector<std::uint32_t> pointsInOrderOfUse(std::vector<std::uint32_t>& rank) const {
     constexpr std::size_t kRun = 4096;  // leaves
-    const std::size_t nl = leaves_.size(), runs = (nl + kRun - 1) / kRun;
+    const std::size_t nl = cells_.size(), runs = (nl + kRun - 1) / kRun;
     const std::size_t passes = octree_ ? 2 : 1;  // the octree's points in a second pass
     std::vector<std::vector<std::uint32_t>> firstUses(runs * passes);
     // Per thread, the run (plus one) that last listed each point.
@@ -138,7 +140,7 @@ class SliceBuilder {
       std::vector<std::uint32_t>& list = firstUses[t];
       const std::size_t begin = (t % runs) * kRun, end = std::min(nl, begin + kRun);
       for (std::size_t l = begin; l < end; ++l)
-        forEachCorner(leaves_[l], [&](std::uint32_t v) {
+        forEachCorner(l, [&](std::uint32_t v) {
           if (listed[v] != mark && (!octree_ || (v >= firstGenerated_) == generated)) {
             listed[v] = mark;
             list.push_back(v);
@@ -228,11 +230,11 @@ class SliceBuilder {
 
   /// Counts the leaves' polygons, corners and loops (in parallel) and sums them up.
   LeafOffsets leafOffsets() const {
-    const std::size_t nl = leaves_.size();
+    const std::size_t nl = cells_.size();
     LeafOffsets at{std::vector<std::uint32_t>(nl + 1, 0), std::vector<std::size_t>(nl + 1, 0),
                    std::vector<std::size_t>(nl + 1, 0)};
     tbb::parallel_for(std::size_t(0), nl, [&](std::size_t l) {
-      if (leaves_[l].whole) {  // quadrilaterals, but for the free sides
+      if (cells_[l].whole) {  // quadrilaterals, but for the free sides
         const auto sides = static_cast<std::uint32_t>(6 - std::popcount(freeSides_[l]));
         at.polygon[l + 1] = sides;
         at.corner[l + 1] = 4 * sides;
@@ -240,11 +242,12 @@ class SliceBuilder {
         return;
       }
       std::size_t corners = 0, loops = 0;
-      for (const PiecePolygon& polygon : leaves_[l].piece) {
+      const Piece& piece = leaves_[cells_[l].piece].piece;
+      for (const PiecePolygon& polygon : piece) {
         corners += polygon.vertices.size();
         loops += polygon.numLoops();
       }
-      at.polygon[l + 1] = static_cast<std::uint32_t>(leaves_[l].piece.size());
+      at.polygon[l + 1] = static_cast<std::uint32_t>(piece.size());
       at.corner[l + 1] = corners;
       at.loop[l + 1] = loops;
     });
@@ -270,7 +273,7 @@ class SliceBuilder {
   /// Each leaf's polygons on the welded vertices (in parallel), kept in flat arrays
   /// (WeldedPolygons): a Face is made only for each face of the mesh.
   LeafPolygons weldPolygons(const LeafOffsets& at, const WeldedVertices& vertexOf) {
-    const std::size_t nl = leaves_.size();
+    const std::size_t nl = cells_.size();
     const std::size_t np = at.polygon[nl];
     LeafPolygons out{WeldedPolygons(np, at.corner[nl], at.loop[nl]), std::vector<char>(np, 0),
                      std::vector<char>(np, 0), std::vector<std::uint64_t>(np, 0),
@@ -280,7 +283,7 @@ class SliceBuilder {
         tbb::blocked_range<std::size_t>(0, nl, 64), [&](const tbb::blocked_range<std::size_t>& r) {
           Piece scratch;
           for (std::size_t l = r.begin(); l != r.end(); ++l) {
-            const Piece& piece = pieceOf(leaves_[l], scratch, freeSides_[l]);
+            const Piece& piece = pieceOf(l, scratch, freeSides_[l]);
             std::size_t corner = at.corner[l], loop = at.loop[l];
             for (std::size_t i = 0; i < piece.size(); ++i) {
               const std::size_t p = at.polygon[l] + i;
@@ -315,7 +318,7 @@ class SliceBuilder {
   /// without polygons has no element.
   void cancelReversedPairs(const LeafOffsets& at, LeafPolygons& out) {
     std::atomic<std::size_t> cancelled{0};
-    tbb::parallel_for(std::size_t(0), leaves_.size(), [&](std::size_t l) {
+    tbb::parallel_for(std::size_t(0), cells_.size(), [&](std::size_t l) {
       boost::container::small_vector<std::pair<std::uint64_t, std::uint32_t>, 16> keyed;
       for (std::uint32_t p = at.polygon[l]; p < at.polygon[l + 1]; ++p)
         if (out.kept[p] && out.touched[p]) keyed.emplace_back(out.keys[p], p);
@@ -563,23 +566,38 @@ class SliceBuilder {
     std::vector<SliceLeaf>().swap(leaves_);
   }
 
-  /// What the build reads of each leaf besides its piece (cells_).
-  void keepCells() {
-    cells_.resize(leaves_.size());
-    tbb::parallel_for(std::size_t(0), leaves_.size(), [&](std::size_t l) {
-      cells_[l] = {leaves_[l].cell, static_cast<std::int16_t>(leaves_[l].level), leaves_[l].whole};
-    });
+  /// The leaves in order (cells_): the sliced leaves and the whole cells, both sorted by cell,
+  /// merged (no cell has both). The whole cells' list is freed.
+  void mergeCells() {
+    auto before = [](const std::array<int, 3>& a, const std::array<int, 3>& b) {
+      return std::tie(a[2], a[1], a[0]) < std::tie(b[2], b[1], b[0]);
+    };
+    cells_.resize(leaves_.size() + wholeCells_.size());
+    std::size_t i = 0, w = 0;
+    for (LeafCell& c : cells_)
+      if (w == wholeCells_.size() ||
+          (i < leaves_.size() && before(leaves_[i].cell, wholeCells_[w]))) {
+        c = {leaves_[i].cell, static_cast<std::uint32_t>(i),
+             static_cast<std::int16_t>(leaves_[i].level), false};
+        ++i;
+      } else {
+        c = {wholeCells_[w++], kNone, 0, true};
+      }
+    std::vector<std::array<int, 3>>().swap(wholeCells_);
   }
 
-  /// What the build reads of a leaf once its piece is spent.
+  /// What the build reads of a leaf: its cell, and its piece's place in `leaves_` (a sliced
+  /// leaf) or that it is a whole cell (made from the grid, with no piece).
   struct LeafCell {
     std::array<int, 3> cell;
-    std::int16_t level;  ///< at most 10
+    std::uint32_t piece;  ///< in leaves_, or kNone for a whole cell
+    std::int16_t level;   ///< at most 10
     bool whole;
   };
 
-  std::vector<SliceLeaf>& leaves_;
-  std::vector<LeafCell> cells_;  ///< per leaf (keepCells()), read after the leaves are freed
+  std::vector<SliceLeaf>& leaves_;  ///< the leaves with a piece, sorted by cell and part
+  std::vector<std::array<int, 3>>& wholeCells_;  ///< sorted; merged into cells_ and freed
+  std::vector<LeafCell> cells_;                  ///< every leaf in order (mergeCells())
   const WholeCells& whole_;
   const bool octree_;
   const std::size_t firstGenerated_;
@@ -594,11 +612,12 @@ class SliceBuilder {
 
 }  // namespace
 
-PolyMesh buildSliceMesh(std::vector<SliceLeaf>& leaves, const WholeCells& whole, bool octree,
-                        std::size_t firstGenerated, std::vector<Vec3> points, SliceStats& stats,
+PolyMesh buildSliceMesh(std::vector<SliceLeaf>& leaves, std::vector<std::array<int, 3>>& wholeCells,
+                        const WholeCells& whole, bool octree, std::size_t firstGenerated,
+                        std::vector<Vec3> points, SliceStats& stats,
                         std::vector<std::array<int, 3>>* elementCell,
                         std::vector<int>* elementLevel, std::vector<char>* elementWhole) {
-  return SliceBuilder(leaves, whole, octree, firstGenerated, stats)
+  return SliceBuilder(leaves, wholeCells, whole, octree, firstGenerated, stats)
       .build(std::move(points), elementCell, elementLevel, elementWhole);
 }
 

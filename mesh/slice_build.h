@@ -20,20 +20,21 @@ struct SliceLeaf {
   std::array<int, 3> cell;
   std::size_t part;  ///< index of the piece among its cell's connected pieces
   int level = 0;     ///< its octree level (the octree's finest for a sliced cell)
-  /// A whole cell of the uniform grid: `piece` is empty, its sides are made when they are read
-  /// (from `whole`, below).
-  bool whole = false;
 };
 
-/// The mesh of `leaves` (sorted by cell, then part), whose polygons use `points`: the
-/// splitter's, then, from `firstGenerated` on, those made for whole cells (the octree's boxes,
-/// or `whole`'s grid nodes). Counts what rounding did in `stats`, frees the leaves (`leaves`
-/// is left empty) and the points as soon as they are read (before the mesh's arrays are made), and
-/// gives each element's leaf's cell and level to `elementCell` and `elementLevel` (optional), and
-/// to `elementWhole` (optional) 1 for a whole cell none of whose corners welding moved (the grid's
-/// box on six quadrilaterals of grid nodes), else 0.
-PolyMesh buildSliceMesh(std::vector<SliceLeaf>& leaves, const WholeCells& whole, bool octree,
-                        std::size_t firstGenerated, std::vector<Vec3> points, SliceStats& stats,
+/// The mesh of `leaves` (sorted by cell, then part) and of the uniform grid's whole cells
+/// `wholeCells` (sorted by cell, z slowest; their sides come from `whole`, on its grid nodes),
+/// taken in cell order, whose polygons use `points`: the splitter's, then, from
+/// `firstGenerated` on, those made for whole cells (the octree's boxes, or `whole`'s grid
+/// nodes). A whole cell is no SliceLeaf (a piece, a part and a level it does not need: 56 bytes
+/// each). Counts what rounding did in `stats`, frees the leaves and the whole cells' list (both
+/// are left empty) and the points as soon as they are read (before the mesh's arrays are
+/// made), and gives each element's leaf's cell and level to `elementCell` and `elementLevel`
+/// (optional), and to `elementWhole` (optional) 1 for a whole cell none of whose corners
+/// welding moved (the grid's box on six quadrilaterals of grid nodes), else 0.
+PolyMesh buildSliceMesh(std::vector<SliceLeaf>& leaves, std::vector<std::array<int, 3>>& wholeCells,
+                        const WholeCells& whole, bool octree, std::size_t firstGenerated,
+                        std::vector<Vec3> points, SliceStats& stats,
                         std::vector<std::array<int, 3>>* elementCell,
                         std::vector<int>* elementLevel, std::vector<char>* elementWhole = nullptr);
 
