@@ -16,7 +16,7 @@ namespace polydg {
 
 /// Freed memory worth returning to the kernel: less is reused sooner than its return saves
 /// (pages returned are faulted in and zeroed again when reused).
-inline constexpr std::size_t kReleaseAtLeast = std::size_t(128) << 20;
+inline constexpr std::size_t kReleaseAtLeast = std::size_t(32) << 20;
 
 /// The freed memory jemalloc holds in all its arenas, in bytes; 0 without jemalloc.
 inline std::size_t heldFreedMemory() {
