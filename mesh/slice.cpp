@@ -9,7 +9,6 @@
 #include <numeric>
 #include <span>
 #include <stdexcept>
-#include <tuple>
 
 #include "mesh/flat_faces.h"
 #include "mesh/plane_split.h"
@@ -75,16 +74,10 @@ class Slicer {
     tbb::parallel_invoke(
         [&] {
           tbb::parallel_sort(leaves_.begin(), leaves_.end(), [](const Leaf& a, const Leaf& b) {
-            return std::tie(a.cell[2], a.cell[1], a.cell[0], a.part) <
-                   std::tie(b.cell[2], b.cell[1], b.cell[0], b.part);
+            return a.cell == b.cell ? a.part < b.part : cellBefore(a.cell, b.cell);
           });
         },
-        [&] {
-          tbb::parallel_sort(wholeCells_.begin(), wholeCells_.end(),
-                             [](const std::array<int, 3>& a, const std::array<int, 3>& b) {
-                               return std::tie(a[2], a[1], a[0]) < std::tie(b[2], b[1], b[0]);
-                             });
-        });
+        [&] { tbb::parallel_sort(wholeCells_.begin(), wholeCells_.end(), cellBefore); });
     stats.splits = splits_;
     stats.polygonsSplit = polygonsSplit_;
     stats.leafCells = leafCells_;

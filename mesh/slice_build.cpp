@@ -7,7 +7,6 @@
 #include <cstdint>
 #include <limits>
 #include <span>
-#include <tuple>
 #include <utility>
 
 #include <tbb/blocked_range.h>
@@ -72,7 +71,7 @@ class SliceBuilder {
     if (elementWhole) {
       elementWhole->assign(ids.elements, 0);
       tbb::parallel_for(std::size_t(0), cells_.size(), [&](std::size_t l) {
-        if (ids.elementOf[l] != kNone && cells_[l].whole)
+        if (ids.elementOf[l] != kNone && cells_[l].whole())
           (*elementWhole)[ids.elementOf[l]] = !weldedCorner(cells_[l].cell, vertices);
       });
     }
@@ -87,7 +86,7 @@ class SliceBuilder {
   /// The polygons of leaf l: its piece, or a whole cell's sides made in `scratch` (without
   /// those in `skip`).
   const Piece& pieceOf(std::size_t l, Piece& scratch, unsigned skip = 0) const {
-    if (!cells_[l].whole) return leaves_[cells_[l].piece].piece;
+    if (!cells_[l].whole()) return leaves_[cells_[l].piece].piece;
     whole_.sides(cells_[l].cell, scratch, skip);
     return scratch;
   }
@@ -108,7 +107,7 @@ class SliceBuilder {
   /// WholeCells::sides makes them, without making them).
   template <class F>
   void forEachCorner(std::size_t l, F&& f) const {
-    if (cells_[l].whole) {
+    if (cells_[l].whole()) {
       for (int s = 0; s < 6; ++s)
         for (const std::uint32_t v : whole_.side(cells_[l].cell, s)) f(v);
       return;
@@ -234,7 +233,7 @@ class SliceBuilder {
     LeafOffsets at{std::vector<std::uint32_t>(nl + 1, 0), std::vector<std::size_t>(nl + 1, 0),
                    std::vector<std::size_t>(nl + 1, 0)};
     tbb::parallel_for(std::size_t(0), nl, [&](std::size_t l) {
-      if (cells_[l].whole) {  // quadrilaterals, but for the free sides
+      if (cells_[l].whole()) {  // quadrilaterals, but for the free sides
         const auto sides = static_cast<std::uint32_t>(6 - std::popcount(freeSides_[l]));
         at.polygon[l + 1] = sides;
         at.corner[l + 1] = 4 * sides;
@@ -343,7 +342,7 @@ class SliceBuilder {
       std::array<RowCursor, 6> beside;
       for (int s = 2; s < 6; ++s) beside[s] = cursorBeside(row, s);
       for (std::uint32_t l = rowStart_[row]; l < rowStart_[row + 1]; ++l) {
-        if (!cells_[l].whole) continue;
+        if (!cells_[l].whole()) continue;
         for (int s = 0; s < 6; ++s) {
           if (wholeLeafBeside(l, s, beside[s]) == kNone) continue;
           const std::array<std::uint32_t, 4> corners = whole_.side(cells_[l].cell, s);
@@ -398,12 +397,12 @@ class SliceBuilder {
       const auto next = whole_.beside(cell, s);
       if (!next || (s == 0 ? l == 0 : l + std::size_t(1) == cells_.size())) return kNone;
       const std::uint32_t m = s == 0 ? l - 1 : l + 1;
-      return cells_[m].whole && cells_[m].cell == *next ? m : kNone;
+      return cells_[m].whole() && cells_[m].cell == *next ? m : kNone;
     }
     while (cursor.at < cursor.end && cells_[cursor.at].cell[0] < cell[0]) ++cursor.at;
     if (cursor.at == cursor.end) return kNone;
     const LeafCell& c = cells_[cursor.at];
-    return c.whole && c.cell[0] == cell[0] ? cursor.at : kNone;
+    return c.whole() && c.cell[0] == cell[0] ? cursor.at : kNone;
   }
 
   /// Whether a corner of whole cell `cell` is a vertex that several points were welded into.
@@ -470,7 +469,7 @@ class SliceBuilder {
   template <class Polygon, class FreeSide>
   void forEachSide(const LeafOffsets& at, std::size_t l, Polygon&& polygon,
                    FreeSide&& freeSide) const {
-    if (!cells_[l].whole) {
+    if (!cells_[l].whole()) {
       for (std::size_t p = at.polygon[l]; p < at.polygon[l + 1]; ++p) polygon(p);
       return;
     }
@@ -554,9 +553,9 @@ class SliceBuilder {
     });
   }
 
-  /// The leaves are spent: their many small buffers are freed in parallel, not one by one
-  /// when the slicer goes, and the leaves themselves (56 bytes each, 92 MB for the bunny at 200
-  /// cells) go before the mesh's arrays are made; the rest of the build reads `cells_`.
+  /// The sliced leaves are spent: their many small buffers are freed in parallel, not one by
+  /// one when the slicer goes, and before the mesh's arrays are made; the rest of the build
+  /// reads `cells_`.
   void freeLeaves() {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves_.size(), 256),
                       [&](const tbb::blocked_range<std::size_t>& r) {
@@ -569,19 +568,16 @@ class SliceBuilder {
   /// The leaves in order (cells_): the sliced leaves and the whole cells, both sorted by cell,
   /// merged (no cell has both). The whole cells' list is freed.
   void mergeCells() {
-    auto before = [](const std::array<int, 3>& a, const std::array<int, 3>& b) {
-      return std::tie(a[2], a[1], a[0]) < std::tie(b[2], b[1], b[0]);
-    };
     cells_.resize(leaves_.size() + wholeCells_.size());
     std::size_t i = 0, w = 0;
     for (LeafCell& c : cells_)
       if (w == wholeCells_.size() ||
-          (i < leaves_.size() && before(leaves_[i].cell, wholeCells_[w]))) {
+          (i < leaves_.size() && cellBefore(leaves_[i].cell, wholeCells_[w]))) {
         c = {leaves_[i].cell, static_cast<std::uint32_t>(i),
-             static_cast<std::int16_t>(leaves_[i].level), false};
+             static_cast<std::int16_t>(leaves_[i].level)};
         ++i;
       } else {
-        c = {wholeCells_[w++], kNone, 0, true};
+        c = {wholeCells_[w++], kNone, 0};
       }
     std::vector<std::array<int, 3>>().swap(wholeCells_);
   }
@@ -592,7 +588,7 @@ class SliceBuilder {
     std::array<int, 3> cell;
     std::uint32_t piece;  ///< in leaves_, or kNone for a whole cell
     std::int16_t level;   ///< at most 10
-    bool whole;
+    bool whole() const { return piece == kNone; }
   };
 
   std::vector<SliceLeaf>& leaves_;  ///< the leaves with a piece, sorted by cell and part

@@ -43,9 +43,8 @@ std::vector<std::array<int, 3>> WholeCells::finish(std::uint32_t firstPoint,
     boxes.insert(boxes.end(), list.begin(), list.end());
     std::vector<Box>().swap(list);
   }
-  std::sort(boxes.begin(), boxes.end(), [](const Box& a, const Box& b) {
-    return std::tie(a.lo[2], a.lo[1], a.lo[0]) < std::tie(b.lo[2], b.lo[1], b.lo[0]);
-  });
+  std::sort(boxes.begin(), boxes.end(),
+            [](const Box& a, const Box& b) { return cellBefore(a.lo, b.lo); });
   std::size_t cells = 0;
   for (const Box& box : boxes) cells += box.cells();
   finished_ += cells;

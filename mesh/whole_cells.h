@@ -6,6 +6,7 @@
 #include <array>
 #include <cstdint>
 #include <optional>
+#include <tuple>
 #include <unordered_map>
 #include <utility>
 #include <vector>
@@ -16,6 +17,13 @@
 #include "polydg/mesh/slice.h"
 
 namespace polydg {
+
+/// Whether cell a comes before cell b in the grid's order, z slowest, then y, then x: the
+/// order of slicing's leaves and whole cells, in which the build takes them, and of its rows
+/// (WholeCells::rowIndex()).
+inline bool cellBefore(const std::array<int, 3>& a, const std::array<int, 3>& b) {
+  return std::tie(a[2], a[1], a[0]) < std::tie(b[2], b[1], b[0]);
+}
 
 /// Whole-cell flags (one per element, or none) after elements are merged: `group[e]` is element
 /// e's new element (of `elements`), or kDroppedElement. A merged element is a whole cell only if
