@@ -74,6 +74,13 @@ class CornerNumbers {
   int shift_ = 0;                     ///< 64 - log2(table_.size())
 };
 
+/// Calls f(use, record) for each record of element e, in file order.
+template <class F>
+void forEachRecordOf(const PolyMesh& mesh, const FaceRecords& records, ElementId e, F&& f) {
+  for (const FaceUse& use : mesh.element(e).faces)
+    for (std::size_t k = 0; k < records.count(use.face); ++k) f(use, records.record(use.face, k));
+}
+
 /// Numbers the vertices of element e's records in file order (so `numbers` ends with its
 /// corners in order of first use) and calls f(use, record, corner) for each record, corner[i]
 /// being the number of record[i].
@@ -82,13 +89,11 @@ void forEachRecord(const PolyMesh& mesh, const FaceRecords& records, ElementId e
                    CornerNumbers& numbers, F&& f) {
   numbers.clear();
   boost::container::small_vector<std::uint32_t, 16> corner;
-  for (const FaceUse& use : mesh.element(e).faces)
-    for (std::size_t k = 0; k < records.count(use.face); ++k) {
-      const auto record = records.record(use.face, k);
-      corner.resize(record.size());
-      for (std::size_t i = 0; i < record.size(); ++i) corner[i] = numbers.number(record[i]);
-      f(use, record, std::span<const std::uint32_t>(corner.data(), corner.size()));
-    }
+  forEachRecordOf(mesh, records, e, [&](const FaceUse& use, std::span<const VertexId> record) {
+    corner.resize(record.size());
+    for (std::size_t i = 0; i < record.size(); ++i) corner[i] = numbers.number(record[i]);
+    f(use, record, std::span<const std::uint32_t>(corner.data(), corner.size()));
+  });
 }
 
 /// A count of one cell, which RunningEnds keeps in 32 bits.
@@ -293,26 +298,27 @@ GeneratedInts CellStreams::faces() const {
               const ElementId e = order_[c];
               const std::size_t first = corners_.begin[e.index()];
               window.put(static_cast<std::int64_t>(recordEnd_.end(c) - recordEnd_.begin(c)));
+              // A record's size, then the points of its vertices 0 .. n-1 (pointOf(i)); backwards
+              // for a reversed use, keeping the first vertex first: v0, v(n-1), ..., v1.
+              auto putRecord = [&](const FaceUse& use, std::size_t n, auto&& pointOf) {
+                window.put(static_cast<std::int64_t>(n));
+                for (std::size_t i = 0; i < n; ++i)
+                  window.put(pointOf(use.reversed ? (n - i) % n : i));
+              };
               if (vertexIds) {  // a corner's point is its vertex: the records' ids as they are
-                for (const FaceUse& use : mesh_.element(e).faces)
-                  for (std::size_t k = 0; k < records_.count(use.face); ++k) {
-                    const auto record = records_.record(use.face, k);
-                    const std::size_t n = record.size();
-                    window.put(static_cast<std::int64_t>(n));
-                    for (std::size_t i = 0; i < n; ++i)
-                      window.put(record[use.reversed ? (n - i) % n : i].value);
-                  }
+                forEachRecordOf(
+                    mesh_, records_, e, [&](const FaceUse& use, std::span<const VertexId> record) {
+                      putRecord(use, record.size(),
+                                [&](std::size_t i) { return std::int64_t(record[i].value); });
+                    });
                 return;
               }
               // The records' vertices are numbered as elementCorners numbered them.
               forEachRecord(mesh_, records_, e, numbers,
                             [&](const FaceUse& use, auto, std::span<const std::uint32_t> corner) {
-                              const std::size_t n = corner.size();
-                              window.put(static_cast<std::int64_t>(n));
-                              // Backwards keeps the first vertex first: v0, v(n-1), ..., v1.
-                              for (std::size_t i = 0; i < n; ++i)
-                                window.put(points_.point(
-                                    corners_, first + corner[use.reversed ? (n - i) % n : i]));
+                              putRecord(use, corner.size(), [&](std::size_t i) {
+                                return std::int64_t(points_.point(corners_, first + corner[i]));
+                              });
                             });
             });
           }};
