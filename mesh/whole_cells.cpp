@@ -1,7 +1,14 @@
 #include "mesh/whole_cells.h"
 
 #include <algorithm>
+#include <atomic>
+#include <numeric>
 #include <tuple>
+
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
+
+#include "util/resident.h"
 
 namespace polydg {
 
@@ -43,31 +50,91 @@ std::vector<std::array<int, 3>> WholeCells::finish(std::uint32_t firstPoint,
     boxes.insert(boxes.end(), list.begin(), list.end());
     std::vector<Box>().swap(list);
   }
-  std::sort(boxes.begin(), boxes.end(),
-            [](const Box& a, const Box& b) { return cellBefore(a.lo, b.lo); });
-  std::size_t cells = 0;
-  for (const Box& box : boxes) cells += box.cells();
+  // Boxes are disjoint, so no two have the same first cell: the order is total.
+  tbb::parallel_sort(boxes.begin(), boxes.end(),
+                     [](const Box& a, const Box& b) { return cellBefore(a.lo, b.lo); });
+  std::vector<std::size_t> cellStart(boxes.size() + 1, 0);
+  for (std::size_t b = 0; b < boxes.size(); ++b) cellStart[b + 1] = cellStart[b] + boxes[b].cells();
+  const std::size_t cells = cellStart.back();
   finished_ += cells;
   if (cells == 0) return {};
   const std::size_t nodes = nodeIndex(grid_.cells) + 1;
-  if (nodes <= 8 * cells + (std::size_t(1) << 20)) table_.assign(nodes, kNone);
-  std::vector<std::array<int, 3>> out;
-  out.reserve(cells);
-  for (const Box& box : boxes) {
-    for (int k = box.lo[2]; k <= box.hi[2]; ++k)
-      for (int j = box.lo[1]; j <= box.hi[1]; ++j)
-        for (int i = box.lo[0]; i <= box.hi[0]; ++i) {
-          const std::size_t n = nodeIndex({i, j, k});
-          std::uint32_t& id = table_.empty() ? map_.try_emplace(n, kNone).first->second : table_[n];
-          if (id != kNone) continue;
-          id = static_cast<std::uint32_t>(firstPoint + points.size());
-          points.emplace_back(grid_.plane(0, i), grid_.plane(1, j), grid_.plane(2, k));
-        }
+  if (nodes <= 8 * cells + (std::size_t(1) << 20)) {
+    numberNodesInParallel(boxes, firstPoint, points);
+  } else {
+    numberNodesInOrder(boxes, firstPoint, points);
+  }
+  auto out = residentVector<std::array<int, 3>>(cells);
+  tbb::parallel_for(std::size_t(0), boxes.size(), [&](std::size_t b) {
+    const Box& box = boxes[b];
+    std::size_t c = cellStart[b];
     for (int k = box.lo[2]; k < box.hi[2]; ++k)
       for (int j = box.lo[1]; j < box.hi[1]; ++j)
-        for (int i = box.lo[0]; i < box.hi[0]; ++i) out.push_back({i, j, k});
-  }
+        for (int i = box.lo[0]; i < box.hi[0]; ++i) out[c++] = {i, j, k};
+  });
   return out;
+}
+
+void WholeCells::numberNodesInOrder(const std::vector<Box>& boxes, std::uint32_t firstPoint,
+                                    std::vector<Vec3>& points) {
+  for (const Box& box : boxes)
+    forEachNode(box, [&](std::size_t n, int i, int j, int k) {
+      std::uint32_t& id = table_.empty() ? map_.try_emplace(n, kNone).first->second : table_[n];
+      if (id != kNone) return;
+      id = static_cast<std::uint32_t>(firstPoint + points.size());
+      points.emplace_back(grid_.plane(0, i), grid_.plane(1, j), grid_.plane(2, k));
+    });
+}
+
+void WholeCells::numberNodesInParallel(const std::vector<Box>& boxes, std::uint32_t firstPoint,
+                                       std::vector<Vec3>& points) {
+  // While numbering, a node's slot holds kOwner | the first box (in order) that has it; its
+  // number, once given, is below kOwner, so that no box mistakes it for its own mark.
+  constexpr std::uint32_t kOwner = 0x80000000u;
+  std::size_t visits = 0;
+  for (const Box& box : boxes) visits += box.nodes();
+  if (boxes.size() >= kOwner - 1 || firstPoint + points.size() + visits >= kOwner) {
+    table_.assign(nodeIndex(grid_.cells) + 1, kNone);
+    numberNodesInOrder(boxes, firstPoint, points);
+    return;
+  }
+  table_.clear();
+  growResident(table_, nodeIndex(grid_.cells) + 1, kNone);
+  auto slot = [&](std::size_t n) { return std::atomic_ref<std::uint32_t>(table_[n]); };
+  tbb::parallel_for(std::size_t(0), boxes.size(), [&](std::size_t b) {
+    const std::uint32_t mark = kOwner | static_cast<std::uint32_t>(b);
+    forEachNode(boxes[b], [&](std::size_t n, int, int, int) {
+      std::atomic_ref<std::uint32_t> s = slot(n);
+      std::uint32_t seen = s.load(std::memory_order_relaxed);
+      while (mark < seen && !s.compare_exchange_weak(seen, mark, std::memory_order_relaxed)) {
+      }
+    });
+  });
+  // The first box of a node numbers it, as one box after the other would: box b's nodes come
+  // after those of the boxes before it, in the order forEachNode visits them.
+  std::vector<std::size_t> nodeStart(boxes.size() + 1, 0);
+  tbb::parallel_for(std::size_t(0), boxes.size(), [&](std::size_t b) {
+    const std::uint32_t mark = kOwner | static_cast<std::uint32_t>(b);
+    std::size_t owned = 0;
+    forEachNode(boxes[b], [&](std::size_t n, int, int, int) {
+      owned += slot(n).load(std::memory_order_relaxed) == mark;
+    });
+    nodeStart[b + 1] = owned;
+  });
+  std::inclusive_scan(nodeStart.begin(), nodeStart.end(), nodeStart.begin());
+  const std::size_t first = points.size();
+  growResident(points, first + nodeStart.back());
+  tbb::parallel_for(std::size_t(0), boxes.size(), [&](std::size_t b) {
+    const std::uint32_t mark = kOwner | static_cast<std::uint32_t>(b);
+    std::size_t p = first + nodeStart[b];
+    forEachNode(boxes[b], [&](std::size_t n, int i, int j, int k) {
+      std::atomic_ref<std::uint32_t> s = slot(n);
+      if (s.load(std::memory_order_relaxed) != mark) return;
+      points[p] = Vec3(grid_.plane(0, i), grid_.plane(1, j), grid_.plane(2, k));
+      s.store(static_cast<std::uint32_t>(firstPoint + p), std::memory_order_relaxed);
+      ++p;
+    });
+  });
 }
 
 std::array<std::uint32_t, 4> WholeCells::side(const std::array<int, 3>& cell, int s) const {

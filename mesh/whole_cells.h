@@ -82,7 +82,26 @@ class WholeCells {
     std::size_t cells() const {
       return static_cast<std::size_t>(hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]);
     }
+    std::size_t nodes() const {
+      return static_cast<std::size_t>(hi[0] - lo[0] + 1) * (hi[1] - lo[1] + 1) *
+             (hi[2] - lo[2] + 1);
+    }
   };
+  /// Calls f(nodeIndex, i, j, k) for the box's nodes, k slowest, then j, then i.
+  template <class F>
+  void forEachNode(const Box& box, F&& f) const {
+    for (int k = box.lo[2]; k <= box.hi[2]; ++k)
+      for (int j = box.lo[1]; j <= box.hi[1]; ++j)
+        for (int i = box.lo[0]; i <= box.hi[0]; ++i) f(nodeIndex({i, j, k}), i, j, k);
+  }
+  /// Gives the boxes' nodes their points, firstPoint + points.size() on, in order of their
+  /// first box and then of forEachNode: one box after the other, with table_ or map_ (which
+  /// ever is not empty) ...
+  void numberNodesInOrder(const std::vector<Box>& boxes, std::uint32_t firstPoint,
+                          std::vector<Vec3>& points);
+  /// ... or, the same numbers, with the boxes on all cores (table_ only).
+  void numberNodesInParallel(const std::vector<Box>& boxes, std::uint32_t firstPoint,
+                             std::vector<Vec3>& points);
   /// Grid node c's index (i fastest, then j, then k).
   std::size_t nodeIndex(const std::array<int, 3>& c) const {
     return linearIndex(c, grid_.cells[0] + 1, grid_.cells[1] + 1);

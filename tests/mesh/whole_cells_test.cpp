@@ -4,7 +4,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <map>
 #include <set>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include "polydg/mesh/geometry.h"
@@ -63,6 +67,61 @@ TEST(WholeCells, SidesOnOnePointPerNodeWithATableOfNodes) { expectSidesOfTwoBoxe
 
 TEST(WholeCells, SidesOnOnePointPerNodeWithAMapForFewCellsInALargeGrid) {
   expectSidesOfTwoBoxes(128);  // 129^3 nodes: more than 2^20 + 8 x 13
+}
+
+/// Boxes tiling cells [0, 8) x [0, 6) x [1, 6) of an n^3 grid, recorded out of order: every
+/// box's nodes take their points in order of the first box (by cell order of its lowest cell)
+/// that has them, k slowest, then j, then i, as a reference numbering here computes them.
+void expectNodesNumberedInOrderOfTheirFirstBox(int n) {
+  Grid grid;
+  grid.centre = Vec3(-3.0, 1e5, 0.5);
+  grid.cellSize = 0.25;
+  grid.cells = {n, n, n};
+  const std::vector<int> xs{0, 3, 5, 8}, ys{0, 2, 6}, zs{1, 2, 6};
+  std::vector<std::pair<std::array<int, 3>, std::array<int, 3>>> boxes;
+  for (std::size_t c = 0; c + 1 < zs.size(); ++c)
+    for (std::size_t b = 0; b + 1 < ys.size(); ++b)
+      for (std::size_t a = 0; a + 1 < xs.size(); ++a)
+        boxes.push_back({{xs[a], ys[b], zs[c]}, {xs[a + 1], ys[b + 1], zs[c + 1]}});
+  WholeCells whole(grid);
+  for (std::size_t i = boxes.size(); i-- > 0;) whole.add(boxes[i].first, boxes[i].second);
+  std::vector<Vec3> points(2, Vec3::Zero());  // points made before: numbering goes on after them
+  const std::vector<std::array<int, 3>> cells = whole.finish(7, points);
+  EXPECT_EQ(cells.size(), 8u * 6u * 5u);
+
+  // The reference: boxes in cell order of their lowest cell (z, then y, then x), nodes numbered
+  // when first met.
+  std::sort(boxes.begin(), boxes.end(), [](const auto& a, const auto& b) {
+    return std::tie(a.first[2], a.first[1], a.first[0]) <
+           std::tie(b.first[2], b.first[1], b.first[0]);
+  });
+  std::map<std::array<int, 3>, std::uint32_t> expected;
+  for (const auto& [lo, hi] : boxes)
+    for (int k = lo[2]; k <= hi[2]; ++k)
+      for (int j = lo[1]; j <= hi[1]; ++j)
+        for (int i = lo[0]; i <= hi[0]; ++i)
+          expected.try_emplace({i, j, k}, static_cast<std::uint32_t>(9 + expected.size()));
+  ASSERT_EQ(points.size(), 2u + expected.size());
+  for (const auto& [node, id] : expected)
+    EXPECT_EQ(points[id - 7],
+              Vec3(grid.plane(0, node[0]), grid.plane(1, node[1]), grid.plane(2, node[2])));
+  // Side 0 (facing -x) of every cell runs over its four nodes at x = cell[0].
+  for (const std::array<int, 3>& cell : cells) {
+    const std::array<std::uint32_t, 4> side = whole.side(cell, 0);
+    std::set<std::uint32_t> got(side.begin(), side.end()), want;
+    for (int dj = 0; dj < 2; ++dj)
+      for (int dk = 0; dk < 2; ++dk)
+        want.insert(expected.at({cell[0], cell[1] + dj, cell[2] + dk}));
+    EXPECT_EQ(got, want);
+  }
+}
+
+TEST(WholeCells, NodesAreNumberedInOrderOfTheirFirstBoxWithATable) {
+  expectNodesNumberedInOrderOfTheirFirstBox(16);
+}
+
+TEST(WholeCells, NodesAreNumberedInOrderOfTheirFirstBoxWithAMap) {
+  expectNodesNumberedInOrderOfTheirFirstBox(128);
 }
 
 TEST(WholeCells, OnlySixFourCornerCapsAreAWholeBox) {
