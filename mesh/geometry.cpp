@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 namespace polydg {
 
 Vec3 areaVector(const PolyMesh& mesh, FaceId f) {
@@ -72,6 +75,16 @@ double signedVolume(const PolyMesh& mesh, ElementId e) {
     threeVolume += use.reversed ? -h : h;
   }
   return threeVolume / 3.0;
+}
+
+std::vector<double> signedVolumes(const PolyMesh& mesh) {
+  std::vector<double> volumes(mesh.numElements());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, volumes.size(), 1024),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t e = r.begin(); e != r.end(); ++e)
+                        volumes[e] = signedVolume(mesh, ElementId(e));
+                    });
+  return volumes;
 }
 
 double planarityDeviation(const PolyMesh& mesh, FaceId f) {

@@ -346,11 +346,14 @@ void reportDuplicateFaces(const PolyMesh& mesh, Problems& problems, GeometryChec
 
 /// Elements: closure and volume in parallel (they are the costly part), then links back to
 /// faces and the report in order.
-void reportElements(const PolyMesh& mesh, Problems& problems, GeometryCheck& report) {
-  // Per element, in parallel: closed, linked (each face it uses lists it on that side), volume.
+void reportElements(const PolyMesh& mesh, std::span<const double> given, Problems& problems,
+                    GeometryCheck& report) {
+  // Per element, in parallel: closed, linked (each face it uses lists it on that side), and
+  // its volume unless given.
   enum : char { kClosed = 1, kLinked = 2 };
   std::vector<char> state(mesh.numElements());
-  std::vector<double> volumes(mesh.numElements());
+  std::vector<double> computed(given.empty() ? mesh.numElements() : 0);
+  const std::span<const double> volumes = given.empty() ? computed : given;
   auto linked = [&](ElementId e) {
     const auto& uses = mesh.element(e).faces;
     return std::all_of(uses.begin(), uses.end(), [&](const FaceUse& use) {
@@ -364,7 +367,7 @@ void reportElements(const PolyMesh& mesh, Problems& problems, GeometryCheck& rep
                         const ElementId e(i);
                         state[i] = static_cast<char>((isClosed(mesh, e) ? kClosed : 0) |
                                                      (linked(e) ? kLinked : 0));
-                        volumes[i] = signedVolume(mesh, e);
+                        if (given.empty()) computed[i] = signedVolume(mesh, e);
                       }
                     });
   // The report in element order, reading the mesh again only where a link is wrong.
@@ -404,7 +407,12 @@ void reportElements(const PolyMesh& mesh, Problems& problems, GeometryCheck& rep
 
 }  // namespace
 
-GeometryCheck checkGeometry(const PolyMesh& mesh, const GeometryCheckOptions& options) {
+GeometryCheck checkGeometry(const PolyMesh& mesh, const GeometryCheckOptions& options,
+                            std::span<const double> volumes) {
+  if (!volumes.empty() && volumes.size() != mesh.numElements())
+    throw std::invalid_argument("checkGeometry: " + std::to_string(volumes.size()) +
+                                " volumes given for " + std::to_string(mesh.numElements()) +
+                                " elements");
   GeometryCheck report;
   Problems problems(report, options.maxMessages);
   report.elements = mesh.numElements();
@@ -412,7 +420,7 @@ GeometryCheck checkGeometry(const PolyMesh& mesh, const GeometryCheckOptions& op
   // Faces: shape and planarity in parallel, then links, duplicates and the report in order.
   reportFaces(mesh, measureFaces(mesh, options), problems, report);
   reportDuplicateFaces(mesh, problems, report);
-  reportElements(mesh, problems, report);
+  reportElements(mesh, volumes, problems, report);
 
   connectedComponents(mesh, report.components);
   report.passed = report.openElements == 0 && report.nonPositiveElements == 0 &&

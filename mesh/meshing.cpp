@@ -287,9 +287,10 @@ void checkMeshing(MeshingResult& result) {
   checkMeshing(result.mesh, result.report, result.wholeCells);
 }
 
-void checkMeshing(const PolyMesh& mesh, MeshingReport& r, const std::vector<char>& wholeCells) {
+void checkMeshing(const PolyMesh& mesh, MeshingReport& r, const std::vector<char>& wholeCells,
+                  std::span<const double> volumes) {
   const Stopwatch start;
-  r.geometry = checkGeometry(mesh);
+  r.geometry = checkGeometry(mesh, {}, volumes);
   r.elements = mesh.numElements();
   r.faces = r.geometry.faces;
   r.interiorFaces = r.geometry.interiorFaces;

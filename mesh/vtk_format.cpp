@@ -191,27 +191,37 @@ void storeValues(StoredType stored, std::span<const T> values, std::vector<char>
 /// Values of a generated array that one task makes: a chunk is split into ranges of this many.
 constexpr std::size_t kFillGrain = 1 << 14;
 
-/// Hands the values of `a` to f(first, values), values[i] being value first + i: a held array
-/// in one run, a generated one chunk by chunk, each chunk filled by ranges on all cores (every
-/// position gets its value whatever the range, so the bytes never depend on the schedule).
-template <class F>
-void forEachRun(const ArrayOut& a, F&& f) {
-  if (!a.isGenerated()) {
-    if (a.stored == StoredType::Float64)
-      f(std::size_t{0}, a.doubles);
-    else
-      f(std::size_t{0}, a.integers);
-    return;
-  }
+/// Hands a generated array's values to f(first, values) chunk by chunk, each chunk filled by
+/// ranges on all cores (every position gets its value whatever the range, so the bytes never
+/// depend on the schedule).
+template <class T, class Fill, class F>
+void forEachChunk(const ArrayOut& a, const Fill& fill, F&& f) {
   const std::size_t chunk = std::max<std::size_t>(a.chunk, 1);
-  std::vector<std::int64_t> run(std::min(a.size(), chunk));
+  std::vector<T> run(std::min(a.size(), chunk));
   for (std::size_t begin = 0; begin < a.size(); begin += chunk) {
     const std::size_t end = std::min(a.size(), begin + chunk);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(begin, end, kFillGrain),
                       [&](const tbb::blocked_range<std::size_t>& r) {
-                        a.generated.fill(r.begin(), r.end(), run.data() + (r.begin() - begin));
+                        fill(r.begin(), r.end(), run.data() + (r.begin() - begin));
                       });
-    f(begin, std::span<const std::int64_t>(run.data(), end - begin));
+    f(begin, std::span<const T>(run.data(), end - begin));
+  }
+}
+
+/// Hands the values of `a` to f(first, values), values[i] being value first + i: a held array
+/// in one run, a generated one chunk by chunk (forEachChunk).
+template <class F>
+void forEachRun(const ArrayOut& a, F&& f) {
+  const bool real = a.stored == StoredType::Float64;
+  if (!a.isGenerated()) {
+    if (real)
+      f(std::size_t{0}, a.doubles);
+    else
+      f(std::size_t{0}, a.integers);
+  } else if (real) {
+    forEachChunk<double>(a, a.generatedDoubles.fill, f);
+  } else {
+    forEachChunk<std::int64_t>(a, a.generated.fill, f);
   }
 }
 
@@ -266,6 +276,14 @@ ArrayOut intArray(std::string_view indent, std::string_view name,
   ArrayOut a = namedArray(indent, name, withTuples);
   a.integers = values;
   a.stored = intType(largest);
+  return a;
+}
+
+ArrayOut generatedFloatArray(std::string_view indent, std::string_view name, int components,
+                             GeneratedDoubles values, bool withTuples) {
+  ArrayOut a = namedArray(indent, name, withTuples);
+  a.components = components;
+  a.generatedDoubles = std::move(values);
   return a;
 }
 

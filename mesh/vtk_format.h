@@ -99,6 +99,13 @@ struct GeneratedInts {
   FillValues fill;
 };
 
+/// Doubles made on demand instead of held, under GeneratedInts' rules: how many, and `fill`,
+/// which writes values [begin, end) to out[0 .. end - begin).
+struct GeneratedDoubles {
+  std::size_t size = 0;
+  std::function<void(std::size_t begin, std::size_t end, double* out)> fill;
+};
+
 /// How many values of a generated array are made and written at a time (8 MB as Int64).
 inline constexpr std::size_t kChunkValues = std::size_t{1} << 20;
 
@@ -114,12 +121,17 @@ struct ArrayOut {
   StoredType stored = StoredType::Float64;
   /// Integers generated `chunk` values at a time (then `integers` is unused), if its fill is set.
   GeneratedInts generated;
+  /// Doubles generated the same way (then `doubles` is unused), if its fill is set.
+  GeneratedDoubles generatedDoubles;
   std::size_t chunk = kChunkValues;  ///< at least 1
 
-  bool isGenerated() const { return static_cast<bool>(generated.fill); }
+  bool isGenerated() const {
+    return static_cast<bool>(generated.fill) || static_cast<bool>(generatedDoubles.fill);
+  }
   std::size_t size() const {
-    if (isGenerated()) return generated.size;
-    return stored == StoredType::Float64 ? doubles.size() : integers.size();
+    if (stored == StoredType::Float64)
+      return generatedDoubles.fill ? generatedDoubles.size : doubles.size();
+    return generated.fill ? generated.size : integers.size();
   }
   /// Bytes of the stored values, without the header.
   std::size_t bytes() const;
@@ -134,6 +146,10 @@ ArrayOut floatArray(std::string_view indent, std::string_view name, int componen
 /// Non-negative `values` stored as the smallest of UInt8, Int32 and Int64 that holds them.
 ArrayOut intArray(std::string_view indent, std::string_view name,
                   std::span<const std::int64_t> values, bool withTuples = false);
+
+/// `values` generated when written, stored as floatArray stores them.
+ArrayOut generatedFloatArray(std::string_view indent, std::string_view name, int components,
+                             GeneratedDoubles values, bool withTuples = false);
 
 /// `values` generated when written, stored as intArray would store them all.
 ArrayOut generatedIntArray(std::string_view indent, std::string_view name, GeneratedInts values,

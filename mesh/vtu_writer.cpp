@@ -32,6 +32,7 @@ namespace {
 
 using vtk_format::ArrayOut;
 using vtk_format::floatArray;
+using vtk_format::generatedFloatArray;
 using vtk_format::generatedIntArray;
 using vtk_format::intArray;
 
@@ -117,8 +118,11 @@ struct FileValues {
   std::vector<double> pointCopies;
   std::vector<std::vector<double>> pointArrays;   ///< pointData, copied to every VTU point
   std::vector<std::vector<double>> cornerArrays;  ///< cornerData, the mean per VTU point
-  std::vector<double> volume;                     ///< per cell
-  std::vector<std::vector<double>> cellArrays;    ///< cellData, in cell order
+  /// Per element (not per cell: the file's volume array is made from them as it is written),
+  /// the caller's or `computedVolumes`.
+  std::span<const double> volumes;
+  std::vector<double> computedVolumes;
+  std::vector<std::vector<double>> cellArrays;  ///< cellData, in cell order
 };
 
 /// The rows of `values` (`components` values per row) in the order `rows` lists them: an
@@ -159,7 +163,7 @@ std::vector<double> cornerMeans(const CellStreams& s, const CornerArray& a) {
   return mean;
 }
 
-FileValues fileValues(const PolyMesh& mesh, const CellStreams& s,
+FileValues fileValues(const PolyMesh& mesh, const CellStreams& s, std::span<const double> volumes,
                       const std::vector<CellArray>& cellData,
                       const std::vector<PointArray>& pointData,
                       const std::vector<CornerArray>& cornerData) {
@@ -177,12 +181,8 @@ FileValues fileValues(const PolyMesh& mesh, const CellStreams& s,
     });
     v.points = v.pointCopies;
   }
-  v.volume.resize(cells.size());
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells.size(), 1024),
-                    [&](const tbb::blocked_range<std::size_t>& r) {
-                      for (std::size_t c = r.begin(); c != r.end(); ++c)
-                        v.volume[c] = signedVolume(mesh, cells[c]);
-                    });
+  if (volumes.empty()) v.computedVolumes = signedVolumes(mesh);
+  v.volumes = volumes.empty() ? std::span<const double>(v.computedVolumes) : volumes;
   for (const PointArray& a : pointData)
     v.pointArrays.push_back(gatherRows(a.values, a.components, pointVertex));
   for (const CornerArray& a : cornerData) v.cornerArrays.push_back(cornerMeans(s, a));
@@ -304,7 +304,13 @@ void writeContents(std::ostream& os, const PolyMesh& mesh, const CellStreams& s,
   for (std::size_t i = 0; i < cornerData.size(); ++i)
     d.pointData.push_back(floatArray(kArrayIndent, cornerData[i].name, cornerData[i].components,
                                      values.cornerArrays[i]));
-  d.cellData.push_back(floatArray(kArrayIndent, "volume", 1, values.volume));
+  const std::span<const ElementId> cells = s.elements();
+  d.cellData.push_back(generatedFloatArray(
+      kArrayIndent, "volume", 1,
+      {cells.size(),
+       [volumes = values.volumes, cells](std::size_t begin, std::size_t end, double* out) {
+         for (std::size_t c = begin; c < end; ++c) out[c - begin] = volumes[cells[c].index()];
+       }}));
   for (std::size_t i = 0; i < cellData.size(); ++i)
     d.cellData.push_back(
         floatArray(kArrayIndent, cellData[i].name, cellData[i].components, values.cellArrays[i]));
@@ -323,7 +329,8 @@ void writeContents(std::ostream& os, const PolyMesh& mesh, const CellStreams& s,
 
 void writeVtu(const PolyMesh& mesh, const std::string& path, const VtuWriteOptions& options,
               const std::vector<CellArray>& cellData, const std::vector<PointArray>& pointData,
-              const std::vector<CornerArray>& cornerData, const VtuFieldData& fieldData) {
+              const std::vector<CornerArray>& cornerData, const VtuFieldData& fieldData,
+              std::span<const double> volumes) {
   std::unordered_set<std::string> cellNames{"volume"}, pointNames;
   checkArrays(cellData, mesh.numElements(), "cell", cellNames);
   checkArrays(pointData, mesh.numVertices(), "point", pointNames);
@@ -333,9 +340,13 @@ void writeVtu(const PolyMesh& mesh, const std::string& path, const VtuWriteOptio
       throw std::invalid_argument("writeVtu: corner array '" + a.name + "' has no value function");
   }
   checkFieldData(fieldData);
+  if (!volumes.empty() && volumes.size() != mesh.numElements())
+    throw std::invalid_argument("writeVtu: " + std::to_string(volumes.size()) +
+                                " volumes given for " + std::to_string(mesh.numElements()) +
+                                " elements");
   // Everything that can fail for reasons other than I/O happens before the file is opened.
   const CellStreams streams(mesh);
-  const FileValues values = fileValues(mesh, streams, cellData, pointData, cornerData);
+  const FileValues values = fileValues(mesh, streams, volumes, cellData, pointData, cornerData);
 
   vtk_format::writeReplacing(path, [&](std::ostream& os) {
     writeContents(os, mesh, streams, values, cellData, pointData, cornerData, fieldData,

@@ -30,12 +30,7 @@ namespace fs = std::filesystem;
 
 double medianElementVolume(const PolyMesh& mesh) {
   if (mesh.numElements() == 0) return 0.0;
-  std::vector<double> volumes(mesh.numElements());
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, volumes.size(), 4096),
-                    [&](const tbb::blocked_range<std::size_t>& r) {
-                      for (std::size_t e = r.begin(); e != r.end(); ++e)
-                        volumes[e] = signedVolume(mesh, ElementId(e));
-                    });
+  std::vector<double> volumes = signedVolumes(mesh);
   std::nth_element(volumes.begin(), volumes.begin() + volumes.size() / 2, volumes.end());
   return volumes[volumes.size() / 2];
 }
@@ -211,8 +206,10 @@ Model Model::fromSurface(const TriangleSurface& surface, const MeshOptions& opti
   if (!options.output.empty()) file.emplace(options.output);
   std::exception_ptr writeFailure, dgFailure;
   MeshCheck dg;
+  // The validation and the file both need every element's volume: computed once, beforehand.
+  const std::vector<double> volumes = signedVolumes(mesh);
   tbb::parallel_invoke(
-      [&] { checkMeshing(mesh, report.meshing, meshed.wholeCells); },
+      [&] { checkMeshing(mesh, report.meshing, meshed.wholeCells, volumes); },
       [&] {
         if (!options.dgChecks) return;
         try {
@@ -231,7 +228,8 @@ Model Model::fromSurface(const TriangleSurface& surface, const MeshOptions& opti
         if (!file || options.tets) return;  // the tets are written once the checks passed
         try {
           const Stopwatch write;
-          writeVtu(mesh, file->temporary(), {}, {}, {}, {}, provenanceFieldData(provenance));
+          writeVtu(mesh, file->temporary(), {}, {}, {}, {}, provenanceFieldData(provenance),
+                   volumes);
           report.writeSeconds = write.seconds();
         } catch (...) {
           writeFailure = std::current_exception();

@@ -52,6 +52,26 @@ TEST(GeometryChecks, AcceptsHexGrid) {
   EXPECT_EQ(r.boundaryFaces, 2u * (3 * 2 + 3 * 2 + 2 * 2));
 }
 
+TEST(GeometryChecks, UsesTheVolumesItIsGiven) {
+  const PolyMesh mesh = hexGridMesh(3, 2, 2, Box3(Vec3(0, 0, 0), Vec3(3, 2, 2)));
+  const std::vector<double> volumes = signedVolumes(mesh);
+  ASSERT_EQ(volumes.size(), 12u);
+  for (std::size_t e = 0; e < volumes.size(); ++e)
+    EXPECT_EQ(volumes[e], signedVolume(mesh, ElementId(e)));
+  const GeometryCheck same = checkGeometry(mesh, {}, volumes);
+  EXPECT_TRUE(same.passed);
+  EXPECT_DOUBLE_EQ(same.volume, 12.0);
+  // Given volumes are taken as they are: one made negative is reported.
+  std::vector<double> wrong = volumes;
+  wrong[5] = -1.0;
+  const GeometryCheck r = checkGeometry(mesh, {}, wrong);
+  EXPECT_FALSE(r.passed);
+  EXPECT_EQ(r.nonPositiveElements, 1u);
+  EXPECT_DOUBLE_EQ(r.volume, 10.0);
+  EXPECT_EQ(r.minElementVolume, -1.0);
+  EXPECT_THROW(checkGeometry(mesh, {}, std::vector<double>(11, 1.0)), std::invalid_argument);
+}
+
 TEST(GeometryChecks, AcceptsNonConvexElementsAndFacesWithHoles) {
   Polygon2 p;
   p.outer = {{0, 0}, {3, 0}, {3, 3}, {0, 3}};

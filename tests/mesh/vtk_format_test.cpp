@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <map>
@@ -157,6 +158,56 @@ TEST_P(VtkDataArrayEncoding, GeneratedArraysWriteTheBytesOfTheirValuesHeldWhole)
           << "largest " << largest << ", chunk " << chunk;
     }
   }
+}
+
+TEST_P(VtkDataArrayEncoding, GeneratedDoublesWriteTheBytesOfTheirValuesHeldWhole) {
+  // 30 doubles as 10 triples, among them -0, a subnormal, the extremes and values without a
+  // short decimal form, made in chunks of every size from one value to all of them.
+  std::vector<double> values(30);
+  for (std::size_t i = 0; i < values.size(); ++i)
+    values[i] = std::ldexp(1.0 + 0.1 * static_cast<double>(i), static_cast<int>(i) - 15) / 3.0;
+  values[3] = -0.0;
+  values[7] = std::numeric_limits<double>::denorm_min();
+  values[11] = std::numeric_limits<double>::max();
+  values[12] = -std::numeric_limits<double>::min();
+  const GeneratedDoubles generated{values.size(),
+                                   [&](std::size_t begin, std::size_t end, double* out) {
+                                     std::copy(values.begin() + begin, values.begin() + end, out);
+                                   }};
+  const ArrayOut held = floatArray("  ", "a", 3, values, /*withTuples=*/true);
+  const std::string expected = fileWith({held}, GetParam());
+  for (std::size_t chunk = 1; chunk <= values.size(); ++chunk) {
+    ArrayOut a = generatedFloatArray("  ", "a", 3, generated, /*withTuples=*/true);
+    a.chunk = chunk;
+    EXPECT_EQ(a.stored, StoredType::Float64);
+    EXPECT_EQ(a.size(), values.size());
+    EXPECT_EQ(a.bytes(), 8 * values.size());
+    EXPECT_EQ(fileWith({a}, GetParam()), expected) << "chunk " << chunk;
+  }
+}
+
+TEST(VtkDataArray, LongGeneratedArraysAreFilledOnAllCoresInOrder) {
+  // One chunk of 100,003 values: more than one task fills, so the chunk is made by several
+  // ranges, each of which must land where its values belong.
+  constexpr std::size_t n = 100003;
+  std::vector<double> reals(n);
+  std::vector<std::int64_t> integers(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    reals[i] = 0.5 + static_cast<double>(i);
+    integers[i] = static_cast<std::int64_t>(i);
+  }
+  const ArrayOut realsMade = generatedFloatArray(
+      "  ", "r", 1, {n, [&](std::size_t begin, std::size_t end, double* out) {
+                       std::copy(reals.begin() + begin, reals.begin() + end, out);
+                     }});
+  const ArrayOut integersMade = generatedIntArray(
+      "  ", "i",
+      {n, std::int64_t(n - 1), [&](std::size_t begin, std::size_t end, std::int64_t* out) {
+         std::copy(integers.begin() + begin, integers.begin() + end, out);
+       }});
+  EXPECT_EQ(fileWith({realsMade, integersMade}, VtuEncoding::Appended),
+            fileWith({floatArray("  ", "r", 1, reals), intArray("  ", "i", integers)},
+                     VtuEncoding::Appended));
 }
 
 TEST(VtkDataArray, GeneratedArraysKnowTheirSizeWithoutMakingValues) {

@@ -369,6 +369,39 @@ std::vector<double> asciiValues(const std::string& text, const std::string& name
   return values;
 }
 
+TEST(VtuWrite, WritesTheVolumesItIsGiven) {
+  // Cells of different point counts, so that the file's cell order is not the elements'.
+  const PolyMesh mesh = mixedCells();
+  const fs::path path = testDir() / "given_volumes.vtu";
+  std::vector<double> given(mesh.numElements());
+  for (std::size_t e = 0; e < given.size(); ++e) given[e] = 0.25 + static_cast<double>(e);
+  writeVtu(mesh, path.string(), {.encoding = VtuEncoding::Ascii}, {}, {}, {}, {}, given);
+  std::string text = readText(path);
+  const std::vector<double> cellElement = asciiValues(text, "polydg_element");
+  std::vector<double> written = asciiValues(text, "volume");
+  ASSERT_EQ(cellElement.size(), mesh.numElements());
+  ASSERT_EQ(written.size(), mesh.numElements());
+  bool reordered = false;
+  for (std::size_t c = 0; c < written.size(); ++c) {
+    const auto e = static_cast<std::size_t>(cellElement[c]);
+    EXPECT_EQ(written[c], given[e]) << "cell " << c;
+    reordered = reordered || e != c;
+  }
+  EXPECT_TRUE(reordered);
+  // Without them, the writer computes signedVolumes().
+  writeVtu(mesh, path.string(), {.encoding = VtuEncoding::Ascii});
+  text = readText(path);
+  written = asciiValues(text, "volume");
+  const std::vector<double> computed = signedVolumes(mesh);
+  ASSERT_EQ(written.size(), mesh.numElements());
+  for (std::size_t c = 0; c < written.size(); ++c)
+    EXPECT_DOUBLE_EQ(written[c], computed[static_cast<std::size_t>(cellElement[c])]);
+  // Not one per element: refused, and the file is left as it was.
+  EXPECT_THROW(writeVtu(mesh, path.string(), {}, {}, {}, {}, {}, std::vector<double>(1, 1.0)),
+               std::invalid_argument);
+  EXPECT_EQ(readText(path), text);
+}
+
 TEST(VtuCut, CornerDataIsAveragedPerSideOfACut) {
   // Each element's value is its index. The cut's two corners at y = 0 are written once per
   // side: one point holds element 0's value, the other element 1's. The corners on the cut's

@@ -42,6 +42,9 @@ Vec3 elementReferencePoint(const PolyMesh& mesh, ElementId e);
 /// cones from the element's reference point to its faces.
 double signedVolume(const PolyMesh& mesh, ElementId e);
 
+/// signedVolume() of every element, in element order, computed in parallel.
+std::vector<double> signedVolumes(const PolyMesh& mesh);
+
 /// Largest distance of a face vertex from the face's plane (through the vertex mean, with the
 /// Newell normal).
 double planarityDeviation(const PolyMesh& mesh, FaceId f);

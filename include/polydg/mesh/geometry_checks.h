@@ -51,8 +51,11 @@ bool isDegenerateFace(const PolyMesh& mesh, FaceId f);
 /// The same, with the face's area vector (areaVector()) already computed.
 bool isDegenerateFace(const PolyMesh& mesh, FaceId f, const Vec3& area);
 
-/// Runs every check over the whole mesh.
-GeometryCheck checkGeometry(const PolyMesh& mesh, const GeometryCheckOptions& options = {});
+/// Runs every check over the whole mesh. `volumes`: empty, or the mesh's signedVolumes() if the
+/// caller has them already (to write them too); they are then not computed again. Throws
+/// std::invalid_argument if it is neither empty nor one per element.
+GeometryCheck checkGeometry(const PolyMesh& mesh, const GeometryCheckOptions& options = {},
+                            std::span<const double> volumes = {});
 
 /// The same checks restricted to `elements` and their faces, at a cost that grows with them:
 /// closure, volume, planarity and degeneracy of their faces, links between those faces and

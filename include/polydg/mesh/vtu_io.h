@@ -4,6 +4,7 @@
 
 #include <functional>
 #include <map>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -119,10 +120,15 @@ inline constexpr std::string_view kVtuTextSuffix = ".utf8";
 /// has the name a text is stored under (numbers "a.utf8" and strings "a"); throws
 /// std::runtime_error("cannot write PATH: reason") if the file cannot be written, and
 /// std::runtime_error if a face with holes cannot be triangulated.
+///
+/// `volumes`: empty, or the mesh's signedVolumes() if the caller has them already (to validate
+/// them too); they are written as given instead of computed again (std::invalid_argument if
+/// there is not one per element).
 void writeVtu(const PolyMesh& mesh, const std::string& path, const VtuWriteOptions& options = {},
               const std::vector<CellArray>& cellData = {},
               const std::vector<PointArray>& pointData = {},
-              const std::vector<CornerArray>& cornerData = {}, const VtuFieldData& fieldData = {});
+              const std::vector<CornerArray>& cornerData = {}, const VtuFieldData& fieldData = {},
+              std::span<const double> volumes = {});
 
 /// Reads a VTK XML UnstructuredGrid file into a PolyMesh.
 ///
