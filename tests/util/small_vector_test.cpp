@@ -120,45 +120,53 @@ TEST(SmallVector, SixteenBitCountsStopAtTheirLargest) {
   EXPECT_EQ(v.size(), 65535u);
 }
 
-TEST(SmallVector, AFacesLoopEndsLeaveTheMembersInTheirPaddingAlone) {
-  // Face::loopEnd lends the padding after its 16-bit counts to `front`: growing, copying,
-  // moving and clearing it must leave each face's `front`, `back` and `origin` as they are.
-  auto face = [](std::size_t front, std::size_t back, FaceOrigin origin) {
+TEST(SmallVector, AFacesCornersLeaveTheMembersInTheirPaddingAlone) {
+  // Face::vertices lends the padding after its 16-bit counts to `loopEnd`: growing, copying,
+  // moving and clearing it must leave each face's loop ends, `front`, `back` and `origin` as
+  // they are.
+  auto face = [](std::uint32_t end, std::size_t front, std::size_t back, FaceOrigin origin) {
     Face f;
+    f.loopEnd = {end};
     f.front = ElementId(front);
     f.back = ElementId(back);
     f.origin = origin;
     return f;
   };
-  Face f = face(7, 9, FaceOrigin::Cut), g = face(5, 6, FaceOrigin::Surface);
-  f.loopEnd = {4, 8};
-  f.loopEnd.push_back(12);  // onto the heap
-  g.loopEnd = {3};
-  g.loopEnd = f.loopEnd;
+  auto ids = [](std::initializer_list<std::uint32_t> values) {
+    SmallVector<VertexId, 4, std::uint16_t> out;
+    for (std::uint32_t v : values) out.push_back(VertexId(std::size_t(v)));
+    return out;
+  };
+  Face f = face(4, 7, 9, FaceOrigin::Cut), g = face(3, 5, 6, FaceOrigin::Surface);
+  f.vertices = ids({1, 2, 3, 4});
+  f.vertices.push_back(VertexId(std::size_t(5)));  // onto the heap
+  g.vertices = ids({9, 8, 7});
+  g.vertices = f.vertices;
   Face h = f;
   h.front = ElementId(std::size_t(3));
-  h.loopEnd = std::move(g.loopEnd);
-  g.loopEnd = std::move(f.loopEnd);
-  f.loopEnd.assign(1, 4);
-  g.loopEnd.swap(h.loopEnd);
-  const std::array<std::array<std::uint32_t, 2>, 3> links{{{7, 9}, {5, 6}, {3, 9}}};
+  h.loopEnd = {2};
+  h.vertices = std::move(g.vertices);
+  g.vertices = std::move(f.vertices);
+  f.vertices.assign(2, VertexId(std::size_t(6)));
+  g.vertices.swap(h.vertices);
+  const std::array<std::array<std::uint32_t, 3>, 3> members{{{4, 7, 9}, {3, 5, 6}, {2, 3, 9}}};
   const std::array<FaceOrigin, 3> origins{FaceOrigin::Cut, FaceOrigin::Surface, FaceOrigin::Cut};
   const std::array<const Face*, 3> faces{&f, &g, &h};
   for (std::size_t i = 0; i < 3; ++i) {
-    EXPECT_EQ(faces[i]->front.value, links[i][0]) << "face " << i;
-    EXPECT_EQ(faces[i]->back.value, links[i][1]) << "face " << i;
+    EXPECT_EQ(faces[i]->loopEnd, (LoopEnds{members[i][0]})) << "face " << i;
+    EXPECT_EQ(faces[i]->front.value, members[i][1]) << "face " << i;
+    EXPECT_EQ(faces[i]->back.value, members[i][2]) << "face " << i;
     EXPECT_EQ(faces[i]->origin, origins[i]) << "face " << i;
   }
-  using LoopEnds = SmallVector<std::uint32_t, 2, std::uint16_t>;
-  EXPECT_EQ(f.loopEnd, (LoopEnds{4}));
-  EXPECT_EQ(g.loopEnd, (LoopEnds{4, 8, 12}));
-  EXPECT_EQ(h.loopEnd, (LoopEnds{4, 8, 12}));
+  EXPECT_EQ(f.vertices, ids({6, 6}));
+  EXPECT_EQ(g.vertices, ids({1, 2, 3, 4, 5}));
+  EXPECT_EQ(h.vertices, ids({1, 2, 3, 4, 5}));
 }
 
 // What the mesh holds per face and per element (5.4 million faces and 1.6 million elements at
 // the bunny's 200 cells): the inline room shares its place with the heap pointer.
-static_assert(sizeof(SmallVector<VertexId, 4>) == 24);
-static_assert(sizeof(Face) == 48);
+static_assert(sizeof(SmallVector<VertexId, 4, std::uint16_t>) == 24);
+static_assert(sizeof(Face) == 40);
 static_assert(sizeof(Element) == 32);
 
 }  // namespace

@@ -17,6 +17,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include "polydg/mesh/ids.h"
+#include "polydg/mesh/loop_ends.h"
 #include "polydg/util/small_vector.h"
 
 namespace polydg {
@@ -48,11 +49,11 @@ struct FaceUse {
 struct Face {
   /// All loops, concatenated; up to 4 corners are stored inline (no allocation): nearly every
   /// face of a sliced mesh is a grid cell's side (95% of the bunny's at 200 cells have 3 or 4).
-  SmallVector<VertexId, 4> vertices;
-  /// Loop k ends at loopEnd[k]; at most 65,535 loops. Its 16-bit counts leave 4 bytes of its
-  /// room to `front` (a face is 48 bytes, not 56: 5.4 million of them for the bunny at 200
-  /// cells).
-  [[no_unique_address]] SmallVector<std::uint32_t, 2, std::uint16_t> loopEnd;
+  /// At most 65,535 corners: the 16-bit counts leave the last 4 bytes of its room to `loopEnd`,
+  /// so that a face is 40 bytes, not 48 (5.4 million of them for the bunny at 200 cells).
+  [[no_unique_address]] SmallVector<VertexId, 4, std::uint16_t> vertices;
+  /// Loop k ends at loopEnd[k]; a single loop's end is kept inline, holes' on the heap.
+  LoopEnds loopEnd;
   ElementId front;
   ElementId back;
   FaceOrigin origin = FaceOrigin::Interior;
@@ -174,6 +175,7 @@ struct Element {
   FaceList faces;
 };
 static_assert(sizeof(Element) == 32, "an element is its packed face uses");
+static_assert(sizeof(Face) == 40, "a face's loop ends sit in its corners' padding");
 
 /// The group of an element left out by PolyMesh::mergeElementGroups.
 inline constexpr std::uint32_t kDroppedElement = 0xffffffffu;
