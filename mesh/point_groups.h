@@ -17,7 +17,9 @@ namespace polydg {
 /// vertices[begin[e] .. begin[e+1]), in an order the caller chooses (the VTU writer: order of
 /// first use by the element's face records). Entry i of `vertices` is corner i.
 struct ElementCorners {
-  std::vector<std::size_t> begin;  ///< numElements() + 1 entries, begin[0] = 0
+  /// numElements() + 1 entries, begin[0] = 0; 32 bits, as the corners' numbers are (below 2^31,
+  /// see groupPoints()): 7 MB less for the bunny at 200 cells, where writing peaks.
+  std::vector<std::uint32_t> begin;
   std::vector<VertexId> vertices;
 
   std::span<const VertexId> of(ElementId e) const {

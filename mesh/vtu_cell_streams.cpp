@@ -239,7 +239,7 @@ void CellStreams::findCorners(std::vector<std::uint32_t>& recordCount,
                         });
           largest.recordsPerCell =
               std::max(largest.recordsPerCell, static_cast<std::int64_t>(records));
-          corners_.begin[e + 1] = numbers.vertices().size();
+          corners_.begin[e + 1] = cellCount(numbers.vertices().size());
           recordCount[e] = cellCount(records);
           streamCount[e] = cellCount(stream);
         }
@@ -247,7 +247,13 @@ void CellStreams::findCorners(std::vector<std::uint32_t>& recordCount,
       },
       most);
   largest_ = most(largest_, counted);
-  std::inclusive_scan(corners_.begin.begin() + 1, corners_.begin.end(), corners_.begin.begin() + 1);
+  std::size_t total = 0;
+  for (std::size_t e = 0; e < ne; ++e) {
+    total += corners_.begin[e + 1];
+    if (total > std::numeric_limits<std::uint32_t>::max())
+      throw std::length_error("writeVtu: the cells have more than 2^32 - 1 corners in all");
+    corners_.begin[e + 1] = static_cast<std::uint32_t>(total);
+  }
   corners_.vertices.resize(corners_.begin[ne]);
   tbb::parallel_for(
       tbb::blocked_range<std::size_t>(0, ne, 512), [&](const tbb::blocked_range<std::size_t>& r) {

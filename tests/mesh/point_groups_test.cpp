@@ -75,7 +75,7 @@ ElementCorners cornersOf(const PolyMesh& mesh) {
         if (std::find(corners.vertices.begin() + static_cast<std::ptrdiff_t>(first),
                       corners.vertices.end(), v) == corners.vertices.end())
           corners.vertices.push_back(v);
-    corners.begin.push_back(corners.vertices.size());
+    corners.begin.push_back(static_cast<std::uint32_t>(corners.vertices.size()));
   }
   return corners;
 }
