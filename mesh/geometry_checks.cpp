@@ -57,9 +57,11 @@ std::string describe(const char* what, std::size_t index) {
 }
 
 /// True if every directed edge of the element's oriented faces is matched by its reverse:
-/// each undirected edge's uses in the two directions balance.
+/// each undirected edge's uses in the two directions balance, that is, the edges running from
+/// the smaller vertex to the larger are, as a multiset, those running back (an edge from a
+/// vertex to itself runs back, unmatched).
 bool isClosed(const PolyMesh& mesh, ElementId e) {
-  boost::container::small_vector<std::pair<std::uint64_t, int>, 64> uses;
+  boost::container::small_vector<std::uint64_t, 32> up, down;
   for (const FaceUse& use : mesh.element(e).faces) {
     const Face& face = mesh.face(use.face);
     for (std::size_t k = 0; k < face.numLoops(); ++k) {
@@ -67,19 +69,14 @@ bool isClosed(const PolyMesh& mesh, ElementId e) {
       for (std::size_t i = 0; i < loop.size(); ++i) {
         std::uint32_t a = loop[i].value, b = loop[(i + 1) % loop.size()].value;
         if (use.reversed) std::swap(a, b);
-        uses.emplace_back(std::uint64_t(std::min(a, b)) << 32 | std::max(a, b), a < b ? 1 : -1);
+        (a < b ? up : down).push_back(std::uint64_t(std::min(a, b)) << 32 | std::max(a, b));
       }
     }
   }
-  std::sort(uses.begin(), uses.end());
-  for (std::size_t i = 0; i < uses.size();) {
-    int balance = 0;
-    std::size_t j = i;
-    for (; j < uses.size() && uses[j].first == uses[i].first; ++j) balance += uses[j].second;
-    if (balance != 0) return false;
-    i = j;
-  }
-  return true;
+  if (up.size() != down.size()) return false;
+  std::sort(up.begin(), up.end());
+  std::sort(down.begin(), down.end());
+  return up == down;
 }
 
 /// True for the two sides of a cut: boundary faces tagged Cut with the same loops, reversed.
