@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <atomic>
 #include <numeric>
-#include <tuple>
 
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_sort.h>

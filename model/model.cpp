@@ -6,7 +6,6 @@
 #include <filesystem>
 #include <sstream>
 
-#include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
 #include <unistd.h>
 

@@ -83,11 +83,7 @@ class LoopEnds {
   template <class It, class = typename std::iterator_traits<It>::iterator_category>
   void assign(It first, It last) {
     const auto n = static_cast<std::size_t>(std::distance(first, last));
-    if (n <= 1 && isInline()) {
-      setInline(n, n == 1 ? static_cast<std::uint32_t>(*first) : 0);
-      return;
-    }
-    if (n <= 1) {  // leaves the heap: a list of at most one end is always inline
+    if (n <= 1) {  // at most one end is always inline, leaving the heap if it was there
       const std::uint32_t value = n == 1 ? static_cast<std::uint32_t>(*first) : 0;
       release();
       setInline(n, value);
