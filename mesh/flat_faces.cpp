@@ -9,6 +9,7 @@
 #include <tbb/parallel_for.h>
 #include <boost/container/small_vector.hpp>
 
+#include "mesh/axis_rectangles.h"
 #include "polydg/mesh/geometry.h"
 #include "util/union_find.h"
 
@@ -120,7 +121,9 @@ std::size_t dissolveFlatFaces(PolyMesh& mesh) {
   // A byte per face, not a list: flat faces are rare, and a mesh has millions of faces.
   std::vector<char> zeroArea(mesh.numFaces());
   tbb::parallel_for(std::size_t(0), mesh.numFaces(), [&](std::size_t f) {
-    zeroArea[f] = areaVector(mesh, FaceId(f)).squaredNorm() == 0.0;
+    const Face& face = mesh.face(FaceId(f));
+    zeroArea[f] =
+        !isAxisAlignedRectangle(mesh, face) && areaVector(mesh, FaceId(f)).squaredNorm() == 0.0;
   });
   std::vector<FaceId> flat;
   std::vector<std::vector<VertexId>> flatCornerSets;

@@ -16,6 +16,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "mesh/axis_rectangles.h"
 #include "polydg/mesh/geometry.h"
 #include "util/union_find.h"
 
@@ -59,15 +60,19 @@ std::string describe(const char* what, std::size_t index) {
 /// True if every directed edge of the element's oriented faces is matched by its reverse:
 /// each undirected edge's uses in the two directions balance, that is, the edges running from
 /// the smaller vertex to the larger are, as a multiset, those running back (an edge from a
-/// vertex to itself runs back, unmatched).
+/// vertex to itself runs back, unmatched). Each loop's edges are taken from its last corner on,
+/// so that no corner's successor needs a division.
 bool isClosed(const PolyMesh& mesh, ElementId e) {
   boost::container::small_vector<std::uint64_t, 32> up, down;
   for (const FaceUse& use : mesh.element(e).faces) {
     const Face& face = mesh.face(use.face);
     for (std::size_t k = 0; k < face.numLoops(); ++k) {
       const auto loop = face.loop(k);
-      for (std::size_t i = 0; i < loop.size(); ++i) {
-        std::uint32_t a = loop[i].value, b = loop[(i + 1) % loop.size()].value;
+      if (loop.empty()) continue;
+      std::uint32_t previous = loop.back().value;
+      for (const VertexId v : loop) {
+        std::uint32_t a = previous, b = v.value;
+        previous = b;
         if (use.reversed) std::swap(a, b);
         (a < b ? up : down).push_back(std::uint64_t(std::min(a, b)) << 32 | std::max(a, b));
       }
@@ -216,6 +221,7 @@ std::vector<FaceProblem> measureFaces(const PolyMesh& mesh, const GeometryCheckO
                     [&](const tbb::blocked_range<std::size_t>& r) {
                       for (std::size_t i = r.begin(); i != r.end(); ++i) {
                         const FaceId f(i);
+                        if (isAxisAlignedRectangle(mesh, mesh.face(f))) continue;
                         const Vec3 area = areaVector(mesh, f);
                         FaceProblem problem{static_cast<std::uint32_t>(i)};
                         problem.degenerate = isDegenerateFace(mesh, f, area);

@@ -7,8 +7,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cstdio>
 #include <string>
+#include <vector>
 
 #include "mesh/primitives.h"
 #include "polydg/mesh/geometry.h"
@@ -247,6 +249,38 @@ TEST(GeometryChecks, RejectsDegenerateFaceAndEmptyMesh) {
   EXPECT_FALSE(r.passed);
   EXPECT_EQ(r.degenerateFaces, 1u);
   EXPECT_FALSE(checkGeometry(PolyMesh()).passed);
+}
+
+TEST(GeometryChecks, JudgesAxisAlignedQuadsAsItJudgesEveryFace) {
+  // Four corners whose sides each change one coordinate, in turn: a rectangle, taken as planar
+  // and sound without measuring it, unless its sides run along one axis (a line) or its area
+  // underflows (sides of 1e-90). One face per element, so only the face counts matter here.
+  struct Quad {
+    std::array<Vec3, 4> corners;
+    bool degenerate;
+  };
+  const Quad quads[] = {
+      {{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1, 2, 0), Vec3(0, 2, 0)}, false},
+      {{Vec3(1e6, 5, -7), Vec3(1e6, 5, -7.001), Vec3(1e6 + 1e-3, 5, -7.001),
+        Vec3(1e6 + 1e-3, 5, -7)},
+       false},
+      {{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(2, 0, 0), Vec3(3, 0, 0)}, true},
+      {{Vec3(0, 0, 0), Vec3(0, 1e-90, 0), Vec3(0, 1e-90, 1e-90), Vec3(0, 0, 1e-90)}, true},
+  };
+  PolyMesh mesh;
+  for (const Quad& quad : quads) {
+    Loop loop;
+    for (const Vec3& p : quad.corners) loop.push_back(mesh.addVertex(p));
+    const FaceId f = mesh.addFace({loop}, FaceOrigin::Surface);
+    mesh.addElementFromFaces(std::vector<FaceUse>{{f, false}});
+  }
+  const GeometryCheck r = checkGeometry(mesh);
+  EXPECT_EQ(r.nonPlanarFaces, 0u);
+  EXPECT_EQ(r.degenerateFaces, 2u);
+  std::vector<std::string> degenerate;
+  for (const std::string& m : r.messages)
+    if (m.starts_with("degenerate face")) degenerate.push_back(m);
+  EXPECT_EQ(degenerate, (std::vector<std::string>{"degenerate face 2", "degenerate face 3"}));
 }
 
 TEST(GeometryChecks, AcceptsTranslatedAndScaledMeshes) {
