@@ -115,7 +115,6 @@ class Window {
     if (at_ >= begin_ && at_ < end_) out_[at_ - begin_] = value;
     ++at_;
   }
-  bool full() const { return at_ >= end_; }
 
  private:
   std::uint64_t at_;
@@ -123,14 +122,34 @@ class Window {
   std::int64_t* out_;
 };
 
+/// The values of a cell whose whole run lies in the range being written: put() stores each
+/// in turn, with none of Window's bounds to check.
+class WholeRun {
+ public:
+  explicit WholeRun(std::int64_t* out) : out_(out) {}
+  void put(std::int64_t value) { *out_++ = value; }
+
+ private:
+  std::int64_t* out_;
+};
+
 /// Writes values [begin, end) of a stream whose cells' runs end at `ends`: emit(c, window)
-/// puts all of cell c's values, for each cell from the one holding `begin` on.
+/// puts all of cell c's values, for each cell from the one holding `begin` on. The cells inside
+/// the range (all but at most the first and the last) get a WholeRun, the others a Window.
 template <class Emit>
 void fillByCell(const RunningEnds& ends, std::size_t begin, std::size_t end, std::int64_t* out,
                 Emit&& emit) {
-  std::size_t c = ends.cellAt(begin);
-  Window window(ends.begin(c), begin, end, out);
-  for (; !window.full(); ++c) emit(c, window);
+  for (std::size_t c = ends.cellAt(begin); c < ends.size(); ++c) {
+    const std::uint64_t first = ends.begin(c), last = ends.end(c);
+    if (first >= end) break;
+    if (first >= begin && last <= end) {
+      WholeRun run(out + (first - begin));
+      emit(c, run);
+    } else {
+      Window window(first, begin, end, out);
+      emit(c, window);
+    }
+  }
 }
 
 /// `size` values, value i being valueOf(i).
@@ -276,7 +295,7 @@ std::vector<std::uint32_t> CellStreams::inCellOrder(
 GeneratedInts CellStreams::connectivity() const {
   return {connectivityEnd_.total(), largest_.point,
           [this](std::size_t begin, std::size_t end, std::int64_t* out) {
-            fillByCell(connectivityEnd_, begin, end, out, [&](std::size_t c, Window& window) {
+            fillByCell(connectivityEnd_, begin, end, out, [&](std::size_t c, auto& window) {
               const std::size_t e = order_[c].index();
               for (std::size_t i = corners_.begin[e]; i < corners_.begin[e + 1]; ++i)
                 window.put(points_.point(corners_, i));
@@ -300,7 +319,7 @@ GeneratedInts CellStreams::faces() const {
           [this](std::size_t begin, std::size_t end, std::int64_t* out) {
             CornerNumbers numbers;
             const bool vertexIds = points_.pointsAreVertices();
-            fillByCell(faceEnd_, begin, end, out, [&](std::size_t c, Window& window) {
+            fillByCell(faceEnd_, begin, end, out, [&](std::size_t c, auto& window) {
               const ElementId e = order_[c];
               const std::size_t first = corners_.begin[e.index()];
               window.put(static_cast<std::int64_t>(recordEnd_.end(c) - recordEnd_.begin(c)));
@@ -339,7 +358,7 @@ template <class Value>
 GeneratedInts CellStreams::perRecord(std::int64_t largest, Value value) const {
   return {recordEnd_.total(), largest,
           [this, value](std::size_t begin, std::size_t end, std::int64_t* out) {
-            fillByCell(recordEnd_, begin, end, out, [&](std::size_t c, Window& window) {
+            fillByCell(recordEnd_, begin, end, out, [&](std::size_t c, auto& window) {
               for (const FaceUse& use : mesh_.element(order_[c]).faces)
                 for (std::size_t k = 0; k < records_.count(use.face); ++k) window.put(value(use));
             });
