@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <span>
 #include <utility>
 
@@ -108,8 +109,9 @@ class SliceBuilder {
   template <class F>
   void forEachCorner(std::size_t l, F&& f) const {
     if (cells_[l].whole()) {
+      const std::array<std::uint32_t, 8> corners = whole_.corners(cells_[l].cell);
       for (int s = 0; s < 6; ++s)
-        for (const std::uint32_t v : whole_.side(cells_[l].cell, s)) f(v);
+        for (const std::uint32_t v : WholeCells::sideOf(corners, s)) f(v);
       return;
     }
     for (const PiecePolygon& polygon : leaves_[cells_[l].piece].piece)
@@ -343,9 +345,10 @@ class SliceBuilder {
       for (int s = 2; s < 6; ++s) beside[s] = cursorBeside(row, s);
       for (std::uint32_t l = rowStart_[row]; l < rowStart_[row + 1]; ++l) {
         if (!cells_[l].whole()) continue;
+        const std::array<std::uint32_t, 8> cellCorners = whole_.corners(cells_[l].cell);
         for (int s = 0; s < 6; ++s) {
           if (wholeLeafBeside(l, s, beside[s]) == kNone) continue;
-          const std::array<std::uint32_t, 4> corners = whole_.side(cells_[l].cell, s);
+          const std::array<std::uint32_t, 4> corners = WholeCells::sideOf(cellCorners, s);
           if (std::none_of(corners.begin(), corners.end(),
                            [&](std::uint32_t p) { return vertexOf.shared[vertexOf(p).index()]; }))
             freeSides_[l] |= std::uint8_t(1u << s);
@@ -407,9 +410,8 @@ class SliceBuilder {
 
   /// Whether a corner of whole cell `cell` is a vertex that several points were welded into.
   bool weldedCorner(const std::array<int, 3>& cell, const WeldedVertices& vertexOf) const {
-    for (const int s : {0, 1})  // the cell's low and high sides hold its eight corners
-      for (const std::uint32_t p : whole_.side(cell, s))
-        if (vertexOf.shared[vertexOf(p).index()]) return true;
+    for (const std::uint32_t p : whole_.corners(cell))
+      if (vertexOf.shared[vertexOf(p).index()]) return true;
     return false;
   }
 
@@ -508,10 +510,12 @@ class SliceBuilder {
               f.front = e;
             };
             // A free side towards +axis is made from the grid (the cell beyond uses it).
+            std::optional<std::array<std::uint32_t, 8>> corners;  // only a whole cell's
             forEachSide(at, l, polygonFace, [&](int s) {
               if (s % 2 == 0) return;
               Face& f = meshFaces[FaceId(std::size_t(next++))];
-              for (std::uint32_t corner : whole_.side(cells_[l].cell, s))
+              if (!corners) corners = whole_.corners(cells_[l].cell);
+              for (std::uint32_t corner : WholeCells::sideOf(*corners, s))
                 f.vertices.push_back(vertexOf(corner));
               f.loopEnd.assign(1, 4);
               f.front = e;

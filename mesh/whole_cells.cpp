@@ -38,10 +38,6 @@ std::size_t WholeCells::count() const {
   return cells;
 }
 
-std::uint32_t WholeCells::node(const std::array<int, 3>& c) const {
-  return table_.empty() ? map_.at(nodeIndex(c)) : table_[nodeIndex(c)];
-}
-
 std::vector<std::array<int, 3>> WholeCells::finish(std::uint32_t firstPoint,
                                                    std::vector<Vec3>& points) {
   std::vector<Box> boxes;
@@ -136,24 +132,12 @@ void WholeCells::numberNodesInParallel(const std::vector<Box>& boxes, std::uint3
   });
 }
 
-std::array<std::uint32_t, 4> WholeCells::side(const std::array<int, 3>& cell, int s) const {
-  const int axis = s / 2;
-  // Corner b of the cell: bit a of b is +1 along axis a.
-  auto corner = [&](int b) {
-    return node({cell[0] + (b & 1), cell[1] + (b >> 1 & 1), cell[2] + (b >> 2 & 1)});
-  };
-  const int u = 1 << (axis + 1) % 3, w = 1 << (axis + 2) % 3, a = (s % 2) << axis;
-  // Counter-clockwise about +axis (u, w, axis are right-handed); the low side faces -axis.
-  std::array<std::uint32_t, 4> loop{corner(a), corner(a | u), corner(a | u | w), corner(a | w)};
-  if (s % 2 == 0) std::reverse(loop.begin(), loop.end());
-  return loop;
-}
-
 void WholeCells::sides(const std::array<int, 3>& cell, Piece& piece, unsigned skip) const {
   piece.clear();
+  const std::array<std::uint32_t, 8> corner = corners(cell);
   for (int s = 0; s < 6; ++s) {
     if (skip >> s & 1) continue;
-    const std::array<std::uint32_t, 4> loop = side(cell, s);
+    const std::array<std::uint32_t, 4> loop = sideOf(corner, s);
     PiecePolygon& polygon = piece.emplace_back();
     polygon.origin = FaceOrigin::Interior;
     polygon.vertices.assign(loop.begin(), loop.end());

@@ -57,7 +57,28 @@ class WholeCells {
   /// `skip` leaves it out.
   void sides(const std::array<int, 3>& cell, Piece& piece, unsigned skip = 0) const;
   /// The corners of side s of `cell`, as sides() gives them.
-  std::array<std::uint32_t, 4> side(const std::array<int, 3>& cell, int s) const;
+  std::array<std::uint32_t, 4> side(const std::array<int, 3>& cell, int s) const {
+    return sideOf(corners(cell), s);
+  }
+  /// The points of `cell`'s eight corners: corner b is +1 along axis a where bit a of b is set.
+  std::array<std::uint32_t, 8> corners(const std::array<int, 3>& cell) const {
+    const std::size_t nx = std::size_t(grid_.cells[0]) + 1;
+    const std::size_t layer = nx * (std::size_t(grid_.cells[1]) + 1);
+    const std::size_t first = nodeIndex(cell);
+    const std::size_t step[8] = {0, 1, nx, nx + 1, layer, layer + 1, layer + nx, layer + nx + 1};
+    std::array<std::uint32_t, 8> out;
+    for (int b = 0; b < 8; ++b)
+      out[b] = table_.empty() ? map_.at(first + step[b]) : table_[first + step[b]];
+    return out;
+  }
+  /// Side s of a cell with these corners (see corners()), as sides() gives it: counter-clockwise
+  /// about +axis for the high side (u, w, axis right-handed), clockwise for the low one.
+  static std::array<std::uint32_t, 4> sideOf(const std::array<std::uint32_t, 8>& corner, int s) {
+    const int axis = s / 2;
+    const int u = 1 << (axis + 1) % 3, w = 1 << (axis + 2) % 3, a = (s % 2) << axis;
+    if (s % 2 == 0) return {corner[a | w], corner[a | u | w], corner[a | u], corner[a]};
+    return {corner[a], corner[a | u], corner[a | u | w], corner[a | w]};
+  }
 
   /// The rows of the grid's cells along x, one per (y, z): their number, how many share a z,
   /// and cell c's (y fastest).
@@ -111,7 +132,6 @@ class WholeCells {
     return (std::size_t(c[2]) * std::size_t(ny) + std::size_t(c[1])) * std::size_t(nx) +
            std::size_t(c[0]);
   }
-  std::uint32_t node(const std::array<int, 3>& c) const;
 
   const Grid& grid_;
   tbb::enumerable_thread_specific<std::vector<Box>> boxes_;
