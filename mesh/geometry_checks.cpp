@@ -347,15 +347,15 @@ void reportDuplicateFaces(const PolyMesh& mesh, Problems& problems, GeometryChec
                      "elements, or twice with the same orientation)");
 }
 
-/// Elements: closure and volume in parallel (they are the costly part), then links back to
-/// faces and the report in order.
-void reportElements(const PolyMesh& mesh, std::span<const double> given, Problems& problems,
-                    GeometryCheck& report) {
+/// Elements: closure (but for `boxes`) and volume in parallel (they are the costly part), then
+/// links back to faces and the report in order.
+void reportElements(const PolyMesh& mesh, std::span<const double> given,
+                    std::span<const char> boxes, Problems& problems, GeometryCheck& report) {
   // Per element, in parallel: closed, linked (each face it uses lists it on that side), and
   // its volume unless given.
   enum : char { kClosed = 1, kLinked = 2 };
   std::vector<char> state(mesh.numElements());
-  std::vector<double> computed(given.empty() ? mesh.numElements() : 0);
+  const std::vector<double> computed = given.empty() ? signedVolumes(mesh) : std::vector<double>();
   const std::span<const double> volumes = given.empty() ? computed : given;
   auto linked = [&](ElementId e) {
     const auto& uses = mesh.element(e).faces;
@@ -368,9 +368,9 @@ void reportElements(const PolyMesh& mesh, std::span<const double> given, Problem
                     [&](const tbb::blocked_range<std::size_t>& r) {
                       for (std::size_t i = r.begin(); i != r.end(); ++i) {
                         const ElementId e(i);
-                        state[i] = static_cast<char>((isClosed(mesh, e) ? kClosed : 0) |
-                                                     (linked(e) ? kLinked : 0));
-                        if (given.empty()) computed[i] = signedVolume(mesh, e);
+                        const bool closed = (!boxes.empty() && boxes[i]) || isClosed(mesh, e);
+                        state[i] =
+                            static_cast<char>((closed ? kClosed : 0) | (linked(e) ? kLinked : 0));
                       }
                     });
   // The report in element order, reading the mesh again only where a link is wrong.
@@ -411,10 +411,14 @@ void reportElements(const PolyMesh& mesh, std::span<const double> given, Problem
 }  // namespace
 
 GeometryCheck checkGeometry(const PolyMesh& mesh, const GeometryCheckOptions& options,
-                            std::span<const double> volumes) {
+                            std::span<const double> volumes, std::span<const char> boxes) {
   if (!volumes.empty() && volumes.size() != mesh.numElements())
     throw std::invalid_argument("checkGeometry: " + std::to_string(volumes.size()) +
                                 " volumes given for " + std::to_string(mesh.numElements()) +
+                                " elements");
+  if (!boxes.empty() && boxes.size() != mesh.numElements())
+    throw std::invalid_argument("checkGeometry: " + std::to_string(boxes.size()) +
+                                " box flags given for " + std::to_string(mesh.numElements()) +
                                 " elements");
   GeometryCheck report;
   Problems problems(report, options.maxMessages);
@@ -423,7 +427,9 @@ GeometryCheck checkGeometry(const PolyMesh& mesh, const GeometryCheckOptions& op
   // Faces: shape and planarity in parallel, then links, duplicates and the report in order.
   reportFaces(mesh, measureFaces(mesh, options), problems, report);
   reportDuplicateFaces(mesh, problems, report);
-  reportElements(mesh, volumes, problems, report);
+  reportElements(mesh, volumes, boxes, problems, report);
+  report.closedByConstruction =
+      static_cast<std::size_t>(std::count_if(boxes.begin(), boxes.end(), [](char b) { return b; }));
 
   connectedComponents(mesh, report.components);
   report.passed = report.openElements == 0 && report.nonPositiveElements == 0 &&

@@ -290,7 +290,7 @@ void checkMeshing(MeshingResult& result) {
 void checkMeshing(const PolyMesh& mesh, MeshingReport& r, const std::vector<char>& wholeCells,
                   std::span<const double> volumes) {
   const Stopwatch start;
-  r.geometry = checkGeometry(mesh, {}, volumes);
+  r.geometry = checkGeometry(mesh, {}, volumes, wholeCells);
   r.elements = mesh.numElements();
   r.faces = r.geometry.faces;
   r.interiorFaces = r.geometry.interiorFaces;

@@ -91,6 +91,7 @@ json toJson(const GeometryCheck& r) {
             {"duplicate_faces", r.duplicateFaces},
             {"inconsistent_faces", r.inconsistentFaces},
             {"empty_elements", r.emptyElements}}},
+          {"closed_by_construction", r.closedByConstruction},
           {"messages", r.messages}};
 }
 

@@ -3,6 +3,7 @@
 #include "polydg/mesh/geometry_checks.h"
 
 #include <set>
+#include <stdexcept>
 
 #include <gtest/gtest.h>
 
@@ -110,6 +111,44 @@ TEST(GeometryChecks, RejectsLeakyElement) {
   const GeometryCheck r = checkGeometry(leaky);
   EXPECT_FALSE(r.passed);
   EXPECT_EQ(r.openElements, 1u);
+}
+
+TEST(GeometryChecks, TakesTheClosureOfFlaggedGridBoxesAsGiven) {
+  // The leaky grid above: element 1 lacks a face. Flagged as a whole grid cell (as slicing
+  // flags the boxes it makes), its closure is taken as given: the flags spare that test, and
+  // only that one (the contract the slicer's flags are trusted with).
+  const PolyMesh grid = hexGridMesh(2, 1, 1, Box3(Vec3(0, 0, 0), Vec3(2, 1, 1)));
+  const FaceId dropped = grid.element(ElementId(1)).faces[3].face;
+  const PolyMesh leaky = rebuild(
+      grid, [dropped](std::size_t e, FaceId f, auto&) { return !(e == 1 && f == dropped); });
+  const std::vector<char> first = {1, 0}, second = {0, 1};
+  const GeometryCheck notFlagged = checkGeometry(leaky, {}, {}, first);
+  EXPECT_EQ(notFlagged.openElements, 1u);
+  EXPECT_EQ(notFlagged.closedByConstruction, 1u);
+  const GeometryCheck flagged = checkGeometry(leaky, {}, {}, second);
+  EXPECT_EQ(flagged.openElements, 0u);
+  EXPECT_EQ(flagged.closedByConstruction, 1u);
+  // Its volume is still measured, as its faces give it.
+  EXPECT_EQ(flagged.volume, notFlagged.volume);
+  EXPECT_EQ(flagged.volume, checkGeometry(leaky).volume);
+  const std::vector<char> three = {1, 1, 1};
+  EXPECT_THROW(checkGeometry(leaky, {}, {}, three), std::invalid_argument);
+}
+
+TEST(GeometryChecks, FlaggedGridBoxesChangeNothingButTheCountOnASoundGrid) {
+  const PolyMesh mesh =
+      hexGridMesh(4, 3, 2, Box3(Vec3(1e6, -2e6, 3e6), Vec3(1e6 + 0.4, -2e6 + 0.3, 3e6 + 0.2)));
+  std::vector<char> boxes(mesh.numElements(), 0);
+  for (std::size_t e = 0; e < boxes.size(); e += 3) boxes[e] = 1;
+  const GeometryCheck plain = checkGeometry(mesh);
+  const GeometryCheck flagged = checkGeometry(mesh, {}, {}, boxes);
+  EXPECT_TRUE(plain.passed);
+  EXPECT_TRUE(flagged.passed);
+  EXPECT_EQ(plain.closedByConstruction, 0u);
+  EXPECT_EQ(flagged.closedByConstruction, 8u);
+  EXPECT_EQ(flagged.faces, plain.faces);
+  EXPECT_EQ(flagged.components, plain.components);
+  EXPECT_EQ(flagged.volume, plain.volume);
 }
 
 TEST(GeometryChecks, RejectsInvertedElement) {

@@ -174,6 +174,13 @@ TEST(Meshing, WholeCellsAreHexahedraAndCountAsWhatTheShapesSay) {
   EXPECT_EQ(m.report.hexahedra, measured.hexahedra);
   EXPECT_EQ(m.report.nonconvex, measured.nonconvex);
   EXPECT_GE(m.report.hexahedra, flagged);
+  // The flagged cells' closure is taken from the flags, the rest is tested: the same verdict
+  // and volume as testing every element.
+  EXPECT_EQ(m.report.geometry.closedByConstruction, flagged);
+  EXPECT_EQ(measured.geometry.closedByConstruction, 0u);
+  EXPECT_TRUE(m.report.geometry.passed);
+  EXPECT_EQ(m.report.geometry.passed, measured.geometry.passed);
+  EXPECT_EQ(m.report.outputVolume, measured.outputVolume);
 }
 
 // --- scale: overflow and underflow ------------------------------------------------------------

@@ -12,6 +12,7 @@
 
 #include "mesh/primitives.h"
 #include "polydg/integrate/moment_cache.h"
+#include "polydg/mesh/geometry_checks.h"
 #include "polydg/mesh/surface_shapes.h"
 #include "polydg/model/model.h"
 #include "polydg/model/report_json.h"
@@ -70,6 +71,26 @@ TEST_F(ModelTest, ProvenanceTravelsWithTheMeshThroughAFile) {
   EXPECT_EQ(back.provenance().sliverFraction, 0.03);
   EXPECT_EQ(back.provenance().source, "torus.obj");
   EXPECT_EQ(back.mesh().numElements(), meshed.mesh().numElements());
+}
+
+TEST_F(ModelTest, MeshingTakesTheWholeCellsClosureFromHowTheyWereBuilt) {
+  // Whole grid cells are validated as a class: their closure is not tested one by one, and the
+  // report counts them; the rest of the validation, and its verdict, are as before.
+  MeshReport report;
+  MeshOptions options;
+  options.cells = 16;
+  options.dgChecks = false;
+  const TriangleSurface torusSurface = torus(Vec3::Zero(), 1.0, 0.4, 48, 24);
+  const Model meshed = Model::fromSurface(torusSurface, options, report, "torus.obj");
+  ASSERT_TRUE(report.passed());
+  const GeometryCheck& g = report.meshing.geometry;
+  EXPECT_GT(g.closedByConstruction, 100u);
+  EXPECT_LE(g.closedByConstruction, report.meshing.hexahedra);
+  const GeometryCheck all = checkGeometry(meshed.mesh());
+  EXPECT_EQ(all.closedByConstruction, 0u);
+  EXPECT_EQ(all.passed, g.passed);
+  EXPECT_EQ(all.openElements, 0u);
+  EXPECT_EQ(all.volume, g.volume);
 }
 
 TEST_F(ModelTest, AMeshWithoutProvenanceUsesItsMedianElementVolume) {

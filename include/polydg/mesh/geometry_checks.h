@@ -42,6 +42,9 @@ struct GeometryCheck {
   std::size_t duplicateFaces = 0;
   std::size_t inconsistentFaces = 0;  ///< face/element links disagree, or unused face
   std::size_t emptyElements = 0;      ///< an element without faces
+  /// Elements whose closure was not tested because the caller knows them closed: whole grid
+  /// cells as slicing made them (see checkGeometry's `boxes`).
+  std::size_t closedByConstruction = 0;
   std::vector<std::string> messages;  ///< the first few problems, one line each
 };
 
@@ -52,10 +55,13 @@ bool isDegenerateFace(const PolyMesh& mesh, FaceId f);
 bool isDegenerateFace(const PolyMesh& mesh, FaceId f, const Vec3& area);
 
 /// Runs every check over the whole mesh. `volumes`: empty, or the mesh's signedVolumes() if the
-/// caller has them already (to write them too); they are then not computed again. Throws
-/// std::invalid_argument if it is neither empty nor one per element.
+/// caller has them already (to write them too); they are then not computed again. `boxes`:
+/// empty, or per element 1 for a whole grid cell as slicing made it (MeshingResult::wholeCells):
+/// six grid sides on its eight corners, closed by construction, so that its closure is not
+/// tested element by element (everything else is: links, volume, its faces' shapes,
+/// duplicates). Throws std::invalid_argument if either is neither empty nor one per element.
 GeometryCheck checkGeometry(const PolyMesh& mesh, const GeometryCheckOptions& options = {},
-                            std::span<const double> volumes = {});
+                            std::span<const double> volumes = {}, std::span<const char> boxes = {});
 
 /// The same checks restricted to `elements` and their faces, at a cost that grows with them:
 /// closure, volume, planarity and degeneracy of their faces, links between those faces and

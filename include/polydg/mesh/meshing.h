@@ -122,8 +122,9 @@ MeshingResult meshSurface(const TriangleSurface& surface, const MeshingOptions& 
 void checkMeshing(MeshingResult& result);
 /// The same for a mesh kept apart from its report (moved into a model before validation).
 /// `wholeCells` (empty, or MeshingResult::wholeCells) spares measuring the shapes of the whole
-/// cells, which are grid hexahedra; `volumes` (empty, or the mesh's signedVolumes()) spares
-/// computing the elements' volumes.
+/// cells, which are grid hexahedra, and testing their closure one by one (checkGeometry's
+/// `boxes`); `volumes` (empty, or the mesh's signedVolumes()) spares computing the elements'
+/// volumes.
 void checkMeshing(const PolyMesh& mesh, MeshingReport& report,
                   const std::vector<char>& wholeCells = {}, std::span<const double> volumes = {});
 
