@@ -96,6 +96,9 @@ void forEachRecord(const PolyMesh& mesh, const FaceRecords& records, ElementId e
   });
 }
 
+/// A whole grid cell, as CellStreams' `boxes` give it: six sides of four corners, eight corners.
+constexpr std::uint32_t kBoxSides = 6, kSideCorners = 4, kBoxCorners = 8;
+
 /// A count of one cell, which RunningEnds keeps in 32 bits.
 std::uint32_t cellCount(std::size_t n) {
   if (n > std::numeric_limits<std::uint32_t>::max())
@@ -204,9 +207,12 @@ std::size_t RunningEnds::cellAt(std::uint64_t at) const {
   return static_cast<std::size_t>(std::upper_bound(wide_.begin(), wide_.end(), at) - wide_.begin());
 }
 
-CellStreams::CellStreams(const PolyMesh& mesh) : mesh_(mesh), records_(mesh) {
+CellStreams::CellStreams(const PolyMesh& mesh, std::span<const char> boxes)
+    : mesh_(mesh), records_(mesh) {
+  if (!boxes.empty() && boxes.size() != mesh.numElements())
+    throw std::invalid_argument("CellStreams: one box flag per element is needed");
   std::vector<std::uint32_t> recordCount, streamCount;
-  findCorners(recordCount, streamCount);
+  findCorners(boxes, recordCount, streamCount);
   points_ = groupPoints(mesh, corners_);
   order_.resize(mesh.numElements());
   for (std::size_t e = 0; e < order_.size(); ++e) order_[e] = ElementId(e);
@@ -228,7 +234,7 @@ CellStreams::CellStreams(const PolyMesh& mesh) : mesh_(mesh), records_(mesh) {
     largest_.vertex = std::max<std::int64_t>(largest_.vertex, v.value);
 }
 
-void CellStreams::findCorners(std::vector<std::uint32_t>& recordCount,
+void CellStreams::findCorners(std::span<const char> boxes, std::vector<std::uint32_t>& recordCount,
                               std::vector<std::uint32_t>& streamCount) {
   const std::size_t ne = mesh_.numElements();
   recordCount.resize(ne);
@@ -246,6 +252,19 @@ void CellStreams::findCorners(std::vector<std::uint32_t>& recordCount,
       [&](const tbb::blocked_range<std::size_t>& r, Largest largest) {
         CornerNumbers numbers;
         for (std::size_t e = r.begin(); e != r.end(); ++e) {
+          if (!boxes.empty() && boxes[e]) {
+            // A grid box: six records (its sides, single loops) of four corners, eight corners.
+            for (const FaceUse& use : mesh_.element(ElementId(e)).faces) {
+              largest.face = std::max<std::int64_t>(largest.face, use.face.value);
+              largest.reversed = std::max<std::int64_t>(largest.reversed, use.reversed);
+            }
+            largest.recordSize = std::max<std::int64_t>(largest.recordSize, kSideCorners);
+            largest.recordsPerCell = std::max<std::int64_t>(largest.recordsPerCell, kBoxSides);
+            corners_.begin[e + 1] = kBoxCorners;
+            recordCount[e] = kBoxSides;
+            streamCount[e] = 1 + kBoxSides * (1 + kSideCorners);
+            continue;
+          }
           std::size_t records = 0, stream = 1;
           forEachRecord(mesh_, records_, ElementId(e), numbers,
                         [&](const FaceUse& use, std::span<const VertexId> record, auto) {
@@ -278,8 +297,18 @@ void CellStreams::findCorners(std::vector<std::uint32_t>& recordCount,
       tbb::blocked_range<std::size_t>(0, ne, 512), [&](const tbb::blocked_range<std::size_t>& r) {
         CornerNumbers numbers;
         for (std::size_t e = r.begin(); e != r.end(); ++e) {
-          forEachRecord(mesh_, records_, ElementId(e), numbers, [](const FaceUse&, auto, auto) {});
+          std::size_t records = 0, sideCorners = 0;  // of a grid box
+          forEachRecord(mesh_, records_, ElementId(e), numbers,
+                        [&](const FaceUse&, std::span<const VertexId> record, auto) {
+                          ++records;
+                          sideCorners += record.size() == kSideCorners;
+                        });
           const auto found = numbers.vertices();
+          if (!boxes.empty() && boxes[e] &&
+              (found.size() != kBoxCorners || records != kBoxSides || sideCorners != kBoxSides))
+            throw std::logic_error("writeVtu: element " + std::to_string(e) +
+                                   " was given as a grid box but has " + std::to_string(records) +
+                                   " faces and " + std::to_string(found.size()) + " corners");
           std::copy(found.begin(), found.end(), corners_.vertices.begin() + corners_.begin[e]);
         }
       });

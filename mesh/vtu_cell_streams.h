@@ -77,8 +77,11 @@ class RunningEnds {
 /// arrays it hands out refer to it, so it can be neither copied nor moved.
 class CellStreams {
  public:
-  /// Throws std::runtime_error if a face with holes cannot be triangulated.
-  explicit CellStreams(const PolyMesh& mesh);
+  /// Throws std::runtime_error if a face with holes cannot be triangulated. `boxes` (empty, or
+  /// one per element): elements known to be whole grid cells (six single-loop sides of four
+  /// corners, eight corners in all), counted without numbering their corners; std::logic_error
+  /// if one is not.
+  explicit CellStreams(const PolyMesh& mesh, std::span<const char> boxes = {});
   CellStreams(const CellStreams&) = delete;
   CellStreams& operator=(const CellStreams&) = delete;
 
@@ -113,7 +116,7 @@ class CellStreams {
   /// Each element's corners, counted in a first pass and written in place in a second, so that
   /// no list per element is held between them; the first pass also counts each element's
   /// records and `faces` values (in element order) and finds the largest values of its records.
-  void findCorners(std::vector<std::uint32_t>& recordCount,
+  void findCorners(std::span<const char> boxes, std::vector<std::uint32_t>& recordCount,
                    std::vector<std::uint32_t>& streamCount);
   /// Counts per element as counts per cell.
   std::vector<std::uint32_t> inCellOrder(const std::vector<std::uint32_t>& perElement) const;

@@ -330,7 +330,7 @@ void writeContents(std::ostream& os, const PolyMesh& mesh, const CellStreams& s,
 void writeVtu(const PolyMesh& mesh, const std::string& path, const VtuWriteOptions& options,
               const std::vector<CellArray>& cellData, const std::vector<PointArray>& pointData,
               const std::vector<CornerArray>& cornerData, const VtuFieldData& fieldData,
-              std::span<const double> volumes) {
+              std::span<const double> volumes, std::span<const char> boxes) {
   std::unordered_set<std::string> cellNames{"volume"}, pointNames;
   checkArrays(cellData, mesh.numElements(), "cell", cellNames);
   checkArrays(pointData, mesh.numVertices(), "point", pointNames);
@@ -344,8 +344,12 @@ void writeVtu(const PolyMesh& mesh, const std::string& path, const VtuWriteOptio
     throw std::invalid_argument("writeVtu: " + std::to_string(volumes.size()) +
                                 " volumes given for " + std::to_string(mesh.numElements()) +
                                 " elements");
+  if (!boxes.empty() && boxes.size() != mesh.numElements())
+    throw std::invalid_argument("writeVtu: " + std::to_string(boxes.size()) +
+                                " box flags given for " + std::to_string(mesh.numElements()) +
+                                " elements");
   // Everything that can fail for reasons other than I/O happens before the file is opened.
-  const CellStreams streams(mesh);
+  const CellStreams streams(mesh, boxes);
   const FileValues values = fileValues(mesh, streams, volumes, cellData, pointData, cornerData);
 
   vtk_format::writeReplacing(path, [&](std::ostream& os) {

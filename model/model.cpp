@@ -228,7 +228,7 @@ Model Model::fromSurface(const TriangleSurface& surface, const MeshOptions& opti
         try {
           const Stopwatch write;
           writeVtu(mesh, file->temporary(), {}, {}, {}, {}, provenanceFieldData(provenance),
-                   volumes);
+                   volumes, meshed.wholeCells);
           report.writeSeconds = write.seconds();
         } catch (...) {
           writeFailure = std::current_exception();

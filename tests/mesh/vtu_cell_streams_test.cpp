@@ -10,6 +10,7 @@
 #include <numbers>
 #include <numeric>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -176,6 +177,70 @@ TEST(VtuCellStreams, ArraysAreTheLayoutOfVtuIoH) {
       EXPECT_EQ(generated.largest, largest) << array;
     }
   }
+}
+
+TEST(VtuCellStreams, GridBoxesCountedWithoutNumberingGiveTheSameArrays) {
+  // A sliced sphere with slicing's whole-cell flags: the boxes' corners, records and `faces`
+  // runs are counted from the flags, and every array is what counting them all gives.
+  const TriangleSurface sphere = icosphere(Vec3(0.1, -0.2, 0.3), 1.0, 3);
+  std::vector<char> boxes;
+  const PolyMesh mesh = sliceSurface(sphere, Grid::withCellsAlongLongest(bounds(sphere), 8),
+                                     nullptr, nullptr, {}, &boxes);
+  ASSERT_EQ(boxes.size(), mesh.numElements());
+  const auto flagged = std::count(boxes.begin(), boxes.end(), 1);
+  ASSERT_GT(flagged, 20);
+  ASSERT_LT(static_cast<std::size_t>(flagged), mesh.numElements());
+  const CellStreams counted(mesh), given(mesh, boxes);
+  for (std::size_t e = 0; e < mesh.numElements(); ++e) {
+    const auto a = counted.corners().of(ElementId(e)), b = given.corners().of(ElementId(e));
+    ASSERT_TRUE(std::equal(a.begin(), a.end(), b.begin(), b.end())) << "element " << e;
+  }
+  const auto a = arrays(counted, wholeArrays(mesh, counted.points()));
+  const auto b = arrays(given, wholeArrays(mesh, given.points()));
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(generate(a[i].second.first), generate(b[i].second.first)) << a[i].first;
+    EXPECT_EQ(a[i].second.first.largest, b[i].second.first.largest) << a[i].first;
+  }
+  // An element given as a box that is none (a cut cell, not of six faces) is refused, not
+  // written wrong.
+  std::vector<char> wrong(mesh.numElements(), 0);
+  std::size_t cut = 0;
+  while (cut < mesh.numElements() && mesh.element(ElementId(cut)).faces.size() == 6) ++cut;
+  ASSERT_LT(cut, mesh.numElements());
+  wrong[cut] = 1;
+  EXPECT_THROW(CellStreams(mesh, wrong), std::logic_error);
+  EXPECT_THROW(CellStreams(mesh, std::vector<char>(3, 1)), std::invalid_argument);
+}
+
+TEST(VtuCellStreams, AnElementGivenAsAGridBoxMustHaveItsSixSidesAndEightCorners) {
+  // The unit cube's corners and sides, one at a time made other than a grid box's: a ninth
+  // corner, a seventh face, a side of three corners. Each is refused when given as a box.
+  std::vector<Vec3> corner;
+  for (int b = 0; b < 8; ++b) corner.emplace_back(b & 1, b >> 1 & 1, b >> 2 & 1);
+  const std::vector<std::vector<std::uint32_t>> sides = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4},
+                                                         {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
+  auto element = [&](std::vector<std::vector<std::uint32_t>> loops, bool ninth) {
+    PolyMesh mesh;
+    for (const Vec3& p : corner) mesh.addVertex(p);
+    if (ninth) mesh.addVertex(Vec3(0.5, 0.5, 0));  // replaces corner 0 in one side
+    std::vector<FaceUse> uses;
+    for (std::size_t k = 0; k < loops.size(); ++k) {
+      Loop loop;
+      for (std::uint32_t v : loops[k]) loop.push_back(VertexId(ninth && k == 4 && v == 0 ? 8 : v));
+      uses.push_back({mesh.addFace({loop}, FaceOrigin::Box), false});
+    }
+    mesh.addElementFromFaces(uses);
+    return mesh;
+  };
+  const std::vector<char> box = {1};
+  EXPECT_NO_THROW(CellStreams(element(sides, false), box));
+  std::vector<std::vector<std::uint32_t>> seven = sides, triangle = sides;
+  seven.push_back({0, 4, 6});  // six sides of four corners still, and a seventh face
+  triangle[5] = {4, 5, 7};
+  EXPECT_THROW(CellStreams(element(sides, true), box), std::logic_error);
+  EXPECT_THROW(CellStreams(element(seven, false), box), std::logic_error);
+  EXPECT_THROW(CellStreams(element(triangle, false), box), std::logic_error);
 }
 
 /// The bytes of `a` in `encoding`: the <DataArray> element, then its appended bytes if any.

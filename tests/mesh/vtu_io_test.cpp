@@ -400,6 +400,13 @@ TEST(VtuWrite, WritesTheVolumesItIsGiven) {
   EXPECT_THROW(writeVtu(mesh, path.string(), {}, {}, {}, {}, {}, std::vector<double>(1, 1.0)),
                std::invalid_argument);
   EXPECT_EQ(readText(path), text);
+  // Box flags: one per element, and only for grid boxes (the prism and the pyramid are none).
+  EXPECT_THROW(writeVtu(mesh, path.string(), {}, {}, {}, {}, {}, {}, std::vector<char>(1, 0)),
+               std::invalid_argument);
+  EXPECT_THROW(writeVtu(mesh, path.string(), {}, {}, {}, {}, {}, {},
+                        std::vector<char>(mesh.numElements(), 1)),
+               std::logic_error);
+  EXPECT_EQ(readText(path), text);
 }
 
 TEST(VtuCut, CornerDataIsAveragedPerSideOfACut) {

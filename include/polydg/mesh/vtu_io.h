@@ -122,13 +122,16 @@ inline constexpr std::string_view kVtuTextSuffix = ".utf8";
 /// std::runtime_error if a face with holes cannot be triangulated.
 ///
 /// `volumes`: empty, or the mesh's signedVolumes() if the caller has them already (to validate
-/// them too); they are written as given instead of computed again (std::invalid_argument if
-/// there is not one per element).
+/// them too); they are written as given instead of computed again. `boxes`: empty, or per
+/// element 1 for a whole grid cell as slicing made it (MeshingResult::wholeCells): six sides of
+/// four corners on eight distinct vertices, which the writer counts without numbering them
+/// (std::logic_error if a flagged element turns out otherwise). Either must be one per element
+/// if given (std::invalid_argument).
 void writeVtu(const PolyMesh& mesh, const std::string& path, const VtuWriteOptions& options = {},
               const std::vector<CellArray>& cellData = {},
               const std::vector<PointArray>& pointData = {},
               const std::vector<CornerArray>& cornerData = {}, const VtuFieldData& fieldData = {},
-              std::span<const double> volumes = {});
+              std::span<const double> volumes = {}, std::span<const char> boxes = {});
 
 /// Reads a VTK XML UnstructuredGrid file into a PolyMesh.
 ///
