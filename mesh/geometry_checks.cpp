@@ -191,10 +191,20 @@ GeometryCheck checkGeometryOf(const PolyMesh& mesh, std::span<const ElementId> e
   return report;
 }
 
-ElementData<std::uint32_t> connectedComponents(const PolyMesh& mesh, std::size_t& count) {
+namespace {
+
+/// The elements joined through their interior faces.
+UnionFind elementSets(const PolyMesh& mesh) {
   UnionFind sets(mesh.numElements());
   for (const Face& face : mesh.faces())
     if (face.front.valid() && face.back.valid()) sets.unite(face.front.value, face.back.value);
+  return sets;
+}
+
+}  // namespace
+
+ElementData<std::uint32_t> connectedComponents(const PolyMesh& mesh, std::size_t& count) {
+  UnionFind sets = elementSets(mesh);
   ElementData<std::uint32_t> component;
   count = sets.labels(component.raw());
   return component;
@@ -281,10 +291,10 @@ void reportFaces(const PolyMesh& mesh, const std::vector<FaceProblem>& shapes, P
 /// Duplicates: faces with the same vertex set. Such faces share their smallest vertex, so the
 /// faces are placed by it (a counting sort, in face order within each vertex) and compared only
 /// with those of the same smallest vertex, by their vertex-set hash and then their sorted
-/// vertices. The pairs found are reported in order of their faces. Besides the mesh this holds
+/// vertices. The pairs found are returned in order of their faces. Besides the mesh this holds
 /// one 32-bit id per face and one count per vertex: the smallest vertex is found again where the
 /// faces are placed rather than kept per face.
-void reportDuplicateFaces(const PolyMesh& mesh, Problems& problems, GeometryCheck& report) {
+std::vector<std::pair<std::uint32_t, std::uint32_t>> findDuplicateFaces(const PolyMesh& mesh) {
   const std::size_t nf = mesh.numFaces();
   // Faces without vertices all go to the place after the last vertex.
   const auto none = static_cast<std::uint32_t>(mesh.numVertices());
@@ -340,6 +350,12 @@ void reportDuplicateFaces(const PolyMesh& mesh, Problems& problems, GeometryChec
   std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
   for (const auto& list : found) pairs.insert(pairs.end(), list.begin(), list.end());
   std::sort(pairs.begin(), pairs.end());
+  return pairs;
+}
+
+/// Reports the duplicate pairs findDuplicateFaces() found, in its order.
+void reportDuplicateFaces(const std::vector<std::pair<std::uint32_t, std::uint32_t>>& pairs,
+                          Problems& problems, GeometryCheck& report) {
   for (const auto& [a, b] : pairs)
     problems.add(report.duplicateFaces,
                  "faces " + std::to_string(a) + " and " + std::to_string(b) +
@@ -425,13 +441,18 @@ GeometryCheck checkGeometry(const PolyMesh& mesh, const GeometryCheckOptions& op
   report.elements = mesh.numElements();
   report.faces = mesh.numFaces();
   // Faces: shape and planarity in parallel, then links, duplicates and the report in order.
+  // The duplicates are found first: their search holds two arrays of one entry per face and per
+  // vertex, freed before the writer beside reaches its own largest.
+  const auto duplicates = findDuplicateFaces(mesh);
   reportFaces(mesh, measureFaces(mesh, options), problems, report);
-  reportDuplicateFaces(mesh, problems, report);
+  reportDuplicateFaces(duplicates, problems, report);
   reportElements(mesh, volumes, boxes, problems, report);
   report.closedByConstruction =
       static_cast<std::size_t>(std::count_if(boxes.begin(), boxes.end(), [](char b) { return b; }));
 
-  connectedComponents(mesh, report.components);
+  // Only their number: no label per element (two arrays of one entry per element less, held
+  // while the mesh is written beside).
+  report.components = elementSets(mesh).count();
   report.passed = report.openElements == 0 && report.nonPositiveElements == 0 &&
                   report.nonPlanarFaces == 0 && report.degenerateFaces == 0 &&
                   report.duplicateFaces == 0 && report.inconsistentFaces == 0 &&

@@ -27,6 +27,13 @@ class UnionFind {
   /// Joins the sets of a and b; the representative of b's set represents the union.
   void unite(std::uint32_t a, std::uint32_t b) { parent_[find(a)] = find(b); }
 
+  /// The number of sets.
+  std::size_t count() {
+    std::size_t roots = 0;
+    for (std::uint32_t i = 0; i < parent_.size(); ++i) roots += find(i) == i;
+    return roots;
+  }
+
   /// Every index's representative, in a vector taken from the forest, which is left empty: for
   /// a caller that relabels the sets in that storage instead of allocating another array.
   std::vector<std::uint32_t> takeRepresentatives() {
