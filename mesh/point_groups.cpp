@@ -48,8 +48,8 @@ class ConcurrentSets {
   std::vector<std::uint32_t>& parent_;
 };
 
-/// Calls f(begin, end) for the blocks of kBlock corners, block b being [b * kBlock, ...), on all
-/// cores.
+/// Calls f(b, begin, end) for each block b of kBlock corners (the last may be shorter), the
+/// blocks on all cores.
 constexpr std::uint32_t kBlock = 1 << 14;
 template <class F>
 void forEachBlock(std::uint32_t n, F&& f) {
