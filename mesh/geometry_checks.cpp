@@ -17,6 +17,7 @@
 #include <stdexcept>
 
 #include "mesh/axis_rectangles.h"
+#include "mesh/per_element.h"
 #include "polydg/mesh/geometry.h"
 #include "util/union_find.h"
 
@@ -428,14 +429,8 @@ void reportElements(const PolyMesh& mesh, std::span<const double> given,
 
 GeometryCheck checkGeometry(const PolyMesh& mesh, const GeometryCheckOptions& options,
                             std::span<const double> volumes, std::span<const char> boxes) {
-  if (!volumes.empty() && volumes.size() != mesh.numElements())
-    throw std::invalid_argument("checkGeometry: " + std::to_string(volumes.size()) +
-                                " volumes given for " + std::to_string(mesh.numElements()) +
-                                " elements");
-  if (!boxes.empty() && boxes.size() != mesh.numElements())
-    throw std::invalid_argument("checkGeometry: " + std::to_string(boxes.size()) +
-                                " box flags given for " + std::to_string(mesh.numElements()) +
-                                " elements");
+  requireNoneOrOnePerElement(volumes.size(), mesh, "checkGeometry", "volumes");
+  requireNoneOrOnePerElement(boxes.size(), mesh, "checkGeometry", "box flags");
   GeometryCheck report;
   Problems problems(report, options.maxMessages);
   report.elements = mesh.numElements();

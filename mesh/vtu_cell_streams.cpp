@@ -14,6 +14,7 @@
 #include <boost/container/small_vector.hpp>
 
 #include "mesh/face_triangulation.h"
+#include "mesh/per_element.h"
 #include "mesh/vtk_cell_types.h"
 
 namespace polydg {
@@ -209,8 +210,7 @@ std::size_t RunningEnds::cellAt(std::uint64_t at) const {
 
 CellStreams::CellStreams(const PolyMesh& mesh, std::span<const char> boxes)
     : mesh_(mesh), records_(mesh) {
-  if (!boxes.empty() && boxes.size() != mesh.numElements())
-    throw std::invalid_argument("CellStreams: one box flag per element is needed");
+  requireNoneOrOnePerElement(boxes.size(), mesh, "CellStreams", "box flags");
   std::vector<std::uint32_t> recordCount, streamCount;
   findCorners(boxes, recordCount, streamCount);
   points_ = groupPoints(mesh, corners_);

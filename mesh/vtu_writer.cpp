@@ -17,6 +17,7 @@
 
 #include <tbb/parallel_for.h>
 
+#include "mesh/per_element.h"
 #include "mesh/point_groups.h"
 #include "mesh/vtk_cell_types.h"
 #include "mesh/vtk_format.h"
@@ -340,14 +341,8 @@ void writeVtu(const PolyMesh& mesh, const std::string& path, const VtuWriteOptio
       throw std::invalid_argument("writeVtu: corner array '" + a.name + "' has no value function");
   }
   checkFieldData(fieldData);
-  if (!volumes.empty() && volumes.size() != mesh.numElements())
-    throw std::invalid_argument("writeVtu: " + std::to_string(volumes.size()) +
-                                " volumes given for " + std::to_string(mesh.numElements()) +
-                                " elements");
-  if (!boxes.empty() && boxes.size() != mesh.numElements())
-    throw std::invalid_argument("writeVtu: " + std::to_string(boxes.size()) +
-                                " box flags given for " + std::to_string(mesh.numElements()) +
-                                " elements");
+  requireNoneOrOnePerElement(volumes.size(), mesh, "writeVtu", "volumes");
+  requireNoneOrOnePerElement(boxes.size(), mesh, "writeVtu", "box flags");
   // Everything that can fail for reasons other than I/O happens before the file is opened.
   const CellStreams streams(mesh, boxes);
   const FileValues values = fileValues(mesh, streams, volumes, cellData, pointData, cornerData);
