@@ -372,7 +372,7 @@ void reportElements(const PolyMesh& mesh, std::span<const double> given,
   // its volume unless given.
   enum : char { kClosed = 1, kLinked = 2 };
   std::vector<char> state(mesh.numElements());
-  const std::vector<double> computed = given.empty() ? signedVolumes(mesh) : std::vector<double>();
+  std::vector<double> computed(given.empty() ? mesh.numElements() : 0);
   const std::span<const double> volumes = given.empty() ? computed : given;
   auto linked = [&](ElementId e) {
     const auto& uses = mesh.element(e).faces;
@@ -388,6 +388,7 @@ void reportElements(const PolyMesh& mesh, std::span<const double> given,
                         const bool closed = (!boxes.empty() && boxes[i]) || isClosed(mesh, e);
                         state[i] =
                             static_cast<char>((closed ? kClosed : 0) | (linked(e) ? kLinked : 0));
+                        if (given.empty()) computed[i] = signedVolume(mesh, e);
                       }
                     });
   // The report in element order, reading the mesh again only where a link is wrong.

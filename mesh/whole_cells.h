@@ -56,10 +56,6 @@ class WholeCells {
   /// -axis, or 2 axis + 1, towards +axis) comes at its place in that order, unless bit s of
   /// `skip` leaves it out.
   void sides(const std::array<int, 3>& cell, Piece& piece, unsigned skip = 0) const;
-  /// The corners of side s of `cell`, as sides() gives them.
-  std::array<std::uint32_t, 4> side(const std::array<int, 3>& cell, int s) const {
-    return sideOf(corners(cell), s);
-  }
   /// The points of `cell`'s eight corners: corner b is +1 along axis a where bit a of b is set.
   std::array<std::uint32_t, 8> corners(const std::array<int, 3>& cell) const {
     const std::size_t nx = std::size_t(grid_.cells[0]) + 1;

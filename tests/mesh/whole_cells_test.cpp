@@ -107,7 +107,7 @@ void expectNodesNumberedInOrderOfTheirFirstBox(int n) {
               Vec3(grid.plane(0, node[0]), grid.plane(1, node[1]), grid.plane(2, node[2])));
   // Side 0 (facing -x) of every cell runs over its four nodes at x = cell[0].
   for (const std::array<int, 3>& cell : cells) {
-    const std::array<std::uint32_t, 4> side = whole.side(cell, 0);
+    const std::array<std::uint32_t, 4> side = WholeCells::sideOf(whole.corners(cell), 0);
     std::set<std::uint32_t> got(side.begin(), side.end()), want;
     for (int dj = 0; dj < 2; ++dj)
       for (int dk = 0; dk < 2; ++dk)
