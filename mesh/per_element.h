@@ -16,8 +16,7 @@ inline void requireNoneOrOnePerElement(std::size_t given, const PolyMesh& mesh, 
                                        const char* what) {
   if (given != 0 && given != mesh.numElements())
     throw std::invalid_argument(std::string(who) + ": " + std::to_string(given) + " " + what +
-                                " given for " + std::to_string(mesh.numElements()) +
-                                " elements");
+                                " given for " + std::to_string(mesh.numElements()) + " elements");
 }
 
 }  // namespace polydg
