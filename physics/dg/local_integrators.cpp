@@ -138,19 +138,69 @@ struct Kernel {
     const Mat t = coefficients(basis, e);
     Side sd;
     if (parts & kValues) sd.p = t.lazyProduct(s);
-    if (parts & kDerivatives)
-      for (int k = 0; k < 3; ++k) sd.q[k] = (derive(t, k) / h).lazyProduct(s);
-    if (parts & kLifting) {
-      const Mat11 o(basis.liftingCoefficients(e));
-      sd.psi = o.lazyProduct(s.template topRows<N1>());
+    if constexpr (P == 1) {
+      // The gradients and the lifting functions are constants, and the constant's row of the
+      // shift is (1, 0, 0, 0): the products below would only copy them.
+      if (parts & kDerivatives)
+        for (int k = 0; k < 3; ++k) sd.q[k] = derive(t, k) / h;
+      if (parts & kLifting) {
+        sd.psi.setZero();
+        sd.psi(0, 0) = basis.liftingCoefficients(e)(0, 0);
+      }
+    } else {
+      if (parts & kDerivatives)
+        for (int k = 0; k < 3; ++k) sd.q[k] = (derive(t, k) / h).lazyProduct(s);
+      if (parts & kLifting) {
+        const Mat11 o(basis.liftingCoefficients(e));
+        sd.psi = o.lazyProduct(s.template topRows<N1>());
+      }
     }
     return sd;
+  }
+
+  /// The coefficients of the IP strain and lifting terms of a block (faceRows()).
+  struct StrainWeights {
+    Vec3 n;        ///< out of self
+    double w, sb;  ///< the average's weight; +1 self's columns, -1 the other's
+    double mu, lambda;
+    double lift;         ///< the lifting term's weight over o_E^2 (degree 1)
+    double trial, test;  ///< 1 or 0: the consistency, the symmetry terms
+  };
+
+  /// Degree 1's strain and lifting terms of the block of self (sk, ck = G p_K^T) against B
+  /// (b, cb). The gradients g are constant and the lifting space is the constants, so each term
+  /// is an outer product of a_i = int_F phi^K_i or g^K_i with g^B_j or b_j = int_F phi^B_j: the
+  /// block (d, c) is a r^T + u b^T, what the matrix products of faceRows() give at any degree.
+  static void addOuterProductTerms(const Side& sk, const Side& b, const Mat& ck, const Mat& cb,
+                                   const StrainWeights& x, Eigen::MatrixXd& out) {
+    using Vec = Eigen::Matrix<double, N, 1>;
+    const Vec a = ck.row(0).transpose(), bj = cb.row(0).transpose();
+    Vec gK[3], gB[3];
+    for (int k = 0; k < 3; ++k) {
+      gK[k] = sk.q[k].col(0);
+      gB[k] = b.q[k].col(0);
+    }
+    const Vec3& n = x.n;
+    const Vec gnK = n.x() * gK[0] + n.y() * gK[1] + n.z() * gK[2];
+    const Vec gnB = n.x() * gB[0] + n.y() * gB[1] + n.z() * gB[2];
+    const double w = x.w, sb = x.sb, mu = x.mu, lambda = x.lambda, ct = x.trial, cv = x.test;
+    for (int d = 0; d < 3; ++d)
+      for (int c = 0; c < 3; ++c) {
+        Vec r = (-ct * w * mu * n[c]) * gB[d] + (-ct * w * lambda * n[d]) * gB[c] +
+                (lambda * w * w * sb * n[d] * n[c] * x.lift) * bj;
+        Vec u = (-cv * w * sb * mu * n[d]) * gK[c] + (-cv * w * sb * lambda * n[c]) * gK[d];
+        if (c == d) {
+          r += (-ct * w * mu) * gnB;
+          u += (-cv * w * sb * mu) * gnK;
+        }
+        out.template block<N, N>(d * N, c * N) += a * r.transpose() + u * bj.transpose();
+      }
   }
 
   static void faceRows(const PolyMesh& mesh, const DgBasis& basis, const MomentCache& moments,
                        const FaceView& view, const FormCoefficients& form,
                        Eigen::MatrixXd& selfBlock, Eigen::MatrixXd& otherBlock, bool withOther,
-                       int terms) {
+                       int terms, bool genericAtDegreeOne = false) {
     const bool trialStrain = terms & kTrialStrainTerms, testStrain = terms & kTestStrainTerms,
                jump = terms & kJumpTerms, otherLift = terms & kOtherLiftingTerms;
     const bool interior = view.kind == FaceKind::Interior;
@@ -173,11 +223,13 @@ struct Kernel {
     const Mat ck = fr.gram.lazyProduct(sk.p.transpose());
     Mat cl;
     if (interior) cl = fr.gram.lazyProduct(sl.p.transpose());
+    const double cK = view.selfCoupledFaces, cL = view.otherCoupledFaces;
+    const bool structured = P == 1 && !genericAtDegreeOne;
     Mat ak;
-    if (ip) ak = sk.p.lazyProduct(fr.gram);
+    if (ip && !structured) ak = sk.p.lazyProduct(fr.gram);
     // Lifting face matrices psi_E against phi_X: mpsi[E][X] = psi_E G phi_X^T (N1 x N).
     Mat1 mkk = Mat1::Zero(), mkl = Mat1::Zero(), mlk = Mat1::Zero(), mll = Mat1::Zero();
-    if (ip) {
+    if (ip && !structured) {
       mkk = sk.psi.lazyProduct(ck);
       if (interior) {
         mkl = sk.psi.lazyProduct(cl);
@@ -185,7 +237,6 @@ struct Kernel {
         mll = sl.psi.lazyProduct(cl);
       }
     }
-    const double cK = view.selfCoupledFaces, cL = view.otherCoupledFaces;
 
     auto block = [&](const Side& b, const Mat& cb, double sb, const Mat1* liftK, const Mat1* liftL,
                      Eigen::MatrixXd& out) {
@@ -198,6 +249,15 @@ struct Kernel {
         for (int d = 0; d < 3; ++d) out.template block<N, N>(d * N, d * N) += (mu * etaF * sb) * m;
       }
       if (!ip) return;
+      if (structured) {
+        double lift = 0.0;  // psi_E = o_E: (psi_E phi_K)^T (psi_E phi_B) = o_E^2 a b^T
+        if (testStrain) lift += cK * sk.psi(0, 0) * sk.psi(0, 0);
+        if (liftL && otherLift) lift += cL * sl.psi(0, 0) * sl.psi(0, 0);
+        const StrainWeights weights{
+            n, w, sb, mu, lambda, lift, trialStrain ? 1.0 : 0.0, testStrain ? 1.0 : 0.0};
+        addOuterProductTerms(sk, b, ck, cb, weights, out);
+        return;
+      }
       Mat wk[3], vk[3];  // wk: int phi^K_i d_k phi^B_j; vk: int d_k phi^K_i phi^B_j
       for (int k = 0; k < 3; ++k) {
         wk[k] = ak.lazyProduct(b.q[k].transpose());
@@ -289,6 +349,20 @@ void faceRows(const PolyMesh& mesh, const DgBasis& basis, const MomentCache& mom
                           terms);
   });
 }
+
+namespace detail {
+
+void faceRowsByMatrixProducts(const PolyMesh& mesh, const DgBasis& basis,
+                              const MomentCache& moments, const FaceView& view,
+                              const FormCoefficients& form, Eigen::MatrixXd& selfBlock,
+                              Eigen::MatrixXd& otherBlock, bool withOther, int terms) {
+  dispatchBasisDegree(basis.degree(), [&](auto p) {
+    Kernel<p()>::faceRows(mesh, basis, moments, view, form, selfBlock, otherBlock, withOther, terms,
+                          true);
+  });
+}
+
+}  // namespace detail
 
 Eigen::MatrixXd liftingFaceGram(const DgBasis& basis, const MomentCache& moments,
                                 const PolyMesh& mesh, FaceId f, ElementId e) {

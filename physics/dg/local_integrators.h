@@ -122,6 +122,15 @@ void faceRows(const PolyMesh& mesh, const DgBasis& basis, const MomentCache& mom
               const FaceView& view, const FormCoefficients& form, Eigen::MatrixXd& selfBlock,
               Eigen::MatrixXd& otherBlock, bool withOther = true, int terms = 15);
 
+namespace detail {
+/// faceRows() as matrix products at every degree, without degree 1's outer products (constant
+/// gradients, constant lifting functions): the reference the tests hold the shortcut to.
+void faceRowsByMatrixProducts(const PolyMesh& mesh, const DgBasis& basis,
+                              const MomentCache& moments, const FaceView& view,
+                              const FormCoefficients& form, Eigen::MatrixXd& selfBlock,
+                              Eigen::MatrixXd& otherBlock, bool withOther, int terms);
+}  // namespace detail
+
 /// The face terms of faceRows() grouped by the element whose strain they hold, for stiffness
 /// warping (Kaufmann et al. 2008, section 7: K_f1 and K_f2 split by side, K_f3 not warped). The
 /// IP lambda lifting term of an element E completes the square of E's lambda terms (the

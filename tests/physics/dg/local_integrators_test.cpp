@@ -11,6 +11,8 @@
 #include "mesh/primitives.h"
 #include "physics/dg/assembly.h"
 #include "physics/dg/face_quadrature.h"
+#include "polydg/mesh/slice.h"
+#include "polydg/mesh/surface_shapes.h"
 
 namespace polydg {
 namespace {
@@ -120,6 +122,70 @@ TEST_P(LocalIntegrators, PenaltyThresholdIsScaleAndPositionInvariant) {
 
 INSTANTIATE_TEST_SUITE_P(Degrees, LocalIntegrators, ::testing::Values(1, 2, 3),
                          [](const auto& info) { return "p" + std::to_string(info.param); });
+
+// At degree 1 faceRows() builds the blocks from outer products (constant gradients, constant
+// lifting functions): they must be the matrix products' blocks for every method, term group
+// and side, on the faces of a sliced ball far from the origin (surface pieces and cut sides).
+TEST(LocalIntegrators, DegreeOneOuterProductsGiveTheMatrixProductsBlocks) {
+  const TriangleSurface ball = icosphere(Vec3(1e3, -2e3, 5e2), 1.0, 2);
+  const PolyMesh mesh = sliceSurface(ball, Grid::withCellsAlongLongest(bounds(ball), 3));
+  ASSERT_GT(mesh.numElements(), 10u);
+  MomentCache moments(mesh, 2);
+  moments.update();
+  const DgBasis basis(mesh, moments, {.degree = 1});
+  LoadCase clamp;
+  clamp.dirichlet.push_back({FaceSelector::allBoundary(), {}});
+  const FaceRoles roles = classifyFaces(mesh, clamp);
+  ElementData<double> eta(mesh.numElements(), 0.0), area(mesh.numElements(), 0.0);
+  for (std::size_t e = 0; e < mesh.numElements(); ++e) {
+    eta[ElementId(e)] = 3.0 + 0.1 * static_cast<double>(e % 7);
+    area[ElementId(e)] = 0.01 * (1.0 + static_cast<double>(e % 3));
+  }
+  FormCoefficients ip{Method::IP, 0.7, 2.3, 11.0}, perElement = ip, bz{Method::BZ, 0.7, 2.3, 5.0},
+                                                   bzMean = bz;
+  perElement.elementEta = &eta;
+  perElement.elementFaceArea = &area;
+  bz.bzFactor = 4.0;
+  bzMean.bzFactor = 4.0;
+  bzMean.bzFactorOnMean = true;
+  std::size_t interior = 0, boundary = 0;
+  for (std::size_t f = 0; f < mesh.numFaces(); ++f) {
+    const FaceId face(f);
+    const FaceUses& uses = roles.uses[face];
+    const FaceKind kind = roles.kind[face];
+    (kind == FaceKind::Interior ? interior : boundary) += 1;
+    for (int s = 0; s < (kind == FaceKind::Interior ? 2 : 1); ++s) {
+      FaceView view;
+      view.face = face;
+      view.kind = kind;
+      view.self = uses.element[s];
+      view.selfIsFront = !uses.reversed[s];
+      view.selfCoupledFaces = 5 + s;
+      if (kind == FaceKind::Interior) {
+        view.other = uses.element[1 - s];
+        view.otherCoupledFaces = 9;
+      }
+      for (const FormCoefficients* form : {&ip, &perElement, &bz, &bzMean})
+        for (int terms = 1; terms <= kAllFaceTerms; ++terms)
+          for (bool withOther : {true, false}) {
+            Eigen::MatrixXd self, other, selfRef, otherRef;
+            faceRows(mesh, basis, moments, view, *form, self, other, withOther, terms);
+            detail::faceRowsByMatrixProducts(mesh, basis, moments, view, *form, selfRef, otherRef,
+                                             withOther, terms);
+            ASSERT_EQ(self.rows(), selfRef.rows());
+            ASSERT_EQ(other.rows(), otherRef.rows());
+            EXPECT_LE((self - selfRef).norm(), 1e-12 * selfRef.norm())
+                << "face " << f << " side " << s << " terms " << terms;
+            if (otherRef.size() > 0) {
+              EXPECT_LE((other - otherRef).norm(), 1e-12 * otherRef.norm())
+                  << "face " << f << " side " << s << " terms " << terms;
+            }
+          }
+    }
+  }
+  EXPECT_GT(interior, 20u);
+  EXPECT_GT(boundary, 20u);
+}
 
 TEST(FaceQuadrature, IntegratesMonomialsOverANonConvexFaceWithAHole) {
   Polygon2 h;
