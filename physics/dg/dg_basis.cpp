@@ -58,6 +58,12 @@ bool orthonormalizer(const Eigen::MatrixXd& g, Eigen::MatrixXd& t) {
 void scaledMonomials(int degree, const Vec3& y, std::span<double> out) {
   const int n = numMonomials(degree);
   out[0] = 1.0;
+  if (degree == 1) {  // the loop below, without its table lookups (the local checks' vertices)
+    static_assert(monomialIndex(1, 0, 0) == 1 && monomialIndex(0, 1, 0) == 2 &&
+                  monomialIndex(0, 0, 1) == 3);
+    for (int k = 0; k < 3; ++k) out[1 + k] = y[k];
+    return;
+  }
   for (int a = 1; a < n; ++a) {
     const Exponents e = monomialExponents(a);
     // Multiply a predecessor by one variable: the first variable with a positive power.

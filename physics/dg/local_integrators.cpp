@@ -49,6 +49,17 @@ struct Kernel {
   /// S with m_a((x - c)/h) = sum_b S(a, b) y^b for x = r + hF y: the binomial expansion of
   /// (sigma y + d)^a, sigma = hF / h, d = (r - c) / h.
   static Mat shift(double sigma, const Vec3& d) {
+    if constexpr (P == 1) {  // (sigma y_k + d_k)^1: the products below, without their ones
+      static_assert(monomialIndex(1, 0, 0) == 1 && monomialIndex(0, 1, 0) == 2 &&
+                    monomialIndex(0, 0, 1) == 3);
+      Mat s = Mat::Zero();
+      s(0, 0) = 1.0;
+      for (int k = 0; k < 3; ++k) {
+        s(1 + k, 0) = d[k];
+        s(1 + k, 1 + k) = sigma;
+      }
+      return s;
+    }
     double sp[P + 1], dp[3][P + 1];
     sp[0] = 1.0;
     for (int k = 0; k < 3; ++k) dp[k][0] = 1.0;
