@@ -78,8 +78,8 @@ class PlaneSplitter {
   std::size_t numPoints() const { return points_.size(); }
   /// Point v's rounded position.
   const Vec3& point(std::uint32_t v) const { return points_.position(v); }
-  /// A copy of all points' rounded positions, in id order.
-  std::vector<Vec3> points() const { return points_.positions(); }
+  /// A copy of all points' rounded positions, in id order, and `room` entries more.
+  std::vector<Vec3> points(std::size_t room = 0) const { return points_.positions(room); }
   /// The points with their exact positions and predicates.
   const SplitPoints& splitPoints() const { return points_; }
 

@@ -19,6 +19,7 @@
 #include "polydg/mesh/merge_elements.h"
 #include "util/stopwatch.h"
 
+#include <tbb/blocked_range.h>
 #include <tbb/concurrent_vector.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
@@ -89,8 +90,14 @@ class Slicer {
 
   PolyMesh build(std::vector<std::array<int, 3>>* elementCell, std::vector<int>* elementLevel,
                  std::vector<char>* elementWhole) {
-    std::vector<Vec3> points = splitter_->points();
-    points.insert(points.end(), generated_.begin(), generated_.end());
+    // One array for both (appended, the generated points reallocated it serially).
+    const std::size_t split = splitter_->numPoints();
+    std::vector<Vec3> points = splitter_->points(generated_.size());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, generated_.size(), 1 << 14),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        std::copy(generated_.begin() + r.begin(), generated_.begin() + r.end(),
+                                  points.begin() + split + r.begin());
+                      });
     std::vector<Vec3>().swap(generated_);
     // The splitter's maps of shared points (hundreds of thousands of nodes) are not needed any
     // more: they are freed beside the build, not after it.

@@ -148,7 +148,11 @@ class SliceBuilder {
           }
         });
     });
+    // Sized once: grown by doubling it was allocated, faulted in and copied four times.
+    std::size_t listed = 0;
+    for (const std::vector<std::uint32_t>& list : firstUses) listed += list.size();
     std::vector<std::uint32_t> used;
+    used.reserve(std::min(listed, rank.size()));
     for (const std::vector<std::uint32_t>& list : firstUses)
       for (const std::uint32_t v : list)
         if (rank[v] == kNone) {
@@ -180,7 +184,10 @@ class SliceBuilder {
     out.rank.assign(points.size(), kNone);
     const std::vector<std::uint32_t> used = pointsInOrderOfUse(out.rank);
     const std::vector<std::uint32_t> target = weldTargets(points, used, resolution);
-    out.positions.raw().reserve(used.size());
+    // The mesh keeps this array: sized for the vertices, not for the points before welding.
+    std::size_t vertices = 0;
+    for (std::size_t i = 0; i < used.size(); ++i) vertices += target[i] == i;
+    out.positions.raw().reserve(vertices);
     out.vertexOfRank.resize(used.size());
     for (std::size_t i = 0; i < used.size(); ++i) {
       if (target[i] == i) {

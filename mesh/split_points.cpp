@@ -6,6 +6,10 @@
 #include <stdexcept>
 
 #include <CGAL/FPU.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "util/resident.h"
 
 namespace polydg {
 
@@ -81,10 +85,14 @@ SplitPoints::SplitPoints(const std::vector<Vec3>& points,
   }
 }
 
-std::vector<Vec3> SplitPoints::positions() const {
-  std::vector<Vec3> out;
-  out.reserve(records_.size());
-  for (const Record& r : records_) out.push_back(r.position);
+std::vector<Vec3> SplitPoints::positions(std::size_t room) const {
+  const std::size_t n = records_.size();
+  std::vector<Vec3> out = residentVector<Vec3>(n + room);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1 << 14),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t i = r.begin(); i != r.end(); ++i)
+                        out[i] = records_[i].position;
+                    });
   return out;
 }
 

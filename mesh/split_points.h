@@ -54,7 +54,9 @@ class SplitPoints {
   std::size_t size() const { return records_.size(); }
   const Vec3& position(std::uint32_t v) const { return records_[v].position; }
   std::uint32_t onPlane(std::uint32_t v) const { return records_[v].onPlane; }
-  std::vector<Vec3> positions() const;
+  /// All rounded positions in id order, then `room` more entries for the caller to fill: one
+  /// array, its pages faulted in and filled on all cores.
+  std::vector<Vec3> positions(std::size_t room = 0) const;
 
   /// Records `plane` under `id`; needed before points are made on it.
   void rememberPlane(const Plane& plane, std::uint32_t id);

@@ -77,6 +77,15 @@ TEST(Slice, SphereFillsItsVolume) {
   EXPECT_GT(s.mesh.numElements(), s.hexahedra + 100);
 }
 
+// Enough whole cells that their grid nodes are copied into the points in several parallel
+// blocks (of 2^14): every block must land at its place for the boxes to keep their volume.
+TEST(Slice, ManyWholeCellsFillTheirVolume) {
+  const TriangleSurface sphere = icosphere(Vec3(0.1, -0.2, 0.05), 1.0, 3);
+  const Sliced s = slice(sphere, Grid::withCellsAlongLongest(bounds(sphere), 40));
+  EXPECT_GT(s.stats.wholeCells, 20000u);
+  expectGood(s, enclosedVolume(sphere), 1);
+}
+
 TEST(Slice, TorusIsOneComponentWithAHole) {
   const TriangleSurface t = torus(Vec3::Zero(), 1.0, 0.35, 48, 24);
   const Sliced s = slice(t, Grid::withCellsAlongLongest(bounds(t), 10));
