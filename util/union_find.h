@@ -27,10 +27,10 @@ class UnionFind {
   /// Joins the sets of a and b; the representative of b's set represents the union.
   void unite(std::uint32_t a, std::uint32_t b) { parent_[find(a)] = find(b); }
 
-  /// The number of sets.
-  std::size_t count() {
+  /// The number of sets: of roots, the indices that are their own parent.
+  std::size_t count() const {
     std::size_t roots = 0;
-    for (std::uint32_t i = 0; i < parent_.size(); ++i) roots += find(i) == i;
+    for (std::uint32_t i = 0; i < parent_.size(); ++i) roots += parent_[i] == i;
     return roots;
   }
 
