@@ -18,6 +18,13 @@ class UnionFind {
 
   std::size_t size() const { return parent_.size(); }
 
+  /// Adds the index size(), a set of its own, and returns it.
+  std::uint32_t add() {
+    const auto i = static_cast<std::uint32_t>(parent_.size());
+    parent_.push_back(i);
+    return i;
+  }
+
   /// The representative of i's set.
   std::uint32_t find(std::uint32_t i) {
     while (parent_[i] != i) i = parent_[i] = parent_[parent_[i]];

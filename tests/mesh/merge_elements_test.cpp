@@ -118,6 +118,18 @@ TEST(MergeElements, SliverMergingKeepsASlicedSphereValid) {
   }
 }
 
+/// Adds a flat element far from the others: a unit square at x = 5 and its reverse.
+void addFlatSquareAlone(PolyMesh& mesh) {
+  const std::uint32_t end[] = {4};
+  std::vector<VertexId> far;
+  for (const Vec3& p : {Vec3(5, 0, 0), Vec3(6, 0, 0), Vec3(6, 1, 0), Vec3(5, 1, 0)})
+    far.push_back(mesh.addVertex(p));
+  const FaceId down = mesh.addFace(far, end, FaceOrigin::Surface);
+  std::reverse(far.begin(), far.end());
+  const FaceId up = mesh.addFace(far, end, FaceOrigin::Surface);
+  mesh.addElementFromFaces(std::vector<FaceUse>{{down, false}, {up, false}});
+}
+
 TEST(MergeElements, DegenerateElementsJoinTheirNeighbourOrGo) {
   // The unit cube with a flat element on its top face (the top used from behind, and the same
   // square again facing up: no volume), and a flat element alone (a square and its reverse).
@@ -136,13 +148,7 @@ TEST(MergeElements, DegenerateElementsJoinTheirNeighbourOrGo) {
   const std::uint32_t end[] = {4};
   const FaceId lid = mesh.addFace(square, end, FaceOrigin::Surface);
   mesh.addElementFromFaces(std::vector<FaceUse>{{top, true}, {lid, false}});
-  std::vector<VertexId> far;
-  for (const Vec3& p : {Vec3(5, 0, 0), Vec3(6, 0, 0), Vec3(6, 1, 0), Vec3(5, 1, 0)})
-    far.push_back(mesh.addVertex(p));
-  const FaceId down = mesh.addFace(far, end, FaceOrigin::Surface);
-  std::reverse(far.begin(), far.end());
-  const FaceId up = mesh.addFace(far, end, FaceOrigin::Surface);
-  mesh.addElementFromFaces(std::vector<FaceUse>{{down, false}, {up, false}});
+  addFlatSquareAlone(mesh);
   EXPECT_FALSE(checkGeometry(mesh).passed);
 
   DegenerateMergeReport report;
@@ -155,6 +161,57 @@ TEST(MergeElements, DegenerateElementsJoinTheirNeighbourOrGo) {
   EXPECT_EQ(report.merged, 1u);
   EXPECT_EQ(report.dropped, 1u);
   EXPECT_EQ(report.group, (std::vector<std::uint32_t>{0, 0, kDroppedElement}));
+}
+
+TEST(MergeElements, DegenerateGroupsJoinWholeCellsAsWithoutTheFlags) {
+  // Three unit cubes in a row, flagged as whole cells, and flat elements on them: one on the
+  // first cube's top, which joins that cube; two joined by a degenerate face (three points on a
+  // line) on the third cube's top, whose group joins that cube; and one far away, dropped. The
+  // flags spare the cubes' measuring until a group joins them: the report and the mesh are
+  // those without the flags.
+  PolyMesh mesh = hexGridMesh(3, 1, 1, Box3(Vec3::Zero(), Vec3(3, 1, 1)));
+  const std::uint32_t end4[] = {4}, end3[] = {3};
+  auto top = [&](std::uint32_t e) {
+    for (const FaceUse& use : mesh.element(ElementId(e)).faces) {
+      bool up = true;
+      for (VertexId v : mesh.face(use.face).vertices) up = up && mesh.position(v).z() == 1.0;
+      if (up) return use.face;
+    }
+    return FaceId();
+  };
+  auto lidOn = [&](FaceId face) {
+    const std::vector<VertexId> square(mesh.face(face).vertices.begin(),
+                                       mesh.face(face).vertices.end());
+    return mesh.addFace(square, end4, FaceOrigin::Surface);
+  };
+  const FaceId top0 = top(0), top2 = top(2);
+  ASSERT_TRUE(top0.valid() && top2.valid());
+  mesh.addElementFromFaces(std::vector<FaceUse>{{top0, true}, {lidOn(top0), false}});
+  std::vector<VertexId> line;
+  for (const Vec3& p : {Vec3(2, 0, 1), Vec3(2.5, 0, 1), Vec3(3, 0, 1)})
+    line.push_back(mesh.addVertex(p));
+  const FaceId degenerate = mesh.addFace(line, end3, FaceOrigin::Surface);
+  const FaceId again = mesh.addFace(line, end3, FaceOrigin::Surface);
+  mesh.addElementFromFaces(
+      std::vector<FaceUse>{{top2, true}, {lidOn(top2), false}, {degenerate, false}});
+  mesh.addElementFromFaces(std::vector<FaceUse>{{degenerate, true}, {again, false}});
+  addFlatSquareAlone(mesh);
+  ASSERT_EQ(mesh.numElements(), 7u);
+
+  DegenerateMergeReport plain, flags;
+  const PolyMesh a = mergeDegenerateElements(mesh, &plain);
+  const PolyMesh b = mergeDegenerateElements(mesh, &flags, {1, 1, 1, 0, 0, 0, 0});
+  EXPECT_EQ(plain.group, (std::vector<std::uint32_t>{0, 1, 2, 0, 2, 2, kDroppedElement}));
+  EXPECT_EQ(plain.merged, 3u);
+  EXPECT_EQ(plain.dropped, 1u);
+  EXPECT_EQ(flags.group, plain.group);
+  EXPECT_EQ(flags.merged, plain.merged);
+  EXPECT_EQ(flags.dropped, plain.dropped);
+  expectIdenticalMeshes(a, b);
+  // The cubes again, two with the flat elements' faces (the degenerate one left on the third).
+  ASSERT_EQ(b.numElements(), 3u);
+  for (std::uint32_t e = 0; e < 3; ++e)
+    EXPECT_NEAR(signedVolume(b, ElementId(e)), 1.0, kVolumeTolerance) << "element " << e;
 }
 
 }  // namespace
