@@ -57,18 +57,12 @@ class SliceBuilder {
     std::vector<char>().swap(polygons.touched);  // matching was the last to read these two
     std::vector<std::uint64_t>().swap(polygons.keys);
     const MeshIds ids = numberMesh(at, polygons, sharesEarlier);
-    // The largest arrays of slicing: their pages are faulted in on both cores.
+    // The largest arrays of slicing, their pages faulted in on both cores: the faces, then,
+    // with what only the faces needed freed, the elements.
     FaceData<Face> meshFaces;
     meshFaces.raw() = residentVector<Face>(ids.faceBase[cells_.size()]);
-    ElementData<Element> meshElements;
-    meshElements.raw() = residentVector<Element>(ids.elements);
-    makeFacesAndElements(at, polygons, sharesEarlier, ids, vertices, meshFaces, meshElements);
-    if (elementCell)
-      for (std::size_t l = 0; l < cells_.size(); ++l)
-        if (ids.elementOf[l] != kNone) elementCell->push_back(cells_[l].cell);
-    if (elementLevel)
-      for (std::size_t l = 0; l < cells_.size(); ++l)
-        if (ids.elementOf[l] != kNone) elementLevel->push_back(cells_[l].level);
+    const std::vector<std::uint32_t> faceId =
+        makeFaces(at, polygons, sharesEarlier, ids, vertices, meshFaces);
     if (elementWhole) {
       elementWhole->assign(ids.elements, 0);
       tbb::parallel_for(std::size_t(0), cells_.size(), [&](std::size_t l) {
@@ -76,6 +70,20 @@ class SliceBuilder {
           (*elementWhole)[ids.elementOf[l]] = !weldedCorner(cells_[l].cell, vertices);
       });
     }
+    polygons.welded = WeldedPolygons(0, 0, 0);
+    std::vector<FaceOrigin>().swap(polygons.origin);
+    std::vector<std::uint32_t>().swap(vertices.rank);
+    std::vector<std::uint32_t>().swap(vertices.vertexOfRank);
+    std::vector<char>().swap(vertices.shared);
+    ElementData<Element> meshElements;
+    meshElements.raw() = residentVector<Element>(ids.elements);
+    makeElements(at, polygons, sharesEarlier, ids, faceId, meshFaces, meshElements);
+    if (elementCell)
+      for (std::size_t l = 0; l < cells_.size(); ++l)
+        if (ids.elementOf[l] != kNone) elementCell->push_back(cells_[l].cell);
+    if (elementLevel)
+      for (std::size_t l = 0; l < cells_.size(); ++l)
+        if (ids.elementOf[l] != kNone) elementLevel->push_back(cells_[l].level);
     PolyMesh mesh;
     mesh.assign(std::move(vertices.positions), std::move(meshFaces), std::move(meshElements));
     return mesh;
@@ -491,13 +499,12 @@ class SliceBuilder {
     }
   }
 
-  /// Fills `meshFaces` and `meshElements` (sized by `ids`) in parallel: the new faces first
-  /// (their ids are known per leaf), then the later sides, which take the earlier side's face
-  /// as its back (an interior face, whatever the earlier side was).
-  void makeFacesAndElements(const LeafOffsets& at, const LeafPolygons& polygons,
-                            const std::vector<std::uint32_t>& sharesEarlier, const MeshIds& ids,
-                            const WeldedVertices& vertexOf, FaceData<Face>& meshFaces,
-                            ElementData<Element>& meshElements) const {
+  /// Fills `meshFaces` (sized by `ids`) in parallel with the new faces, whose ids are known per
+  /// leaf; returns each polygon's face, or kNone (a later side, or a polygon not kept).
+  std::vector<std::uint32_t> makeFaces(const LeafOffsets& at, const LeafPolygons& polygons,
+                                       const std::vector<std::uint32_t>& sharesEarlier,
+                                       const MeshIds& ids, const WeldedVertices& vertexOf,
+                                       FaceData<Face>& meshFaces) const {
     const std::size_t nl = cells_.size();
     std::vector<std::uint32_t> faceId(at.polygon[nl], kNone);
     tbb::parallel_for(
@@ -529,6 +536,15 @@ class SliceBuilder {
             });
           }
         });
+    return faceId;
+  }
+
+  /// Fills `meshElements` (sized by `ids`) in parallel, each with its faces: a later side takes
+  /// the earlier side's face as its back (an interior face, whatever the earlier side was).
+  void makeElements(const LeafOffsets& at, const LeafPolygons& polygons,
+                    const std::vector<std::uint32_t>& sharesEarlier, const MeshIds& ids,
+                    const std::vector<std::uint32_t>& faceId, FaceData<Face>& meshFaces,
+                    ElementData<Element>& meshElements) const {
     forEachRow([&](std::size_t row) {
       std::array<RowCursor, 6> beside;
       for (const int s : {2, 4}) beside[s] = cursorBeside(row, s);
