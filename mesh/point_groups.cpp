@@ -1,6 +1,8 @@
 #include "mesh/point_groups.h"
 
+#include <algorithm>
 #include <atomic>
+#include <bit>
 #include <stdexcept>
 
 #include <tbb/blocked_range.h>
@@ -43,6 +45,7 @@ class ConcurrentSets {
     return std::atomic_ref<std::uint32_t>(parent_[i]);
   }
   std::uint32_t load(std::uint32_t i) const { return at(i).load(std::memory_order_relaxed); }
+  std::uint32_t size() const { return static_cast<std::uint32_t>(parent_.size()); }
 
  private:
   std::vector<std::uint32_t>& parent_;
@@ -58,34 +61,131 @@ void forEachBlock(std::uint32_t n, F&& f) {
                     [&](std::uint32_t b) { f(b, b * kBlock, std::min(n, (b + 1) * kBlock)); });
 }
 
-}  // namespace
-
-PointGroups groupPoints(const PolyMesh& mesh, const ElementCorners& corners) {
-  const std::size_t numCorners = corners.vertices.size();
-  const std::size_t nv = mesh.numVertices();
-  // Corners and points are numbered in 31 bits: the top bit marks a root whose point is known.
-  constexpr std::uint32_t kKnown = 0x80000000u;
-  if (numCorners + nv >= kKnown)
-    throw std::length_error("groupPoints: more than 2^31 corners and vertices");
-  const auto nc = static_cast<std::uint32_t>(numCorners);
-  auto vertexOf = [&](std::uint32_t corner) { return corners.vertices[corner].value; };
-
-  // The corners of each vertex joined through the interior faces that contain it, on all cores.
-  // A group's corners share one vertex, and its root is its first corner.
-  std::vector<std::uint32_t> slot(numCorners);
-  forEachBlock(nc, [&](std::uint32_t, std::uint32_t begin, std::uint32_t end) {
-    for (std::uint32_t i = begin; i < end; ++i) slot[i] = i;
+/// Starts `sets` (over its parent array, all of whose entries are set here) with each entry a
+/// set of its own, then joins the corners of each vertex v that `take(v)` accepts where an
+/// interior face at v joins two elements, corner c at entry `entry(c)`; on all cores.
+template <class Take, class Entry>
+void joinThroughInteriorFaces(const PolyMesh& mesh, const ElementCorners& corners,
+                              const ConcurrentSets& sets, Take&& take, Entry&& entry) {
+  forEachBlock(sets.size(), [&](std::uint32_t, std::uint32_t begin, std::uint32_t end) {
+    for (std::uint32_t i = begin; i < end; ++i) sets.at(i).store(i, std::memory_order_relaxed);
   });
-  const ConcurrentSets sets(slot);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.numFaces(), 4096),
                     [&](const tbb::blocked_range<std::size_t>& r) {
                       for (std::size_t f = r.begin(); f != r.end(); ++f) {
                         const Face& face = mesh.face(FaceId(f));
                         if (!face.front.valid() || !face.back.valid()) continue;
                         for (VertexId v : face.vertices)
-                          sets.unite(corners.find(face.front, v), corners.find(face.back, v));
+                          if (take(v.value))
+                            sets.unite(entry(corners.find(face.front, v)),
+                                       entry(corners.find(face.back, v)));
                       }
                     });
+}
+
+}  // namespace
+
+// The forest over all corners would be the largest array while a mesh of millions of elements
+// is written (53 MB for the bunny at 200 cells).
+bool detail::anyVertexSplits(const PolyMesh& mesh, const ElementCorners& corners,
+                             std::uint32_t rangeCorners) {
+  const auto nc = static_cast<std::uint32_t>(corners.vertices.size());
+  const std::size_t nv = mesh.numVertices();
+  auto vertexOf = [&](std::uint32_t corner) { return corners.vertices[corner].value; };
+  // The vertices that have a corner, a bit each.
+  std::vector<std::uint64_t> hasCorner((nv + 63) / 64, 0);
+  forEachBlock(nc, [&](std::uint32_t, std::uint32_t begin, std::uint32_t end) {
+    for (std::uint32_t i = begin; i < end; ++i) {
+      const std::uint32_t v = vertexOf(i);
+      std::atomic_ref<std::uint64_t>(hasCorner[v / 64])
+          .fetch_or(std::uint64_t(1) << (v % 64), std::memory_order_relaxed);
+    }
+  });
+  std::size_t withCorners = 0;
+  for (const std::uint64_t word : hasCorner) withCorners += std::popcount(word);
+
+  const std::size_t ranges = std::max<std::size_t>(1, (nc + rangeCorners - 1) / rangeCorners);
+  const std::uint32_t words = (nc + 63) / 64;
+  std::vector<std::uint64_t> in(words);          // corner i is in the range: bit i % 64
+  std::vector<std::uint32_t> before(words + 1);  // corners of the range before word w
+  // Range r holds the vertices first[r] .. first[r + 1] - 1.
+  std::vector<std::uint32_t> first(ranges + 1);
+  for (std::size_t r = 0; r <= ranges; ++r) first[r] = static_cast<std::uint32_t>(nv * r / ranges);
+  // Room for the largest range's forest, made once.
+  std::vector<std::atomic<std::size_t>> cornersIn(ranges);
+  forEachBlock(nc, [&](std::uint32_t, std::uint32_t begin, std::uint32_t end) {
+    std::vector<std::size_t> own(ranges, 0);
+    for (std::uint32_t i = begin; i < end; ++i)
+      ++own[std::upper_bound(first.begin() + 1, first.end() - 1, vertexOf(i)) - first.begin() - 1];
+    for (std::size_t r = 0; r < ranges; ++r) cornersIn[r] += own[r];
+  });
+  std::size_t largest = 0;
+  for (const std::atomic<std::size_t>& n : cornersIn) largest = std::max(largest, n.load());
+  std::vector<std::uint32_t> slot;
+  slot.reserve(largest);
+  std::size_t groups = 0;
+  for (std::size_t r = 0; r < ranges; ++r) {
+    auto inRange = [&](std::uint32_t v) { return v >= first[r] && v < first[r + 1]; };
+    forEachBlock(words, [&](std::uint32_t, std::uint32_t begin, std::uint32_t end) {
+      for (std::uint32_t w = begin; w < end; ++w) {
+        std::uint64_t bits = 0;
+        for (std::uint32_t i = w * 64; i < std::min(nc, w * 64 + 64); ++i)
+          bits |= std::uint64_t(inRange(vertexOf(i))) << (i % 64);
+        in[w] = bits;
+        before[w + 1] = static_cast<std::uint32_t>(std::popcount(bits));
+      }
+    });
+    before[0] = 0;
+    for (std::uint32_t w = 0; w < words; ++w) before[w + 1] += before[w];
+    auto rank = [&](std::uint32_t i) {
+      const std::uint64_t lower = in[i / 64] & ((std::uint64_t(1) << (i % 64)) - 1);
+      return before[i / 64] + static_cast<std::uint32_t>(std::popcount(lower));
+    };
+    const std::uint32_t n = before[words];
+    slot.resize(n);
+    const ConcurrentSets sets(slot);
+    joinThroughInteriorFaces(mesh, corners, sets, inRange, rank);
+    std::atomic<std::size_t> roots{0};
+    forEachBlock(n, [&](std::uint32_t, std::uint32_t begin, std::uint32_t end) {
+      std::size_t own = 0;
+      for (std::uint32_t i = begin; i < end; ++i) own += sets.load(i) == i;
+      roots += own;
+    });
+    groups += roots;
+  }
+  return groups != withCorners;
+}
+
+PointGroups groupPoints(const PolyMesh& mesh, const ElementCorners& corners,
+                        std::uint32_t rangeCorners) {
+  const std::size_t numCorners = corners.vertices.size();
+  const std::size_t nv = mesh.numVertices();
+  // Corners and points are numbered in 31 bits: the top bit marks a root whose point is known.
+  constexpr std::uint32_t kKnown = 0x80000000u;
+  if (numCorners + nv >= kKnown)
+    throw std::length_error("groupPoints: more than 2^31 corners and vertices");
+  // With more corners than a range takes, whether any vertex splits is found range by range
+  // first: when none does (a mesh fresh from slicing), the points are the vertices.
+  if (numCorners > rangeCorners && !detail::anyVertexSplits(mesh, corners, rangeCorners)) {
+    PointGroups out;
+    out.pointVertex.resize(nv);
+    forEachBlock(static_cast<std::uint32_t>(nv),
+                 [&](std::uint32_t, std::uint32_t begin, std::uint32_t end) {
+                   for (std::uint32_t v = begin; v < end; ++v)
+                     out.pointVertex[v] = VertexId(std::size_t(v));
+                 });
+    return out;
+  }
+  const auto nc = static_cast<std::uint32_t>(numCorners);
+  auto vertexOf = [&](std::uint32_t corner) { return corners.vertices[corner].value; };
+
+  // The corners of each vertex joined through the interior faces that contain it, on all cores.
+  // A group's corners share one vertex, and its root is its first corner.
+  std::vector<std::uint32_t> slot(numCorners);
+  const ConcurrentSets sets(slot);
+  joinThroughInteriorFaces(
+      mesh, corners, sets, [](std::uint32_t) { return true; },
+      [](std::uint32_t corner) { return corner; });
   forEachBlock(nc, [&](std::uint32_t, std::uint32_t begin, std::uint32_t end) {
     for (std::uint32_t i = begin; i < end; ++i)
       sets.at(i).store(sets.find(i), std::memory_order_relaxed);

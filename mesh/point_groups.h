@@ -54,6 +54,9 @@ struct PointGroups {
   }
 };
 
+/// About a quarter of the corners of the bunny at 200 cells (13 million).
+inline constexpr std::uint32_t kGroupRangeCorners = 1u << 22;
+
 /// Groups the corners of each vertex: two elements' corners at vertex v are in one group when
 /// the elements are joined by a chain of interior faces (front and back both valid) that all
 /// contain v. Each group is one point: the group of v's first corner (in corner order) is v's
@@ -61,6 +64,21 @@ struct PointGroups {
 /// interior faces share points, while the two sides of a FaceOrigin::Cut face (boundary faces of
 /// both, on the same vertex ids), or elements touching only at a vertex or an edge, do not; a
 /// finite cut shares points only along its front. A vertex of no element keeps its own point.
-PointGroups groupPoints(const PolyMesh& mesh, const ElementCorners& corners);
+///
+/// A mesh of more than `rangeCorners` corners is first checked for vertices with several
+/// groups a range of vertices at a time, with a forest over at most about that many corners
+/// (4 bytes each) instead of one over all of them; the full grouping runs only if one splits.
+PointGroups groupPoints(const PolyMesh& mesh, const ElementCorners& corners,
+                        std::uint32_t rangeCorners = kGroupRangeCorners);
+
+namespace detail {
+/// Whether some vertex's corners fall into two groups or more (groupPoints()), found one range
+/// of vertices at a time (about `rangeCorners` corners each) in a forest over that range's
+/// corners alone, each at its rank among them (a bit per corner). A vertex's groups are those
+/// of its range's forest, which holds all of its corners; so the groups of all ranges are as
+/// many as the vertices with a corner exactly when no vertex splits.
+bool anyVertexSplits(const PolyMesh& mesh, const ElementCorners& corners,
+                     std::uint32_t rangeCorners);
+}  // namespace detail
 
 }  // namespace polydg

@@ -104,15 +104,57 @@ void expectConsistent(const PolyMesh& mesh, const ElementCorners& corners,
 }
 
 TEST(PointGroups, JoinedElementsShareEveryPoint) {
+  // Also when the corners are first checked a range of vertices at a time (ranges of 10
+  // corners or 40: 10 and 3 of them).
   const PolyMesh mesh = hexGridMesh(3, 2, 2, Box3(Vec3(0, 0, 0), Vec3(3, 2, 2)));
   const ElementCorners corners = cornersOf(mesh);
-  const PointGroups groups = groupPoints(mesh, corners);
-  expectConsistent(mesh, corners, groups);
-  EXPECT_EQ(groups.numPoints(), mesh.numVertices());
-  // Every corner's point is its vertex: nothing is stored per corner.
-  EXPECT_TRUE(groups.cornerPoint.empty());
-  for (std::size_t i = 0; i < corners.vertices.size(); ++i)
-    EXPECT_EQ(groups.point(corners, i), corners.vertices[i].value);
+  for (const std::uint32_t range : {kGroupRangeCorners, 40u, 10u}) {
+    SCOPED_TRACE(range);
+    const PointGroups groups = groupPoints(mesh, corners, range);
+    expectConsistent(mesh, corners, groups);
+    EXPECT_EQ(groups.numPoints(), mesh.numVertices());
+    // Every corner's point is its vertex: nothing is stored per corner.
+    EXPECT_TRUE(groups.cornerPoint.empty());
+    for (std::size_t i = 0; i < corners.vertices.size(); ++i)
+      EXPECT_EQ(groups.point(corners, i), corners.vertices[i].value);
+  }
+}
+
+TEST(PointGroups, RangesFindNoSplitWhereNoVertexSplits) {
+  // The check range by range says a vertex splits exactly when one does: on a block of cubes
+  // (none does, whatever the ranges) and with one cube touching it at a corner only.
+  const PolyMesh block = hexGridMesh(3, 2, 2, Box3(Vec3(0, 0, 0), Vec3(3, 2, 2)));
+  const ElementCorners blockCorners = cornersOf(block);
+  for (std::uint32_t range = 1; range <= blockCorners.vertices.size() + 1; ++range)
+    EXPECT_FALSE(detail::anyVertexSplits(block, blockCorners, range)) << "range " << range;
+  std::vector<CubeBuilder::Cell> cells{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {2, 2, 1}};
+  CubeBuilder builder;
+  const PolyMesh touching = builder.build(cells);
+  const ElementCorners touchingCorners = cornersOf(touching);
+  for (std::uint32_t range = 1; range <= touchingCorners.vertices.size() + 1; ++range)
+    EXPECT_TRUE(detail::anyVertexSplits(touching, touchingCorners, range)) << "range " << range;
+}
+
+TEST(PointGroups, OneSplitVertexIsFoundInWhicheverRangeItFalls) {
+  // A block of cubes, and one more cube touching its last corner only: that vertex has two
+  // points. Checked range by range (ranges of 8 corners up to all of them), the split is found
+  // wherever the vertex falls, and the grouping is the one without ranges.
+  std::vector<CubeBuilder::Cell> cells;
+  for (int x = 0; x < 3; ++x)
+    for (int y = 0; y < 3; ++y)
+      for (int z = 0; z < 2; ++z) cells.push_back({x, y, z});
+  cells.push_back({3, 3, 2});
+  CubeBuilder builder;
+  const PolyMesh mesh = builder.build(cells);
+  const ElementCorners corners = cornersOf(mesh);
+  const PointGroups whole = groupPoints(mesh, corners);
+  ASSERT_EQ(whole.numPoints(), mesh.numVertices() + 1);
+  for (std::uint32_t range = 8; range <= corners.vertices.size(); range += 8) {
+    SCOPED_TRACE(range);
+    const PointGroups groups = groupPoints(mesh, corners, range);
+    EXPECT_EQ(groups.pointVertex, whole.pointVertex);
+    EXPECT_EQ(groups.cornerPoint, whole.cornerPoint);
+  }
 }
 
 TEST(PointGroups, TheTwoSidesOfACutGetTheirOwnPoints) {
@@ -236,13 +278,16 @@ TEST(PointGroups, AsDocumentedOnCubesWithRandomCutsAndGaps) {
     CubeBuilder builder(cuts);
     const PolyMesh mesh = builder.build(cells);
     const ElementCorners corners = cornersOf(mesh);
-    const PointGroups groups = groupPoints(mesh, corners);
-    expectConsistent(mesh, corners, groups);
     const PointGroups reference = referenceGroups(mesh, corners);
     EXPECT_GT(reference.numPoints(), mesh.numVertices() + 10);
-    EXPECT_EQ(groups.pointVertex, reference.pointVertex) << "round " << round;
-    ASSERT_EQ(groups.cornerPoint.size(), reference.cornerPoint.size()) << "round " << round;
-    EXPECT_EQ(groups.cornerPoint, reference.cornerPoint) << "round " << round;
+    // Also checked a range of vertices at a time first, in ranges of 100 corners.
+    for (const std::uint32_t range : {kGroupRangeCorners, 100u}) {
+      const PointGroups groups = groupPoints(mesh, corners, range);
+      expectConsistent(mesh, corners, groups);
+      EXPECT_EQ(groups.pointVertex, reference.pointVertex) << "round " << round;
+      ASSERT_EQ(groups.cornerPoint.size(), reference.cornerPoint.size()) << "round " << round;
+      EXPECT_EQ(groups.cornerPoint, reference.cornerPoint) << "round " << round;
+    }
   }
 }
 
