@@ -224,8 +224,8 @@ CellStreams::CellStreams(const PolyMesh& mesh, std::span<const char> boxes)
   for (std::size_t c = 0; c < order_.size(); ++c)
     cornerCount[c] = cellCount(corners_.of(order_[c]).size());
   connectivityEnd_ = RunningEnds(std::move(cornerCount));
-  recordEnd_ = RunningEnds(inCellOrder(recordCount));
-  faceEnd_ = RunningEnds(inCellOrder(streamCount));
+  recordEnd_ = RunningEnds(inCellOrder(std::move(recordCount)));
+  faceEnd_ = RunningEnds(inCellOrder(std::move(streamCount)));
   for (std::size_t i = 0; i < corners_.vertices.size(); ++i)
     largest_.point = std::max<std::int64_t>(largest_.point, points_.point(corners_, i));
   for (const Face& face : mesh.faces())
@@ -314,11 +314,26 @@ void CellStreams::findCorners(std::span<const char> boxes, std::vector<std::uint
       });
 }
 
-std::vector<std::uint32_t> CellStreams::inCellOrder(
-    const std::vector<std::uint32_t>& perElement) const {
-  std::vector<std::uint32_t> perCell(order_.size());
-  for (std::size_t c = 0; c < order_.size(); ++c) perCell[c] = perElement[order_[c].index()];
-  return perCell;
+std::vector<std::uint32_t> CellStreams::inCellOrder(std::vector<std::uint32_t> perElement) const {
+  // Cell c takes element order_[c]'s value: along each cycle c -> order_[c] -> ..., every entry
+  // takes its successor's, the last the first's.
+  std::vector<bool> done(order_.size(), false);
+  for (std::size_t start = 0; start < order_.size(); ++start) {
+    if (done[start]) continue;
+    const std::uint32_t first = perElement[start];
+    std::size_t c = start;
+    while (true) {
+      done[c] = true;
+      const std::size_t next = order_[c].index();
+      if (next == start) {
+        perElement[c] = first;
+        break;
+      }
+      perElement[c] = perElement[next];
+      c = next;
+    }
+  }
+  return perElement;
 }
 
 GeneratedInts CellStreams::connectivity() const {
