@@ -13,8 +13,19 @@ Vec3 areaVector(const PolyMesh& mesh, FaceId f) {
   const Vec3& c = faceReferencePoint(mesh, f);
   Vec3 twiceArea = Vec3::Zero();
   // Each corner's offset is taken once and serves the two edges it ends; the sum runs over the
-  // edges in loop order, closing edge last.
-  for (std::size_t k = 0; k < face.numLoops(); ++k) {
+  // edges in loop order, closing edge last. The outer loop starts at c: its first corner's
+  // offset is zero, and the two products with it (first and closing edge) are zeros, which the
+  // sum (+0 so far, and never -0) does not change: they are skipped.
+  const auto outer = face.numLoops() > 0 ? face.loop(0) : std::span<const VertexId>();
+  if (outer.size() > 1) {
+    Vec3 a = mesh.position(outer[1]) - c;
+    for (std::size_t i = 2; i < outer.size(); ++i) {
+      const Vec3 b = mesh.position(outer[i]) - c;
+      twiceArea += a.cross(b);
+      a = b;
+    }
+  }
+  for (std::size_t k = 1; k < face.numLoops(); ++k) {
     const auto loop = face.loop(k);
     if (loop.empty()) continue;
     const Vec3 first = mesh.position(loop[0]) - c;
