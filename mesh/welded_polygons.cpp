@@ -14,9 +14,12 @@ namespace polydg {
 std::vector<std::uint32_t> weldTargets(const std::vector<Vec3>& points,
                                        const std::vector<std::uint32_t>& used, double resolution) {
   using Cell = std::array<std::int64_t, 3>;
-  const double cellSize = 64.0 * resolution;
+  // A point's cell by multiplying with the cell's inverse: the cell index only has to grow
+  // with the coordinate for every pair within the resolution to be found, each once.
+  const double cellSize = kWeldCellResolutions * resolution;
+  const double perCell = cellSize > 0 ? 1.0 / cellSize : 0.0;
   auto cellIndex = [&](double x) {
-    return cellSize > 0 ? static_cast<std::int64_t>(std::floor(x / cellSize + 0.5)) : 0;
+    return static_cast<std::int64_t>(std::floor(x * perCell + 0.5));
   };
   auto cellOf = [&](const Vec3& p) {
     return Cell{cellIndex(p.x()), cellIndex(p.y()), cellIndex(p.z())};
@@ -33,24 +36,22 @@ std::vector<std::uint32_t> weldTargets(const std::vector<Vec3>& points,
     sorted[i] = {key(cellOf(points[used[i]])), static_cast<std::uint32_t>(i)};
   });
   tbb::parallel_sort(sorted.begin(), sorted.end());
-  std::vector<std::uint32_t> position(used.size());
-  tbb::parallel_for(std::size_t(0), used.size(), [&](std::size_t s) {
-    position[sorted[s].second] = static_cast<std::uint32_t>(s);
-  });
+  // The points in that order: a point and the earlier ones of its run are read in sequence.
+  std::vector<Vec3> inOrder(used.size());
+  tbb::parallel_for(std::size_t(0), used.size(),
+                    [&](std::size_t s) { inOrder[s] = points[used[sorted[s].second]]; });
   tbb::concurrent_vector<std::pair<std::uint32_t, std::uint32_t>> near;  // (later, earlier)
-  auto nearPoint = [&](std::size_t i, std::uint32_t j) {
-    if ((points[used[j]] - points[used[i]]).cwiseAbs().maxCoeff() <= resolution)
-      near.push_back({static_cast<std::uint32_t>(i), j});
+  auto nearPoint = [&](std::uint32_t i, const Vec3& p, std::uint32_t j, const Vec3& q) {
+    if ((q - p).cwiseAbs().maxCoeff() <= resolution) near.push_back({i, j});
   };
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, used.size(), 4096),
                     [&](const tbb::blocked_range<std::size_t>& r) {
-                      for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                        const Vec3& p = points[used[i]];
-                        const std::size_t at = position[i];
-                        const std::uint64_t own = sorted[at].first;
+                      for (std::size_t at = r.begin(); at != r.end(); ++at) {
+                        const auto [own, i] = sorted[at];
+                        const Vec3& p = inOrder[at];
                         // Earlier points of the own cell: just before i in the sorted order.
                         for (std::size_t s = at; s > 0 && sorted[s - 1].first == own; --s)
-                          nearPoint(i, sorted[s - 1].second);
+                          nearPoint(i, p, sorted[s - 1].second, inOrder[s - 1]);
                         const Cell centre = cellOf(p);
                         Cell lo, hi;
                         for (int a = 0; a < 3; ++a) {
@@ -71,7 +72,8 @@ std::vector<std::uint32_t> weldTargets(const std::vector<Vec3>& points,
                               auto it = std::lower_bound(sorted.begin(), sorted.end(),
                                                          std::make_pair(k, 0u));
                               for (; it != sorted.end() && it->first == k && it->second < i; ++it)
-                                nearPoint(i, it->second);
+                                nearPoint(i, p, it->second,
+                                          inOrder[static_cast<std::size_t>(it - sorted.begin())]);
                             }
                       }
                     });

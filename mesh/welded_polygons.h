@@ -17,14 +17,18 @@
 
 namespace polydg {
 
+/// The side of weldTargets' cells, in resolutions: a point is within the resolution of another
+/// cell about 1 time in 700. (Which pairs are found does not depend on it.)
+inline constexpr double kWeldCellResolutions = 4096.0;
+
 /// For used point i (in order of first use: points[used[i]]), the earliest kept point within
 /// `resolution` (in every coordinate) before it, or i itself if there is none: i is then kept.
-/// Points are bucketed in cells 64 times the resolution, offset by half a cell so that grid
-/// planes (at dyadic multiples of the resolution) run through cell centres, and sorted by a
-/// hash of their cell. A point's search box meets its own cell, whose earlier points sit just
-/// before it in that order, and only rarely (when it lies within the resolution of a cell side)
-/// a neighbouring cell, found by binary search. The search runs in parallel, the rare welds are
-/// resolved in order.
+/// Points are bucketed in cells kWeldCellResolutions times the resolution, offset by half a
+/// cell so that grid planes (at dyadic multiples of the resolution) run through cell centres,
+/// and sorted by a hash of their cell. A point's search box meets its own cell, whose earlier
+/// points sit just before it in that order, and only rarely (when it lies within the
+/// resolution of a cell side) a neighbouring cell, found by binary search. The search runs in
+/// parallel, the rare welds are resolved in order.
 std::vector<std::uint32_t> weldTargets(const std::vector<Vec3>& points,
                                        const std::vector<std::uint32_t>& used, double resolution);
 

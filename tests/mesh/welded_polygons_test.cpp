@@ -32,10 +32,10 @@ std::vector<std::uint32_t> weldTargetsByAllPairs(const std::vector<Vec3>& points
 }
 
 TEST(WeldTargets, EarliestKeptPointWithinTheResolutionAcrossBucketSides) {
-  // Buckets are 64 resolutions wide, their sides at odd multiples of 32 resolutions: the
+  // Buckets are kWeldCellResolutions wide, their sides at odd multiples of half that: the
   // clusters sit on those sides, so a point and the one it welds into often fall in
   // different buckets, and on an exact multiple of the resolution apart.
-  const double resolution = 0.001, side = 32 * resolution;
+  const double resolution = 0.001, side = kWeldCellResolutions / 2 * resolution;
   std::mt19937 random(7);
   std::uniform_int_distribution<int> bucket(-20, 20), pick(0, 3);
   std::uniform_real_distribution<double> offset(-1.5 * resolution, 1.5 * resolution);
