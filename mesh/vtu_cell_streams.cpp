@@ -315,25 +315,11 @@ void CellStreams::findCorners(std::span<const char> boxes, std::vector<std::uint
 }
 
 std::vector<std::uint32_t> CellStreams::inCellOrder(std::vector<std::uint32_t> perElement) const {
-  // Cell c takes element order_[c]'s value: along each cycle c -> order_[c] -> ..., every entry
-  // takes its successor's, the last the first's.
-  std::vector<bool> done(order_.size(), false);
-  for (std::size_t start = 0; start < order_.size(); ++start) {
-    if (done[start]) continue;
-    const std::uint32_t first = perElement[start];
-    std::size_t c = start;
-    while (true) {
-      done[c] = true;
-      const std::size_t next = order_[c].index();
-      if (next == start) {
-        perElement[c] = first;
-        break;
-      }
-      perElement[c] = perElement[next];
-      c = next;
-    }
-  }
-  return perElement;
+  // A gather, whose reads are independent: following the order's cycles in place instead made
+  // each read wait for the one before (0.3 s more for the bunny at 200 cells).
+  std::vector<std::uint32_t> perCell(order_.size());
+  for (std::size_t c = 0; c < order_.size(); ++c) perCell[c] = perElement[order_[c].index()];
+  return perCell;
 }
 
 GeneratedInts CellStreams::connectivity() const {

@@ -118,8 +118,8 @@ class CellStreams {
   /// records and `faces` values (in element order) and finds the largest values of its records.
   void findCorners(std::span<const char> boxes, std::vector<std::uint32_t>& recordCount,
                    std::vector<std::uint32_t>& streamCount);
-  /// Counts per element as counts per cell, in their own storage (following the cycles of the
-  /// cell order): a second array per element would be held at the writer's largest.
+  /// Counts per element as counts per cell; the counts per element (taken) are freed on return,
+  /// before the next such array is made, as the writer holds the most then.
   std::vector<std::uint32_t> inCellOrder(std::vector<std::uint32_t> perElement) const;
   /// One value per face record, value(use) for each record of the face use `use`.
   template <class Value>
