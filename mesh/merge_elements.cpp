@@ -74,8 +74,8 @@ class ElementSets {
 
   /// `listed`: distinct elements of a mesh of n.
   ElementSets(std::size_t n, std::vector<std::uint32_t> listed)
-      : element_(std::move(listed)), listed_(element_.size()), slot_(n, kNone), sets_(listed_) {
-    for (std::uint32_t s = 0; s < listed_; ++s) slot_[element_[s]] = s;
+      : element_(std::move(listed)), slot_(n, kNone), sets_(element_.size()) {
+    for (std::uint32_t s = 0; s < element_.size(); ++s) slot_[element_[s]] = s;
   }
 
   std::size_t slots() const { return element_.size(); }
@@ -125,10 +125,23 @@ class ElementSets {
 
  private:
   std::vector<std::uint32_t> element_;  ///< per slot: the listed elements, then those taken
-  std::size_t listed_;
-  std::vector<std::uint32_t> slot_;  ///< per element: its slot, or kNone
-  UnionFind sets_;                   ///< over slots
+  std::vector<std::uint32_t> slot_;     ///< per element: its slot, or kNone
+  UnionFind sets_;                      ///< over slots
 };
+
+/// Adds to shared[h] the area of the interior faces between group g (its `members`) and each
+/// other group h.
+void addSharedAreas(const PolyMesh& mesh, ElementSets& sets, std::uint32_t g,
+                    const std::vector<std::uint32_t>& members,
+                    std::map<std::uint32_t, double>& shared) {
+  for (std::uint32_t m : members)
+    for (const FaceUse& use : mesh.element(ElementId(m)).faces) {
+      const Face& face = mesh.face(use.face);
+      if (!face.front.valid() || !face.back.valid()) continue;
+      const std::uint32_t other = sets.find((use.reversed ? face.front : face.back).value);
+      if (other != g) shared[other] += areaVector(mesh, use.face).norm();
+    }
+}
 
 /// Groups of elements merged by mergeSlivers(): a group's volume and area are kept at its
 /// representative's slot. NaN marks a whole cell no sliver has joined yet, measured when one
@@ -152,13 +165,7 @@ class SliverGroups {
   double volume(std::uint32_t g) { return measured(g).first; }
   double area(std::uint32_t g) { return measured(g).second; }
   void sharedAreas(std::uint32_t g, std::map<std::uint32_t, double>& shared) {
-    for (std::uint32_t m : membersAt(slotOf(g)))
-      for (const FaceUse& use : mesh_.element(ElementId(m)).faces) {
-        const Face& face = mesh_.face(use.face);
-        if (!face.front.valid() || !face.back.valid()) continue;
-        const std::uint32_t other = sets_.find((use.reversed ? face.front : face.back).value);
-        if (other != g) shared[other] += areaVector(mesh_, use.face).norm();
-      }
+    addSharedAreas(mesh_, sets_, g, membersAt(slotOf(g)), shared);
   }
   std::uint32_t merge(std::uint32_t g, std::uint32_t target, double sharedArea) {
     measured(target);
@@ -258,13 +265,7 @@ class DegenerateGroups {
     std::map<std::uint32_t, double> shared;
     while (!(volume(g) > 0.0)) {
       shared.clear();
-      for (std::uint32_t m : members_[sets_.slot(g)])
-        for (const FaceUse& use : mesh_.element(ElementId(m)).faces) {
-          const Face& face = mesh_.face(use.face);
-          if (!face.front.valid() || !face.back.valid()) continue;
-          const std::uint32_t other = sets_.find((use.reversed ? face.front : face.back).value);
-          if (other != g) shared[other] += areaVector(mesh_, use.face).norm();
-        }
+      addSharedAreas(mesh_, sets_, g, members_[sets_.slot(g)], shared);
       if (shared.empty()) return false;
       const auto best = std::max_element(shared.begin(), shared.end(),
                                          [](auto& a, auto& b) { return a.second < b.second; });

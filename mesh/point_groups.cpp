@@ -61,6 +61,15 @@ void forEachBlock(std::uint32_t n, F&& f) {
                     [&](std::uint32_t b) { f(b, b * kBlock, std::min(n, (b + 1) * kBlock)); });
 }
 
+/// Point p is vertex p, for every entry of `pointVertex`; on all cores.
+void numberAsVertices(std::vector<VertexId>& pointVertex) {
+  forEachBlock(static_cast<std::uint32_t>(pointVertex.size()),
+               [&](std::uint32_t, std::uint32_t begin, std::uint32_t end) {
+                 for (std::uint32_t v = begin; v < end; ++v)
+                   pointVertex[v] = VertexId(std::size_t(v));
+               });
+}
+
 /// Starts `sets` (over its parent array, all of whose entries are set here) with each entry a
 /// set of its own, then joins the corners of each vertex v that `take(v)` accepts where an
 /// interior face at v joins two elements, corner c at entry `entry(c)`; on all cores.
@@ -169,11 +178,7 @@ PointGroups groupPoints(const PolyMesh& mesh, const ElementCorners& corners,
   if (numCorners > rangeCorners && !detail::anyVertexSplits(mesh, corners, rangeCorners)) {
     PointGroups out;
     out.pointVertex.resize(nv);
-    forEachBlock(static_cast<std::uint32_t>(nv),
-                 [&](std::uint32_t, std::uint32_t begin, std::uint32_t end) {
-                   for (std::uint32_t v = begin; v < end; ++v)
-                     out.pointVertex[v] = VertexId(std::size_t(v));
-                 });
+    numberAsVertices(out.pointVertex);
     return out;
   }
   const auto nc = static_cast<std::uint32_t>(numCorners);
@@ -230,11 +235,7 @@ PointGroups groupPoints(const PolyMesh& mesh, const ElementCorners& corners,
       sets.at(i).store(point | kKnown, std::memory_order_relaxed);
     }
   });
-  forEachBlock(static_cast<std::uint32_t>(nv),
-               [&](std::uint32_t, std::uint32_t begin, std::uint32_t end) {
-                 for (std::uint32_t v = begin; v < end; ++v)
-                   out.pointVertex[v] = VertexId(std::size_t(v));
-               });
+  numberAsVertices(out.pointVertex);
   // Without a second point for any vertex, every corner's point is its vertex: no list needed.
   if (added == 0) return out;
   out.pointVertex.insert(out.pointVertex.end(), newPoints.begin(), newPoints.end());
