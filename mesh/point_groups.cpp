@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <atomic>
 #include <bit>
+#include <limits>
 #include <stdexcept>
+#include <string>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -81,38 +83,82 @@ void joinThroughInteriorFaces(const PolyMesh& mesh, const ElementCorners& corner
   });
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.numFaces(), 4096),
                     [&](const tbb::blocked_range<std::size_t>& r) {
+                      // Both sides' corners, read once for all the face's vertices and kept
+                      // while the next faces have the same sides (as a cell's new sides do).
+                      ElementCorners::BoxRoom frontRoom, backRoom;
+                      ElementId frontOf, backOf;
+                      std::span<const VertexId> front, back;
                       for (std::size_t f = r.begin(); f != r.end(); ++f) {
                         const Face& face = mesh.face(FaceId(f));
                         if (!face.front.valid() || !face.back.valid()) continue;
+                        if (std::none_of(face.vertices.begin(), face.vertices.end(),
+                                         [&](VertexId v) { return take(v.value); }))
+                          continue;
+                        if (face.front != frontOf) {
+                          frontOf = face.front;
+                          front = corners.view(frontOf, frontRoom);
+                        }
+                        if (face.back != backOf) {
+                          backOf = face.back;
+                          back = corners.view(backOf, backRoom);
+                        }
                         for (VertexId v : face.vertices)
                           if (take(v.value))
-                            sets.unite(entry(corners.find(face.front, v)),
-                                       entry(corners.find(face.back, v)));
+                            sets.unite(entry(corners.find(face.front, front, v)),
+                                       entry(corners.find(face.back, back, v)));
                       }
                     });
 }
 
 }  // namespace
 
+ElementCorners::ElementCorners(std::vector<std::uint32_t> begin, std::vector<VertexId> vertices)
+    : begin_(std::move(begin)), stored_(std::move(vertices)) {}
+
+ElementCorners::ElementCorners(const PolyMesh& mesh, std::vector<std::uint32_t> count,
+                               const std::vector<char>& box)
+    : mesh_(&mesh), begin_(std::move(count)) {
+  const std::size_t ne = box.size();
+  if (begin_.size() != ne + 1 || begin_[0] != 0)
+    throw std::logic_error("ElementCorners: " + std::to_string(begin_.size()) + " counts for " +
+                           std::to_string(ne) + " elements");
+  box_.assign((ne + 63) / 64, 0);
+  boxesBefore_.assign(box_.size(), 0);
+  std::size_t boxes = 0;
+  for (std::size_t w = 0; w < box_.size(); ++w) {
+    boxesBefore_[w] = static_cast<std::uint32_t>(boxes);
+    for (std::size_t e = 64 * w; e < std::min(ne, 64 * w + 64); ++e)
+      if (box[e]) {
+        if (begin_[e + 1] != kBoxCorners)
+          throw std::logic_error("ElementCorners: a box with " + std::to_string(begin_[e + 1]) +
+                                 " corners");
+        box_[w] |= std::uint64_t(1) << (e % 64);
+        ++boxes;
+      }
+  }
+  // Counts to running ends, in place: begin_[e] is then element e's first corner.
+  std::uint64_t total = 0;
+  for (std::uint32_t& c : begin_) {
+    total += c;
+    if (total > std::numeric_limits<std::uint32_t>::max())
+      throw std::length_error("writeVtu: the cells have more than 2^32 - 1 corners in all");
+    c = static_cast<std::uint32_t>(total);
+  }
+  stored_.resize(total - kBoxCorners * boxes);
+}
+
+std::size_t ElementCorners::elementOf(std::uint32_t i) const {
+  return static_cast<std::size_t>(std::upper_bound(begin_.begin(), begin_.end(), i) -
+                                  begin_.begin()) -
+         1;
+}
+
 // The forest over all corners would be the largest array while a mesh of millions of elements
 // is written (53 MB for the bunny at 200 cells).
 bool detail::anyVertexSplits(const PolyMesh& mesh, const ElementCorners& corners,
                              std::uint32_t rangeCorners) {
-  const auto nc = static_cast<std::uint32_t>(corners.vertices.size());
+  const auto nc = static_cast<std::uint32_t>(corners.size());
   const std::size_t nv = mesh.numVertices();
-  auto vertexOf = [&](std::uint32_t corner) { return corners.vertices[corner].value; };
-  // The vertices that have a corner, a bit each.
-  std::vector<std::uint64_t> hasCorner((nv + 63) / 64, 0);
-  forEachBlock(nc, [&](std::uint32_t, std::uint32_t begin, std::uint32_t end) {
-    for (std::uint32_t i = begin; i < end; ++i) {
-      const std::uint32_t v = vertexOf(i);
-      std::atomic_ref<std::uint64_t>(hasCorner[v / 64])
-          .fetch_or(std::uint64_t(1) << (v % 64), std::memory_order_relaxed);
-    }
-  });
-  std::size_t withCorners = 0;
-  for (const std::uint64_t word : hasCorner) withCorners += std::popcount(word);
-
   const std::size_t ranges = std::max<std::size_t>(1, (nc + rangeCorners - 1) / rangeCorners);
   const std::uint32_t words = (nc + 63) / 64;
   std::vector<std::uint64_t> in(words);          // corner i is in the range: bit i % 64
@@ -120,14 +166,21 @@ bool detail::anyVertexSplits(const PolyMesh& mesh, const ElementCorners& corners
   // Range r holds the vertices first[r] .. first[r + 1] - 1.
   std::vector<std::uint32_t> first(ranges + 1);
   for (std::size_t r = 0; r <= ranges; ++r) first[r] = static_cast<std::uint32_t>(nv * r / ranges);
-  // Room for the largest range's forest, made once.
+  // In one pass: the vertices that have a corner, a bit each, and the corners of each range
+  // (room for the largest range's forest is made once).
+  std::vector<std::uint64_t> hasCorner((nv + 63) / 64, 0);
   std::vector<std::atomic<std::size_t>> cornersIn(ranges);
   forEachBlock(nc, [&](std::uint32_t, std::uint32_t begin, std::uint32_t end) {
     std::vector<std::size_t> own(ranges, 0);
-    for (std::uint32_t i = begin; i < end; ++i)
-      ++own[std::upper_bound(first.begin() + 1, first.end() - 1, vertexOf(i)) - first.begin() - 1];
+    corners.forEachIn(begin, end, [&](std::uint32_t, VertexId v) {
+      std::atomic_ref<std::uint64_t>(hasCorner[v.index() / 64])
+          .fetch_or(std::uint64_t(1) << (v.index() % 64), std::memory_order_relaxed);
+      ++own[std::upper_bound(first.begin() + 1, first.end() - 1, v.value) - first.begin() - 1];
+    });
     for (std::size_t r = 0; r < ranges; ++r) cornersIn[r] += own[r];
   });
+  std::size_t withCorners = 0;
+  for (const std::uint64_t word : hasCorner) withCorners += std::popcount(word);
   std::size_t largest = 0;
   for (const std::atomic<std::size_t>& n : cornersIn) largest = std::max(largest, n.load());
   std::vector<std::uint32_t> slot;
@@ -136,13 +189,12 @@ bool detail::anyVertexSplits(const PolyMesh& mesh, const ElementCorners& corners
   for (std::size_t r = 0; r < ranges; ++r) {
     auto inRange = [&](std::uint32_t v) { return v >= first[r] && v < first[r + 1]; };
     forEachBlock(words, [&](std::uint32_t, std::uint32_t begin, std::uint32_t end) {
-      for (std::uint32_t w = begin; w < end; ++w) {
-        std::uint64_t bits = 0;
-        for (std::uint32_t i = w * 64; i < std::min(nc, w * 64 + 64); ++i)
-          bits |= std::uint64_t(inRange(vertexOf(i))) << (i % 64);
-        in[w] = bits;
-        before[w + 1] = static_cast<std::uint32_t>(std::popcount(bits));
-      }
+      std::fill(in.begin() + begin, in.begin() + end, 0);
+      corners.forEachIn(begin * 64, std::min(nc, end * 64), [&](std::uint32_t i, VertexId v) {
+        in[i / 64] |= std::uint64_t(inRange(v.value)) << (i % 64);
+      });
+      for (std::uint32_t w = begin; w < end; ++w)
+        before[w + 1] = static_cast<std::uint32_t>(std::popcount(in[w]));
     });
     before[0] = 0;
     for (std::uint32_t w = 0; w < words; ++w) before[w + 1] += before[w];
@@ -167,7 +219,7 @@ bool detail::anyVertexSplits(const PolyMesh& mesh, const ElementCorners& corners
 
 PointGroups groupPoints(const PolyMesh& mesh, const ElementCorners& corners,
                         std::uint32_t rangeCorners) {
-  const std::size_t numCorners = corners.vertices.size();
+  const std::size_t numCorners = corners.size();
   const std::size_t nv = mesh.numVertices();
   // Corners and points are numbered in 31 bits: the top bit marks a root whose point is known.
   constexpr std::uint32_t kKnown = 0x80000000u;
@@ -182,7 +234,6 @@ PointGroups groupPoints(const PolyMesh& mesh, const ElementCorners& corners,
     return out;
   }
   const auto nc = static_cast<std::uint32_t>(numCorners);
-  auto vertexOf = [&](std::uint32_t corner) { return corners.vertices[corner].value; };
 
   // The corners of each vertex joined through the interior faces that contain it, on all cores.
   // A group's corners share one vertex, and its root is its first corner.
@@ -205,35 +256,36 @@ PointGroups groupPoints(const PolyMesh& mesh, const ElementCorners& corners,
     return std::atomic_ref<std::uint32_t>(out.pointVertex[v].value);
   };
   forEachBlock(nc, [&](std::uint32_t, std::uint32_t begin, std::uint32_t end) {
-    for (std::uint32_t i = begin; i < end; ++i) {
-      std::atomic_ref<std::uint32_t> first = firstOf(vertexOf(i));
+    corners.forEachIn(begin, end, [&](std::uint32_t i, VertexId v) {
+      std::atomic_ref<std::uint32_t> first = firstOf(v.value);
       std::uint32_t seen = first.load(std::memory_order_relaxed);
       while (i < seen && !first.compare_exchange_weak(seen, i, std::memory_order_relaxed)) {
       }
-    }
+    });
   });
-  auto isNewPoint = [&](std::uint32_t i) {
-    return slot[i] == i && firstOf(vertexOf(i)).load(std::memory_order_relaxed) != i;
+  auto isNewPoint = [&](std::uint32_t i, VertexId v) {
+    return slot[i] == i && firstOf(v.value).load(std::memory_order_relaxed) != i;
   };
   const std::uint32_t blocks = (nc + kBlock - 1) / kBlock;
   std::vector<std::uint32_t> newBefore(std::size_t(blocks) + 1, 0);  // per block, then summed
   forEachBlock(nc, [&](std::uint32_t b, std::uint32_t begin, std::uint32_t end) {
-    for (std::uint32_t i = begin; i < end; ++i) newBefore[b + 1] += isNewPoint(i);
+    corners.forEachIn(begin, end,
+                      [&](std::uint32_t i, VertexId v) { newBefore[b + 1] += isNewPoint(i, v); });
   });
   for (std::uint32_t b = 0; b < blocks; ++b) newBefore[b + 1] += newBefore[b];
   const std::uint32_t added = newBefore[blocks];
   std::vector<VertexId> newPoints(added);
   forEachBlock(nc, [&](std::uint32_t b, std::uint32_t begin, std::uint32_t end) {
     std::uint32_t next = newBefore[b];
-    for (std::uint32_t i = begin; i < end; ++i) {
-      if (slot[i] != i) continue;
-      std::uint32_t point = vertexOf(i);
-      if (isNewPoint(i)) {
-        newPoints[next] = VertexId(std::size_t(vertexOf(i)));
+    corners.forEachIn(begin, end, [&](std::uint32_t i, VertexId v) {
+      if (slot[i] != i) return;
+      std::uint32_t point = v.value;
+      if (isNewPoint(i, v)) {
+        newPoints[next] = v;
         point = static_cast<std::uint32_t>(nv + next++);
       }
       sets.at(i).store(point | kKnown, std::memory_order_relaxed);
-    }
+    });
   });
   numberAsVertices(out.pointVertex);
   // Without a second point for any vertex, every corner's point is its vertex: no list needed.

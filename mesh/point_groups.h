@@ -4,6 +4,8 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
+#include <bit>
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -13,24 +15,98 @@
 
 namespace polydg {
 
-/// Each element's distinct vertices (its corners), flattened: element e's corners are
-/// vertices[begin[e] .. begin[e+1]), in an order the caller chooses (the VTU writer: order of
-/// first use by the element's face records). Entry i of `vertices` is corner i.
-struct ElementCorners {
-  /// numElements() + 1 entries, begin[0] = 0; 32 bits, as the corners' numbers are (below 2^31,
-  /// see groupPoints()): 7 MB less for the bunny at 200 cells, where writing peaks.
-  std::vector<std::uint32_t> begin;
-  std::vector<VertexId> vertices;
+/// Each element's distinct vertices (its corners), numbered in one sequence: element e's are
+/// corners first(e) .. first(e) + count(e) - 1, in an order the caller chooses (the VTU writer:
+/// order of first use by the element's face records). They are stored, except for the elements
+/// taken as boxes: grid cells whose first two faces are disjoint single loops of four, their
+/// corners those loops' vertices in turn, read from the mesh when asked for (1.53 million of the
+/// 1.65 million elements of the bunny at 200 cells, whose 49 MB of corners the writer then does
+/// not hold).
+class ElementCorners {
+ public:
+  ElementCorners() = default;
+  /// Every element's corners stored: element e's are vertices[begin[e] .. begin[e + 1]), where
+  /// begin has numElements() + 1 entries, begin[0] = 0.
+  ElementCorners(std::vector<std::uint32_t> begin, std::vector<VertexId> vertices);
+  /// Per element e of `mesh`, its corner count count[e + 1] (count[0] is 0; the storage of
+  /// `count` becomes the corners' numbering) and whether it is taken as a box (box[e] != 0; its
+  /// count must then be 8, its first two faces as above). Room is made for the other elements'
+  /// corners, which the caller then writes through stored(). Keeps a reference to `mesh`, which
+  /// must outlive it. std::length_error beyond 2^32 - 1 corners in all.
+  ElementCorners(const PolyMesh& mesh, std::vector<std::uint32_t> count,
+                 const std::vector<char>& box);
 
-  std::span<const VertexId> of(ElementId e) const {
-    return {vertices.data() + begin[e.index()], begin[e.index() + 1] - begin[e.index()]};
+  std::size_t numElements() const { return begin_.empty() ? 0 : begin_.size() - 1; }
+  /// The corners of all elements.
+  std::size_t size() const { return begin_.empty() ? 0 : begin_.back(); }
+  std::uint32_t first(ElementId e) const { return begin_[e.index()]; }
+  std::uint32_t count(ElementId e) const { return begin_[e.index() + 1] - begin_[e.index()]; }
+  bool isBox(ElementId e) const {
+    return !box_.empty() && (box_[e.index() / 64] >> (e.index() % 64) & 1);
+  }
+
+  /// Room for a box's corners, which view() copies there.
+  using BoxRoom = std::array<VertexId, 8>;
+  /// Element e's corners in order: where they are stored, or a box's copied into `room`.
+  std::span<const VertexId> view(ElementId e, BoxRoom& room) const {
+    if (!isBox(e)) return {stored_.data() + storedBegin(e), count(e)};
+    const FaceList& faces = mesh_->element(e).faces;
+    for (std::size_t s = 0; s < 2; ++s) {
+      const auto& side = mesh_->face(faces[s].face).vertices;
+      std::copy(side.begin(), side.end(), room.begin() + 4 * s);
+    }
+    return room;
+  }
+  /// Calls f(VertexId) for element e's corners in order.
+  template <class F>
+  void forEach(ElementId e, F&& f) const {
+    BoxRoom room;
+    for (VertexId v : view(e, room)) f(v);
+  }
+  /// Calls f(i, VertexId) for corners i = begin .. end - 1 in order, element by element.
+  template <class F>
+  void forEachIn(std::uint32_t begin, std::uint32_t end, F&& f) const {
+    if (begin >= end) return;
+    std::size_t e = elementOf(begin);
+    std::uint32_t i = begin_[e];
+    for (; i < end; ++e)
+      forEach(ElementId(e), [&](VertexId v) {
+        if (i >= begin && i < end) f(i, v);
+        ++i;
+      });
   }
   /// The corner of vertex v in element e (v must be one of e's vertices).
   std::uint32_t find(ElementId e, VertexId v) const {
-    const auto vs = of(e);
-    return static_cast<std::uint32_t>(begin[e.index()] +
-                                      (std::find(vs.begin(), vs.end(), v) - vs.begin()));
+    BoxRoom room;
+    return find(e, view(e, room), v);
   }
+  /// The corner of vertex v in element e, whose corners `view` is (as view() gives them).
+  std::uint32_t find(ElementId e, std::span<const VertexId> view, VertexId v) const {
+    return first(e) +
+           static_cast<std::uint32_t>(std::find(view.begin(), view.end(), v) - view.begin());
+  }
+  /// The room for element e's corners, which is not a box.
+  std::span<VertexId> stored(ElementId e) { return {stored_.data() + storedBegin(e), count(e)}; }
+
+ private:
+  /// The element that holds corner i (< size()).
+  std::size_t elementOf(std::uint32_t i) const;
+  /// The position in stored_ of element e's corners: its first corner less the boxes' before.
+  std::size_t storedBegin(ElementId e) const {
+    if (box_.empty()) return begin_[e.index()];
+    const std::size_t w = e.index() / 64;
+    const std::uint64_t lower = box_[w] & ((std::uint64_t(1) << (e.index() % 64)) - 1);
+    return begin_[e.index()] - kBoxCorners * (boxesBefore_[w] + std::popcount(lower));
+  }
+
+  static constexpr std::size_t kBoxCorners = 8;
+  const PolyMesh* mesh_ = nullptr;
+  /// numElements() + 1 entries, begin_[0] = 0; 32 bits, as the corners' numbers are (below
+  /// 2^31, see groupPoints()).
+  std::vector<std::uint32_t> begin_;
+  std::vector<std::uint64_t> box_;          ///< element e is a box: bit e % 64 of word e / 64
+  std::vector<std::uint32_t> boxesBefore_;  ///< per word of box_, the boxes before it
+  std::vector<VertexId> stored_;            ///< the other elements' corners, in element order
 };
 
 /// The points of a file and which corners use them.
@@ -48,9 +124,9 @@ struct PointGroups {
   /// Whether the points are the vertices (point p is vertex p), so that every corner's point is
   /// its vertex and nothing is stored per corner.
   bool pointsAreVertices() const { return cornerPoint.empty(); }
-  /// Corner i's point.
-  std::uint32_t point(const ElementCorners& corners, std::size_t i) const {
-    return pointsAreVertices() ? corners.vertices[i].value : cornerPoint[i];
+  /// The point of corner i, at vertex v.
+  std::uint32_t point(std::size_t i, VertexId v) const {
+    return pointsAreVertices() ? v.value : cornerPoint[i];
   }
 };
 

@@ -100,6 +100,29 @@ void forEachRecord(const PolyMesh& mesh, const FaceRecords& records, ElementId e
 /// A whole grid cell, as CellStreams' `boxes` give it: six sides of four corners, eight corners.
 constexpr std::uint32_t kBoxSides = 6, kSideCorners = 4, kBoxCorners = 8;
 
+/// Whether element e has six sides of one loop of four corners, its first two disjoint and the
+/// others on their eight corners: a grid box whose corners, in order of first use, are its first
+/// two sides' (see ElementCorners).
+bool isBoxOnItsFirstTwoSides(const PolyMesh& mesh, ElementId e) {
+  const FaceList& faces = mesh.element(e).faces;
+  if (faces.size() != kBoxSides) return false;
+  std::array<VertexId, kBoxCorners> corner;
+  std::size_t known = 0;  // the first two sides' corners so far
+  for (std::size_t s = 0; s < kBoxSides; ++s) {
+    const Face& side = mesh.face(faces[s].face);
+    if (side.numLoops() != 1 || side.vertices.size() != kSideCorners) return false;
+    for (const VertexId v : side.vertices) {
+      const bool seen =
+          std::find(corner.begin(), corner.begin() + known, v) != corner.begin() + known;
+      if (s >= 2 && !seen) return false;  // a ninth corner
+      if (s >= 2) continue;
+      if (seen) return false;  // a corner twice in the first two sides
+      corner[known++] = v;
+    }
+  }
+  return true;
+}
+
 /// A count of one cell, which RunningEnds keeps in 32 bits.
 std::uint32_t cellCount(std::size_t n) {
   if (n > std::numeric_limits<std::uint32_t>::max())
@@ -217,17 +240,16 @@ CellStreams::CellStreams(const PolyMesh& mesh, std::span<const char> boxes)
   order_.resize(mesh.numElements());
   for (std::size_t e = 0; e < order_.size(); ++e) order_[e] = ElementId(e);
   // Cells in increasing order of their point count (stable), see kElementArray.
-  std::stable_sort(order_.begin(), order_.end(), [&](ElementId a, ElementId b) {
-    return corners_.of(a).size() < corners_.of(b).size();
-  });
+  std::stable_sort(order_.begin(), order_.end(),
+                   [&](ElementId a, ElementId b) { return corners_.count(a) < corners_.count(b); });
   std::vector<std::uint32_t> cornerCount(order_.size());
-  for (std::size_t c = 0; c < order_.size(); ++c)
-    cornerCount[c] = cellCount(corners_.of(order_[c]).size());
+  for (std::size_t c = 0; c < order_.size(); ++c) cornerCount[c] = corners_.count(order_[c]);
   connectivityEnd_ = RunningEnds(std::move(cornerCount));
   recordEnd_ = RunningEnds(inCellOrder(std::move(recordCount)));
   faceEnd_ = RunningEnds(inCellOrder(std::move(streamCount)));
-  for (std::size_t i = 0; i < corners_.vertices.size(); ++i)
-    largest_.point = std::max<std::int64_t>(largest_.point, points_.point(corners_, i));
+  largest_.point = largest_.cornerVertex;
+  for (const std::uint32_t p : points_.cornerPoint)
+    largest_.point = std::max<std::int64_t>(largest_.point, p);
   for (const Face& face : mesh.faces())
     largest_.origin = std::max(largest_.origin, static_cast<std::int64_t>(face.origin));
   for (VertexId v : points_.pointVertex)
@@ -239,12 +261,15 @@ void CellStreams::findCorners(std::span<const char> boxes, std::vector<std::uint
   const std::size_t ne = mesh_.numElements();
   recordCount.resize(ne);
   streamCount.resize(ne);
-  corners_.begin.assign(ne + 1, 0);
+  std::vector<std::uint32_t> cornerCount(ne + 1, 0);  // element e's at e + 1
+  // Per element, whether its corners are read from its first two sides (ElementCorners' boxes).
+  std::vector<char> implicit(ne, 0);
   auto most = [](Largest a, const Largest& b) {
     a.recordsPerCell = std::max(a.recordsPerCell, b.recordsPerCell);
     a.recordSize = std::max(a.recordSize, b.recordSize);
     a.face = std::max(a.face, b.face);
     a.reversed = std::max(a.reversed, b.reversed);
+    a.cornerVertex = std::max(a.cornerVertex, b.cornerVertex);
     return a;
   };
   const Largest counted = tbb::parallel_reduce(
@@ -252,32 +277,47 @@ void CellStreams::findCorners(std::span<const char> boxes, std::vector<std::uint
       [&](const tbb::blocked_range<std::size_t>& r, Largest largest) {
         CornerNumbers numbers;
         for (std::size_t e = r.begin(); e != r.end(); ++e) {
-          if (!boxes.empty() && boxes[e]) {
-            // A grid box: six records (its sides, single loops) of four corners, eight corners.
+          std::size_t records = 0, stream = 1, sideCorners = 0;  // of a grid box
+          if (!boxes.empty() && boxes[e] && isBoxOnItsFirstTwoSides(mesh_, ElementId(e))) {
+            // Six single loops of four corners, the first two disjoint, the others on their
+            // eight: the first two sides' corners, in order, are those of first use.
             for (const FaceUse& use : mesh_.element(ElementId(e)).faces) {
               largest.face = std::max<std::int64_t>(largest.face, use.face.value);
               largest.reversed = std::max<std::int64_t>(largest.reversed, use.reversed);
             }
             largest.recordSize = std::max<std::int64_t>(largest.recordSize, kSideCorners);
             largest.recordsPerCell = std::max<std::int64_t>(largest.recordsPerCell, kBoxSides);
-            corners_.begin[e + 1] = kBoxCorners;
+            for (std::size_t s = 0; s < 2; ++s)
+              for (const VertexId v :
+                   mesh_.face(mesh_.element(ElementId(e)).faces[s].face).vertices)
+                largest.cornerVertex = std::max<std::int64_t>(largest.cornerVertex, v.value);
+            implicit[e] = 1;
+            cornerCount[e + 1] = kBoxCorners;
             recordCount[e] = kBoxSides;
             streamCount[e] = 1 + kBoxSides * (1 + kSideCorners);
             continue;
           }
-          std::size_t records = 0, stream = 1;
           forEachRecord(mesh_, records_, ElementId(e), numbers,
                         [&](const FaceUse& use, std::span<const VertexId> record, auto) {
                           ++records;
                           stream += 1 + record.size();
+                          sideCorners += record.size() == kSideCorners;
                           largest.recordSize = std::max(largest.recordSize,
                                                         static_cast<std::int64_t>(record.size()));
                           largest.face = std::max<std::int64_t>(largest.face, use.face.value);
                           largest.reversed = std::max<std::int64_t>(largest.reversed, use.reversed);
                         });
+          const std::size_t found = numbers.vertices().size();
+          for (const VertexId v : numbers.vertices())
+            largest.cornerVertex = std::max<std::int64_t>(largest.cornerVertex, v.value);
+          if (!boxes.empty() && boxes[e] &&
+              (found != kBoxCorners || records != kBoxSides || sideCorners != kBoxSides))
+            throw std::logic_error("writeVtu: element " + std::to_string(e) +
+                                   " was given as a grid box but has " + std::to_string(records) +
+                                   " faces and " + std::to_string(found) + " corners");
           largest.recordsPerCell =
               std::max(largest.recordsPerCell, static_cast<std::int64_t>(records));
-          corners_.begin[e + 1] = cellCount(numbers.vertices().size());
+          cornerCount[e + 1] = cellCount(found);
           recordCount[e] = cellCount(records);
           streamCount[e] = cellCount(stream);
         }
@@ -285,31 +325,15 @@ void CellStreams::findCorners(std::span<const char> boxes, std::vector<std::uint
       },
       most);
   largest_ = most(largest_, counted);
-  std::size_t total = 0;
-  for (std::size_t e = 0; e < ne; ++e) {
-    total += corners_.begin[e + 1];
-    if (total > std::numeric_limits<std::uint32_t>::max())
-      throw std::length_error("writeVtu: the cells have more than 2^32 - 1 corners in all");
-    corners_.begin[e + 1] = static_cast<std::uint32_t>(total);
-  }
-  corners_.vertices.resize(corners_.begin[ne]);
+  corners_ = ElementCorners(mesh_, std::move(cornerCount), implicit);
   tbb::parallel_for(
       tbb::blocked_range<std::size_t>(0, ne, 512), [&](const tbb::blocked_range<std::size_t>& r) {
         CornerNumbers numbers;
         for (std::size_t e = r.begin(); e != r.end(); ++e) {
-          std::size_t records = 0, sideCorners = 0;  // of a grid box
-          forEachRecord(mesh_, records_, ElementId(e), numbers,
-                        [&](const FaceUse&, std::span<const VertexId> record, auto) {
-                          ++records;
-                          sideCorners += record.size() == kSideCorners;
-                        });
+          if (implicit[e]) continue;
+          forEachRecord(mesh_, records_, ElementId(e), numbers, [](auto&&...) {});
           const auto found = numbers.vertices();
-          if (!boxes.empty() && boxes[e] &&
-              (found.size() != kBoxCorners || records != kBoxSides || sideCorners != kBoxSides))
-            throw std::logic_error("writeVtu: element " + std::to_string(e) +
-                                   " was given as a grid box but has " + std::to_string(records) +
-                                   " faces and " + std::to_string(found.size()) + " corners");
-          std::copy(found.begin(), found.end(), corners_.vertices.begin() + corners_.begin[e]);
+          std::copy(found.begin(), found.end(), corners_.stored(ElementId(e)).begin());
         }
       });
 }
@@ -326,9 +350,8 @@ GeneratedInts CellStreams::connectivity() const {
   return {connectivityEnd_.total(), largest_.point,
           [this](std::size_t begin, std::size_t end, std::int64_t* out) {
             fillByCell(connectivityEnd_, begin, end, out, [&](std::size_t c, auto& window) {
-              const std::size_t e = order_[c].index();
-              for (std::size_t i = corners_.begin[e]; i < corners_.begin[e + 1]; ++i)
-                window.put(points_.point(corners_, i));
+              std::uint32_t i = corners_.first(order_[c]);
+              corners_.forEach(order_[c], [&](VertexId v) { window.put(points_.point(i++, v)); });
             });
           }};
 }
@@ -351,7 +374,7 @@ GeneratedInts CellStreams::faces() const {
             const bool vertexIds = points_.pointsAreVertices();
             fillByCell(faceEnd_, begin, end, out, [&](std::size_t c, auto& window) {
               const ElementId e = order_[c];
-              const std::size_t first = corners_.begin[e.index()];
+              const std::size_t first = corners_.first(e);
               window.put(static_cast<std::int64_t>(recordEnd_.end(c) - recordEnd_.begin(c)));
               // A record's size, then the points of its vertices 0 .. n-1 (pointOf(i)); backwards
               // for a reversed use, keeping the first vertex first: v0, v(n-1), ..., v1.
@@ -370,9 +393,10 @@ GeneratedInts CellStreams::faces() const {
               }
               // The records' vertices are numbered as elementCorners numbered them.
               forEachRecord(mesh_, records_, e, numbers,
-                            [&](const FaceUse& use, auto, std::span<const std::uint32_t> corner) {
+                            [&](const FaceUse& use, std::span<const VertexId> record,
+                                std::span<const std::uint32_t> corner) {
                               putRecord(use, corner.size(), [&](std::size_t i) {
-                                return std::int64_t(points_.point(corners_, first + corner[i]));
+                                return std::int64_t(points_.point(first + corner[i], record[i]));
                               });
                             });
             });

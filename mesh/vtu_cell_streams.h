@@ -71,7 +71,8 @@ class RunningEnds {
 /// order of their point count, stably (see kElementArray). Point ids are VTU points (see
 /// PointGroups), not mesh vertices.
 ///
-/// It holds each element's corners and their points, the cell order and the running ends of
+/// It holds each element's corners (those of a flagged grid box are read from its first two
+/// sides instead, see ElementCorners) and their points, the cell order and the running ends of
 /// each cell's connectivity, face records and `faces` run; the arrays are made from them a
 /// range at a time when written. It keeps a reference to `mesh`, which must outlive it, and the
 /// arrays it hands out refer to it, so it can be neither copied nor moved.
@@ -79,8 +80,9 @@ class CellStreams {
  public:
   /// Throws std::runtime_error if a face with holes cannot be triangulated. `boxes` (empty, or
   /// one per element): elements known to be whole grid cells (six single-loop sides of four
-  /// corners, eight corners in all), counted without numbering their corners; std::logic_error
-  /// if one is not.
+  /// corners, eight corners in all), counted without numbering their corners and, where their
+  /// first two sides are opposite (as slicing makes them), with corners read from those sides,
+  /// not held; std::logic_error if one is not a grid cell.
   explicit CellStreams(const PolyMesh& mesh, std::span<const char> boxes = {});
   CellStreams(const CellStreams&) = delete;
   CellStreams& operator=(const CellStreams&) = delete;
@@ -111,11 +113,14 @@ class CellStreams {
   struct Largest {
     std::int64_t point = 0, recordsPerCell = 0, recordSize = 0, face = 0, reversed = 0;
     std::int64_t origin = 0, vertex = 0;
+    std::int64_t cornerVertex = 0;  ///< of the vertices that are corners (the points, if unsplit)
   };
 
-  /// Each element's corners, counted in a first pass and written in place in a second, so that
-  /// no list per element is held between them; the first pass also counts each element's
-  /// records and `faces` values (in element order) and finds the largest values of its records.
+  /// Each element's corners, counted in a first pass (which also checks the flagged boxes and
+  /// finds those read from their sides) and, for the elements other than those, written in
+  /// place in a second, so that no list per element is held between them; the first pass also
+  /// counts each element's records and `faces` values (in element order) and finds the largest
+  /// values of its records and of the corners' vertices.
   void findCorners(std::span<const char> boxes, std::vector<std::uint32_t>& recordCount,
                    std::vector<std::uint32_t>& streamCount);
   /// Counts per element as counts per cell; the counts per element (taken) are freed on return,

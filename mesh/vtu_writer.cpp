@@ -143,21 +143,24 @@ std::vector<double> cornerMeans(const CellStreams& s, const CornerArray& a) {
   const auto k = static_cast<std::size_t>(a.components);
   const ElementCorners& corners = s.corners();
   const PointGroups& points = s.points();
-  const std::size_t ne = corners.begin.size() - 1;
-  std::vector<double> corner(corners.vertices.size() * k);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ne, 256),
+  std::vector<double> corner(corners.size() * k);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, corners.numElements(), 256),
                     [&](const tbb::blocked_range<std::size_t>& r) {
-                      for (std::size_t e = r.begin(); e != r.end(); ++e)
-                        for (std::size_t i = corners.begin[e]; i < corners.begin[e + 1]; ++i)
-                          a.value(ElementId(e), corners.vertices[i], corner.data() + i * k);
+                      for (std::size_t e = r.begin(); e != r.end(); ++e) {
+                        std::size_t i = corners.first(ElementId(e));
+                        corners.forEach(ElementId(e), [&](VertexId v) {
+                          a.value(ElementId(e), v, corner.data() + k * i++);
+                        });
+                      }
                     });
   std::vector<double> mean(points.numPoints() * k, 0.0);
   std::vector<std::uint32_t> count(points.numPoints(), 0);
-  for (std::size_t i = 0; i < corners.vertices.size(); ++i) {
-    const std::size_t p = points.point(corners, i);
-    ++count[p];
-    for (std::size_t c = 0; c < k; ++c) mean[p * k + c] += corner[i * k + c];
-  }
+  corners.forEachIn(0, static_cast<std::uint32_t>(corners.size()),
+                    [&](std::uint32_t i, VertexId v) {
+                      const std::size_t p = points.point(i, v);
+                      ++count[p];
+                      for (std::size_t c = 0; c < k; ++c) mean[p * k + c] += corner[i * k + c];
+                    });
   for (std::size_t p = 0; p < count.size(); ++p)
     for (std::size_t c = 0; c < k; ++c)
       if (count[p] > 0) mean[p * k + c] /= count[p];  // a vertex of no element keeps 0

@@ -64,20 +64,51 @@ class CubeBuilder {
   PolyMesh mesh_;
 };
 
-/// Each element's distinct vertices in order of first appearance in its faces' loops.
-ElementCorners cornersOf(const PolyMesh& mesh) {
-  ElementCorners corners;
-  corners.begin.push_back(0);
+/// Each element's distinct vertices in order of first appearance in its faces' loops, all
+/// stored, or (`boxes`) read from the mesh for the elements of six faces of four corners whose
+/// first two faces hold all eight.
+ElementCorners cornersOf(const PolyMesh& mesh, bool boxes = false) {
+  std::vector<std::uint32_t> begin{0}, count{0};
+  std::vector<VertexId> all, stored;
+  std::vector<char> box;
   for (const Element& element : mesh.elements()) {
-    const std::size_t first = corners.vertices.size();
-    for (const FaceUse& use : element.faces)
+    std::vector<VertexId> corners;
+    std::size_t quads = 0;
+    for (const FaceUse& use : element.faces) {
+      quads += mesh.face(use.face).vertices.size() == 4;
       for (VertexId v : mesh.face(use.face).vertices)
-        if (std::find(corners.vertices.begin() + static_cast<std::ptrdiff_t>(first),
-                      corners.vertices.end(), v) == corners.vertices.end())
-          corners.vertices.push_back(v);
-    corners.begin.push_back(static_cast<std::uint32_t>(corners.vertices.size()));
+        if (std::find(corners.begin(), corners.end(), v) == corners.end()) corners.push_back(v);
+    }
+    const auto& first = mesh.face(element.faces[0].face).vertices;
+    const bool isBox = boxes && element.faces.size() == 6 && quads == 6 && corners.size() == 8 &&
+                       std::equal(first.begin(), first.end(), corners.begin());
+    all.insert(all.end(), corners.begin(), corners.end());
+    begin.push_back(static_cast<std::uint32_t>(all.size()));
+    count.push_back(static_cast<std::uint32_t>(corners.size()));
+    box.push_back(isBox ? 1 : 0);
+    if (!isBox) stored.insert(stored.end(), corners.begin(), corners.end());
   }
-  return corners;
+  if (!boxes) return ElementCorners(std::move(begin), std::move(all));
+  ElementCorners out(mesh, std::move(count), box);
+  EXPECT_GT(std::count(box.begin(), box.end(), 1), 0) << "no element is a box";
+  for (std::size_t e = 0, at = 0; e < box.size(); ++e)
+    if (!box[e]) {
+      const auto room = out.stored(ElementId(e));
+      std::copy_n(stored.begin() + static_cast<std::ptrdiff_t>(at), room.size(), room.begin());
+      at += room.size();
+    }
+  return out;
+}
+
+/// Every corner's vertex, corner i at i.
+std::vector<VertexId> cornerVertices(const ElementCorners& corners) {
+  std::vector<VertexId> out;
+  corners.forEachIn(0, static_cast<std::uint32_t>(corners.size()),
+                    [&](std::uint32_t i, VertexId v) {
+                      EXPECT_EQ(i, out.size());
+                      out.push_back(v);
+                    });
+  return out;
 }
 
 /// The invariants of any grouping: points stand for the vertices their corners are at; the
@@ -85,21 +116,22 @@ ElementCorners cornersOf(const PolyMesh& mesh) {
 /// at each of its vertices are one point.
 void expectConsistent(const PolyMesh& mesh, const ElementCorners& corners,
                       const PointGroups& groups) {
+  const std::vector<VertexId> vertexOf = cornerVertices(corners);
   if (!groups.cornerPoint.empty()) {
-    ASSERT_EQ(groups.cornerPoint.size(), corners.vertices.size());
+    ASSERT_EQ(groups.cornerPoint.size(), corners.size());
   }
   ASSERT_GE(groups.numPoints(), mesh.numVertices());
   for (std::size_t v = 0; v < mesh.numVertices(); ++v)
     EXPECT_EQ(groups.pointVertex[v], VertexId(v));
-  for (std::size_t i = 0; i < corners.vertices.size(); ++i) {
-    ASSERT_LT(groups.point(corners, i), groups.numPoints());
-    EXPECT_EQ(groups.pointVertex[groups.point(corners, i)], corners.vertices[i]) << "corner " << i;
+  for (std::size_t i = 0; i < vertexOf.size(); ++i) {
+    ASSERT_LT(groups.point(i, vertexOf[i]), groups.numPoints());
+    EXPECT_EQ(groups.pointVertex[groups.point(i, vertexOf[i])], vertexOf[i]) << "corner " << i;
   }
   for (const Face& face : mesh.faces())
     if (!face.isBoundary()) {
       for (VertexId v : face.vertices)
-        EXPECT_EQ(groups.point(corners, corners.find(face.front, v)),
-                  groups.point(corners, corners.find(face.back, v)));
+        EXPECT_EQ(groups.point(corners.find(face.front, v), v),
+                  groups.point(corners.find(face.back, v), v));
     }
 }
 
@@ -107,32 +139,39 @@ TEST(PointGroups, JoinedElementsShareEveryPoint) {
   // Also when the corners are first checked a range of vertices at a time (ranges of 10
   // corners or 40: 10 and 3 of them).
   const PolyMesh mesh = hexGridMesh(3, 2, 2, Box3(Vec3(0, 0, 0), Vec3(3, 2, 2)));
-  const ElementCorners corners = cornersOf(mesh);
-  for (const std::uint32_t range : {kGroupRangeCorners, 40u, 10u}) {
-    SCOPED_TRACE(range);
-    const PointGroups groups = groupPoints(mesh, corners, range);
-    expectConsistent(mesh, corners, groups);
-    EXPECT_EQ(groups.numPoints(), mesh.numVertices());
-    // Every corner's point is its vertex: nothing is stored per corner.
-    EXPECT_TRUE(groups.cornerPoint.empty());
-    for (std::size_t i = 0; i < corners.vertices.size(); ++i)
-      EXPECT_EQ(groups.point(corners, i), corners.vertices[i].value);
+  for (const bool boxes : {false, true}) {
+    const ElementCorners corners = cornersOf(mesh, boxes);
+    const std::vector<VertexId> vertexOf = cornerVertices(corners);
+    for (const std::uint32_t range : {kGroupRangeCorners, 40u, 10u}) {
+      SCOPED_TRACE(::testing::Message() << "range " << range << (boxes ? ", boxes" : ""));
+      const PointGroups groups = groupPoints(mesh, corners, range);
+      expectConsistent(mesh, corners, groups);
+      EXPECT_EQ(groups.numPoints(), mesh.numVertices());
+      // Every corner's point is its vertex: nothing is stored per corner.
+      EXPECT_TRUE(groups.cornerPoint.empty());
+      for (std::size_t i = 0; i < vertexOf.size(); ++i)
+        EXPECT_EQ(groups.point(i, vertexOf[i]), vertexOf[i].value);
+    }
   }
 }
 
 TEST(PointGroups, RangesFindNoSplitWhereNoVertexSplits) {
   // The check range by range says a vertex splits exactly when one does: on a block of cubes
   // (none does, whatever the ranges) and with one cube touching it at a corner only.
+  // The corners stored, and the cubes' read from their first two faces.
   const PolyMesh block = hexGridMesh(3, 2, 2, Box3(Vec3(0, 0, 0), Vec3(3, 2, 2)));
-  const ElementCorners blockCorners = cornersOf(block);
-  for (std::uint32_t range = 1; range <= blockCorners.vertices.size() + 1; ++range)
-    EXPECT_FALSE(detail::anyVertexSplits(block, blockCorners, range)) << "range " << range;
   std::vector<CubeBuilder::Cell> cells{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {2, 2, 1}};
   CubeBuilder builder;
   const PolyMesh touching = builder.build(cells);
-  const ElementCorners touchingCorners = cornersOf(touching);
-  for (std::uint32_t range = 1; range <= touchingCorners.vertices.size() + 1; ++range)
-    EXPECT_TRUE(detail::anyVertexSplits(touching, touchingCorners, range)) << "range " << range;
+  for (const bool boxes : {false, true}) {
+    SCOPED_TRACE(boxes ? "boxes" : "stored");
+    const ElementCorners blockCorners = cornersOf(block, boxes);
+    for (std::uint32_t range = 1; range <= blockCorners.size() + 1; ++range)
+      EXPECT_FALSE(detail::anyVertexSplits(block, blockCorners, range)) << "range " << range;
+    const ElementCorners touchingCorners = cornersOf(touching, boxes);
+    for (std::uint32_t range = 1; range <= touchingCorners.size() + 1; ++range)
+      EXPECT_TRUE(detail::anyVertexSplits(touching, touchingCorners, range)) << "range " << range;
+  }
 }
 
 TEST(PointGroups, OneSplitVertexIsFoundInWhicheverRangeItFalls) {
@@ -149,7 +188,7 @@ TEST(PointGroups, OneSplitVertexIsFoundInWhicheverRangeItFalls) {
   const ElementCorners corners = cornersOf(mesh);
   const PointGroups whole = groupPoints(mesh, corners);
   ASSERT_EQ(whole.numPoints(), mesh.numVertices() + 1);
-  for (std::uint32_t range = 8; range <= corners.vertices.size(); range += 8) {
+  for (std::uint32_t range = 8; range <= corners.size(); range += 8) {
     SCOPED_TRACE(range);
     const PointGroups groups = groupPoints(mesh, corners, range);
     EXPECT_EQ(groups.pointVertex, whole.pointVertex);
@@ -168,12 +207,14 @@ TEST(PointGroups, TheTwoSidesOfACutGetTheirOwnPoints) {
   // numbered in the order of its corners.
   ASSERT_EQ(groups.numPoints(), 16u);
   std::vector<VertexId> copied;
-  for (std::size_t i = corners.begin[1]; i < corners.begin[2]; ++i)
-    if (mesh.position(corners.vertices[i]).x() == 1.0) copied.push_back(corners.vertices[i]);
+  corners.forEach(ElementId(std::size_t(1)), [&](VertexId v) {
+    if (mesh.position(v).x() == 1.0) copied.push_back(v);
+  });
   ASSERT_EQ(copied.size(), 4u);
   for (std::size_t k = 0; k < 4; ++k) EXPECT_EQ(groups.pointVertex[12 + k], copied[k]);
-  for (std::size_t i = corners.begin[0]; i < corners.begin[1]; ++i)
-    EXPECT_EQ(groups.point(corners, i), corners.vertices[i].value);
+  std::uint32_t i = corners.first(ElementId(std::size_t(0)));
+  corners.forEach(ElementId(std::size_t(0)),
+                  [&](VertexId v) { EXPECT_EQ(groups.point(i++, v), v.value); });
 }
 
 TEST(PointGroups, AFiniteCutSharesPointsOnlyAlongItsFront) {
@@ -222,9 +263,11 @@ PointGroups referenceGroups(const PolyMesh& mesh, const ElementCorners& corners)
   for (std::size_t v = 0; v < mesh.numVertices(); ++v) out.pointVertex.push_back(VertexId(v));
   std::vector<bool> taken(mesh.numVertices(), false);
   std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> pointOf;  // (element, vertex)
-  const std::size_t ne = corners.begin.size() - 1;
-  for (std::size_t e = 0; e < ne; ++e)
-    for (VertexId v : corners.of(ElementId(e))) {
+  std::vector<VertexId> vertices;
+  for (std::size_t e = 0; e < corners.numElements(); ++e) {
+    vertices.clear();
+    corners.forEach(ElementId(e), [&](VertexId v) { vertices.push_back(v); });
+    for (VertexId v : vertices) {
       if (pointOf.contains({std::uint32_t(e), v.value})) {
         out.cornerPoint.push_back(pointOf.at({std::uint32_t(e), v.value}));
         continue;
@@ -251,6 +294,7 @@ PointGroups referenceGroups(const PolyMesh& mesh, const ElementCorners& corners)
       }
       out.cornerPoint.push_back(point);
     }
+  }
   return out;
 }
 
@@ -277,16 +321,19 @@ TEST(PointGroups, AsDocumentedOnCubesWithRandomCutsAndGaps) {
       }
     CubeBuilder builder(cuts);
     const PolyMesh mesh = builder.build(cells);
-    const ElementCorners corners = cornersOf(mesh);
-    const PointGroups reference = referenceGroups(mesh, corners);
+    const PointGroups reference = referenceGroups(mesh, cornersOf(mesh));
     EXPECT_GT(reference.numPoints(), mesh.numVertices() + 10);
-    // Also checked a range of vertices at a time first, in ranges of 100 corners.
-    for (const std::uint32_t range : {kGroupRangeCorners, 100u}) {
-      const PointGroups groups = groupPoints(mesh, corners, range);
-      expectConsistent(mesh, corners, groups);
-      EXPECT_EQ(groups.pointVertex, reference.pointVertex) << "round " << round;
-      ASSERT_EQ(groups.cornerPoint.size(), reference.cornerPoint.size()) << "round " << round;
-      EXPECT_EQ(groups.cornerPoint, reference.cornerPoint) << "round " << round;
+    // Also checked a range of vertices at a time first, in ranges of 100 corners; and with the
+    // cubes' corners read from their first two faces.
+    for (const bool boxes : {false, true}) {
+      const ElementCorners corners = cornersOf(mesh, boxes);
+      for (const std::uint32_t range : {kGroupRangeCorners, 100u}) {
+        const PointGroups groups = groupPoints(mesh, corners, range);
+        expectConsistent(mesh, corners, groups);
+        EXPECT_EQ(groups.pointVertex, reference.pointVertex) << "round " << round;
+        ASSERT_EQ(groups.cornerPoint.size(), reference.cornerPoint.size()) << "round " << round;
+        EXPECT_EQ(groups.cornerPoint, reference.cornerPoint) << "round " << round;
+      }
     }
   }
 }
