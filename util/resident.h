@@ -15,6 +15,22 @@
 
 namespace polydg {
 
+/// Asks the kernel for transparent huge pages on the 2 MiB-aligned part of [data, data +
+/// bytes), a large array's: it then faults in 2 MiB at a time instead of 4 KiB, and its reads
+/// miss the TLB less. The heap is not on huge pages (cli/allocator.cpp), since it would count
+/// every partly used one in full. A hint only; ignored where unsupported.
+inline void adviseHugePages(void* data, std::size_t bytes) {
+#ifdef MADV_HUGEPAGE
+  constexpr std::uintptr_t kHuge = std::uintptr_t(1) << 21;
+  const std::uintptr_t begin = (reinterpret_cast<std::uintptr_t>(data) + kHuge - 1) & ~(kHuge - 1);
+  const std::uintptr_t end = (reinterpret_cast<std::uintptr_t>(data) + bytes) & ~(kHuge - 1);
+  if (end > begin) ::madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
+#else
+  (void)data;
+  (void)bytes;
+#endif
+}
+
 /// Faults in the pages of [data, data + bytes) for writing, in parallel, without touching their
 /// contents (Linux 5.14's MADV_POPULATE_WRITE). Does nothing for small ranges, or where the
 /// kernel cannot: the pages then fault in when they are first written, as they would anyway.
@@ -26,6 +42,7 @@ inline void makeResident(void* data, std::size_t bytes) {
   const std::uintptr_t end = begin + bytes;
   const std::uintptr_t first = (begin + kChunk - 1) / kChunk * kChunk;  // aligned chunks
   const std::size_t chunks = (end - first) / kChunk;
+  adviseHugePages(data, bytes);
   tbb::parallel_for(std::size_t(0), chunks + 1, [&](std::size_t c) {
     // Chunk `chunks` is the unaligned rest at both ends: the head before `first` (whole pages
     // only) and the tail after the last aligned chunk.

@@ -12,6 +12,8 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "util/resident.h"
+
 namespace polydg {
 
 /// An allocator whose value-less construct() default-initializes: resize() of a vector of
@@ -27,6 +29,15 @@ struct UninitializedAllocator : std::allocator<T> {
   UninitializedAllocator() = default;
   template <class U>
   UninitializedAllocator(const UninitializedAllocator<U>&) noexcept {}
+  /// Huge pages for a large array (the block rows of K and of its coarse levels, read in every
+  /// product): adviseHugePages.
+  T* allocate(std::size_t n) {
+    T* p = std::allocator<T>::allocate(n);
+    if (n * sizeof(T) >= kHugePagesAtLeast) adviseHugePages(p, n * sizeof(T));
+    return p;
+  }
+  /// Arrays below this are left on the heap's pages: 4 huge pages.
+  static constexpr std::size_t kHugePagesAtLeast = std::size_t(8) << 20;
   template <class U>
   void construct(U* p) noexcept(std::is_nothrow_default_constructible_v<U>) {
     ::new (static_cast<void*>(p)) U;

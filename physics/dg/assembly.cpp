@@ -11,13 +11,10 @@
 #include <tbb/parallel_for.h>
 #include <Eigen/Eigenvalues>
 
-#ifdef __linux__
-#include <sys/mman.h>
-#endif
-
 #include "integrate/quadrature.h"
 #include "physics/dg/block_rows.h"
 #include "physics/dg/face_quadrature.h"
+#include "util/resident.h"
 
 namespace polydg {
 
@@ -121,21 +118,6 @@ double largestEigenvalue(const Eigen::MatrixXd& a) {
       return eig.eigenvalues().maxCoeff();
     }
   }
-}
-
-/// Asks the kernel for transparent huge pages on the 2 MiB-aligned part of a fresh, untouched
-/// allocation: K's arrays then fault in 2 MiB at a time instead of 4 KiB, whose faults were a
-/// seventh of the assembly time. A hint only; ignored where unsupported.
-void adviseHugePages(void* data, std::size_t bytes) {
-#ifdef MADV_HUGEPAGE
-  constexpr std::uintptr_t kHuge = std::uintptr_t(1) << 21;
-  const std::uintptr_t begin = (reinterpret_cast<std::uintptr_t>(data) + kHuge - 1) & ~(kHuge - 1);
-  const std::uintptr_t end = (reinterpret_cast<std::uintptr_t>(data) + bytes) & ~(kHuge - 1);
-  if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
-#else
-  (void)data;
-  (void)bytes;
-#endif
 }
 
 /// Side index of element e at face f.
