@@ -26,7 +26,7 @@ namespace {
 class SliceBuilder {
  public:
   SliceBuilder(std::vector<SliceLeaf>& leaves, std::vector<std::array<int, 3>>& wholeCells,
-               const WholeCells& whole, bool octree, std::size_t firstGenerated, SliceStats& stats)
+               WholeCells& whole, bool octree, std::size_t firstGenerated, SliceStats& stats)
       : leaves_(leaves),
         wholeCells_(wholeCells),
         whole_(whole),
@@ -72,9 +72,9 @@ class SliceBuilder {
     }
     polygons.welded = WeldedPolygons(0, 0, 0);
     std::vector<FaceOrigin>().swap(polygons.origin);
-    std::vector<std::uint32_t>().swap(vertices.rank);
-    std::vector<std::uint32_t>().swap(vertices.vertexOfRank);
+    std::vector<std::uint32_t>().swap(vertices.vertexOfPoint);
     std::vector<char>().swap(vertices.shared);
+    whole_.freeNodes();  // the elements are made of the faces, not of the grid's nodes
     ElementData<Element> meshElements;
     meshElements.raw() = residentVector<Element>(ids.elements);
     makeElements(at, polygons, sharesEarlier, ids, faceId, meshFaces, meshElements);
@@ -83,7 +83,7 @@ class SliceBuilder {
         if (ids.elementOf[l] != kNone) elementCell->push_back(cells_[l].cell);
     if (elementLevel)
       for (std::size_t l = 0; l < cells_.size(); ++l)
-        if (ids.elementOf[l] != kNone) elementLevel->push_back(cells_[l].level);
+        if (ids.elementOf[l] != kNone) elementLevel->push_back(levels_.empty() ? 0 : levels_[l]);
     PolyMesh mesh;
     mesh.assign(std::move(vertices.positions), std::move(meshFaces), std::move(meshElements));
     return mesh;
@@ -105,11 +105,10 @@ class SliceBuilder {
 
   /// The points the leaves use, welded: each point's vertex, and the vertices' positions.
   struct WeldedVertices {
-    std::vector<std::uint32_t> rank;          ///< point -> its order of first use, or kNone
-    std::vector<std::uint32_t> vertexOfRank;  ///< order of first use -> vertex id
+    std::vector<std::uint32_t> vertexOfPoint;  ///< point -> its vertex id, or kNone if unused
     VertexData<Vec3> positions;
     std::vector<char> shared;  ///< per vertex: two or more points were welded into it
-    VertexId operator()(std::uint32_t v) const { return VertexId(vertexOfRank[rank[v]]); }
+    VertexId operator()(std::uint32_t v) const { return VertexId(vertexOfPoint[v]); }
   };
 
   /// Calls f(v) for each corner v of leaf l's polygons, in order (a whole cell's sides as
@@ -189,41 +188,46 @@ class SliceBuilder {
 
     // Points in order of first use, then welded; vertex ids follow that order.
     WeldedVertices out;
-    out.rank.assign(points.size(), kNone);
-    const std::vector<std::uint32_t> used = pointsInOrderOfUse(out.rank);
+    std::vector<std::uint32_t> rank(points.size(), kNone);  // point -> order of first use
+    const std::vector<std::uint32_t> used = pointsInOrderOfUse(rank);
     const std::vector<std::uint32_t> target = weldTargets(points, used, resolution);
     // The mesh keeps this array: sized for the vertices, not for the points before welding.
     std::size_t vertices = 0;
     for (std::size_t i = 0; i < used.size(); ++i) vertices += target[i] == i;
     out.positions.raw().reserve(vertices);
-    out.vertexOfRank.resize(used.size());
+    std::vector<std::uint32_t> vertexOfRank(used.size());  // order of first use -> vertex
     for (std::size_t i = 0; i < used.size(); ++i) {
       if (target[i] == i) {
-        out.vertexOfRank[i] = static_cast<std::uint32_t>(out.positions.size());
+        vertexOfRank[i] = static_cast<std::uint32_t>(out.positions.size());
         out.positions.push_back(points[used[i]]);
       } else {
-        out.vertexOfRank[i] = out.vertexOfRank[target[i]];
+        vertexOfRank[i] = vertexOfRank[target[i]];
         if (octree_) stats_.weldedPoints += used[i] < firstGenerated_;
       }
     }
+    // Each point's vertex, in the ranks' room: one array less while the faces are made.
+    tbb::parallel_for(std::size_t(0), rank.size(), [&](std::size_t p) {
+      if (rank[p] != kNone) rank[p] = vertexOfRank[rank[p]];
+    });
+    out.vertexOfPoint = std::move(rank);
     out.shared.assign(out.positions.size(), 0);
     if (octree_) {
       for (std::size_t i = 0; i < used.size(); ++i)
-        if (target[i] != i && used[i] < firstGenerated_) out.shared[out.vertexOfRank[i]] = 1;
+        if (target[i] != i && used[i] < firstGenerated_) out.shared[vertexOfRank[i]] = 1;
       return out;
     }
     // Uniform grid: a vertex is shared if two distinct points were welded into it; a grid node
     // made for whole cells is the same point as the splitter's at its position.
     std::vector<std::uint32_t> node(out.positions.size(), kNone), distinct(out.positions.size(), 0);
     for (std::size_t i = 0; i < used.size(); ++i)
-      if (used[i] >= firstGenerated_ && node[out.vertexOfRank[i]] == kNone) {
-        node[out.vertexOfRank[i]] = used[i];
-        distinct[out.vertexOfRank[i]] = 1;
+      if (used[i] >= firstGenerated_ && node[vertexOfRank[i]] == kNone) {
+        node[vertexOfRank[i]] = used[i];
+        distinct[vertexOfRank[i]] = 1;
       }
     std::vector<char> standsFor(out.positions.size(), 0);
     for (std::size_t i = 0; i < used.size(); ++i) {
       if (used[i] >= firstGenerated_) continue;
-      const std::uint32_t v = out.vertexOfRank[i];
+      const std::uint32_t v = vertexOfRank[i];
       if (node[v] != kNone && !standsFor[v] && points[used[i]] == points[node[v]])
         standsFor[v] = 1;
       else
@@ -596,15 +600,16 @@ class SliceBuilder {
   /// merged (no cell has both). The whole cells' list is freed.
   void mergeCells() {
     cells_.resize(leaves_.size() + wholeCells_.size());
+    if (octree_) levels_.assign(cells_.size(), 0);
     std::size_t i = 0, w = 0;
-    for (LeafCell& c : cells_)
+    for (std::size_t l = 0; l < cells_.size(); ++l)
       if (w == wholeCells_.size() ||
           (i < leaves_.size() && cellBefore(leaves_[i].cell, wholeCells_[w]))) {
-        c = {leaves_[i].cell, static_cast<std::uint32_t>(i),
-             static_cast<std::int16_t>(leaves_[i].level)};
+        cells_[l] = {leaves_[i].cell, static_cast<std::uint32_t>(i)};
+        if (octree_) levels_[l] = static_cast<std::uint8_t>(leaves_[i].level);
         ++i;
       } else {
-        c = {wholeCells_[w++], kNone, 0};
+        cells_[l] = {wholeCells_[w++], kNone};
       }
     std::vector<std::array<int, 3>>().swap(wholeCells_);
   }
@@ -614,14 +619,17 @@ class SliceBuilder {
   struct LeafCell {
     std::array<int, 3> cell;
     std::uint32_t piece;  ///< in leaves_, or kNone for a whole cell
-    std::int16_t level;   ///< at most 10
     bool whole() const { return piece == kNone; }
   };
 
   std::vector<SliceLeaf>& leaves_;  ///< the leaves with a piece, sorted by cell and part
   std::vector<std::array<int, 3>>& wholeCells_;  ///< sorted; merged into cells_ and freed
   std::vector<LeafCell> cells_;                  ///< every leaf in order (mergeCells())
-  const WholeCells& whole_;
+  /// Per leaf of cells_, its octree level (at most 10; whole cells 0); empty on a uniform grid,
+  /// whose leaves are all at level 0. Apart from cells_, which it would make 20 bytes a leaf,
+  /// not 16.
+  std::vector<std::uint8_t> levels_;
+  WholeCells& whole_;
   const bool octree_;
   const std::size_t firstGenerated_;
   SliceStats& stats_;
@@ -636,7 +644,7 @@ class SliceBuilder {
 }  // namespace
 
 PolyMesh buildSliceMesh(std::vector<SliceLeaf>& leaves, std::vector<std::array<int, 3>>& wholeCells,
-                        const WholeCells& whole, bool octree, std::size_t firstGenerated,
+                        WholeCells& whole, bool octree, std::size_t firstGenerated,
                         std::vector<Vec3> points, SliceStats& stats,
                         std::vector<std::array<int, 3>>* elementCell,
                         std::vector<int>* elementLevel, std::vector<char>* elementWhole) {

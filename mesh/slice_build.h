@@ -31,9 +31,10 @@ struct SliceLeaf {
 /// are left empty) and the points as soon as they are read (before the mesh's arrays are
 /// made), and gives each element's leaf's cell and level to `elementCell` and `elementLevel`
 /// (optional), and to `elementWhole` (optional) 1 for a whole cell none of whose corners
-/// welding moved (the grid's box on six quadrilaterals of grid nodes), else 0.
+/// welding moved (the grid's box on six quadrilaterals of grid nodes), else 0. Frees `whole`'s
+/// nodes (WholeCells::freeNodes) once the faces are made.
 PolyMesh buildSliceMesh(std::vector<SliceLeaf>& leaves, std::vector<std::array<int, 3>>& wholeCells,
-                        const WholeCells& whole, bool octree, std::size_t firstGenerated,
+                        WholeCells& whole, bool octree, std::size_t firstGenerated,
                         std::vector<Vec3> points, SliceStats& stats,
                         std::vector<std::array<int, 3>>* elementCell,
                         std::vector<int>* elementLevel, std::vector<char>* elementWhole = nullptr);

@@ -76,6 +76,14 @@ class WholeCells {
     return {corner[a], corner[a | u], corner[a | u | w], corner[a | w]};
   }
 
+  /// Frees the grid nodes' points that finish() made (corners() and sides() may not be called
+  /// after): the slice build is done with them once the faces are made, before it makes the
+  /// elements' array (25 MB for the bunny at 200 cells).
+  void freeNodes() {
+    std::vector<std::uint32_t>().swap(table_);
+    std::unordered_map<std::size_t, std::uint32_t>().swap(map_);
+  }
+
   /// The rows of the grid's cells along x, one per (y, z): their number, how many share a z,
   /// and cell c's (y fastest).
   std::size_t numRows() const { return std::size_t(grid_.cells[1]) * std::size_t(grid_.cells[2]); }

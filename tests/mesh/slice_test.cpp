@@ -92,6 +92,24 @@ TEST(Slice, TorusIsOneComponentWithAHole) {
   expectGood(s, enclosedVolume(t), 1);
 }
 
+TEST(Slice, ACellSideWithAHoleKeepsBothLoops) {
+  // A torus whose hole (radius about 0.1) lies inside one cell's side on the grid plane z = 0:
+  // that side is a square with a round hole, one face of two loops, whose corners are those of
+  // both (welding keeps a polygon's corner count only as its last loop's end).
+  const TriangleSurface t = torus(Vec3(0.5, 0.5, 0.05), 1.0, 0.9, 64, 32);
+  const Sliced s = slice(t, Grid::covering(Box3(Vec3(-2, -2, -1), Vec3(3, 3, 1)), 1.0));
+  expectGood(s, enclosedVolume(t), 1);
+  std::size_t holed = 0;
+  for (const Face& face : s.mesh.faces()) {
+    if (face.numLoops() < 2) continue;
+    ++holed;
+    EXPECT_EQ(face.numLoops(), 2u);
+    EXPECT_EQ(face.loopEnd[1], face.vertices.size());
+    EXPECT_GE(face.loop(1).size(), 8u);  // the hole, a polygon of the torus's 64 segments
+  }
+  EXPECT_EQ(holed, 1u);
+}
+
 TEST(Slice, GridAlignedCubeGivesExactHexahedra) {
   // Faces on grid planes, corners on grid nodes, edges on grid lines.
   const TriangleSurface cube = boxSurface(Box3(Vec3(0, 0, 0), Vec3(1, 1, 1)));
