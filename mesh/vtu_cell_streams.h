@@ -119,13 +119,8 @@ class CellStreams {
   /// Each element's corners, counted in a first pass (which also checks the flagged boxes and
   /// finds those read from their sides) and, for the elements other than those, written in
   /// place in a second, so that no list per element is held between them; the first pass also
-  /// counts each element's records and `faces` values (in element order) and finds the largest
-  /// values of its records and of the corners' vertices.
-  void findCorners(std::span<const char> boxes, std::vector<std::uint32_t>& recordCount,
-                   std::vector<std::uint32_t>& streamCount);
-  /// Counts per element as counts per cell; the counts per element (taken) are freed on return,
-  /// before the next such array is made, as the writer holds the most then.
-  std::vector<std::uint32_t> inCellOrder(std::vector<std::uint32_t> perElement) const;
+  /// finds the largest values of the records and of the corners' vertices.
+  void findCorners(std::span<const char> boxes);
   /// One value per face record, value(use) for each record of the face use `use`.
   template <class Value>
   vtk_format::GeneratedInts perRecord(std::int64_t largest, Value value) const;
