@@ -147,6 +147,27 @@ ElementCorners::ElementCorners(const PolyMesh& mesh, std::vector<std::uint32_t> 
   stored_.resize(total - kBoxCorners * boxes);
 }
 
+bool ElementCorners::hasBoxSides(const PolyMesh& mesh, ElementId e) {
+  constexpr std::size_t kSides = 6, kSideCorners = 4;
+  const FaceList& faces = mesh.element(e).faces;
+  if (faces.size() != kSides) return false;
+  std::array<VertexId, kBoxCorners> corner;
+  std::size_t known = 0;  // the first two sides' corners so far
+  for (std::size_t s = 0; s < kSides; ++s) {
+    const Face& side = mesh.face(faces[s].face);
+    if (side.numLoops() != 1 || side.vertices.size() != kSideCorners) return false;
+    for (const VertexId v : side.vertices) {
+      const bool seen =
+          std::find(corner.begin(), corner.begin() + known, v) != corner.begin() + known;
+      if (s >= 2 && !seen) return false;  // a ninth corner
+      if (s >= 2) continue;
+      if (seen) return false;  // a corner twice in the first two sides
+      corner[known++] = v;
+    }
+  }
+  return true;
+}
+
 std::size_t ElementCorners::elementOf(std::uint32_t i) const {
   return static_cast<std::size_t>(std::upper_bound(begin_.begin(), begin_.end(), i) -
                                   begin_.begin()) -

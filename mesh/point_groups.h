@@ -29,12 +29,17 @@ class ElementCorners {
   /// begin has numElements() + 1 entries, begin[0] = 0.
   ElementCorners(std::vector<std::uint32_t> begin, std::vector<VertexId> vertices);
   /// Per element e of `mesh`, its corner count count[e + 1] (count[0] is 0; the storage of
-  /// `count` becomes the corners' numbering) and whether it is taken as a box (box[e] != 0; its
-  /// count must then be 8, its first two faces as above). Room is made for the other elements'
-  /// corners, which the caller then writes through stored(). Keeps a reference to `mesh`, which
-  /// must outlive it. std::length_error beyond 2^32 - 1 corners in all.
+  /// `count` becomes the corners' numbering) and whether it is taken as a box (box[e] != 0,
+  /// only where hasBoxSides(mesh, e); its count must then be 8). Room is made for the other
+  /// elements' corners, which the caller then writes through stored(). Keeps a reference to
+  /// `mesh`, which must outlive it. std::length_error beyond 2^32 - 1 corners in all.
   ElementCorners(const PolyMesh& mesh, std::vector<std::uint32_t> count,
                  const std::vector<char>& box);
+
+  /// Whether element e can be taken as a box: six faces of one loop of four corners, the first
+  /// two disjoint and the others on their eight corners, so that its corners in order of first
+  /// use are its first two faces' (as slicing makes every whole grid cell).
+  static bool hasBoxSides(const PolyMesh& mesh, ElementId e);
 
   std::size_t numElements() const { return begin_.empty() ? 0 : begin_.size() - 1; }
   /// The corners of all elements.

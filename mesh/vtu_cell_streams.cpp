@@ -100,29 +100,6 @@ void forEachRecord(const PolyMesh& mesh, const FaceRecords& records, ElementId e
 /// A whole grid cell, as CellStreams' `boxes` give it: six sides of four corners, eight corners.
 constexpr std::uint32_t kBoxSides = 6, kSideCorners = 4, kBoxCorners = 8;
 
-/// Whether element e has six sides of one loop of four corners, its first two disjoint and the
-/// others on their eight corners: a grid box whose corners, in order of first use, are its first
-/// two sides' (see ElementCorners).
-bool isBoxOnItsFirstTwoSides(const PolyMesh& mesh, ElementId e) {
-  const FaceList& faces = mesh.element(e).faces;
-  if (faces.size() != kBoxSides) return false;
-  std::array<VertexId, kBoxCorners> corner;
-  std::size_t known = 0;  // the first two sides' corners so far
-  for (std::size_t s = 0; s < kBoxSides; ++s) {
-    const Face& side = mesh.face(faces[s].face);
-    if (side.numLoops() != 1 || side.vertices.size() != kSideCorners) return false;
-    for (const VertexId v : side.vertices) {
-      const bool seen =
-          std::find(corner.begin(), corner.begin() + known, v) != corner.begin() + known;
-      if (s >= 2 && !seen) return false;  // a ninth corner
-      if (s >= 2) continue;
-      if (seen) return false;  // a corner twice in the first two sides
-      corner[known++] = v;
-    }
-  }
-  return true;
-}
-
 /// A count of one cell, which RunningEnds keeps in 32 bits.
 std::uint32_t cellCount(std::size_t n) {
   if (n > std::numeric_limits<std::uint32_t>::max())
@@ -295,7 +272,7 @@ void CellStreams::findCorners(std::span<const char> boxes) {
         CornerNumbers numbers;
         for (std::size_t e = r.begin(); e != r.end(); ++e) {
           std::size_t records = 0, sideCorners = 0;  // of a grid box
-          if (!boxes.empty() && boxes[e] && isBoxOnItsFirstTwoSides(mesh_, ElementId(e))) {
+          if (!boxes.empty() && boxes[e] && ElementCorners::hasBoxSides(mesh_, ElementId(e))) {
             // Six single loops of four corners, the first two disjoint, the others on their
             // eight: the first two sides' corners, in order, are those of first use.
             for (const FaceUse& use : mesh_.element(ElementId(e)).faces) {

@@ -65,23 +65,18 @@ class CubeBuilder {
 };
 
 /// Each element's distinct vertices in order of first appearance in its faces' loops, all
-/// stored, or (`boxes`) read from the mesh for the elements of six faces of four corners whose
-/// first two faces hold all eight.
+/// stored, or (`boxes`) read from the mesh for the elements that can be taken as boxes
+/// (ElementCorners::hasBoxSides).
 ElementCorners cornersOf(const PolyMesh& mesh, bool boxes = false) {
   std::vector<std::uint32_t> begin{0}, count{0};
   std::vector<VertexId> all, stored;
   std::vector<char> box;
-  for (const Element& element : mesh.elements()) {
+  for (std::size_t e = 0; e < mesh.numElements(); ++e) {
     std::vector<VertexId> corners;
-    std::size_t quads = 0;
-    for (const FaceUse& use : element.faces) {
-      quads += mesh.face(use.face).vertices.size() == 4;
+    for (const FaceUse& use : mesh.element(ElementId(e)).faces)
       for (VertexId v : mesh.face(use.face).vertices)
         if (std::find(corners.begin(), corners.end(), v) == corners.end()) corners.push_back(v);
-    }
-    const auto& first = mesh.face(element.faces[0].face).vertices;
-    const bool isBox = boxes && element.faces.size() == 6 && quads == 6 && corners.size() == 8 &&
-                       std::equal(first.begin(), first.end(), corners.begin());
+    const bool isBox = boxes && ElementCorners::hasBoxSides(mesh, ElementId(e));
     all.insert(all.end(), corners.begin(), corners.end());
     begin.push_back(static_cast<std::uint32_t>(all.size()));
     count.push_back(static_cast<std::uint32_t>(corners.size()));
