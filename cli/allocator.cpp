@@ -1,18 +1,63 @@
 // The polydg program's memory allocator: jemalloc (linked into this executable only, not into the
-// library or the Python module), with transparent huge pages for the large arrays only.
+// library or the Python module), with transparent huge pages for the large blocks only.
 //
 // Meshing builds hundreds of MB of small, short-lived buffers (plane splits, faces, element
 // lists) and solving allocates K and its preconditioner once, large. With glibc's malloc on
 // 4 KiB pages, `polydg mesh` of a 75k-triangle scan at 64 cells spent about a third of its wall
-// time in page faults; jemalloc reuses the small buffers' pages. Huge pages are asked for where
-// a large array is made (makeResident in util/resident.h, adviseHugePages for K), not for the
-// whole heap: a heap on huge pages ("thp:always") counts every partly used 2 MB page in full,
-// 25 MiB more at the peak of meshing the bunny at 200 cells for no measurable time.
+// time in page faults; jemalloc reuses the small buffers' pages. Huge pages are asked for every
+// block of 4 MiB or more (operator new below; makeResident in util/resident.h also faults a
+// large array in on all cores), not for the whole heap: a heap on huge pages ("thp:always")
+// counts every partly used 2 MB page in full, 35 MiB more at the peak of meshing the bunny at
+// 200 cells.
 // jemalloc reads this string when it starts (before main), then /etc/malloc.conf, then the
 // environment variable MALLOC_CONF, each overriding the one before: a user who wants other
 // settings sets MALLOC_CONF.
+#include <cstddef>
+#include <cstdlib>
+#include <new>
+
+#include "util/resident.h"
+
 extern "C" {
 // NOLINTNEXTLINE(readability-identifier-naming): the name jemalloc looks for.
 extern const char* malloc_conf;
 const char* malloc_conf = "thp:default,metadata_thp:disabled";
 }
+
+namespace {
+
+/// Blocks from this size on are advised onto huge pages, so that they fault in 2 MiB at a time
+/// instead of 4 KiB (a fault is dear on a virtual machine); each holds at least one whole one.
+constexpr std::size_t kHugePagesAtLeast = std::size_t(4) << 20;
+
+}  // namespace
+
+namespace {
+
+void* allocate(std::size_t n) {
+  void* p = std::malloc(n == 0 ? 1 : n);
+  if (p == nullptr) throw std::bad_alloc();
+  if (n >= kHugePagesAtLeast) polydg::adviseHugePages(p, n);
+  return p;
+}
+
+void* allocateOrNull(std::size_t n) noexcept {
+  void* p = std::malloc(n == 0 ? 1 : n);
+  if (p != nullptr && n >= kHugePagesAtLeast) polydg::adviseHugePages(p, n);
+  return p;
+}
+
+}  // namespace
+
+// The replaceable allocation functions but the aligned ones (those keep the standard library's,
+// over aligned_alloc and free): every other C++ allocation of the program comes here, the
+// library's and the standard containers' included. Each form is replaced, since the standard
+// library's own forms need not call the replaced ones.
+void* operator new(std::size_t n) { return allocate(n); }
+void* operator new[](std::size_t n) { return allocate(n); }
+void* operator new(std::size_t n, const std::nothrow_t&) noexcept { return allocateOrNull(n); }
+void* operator new[](std::size_t n, const std::nothrow_t&) noexcept { return allocateOrNull(n); }
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }

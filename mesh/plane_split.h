@@ -4,11 +4,11 @@
 // plane. The building block of hexahedral slicing and of plane cutting.
 #pragma once
 
-#include <array>
-#include <cstdint>
-
 #include <tbb/concurrent_hash_map.h>
+#include <array>
 #include <boost/container/small_vector.hpp>
+#include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "mesh/split_points.h"
@@ -120,7 +120,11 @@ class PlaneSplitter {
     }
     static bool equal(const EdgeKey& x, const EdgeKey& y) { return x == y; }
   };
-  tbb::concurrent_hash_map<EdgeKey, std::uint32_t, EdgeKeyHashCompare> edgePoints_;
+  // std::allocator, not TBB's: the table's large arrays then come from the program's allocator,
+  // on huge pages (cli/allocator.cpp), and its nodes from jemalloc's caches.
+  tbb::concurrent_hash_map<EdgeKey, std::uint32_t, EdgeKeyHashCompare,
+                           std::allocator<std::pair<const EdgeKey, std::uint32_t>>>
+      edgePoints_;
 };
 
 /// A polygon's loops as a PolygonLoops view (for the predicates of SplitPoints).

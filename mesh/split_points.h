@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -115,7 +116,9 @@ class SplitPoints {
   std::array<Interval, 3> intervalNormal(const PolygonLoops& polygon) const;
   ExactPoint exactNormal(const PolygonLoops& polygon) const;
 
-  tbb::concurrent_vector<Record> records_;
+  // std::allocator, not TBB's: its large segments then come from the program's allocator, on
+  // huge pages (cli/allocator.cpp).
+  tbb::concurrent_vector<Record, std::allocator<Record>> records_;
   tbb::concurrent_hash_map<std::uint32_t, Plane> planes_;
   /// Exact positions computed so far (of the points whose predicates the radii did not decide).
   mutable tbb::concurrent_hash_map<std::uint32_t, ExactPoint> exact_;
