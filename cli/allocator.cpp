@@ -30,20 +30,15 @@ namespace {
 /// instead of 4 KiB (a fault is dear on a virtual machine); each holds at least one whole one.
 constexpr std::size_t kHugePagesAtLeast = std::size_t(4) << 20;
 
-}  // namespace
-
-namespace {
-
-void* allocate(std::size_t n) {
-  void* p = std::malloc(n == 0 ? 1 : n);
-  if (p == nullptr) throw std::bad_alloc();
-  if (n >= kHugePagesAtLeast) polydg::adviseHugePages(p, n);
-  return p;
-}
-
 void* allocateOrNull(std::size_t n) noexcept {
   void* p = std::malloc(n == 0 ? 1 : n);
   if (p != nullptr && n >= kHugePagesAtLeast) polydg::adviseHugePages(p, n);
+  return p;
+}
+
+void* allocate(std::size_t n) {
+  void* p = allocateOrNull(n);
+  if (p == nullptr) throw std::bad_alloc();
   return p;
 }
 

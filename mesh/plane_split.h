@@ -4,11 +4,12 @@
 // plane. The building block of hexahedral slicing and of plane cutting.
 #pragma once
 
-#include <tbb/concurrent_hash_map.h>
 #include <array>
 #include <cstdint>
 #include <memory>
 #include <vector>
+
+#include <tbb/concurrent_hash_map.h>
 
 #include "mesh/split_points.h"
 #include "polydg/mesh/loop_ends.h"
