@@ -26,13 +26,11 @@ const char* malloc_conf = "thp:default,metadata_thp:disabled";
 
 namespace {
 
-/// Blocks from this size on are advised onto huge pages, so that they fault in 2 MiB at a time
-/// instead of 4 KiB (a fault is dear on a virtual machine); each holds at least one whole one.
-constexpr std::size_t kHugePagesAtLeast = std::size_t(4) << 20;
-
+/// A large block is advised onto huge pages (adviseLargeBlock), so that it faults in 2 MiB at a
+/// time instead of 4 KiB: a fault is dear on a virtual machine.
 void* allocateOrNull(std::size_t n) noexcept {
   void* p = std::malloc(n == 0 ? 1 : n);
-  if (p != nullptr && n >= kHugePagesAtLeast) polydg::adviseHugePages(p, n);
+  if (p != nullptr) polydg::adviseLargeBlock(p, n);
   return p;
 }
 

@@ -31,6 +31,15 @@ inline void adviseHugePages(void* data, std::size_t bytes) {
 #endif
 }
 
+/// Blocks from this size on are advised onto huge pages (adviseLargeBlock): each holds at least
+/// one whole one, and the heap's smaller blocks stay on its pages.
+inline constexpr std::size_t kHugePagesAtLeast = std::size_t(4) << 20;
+
+/// adviseHugePages for a block of kHugePagesAtLeast bytes or more; nothing for a smaller one.
+inline void adviseLargeBlock(void* data, std::size_t bytes) {
+  if (bytes >= kHugePagesAtLeast) adviseHugePages(data, bytes);
+}
+
 /// Faults in the pages of [data, data + bytes) for writing, in parallel, without touching their
 /// contents (Linux 5.14's MADV_POPULATE_WRITE). Does nothing for small ranges, or where the
 /// kernel cannot: the pages then fault in when they are first written, as they would anyway.

@@ -30,14 +30,13 @@ struct UninitializedAllocator : std::allocator<T> {
   template <class U>
   UninitializedAllocator(const UninitializedAllocator<U>&) noexcept {}
   /// Huge pages for a large array (the block rows of K and of its coarse levels, read in every
-  /// product): adviseHugePages.
+  /// product): adviseLargeBlock. The polydg program's operator new does so for every block
+  /// (cli/allocator.cpp); this is for the library's other hosts, the Python module's.
   T* allocate(std::size_t n) {
     T* p = std::allocator<T>::allocate(n);
-    if (n * sizeof(T) >= kHugePagesAtLeast) adviseHugePages(p, n * sizeof(T));
+    adviseLargeBlock(p, n * sizeof(T));
     return p;
   }
-  /// Arrays below this are left on the heap's pages: 4 huge pages.
-  static constexpr std::size_t kHugePagesAtLeast = std::size_t(8) << 20;
   template <class U>
   void construct(U* p) noexcept(std::is_nothrow_default_constructible_v<U>) {
     ::new (static_cast<void*>(p)) U;

@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "util/resident.h"
+
 namespace {
 
 /// Whether the mapping that holds `address` is advised onto huge pages: "hg" in its VmFlags.
@@ -39,7 +41,7 @@ TEST(Allocator, LargeBlocksAreAdvisedOntoHugePagesAndSmallOnesAreNot) {
   constexpr std::uintptr_t kHuge = std::uintptr_t(2) << 20;
   // Just below the size advised: large enough to hold a whole huge page (a large block is
   // page-aligned), which must be left alone.
-  const auto small = std::make_unique<char[]>((std::size_t(4) << 20) - 4096);
+  const auto small = std::make_unique<char[]>(polydg::kHugePagesAtLeast - 4096);
   const auto large = std::make_unique<char[]>(std::size_t(16) << 20);
   const auto interior = (reinterpret_cast<std::uintptr_t>(large.get()) + kHuge - 1) & ~(kHuge - 1);
   EXPECT_TRUE(advisedOntoHugePages(reinterpret_cast<const void*>(interior)));
