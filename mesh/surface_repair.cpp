@@ -91,13 +91,19 @@ SurfaceDiagnosis diagnose(const TriangleSurface& surface, const SurfaceTopology*
   if (surface.triangles.empty()) return d;
   if (d.topology.nonManifoldEdges > 0) return d;
   // Consistently oriented copy (orientation does not change intersections or nesting); a
-  // closed surface without singular vertices is one already.
+  // closed surface without singular vertices or degenerate triangles is one already, and its
+  // triangles go in as they are (no polygon allocated per triangle).
   auto points = toPoints(surface);
-  auto polygons = toPolygons(surface);
-  if (!d.topology.closed() || d.topology.singularVertices > 0)
-    PMP::orient_polygon_soup(points, polygons);
   Mesh mesh;
-  PMP::polygon_soup_to_polygon_mesh(points, polygons, mesh);
+  if (d.topology.closed() && d.topology.singularVertices == 0 &&
+      d.topology.degenerateTriangles == 0) {
+    PMP::polygon_soup_to_polygon_mesh(points, surface.triangles, mesh);
+  } else {
+    auto polygons = toPolygons(surface);
+    if (!d.topology.closed() || d.topology.singularVertices > 0)
+      PMP::orient_polygon_soup(points, polygons);
+    PMP::polygon_soup_to_polygon_mesh(points, polygons, mesh);
+  }
   std::vector<std::pair<Mesh::Face_index, Mesh::Face_index>> pairs;
   PMP::self_intersections<CGAL::Parallel_if_available_tag>(faces(mesh), mesh,
                                                            std::back_inserter(pairs));
