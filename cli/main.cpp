@@ -17,6 +17,7 @@
 #include <dlfcn.h>
 #include <unistd.h>
 
+#include "cli/blas_threads.h"
 #include "cli/commands.h"
 #include "polydg/util/error.h"
 #include "polydg/util/process.h"
@@ -64,6 +65,7 @@ const char* requestedCommand(int argc, char** argv) {
 
 int main(int argc, char** argv) {
   useMatchingBlasKernels(argv);
+  polydg::cli::stopIdleBlasThreads();
   polydg::keepFreedMemory();
   CLI::App app{"polydg: turn surface meshes into polyhedral DG simulation meshes"};
   app.require_subcommand(1);
