@@ -35,29 +35,29 @@ bool advisedOntoHugePages(const void* address) {
   return false;
 }
 
+/// The first 2 MiB boundary at or after `p`: where a huge page of its block would begin.
+const void* firstHugePageIn(const void* p) {
+  constexpr std::uintptr_t kHuge = std::uintptr_t(2) << 20;
+  return reinterpret_cast<const void*>((reinterpret_cast<std::uintptr_t>(p) + kHuge - 1) &
+                                       ~(kHuge - 1));
+}
+
 TEST(Allocator, LargeBlocksAreAdvisedOntoHugePagesAndSmallOnesAreNot) {
   if (!std::filesystem::exists("/sys/kernel/mm/transparent_hugepage"))
     GTEST_SKIP() << "this kernel has no transparent huge pages";
-  constexpr std::uintptr_t kHuge = std::uintptr_t(2) << 20;
+  constexpr std::size_t kHuge = std::size_t(2) << 20;
   // Just below the size advised: large enough to hold a whole huge page (a large block is
   // page-aligned), which must be left alone.
   const auto small = std::make_unique<char[]>(polydg::kHugePagesAtLeast - 4096);
   const auto large = std::make_unique<char[]>(std::size_t(16) << 20);
-  const auto interior = (reinterpret_cast<std::uintptr_t>(large.get()) + kHuge - 1) & ~(kHuge - 1);
-  EXPECT_TRUE(advisedOntoHugePages(reinterpret_cast<const void*>(interior)));
+  EXPECT_TRUE(advisedOntoHugePages(firstHugePageIn(large.get())));
   EXPECT_TRUE(advisedOntoHugePages(large.get() + (std::size_t(16) << 20) - kHuge - 1));
-  const auto smallInterior =
-      (reinterpret_cast<std::uintptr_t>(small.get()) + kHuge - 1) & ~(kHuge - 1);
-  EXPECT_FALSE(advisedOntoHugePages(reinterpret_cast<const void*>(smallInterior)));
+  EXPECT_FALSE(advisedOntoHugePages(firstHugePageIn(small.get())));
   const std::vector<char> containers(std::size_t(12) << 20);  // through std::allocator
-  const auto containersInterior =
-      (reinterpret_cast<std::uintptr_t>(containers.data()) + kHuge - 1) & ~(kHuge - 1);
-  EXPECT_TRUE(advisedOntoHugePages(reinterpret_cast<const void*>(containersInterior)));
+  EXPECT_TRUE(advisedOntoHugePages(firstHugePageIn(containers.data())));
   const auto nothrowLarge = std::unique_ptr<char[]>(new (std::nothrow) char[std::size_t(8) << 20]);
   ASSERT_NE(nothrowLarge, nullptr);
-  const auto nothrowInterior =
-      (reinterpret_cast<std::uintptr_t>(nothrowLarge.get()) + kHuge - 1) & ~(kHuge - 1);
-  EXPECT_TRUE(advisedOntoHugePages(reinterpret_cast<const void*>(nothrowInterior)));
+  EXPECT_TRUE(advisedOntoHugePages(firstHugePageIn(nothrowLarge.get())));
 }
 
 }  // namespace
