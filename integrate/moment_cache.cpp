@@ -44,6 +44,17 @@ void MomentCache::sync() {
   growResident(elementMoments_, ne * stride_, 0.0);
   growResident(faceNormals_.raw(), nf, Vec3(Vec3::Zero()));
   growResident(elementOrigins_.raw(), ne, Vec3(Vec3::Zero()));
+  if (oldFaces == 0 && oldElements == 0 && dirtyFaces_.empty() && dirtyElements_.empty()) {
+    // A new cache: everything is dirty, listed in id order, without visiting each face's
+    // elements (update() does not depend on the order of the lists).
+    faceDirty_.assign(nf, 1);
+    elementDirty_.assign(ne, 1);
+    dirtyFaces_.resize(nf);
+    dirtyElements_.resize(ne);
+    forEach(nf, [&](std::size_t f) { dirtyFaces_[f] = FaceId(f); });
+    forEach(ne, [&](std::size_t e) { dirtyElements_[e] = ElementId(e); });
+    return;
+  }
   faceDirty_.resize(nf, 0);
   elementDirty_.resize(ne, 0);
   for (std::size_t f = oldFaces; f < nf; ++f) invalidateFace(FaceId(f));
