@@ -1,6 +1,7 @@
 #include "physics/dg/assembly.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -8,7 +9,9 @@
 #include <string>
 #include <tuple>
 
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 #include <Eigen/Eigenvalues>
 
 #include "integrate/quadrature.h"
@@ -18,7 +21,10 @@
 
 namespace polydg {
 
-FaceData<FaceUses> faceUses(const PolyMesh& mesh) {
+namespace {
+
+/// faceUses() one element after another: the reference order, and the error it throws.
+FaceData<FaceUses> faceUsesInOrder(const PolyMesh& mesh) {
   FaceData<FaceUses> uses(mesh.numFaces());
   for (std::size_t i = 0; i < mesh.numElements(); ++i) {
     const ElementId e(i);
@@ -38,6 +44,49 @@ FaceData<FaceUses> faceUses(const PolyMesh& mesh) {
   return uses;
 }
 
+}  // namespace
+
+FaceData<FaceUses> faceUses(const PolyMesh& mesh) {
+  // On both cores: each use takes the next of its face's two slots, then a face's two uses are
+  // put in element order, as faceUsesInOrder() finds them. A face used wrongly (a third time,
+  // or twice the same way) is rare: the serial pass then says which, as it always did.
+  FaceData<FaceUses> uses(mesh.numFaces());
+  std::atomic<bool> wrong{false};
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.numElements(), 1024),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                        const ElementId e(i);
+                        for (const FaceUse& use : mesh.element(e).faces) {
+                          FaceUses& u = uses[use.face];
+                          const int slot =
+                              std::atomic_ref<int>(u.count).fetch_add(1, std::memory_order_relaxed);
+                          if (slot >= 2) {
+                            wrong.store(true, std::memory_order_relaxed);
+                            continue;
+                          }
+                          u.element[slot] = e;
+                          u.reversed[slot] = use.reversed;
+                        }
+                      }
+                    });
+  if (wrong.load()) return faceUsesInOrder(mesh);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.numFaces(), 4096),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t f = r.begin(); f != r.end(); ++f) {
+                        FaceUses& u = uses[FaceId(f)];
+                        if (u.count < 2) continue;
+                        if (u.reversed[0] == u.reversed[1])
+                          wrong.store(true, std::memory_order_relaxed);
+                        if (u.element[1].value < u.element[0].value) {
+                          std::swap(u.element[0], u.element[1]);
+                          std::swap(u.reversed[0], u.reversed[1]);
+                        }
+                      }
+                    });
+  if (wrong.load()) return faceUsesInOrder(mesh);
+  return uses;
+}
+
 FaceRoles classifyFaces(const PolyMesh& mesh, const LoadCase& loads) {
   FaceRoles roles;
   roles.uses = faceUses(mesh);
@@ -47,36 +96,58 @@ FaceRoles classifyFaces(const PolyMesh& mesh, const LoadCase& loads) {
   roles.traction.resize(nf, -1);
   roles.coupledFaces.resize(mesh.numElements(), 0);
   const double diagonal = meshBounds(mesh).diagonal().norm();
-  for (std::size_t i = 0; i < nf; ++i) {
-    const FaceId f(i);
-    const FaceUses& u = roles.uses[f];
-    if (u.count == 2) {
-      roles.kind[f] = FaceKind::Interior;
-      ++roles.interiorFaces;
-      continue;
-    }
-    if (u.count == 0) continue;  // unused face: no terms
-    for (std::size_t c = 0; c < loads.dirichlet.size(); ++c)
-      if (selects(loads.dirichlet[c].where, mesh, f, diagonal)) {
-        roles.kind[f] = FaceKind::Dirichlet;
-        roles.dirichlet[f] = static_cast<int>(c);
-        ++roles.dirichletFaces;
-        break;
-      }
-    if (roles.kind[f] == FaceKind::Dirichlet) continue;
-    for (std::size_t c = 0; c < loads.tractions.size(); ++c)
-      if (selects(loads.tractions[c].where, mesh, f, diagonal)) {
-        roles.traction[f] = static_cast<int>(c);
-        ++roles.tractionFaces;
-        break;
-      }
-  }
-  for (std::size_t i = 0; i < nf; ++i) {
-    const FaceId f(i);
-    if (roles.kind[f] == FaceKind::Free) continue;
-    const FaceUses& u = roles.uses[f];
-    for (int s = 0; s < u.count; ++s) ++roles.coupledFaces[u.element[s]];
-  }
+  struct Counts {
+    std::size_t interior = 0, dirichlet = 0, traction = 0;
+  };
+  const Counts counts = tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, nf, 4096), Counts{},
+      [&](const tbb::blocked_range<std::size_t>& r, Counts c) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+          const FaceId f(i);
+          const FaceUses& u = roles.uses[f];
+          if (u.count == 2) {
+            roles.kind[f] = FaceKind::Interior;
+            ++c.interior;
+            continue;
+          }
+          if (u.count == 0) continue;  // unused face: no terms
+          for (std::size_t k = 0; k < loads.dirichlet.size(); ++k)
+            if (selects(loads.dirichlet[k].where, mesh, f, diagonal)) {
+              roles.kind[f] = FaceKind::Dirichlet;
+              roles.dirichlet[f] = static_cast<int>(k);
+              ++c.dirichlet;
+              break;
+            }
+          if (roles.kind[f] == FaceKind::Dirichlet) continue;
+          for (std::size_t k = 0; k < loads.tractions.size(); ++k)
+            if (selects(loads.tractions[k].where, mesh, f, diagonal)) {
+              roles.traction[f] = static_cast<int>(k);
+              ++c.traction;
+              break;
+            }
+        }
+        return c;
+      },
+      [](Counts a, const Counts& b) {
+        a.interior += b.interior;
+        a.dirichlet += b.dirichlet;
+        a.traction += b.traction;
+        return a;
+      });
+  roles.interiorFaces = counts.interior;
+  roles.dirichletFaces = counts.dirichlet;
+  roles.tractionFaces = counts.traction;
+  // c_K: the uses of faces with terms, counted per element (a face an element uses twice
+  // counts twice, as it has two uses).
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.numElements(), 1024),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                        int coupled = 0;
+                        for (const FaceUse& use : mesh.element(ElementId(i)).faces)
+                          coupled += roles.kind[use.face] != FaceKind::Free;
+                        roles.coupledFaces[ElementId(i)] = coupled;
+                      }
+                    });
   return roles;
 }
 

@@ -7,6 +7,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "mesh/primitives.h"
 #include "physics/dg/assembly.h"
@@ -185,6 +188,92 @@ TEST(LocalIntegrators, DegreeOneOuterProductsGiveTheMatrixProductsBlocks) {
   }
   EXPECT_GT(interior, 20u);
   EXPECT_GT(boundary, 20u);
+}
+
+// faceUses() and classifyFaces() run on both cores; what they give must be what one pass over
+// the elements in order gives: each face's users in element order with their orientations,
+// the counts of each kind, and per element the faces with terms. A sliced ball of a few
+// thousand elements (many per task) with a region clamp and a traction.
+TEST(FaceUses, EachFaceListsItsElementsInOrderAndEachKindIsCounted) {
+  const TriangleSurface ball = icosphere(Vec3(3.0, -1.0, 2.0), 1.0, 3);
+  const PolyMesh mesh = sliceSurface(ball, Grid::withCellsAlongLongest(bounds(ball), 18));
+  ASSERT_GT(mesh.numElements(), 3000u);
+  LoadCase loads;
+  loads.dirichlet.push_back({FaceSelector::below(Plane::make(Vec3(0, 0, 1), 1.6)), {}});
+  loads.tractions.push_back({FaceSelector::below(Plane::make(Vec3(1, 0, 0), 3.5)), Vec3(0, 0, -1)});
+  const FaceRoles roles = classifyFaces(mesh, loads);
+
+  std::vector<std::vector<std::pair<ElementId, bool>>> expected(mesh.numFaces());
+  for (std::size_t e = 0; e < mesh.numElements(); ++e)
+    for (const FaceUse& use : mesh.element(ElementId(e)).faces)
+      expected[use.face.index()].emplace_back(ElementId(e), use.reversed);
+  std::size_t interior = 0, dirichlet = 0, traction = 0;
+  const double diagonal = meshBounds(mesh).diagonal().norm();
+  for (std::size_t f = 0; f < mesh.numFaces(); ++f) {
+    const FaceId face(f);
+    const FaceUses& u = roles.uses[face];
+    ASSERT_EQ(u.count, static_cast<int>(expected[f].size())) << "face " << f;
+    for (int s = 0; s < u.count; ++s) {
+      EXPECT_EQ(u.element[s], expected[f][s].first) << "face " << f << " use " << s;
+      EXPECT_EQ(u.reversed[s], expected[f][s].second) << "face " << f << " use " << s;
+    }
+    FaceKind kind = FaceKind::Free;
+    if (u.count == 2) {
+      kind = FaceKind::Interior;
+      ++interior;
+    } else if (selects(loads.dirichlet[0].where, mesh, face, diagonal)) {
+      kind = FaceKind::Dirichlet;
+      ++dirichlet;
+    } else if (selects(loads.tractions[0].where, mesh, face, diagonal)) {
+      EXPECT_EQ(roles.traction[face], 0) << "face " << f;
+      ++traction;
+    }
+    EXPECT_EQ(roles.kind[face], kind) << "face " << f;
+  }
+  EXPECT_EQ(roles.interiorFaces, interior);
+  EXPECT_EQ(roles.dirichletFaces, dirichlet);
+  EXPECT_EQ(roles.tractionFaces, traction);
+  EXPECT_GT(dirichlet, 100u);
+  EXPECT_GT(traction, 100u);
+  for (std::size_t e = 0; e < mesh.numElements(); ++e) {
+    int coupled = 0;
+    for (const FaceUse& use : mesh.element(ElementId(e)).faces)
+      coupled +=
+          roles.kind[use.face] == FaceKind::Interior || roles.kind[use.face] == FaceKind::Dirichlet;
+    EXPECT_EQ(roles.coupledFaces[ElementId(e)], coupled) << "element " << e;
+  }
+}
+
+// A face used a third time, or twice the same way, is refused with the face's id, also when
+// the wrong use is far from the first (the elements are split among tasks).
+TEST(FaceUses, AFaceUsedThreeTimesOrTwiceTheSameWayIsNamed) {
+  const PolyMesh grid = hexGridMesh(16, 16, 16, Box3(Vec3::Zero(), Vec3(1.0, 1.0, 1.0)));
+  const ElementId last(grid.numElements() - 1);
+  FaceId interior, boundary;
+  for (const FaceUse& use : grid.element(ElementId(0)).faces)
+    (grid.face(use.face).isBoundary() ? boundary : interior) = use.face;
+  ASSERT_TRUE(interior.valid() && boundary.valid());
+  auto withExtraUse = [&](FaceUse extra) {
+    ElementData<Element> elements = grid.elements();
+    elements[last].faces.push_back(extra);
+    PolyMesh mesh;
+    mesh.assign(grid.positions(), grid.faces(), std::move(elements));
+    return mesh;
+  };
+  const auto message = [](const PolyMesh& mesh) {
+    try {
+      faceUses(mesh);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(message(withExtraUse({interior, true})),
+            "face " + std::to_string(interior.value) + " is used by more than two elements");
+  const bool firstWay = grid.face(boundary).front == ElementId(0) ? false : true;
+  EXPECT_EQ(message(withExtraUse({boundary, firstWay})),
+            "face " + std::to_string(boundary.value) + " is used twice with the same orientation");
+  EXPECT_EQ(message(withExtraUse({boundary, !firstWay})), "no error");
 }
 
 TEST(FaceQuadrature, IntegratesMonomialsOverANonConvexFaceWithAHole) {
