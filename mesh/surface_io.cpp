@@ -570,7 +570,8 @@ TriangleSurface readSurface(const std::string& path, SurfaceReadInfo* info) {
       soup = std::move(std::get<PolygonSoup>(read));
   }
 
-  Assimp::Importer importer;
+  // Made only for the formats CGAL does not read: it sets up every assimp importer.
+  std::optional<Assimp::Importer> importer;
   if (soup) {
     if (soup->onlyPointsOrLines)
       fail(path, "contains only points/lines, no triangles; polydg needs a surface mesh");
@@ -589,7 +590,7 @@ TriangleSurface readSurface(const std::string& path, SurfaceReadInfo* info) {
     counts.ignoredLines += soup->ignoredLines;
     counts.warnings = std::move(soup->warnings);
   } else {
-    const aiScene* scene = importScene(importer, path, cgalReason);
+    const aiScene* scene = importScene(importer.emplace(), path, cgalReason);
     counts.reader = "assimp";
     counts.meshes = scene->mNumMeshes;
     for (unsigned m = 0; m < scene->mNumMeshes; ++m) {

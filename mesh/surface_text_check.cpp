@@ -120,6 +120,13 @@ void checkOffText(const std::string& path, std::string_view text, const OffHeade
   OffRecords unused;
   OffRecords& out = values ? *values : unused;
   out.plain = values != nullptr && header.keyword == "OFF";
+  if (out.plain) {
+    // Room for the counts the header declares, but no more than the text can hold (a vertex
+    // line has at least 6 characters, a triangle's 8): a wrong header reserves nothing huge.
+    const std::size_t rest = text.size() - std::min(text.size(), header.dataOffset);
+    out.vertices.reserve(std::min<std::uint64_t>(vertices, rest / 6));
+    out.faces.reserve(std::min<std::uint64_t>(faces, rest / 8));
+  }
   while (lines.next(line)) {
     if (out.plain && line.find('#') != std::string_view::npos) out.plain = false;
     splitWords(uncommented(line), w);
