@@ -45,7 +45,9 @@ inline void adviseLargeBlock(void* data, std::size_t bytes) {
 /// kernel cannot: the pages then fault in when they are first written, as they would anyway.
 inline void makeResident(void* data, std::size_t bytes) {
 #ifdef MADV_POPULATE_WRITE
-  constexpr std::uintptr_t kChunk = std::uintptr_t(4) << 20;  // two huge pages
+  // One huge page a task, from two on: the arrays of a few MB that checks and caches make
+  // while the other core waits are faulted in on both too.
+  constexpr std::uintptr_t kChunk = std::uintptr_t(2) << 20;
   if (bytes < 2 * kChunk) return;
   const std::uintptr_t begin = reinterpret_cast<std::uintptr_t>(data);
   const std::uintptr_t end = begin + bytes;

@@ -19,6 +19,7 @@
 #include "polydg/integrate/moments.h"
 #include "polydg/mesh/geometry_checks.h"
 #include "polydg/physics/dg/post_process.h"
+#include "util/resident.h"
 #include "util/stopwatch.h"
 
 namespace polydg {
@@ -347,7 +348,8 @@ PolyMesh selectionWithNeighbours(const PolyMesh& mesh, const std::vector<char>& 
       kept = newFace[f] + std::size_t(1);
       break;
     }
-  FaceData<Face> faces(kept);
+  FaceData<Face> faces;
+  growResident(faces.raw(), kept);  // faulted in on both cores, then filled in parallel
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nf, 4096),
                     [&](const tbb::blocked_range<std::size_t>& r) {
                       for (std::size_t f = r.begin(); f != r.end(); ++f) {
@@ -366,8 +368,17 @@ PolyMesh selectionWithNeighbours(const PolyMesh& mesh, const std::vector<char>& 
                           elements[ElementId(i)].faces.push_back(
                               {FaceId(std::size_t(newFace[use.face.index()])), use.reversed});
                     });
+  // Every vertex, copied in parallel into resident pages.
+  VertexData<Vec3> positions;
+  growResident(positions.raw(), mesh.numVertices());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.numVertices(), 1 << 14),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      std::copy(mesh.positions().raw().begin() + r.begin(),
+                                mesh.positions().raw().begin() + r.end(),
+                                positions.raw().begin() + r.begin());
+                    });
   PolyMesh sub;
-  sub.assign(mesh.positions(), std::move(faces), std::move(elements));
+  sub.assign(std::move(positions), std::move(faces), std::move(elements));
   return sub;
 }
 

@@ -50,7 +50,8 @@ FaceData<FaceUses> faceUses(const PolyMesh& mesh) {
   // On both cores: each use takes the next of its face's two slots, then a face's two uses are
   // put in element order, as faceUsesInOrder() finds them. A face used wrongly (a third time,
   // or twice the same way) is rare: the serial pass then says which, as it always did.
-  FaceData<FaceUses> uses(mesh.numFaces());
+  FaceData<FaceUses> uses;
+  growResident(uses.raw(), mesh.numFaces());
   std::atomic<bool> wrong{false};
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.numElements(), 1024),
                     [&](const tbb::blocked_range<std::size_t>& r) {

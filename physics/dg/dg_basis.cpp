@@ -7,6 +7,7 @@
 #include <Eigen/Cholesky>
 
 #include "physics/dg/polynomial_tables.h"
+#include "util/resident.h"
 
 namespace polydg {
 
@@ -89,8 +90,8 @@ DgBasis::DgBasis(const PolyMesh& mesh, const MomentCache& moments, const BasisOp
   const std::size_t ne = mesh.numElements();
   centres_.resize(ne);
   scales_.resize(ne);
-  coefficients_.assign(ne * n_ * n_, 0.0);
-  lifting_.assign(ne * n1_ * n1_, 0.0);
+  growResident(coefficients_, ne * n_ * n_, 0.0);
+  growResident(lifting_, ne * n1_ * n1_, 0.0);
   std::vector<char> fellBack(ne, 0);
   tbb::parallel_for(std::size_t(0), ne, [&](std::size_t i) {
     const ElementId e(i);

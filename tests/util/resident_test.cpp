@@ -15,7 +15,7 @@ namespace {
 std::uint8_t pattern(std::size_t i) { return static_cast<std::uint8_t>(i * 2654435761u >> 13); }
 
 TEST(Resident, MakingPagesResidentKeepsEveryByte) {
-  // 24 MB, several aligned 4 MB chunks, with the range starting and ending inside pages.
+  // 24 MB, several aligned 2 MB chunks, with the range starting and ending inside pages.
   std::vector<std::uint8_t> bytes(24u << 20);
   for (std::size_t i = 0; i < bytes.size(); ++i) bytes[i] = pattern(i);
   for (const std::size_t skip :
