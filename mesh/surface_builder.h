@@ -35,6 +35,33 @@ class SurfaceBuilder {
     surface_.triangles.push_back({id(ka, a), id(kb, b), id(kc, c)});
   }
 
+  /// Room for about `vertices` distinct vertices and `triangles` triangles.
+  void reserve(std::size_t vertices, std::size_t triangles) {
+    welded_.reserve(vertices);
+    surface_.vertices.reserve(vertices);
+    surface_.triangles.reserve(triangles);
+  }
+
+  /// Adds the triangle of corners a, b, c at positions pa, pb, pc, as addTriangle(pa, pb, pc),
+  /// for readers whose faces index a list of points: `welded` holds the vertex of each point
+  /// once it has one (kNoVertex before), so a point shared by many faces is looked up once.
+  void addTriangle(const std::array<std::size_t, 3>& corners, const std::array<Vec3, 3>& at,
+                   std::vector<std::uint32_t>& welded) {
+    const PositionKey keys[3] = {keyOf(at[0]), keyOf(at[1]), keyOf(at[2])};
+    if (keys[0] == keys[1] || keys[1] == keys[2] || keys[2] == keys[0]) {
+      ++info_.droppedDegenerate;
+      return;
+    }
+    std::array<std::uint32_t, 3> t;
+    for (int k = 0; k < 3; ++k) {
+      std::uint32_t& w = welded[corners[k]];
+      if (w == kNoVertex) w = id(keys[k], at[k]);
+      t[k] = w;
+    }
+    surface_.triangles.push_back(t);
+  }
+  static constexpr std::uint32_t kNoVertex = 0xffffffffu;
+
   /// Adds the triangles of a planar polygon of four or more corners: its exact constrained
   /// triangulation (triangulateFace), or a fan from the first corner, counted, if it has zero
   /// area or crossing edges.

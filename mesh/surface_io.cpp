@@ -578,7 +578,21 @@ TriangleSurface readSurface(const std::string& path, SurfaceReadInfo* info) {
     counts.reader = "cgal";
     counts.meshes = soup->meshes;
     counts.inputVertices = soup->inputVertices;
+    builder.reserve(soup->points.size(), soup->polygons.size());
+    std::vector<std::uint32_t> welded(soup->points.size(), SurfaceBuilder::kNoVertex);
     for (const SoupPolygon& polygon : soup->polygons) {
+      if (polygon.size() == 3) {  // nearly every face: its points welded once each
+        std::array<Vec3, 3> at;
+        for (int k = 0; k < 3; ++k) {
+          const Vec3& p = soup->points[polygon[k]];
+          at[k] = Vec3(canonical(p.x()), canonical(p.y()), canonical(p.z()));
+          if (!at[k].allFinite())
+            fail(path, "a vertex has a non-finite coordinate (NaN or infinity); fix the file");
+        }
+        ++inputFaces;
+        builder.addTriangle({polygon[0], polygon[1], polygon[2]}, at, welded);
+        continue;
+      }
       corners.clear();
       for (std::size_t v : polygon) {
         const Vec3& p = soup->points[v];
