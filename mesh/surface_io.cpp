@@ -9,11 +9,6 @@
 #include <CGAL/IO/OFF.h>
 #include <CGAL/IO/PLY.h>
 #include <CGAL/IO/STL.h>
-#include <assimp/config.h>
-#include <assimp/postprocess.h>
-#include <assimp/scene.h>
-#include <assimp/Importer.hpp>
-
 #include <algorithm>
 #include <array>
 #include <bit>
@@ -38,42 +33,18 @@
 #include <variant>
 #include <vector>
 
+#include "mesh/assimp_import.h"
 #include "mesh/surface_builder.h"
 #include "mesh/surface_text_check.h"
+#include "util/format.h"
+#include "util/modules.h"
 
 namespace polydg {
 
 namespace {
 
-/// Post-processing: apply node transforms (PreTransformVertices also joins meshes per material
-/// and instantiates meshes used by several nodes) and reject scenes with inconsistent indices
-/// or counts. Polygons are not triangulated by assimp (aiProcess_Triangulate): its ear clipping
-/// turns some non-convex faces into overlapping triangles (testdata/Lprism.ply's top face).
-constexpr unsigned kPostProcess = aiProcess_PreTransformVertices | aiProcess_ValidateDataStructure;
-
 [[noreturn]] void fail(const std::string& path, const std::string& what) {
   throw std::runtime_error(path + ": " + what);
-}
-
-/// `text` on one line: line breaks and runs of white space become one space, ends trimmed.
-std::string oneLine(const std::string& text) {
-  std::string out;
-  for (char c : text) {
-    if (std::isspace(static_cast<unsigned char>(c))) {
-      if (!out.empty() && out.back() != ' ') out += ' ';
-    } else {
-      out += c;
-    }
-  }
-  while (!out.empty() && out.back() == ' ') out.pop_back();
-  return out.empty() ? "unknown error" : out;
-}
-
-/// assimp's reason, and CGAL's if CGAL was tried first (`cgalReason` not empty).
-std::string assimpError(const std::string& message, const std::string& cgalReason) {
-  return "assimp cannot read it (" + oneLine(message) + ")" +
-         (cgalReason.empty() ? "" : "; nor can CGAL (" + oneLine(cgalReason) + ")") +
-         "; check that it is a valid mesh file in a format assimp supports";
 }
 
 std::string lowercase(std::string text) {
@@ -149,57 +120,6 @@ void checkDeclaredCounts(const std::string& path, const std::string& head,
   if (!keyword.ends_with("OFF")) return;
   check(tokens[1], "vertices");
   check(tokens[2], "faces");
-}
-
-// --- import -----------------------------------------------------------------------------------
-
-/// True if some mesh has a vertex. Safe on a scene that has not been validated yet.
-bool hasVertices(const aiScene& scene) {
-  for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
-    const aiMesh* mesh = scene.mMeshes ? scene.mMeshes[m] : nullptr;
-    if (mesh != nullptr && mesh->mNumVertices > 0) return true;
-  }
-  return false;
-}
-
-/// True if the scene holds only point clouds, points and lines: no face has three or more
-/// corners, and none is malformed (no corners). Safe on a scene that has not been validated.
-bool onlyPointsOrLines(const aiScene& scene) {
-  for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
-    const aiMesh* mesh = scene.mMeshes ? scene.mMeshes[m] : nullptr;
-    if (mesh == nullptr || mesh->mNumFaces == 0) continue;
-    if (mesh->mFaces == nullptr) return false;
-    for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
-      const unsigned corners = mesh->mFaces[f].mNumIndices;
-      if (corners == 0 || corners >= 3) return false;
-    }
-  }
-  return true;
-}
-
-/// Imports the file and post-processes it, or throws (quoting `cgalReason` too if not empty).
-/// Point clouds are recognised before post-processing because validation rejects their
-/// face-less meshes with a cryptic message.
-const aiScene* importScene(Assimp::Importer& importer, const std::string& path,
-                           const std::string& cgalReason) {
-  // Files holding only a skeleton or animation would otherwise get a made-up mesh of bones.
-  importer.SetPropertyBool(AI_CONFIG_IMPORT_NO_SKELETON_MESHES, true);
-  // assimp reports errors by returning null; the catch is for anything that escapes it.
-  const auto checked = [&](auto step) {
-    const aiScene* scene = nullptr;
-    try {
-      scene = step();
-    } catch (const std::exception& e) {
-      fail(path, assimpError(e.what(), cgalReason));
-    }
-    if (scene == nullptr) fail(path, assimpError(importer.GetErrorString(), cgalReason));
-    return scene;
-  };
-  const aiScene* raw = checked([&] { return importer.ReadFile(path.c_str(), 0); });
-  if (!hasVertices(*raw)) fail(path, "contains no meshes");
-  if (onlyPointsOrLines(*raw))
-    fail(path, "contains only points/lines, no triangles; polydg needs a surface mesh");
-  return checked([&] { return importer.ApplyPostProcessing(kPostProcess); });
 }
 
 // --- CGAL: OBJ, OFF, PLY and STL in double precision --------------------------------------------
@@ -570,8 +490,6 @@ TriangleSurface readSurface(const std::string& path, SurfaceReadInfo* info) {
       soup = std::move(std::get<PolygonSoup>(read));
   }
 
-  // Made only for the formats CGAL does not read: it sets up every assimp importer.
-  std::optional<Assimp::Importer> importer;
   if (soup) {
     if (soup->onlyPointsOrLines)
       fail(path, "contains only points/lines, no triangles; polydg needs a surface mesh");
@@ -604,22 +522,23 @@ TriangleSurface readSurface(const std::string& path, SurfaceReadInfo* info) {
     counts.ignoredLines += soup->ignoredLines;
     counts.warnings = std::move(soup->warnings);
   } else {
-    const aiScene* scene = importScene(importer.emplace(), path, cgalReason);
+    const ImportedScene scene = importWithAssimp(path, cgalReason);
+    if (!scene.error.empty()) fail(path, scene.error);
     counts.reader = "assimp";
-    counts.meshes = scene->mNumMeshes;
-    for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
-      const aiMesh& mesh = *scene->mMeshes[m];
-      counts.inputVertices += mesh.mNumVertices;
-      for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
-        const aiFace& face = mesh.mFaces[f];
+    counts.meshes = scene.meshes.size();
+    for (std::size_t m = 0; m < scene.meshes.size(); ++m) {
+      const ImportedMesh& mesh = scene.meshes[m];
+      counts.inputVertices += mesh.vertices.size();
+      std::size_t next = 0;
+      for (const unsigned size : mesh.faceSizes) {
         corners.clear();
-        for (unsigned k = 0; k < face.mNumIndices; ++k) {
-          const unsigned v = face.mIndices[k];
-          if (v >= mesh.mNumVertices)
+        for (unsigned k = 0; k < size; ++k) {
+          const unsigned v = mesh.corners[next++];
+          if (v >= mesh.vertices.size())
             fail(path, "mesh " + std::to_string(m) + " refers to vertex " + std::to_string(v) +
-                           " of " + std::to_string(mesh.mNumVertices) + "; the file is corrupt");
-          const aiVector3D& p = mesh.mVertices[v];
-          corners.emplace_back(canonical(p.x), canonical(p.y), canonical(p.z));
+                           " of " + std::to_string(mesh.vertices.size()) + "; the file is corrupt");
+          const Vec3& p = mesh.vertices[v];
+          corners.emplace_back(canonical(p.x()), canonical(p.y()), canonical(p.z()));
         }
         addFace();
       }
@@ -636,6 +555,16 @@ TriangleSurface readSurface(const std::string& path, SurfaceReadInfo* info) {
   counts.triangles = builder.numTriangles();
   if (info != nullptr) *info = counts;
   return builder.take();
+}
+
+ImportedScene importWithAssimp(const std::string& path, const std::string& cgalReason) {
+  // Loaded once; a failure is not remembered, so a later call tries again.
+  static const auto import = reinterpret_cast<ImportWithAssimp>(
+      loadModuleEntry(POLYDG_ASSIMP_MODULE, POLYDG_BIN_TO_LIB, kImportWithAssimp,
+                      "reading " + path + " (a format CGAL does not read)", "reinstall polydg"));
+  ImportedScene scene;
+  import(path, cgalReason, scene);
+  return scene;
 }
 
 }  // namespace polydg
