@@ -5,6 +5,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <boost/container/small_vector.hpp>
 
 namespace polydg {
 
@@ -138,9 +139,16 @@ bool isGridHexahedron(const PolyMesh& mesh, ElementId e) {
 }
 
 bool isConvex(const PolyMesh& mesh, ElementId e, double relativeTolerance) {
-  const Box3 box = elementBounds(mesh, e);
+  // The corners of every face, in one array: a vertex met more than once is tested more than
+  // once, which changes no answer and costs less than finding the distinct ones.
+  boost::container::small_vector<Vec3, 64> corners;
+  Box3 box;
+  for (const FaceUse& use : mesh.element(e).faces)
+    for (VertexId v : mesh.face(use.face).vertices) {
+      corners.push_back(mesh.position(v));
+      box.extend(corners.back());
+    }
   const double tolerance = relativeTolerance * box.diagonal().norm();
-  const std::vector<VertexId> vertices = elementVertices(mesh, e);
   for (const FaceUse& use : mesh.element(e).faces) {
     // A face narrower than the tolerance (area / diameter) cannot show non-convexity at that
     // tolerance, and the normal of a face of round-off width means nothing.
@@ -149,8 +157,8 @@ bool isConvex(const PolyMesh& mesh, ElementId e, double relativeTolerance) {
     Vec3 n = a.normalized();
     if (use.reversed) n = -n;
     const Vec3& c = faceReferencePoint(mesh, use.face);
-    for (VertexId v : vertices)
-      if (n.dot(mesh.position(v) - c) > tolerance) return false;
+    for (const Vec3& x : corners)
+      if (n.dot(x - c) > tolerance) return false;
   }
   return true;
 }

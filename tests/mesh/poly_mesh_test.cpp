@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdint>
 #include <random>
 #include <stdexcept>
@@ -11,7 +12,9 @@
 
 #include "mesh/primitives.h"
 #include "polydg/mesh/geometry.h"
+#include "polydg/mesh/slice.h"
 #include "polydg/mesh/surface.h"
+#include "polydg/mesh/surface_shapes.h"
 #include "tests/support/shapes.h"
 
 namespace polydg {
@@ -158,6 +161,51 @@ TEST(Geometry, BoundsAndAreaVectorsOfShearedStarPrisms) {
       EXPECT_GT(area.norm(), 0.0);
     }
   }
+}
+
+// Convex: grid cells, a hexagonal prism and every cell of a sliced icosphere (a convex solid
+// cut by boxes); not convex: an L-shaped prism, and some cells of a sliced torus (those around
+// its hole), though none of its whole grid cells.
+TEST(Geometry, IsConvexTellsConvexCellsFromNonConvexOnes) {
+  const PolyMesh grid = hexGridMesh(2, 2, 2, Box3(Vec3(-1.0, 2.0, 3.0), Vec3(1.0, 3.0, 3.5)));
+  for (std::size_t e = 0; e < grid.numElements(); ++e) EXPECT_TRUE(isConvex(grid, ElementId(e)));
+  Polygon2 hexagon, l;
+  for (int k = 0; k < 6; ++k)
+    hexagon.outer.emplace_back(std::cos(k * M_PI / 3.0), std::sin(k * M_PI / 3.0));
+  l.outer = {{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}};
+  EXPECT_TRUE(isConvex(prismMesh(hexagon, 0.0, 0.7, Vec2(0.3, -0.2)), ElementId(0)));
+  EXPECT_FALSE(isConvex(prismMesh(l, 0.0, 0.5, Vec2(0.5, 0.25)), ElementId(0)));
+
+  const TriangleSurface ball = icosphere(Vec3(1e3, -2e3, 5e2), 1.0, 3);
+  const PolyMesh sliced = sliceSurface(ball, Grid::withCellsAlongLongest(bounds(ball), 6));
+  for (std::size_t e = 0; e < sliced.numElements(); ++e)
+    EXPECT_TRUE(isConvex(sliced, ElementId(e))) << "element " << e;
+  const TriangleSurface ring = torus(Vec3::Zero(), 1.0, 0.35, 48, 24);
+  const PolyMesh ringCells = sliceSurface(ring, Grid::withCellsAlongLongest(bounds(ring), 8));
+  // The definition, as a reference: no distinct vertex more than the tolerance (1e-9 of the
+  // diagonal) outside the plane of a face that is wider than the tolerance.
+  auto convexByDefinition = [](const PolyMesh& mesh, ElementId e) {
+    const std::vector<VertexId> vertices = elementVertices(mesh, e);
+    Box3 box;
+    for (VertexId v : vertices) box.extend(mesh.position(v));
+    const double tolerance = 1e-9 * box.diagonal().norm();
+    for (const FaceUse& use : mesh.element(e).faces) {
+      const Vec3 a = areaVector(mesh, use.face);
+      if (a.norm() <= tolerance * faceBounds(mesh, use.face).diagonal().norm()) continue;
+      const Vec3 n = (use.reversed ? -1.0 : 1.0) * a.normalized();
+      for (VertexId v : vertices)
+        if (n.dot(mesh.position(v) - faceReferencePoint(mesh, use.face)) > tolerance) return false;
+    }
+    return true;
+  };
+  std::size_t nonConvex = 0;
+  for (std::size_t e = 0; e < ringCells.numElements(); ++e) {
+    const bool convex = isConvex(ringCells, ElementId(e));
+    nonConvex += !convex;
+    EXPECT_EQ(convex, convexByDefinition(ringCells, ElementId(e))) << "element " << e;
+    if (isGridHexahedron(ringCells, ElementId(e))) EXPECT_TRUE(convex) << "element " << e;
+  }
+  EXPECT_GT(nonConvex, 0u);
 }
 
 TEST(SurfaceTopology, CountsBoundaryNonManifoldAndMisorientedEdges) {
