@@ -21,6 +21,7 @@
 #include <pugixml.hpp>
 
 #include "mesh/xml_escape.h"
+#include "util/uninitialized.h"
 
 namespace polydg::vtk_format {
 
@@ -197,7 +198,7 @@ constexpr std::size_t kFillGrain = 1 << 14;
 template <class T, class Fill, class F>
 void forEachChunk(const ArrayOut& a, const Fill& fill, F&& f) {
   const std::size_t chunk = std::max<std::size_t>(a.chunk, 1);
-  std::vector<T> run(std::min(a.size(), chunk));
+  UninitializedVector<T> run(std::min(a.size(), chunk));  // every value is filled below
   for (std::size_t begin = 0; begin < a.size(); begin += chunk) {
     const std::size_t end = std::min(a.size(), begin + chunk);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(begin, end, kFillGrain),
