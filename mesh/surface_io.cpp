@@ -1,7 +1,8 @@
 // Reading surfaces: guard the header counts; read OBJ/OFF/PLY/STL in double precision through
 // CGAL's polygon-soup readers (after checks for what they misread) and everything else, or what
-// CGAL cannot read, through assimp with transforms baked in; then weld by exact position and
-// triangulate polygons exactly (mesh/surface_builder.h).
+// CGAL cannot read, through assimp with transforms baked in (the module libpolydg_assimp.so,
+// mesh/assimp_import.h); then weld by exact position and triangulate polygons exactly
+// (mesh/surface_builder.h).
 #include "polydg/mesh/surface_io.h"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
@@ -9,6 +10,7 @@
 #include <CGAL/IO/OFF.h>
 #include <CGAL/IO/PLY.h>
 #include <CGAL/IO/STL.h>
+
 #include <algorithm>
 #include <array>
 #include <bit>
