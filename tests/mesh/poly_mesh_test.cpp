@@ -203,7 +203,9 @@ TEST(Geometry, IsConvexTellsConvexCellsFromNonConvexOnes) {
     const bool convex = isConvex(ringCells, ElementId(e));
     nonConvex += !convex;
     EXPECT_EQ(convex, convexByDefinition(ringCells, ElementId(e))) << "element " << e;
-    if (isGridHexahedron(ringCells, ElementId(e))) EXPECT_TRUE(convex) << "element " << e;
+    if (isGridHexahedron(ringCells, ElementId(e))) {
+      EXPECT_TRUE(convex) << "element " << e;
+    }
   }
   EXPECT_GT(nonConvex, 0u);
 }
