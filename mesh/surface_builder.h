@@ -17,6 +17,10 @@ namespace polydg {
 /// A coordinate widened to double, with -0.0 replaced by 0.0: after this, two coordinates are
 /// equal exactly when their bits are.
 inline double canonical(double x) { return x == 0 ? 0.0 : x; }
+/// A position with each coordinate canonical().
+inline Vec3 canonical(const Vec3& p) {
+  return {canonical(p.x()), canonical(p.y()), canonical(p.z())};
+}
 
 /// Builds the surface: triangles go in as given, vertices are shared by exact position and
 /// numbered in order of first use. Counts what it drops or fans in `info`.
@@ -28,10 +32,7 @@ class SurfaceBuilder {
   /// Adds triangle (a, b, c), or counts it as degenerate if two corners are at one position.
   void addTriangle(const Vec3& a, const Vec3& b, const Vec3& c) {
     const PositionKey ka = keyOf(a), kb = keyOf(b), kc = keyOf(c);
-    if (ka == kb || kb == kc || kc == ka) {
-      ++info_.droppedDegenerate;
-      return;
-    }
+    if (droppedAsDegenerate(ka, kb, kc)) return;
     surface_.triangles.push_back({id(ka, a), id(kb, b), id(kc, c)});
   }
 
@@ -48,10 +49,7 @@ class SurfaceBuilder {
   void addTriangle(const std::array<std::size_t, 3>& corners, const std::array<Vec3, 3>& at,
                    std::vector<std::uint32_t>& welded) {
     const PositionKey keys[3] = {keyOf(at[0]), keyOf(at[1]), keyOf(at[2])};
-    if (keys[0] == keys[1] || keys[1] == keys[2] || keys[2] == keys[0]) {
-      ++info_.droppedDegenerate;
-      return;
-    }
+    if (droppedAsDegenerate(keys[0], keys[1], keys[2])) return;
     std::array<std::uint32_t, 3> t;
     for (int k = 0; k < 3; ++k) {
       std::uint32_t& w = welded[corners[k]];
@@ -89,6 +87,13 @@ class SurfaceBuilder {
   static PositionKey keyOf(const Vec3& p) {
     return {std::bit_cast<std::uint64_t>(p.x()), std::bit_cast<std::uint64_t>(p.y()),
             std::bit_cast<std::uint64_t>(p.z())};
+  }
+
+  /// True, and counted, if two corners of a triangle are at one position.
+  bool droppedAsDegenerate(const PositionKey& a, const PositionKey& b, const PositionKey& c) {
+    if (a != b && b != c && c != a) return false;
+    ++info_.droppedDegenerate;
+    return true;
   }
 
   /// The id of the vertex at `p` (key `key`), added if new; throws past 2^32 - 1 vertices.

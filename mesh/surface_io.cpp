@@ -458,6 +458,10 @@ TriangleSurface readSurface(const std::string& path, SurfaceReadInfo* info) {
   SurfaceBuilder builder(path, counts);
   std::size_t inputFaces = 0;  // faces with three or more corners
   std::vector<Vec3> corners;
+  const auto requireFinite = [&](const Vec3& p) {
+    if (!p.allFinite())
+      fail(path, "a vertex has a non-finite coordinate (NaN or infinity); fix the file");
+  };
   // Adds a face whose corners are in `corners` (points and lines are counted, not added).
   const auto addFace = [&] {
     if (corners.empty()) return;
@@ -470,9 +474,7 @@ TriangleSurface readSurface(const std::string& path, SurfaceReadInfo* info) {
       return;
     }
     ++inputFaces;
-    for (const Vec3& p : corners)
-      if (!p.allFinite())
-        fail(path, "a vertex has a non-finite coordinate (NaN or infinity); fix the file");
+    for (const Vec3& p : corners) requireFinite(p);
     if (corners.size() == 3) {
       builder.addTriangle(corners[0], corners[1], corners[2]);
     } else {
@@ -504,20 +506,15 @@ TriangleSurface readSurface(const std::string& path, SurfaceReadInfo* info) {
       if (polygon.size() == 3) {  // nearly every face: its points welded once each
         std::array<Vec3, 3> at;
         for (int k = 0; k < 3; ++k) {
-          const Vec3& p = soup->points[polygon[k]];
-          at[k] = Vec3(canonical(p.x()), canonical(p.y()), canonical(p.z()));
-          if (!at[k].allFinite())
-            fail(path, "a vertex has a non-finite coordinate (NaN or infinity); fix the file");
+          at[k] = canonical(soup->points[polygon[k]]);
+          requireFinite(at[k]);
         }
         ++inputFaces;
         builder.addTriangle({polygon[0], polygon[1], polygon[2]}, at, welded);
         continue;
       }
       corners.clear();
-      for (std::size_t v : polygon) {
-        const Vec3& p = soup->points[v];
-        corners.emplace_back(canonical(p.x()), canonical(p.y()), canonical(p.z()));
-      }
+      for (std::size_t v : polygon) corners.push_back(canonical(soup->points[v]));
       addFace();
     }
     counts.ignoredPoints += soup->ignoredPoints;
@@ -539,8 +536,7 @@ TriangleSurface readSurface(const std::string& path, SurfaceReadInfo* info) {
           if (v >= mesh.vertices.size())
             fail(path, "mesh " + std::to_string(m) + " refers to vertex " + std::to_string(v) +
                            " of " + std::to_string(mesh.vertices.size()) + "; the file is corrupt");
-          const Vec3& p = mesh.vertices[v];
-          corners.emplace_back(canonical(p.x()), canonical(p.y()), canonical(p.z()));
+          corners.push_back(canonical(mesh.vertices[v]));
         }
         addFace();
       }
