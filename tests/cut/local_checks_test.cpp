@@ -32,11 +32,11 @@
 namespace polydg {
 namespace {
 
-constexpr std::uint64_t kSeed = 20261204;
+constexpr std::uint64_t kLocalChecksSeed = 20261204;
 /// Cuts, each on a fresh copy of the sliced block (as `polydg cut b.vtu --plane ...` runs them),
 /// made in batches of kCutsPerBatch (one ctest entry each: full validation of every cut is
 /// most of the cost, ~1 s a cut on a loaded machine).
-constexpr int kCuts = 15;
+constexpr int kLocalChecksCuts = 15;
 constexpr int kCutsPerBatch = 5;
 
 /// The cheese of the test, meshed once: 19 crossing holes, 12 cells along x (424 elements).
@@ -51,13 +51,13 @@ const MeshingResult& cheeseBlock() {
   return block;
 }
 
-/// The kCuts blades: a uniform point of the block's bounding box and a normal uniform in
-/// [-1, 1]^3, from kSeed.
+/// The kLocalChecksCuts blades: a uniform point of the block's bounding box and a normal uniform in
+/// [-1, 1]^3, from kLocalChecksSeed.
 std::vector<Blade> randomBlades(const Box3& box) {
-  std::mt19937_64 rng(kSeed);
+  std::mt19937_64 rng(kLocalChecksSeed);
   std::uniform_real_distribution<double> unit(0.0, 1.0), component(-1.0, 1.0);
   std::vector<Blade> blades;
-  for (int i = 0; i < kCuts; ++i) {
+  for (int i = 0; i < kLocalChecksCuts; ++i) {
     const Vec3 p = box.min() + Vec3(unit(rng), unit(rng), unit(rng)).cwiseProduct(box.sizes());
     Vec3 n(component(rng), component(rng), component(rng));
     if (n.squaredNorm() == 0.0) n = Vec3::UnitX();
@@ -69,7 +69,7 @@ std::vector<Blade> randomBlades(const Box3& box) {
 class LocalChecks : public ::testing::TestWithParam<int> {};
 
 TEST_P(LocalChecks, AgreesWithFullOnRandomCutsThroughSwissCheese) {
-  std::printf("seed %llu\n", static_cast<unsigned long long>(kSeed));
+  std::printf("seed %llu\n", static_cast<unsigned long long>(kLocalChecksSeed));
   const MeshingResult& block = cheeseBlock();
   ASSERT_TRUE(block.report.geometry.passed);
   const std::vector<Blade> blades = randomBlades(meshBounds(block.mesh));
@@ -84,8 +84,8 @@ TEST_P(LocalChecks, AgreesWithFullOnRandomCutsThroughSwissCheese) {
     const Vec3& n = blade.normal;
     std::ostringstream where;
     where.precision(17);
-    where << "cut " << i << " (seed " << kSeed << "), --plane " << n.x() << "," << n.y() << ","
-          << n.z() << "," << blade.offset;
+    where << "cut " << i << " (seed " << kLocalChecksSeed << "), --plane " << n.x() << "," << n.y()
+          << "," << n.z() << "," << blade.offset;
     CutOptions options;
     options.checks = CheckLevel::Local;
     MeshEditor local(block.mesh);
@@ -126,7 +126,8 @@ TEST_P(LocalChecks, AgreesWithFullOnRandomCutsThroughSwissCheese) {
       fullSeconds, split, regionElements, regionComponents, localFailures, fullFailures);
 }
 
-INSTANTIATE_TEST_SUITE_P(Batches, LocalChecks, ::testing::Range(0, kCuts / kCutsPerBatch));
+INSTANTIATE_TEST_SUITE_P(Batches, LocalChecks,
+                         ::testing::Range(0, kLocalChecksCuts / kCutsPerBatch));
 
 }  // namespace
 }  // namespace polydg

@@ -27,7 +27,7 @@ constexpr int kCuts = 1000;
 /// to (n^3 + 5n + 6) / 6 components (40,560 after 100 of these cuts): the 1000 cuts are made
 /// as sequences of this many on fresh copies of the sphere.
 constexpr int kCutsPerSphere = 10;
-constexpr double kVolumeTolerance = 1e-10;
+constexpr double kRandomCutsVolumeTolerance = 1e-10;
 
 /// Components as unions of elements that list the same face (element face lists only, not the
 /// faces' front/back links that checkGeometry() and the editor use).
@@ -95,8 +95,8 @@ TEST(RandomCuts, ThousandCutsThroughSlicedSpheres) {
 
       const GeometryCheck check = checkGeometry(editor.mesh());
       ASSERT_TRUE(check.passed) << where << ": " << check.messages.front();
-      ASSERT_NEAR(check.volume, volume, kVolumeTolerance * volume) << where;
-      ASSERT_NEAR(editor.volume(), volume, kVolumeTolerance * volume) << where;
+      ASSERT_NEAR(check.volume, volume, kRandomCutsVolumeTolerance * volume) << where;
+      ASSERT_NEAR(editor.volume(), volume, kRandomCutsVolumeTolerance * volume) << where;
       ASSERT_EQ(check.components, componentsFromFaceLists(editor.mesh())) << where;
       ASSERT_EQ(check.components, componentsFromPlaneSides(editor, planes)) << where;
     }

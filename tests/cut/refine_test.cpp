@@ -15,7 +15,7 @@
 namespace polydg {
 namespace {
 
-constexpr double kVolumeTolerance = 1e-12;
+constexpr double kRefineVolumeTolerance = 1e-12;
 
 /// The three mid-planes of element e's bounding box (1-to-8).
 ElementRefinement octants(const PolyMesh& mesh, ElementId e) {
@@ -42,8 +42,8 @@ std::size_t countOrigin(const PolyMesh& mesh, FaceOrigin origin) {
 void expectValid(const MeshEditor& editor, double volume) {
   const GeometryCheck report = checkGeometry(editor.mesh());
   ASSERT_TRUE(report.passed) << (report.messages.empty() ? "" : report.messages.front());
-  EXPECT_NEAR(report.volume, volume, kVolumeTolerance * volume);
-  EXPECT_NEAR(editor.volume(), volume, kVolumeTolerance * volume);
+  EXPECT_NEAR(report.volume, volume, kRefineVolumeTolerance * volume);
+  EXPECT_NEAR(editor.volume(), volume, kRefineVolumeTolerance * volume);
   MomentCache fresh(editor.mesh(), editor.moments().degree());
   fresh.update();
   for (std::size_t e = 0; e < editor.mesh().numElements(); ++e) {

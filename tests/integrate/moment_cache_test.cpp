@@ -9,20 +9,20 @@
 namespace polydg {
 namespace {
 
-constexpr double kTolerance = 1e-13;
-constexpr int kDegree = 4;
+constexpr double kCacheTolerance = 1e-13;
+constexpr int kCacheDegree = 4;
 
 void expectElementMatchesOneShot(const PolyMesh& mesh, const MomentCache& cache, ElementId e) {
-  const auto expected = elementMoments(mesh, e, kDegree, cache.elementOrigin(e));
+  const auto expected = elementMoments(mesh, e, kCacheDegree, cache.elementOrigin(e));
   const auto actual = cache.element(e);
   for (std::size_t i = 0; i < expected.size(); ++i)
-    EXPECT_NEAR(actual[i], expected[i], kTolerance * std::max(1.0, std::abs(expected[i])))
+    EXPECT_NEAR(actual[i], expected[i], kCacheTolerance * std::max(1.0, std::abs(expected[i])))
         << "element " << e.value << " monomial " << i;
 }
 
 TEST(MomentCache, IntegratesEachSharedFaceOnce) {
   const PolyMesh mesh = hexGridMesh(3, 4, 5, Box3(Vec3(-1, 0, 2), Vec3(2, 1, 4)));
-  MomentCache cache(mesh, kDegree);
+  MomentCache cache(mesh, kCacheDegree);
   EXPECT_EQ(cache.update(), mesh.numFaces());
   EXPECT_EQ(cache.facesIntegrated(), mesh.numFaces());
   // 3*4*5 hexes: faces = (4*4*5) + (3*5*5) + (3*4*6) = 80 + 75 + 72.
@@ -38,7 +38,7 @@ TEST(MomentCache, IntegratesEachSharedFaceOnce) {
 
 TEST(MomentCache, InvalidatingAFaceRecomputesOnlyThatFace) {
   PolyMesh mesh = hexGridMesh(2, 2, 2, Box3(Vec3(0, 0, 0), Vec3(1, 1, 1)));
-  MomentCache cache(mesh, kDegree);
+  MomentCache cache(mesh, kCacheDegree);
   cache.update();
   const std::vector<double> before(cache.element(ElementId(7)).begin(),
                                    cache.element(ElementId(7)).end());
@@ -70,7 +70,7 @@ TEST(MomentCache, InvalidatingAFaceRecomputesOnlyThatFace) {
 
 TEST(MomentCache, SyncPicksUpAppendedElements) {
   PolyMesh mesh = hexGridMesh(1, 1, 1, Box3(Vec3(0, 0, 0), Vec3(1, 1, 1)));
-  MomentCache cache(mesh, kDegree);
+  MomentCache cache(mesh, kCacheDegree);
   cache.update();
   // Append a second box sharing no vertices.
   const std::size_t first = mesh.numVertices();

@@ -27,7 +27,7 @@ namespace polydg {
 namespace {
 
 /// Volume kept by slicing: the exact polyhedral volume up to round-off (issue 3).
-constexpr double kVolumeTolerance = 1e-10;
+constexpr double kMeshingVolumeTolerance = 1e-10;
 
 bool hasPhase(const MeshingReport& r, const std::string& phase) {
   return std::any_of(r.timings.begin(), r.timings.end(),
@@ -53,7 +53,7 @@ TEST(Meshing, ClosedSurfaceReportsItsDiagnosisAndEveryPhase) {
   EXPECT_EQ(r.selfIntersections, 0u);
   EXPECT_EQ(r.shells, 1u);
   EXPECT_TRUE(r.repairs.empty());
-  EXPECT_LT(r.volumeRelError, kVolumeTolerance);
+  EXPECT_LT(r.volumeRelError, kMeshingVolumeTolerance);
   for (const char* phase : {"check", "orient", "slice", "merge_slivers", "validate"})
     EXPECT_TRUE(hasPhase(r, phase)) << phase;
   // The whole is at least as long as any phase inside it (phases may overlap).
@@ -78,7 +78,7 @@ TEST(Meshing, SelfIntersectingClosedSurfaceIsRefusedOrWrapped) {
   EXPECT_GT(m.report.selfIntersections, 0u);
   ASSERT_FALSE(m.report.repairs.empty());
   EXPECT_NE(m.report.repairs[0].find("alpha-wrapped"), std::string::npos);
-  EXPECT_LT(m.report.volumeRelError, kVolumeTolerance);
+  EXPECT_LT(m.report.volumeRelError, kMeshingVolumeTolerance);
 }
 
 TEST(Meshing, InwardSurfaceIsReorientedAndKeepsItsVolume) {
@@ -91,7 +91,7 @@ TEST(Meshing, InwardSurfaceIsReorientedAndKeepsItsVolume) {
   EXPECT_EQ(inward.report.elements, outward.report.elements);
   EXPECT_LT(std::abs(inward.report.outputVolume - outward.report.outputVolume) /
                 outward.report.outputVolume,
-            kVolumeTolerance);
+            kMeshingVolumeTolerance);
 }
 
 // One consistently oriented shell takes the shortcut of orientToBoundVolume(): the sign of its
@@ -141,7 +141,7 @@ TEST(Meshing, GeometryChecksCanBeLeftToTheCaller) {
   EXPECT_TRUE(m.report.geometry.passed);
   EXPECT_EQ(m.report.elements, m.mesh.numElements());
   EXPECT_EQ(m.report.hexahedra + m.report.polyhedra, m.report.elements);
-  EXPECT_LT(m.report.volumeRelError, kVolumeTolerance);
+  EXPECT_LT(m.report.volumeRelError, kMeshingVolumeTolerance);
 }
 
 TEST(Meshing, WholeCellsAreHexahedraAndCountAsWhatTheShapesSay) {
@@ -206,7 +206,7 @@ void expectMeshesExactly(const TriangleSurface& surface, const MeshingOptions& o
   const MeshingResult m = meshSurface(surface, options);
   EXPECT_TRUE(m.report.geometry.passed);
   EXPECT_EQ(m.report.elements, elements);
-  EXPECT_LT(std::abs(m.report.outputVolume - volume) / volume, kVolumeTolerance)
+  EXPECT_LT(std::abs(m.report.outputVolume - volume) / volume, kMeshingVolumeTolerance)
       << m.report.outputVolume << " vs " << volume;
   MomentCache moments(m.mesh, 6);
   moments.update();
@@ -309,7 +309,7 @@ TEST(Meshing, SwissCheeseBlockMeshesToItsKnownVolume) {
   // hole directions shares the 27 crossings, all three share them too.
   const double volume = 11 * 10 * 9 - (99 + 90 + 81) + 3 * 27 - 27;
   EXPECT_EQ(swissCheeseVolume(uniformCheeseWalls(box, n)), volume);
-  EXPECT_LT(std::abs(enclosedVolume(cheese) - volume) / volume, kVolumeTolerance);
+  EXPECT_LT(std::abs(enclosedVolume(cheese) - volume) / volume, kMeshingVolumeTolerance);
 
   const MeshingResult m = meshSurface(cheese, cells(16));
   const MeshingReport& r = m.report;
@@ -322,7 +322,7 @@ TEST(Meshing, SwissCheeseBlockMeshesToItsKnownVolume) {
   EXPECT_EQ(r.cavities, 0u);
   EXPECT_TRUE(r.repairs.empty());
   EXPECT_EQ(r.geometry.components, 1u);
-  EXPECT_LT(std::abs(r.outputVolume - volume) / volume, kVolumeTolerance);
+  EXPECT_LT(std::abs(r.outputVolume - volume) / volume, kMeshingVolumeTolerance);
 }
 
 TEST(Meshing, SwissCheeseWithWallsJustOffTheGridPlanes) {
@@ -334,8 +334,8 @@ TEST(Meshing, SwissCheeseWithWallsJustOffTheGridPlanes) {
   EXPECT_EQ(m.report.selfIntersections, 0u);
   EXPECT_GT(m.report.slivers.merged, 0u);
   const double volume = swissCheeseVolume(walls);
-  EXPECT_LT(std::abs(m.report.inputVolume - volume) / volume, kVolumeTolerance);
-  EXPECT_LT(std::abs(m.report.outputVolume - volume) / volume, kVolumeTolerance);
+  EXPECT_LT(std::abs(m.report.inputVolume - volume) / volume, kMeshingVolumeTolerance);
+  EXPECT_LT(std::abs(m.report.outputVolume - volume) / volume, kMeshingVolumeTolerance);
 }
 
 TEST(Meshing, TorusObjAtCellCountsPuttingAVertexOnOneGridPlaneAndNearAnother) {
@@ -350,7 +350,7 @@ TEST(Meshing, TorusObjAtCellCountsPuttingAVertexOnOneGridPlaneAndNearAnother) {
     EXPECT_TRUE(m.report.geometry.passed);
     EXPECT_EQ(m.report.geometry.components, 1u);
     EXPECT_LT(std::abs(m.report.outputVolume - m.report.inputVolume) / m.report.inputVolume,
-              kVolumeTolerance);
+              kMeshingVolumeTolerance);
   }
 }
 

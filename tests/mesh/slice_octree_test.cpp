@@ -20,7 +20,7 @@ namespace polydg {
 namespace {
 
 /// Octree and uniform volumes agree to round-off: sums of some 10^4 rounded element volumes.
-constexpr double kVolumeTolerance = 1e-12;
+constexpr double kOctreeVolumeTolerance = 1e-12;
 
 /// How far the volume may move when slicing welds points closer than the coordinates resolve
 /// (8 ulps of the largest coordinate, sliceSurface()): which point of a welded group stands for
@@ -71,7 +71,7 @@ OctreeShape checkOctree(const OctreeCase& c) {
   EXPECT_EQ(check.components, c.components);
   const double exact = enclosedVolume(c.surface);
   const double uniformVolume = checkGeometry(uniform).volume;
-  const double tolerance = std::max(kVolumeTolerance * exact, weldingTolerance(c.surface));
+  const double tolerance = std::max(kOctreeVolumeTolerance * exact, weldingTolerance(c.surface));
   EXPECT_NEAR(check.volume, uniformVolume, tolerance);
   EXPECT_NEAR(check.volume, exact, tolerance);
   EXPECT_LE(mesh.numElements(), uniform.numElements());
@@ -81,8 +81,9 @@ OctreeShape checkOctree(const OctreeCase& c) {
   for (std::size_t f = 0; f < mesh.numFaces(); ++f)
     if (!mesh.face(FaceId(f)).back.valid()) boundaryArea += areaVector(mesh, FaceId(f)).norm();
   const double area = surfaceArea(c.surface);
-  EXPECT_NEAR(boundaryArea, area,
-              std::max(kVolumeTolerance * area, weldingTolerance(c.surface) / std::sqrt(area)));
+  EXPECT_NEAR(
+      boundaryArea, area,
+      std::max(kOctreeVolumeTolerance * area, weldingTolerance(c.surface) / std::sqrt(area)));
 
   EXPECT_EQ(level.size(), mesh.numElements());
   if (level.size() != mesh.numElements()) return shape;

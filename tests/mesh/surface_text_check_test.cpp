@@ -24,7 +24,7 @@ namespace {
 using polydg::testing::TempDir;
 
 /// The tetrahedron's volume is exact (integer coordinates) up to round-off.
-constexpr double kExactRelTol = 1e-12;
+constexpr double kTextExactRelTol = 1e-12;
 
 using Lines = std::vector<std::string>;
 
@@ -87,7 +87,7 @@ std::string joined(const Lines& lines, const std::string& end = "\n") {
   return text;
 }
 
-double relativeError(double value, double exact) {
+double textRelativeError(double value, double exact) {
   return std::abs(value - exact) / std::abs(exact);
 }
 
@@ -107,7 +107,7 @@ std::vector<std::string> tetraWarnings(const TempDir& dir, const std::string& fi
   const TriangleSurface s = readSurface(path, &info);
   EXPECT_EQ(info.reader, "cgal");
   EXPECT_EQ(s.triangles.size(), 4u);
-  EXPECT_LT(relativeError(enclosedVolume(s), 4.0), kExactRelTol) << enclosedVolume(s);
+  EXPECT_LT(textRelativeError(enclosedVolume(s), 4.0), kTextExactRelTol) << enclosedVolume(s);
   return info.warnings;
 }
 

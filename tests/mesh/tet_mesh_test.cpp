@@ -32,7 +32,7 @@ namespace fs = std::filesystem;
 using Tet = std::array<std::uint32_t, 4>;
 
 /// Volumes here are sums of a few dozen exact sixths: they agree to round-off.
-constexpr double kVolumeTolerance = 1e-14;
+constexpr double kTetVolumeTolerance = 1e-14;
 
 // ============================================================================================
 // Meshes
@@ -276,8 +276,8 @@ TEST(TetMeshToPolyMesh, SharesFacesAndPassesCheckGeometry) {
     EXPECT_EQ(check.interiorFaces, c.interior);
     EXPECT_EQ(check.boundaryFaces, 48u);
     EXPECT_EQ(check.components, 1u);
-    EXPECT_NEAR(check.volume, 8.0, kVolumeTolerance);
-    EXPECT_NEAR(volume(c.mesh), 8.0, kVolumeTolerance);
+    EXPECT_NEAR(check.volume, 8.0, kTetVolumeTolerance);
+    EXPECT_NEAR(volume(c.mesh), 8.0, kTetVolumeTolerance);
     EXPECT_EQ(poly.numVertices(), c.mesh.numVertices());
     for (std::size_t f = 0; f < poly.numFaces(); ++f) {
       const Face& face = poly.face(FaceId(f));
@@ -537,7 +537,7 @@ TEST_F(TetMeshRead, CubesReadAlikeFromEveryFormat) {
   ASSERT_EQ(cubes.numVertices(), 27u);
   ASSERT_EQ(cubes.numTets(), 48u);
   // Half the tets are written negatively oriented: the readers must turn them.
-  EXPECT_NEAR(volume(cubes), 0.0, kVolumeTolerance);
+  EXPECT_NEAR(volume(cubes), 0.0, kTetVolumeTolerance);
   std::map<std::string, fs::path> files = {
       {"vtu ascii", file("ascii.vtu", vtuText(cubes, VtuEncoding::Ascii))},
       {"vtu binary", file("binary.vtu", vtuText(cubes, VtuEncoding::Binary))},
@@ -550,7 +550,7 @@ TEST_F(TetMeshRead, CubesReadAlikeFromEveryFormat) {
     const TetMesh read = readTetMesh(path.string());
     EXPECT_EQ(read.vertices, cubes.vertices);
     expectSameTets(cubes, read);
-    EXPECT_NEAR(volume(read), 8.0, kVolumeTolerance);
+    EXPECT_NEAR(volume(read), 8.0, kTetVolumeTolerance);
   }
 }
 
@@ -587,7 +587,7 @@ TEST_F(TetMeshRead, InvertedTetsAreReoriented) {
     EXPECT_EQ(read.tets[t][0], inverted.tets[t][0]);
     EXPECT_EQ(read.tets[t][2], inverted.tets[t][3]);
   }
-  EXPECT_NEAR(volume(read), 8.0, kVolumeTolerance);
+  EXPECT_NEAR(volume(read), 8.0, kTetVolumeTolerance);
 }
 
 TEST_F(TetMeshRead, TetgenCommentsAttributesAndTenNodeTets) {
@@ -632,10 +632,10 @@ TEST_F(TetMeshRead, ReadsFilesMadeByTetgenAndGmsh) {
     SCOPED_TRACE(name);
     const TetMesh mesh = readTetMesh(data + "/" + name);
     EXPECT_GT(mesh.numTets(), 20u);
-    EXPECT_NEAR(volume(mesh), 1.0, kVolumeTolerance);
+    EXPECT_NEAR(volume(mesh), 1.0, kTetVolumeTolerance);
     const GeometryCheck check = checkGeometry(toPolyMesh(mesh));
     EXPECT_TRUE(check.passed) << (check.messages.empty() ? "" : check.messages[0]);
-    EXPECT_NEAR(check.volume, 1.0, kVolumeTolerance);
+    EXPECT_NEAR(check.volume, 1.0, kTetVolumeTolerance);
   }
 }
 

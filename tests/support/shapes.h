@@ -79,6 +79,14 @@ inline PolyMesh withReversedFaces(const PolyMesh& mesh, ElementId bad, int k) {
   return out;
 }
 
+/// An L-shaped prism (non-convex, one element): the L of side 2 and arm 1, 0.5 deep, its top
+/// sheared by (0.5, 0.25).
+inline PolyMesh lPrism() {
+  Polygon2 l;
+  l.outer = {{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}};
+  return prismMesh(l, 0.0, 0.5, Vec2(0.5, 0.25));
+}
+
 /// Two unit cubes apart: a 2 x 1 x 1 hex grid on [0,2] x [0,1]^2 and one cube on [3,4] x [0,1]^2,
 /// two connected components (twelve zero modes without boundary conditions).
 inline PolyMesh twoSeparateBlocks() {

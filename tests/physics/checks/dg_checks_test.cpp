@@ -35,11 +35,7 @@ struct NamedMesh {
   PolyMesh mesh;
 };
 
-PolyMesh lPrism() {
-  Polygon2 l;
-  l.outer = {{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}};
-  return prismMesh(l, 0.0, 0.5, Vec2(0.5, 0.25));
-}
+using testing::lPrism;
 
 PolyMesh holePrism() {
   Polygon2 h;

@@ -16,17 +16,14 @@
 #include "physics/dg/face_quadrature.h"
 #include "polydg/mesh/slice.h"
 #include "polydg/mesh/surface_shapes.h"
+#include "tests/support/shapes.h"
 
 namespace polydg {
 namespace {
 
 constexpr double kTolerance = 1e-12;
 
-PolyMesh lPrism() {
-  Polygon2 l;
-  l.outer = {{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}};
-  return prismMesh(l, 0.0, 0.5, Vec2(0.5, 0.25));
-}
+using testing::lPrism;
 
 class LocalIntegrators : public ::testing::TestWithParam<int> {};
 

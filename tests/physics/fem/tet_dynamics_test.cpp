@@ -15,7 +15,7 @@
 namespace polydg {
 namespace {
 
-constexpr TetMethod kMethods[] = {TetMethod::Fem, TetMethod::FsFem};
+constexpr TetMethod kDynamicsMethods[] = {TetMethod::Fem, TetMethod::FsFem};
 const char* name(TetMethod m, bool corotational) {
   if (m == TetMethod::Fem) return corotational ? "C-FEM" : "L-FEM";
   return corotational ? "CS-FEM" : "LFS-FEM";
@@ -26,7 +26,7 @@ TEST(TetDynamics, FallsAsBackwardEulerSays) {
   // dt^2 g n (n + 1) / 2, whatever the stiffness (a translation stretches nothing).
   const TetMesh mesh = cubeTets(2, 1.0, 0.2);
   const Eigen::Vector3d g(0.0, 0.0, -9.81);
-  for (TetMethod method : kMethods)
+  for (TetMethod method : kDynamicsMethods)
     for (bool corotational : {false, true}) {
       SCOPED_TRACE(name(method, corotational));
       const TetDiscretization d(mesh, method);
@@ -55,7 +55,7 @@ TEST(TetDynamics, ADampedCantileverSettlesOnTheStaticSolution) {
     if (mesh.vertices[v].x() == 0.0) clamped.push_back(static_cast<std::uint32_t>(v));
   const Material material{1e5, 0.3, 1.0};
   const Eigen::Vector3d g(0, 0, -10);
-  for (TetMethod method : kMethods) {
+  for (TetMethod method : kDynamicsMethods) {
     const TetDiscretization d(mesh, method);
     TetStaticProblem p;
     p.material = material;
@@ -117,7 +117,7 @@ TEST(TetDynamics, SpinningLinearBodiesGrowAndCorotatedOnesDoNot) {
   // linear forces take the rotation for a deformation and inflate the body; warped ones keep
   // its volume.
   const TetMesh mesh = cubeTets(3, 1.0, 0.2);
-  for (TetMethod method : kMethods)
+  for (TetMethod method : kDynamicsMethods)
     for (bool corotational : {false, true}) {
       SCOPED_TRACE(name(method, corotational));
       const TetDiscretization d(mesh, method);
@@ -210,7 +210,7 @@ TEST(TetDynamics, NewmarkKeepsTheLinearBodysEnergy) {
   // it constant, while backward Euler loses some of it every step.
   std::vector<std::uint32_t> clamped;
   const TetMesh mesh = cantilever(clamped);
-  for (TetMethod method : kMethods) {
+  for (TetMethod method : kDynamicsMethods) {
     const TetDiscretization d(mesh, method);
     for (Integrator integrator : {Integrator::Newmark, Integrator::BackwardEuler}) {
       TetDynamicsOptions o = cantileverDynamics(clamped, integrator, false);

@@ -29,7 +29,7 @@ using bench::BenchmarkMesh;
 constexpr double kCgTolerance = 1e-10;
 constexpr double kSolutionAgreement = 1e-7;
 /// Symmetry of the V-cycle: rounding only.
-constexpr double kSymmetryTolerance = 1e-12;
+constexpr double kVCycleSymmetryTolerance = 1e-12;
 /// CG iterations on the sliced torus at p = 2 (GroupedSmootherOnASlicedTorus): 57 with one
 /// smoother block per element, 53 with groups.
 constexpr int kTorusIterations = 55;
@@ -173,7 +173,7 @@ void expectSymmetricPositive(const PMultigrid& mg, Eigen::Index n, unsigned seed
     mg.apply(x, mx);
     mg.apply(y, my);
     const double xy = x.dot(my), yx = y.dot(mx);
-    EXPECT_NEAR(xy, yx, kSymmetryTolerance * (std::abs(xy) + x.norm() * my.norm()));
+    EXPECT_NEAR(xy, yx, kVCycleSymmetryTolerance * (std::abs(xy) + x.norm() * my.norm()));
     EXPECT_GT(x.dot(mx), 0.0);
   }
 }
