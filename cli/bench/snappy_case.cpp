@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <system_error>
 #include <tuple>
 #include <utility>
@@ -11,6 +10,7 @@
 #include "model/files.h"
 #include "polydg/mesh/slice.h"
 #include "polydg/util/error.h"
+#include "util/format.h"
 
 namespace polydg::bench {
 
@@ -23,14 +23,9 @@ namespace {
 /// model; every cell is tried when it finds none.
 constexpr int kLocationSamples = 16;
 
-std::string number(double v) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.17g", v);
-  return text;
-}
-
 std::string foamVector(const Vec3& v) {
-  return "(" + number(v.x()) + " " + number(v.y()) + " " + number(v.z()) + ")";
+  return "(" + formatNumber(v.x(), 17) + " " + formatNumber(v.y(), 17) + " " +
+         formatNumber(v.z(), 17) + ")";
 }
 
 std::string header(const std::string& object) {
@@ -163,7 +158,7 @@ void writeSnappyCase(const fs::path& dir, const TriangleSurface& surface, const 
   write(system / "surfaceFeatureExtractDict",
         header("surfaceFeatureExtractDict") + s.surface +
             ".stl\n{\n    extractionMethod extractFromSurface;\n    includedAngle " +
-            number(s.includedAngle) + ";\n    writeObj no;\n}\n");
+            formatNumber(s.includedAngle, 17) + ";\n    writeObj no;\n}\n");
   write(system / "snappyHexMeshDict", snappyHexMeshDict(s));
   writeAsciiStl(dir / "constant" / "triSurface" / (s.surface + ".stl"), surface, s.surface);
 }
