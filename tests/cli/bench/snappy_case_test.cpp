@@ -8,7 +8,9 @@
 #include <cmath>
 #include <fstream>
 #include <iterator>
+#include <sstream>
 #include <string>
+#include <vector>
 
 #include "polydg/mesh/slice.h"
 #include "polydg/mesh/surface_io.h"
@@ -22,6 +24,14 @@ namespace {
 std::string readText(const std::filesystem::path& file) {
   std::ifstream in(file);
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+/// The vector "(x y z)" in `text`, read back in double precision.
+Vec3 vectorIn(const std::string& text) {
+  std::istringstream in(text.substr(text.find('(') + 1));
+  Vec3 v;
+  in >> v.x() >> v.y() >> v.z();
+  return v;
 }
 
 TEST(SnappyCase, TheBlockIsPolydgsGridWithOneMoreCellAround) {
@@ -59,7 +69,22 @@ TEST(SnappyCase, WritesTheDictionariesAndTheSurface) {
     EXPECT_TRUE(std::filesystem::exists(c / "system" / file)) << file;
   const std::string block = readText(c / "system" / "blockMeshDict");
   EXPECT_NE(block.find("(14 14 6) simpleGrading (1 1 1)"), std::string::npos) << block;
+  // The block's first and seventh corners are its min and max, and locationInMesh a cell
+  // centre, all exactly: blockMesh's planes are then polydg's grid planes.
+  const std::size_t list = block.find("vertices\n(\n");
+  ASSERT_NE(list, std::string::npos) << block;
+  std::istringstream corners(block.substr(list + 11));
+  std::vector<Vec3> corner;
+  for (std::string line; std::getline(corners, line) && line.find('(') != std::string::npos;)
+    corner.push_back(vectorIn(line));
+  ASSERT_EQ(corner.size(), 8u) << block;
+  EXPECT_EQ(corner[0], s.blockMin);
+  EXPECT_EQ(corner[6], s.blockMax);
   const std::string snappy = readText(c / "system" / "snappyHexMeshDict");
+  const std::size_t location = snappy.find("locationInMesh (");
+  ASSERT_NE(location, std::string::npos);
+  EXPECT_EQ(vectorIn(snappy.substr(location, snappy.find(')', location) - location + 1)),
+            s.locationInMesh);
   for (const char* entry :
        {"castellatedMesh true;", "snap true;", "addLayers false;", "level (0 0);",
         "file \"ring.extendedFeatureEdgeMesh\"; level 0;", "locationInMesh (", "ring.stl"})
