@@ -5,6 +5,7 @@
 // (tests/mesh/surface_volume.py).
 #include "polydg/mesh/surface_io.h"
 #include "tests/support/assimp_models.h"
+#include "tests/support/exact_figures.h"
 #include "tests/support/packages.h"
 #include "tests/support/temp_dir.h"
 
@@ -38,8 +39,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-/// Volumes and areas of the testdata models are exact (dyadic coordinates) up to round-off.
-constexpr double kExactRelTol = 1e-12;
 /// VTK's volume against polydg's: the tolerance the CLI test uses.
 constexpr double kVtkRelTol = 1e-9;
 /// Address space allowed while reading foreign or corrupt files (see AddressSpaceCap).
@@ -47,6 +46,8 @@ constexpr rlim_t kReadAddressSpace = rlim_t{4} << 30;
 
 using polydg::corpus::kAssimpModels;
 using polydg::packages::kSystemPython;
+using polydg::testing::kExactRelTol;  // the testdata models' coordinates are dyadic
+using polydg::testing::relativeError;
 using polydg::testing::TempDir;
 
 std::string testdata(const std::string& name) {
@@ -55,10 +56,6 @@ std::string testdata(const std::string& name) {
 
 fs::path volumeScript() {
   return fs::path(POLYDG_TESTDATA_DIR).parent_path() / "tests" / "mesh" / "surface_volume.py";
-}
-
-double relativeError(double value, double exact) {
-  return std::abs(value - exact) / std::abs(exact);
 }
 
 /// Caps this process's address space for its lifetime, so that a reader allocating what a

@@ -7,7 +7,6 @@
 
 #include <gtest/gtest.h>
 
-#include <cmath>
 #include <filesystem>
 #include <stdexcept>
 #include <string>
@@ -15,16 +14,16 @@
 
 #include "polydg/mesh/surface_io.h"
 #include "tests/support/assimp_models.h"
+#include "tests/support/exact_figures.h"
 #include "tests/support/packages.h"
 #include "tests/support/temp_dir.h"
 
 namespace polydg {
 namespace {
 
+using polydg::testing::kExactRelTol;  // the tetrahedron's coordinates are integers
+using polydg::testing::relativeError;
 using polydg::testing::TempDir;
-
-/// The tetrahedron's volume is exact (integer coordinates) up to round-off.
-constexpr double kTextExactRelTol = 1e-12;
 
 using Lines = std::vector<std::string>;
 
@@ -87,10 +86,6 @@ std::string joined(const Lines& lines, const std::string& end = "\n") {
   return text;
 }
 
-double textRelativeError(double value, double exact) {
-  return std::abs(value - exact) / std::abs(exact);
-}
-
 struct LineCase {
   std::string file;  ///< its extension chooses the format
   std::string text;
@@ -107,7 +102,7 @@ std::vector<std::string> tetraWarnings(const TempDir& dir, const std::string& fi
   const TriangleSurface s = readSurface(path, &info);
   EXPECT_EQ(info.reader, "cgal");
   EXPECT_EQ(s.triangles.size(), 4u);
-  EXPECT_LT(textRelativeError(enclosedVolume(s), 4.0), kTextExactRelTol) << enclosedVolume(s);
+  EXPECT_LT(relativeError(enclosedVolume(s), 4.0), kExactRelTol) << enclosedVolume(s);
   return info.warnings;
 }
 

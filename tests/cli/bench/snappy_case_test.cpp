@@ -71,9 +71,10 @@ TEST(SnappyCase, WritesTheDictionariesAndTheSurface) {
   EXPECT_NE(block.find("(14 14 6) simpleGrading (1 1 1)"), std::string::npos) << block;
   // The block's first and seventh corners are its min and max, and locationInMesh a cell
   // centre, all exactly: blockMesh's planes are then polydg's grid planes.
-  const std::size_t list = block.find("vertices\n(\n");
+  const std::string listStart = "vertices\n(\n";
+  const std::size_t list = block.find(listStart);
   ASSERT_NE(list, std::string::npos) << block;
-  std::istringstream corners(block.substr(list + 11));
+  std::istringstream corners(block.substr(list + listStart.size()));
   std::vector<Vec3> corner;
   for (std::string line; std::getline(corners, line) && line.find('(') != std::string::npos;)
     corner.push_back(vectorIn(line));
