@@ -24,7 +24,10 @@ struct ExportCommandOptions {
 };
 
 void run(const ExportCommandOptions& o, const CommonOptions& common) {
-  if (!o.report.empty()) requireDistinct(o.report, o.input);
+  if (!o.report.empty()) {
+    requireDistinct(o.report, o.input);
+    requireWritable(o.report);
+  }
   const Model model = Model::read(o.input);
   const ExportReport r = model.exportOpenFoam(o.output, o.exporting);
   if (!o.report.empty()) {

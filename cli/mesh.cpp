@@ -64,6 +64,8 @@ void run(const MeshCommandOptions& o, const CommonOptions& common, int& exitCode
   if (!isVolumeMeshPath(o.output)) throw InputError(o.output + ": the output must be a .vtu file");
   requireDistinct(o.output, o.input);
   if (!o.report.empty()) requireDistinct(o.report, o.input);
+  requireWritable(o.output);
+  if (!o.report.empty()) requireWritable(o.report);
 
   const Stopwatch wall;
   SurfaceReadInfo info;

@@ -53,7 +53,10 @@ void run(const RunOptions& o, const CommonOptions& common, int& exitCode) {
   batch.jobs = o.jobs;
   batch.out =
       o.out.empty() ? fs::path(fs::path(o.pipeline).stem().string() + "-out") : fs::path(o.out);
-  if (!o.report.empty()) requireDistinct(o.report, o.pipeline);
+  if (!o.report.empty()) {
+    requireDistinct(o.report, o.pipeline);
+    requireWritable(o.report);
+  }
   ProgressBar bar("run", common.quiet);
   std::size_t done = 0;
   batch.onDone = [&](std::size_t, const InputOutcome& outcome) {

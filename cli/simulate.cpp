@@ -34,6 +34,7 @@ void run(const SimulateCommandOptions& o, const CommonOptions& common) {
   if (!o.report.empty()) {
     requireDistinct(o.report, o.input);
     requireDistinct(o.report, o.scene);
+    requireWritable(o.report);
   }
   const Scene scene = readScene(o.scene);  // every key checked before anything runs
   // The frames are OUTDIR/scene_NNNNNN.vtu and OUTDIR/scene.pvd: no input may be one of them.

@@ -41,6 +41,19 @@ void writeJsonFile(const fs::path& path, const nlohmann::json& document) {
   writeFileAtomically(path, [&](std::ostream& out) { out << document.dump(2) << '\n'; });
 }
 
+void requireWritable(const fs::path& output) {
+  const fs::path folder = output.parent_path().empty() ? fs::path(".") : output.parent_path();
+  std::error_code ec;
+  if (!fs::is_directory(folder, ec))
+    throw InputError("cannot write " + output.string() + ": the folder " + folder.string() +
+                     " does not exist; create it or choose another output path");
+  if (::access(folder.c_str(), W_OK) != 0)
+    throw InputError("cannot write " + output.string() + ": the folder " + folder.string() +
+                     " is not writable; choose another output path");
+  if (fs::is_directory(output, ec))
+    throw InputError("cannot write " + output.string() + ": it is a folder; give a file name");
+}
+
 void requireDistinct(const fs::path& output, const fs::path& input) {
   std::error_code ec;
   if (fs::equivalent(output, input, ec))

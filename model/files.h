@@ -19,6 +19,11 @@ void writeFileAtomically(const std::filesystem::path& path,
 /// Writes `document` as indented JSON to `path`, atomically.
 void writeJsonFile(const std::filesystem::path& path, const nlohmann::json& document);
 
+/// Throws InputError if the file `output` could not be written where it is to go: its folder
+/// does not exist or is not writable, or `output` is a folder. Called before the work whose
+/// result the file holds, so that a mistyped path costs nothing and leaves nothing half done.
+void requireWritable(const std::filesystem::path& output);
+
 /// Throws InputError if `output` is the file `input` (the same file by any path, including
 /// links), so that no command ever overwrites its input.
 void requireDistinct(const std::filesystem::path& output, const std::filesystem::path& input);

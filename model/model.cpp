@@ -9,6 +9,7 @@
 #include <tbb/parallel_invoke.h>
 #include <unistd.h>
 
+#include "model/files.h"
 #include "model/tet_solve.h"
 #include "model_state.h"
 #include "physics/checks/mesh_checks.h"
@@ -110,6 +111,17 @@ class PendingFile {
     if (!committed_) fs::remove(temporary_, ignored);
   }
   const std::string& temporary() const { return temporary_; }
+  /// In a handler of `e`: a writer's error that names the temporary file, as one about the
+  /// file asked for; any other error as it is.
+  std::exception_ptr failure(const std::exception& e) const {
+    std::string message = e.what();
+    if (message.find(temporary_) == std::string::npos) return std::current_exception();
+    for (std::size_t at = message.find(temporary_); at != std::string::npos;
+         at = message.find(temporary_, at + path_.size()))
+      message.replace(at, temporary_.size(), path_);
+    return std::make_exception_ptr(
+        InputError(message + "; check the output's folder and its free space"));
+  }
   void commit() {
     std::error_code ec;
     fs::rename(temporary_, path_, ec);
@@ -153,6 +165,7 @@ Model Model::fromSurface(const TriangleSurface& surface, const MeshOptions& opti
     throw InputError("the moment degree to keep must be 0 or 2..6");
   if (options.tets && options.output.empty())
     throw InputError("the tets are written to the output file: give one");
+  if (!options.output.empty()) requireWritable(options.output);  // before the work, not after
   MeshingOptions meshing;
   meshing.cellSize = options.cellSize;
   meshing.cellsAlongLongest = options.cells;
@@ -230,6 +243,8 @@ Model Model::fromSurface(const TriangleSurface& surface, const MeshOptions& opti
           writeVtu(mesh, file->temporary(), {}, {}, {}, {}, provenanceFieldData(provenance),
                    volumes, meshed.wholeCells);
           report.writeSeconds = write.seconds();
+        } catch (const std::exception& e) {
+          writeFailure = file->failure(e);
         } catch (...) {
           writeFailure = std::current_exception();
         }
@@ -247,7 +262,11 @@ Model Model::fromSurface(const TriangleSurface& surface, const MeshOptions& opti
   model.state_->valid = report.meshing.geometry.passed;
   if (file && report.passed()) {
     if (options.tets) {
-      report.tets = writeTets(mesh, provenance, report.meshing.outputVolume, file->temporary());
+      try {
+        report.tets = writeTets(mesh, provenance, report.meshing.outputVolume, file->temporary());
+      } catch (const std::exception& e) {
+        std::rethrow_exception(file->failure(e));
+      }
       report.writeSeconds = report.tets->writeSeconds;
     }
     file->commit();

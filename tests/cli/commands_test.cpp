@@ -86,6 +86,50 @@ TEST_F(Commands, NoCommandOverwritesItsInput) {
   EXPECT_EQ(bytes(pipeline), text);
 }
 
+// A file output into a folder that does not exist is refused before the work whose result it
+// would hold: no mesh written and then the report refused, no case exported, no frames written.
+TEST_F(Commands, OutputsIntoAMissingFolderAreRefusedBeforeTheWork) {
+  const std::string mesh = meshTorus("m.vtu");
+  const std::string missing = path("missing") + "/";
+  const std::string refused = "the folder " + path("missing") + " does not exist";
+  const std::string torus = testData("torus.obj");
+  expectRefused(runPolydg("mesh " + torus + " --cells 4 -o " + missing + "x.vtu"), refused);
+  expectRefused(runPolydg("mesh " + torus + " --cells 4 -o " + path("x.vtu") + " --report " +
+                          missing + "r.json"),
+                refused);
+  EXPECT_FALSE(fs::exists(path("x.vtu")));
+  const std::string cut = "cut " + mesh + " --plane 1,0,0,0.1 -o ";
+  expectRefused(runPolydg(cut + missing + "c.vtu"), refused);
+  expectRefused(runPolydg(cut + path("c.vtu") + " --report " + missing + "r.json"), refused);
+  EXPECT_FALSE(fs::exists(path("c.vtu")));
+  const std::string solve = "solve " + mesh + " --clamp-below 0,0,1,0 -o ";
+  expectRefused(runPolydg(solve + missing + "s.vtu"), refused);
+  expectRefused(runPolydg(solve + path("s.vtu") + " --report " + missing + "r.json"), refused);
+  EXPECT_FALSE(fs::exists(path("s.vtu")));
+  expectRefused(runPolydg("check " + mesh + " --report " + missing + "r.json"), refused);
+  expectRefused(runPolydg("info " + mesh + " --report " + missing + "r.json"), refused);
+  expectRefused(runPolydg("export " + mesh + " --format openfoam -o " + path("case") +
+                          " --report " + missing + "r.json"),
+                refused);
+  EXPECT_FALSE(fs::exists(path("case")));
+  const std::string scene = path("scene.json");
+  std::ofstream(scene) << R"({"material": {"E": 1000, "nu": 0.3, "density": 1}, "dt": 0.01,
+                             "steps": 1})";
+  expectRefused(runPolydg("simulate " + mesh + " --scene " + scene + " -o " + path("frames") +
+                          " --report " + missing + "r.json"),
+                refused);
+  EXPECT_FALSE(fs::exists(path("frames")));
+  const std::string pipeline = path("p.json");
+  std::ofstream(pipeline) << R"({"steps": [{"step": "mesh", "cells": 4}]})";
+  expectRefused(runPolydg("run " + pipeline + " --inputs " + torus + " --out " + path("runs") +
+                          " --report " + missing + "r.json"),
+                refused);
+  EXPECT_FALSE(fs::exists(path("runs")));
+  // A folder where the file should go.
+  fs::create_directory(path("folder.vtu"));
+  expectRefused(runPolydg(cut + path("folder.vtu")), "it is a folder");
+}
+
 TEST_F(Commands, NonFiniteAndOutOfRangeValuesNameTheirOption) {
   const std::string mesh = meshTorus("m.vtu");
   const std::string solve = "solve " + mesh + " -o " + path("s.vtu") + " ";

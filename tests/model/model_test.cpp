@@ -16,6 +16,7 @@
 #include "polydg/mesh/surface_shapes.h"
 #include "polydg/model/model.h"
 #include "polydg/model/report_json.h"
+#include "polydg/util/error.h"
 
 namespace polydg {
 namespace {
@@ -71,6 +72,36 @@ TEST_F(ModelTest, ProvenanceTravelsWithTheMeshThroughAFile) {
   EXPECT_EQ(back.provenance().sliverFraction, 0.03);
   EXPECT_EQ(back.provenance().source, "torus.obj");
   EXPECT_EQ(back.mesh().numElements(), meshed.mesh().numElements());
+}
+
+// An output into a folder that does not exist is refused before the surface is sliced; one that
+// fails when written is reported under its own name, not the temporary file's.
+TEST_F(ModelTest, AnOutputThatCannotBeWrittenIsNamedAndAMissingFolderCostsNoMeshing) {
+  MeshOptions options;
+  options.cells = 6;
+  int progressCalls = 0;
+  options.progress = [&](double) { ++progressCalls; };
+  const TriangleSurface surface = torus(Vec3::Zero(), 1.0, 0.4, 48, 24);
+  MeshReport report;
+  options.output = (dir_ / "missing" / "torus.vtu").string();
+  try {
+    (void)Model::fromSurface(surface, options, report);
+    ADD_FAILURE() << "meshing into a missing folder did not fail";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("does not exist"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(progressCalls, 0);
+  // /proc takes no new files: refused before the work, or by the writer (as root, who may write
+  // to any folder), under the name asked for either way.
+  options.output = "/proc/torus.vtu";
+  try {
+    (void)Model::fromSurface(surface, options, report);
+    ADD_FAILURE() << "meshing into /proc did not fail";
+  } catch (const InputError& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("cannot write /proc/torus.vtu:"), std::string::npos) << message;
+    EXPECT_EQ(message.find("pending"), std::string::npos) << message;
+  }
 }
 
 TEST_F(ModelTest, MeshingTakesTheWholeCellsClosureFromHowTheyWereBuilt) {
