@@ -42,7 +42,7 @@ struct DynamicsOptions {
   }();
   /// CG: start with the block-Jacobi preconditioner (a step's matrix M + c K is dominated by
   /// the mass for small steps, where its iterations are few and cheap) and switch to the
-  /// p-multigrid once a solve needs more than 80 iterations; false: solver.preconditioner.
+  /// p-multigrid once a solve needs more than 50 iterations; false: solver.preconditioner.
   bool adaptivePreconditioner = true;
   bool corotational = true;
   Integrator integrator = Integrator::BackwardEuler;
