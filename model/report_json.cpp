@@ -574,6 +574,7 @@ json toJson(const SimulationReport& r) {
     step["rotation_seconds"] = s.step.rotationSeconds;
     step["assembly_seconds"] = s.step.assemblySeconds;
     step["solve_seconds"] = s.step.solveSeconds;
+    step["preconditioner_seconds"] = s.step.preconditionerSeconds;
     steps.push_back(std::move(step));
   }
   j["steps"] = std::move(steps);
@@ -593,6 +594,9 @@ json toJson(const SimulationReport& r) {
                       {"solver", c.solverSeconds},
                       {"transfer", c.transferSeconds},
                       {"next_step", c.nextStepSeconds ? json(*c.nextStepSeconds) : json(nullptr)},
+                      {"next_step_preconditioner", c.nextStepPreconditionerSeconds
+                                                       ? json(*c.nextStepPreconditionerSeconds)
+                                                       : json(nullptr)},
                       {"latency", c.nextStepSeconds ? json(c.seconds + *c.nextStepSeconds)
                                                     : json(nullptr)}}}});
   j["cuts"] = std::move(cuts);

@@ -276,8 +276,10 @@ void Simulation::step(int k) {
   }
   step.seconds = ts.seconds();
   // The cuts made at the last step boundary: this step completes their latency.
-  for (std::size_t i = report_.cuts.size() - cutsAwaitingStep_; i < report_.cuts.size(); ++i)
+  for (std::size_t i = report_.cuts.size() - cutsAwaitingStep_; i < report_.cuts.size(); ++i) {
     report_.cuts[i].nextStepSeconds = step.seconds;
+    report_.cuts[i].nextStepPreconditionerSeconds = step.step.preconditionerSeconds;
+  }
   cutsAwaitingStep_ = 0;
   step.solver = solverAction(step.step, solver_->solverKind(), freshSolver_);
   freshSolver_ = false;

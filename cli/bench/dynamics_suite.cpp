@@ -462,6 +462,7 @@ nlohmann::json cutLatencyPart(bool quick, SuiteOutput& s,
         static_cast<double>(cut.report.elementsSplit) / static_cast<double>(cut.elementsBefore);
     const double step = 0.5 * (r.steps[0].seconds + r.steps[1].seconds);
     const double next = cut.nextStepSeconds.value_or(0.0);
+    const double build = cut.nextStepPreconditionerSeconds.value_or(0.0);
     nlohmann::json j{{"part", "cut_latency"},
                      {"grid", grid},
                      {"blade", blade.what},
@@ -476,6 +477,7 @@ nlohmann::json cutLatencyPart(bool quick, SuiteOutput& s,
                      {"solver_elements", cut.solverElements},
                      {"t_transfer", cut.transferSeconds},
                      {"t_next_step", next},
+                     {"t_next_step_preconditioner", build},
                      {"t_latency", cut.seconds + next},
                      {"t_step_before", step}};
     runs.push_back(j);
@@ -485,7 +487,8 @@ nlohmann::json cutLatencyPart(bool quick, SuiteOutput& s,
         shortNumber(cut.cutSeconds) + ", solver " + shortNumber(cut.solverSeconds) + " for " +
         std::to_string(cut.solverElements) + " elements, transfer " +
         shortNumber(cut.transferSeconds) + ", next step " + shortNumber(next) +
-        "; a step before it " + shortNumber(step) + ")");
+        " (preconditioner " + shortNumber(build) + "); a step before it " + shortNumber(step) +
+        ")");
   }
   return {{"setup", "B10's beam [0,10]x[0,1]x[0,1], " + grid +
                         " hex grid, p = 1, corotational, backward Euler, dt = 0.01; one plane "

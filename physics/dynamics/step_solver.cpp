@@ -4,6 +4,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "util/stopwatch.h"
+
 namespace polydg {
 
 namespace {
@@ -14,6 +16,20 @@ namespace {
 /// 68 block-Jacobi iterations a solve at 960k DOFs cost 3.67 s a step where BDF2's V-cycles
 /// took 2.34 (docs/benchmarks.md).
 constexpr int kBlockJacobiLimit = 50;
+
+/// Adds the seconds since `watch` started to the report's preconditioner time when it goes out
+/// of scope (a prepare() that kept everything adds its few microseconds).
+class Timed {
+ public:
+  Timed(StepReport& report, const Stopwatch& watch) : report_(report), watch_(watch) {}
+  ~Timed() { report_.preconditionerSeconds += watch_.seconds(); }
+  Timed(const Timed&) = delete;
+  Timed& operator=(const Timed&) = delete;
+
+ private:
+  StepReport& report_;
+  const Stopwatch& watch_;
+};
 
 /// A step's matrix that is not positive definite: a smaller step is what helps.
 [[noreturn]] void throwNotDefinite(const std::string& matrix, const std::string& why) {
@@ -49,6 +65,8 @@ void StepSolver::beginStep() {
 
 void StepSolver::prepare(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix,
                          bool changed, StepReport& report) {
+  const Stopwatch watch;
+  const Timed timed(report, watch);
   if (!ready_) {
     const bool direct = chooseSolver(matrix, active_) == SolverKind::Cholesky;
     if (!solver_.compute(matrix, blockSize_, direct ? nullptr : frames_) && direct)
@@ -76,6 +94,8 @@ bool StepSolver::refreshDue() const {
 }
 
 void StepSolver::prepare(const BlockRows<double>& rows, bool changed, StepReport& report) {
+  const Stopwatch watch;
+  const Timed timed(report, watch);
   if (!ready_) {
     solver_.computeForUpdates(rows, frames_);
     report.preconditionerRebuilt = true;
@@ -100,6 +120,8 @@ void StepSolver::prepareWithAddedTerms(
 
 void StepSolver::prepareWithContact(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix,
                                     StepReport& report) {
+  const Stopwatch watch;
+  const Timed timed(report, watch);
   const bool direct = chooseSolver(matrix, active_) == SolverKind::Cholesky;
   if (!solver_.compute(matrix, blockSize_, direct ? nullptr : frames_) && direct)
     throwNotDefinite("system matrix with contacts", "");

@@ -209,7 +209,8 @@ PHASES = ["setup", "rotation", "assembly", "solve", "state", "cut", "output", "f
 def phases(polydg, work):
     """The report's phase times add up to its wall time within 5% (issue 31): a clamped bar
     under gravity on 256 elements, cut mid-run, a frame every 5 steps; every phase that ran is
-    counted once (the cut's new solver in cut, not again in setup)."""
+    counted once (the cut's new solver in cut, not again in setup); each step's preconditioner
+    time lies within its solve, and the cut's latency names the next step's."""
     obj = box_obj(work / "long_bar.obj", (0.0, 0.0, 0.0), (4.0, 1.0, 1.0))
     mesh = work / "long_bar.vtu"
     run([polydg, "mesh", obj, "--cells", 16, "-o", mesh, "--quiet"])
@@ -230,6 +231,16 @@ def phases(polydg, work):
                 for s in r["steps"])
     close("the steps' phases against rotation + assembly + solve", steps,
           t["rotation"] + t["assembly"] + t["solve"], 1e-9)
+    for s in r["steps"]:
+        check(0.0 <= s["preconditioner_seconds"] <= s["solve_seconds"],
+              "t = %g: preconditioner %.3g s within the solve's %.3g s"
+              % (s["t"], s["preconditioner_seconds"], s["solve_seconds"]))
+    latency = r["cuts"][0]["cut_seconds"]
+    after = next(s for s in r["steps"] if s["t"] > 0.15 + 1e-9)
+    check(latency["next_step_preconditioner"] == after["preconditioner_seconds"] > 0.0
+          and latency["next_step_preconditioner"] <= latency["next_step"],
+          "the cut's next step built its preconditioner in %.3g s of %.3g s"
+          % (latency["next_step_preconditioner"], latency["next_step"]))
 
 
 # --- obstacle ------------------------------------------------------------------------------

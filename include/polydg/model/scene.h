@@ -144,6 +144,8 @@ struct SimulationCut {
   /// fields carried over, and the next step (none if the run ended with the cut).
   double cutSeconds = 0.0, checkSeconds = 0.0, solverSeconds = 0.0, transferSeconds = 0.0;
   std::optional<double> nextStepSeconds;
+  /// Of nextStepSeconds: the preconditioner built (or the matrix factorized) for the edited mesh.
+  std::optional<double> nextStepPreconditionerSeconds;
   /// Elements whose blocks the new solver computed: those the cut made or changed and their
   /// neighbours (the others' were the old solver's).
   std::size_t solverElements = 0;

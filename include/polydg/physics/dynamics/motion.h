@@ -50,6 +50,9 @@ struct StepReport {
   double rotationSeconds = 0.0;
   double assemblySeconds = 0.0;  ///< warping the blocks, the system matrix, the forces
   double solveSeconds = 0.0;     ///< factorization or preconditioner, and the solve
+  /// Of solveSeconds: the factorization (Cholesky) or the preconditioner's build (CG);
+  /// microseconds for a step that kept them.
+  double preconditionerSeconds = 0.0;
   /// Contact (setContact()): points in contact at the step's last pass, passes of the active
   /// set (solves of the step's matrix, each with its corrections), and the seconds spent in
   /// obstacle queries and point positions (also counted in assemblySeconds).
