@@ -532,6 +532,10 @@ SolveReport Model::solve(const SolveOptions& options) {
     throw CheckFailure(e.what());
   }
   report.solve = solver.report();
+  if (!u->allFinite())
+    throw InputError(
+        "the solution overflows double precision: the loads are too large for the material's "
+        "stiffness; scale them or the model's units down");
   if (!report.solve.solver.success)
     throw CheckFailure("the linear solver did not converge (residual " +
                        std::to_string(report.solve.solver.residual) +

@@ -17,6 +17,7 @@
 #include "integrate/quadrature.h"
 #include "physics/dg/block_rows.h"
 #include "physics/dg/face_quadrature.h"
+#include "polydg/util/error.h"
 #include "util/resident.h"
 
 namespace polydg {
@@ -686,6 +687,12 @@ Eigen::VectorXd assembleLoad(const PolyMesh& mesh, const DgBasis& basis, const M
       }
     }
   });
+  // A load that overflows (a traction or gravity near 1e308, or times a large density) would
+  // make CG stop at once on an infinite residual and report the zero displacement as converged.
+  if (!f.allFinite())
+    throw InputError(
+        "the loads overflow double precision (a traction, gravity times the density, or a "
+        "prescribed displacement is too large); scale them or the model's units down");
   return f;
 }
 

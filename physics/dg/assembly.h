@@ -223,7 +223,8 @@ Eigen::SparseMatrix<double, Eigen::ColMajor, int> assembleStiffness(const PolyMe
 /// `quadratureDegree`), tractions, and the Dirichlet terms of `form`:
 ///   int_F mu eta_F g.v - (sigma(v) n).g + lambda c_K (R g.n, R v.n)      (IP)
 ///   int_F mu eta_F g.v                                                   (BZ)
-/// with g integrated by face quadrature of degree `quadratureDegree`.
+/// with g integrated by face quadrature of degree `quadratureDegree`. Throws InputError if F
+/// overflows (not finite).
 Eigen::VectorXd assembleLoad(const PolyMesh& mesh, const DgBasis& basis, const MomentCache& moments,
                              const FaceRoles& roles, const FormCoefficients& form,
                              const Material& material, const LoadCase& loads, int quadratureDegree);

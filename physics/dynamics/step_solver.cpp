@@ -1,6 +1,7 @@
 #include "physics/dynamics/step_solver.h"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -133,6 +134,11 @@ void StepSolver::prepareWithContact(const Eigen::SparseMatrix<double, Eigen::Col
 
 Eigen::VectorXd StepSolver::solve(const Eigen::VectorXd& rhs, const Eigen::VectorXd& guess,
                                   StepReport& report, double tolerance) {
+  // CG's residual target is relative to |rhs|: an overflowing norm would stop it at once.
+  if (!std::isfinite(rhs.squaredNorm()))
+    throw std::runtime_error(
+        "the time step's right-hand side overflows double precision (an initial velocity or a "
+        "load too large for the body); scale the scene's values or units down");
   LinearSolveReport lr;
   Eigen::VectorXd x =
       solver_.solve(rhs, lr, &guess, std::max(tolerance, options_.solver.tolerance));

@@ -214,6 +214,10 @@ struct LinearSolver::Impl {
                                     const Eigen::VectorXd* guess, double tolerance) const {
     const double fNorm = std::sqrt(parallelDot(f, f));
     Eigen::VectorXd u = Eigen::VectorXd::Zero(f.size());
+    if (!std::isfinite(fNorm)) {  // else an infinite target would pass u = 0 as converged
+      report.success = false;
+      return u;
+    }
     if (fNorm == 0.0) {
       report.success = true;
       return u;
@@ -388,6 +392,7 @@ Eigen::VectorXd LinearSolver::solve(const Eigen::VectorXd& rhs, LinearSolveRepor
     u = m.conjugateGradient(rhs, report, guess, tolerance > 0.0 ? tolerance : m.options.tolerance);
   }
   report.solveSeconds = t0.seconds();
+  if (!u.allFinite()) report.success = false;  // overflowed: loads too large for the matrix
   Eigen::VectorXd ku;
   m.productDot(u, ku);
   const double fNorm = rhs.norm();

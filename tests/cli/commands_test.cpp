@@ -130,6 +130,34 @@ TEST_F(Commands, OutputsIntoAMissingFolderAreRefusedBeforeTheWork) {
   expectRefused(runPolydg(cut + path("folder.vtu")), "it is a folder");
 }
 
+// Finite values whose loads or solution overflow (a traction near the largest double, gravity
+// times a density) are refused with one line, not written as a displacement of NaN or zero.
+TEST_F(Commands, LoadsThatOverflowAreRefused) {
+  const std::string mesh = meshTorus("m.vtu");
+  const std::string overflow = "the loads overflow double precision";
+  const std::string solve = "solve " + mesh + " -o " + path("s.vtu") + " --clamp-below 0,0,1,-0.3 ";
+  // A traction whose load still fits, but not the displacement it would cause.
+  expectRefused(runPolydg(solve + "--traction-below 0,0,-1,-0.3:0,0,1e308"),
+                "the solution overflows double precision");
+  expectRefused(runPolydg(solve + "--gravity 0,0,1e308"), overflow);
+  expectRefused(runPolydg(solve + "--density 1e299 --gravity 0,0,1e100"), overflow);
+  EXPECT_FALSE(fs::exists(path("s.vtu")));
+  const std::string scene = path("scene.json");
+  std::ofstream(scene) << R"({"material": {"E": 1000, "nu": 0.3, "density": 1}, "dt": 0.01,
+                             "steps": 2, "gravity": [0, 0, 1e308]})";
+  expectRefused(runPolydg("simulate " + mesh + " --scene " + scene + " -o " + path("frames")),
+                overflow);
+  // A motion too fast for double precision stops the first step (a failed step: exit 1).
+  std::ofstream(scene) << R"({"material": {"E": 1000, "nu": 0.3, "density": 1}, "dt": 0.01,
+                             "steps": 2, "initial": {"velocity": [1e308, 0, 0]}})";
+  const CommandResult fast =
+      runPolydg("simulate " + mesh + " --scene " + scene + " -o " + path("frames2"));
+  EXPECT_EQ(fast.exitCode, 1) << fast.out;
+  EXPECT_NE(fast.out.find("the time step's right-hand side overflows double precision"),
+            std::string::npos)
+      << fast.out;
+}
+
 TEST_F(Commands, NonFiniteAndOutOfRangeValuesNameTheirOption) {
   const std::string mesh = meshTorus("m.vtu");
   const std::string solve = "solve " + mesh + " -o " + path("s.vtu") + " ";
@@ -151,6 +179,9 @@ TEST_F(Commands, NonFiniteAndOutOfRangeValuesNameTheirOption) {
   expectRefused(runPolydg(solve + "--clamp x=0 --E 0"),
                 "Young's modulus must be a positive number");
   expectRefused(runPolydg(solve + "--clamp x=0 --nu -1"), "Poisson's ratio must lie in (-1, 0.5)");
+  // Finite but beyond what the material's terms can hold: the bound is named.
+  expectRefused(runPolydg(solve + "--clamp x=0 --E 1e308"), "a positive number below 1e300");
+  expectRefused(runPolydg(solve + "--clamp x=0 --density 1e300"), "a number >= 0 and below 1e300");
   expectRefused(runPolydg(solve + "--clamp x=0 --degree 4"), "--degree");
   expectRefused(runPolydg(solve + "--clamp x=0 --degree 0"), "must be 1, 2 or 3");
   expectRefused(runPolydg(solve + "--clamp x=0 --eta 0"), "the penalty must be a positive number");

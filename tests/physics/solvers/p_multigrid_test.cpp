@@ -7,6 +7,9 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
+#include <utility>
+
 #include <cstdio>
 #include <random>
 
@@ -264,6 +267,31 @@ TEST(PMultigrid, PlateOneElementThickNeedsAboutTheCubesIterations) {
   const int cube = iterations(bench::benchmarkB2Mesh());
   std::printf("p = 2: plate %d iterations, cube %d\n", plate, cube);
   EXPECT_LE(plate, 1.5 * cube);
+}
+
+// A right-hand side that overflowed makes the residual target |F| tol infinite: CG must report
+// that it failed, not the zero vector as converged, with either preconditioner; and Cholesky's
+// solution of it, not finite, is no success either.
+TEST(PMultigrid, CgFailsOnARightHandSideThatOverflowed) {
+  const FramedSystem framed = b1FramedSystem(benchmarkB1Mesh(BenchmarkMesh::Hex, 3), Method::IP, 1);
+  for (const auto& [kind, preconditioner] :
+       {std::pair{SolverKind::ConjugateGradient, CgPreconditioner::PMultigrid},
+        std::pair{SolverKind::ConjugateGradient, CgPreconditioner::BlockJacobi},
+        std::pair{SolverKind::Cholesky, CgPreconditioner::PMultigrid}}) {
+    SolverOptions options;
+    options.kind = kind;
+    options.preconditioner = preconditioner;
+    LinearSolver solver(options);
+    ASSERT_TRUE(solver.compute(framed.system.matrix, framed.system.blockSize));
+    for (double bad :
+         {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::quiet_NaN()}) {
+      Eigen::VectorXd rhs = framed.system.rhs;
+      rhs[0] = bad;
+      LinearSolveReport report;
+      solver.solve(rhs, report);
+      EXPECT_FALSE(report.success) << "rhs[0] = " << bad;
+    }
+  }
 }
 
 TEST(PMultigrid, ReportsABodyWithoutDirichletCondition) {

@@ -24,11 +24,11 @@ struct Material {
   /// nears 1/2) and 0 <= density < 1e300.
   void check() const {
     if (!(youngsModulus > 0.0 && youngsModulus < 1e300))
-      throw InvalidOption("E", "Young's modulus must be a positive number");
+      throw InvalidOption("E", "Young's modulus must be a positive number below 1e300");
     if (!(poissonRatio >= -0.999999 && poissonRatio <= 0.499999999))
       throw InvalidOption("nu", "Poisson's ratio must lie in (-1, 0.5), at most 0.499999999");
     if (!(density >= 0.0 && density < 1e300))
-      throw InvalidOption("density", "the density must be a number >= 0");
+      throw InvalidOption("density", "the density must be a number >= 0 and below 1e300");
   }
 };
 
