@@ -46,10 +46,7 @@ void run(CheckCommandOptions o, const CommonOptions& common, int& exitCode) {
     throw InputError(o.input +
                      ": check reads simulation meshes (.vtu) and tet meshes (TetGen .ele, Gmsh "
                      ".msh); for a surface use 'polydg info'");
-  if (!o.report.empty()) {
-    requireDistinct(o.report, o.input);
-    requireWritable(o.report);
-  }
+  if (!o.report.empty()) requireOutput(o.report, {o.input});
   Model model = Model::read(o.input);
   if (o.skipDg) {
     o.check.local = false;

@@ -41,10 +41,8 @@ void run(const CutCommandOptions& o, bool quiet, int& exitCode) {
   if (!isVolumeMeshPath(o.input))
     throw InputError(o.input + ": cut reads simulation meshes (.vtu); make one with 'polydg mesh'");
   if (!isVolumeMeshPath(o.output)) throw InputError(o.output + ": the output must be a .vtu file");
-  requireDistinct(o.output, o.input);
-  if (!o.report.empty()) requireDistinct(o.report, o.input);
-  requireWritable(o.output);
-  if (!o.report.empty()) requireWritable(o.report);
+  requireOutput(o.output, {o.input});
+  if (!o.report.empty()) requireOutput(o.report, {o.input});
   std::vector<Blade> blades = o.blades;
   if (o.polygon) blades.push_back(*o.polygon);
   if (blades.empty()) throw InputError("nothing to cut with: give --plane or --polygon");

@@ -24,10 +24,7 @@ struct ExportCommandOptions {
 };
 
 void run(const ExportCommandOptions& o, const CommonOptions& common) {
-  if (!o.report.empty()) {
-    requireDistinct(o.report, o.input);
-    requireWritable(o.report);
-  }
+  if (!o.report.empty()) requireOutput(o.report, {o.input});
   const Model model = Model::read(o.input);
   const ExportReport r = model.exportOpenFoam(o.output, o.exporting);
   if (!o.report.empty()) {

@@ -34,10 +34,7 @@ void addInfoCommand(CLI::App& app, const CommonOptions& common, int& exitCode) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--report", o->report, "write the figures as JSON to this file");
   cmd->callback([o, &common, &exitCode] {
-    if (!o->report.empty()) {
-      requireDistinct(o->report, o->input);
-      requireWritable(o->report);
-    }
+    if (!o->report.empty()) requireOutput(o->report, {o->input});
     const nlohmann::json j = isVolumeMeshPath(o->input) ? toJson(inspectVolumeMesh(o->input))
                                                         : toJson(inspectSurface(o->input));
     if (!o->report.empty()) {

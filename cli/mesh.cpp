@@ -62,10 +62,8 @@ void run(const MeshCommandOptions& o, const CommonOptions& common, int& exitCode
   if (!o.mesh.cellSize && o.mesh.cells == 0)
     throw InputError("polydg mesh needs --cell H or --cells N");
   if (!isVolumeMeshPath(o.output)) throw InputError(o.output + ": the output must be a .vtu file");
-  requireDistinct(o.output, o.input);
-  if (!o.report.empty()) requireDistinct(o.report, o.input);
-  requireWritable(o.output);
-  if (!o.report.empty()) requireWritable(o.report);
+  requireOutput(o.output, {o.input});
+  if (!o.report.empty()) requireOutput(o.report, {o.input});
 
   const Stopwatch wall;
   SurfaceReadInfo info;

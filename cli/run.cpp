@@ -53,10 +53,7 @@ void run(const RunOptions& o, const CommonOptions& common, int& exitCode) {
   batch.jobs = o.jobs;
   batch.out =
       o.out.empty() ? fs::path(fs::path(o.pipeline).stem().string() + "-out") : fs::path(o.out);
-  if (!o.report.empty()) {
-    requireDistinct(o.report, o.pipeline);
-    requireWritable(o.report);
-  }
+  if (!o.report.empty()) requireOutput(o.report, {o.pipeline});
   ProgressBar bar("run", common.quiet);
   std::size_t done = 0;
   batch.onDone = [&](std::size_t, const InputOutcome& outcome) {

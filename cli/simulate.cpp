@@ -31,11 +31,7 @@ void run(const SimulateCommandOptions& o, const CommonOptions& common) {
     throw InputError(o.input +
                      ": simulate reads simulation meshes (.vtu), and tet meshes (TetGen .ele, "
                      "Gmsh .msh) for the tet methods; make a simulation mesh with 'polydg mesh'");
-  if (!o.report.empty()) {
-    requireDistinct(o.report, o.input);
-    requireDistinct(o.report, o.scene);
-    requireWritable(o.report);
-  }
+  if (!o.report.empty()) requireOutput(o.report, {o.input, o.scene});
   const Scene scene = readScene(o.scene);  // every key checked before anything runs
   // The frames are OUTDIR/scene_NNNNNN.vtu and OUTDIR/scene.pvd: no input may be one of them.
   namespace fs = std::filesystem;

@@ -48,10 +48,8 @@ struct SolveCommandOptions {
 /// report), and something that holds the body.
 void checkOutputsAndClamps(const SolveCommandOptions& o) {
   if (!isVolumeMeshPath(o.output)) throw InputError(o.output + ": the output must be a .vtu file");
-  requireDistinct(o.output, o.input);
-  if (!o.report.empty()) requireDistinct(o.report, o.input);
-  requireWritable(o.output);
-  if (!o.report.empty()) requireWritable(o.report);
+  requireOutput(o.output, {o.input});
+  if (!o.report.empty()) requireOutput(o.report, {o.input});
   if (o.solve.clamps.empty())
     throw InputError(
         "nothing holds the body: add at least one --clamp, --clamp-plane, "
@@ -84,9 +82,7 @@ void run(const SolveCommandOptions& o, const CommonOptions& common) {
   if (!o.surfaceOutput.empty()) {
     if (std::filesystem::path(o.surfaceOutput).extension() != ".vtp")
       throw InputError(o.surfaceOutput + ": the deformed surface is written as a .vtp file");
-    requireDistinct(o.surfaceOutput, o.input);
-    if (!o.embed.empty()) requireDistinct(o.surfaceOutput, o.embed);
-    requireWritable(o.surfaceOutput);
+    requireOutput(o.surfaceOutput, {o.input, o.embed});
   }
   ReadReport read;
   Model model = Model::read(o.input, &read);

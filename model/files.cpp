@@ -54,11 +54,14 @@ void requireWritable(const fs::path& output) {
     throw InputError("cannot write " + output.string() + ": it is a folder; give a file name");
 }
 
-void requireDistinct(const fs::path& output, const fs::path& input) {
-  std::error_code ec;
-  if (fs::equivalent(output, input, ec))
-    throw InputError("refusing to overwrite the input " + input.string() +
-                     "; choose another output path");
+void requireOutput(const fs::path& output, std::initializer_list<fs::path> inputs) {
+  for (const fs::path& input : inputs) {
+    std::error_code ec;
+    if (fs::equivalent(output, input, ec))
+      throw InputError("refusing to overwrite the input " + input.string() +
+                       "; choose another output path");
+  }
+  requireWritable(output);
 }
 
 }  // namespace polydg

@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <functional>
+#include <initializer_list>
 #include <ostream>
 
 #include <nlohmann/json.hpp>
@@ -24,8 +25,10 @@ void writeJsonFile(const std::filesystem::path& path, const nlohmann::json& docu
 /// result the file holds, so that a mistyped path costs nothing and leaves nothing half done.
 void requireWritable(const std::filesystem::path& output);
 
-/// Throws InputError if `output` is the file `input` (the same file by any path, including
-/// links), so that no command ever overwrites its input.
-void requireDistinct(const std::filesystem::path& output, const std::filesystem::path& input);
+/// The checks of an output file, made before the work: throws InputError if `output` is one of
+/// `inputs` (the same file by any path, including links; an empty or missing input is none), so
+/// that no command ever overwrites its input, and then as requireWritable() does.
+void requireOutput(const std::filesystem::path& output,
+                   std::initializer_list<std::filesystem::path> inputs);
 
 }  // namespace polydg

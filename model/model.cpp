@@ -115,9 +115,9 @@ class PendingFile {
   /// file asked for; any other error as it is.
   std::exception_ptr failure(const std::exception& e) const {
     std::string message = e.what();
-    if (message.find(temporary_) == std::string::npos) return std::current_exception();
-    for (std::size_t at = message.find(temporary_); at != std::string::npos;
-         at = message.find(temporary_, at + path_.size()))
+    std::size_t at = message.find(temporary_);
+    if (at == std::string::npos) return std::current_exception();
+    for (; at != std::string::npos; at = message.find(temporary_, at + path_.size()))
       message.replace(at, temporary_.size(), path_);
     return std::make_exception_ptr(
         InputError(message + "; check the output's folder and its free space"));

@@ -18,18 +18,18 @@ namespace {
 /// took 2.34 (docs/benchmarks.md).
 constexpr int kBlockJacobiLimit = 50;
 
-/// Adds the seconds since `watch` started to the report's preconditioner time when it goes out
-/// of scope (a prepare() that kept everything adds its few microseconds).
-class Timed {
+/// Adds the seconds from its making to its end to the report's preconditioner time (a prepare()
+/// that kept everything adds its few microseconds).
+class PreconditionerTimer {
  public:
-  Timed(StepReport& report, const Stopwatch& watch) : report_(report), watch_(watch) {}
-  ~Timed() { report_.preconditionerSeconds += watch_.seconds(); }
-  Timed(const Timed&) = delete;
-  Timed& operator=(const Timed&) = delete;
+  explicit PreconditionerTimer(StepReport& report) : report_(report) {}
+  ~PreconditionerTimer() { report_.preconditionerSeconds += watch_.seconds(); }
+  PreconditionerTimer(const PreconditionerTimer&) = delete;
+  PreconditionerTimer& operator=(const PreconditionerTimer&) = delete;
 
  private:
   StepReport& report_;
-  const Stopwatch& watch_;
+  Stopwatch watch_;
 };
 
 /// A step's matrix that is not positive definite: a smaller step is what helps.
@@ -66,8 +66,7 @@ void StepSolver::beginStep() {
 
 void StepSolver::prepare(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix,
                          bool changed, StepReport& report) {
-  const Stopwatch watch;
-  const Timed timed(report, watch);
+  const PreconditionerTimer timer(report);
   if (!ready_) {
     const bool direct = chooseSolver(matrix, active_) == SolverKind::Cholesky;
     if (!solver_.compute(matrix, blockSize_, direct ? nullptr : frames_) && direct)
@@ -95,8 +94,7 @@ bool StepSolver::refreshDue() const {
 }
 
 void StepSolver::prepare(const BlockRows<double>& rows, bool changed, StepReport& report) {
-  const Stopwatch watch;
-  const Timed timed(report, watch);
+  const PreconditionerTimer timer(report);
   if (!ready_) {
     solver_.computeForUpdates(rows, frames_);
     report.preconditionerRebuilt = true;
@@ -121,8 +119,7 @@ void StepSolver::prepareWithAddedTerms(
 
 void StepSolver::prepareWithContact(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix,
                                     StepReport& report) {
-  const Stopwatch watch;
-  const Timed timed(report, watch);
+  const PreconditionerTimer timer(report);
   const bool direct = chooseSolver(matrix, active_) == SolverKind::Cholesky;
   if (!solver_.compute(matrix, blockSize_, direct ? nullptr : frames_) && direct)
     throwNotDefinite("system matrix with contacts", "");
