@@ -1,14 +1,18 @@
 // The polydg program's memory allocator: jemalloc (linked into this executable only, not into the
-// library or the Python module), with transparent huge pages for the large blocks only.
+// library or the Python module), its heap on transparent huge pages, in one arena.
 //
 // Meshing builds hundreds of MB of small, short-lived buffers (plane splits, faces, element
 // lists) and solving allocates K and its preconditioner once, large. With glibc's malloc on
 // 4 KiB pages, `polydg mesh` of a 75k-triangle scan at 64 cells spent about a third of its wall
-// time in page faults; jemalloc reuses the small buffers' pages. Huge pages are asked for every
-// block of 4 MiB or more (operator new below; makeResident in util/resident.h also faults a
-// large array in on all cores), not for the whole heap: a heap on huge pages ("thp:always")
-// counts every partly used 2 MB page in full, 35 MiB more at the peak of meshing the bunny at
-// 200 cells.
+// time in page faults; jemalloc reuses the small buffers' pages. A fault costs about 9 us on
+// this kind of virtual machine, so the heap faults in 2 MiB at a time ("thp:always"): the bunny
+// meshed at 64 cells in 0.87 of the time, at 200 cells in 0.93, a solve and a simulation in
+// 0.90 (docs/benchmarks.md, "The heap on huge pages, in one arena"). Its cost is every partly
+// used 2 MiB page counted in full; one arena ("narenas:1", where jemalloc makes four per CPU)
+// keeps those few: 10-20 MiB more at the peak, where eight arenas cost up to 37. Every block of
+// 4 MiB or more is also advised onto huge pages below (operator new; makeResident in
+// util/resident.h also faults a large array in on all cores), which still holds when a user's
+// MALLOC_CONF takes the heap off them.
 // jemalloc reads this string when it starts (before main), then /etc/malloc.conf, then the
 // environment variable MALLOC_CONF, each overriding the one before: a user who wants other
 // settings sets MALLOC_CONF.
@@ -21,7 +25,7 @@
 extern "C" {
 // NOLINTNEXTLINE(readability-identifier-naming): the name jemalloc looks for.
 extern const char* malloc_conf;
-const char* malloc_conf = "thp:default,metadata_thp:disabled";
+const char* malloc_conf = "thp:always,narenas:1,metadata_thp:disabled";
 }
 
 namespace {

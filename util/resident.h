@@ -17,8 +17,8 @@ namespace polydg {
 
 /// Asks the kernel for transparent huge pages on the 2 MiB-aligned part of [data, data +
 /// bytes), a large array's: it then faults in 2 MiB at a time instead of 4 KiB, and its reads
-/// miss the TLB less. The heap is not on huge pages (cli/allocator.cpp), since it would count
-/// every partly used one in full. A hint only; ignored where unsupported.
+/// miss the TLB less. (The polydg program's heap is on huge pages as a whole, cli/allocator.cpp;
+/// the Python module's glibc heap is not.) A hint only; ignored where unsupported.
 inline void adviseHugePages(void* data, std::size_t bytes) {
 #ifdef MADV_HUGEPAGE
   constexpr std::uintptr_t kHuge = std::uintptr_t(1) << 21;
@@ -32,7 +32,7 @@ inline void adviseHugePages(void* data, std::size_t bytes) {
 }
 
 /// Blocks from this size on are advised onto huge pages (adviseLargeBlock): each holds at least
-/// one whole one, and the heap's smaller blocks stay on its pages.
+/// one whole one; smaller blocks are left to the heap's own pages.
 inline constexpr std::size_t kHugePagesAtLeast = std::size_t(4) << 20;
 
 /// adviseHugePages for a block of kHugePagesAtLeast bytes or more; nothing for a smaller one.
