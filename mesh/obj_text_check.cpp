@@ -1,5 +1,5 @@
-// The OBJ check of mesh/surface_text_check.h: each line of an OBJ file checked and reduced to
-// what CGAL's reader is to parse.
+// The OBJ check of mesh/surface_text_check.h: each line of an OBJ file checked, and its vertices
+// and faces read as CGAL's OBJ reader (CGAL/IO/OBJ.h) reads them.
 #include <algorithm>
 #include <optional>
 #include <set>
@@ -64,7 +64,9 @@ class ObjLineChecks {
  public:
   ObjLineChecks(const std::string& path, ObjText& out, ReadWarnings& warnings,
                 long long allVertices)
-      : path_(path), out_(out), warnings_(warnings), allVertices_(allVertices) {}
+      : path_(path), out_(out), warnings_(warnings), allVertices_(allVertices) {
+    out_.positions.reserve(static_cast<std::size_t>(allVertices));
+  }
 
   /// A `v` line: x y z, then perhaps a weight w or a colour r g b.
   void vertex(std::size_t number, const Words& w) {
@@ -96,12 +98,8 @@ class ObjLineChecks {
                                 " after the vertex's x y z (neither a weight w nor a colour r g "
                                 "b); ignored");
     }
-    out_.cgalText += "v ";
-    out_.cgalText += w[1];
-    out_.cgalText += ' ';
-    out_.cgalText += w[2];
-    out_.cgalText += ' ';
-    out_.cgalText += w[3];
+    out_.positions.push_back(
+        {realValue<double>(w[1]), realValue<double>(w[2]), realValue<double>(w[3])});
   }
 
   /// An `f` line: a point or a line if it has fewer than three corners, else a face whose
@@ -116,11 +114,12 @@ class ObjLineChecks {
       warnings_.add(number, corners == 1 ? "face of one corner (a point); skipped"
                                          : "face of two corners (a line); skipped");
     } else {
-      ++out_.faces;
       useMaterial();
-      out_.cgalText += 'f';
+      std::vector<std::size_t>& polygon = out_.polygons.emplace_back();
+      polygon.reserve(corners);
       bool attributeWarned = false;
-      for (std::size_t k = 1; k < w.size(); ++k) faceCorner(number, w[k], attributeWarned);
+      for (std::size_t k = 1; k < w.size(); ++k)
+        polygon.push_back(faceCorner(number, w[k], attributeWarned));
     }
   }
 
@@ -163,8 +162,10 @@ class ObjLineChecks {
   }
 
   /// A corner of a face (v, v/vt, v//vn or v/vt/vn): its vertex index must name a vertex; a
-  /// malformed texture or normal reference is warned about once per face.
-  void faceCorner(std::size_t number, std::string_view corner, bool& attributeWarned) {
+  /// malformed texture or normal reference is warned about once per face. Returns the vertex
+  /// from 0: i - 1 for an index i from 1, the vertices before this line plus i for an index i
+  /// counted back from -1 (CGAL's OBJ reader does the same).
+  std::size_t faceCorner(std::size_t number, std::string_view corner, bool& attributeWarned) {
     const std::string_view vertex = corner.substr(0, corner.find('/'));
     if (!isIntegerNumber(vertex))
       failAtLine(path_, number,
@@ -201,8 +202,7 @@ class ObjLineChecks {
       warnings_.add(number, "texture/normal reference in face corner " + quoted(corner) +
                                 " is not an integer; ignored (only vertex indices are used)");
     }
-    out_.cgalText += ' ';
-    out_.cgalText += vertex;
+    return static_cast<std::size_t>(*index > 0 ? *index - 1 : before + *index);
   }
 
   const std::string& path_;
@@ -223,7 +223,6 @@ ObjText checkObjText(const std::string& path, std::string_view text, ReadWarning
   }
   // A UTF-8 byte order mark is no part of the first line (it would make "v" a word of its own).
   if (text.starts_with("\xEF\xBB\xBF")) text.remove_prefix(3);
-  out.cgalText.reserve(text.size());
   ObjLineChecks checks(path, out, warnings, static_cast<long long>(countObjVertices(text)));
   LineReader lines(text, 0, 1);
   std::string_view raw;
@@ -240,17 +239,13 @@ ObjText checkObjText(const std::string& path, std::string_view text, ReadWarning
       return out;
     }
     splitWords(line, w);
-    if (w.empty()) {
-      out.cgalText += '\n';
-      continue;
-    }
+    if (w.empty()) continue;
     if (w[0] == "v")
       checks.vertex(number, w);
     else if (w[0] == "f")
       checks.face(number, w);
     else
       checks.other(number, w, line);
-    out.cgalText += '\n';
   }
   return out;
 }

@@ -1,12 +1,11 @@
-// Reading surfaces: guard the header counts; read OBJ/OFF/PLY/STL in double precision through
-// CGAL's polygon-soup readers (after checks for what they misread) and everything else, or what
-// CGAL cannot read, through assimp with transforms baked in (the module libpolydg_assimp.so,
-// mesh/assimp_import.h); then weld by exact position and triangulate polygons exactly
-// (mesh/surface_builder.h).
+// Reading surfaces: guard the header counts; read OBJ/OFF/PLY/STL in double precision (OBJ and
+// plain OFF files as their text is checked, the others through CGAL's polygon-soup readers after
+// checks for what they misread) and everything else, or what CGAL cannot read, through assimp
+// with transforms baked in (the module libpolydg_assimp.so, mesh/assimp_import.h); then weld by
+// exact position and triangulate polygons exactly (mesh/surface_builder.h).
 #include "polydg/mesh/surface_io.h"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/IO/OBJ.h>
 #include <CGAL/IO/OFF.h>
 #include <CGAL/IO/PLY.h>
 #include <CGAL/IO/STL.h>
@@ -143,8 +142,9 @@ struct PolygonSoup {
   std::vector<std::string> warnings;  ///< see SurfaceReadInfo::warnings
 };
 
-/// The point type for CGAL's STL reader, which merges equal points through a std::map: ordered
-/// by bits, so that a NaN is kept (and reported) instead of breaking the map's ordering.
+/// The point type for STL files. CGAL's ASCII STL reader merges equal points through a
+/// std::map: ordered by bits, so that a NaN is kept (and reported) instead of breaking the
+/// map's ordering.
 struct StlPoint {
   std::array<double, 3> c{};
   double& operator[](std::size_t i) { return c[i]; }
@@ -250,36 +250,27 @@ std::optional<std::string> readText(const std::string& path) {
   return text;
 }
 
-/// Reads an OBJ file with CGAL after checkObjText, or returns why CGAL must not read it. CGAL
-/// parses only the `v` and `f` lines (checkObjText counts and checks the rest): it would
-/// silently misread face indices that are zero (taken as relative), overflow an int or are not
-/// integers (the face ends there), homogeneous coordinates (w ignored) and line continuations,
-/// and it rejects `l` lines and keywords it does not know.
-std::variant<PolygonSoup, Reason> readObjWithCgal(const std::string& path, ReadWarnings& warnings) {
+/// Reads an OBJ file: its vertices and faces as checkObjText reads them while it checks each
+/// line (what CGAL's OBJ reader would read of a file that passes the check, parsed once instead
+/// of again by CGAL's stream parser, which took three quarters of reading a 75k-triangle scan),
+/// or returns why polydg must not read it (assimp then does).
+std::variant<PolygonSoup, Reason> readObj(const std::string& path, ReadWarnings& warnings) {
   const std::optional<std::string> text = readText(path);
   if (!text) return Reason("cannot read the file");
-  const ObjText scan = checkObjText(path, *text, warnings);
+  ObjText scan = checkObjText(path, *text, warnings);
   if (!scan.assimpReason.empty()) return scan.assimpReason;
   PolygonSoup soup;
   soup.meshes = std::max<std::size_t>(1, scan.materials.size());
   soup.inputVertices = scan.vertices;
   soup.ignoredPoints = scan.points;
   soup.ignoredLines = scan.lines;
-  if (scan.faces == 0 && scan.vertices > 0) {
+  if (scan.polygons.empty() && scan.vertices > 0) {
     soup.onlyPointsOrLines = true;
     return soup;
   }
-  std::vector<CgalPoint> points;
-  std::istringstream in(scan.cgalText);
-  Reason reason = runCgal([&] {
-    return CGAL::IO::read_OBJ(in, points, soup.polygons, CGAL::parameters::verbose(true));
-  });
-  if (!reason.empty()) return reason;
-  if (points.size() != scan.vertices || soup.polygons.size() != scan.faces)
-    return Reason("its reader found " + std::to_string(points.size()) + " vertices and " +
-                  std::to_string(soup.polygons.size()) + " faces, not " +
-                  std::to_string(scan.vertices) + " and " + std::to_string(scan.faces));
-  soup.points = toVec3(points);
+  soup.points.reserve(scan.positions.size());
+  for (const std::array<double, 3>& p : scan.positions) soup.points.emplace_back(p[0], p[1], p[2]);
+  soup.polygons = std::move(scan.polygons);
   return soup;
 }
 
@@ -341,13 +332,46 @@ Reason offHeaderProblem(const OffHeader& header) {
   return "";
 }
 
-/// Reads an STL file with the binary or the ASCII parser of CGAL/IO/STL/STL_reader.h (CGAL 5.5),
-/// chosen as assimp chooses: binary if the file has exactly 84 + 50 n bytes, n being the facet
-/// count at byte 80; else ASCII if its first word is "solid". CGAL's read_STL is not used: it
-/// takes "solid" followed by a tab for binary, and when one parser fails it runs the other on
-/// the same output, appending the second parse to what the first left. An ASCII file's text is
-/// checked first (checkAsciiStlText), unless it holds NUL bytes (binary content, which CGAL then
-/// fails on).
+/// The `facets` facets of a binary STL file (84 + 50 n bytes, checked by the caller) as CGAL's
+/// binary parser reads them: each corner's three little-endian floats converted exactly to
+/// doubles. Written here without that parser's std::map of the points it has seen (most of
+/// reading a 75k-triangle scan): each facet keeps its own three points, which readSurface welds
+/// by exact position as it welds the points CGAL merged.
+Reason readBinaryStl(const std::string& path, std::uint32_t facets, std::vector<StlPoint>& points,
+                     std::vector<SoupPolygon>& triangles) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in.seekg(84)) return "cannot read the file";
+  constexpr std::size_t kFacetBytes = 50, kChunk = 65536;  // facets read at a time
+  std::vector<char> bytes(kFacetBytes * std::min<std::size_t>(facets, kChunk));
+  points.resize(3 * std::size_t{facets});
+  triangles.resize(facets);
+  for (std::size_t first = 0; first < facets; first += kChunk) {
+    const std::size_t count = std::min<std::size_t>(kChunk, facets - first);
+    if (!in.read(bytes.data(), static_cast<std::streamsize>(count * kFacetBytes)))
+      return "the file ended before its " + std::to_string(facets) + " facets";
+    for (std::size_t i = 0; i < count; ++i) {
+      const char* facet = bytes.data() + i * kFacetBytes + 12;  // after the normal
+      const std::size_t f = first + i;
+      for (std::size_t corner = 0; corner < 3; ++corner)
+        for (std::size_t k = 0; k < 3; ++k) {
+          const auto* b = reinterpret_cast<const unsigned char*>(facet + 12 * corner + 4 * k);
+          const std::uint32_t word = b[0] | std::uint32_t{b[1]} << 8 | std::uint32_t{b[2]} << 16 |
+                                     std::uint32_t{b[3]} << 24;
+          points[3 * f + corner][k] = std::bit_cast<float>(word);
+        }
+      triangles[f] = {3 * f, 3 * f + 1, 3 * f + 2};
+    }
+  }
+  return "";
+}
+
+/// Reads an STL file, binary (readBinaryStl) or ASCII (the ASCII parser of
+/// CGAL/IO/STL/STL_reader.h, CGAL 5.5), chosen as assimp chooses: binary if the file has
+/// exactly 84 + 50 n bytes, n being the facet count at byte 80; else ASCII if its first word is
+/// "solid". CGAL's read_STL is not used: it takes "solid" followed by a tab for binary, and when
+/// one parser fails it runs the other on the same output, appending the second parse to what
+/// the first left. An ASCII file's text is checked first (checkAsciiStlText), unless it holds
+/// NUL bytes (binary content, which CGAL then fails on).
 Reason readStl(const std::string& path, const std::string& head, std::vector<StlPoint>& points,
                std::vector<SoupPolygon>& triangles, ReadWarnings& warnings) {
   std::error_code ec;
@@ -361,19 +385,16 @@ Reason readStl(const std::string& path, const std::string& head, std::vector<Stl
     return "neither binary (" + std::to_string(size) +
            " bytes, not 84 + 50 x its facet count) "
            "nor ASCII (no 'solid' first)";
-  if (!binary) {
-    const std::optional<std::string> text = readText(path);
-    if (!text) return "cannot read the file";
-    if (text->find('\0') == std::string::npos) checkAsciiStlText(path, *text, warnings);
-  }
+  if (binary) return readBinaryStl(path, facets, points, triangles);
+  const std::optional<std::string> text = readText(path);
+  if (!text) return "cannot read the file";
+  if (text->find('\0') == std::string::npos) checkAsciiStlText(path, *text, warnings);
   std::ifstream in(path, std::ios::binary);
-  return runCgal([&] {
-    return binary ? CGAL::IO::internal::parse_binary_STL(in, points, triangles, true)
-                  : CGAL::IO::internal::parse_ASCII_STL(in, points, triangles, true);
-  });
+  return runCgal([&] { return CGAL::IO::internal::parse_ASCII_STL(in, points, triangles, true); });
 }
 
-/// Reads an OBJ, OFF, PLY or STL file (`extension` in lower case) with CGAL, or returns why not.
+/// Reads an OBJ, OFF, PLY or STL file (`extension` in lower case) as CGAL's readers read it, or
+/// returns why not.
 /// Malformed lines throw; warnings go into the soup.
 std::variant<PolygonSoup, Reason> readWithCgal(const std::string& path,
                                                const std::string& extension,
@@ -384,7 +405,7 @@ std::variant<PolygonSoup, Reason> readWithCgal(const std::string& path,
   Reason reason;
   bool linesChecked = false;  // faces without corners were warned about and are dropped
   if (extension == "obj") {
-    auto read = readObjWithCgal(path, warnings);
+    auto read = readObj(path, warnings);
     if (auto* r = std::get_if<Reason>(&read)) return *r;
     soup = std::move(std::get<PolygonSoup>(read));
     if (soup.onlyPointsOrLines) return soup;

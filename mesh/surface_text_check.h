@@ -46,24 +46,25 @@ bool isDecimalNumber(std::string_view token);
 /// True if `token` is [+-] digits.
 bool isIntegerNumber(std::string_view token);
 
-/// What checkObjText found in an OBJ file, and the text CGAL is to parse.
+/// What checkObjText found in an OBJ file, and its vertices and faces.
 struct ObjText {
-  /// One line per line of the file: `v` lines reduced to "v x y z" (the coordinates' own text),
-  /// `f` lines of three or more corners reduced to "f" and their vertex indices, every other
-  /// line empty. CGAL's reader parses it; line numbers are kept.
-  std::string cgalText;
+  /// The `v` lines' x y z (correctly rounded, as CGAL's stream reader rounds them), in order.
+  std::vector<std::array<double, 3>> positions;
+  /// The `f` lines of three or more corners: their vertex indices from 0, a relative (negative)
+  /// index resolved against the vertices before its line, as CGAL's OBJ reader resolves it.
+  std::vector<std::vector<std::size_t>> polygons;
   std::size_t vertices = 0;         ///< `v` lines
-  std::size_t faces = 0;            ///< `f` lines of three or more corners, in cgalText
   std::size_t points = 0;           ///< `p` indices and faces of one corner
   std::size_t lines = 0;            ///< `l` segments and faces of two corners
   std::set<std::string> materials;  ///< used by faces, points and lines ("" before any usemtl)
-  /// Not empty: CGAL must not read this file (homogeneous coordinates, which CGAL ignores; a line
-  /// continuation, which it does not join; NUL bytes), and the warnings do not apply.
+  /// Not empty: polydg must not read this file itself (homogeneous coordinates, which CGAL's
+  /// reader ignored too; a line continuation; NUL bytes): assimp does, and the warnings do not
+  /// apply.
   std::string assimpReason;
 };
 
 /// Checks the OBJ `text` of the file at `path` line by line (comments cut at '#'; tabs, CRs and
-/// other control white space are spaces) and returns what CGAL is to read. Warnings go to
+/// other control white space are spaces) and returns its vertices and faces. Warnings go to
 /// `warnings`; errors throw (failAtLine). The rule is the OBJ part of readSurface's table.
 ObjText checkObjText(const std::string& path, std::string_view text, ReadWarnings& warnings);
 

@@ -1,14 +1,19 @@
 // Tests of mesh/surface_io.h: the testdata models read with exact counts, closure, volumes and
-// areas; double precision through CGAL for OBJ/OFF/PLY/STL and the fallback to assimp;
+// areas; double precision for OBJ/OFF/PLY/STL, as CGAL's readers read them, and the fallback to
+// assimp;
 // welding, degenerate and point/line handling; one-line errors; no crash and no output over
 // assimp's own test models; agreement with meshio's and VTK's volumes
 // (tests/mesh/surface_volume.py).
 #include "polydg/mesh/surface_io.h"
+#include "mesh/surface_text_check.h"
 #include "tests/support/assimp_models.h"
 #include "tests/support/exact_figures.h"
 #include "tests/support/packages.h"
 #include "tests/support/temp_dir.h"
 
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/IO/OBJ.h>
+#include <CGAL/IO/STL/STL_reader.h>
 #include <gtest/gtest.h>
 
 #include <sys/resource.h>
@@ -426,6 +431,45 @@ TEST(ReadSurfaceDouble, BinaryStlReadsExactlyItsFloatValues) {
   }
 }
 
+TEST(ReadSurfaceDouble, BinaryStlReadsWhatCgalsBinaryParserReads) {
+  // polydg reads a binary STL's facets itself; CGAL's binary parser, which merges bit-equal
+  // points as it reads, is the reference: the welded surface has CGAL's points, in CGAL's order
+  // (of first use), bit for bit, and CGAL's triangles. A wavy 16 x 12 patch of float
+  // coordinates far from the origin, each inner point shared by six facets.
+  std::vector<std::array<std::array<float, 3>, 3>> facets;
+  const auto at = [](int i, int j) {
+    return std::array<float, 3>{
+        1.0e4f + 0.1f * static_cast<float>(i), -3.3f + 0.37f * static_cast<float>(j),
+        std::sin(0.7f * static_cast<float>(i)) * 0.01f + static_cast<float>(j * j) * 1.0e-3f};
+  };
+  for (int i = 0; i < 16; ++i)
+    for (int j = 0; j < 12; ++j) {
+      facets.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+      facets.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+    }
+  const TempDir dir("binary_stl_cgal");
+  const std::string path = dir.write("patch.stl", binaryStl("patch", facets));
+  SurfaceReadInfo info;
+  const TriangleSurface ours = readSurface(path, &info);
+  using Point = CGAL::Exact_predicates_inexact_constructions_kernel::Point_3;
+  std::vector<Point> points;
+  std::vector<std::array<std::size_t, 3>> triangles;
+  std::ifstream in(path, std::ios::binary);
+  ASSERT_TRUE(CGAL::IO::internal::parse_binary_STL(in, points, triangles));
+  ASSERT_EQ(points.size(), 17u * 13u);
+  ASSERT_EQ(ours.vertices.size(), points.size());
+  for (std::size_t v = 0; v < points.size(); ++v)
+    for (int k = 0; k < 3; ++k)
+      EXPECT_EQ(std::bit_cast<std::uint64_t>(ours.vertices[v][k]),
+                std::bit_cast<std::uint64_t>(points[v][k]))
+          << "vertex " << v << ", coordinate " << k;
+  ASSERT_EQ(ours.triangles.size(), triangles.size());
+  for (std::size_t t = 0; t < triangles.size(); ++t)
+    for (std::size_t k = 0; k < 3; ++k)
+      EXPECT_EQ(ours.triangles[t][k], triangles[t][k]) << "triangle " << t;
+  EXPECT_EQ(info.inputVertices, 3 * facets.size());
+}
+
 TEST(ReadSurfaceDouble, AsciiPlyKeepsDoubleValuesAndRoundsFloatOnesOnce) {
   const std::array<std::array<std::string, 3>, 4> text = {{
       {"0.1234567890123456", "-0.000000001", "1000.000000000001"},
@@ -529,6 +573,60 @@ TEST(ReadSurfaceDouble, PlainOffReadsWhatCgalsReaderReads) {
   EXPECT_EQ(a.vertices[1].x(), 0.30000000000000004);
   EXPECT_EQ(a.vertices[3].y(), std::nextafter(1.5, 2.0));
   EXPECT_TRUE(analyzeTopology(a).closed());
+}
+
+TEST(ReadSurfaceDouble, ObjRecordsAreWhatCgalsObjReaderReads) {
+  // polydg reads an OBJ file's vertices and faces while it checks the text (checkObjText); CGAL's
+  // OBJ reader, run on the same text, is the reference: the same points, bit for bit (signs, a
+  // leading '+', 17 and 30 significant digits, a subnormal, exponents, forms without a digit
+  // before or after the point), and the same faces: corners with texture and normal references,
+  // indices counted back from -1 and forward references, quads and a pentagon, among
+  // comments, groups, materials, tabs, CR LF line ends, a colour and a weight of 1.
+  const std::string text =
+      "# corners of a box\r\n"
+      "mtllib box.mtl\r\n"
+      "v -0 0.30000000000000004441 4.9406564584124654e-324\r\n"
+      "v +1.5 0.30000000000000004441 4.9406564584124654e-324 1\n"
+      "v -0 1.500000000000000222044604925031308\t1E5\n"
+      "vt 0.5 0.5\n"
+      "vn 0 0 1\n"
+      "g side\n"
+      "usemtl red\n"
+      "f 1/1/1 3//1 8 6  # a forward reference\n"
+      "v +1.5 1.500000000000000222044604925031308 1E5 0.2 0.3 0.4\n"
+      "v -0 .5 5. \n"
+      "f -5 -1 -3\n"
+      "v 1.5 .5 5.\n"
+      "v .25 -2.5e-3 -1e+2\n"
+      "v 7 8 9\n"
+      "f 2 4 8 7 5\n"
+      "o second\n"
+      "f 6/2 5/2 4/2 3/2\n"
+      "f 1 -2 8 # the last vertex read is 8, -2 is 7\n";
+  ReadWarnings warnings("records.obj");
+  const ObjText ours = checkObjText("records.obj", text, warnings);
+  EXPECT_TRUE(warnings.lines().empty()) << warnings.lines().front();
+  ASSERT_TRUE(ours.assimpReason.empty()) << ours.assimpReason;
+  using Point = CGAL::Exact_predicates_inexact_constructions_kernel::Point_3;
+  std::vector<Point> points;
+  std::vector<std::vector<std::size_t>> polygons;
+  std::istringstream in(text);
+  ASSERT_TRUE(CGAL::IO::read_OBJ(in, points, polygons));
+  ASSERT_EQ(ours.positions.size(), points.size());
+  for (std::size_t v = 0; v < points.size(); ++v)
+    for (int k = 0; k < 3; ++k)
+      EXPECT_EQ(std::bit_cast<std::uint64_t>(ours.positions[v][static_cast<std::size_t>(k)]),
+                std::bit_cast<std::uint64_t>(points[v][k]))
+          << "vertex " << v << ", coordinate " << k;
+  EXPECT_EQ(ours.polygons, polygons);
+  // What both read, spelled out: the relative corners resolved and the forward reference kept.
+  ASSERT_EQ(ours.polygons.size(), 5u);
+  EXPECT_EQ(ours.polygons[1], (std::vector<std::size_t>{0, 4, 2}));
+  EXPECT_EQ(ours.polygons[0], (std::vector<std::size_t>{0, 2, 7, 5}));
+  EXPECT_EQ(ours.polygons[4], (std::vector<std::size_t>{0, 6, 7}));
+  EXPECT_EQ(ours.positions[1][1], 0.30000000000000004);
+  EXPECT_EQ(ours.positions[0][2], std::numeric_limits<double>::denorm_min());
+  EXPECT_EQ(ours.positions[6][1], -2.5e-3);
 }
 
 TEST(ReadSurfaceDouble, FallsBackToAssimpForWhatCgalDoesNotRead) {
