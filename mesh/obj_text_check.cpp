@@ -1,6 +1,7 @@
 // The OBJ check of mesh/surface_text_check.h: each line of an OBJ file checked, and its vertices
 // and faces read as CGAL's OBJ reader (CGAL/IO/OBJ.h) reads them.
 #include <algorithm>
+#include <array>
 #include <optional>
 #include <set>
 #include <string>
@@ -72,8 +73,9 @@ class ObjLineChecks {
   void vertex(std::size_t number, const Words& w) {
     ++out_.vertices;
     const std::size_t n = w.size() - 1;
+    std::array<double, 3> xyz{};
     for (std::size_t k = 1; k <= std::min<std::size_t>(n, 3); ++k)
-      if (const std::string problem = coordinateProblem(w[k]); !problem.empty())
+      if (const std::string problem = coordinateProblem(w[k], &xyz[k - 1]); !problem.empty())
         failAtLine(path_, number, problem + "; correct it");
     if (n < 3)
       failAtLine(path_, number,
@@ -98,8 +100,7 @@ class ObjLineChecks {
                                 " after the vertex's x y z (neither a weight w nor a colour r g "
                                 "b); ignored");
     }
-    out_.positions.push_back(
-        {realValue<double>(w[1]), realValue<double>(w[2]), realValue<double>(w[3])});
+    out_.positions.push_back(xyz);
   }
 
   /// An `f` line: a point or a line if it has fewer than three corners, else a face whose

@@ -365,8 +365,9 @@ Reason readBinaryStl(const std::string& path, std::uint32_t facets, std::vector<
   return "";
 }
 
-/// Reads an STL file, binary (readBinaryStl) or ASCII (the ASCII parser of
-/// CGAL/IO/STL/STL_reader.h, CGAL 5.5), chosen as assimp chooses: binary if the file has
+/// Reads an STL file, binary (readBinaryStl) or ASCII (a plain file's facets as its check read
+/// them, any other through the ASCII parser of CGAL/IO/STL/STL_reader.h, CGAL 5.5), chosen as
+/// assimp chooses: binary if the file has
 /// exactly 84 + 50 n bytes, n being the facet count at byte 80; else ASCII if its first word is
 /// "solid". CGAL's read_STL is not used: it takes "solid" followed by a tab for binary, and when
 /// one parser fails it runs the other on the same output, appending the second parse to what
@@ -388,7 +389,20 @@ Reason readStl(const std::string& path, const std::string& head, std::vector<Stl
   if (binary) return readBinaryStl(path, facets, points, triangles);
   const std::optional<std::string> text = readText(path);
   if (!text) return "cannot read the file";
-  if (text->find('\0') == std::string::npos) checkAsciiStlText(path, *text, warnings);
+  StlRecords records;
+  if (text->find('\0') == std::string::npos) {
+    checkAsciiStlText(path, *text, warnings, &records);
+  } else {
+    records.plain = false;
+  }
+  if (records.plain) {  // the facets the check read: not parsed a second time
+    const std::size_t n = records.corners.size() / 3;
+    points.resize(records.corners.size());
+    triangles.resize(n);
+    for (std::size_t i = 0; i < records.corners.size(); ++i) points[i].c = records.corners[i];
+    for (std::size_t f = 0; f < n; ++f) triangles[f] = {3 * f, 3 * f + 1, 3 * f + 2};
+    return "";
+  }
   std::ifstream in(path, std::ios::binary);
   return runCgal([&] { return CGAL::IO::internal::parse_ASCII_STL(in, points, triangles, true); });
 }

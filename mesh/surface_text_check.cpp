@@ -134,8 +134,9 @@ void checkOffText(const std::string& path, std::string_view text, const OffHeade
     const std::size_t number = lines.number();
     if (number == header.dataLine) out.plain = false;
     if (records < vertices) {
+      std::array<double, 4> xyzw{};
       for (std::size_t k = 0; k < std::min(w.size(), coordinates); ++k)
-        if (const std::string problem = coordinateProblem(w[k]); !problem.empty())
+        if (const std::string problem = coordinateProblem(w[k], &xyzw[k]); !problem.empty())
           failAtLine(path, number, problem + "; correct it");
       if (w.size() < coordinates)
         failAtLine(path, number,
@@ -149,8 +150,7 @@ void checkOffText(const std::string& path, std::string_view text, const OffHeade
           break;
         }
       if (out.plain && w.size() == 3)
-        out.vertices.push_back(
-            {realValue<double>(w[0]), realValue<double>(w[1]), realValue<double>(w[2])});
+        out.vertices.push_back({xyzw[0], xyzw[1], xyzw[2]});
       else
         out.plain = false;
     } else if (records < vertices + faces) {
@@ -377,7 +377,8 @@ void checkAsciiPlyText(const std::string& path, std::string_view text, const Ply
 
 // --- STL --------------------------------------------------------------------------------------
 
-void checkAsciiStlText(const std::string& path, std::string_view text, ReadWarnings& warnings) {
+void checkAsciiStlText(const std::string& path, std::string_view text, ReadWarnings& warnings,
+                       StlRecords* values) {
   WordReader words(text);
   std::string_view word;
   bool inFacet = false;
@@ -385,6 +386,16 @@ void checkAsciiStlText(const std::string& path, std::string_view text, ReadWarni
   const auto isKeyword = [](std::string_view s) {
     return s == "solid" || s == "endsolid" || s == "facet" || s == "outer" || s == "vertex" ||
            s == "endloop" || s == "endfacet";
+  };
+  StlRecords unused;
+  StlRecords& out = values ? *values : unused;
+  out.plain = values != nullptr;
+  const std::size_t warned = warnings.count();
+  // CGAL's parser: a "solid" inside a solid stops it (the file then fails), and a solid's name
+  // is read as words, so a keyword there would be taken as one.
+  bool inSolid = false, solidClosed = false;
+  const auto plainName = [&](const std::vector<std::string_view>& name) {
+    if (std::any_of(name.begin(), name.end(), isKeyword)) out.plain = false;
   };
   // A number as strtod reads it, "nan" and "inf" included: normals are not used, and
   // exporters write NaN normals for degenerate facets.
@@ -401,7 +412,10 @@ void checkAsciiStlText(const std::string& path, std::string_view text, ReadWarni
         failAtLine(path, facetLine,
                    "facet without endfacet (the solid ends at line " + std::to_string(number) +
                        "); complete it");
-      words.restOfLine();  // the name
+      if (word == "solid" && inSolid) out.plain = false;
+      inSolid = word == "solid";
+      solidClosed = solidClosed || !inSolid;
+      plainName(words.restOfLine());
     } else if (word == "facet") {
       if (inFacet)
         failAtLine(path, facetLine,
@@ -426,14 +440,16 @@ void checkAsciiStlText(const std::string& path, std::string_view text, ReadWarni
         failAtLine(path, number,
                    "vertex outside a facet (CGAL would skip it); put it inside "
                    "'facet normal ... outer loop ... endloop endfacet'");
+      std::array<double, 3> corner{};
       for (std::size_t k = 0; k < 3; ++k) {
         std::string_view coordinate;
         if (!words.next(coordinate) || isKeyword(coordinate))
           failAtLine(path, number,
                      "a vertex needs x y z but this one has " + numbers(k) + "; complete it");
-        if (const std::string problem = coordinateProblem(coordinate); !problem.empty())
+        if (const std::string problem = coordinateProblem(coordinate, &corner[k]); !problem.empty())
           failAtLine(path, words.line(), problem + "; correct it");
       }
+      if (out.plain) out.corners.push_back(corner);
       if (++corners > 3)
         failAtLine(path, number,
                    "a fourth vertex in the facet of line " + std::to_string(facetLine) +
@@ -459,6 +475,8 @@ void checkAsciiStlText(const std::string& path, std::string_view text, ReadWarni
     failAtLine(path, words.line(),
                "the file ends inside the facet of line " + std::to_string(facetLine) +
                    "; the file is truncated");
+  if (inSolid || !solidClosed || warnings.count() != warned) out.plain = false;
+  if (!out.plain) out.corners.clear();
 }
 
 }  // namespace polydg

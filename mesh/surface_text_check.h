@@ -126,7 +126,19 @@ PlyHeader parsePlyHeader(std::string_view text);
 void checkAsciiPlyText(const std::string& path, std::string_view text, const PlyHeader& header,
                        ReadWarnings& warnings);
 
-/// Checks an ASCII STL file ("solid" ... "endsolid"), token by token as CGAL reads it.
-void checkAsciiStlText(const std::string& path, std::string_view text, ReadWarnings& warnings);
+/// The facets of a plain ASCII STL file, read while checkAsciiStlText checks them.
+struct StlRecords {
+  /// The file is plain: each solid opened by "solid" and closed by "endsolid" (one after the
+  /// other, at least one), their names without a keyword of the format, and nothing the check
+  /// warns about. Then `corners` (three per facet, in order, correctly rounded as CGAL's
+  /// stream reads them) are the points CGAL's ASCII parser reads, before it merges equal ones.
+  bool plain = true;
+  std::vector<std::array<double, 3>> corners;
+};
+
+/// Checks an ASCII STL file ("solid" ... "endsolid"), token by token as CGAL reads it. If
+/// `values` is given, also reads the facets of a plain file into it (see StlRecords).
+void checkAsciiStlText(const std::string& path, std::string_view text, ReadWarnings& warnings,
+                       StlRecords* values = nullptr);
 
 }  // namespace polydg

@@ -128,11 +128,13 @@ inline std::optional<long long> integerValue(std::string_view token) {
   return value;
 }
 
-/// Why `token` is not a finite double, or "" if it is one.
-inline std::string coordinateProblem(std::string_view token) {
+/// Why `token` is not a finite double, or "" if it is one; then `value` (if given) receives it,
+/// correctly rounded (a coordinate is parsed once).
+inline std::string coordinateProblem(std::string_view token, double* value = nullptr) {
   if (!isDecimalNumber(token)) return "coordinate " + quoted(token) + " is not a number";
-  if (!std::isfinite(realValue<double>(token)))
-    return "coordinate " + quoted(token) + " is beyond the range of double";
+  const double v = realValue<double>(token);
+  if (!std::isfinite(v)) return "coordinate " + quoted(token) + " is beyond the range of double";
+  if (value) *value = v;
   return "";
 }
 

@@ -470,6 +470,83 @@ TEST(ReadSurfaceDouble, BinaryStlReadsWhatCgalsBinaryParserReads) {
   EXPECT_EQ(info.inputVertices, 3 * facets.size());
 }
 
+TEST(ReadSurfaceDouble, PlainAsciiStlReadsWhatCgalsAsciiParserReads) {
+  // A plain ASCII STL file's facets are read while its text is checked; CGAL's ASCII parser
+  // (which merges bit-equal points) is the reference, bit for bit: the wavy patch of the binary
+  // test in double precision, written with 17 digits, exponents, tabs and CR LF line ends, in
+  // two solids one after the other.
+  const auto at = [](int i, int j) {
+    return std::array<double, 3>{1.0e4 + 0.1 * i, -3.3 + 0.37 * j,
+                                 std::sin(0.7 * i) * 0.01 + j * j * 1.0e-3};
+  };
+  const auto number = [](double x, bool exponent) {
+    char buffer[40];
+    std::snprintf(buffer, sizeof buffer, exponent ? "%.16e" : "%.17g", x);
+    return std::string(buffer);
+  };
+  std::string text = "solid patch\r\n";
+  int count = 0;
+  for (int i = 0; i < 8; ++i) {
+    if (i == 4) text += "endsolid patch\nsolid second part\n";
+    for (int j = 0; j < 6; ++j)
+      for (const auto& facet : {std::array{at(i, j), at(i + 1, j), at(i + 1, j + 1)},
+                                std::array{at(i, j), at(i + 1, j + 1), at(i, j + 1)}}) {
+        text += "  facet normal 0 0 1\r\n    outer loop\r\n";
+        for (const auto& p : facet)
+          text += "\tvertex " + number(p[0], count % 2 == 0) + " " + number(p[1], false) + "\t" +
+                  number(p[2], count % 3 == 0) + "\r\n";
+        text += "    endloop\r\n  endfacet\r\n";
+        ++count;
+      }
+  }
+  text += "endsolid second part\n";
+  ReadWarnings warnings("patch.stl");
+  StlRecords records;
+  checkAsciiStlText("patch.stl", text, warnings, &records);
+  ASSERT_TRUE(records.plain);
+  EXPECT_EQ(records.corners.size(), 3u * 96u);
+  const TempDir dir("ascii_stl_cgal");
+  const std::string path = dir.write("patch.stl", text);
+  const TriangleSurface ours = readSurface(path);
+  using Point = CGAL::Exact_predicates_inexact_constructions_kernel::Point_3;
+  std::vector<Point> points;
+  std::vector<std::array<std::size_t, 3>> triangles;
+  std::ifstream in(path, std::ios::binary);
+  ASSERT_TRUE(CGAL::IO::internal::parse_ASCII_STL(in, points, triangles));
+  ASSERT_EQ(points.size(), 9u * 7u);
+  ASSERT_EQ(ours.vertices.size(), points.size());
+  for (std::size_t v = 0; v < points.size(); ++v)
+    for (int k = 0; k < 3; ++k)
+      EXPECT_EQ(std::bit_cast<std::uint64_t>(ours.vertices[v][k]),
+                std::bit_cast<std::uint64_t>(points[v][k]))
+          << "vertex " << v << ", coordinate " << k;
+  ASSERT_EQ(ours.triangles.size(), triangles.size());
+  for (std::size_t t = 0; t < triangles.size(); ++t)
+    for (std::size_t k = 0; k < 3; ++k)
+      EXPECT_EQ(ours.triangles[t][k], triangles[t][k]) << "triangle " << t;
+
+  // What is not plain goes to CGAL's parser as before: a solid opened inside another (CGAL
+  // stops there), a keyword in a solid's name (CGAL reads it as one), no endsolid (CGAL fails),
+  // a line the check warns about.
+  const std::string facet =
+      "facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\n"
+      "endfacet\n";
+  for (const std::string& variant : {"solid a\n" + facet + "solid b\n" + facet + "endsolid b\n",
+                                     "solid facet\n" + facet + "endsolid\n", "solid a\n" + facet,
+                                     "solid a\n" + facet + "colour red\nendsolid a\n"}) {
+    ReadWarnings quiet("variant.stl");
+    StlRecords read;
+    checkAsciiStlText("variant.stl", variant, quiet, &read);
+    EXPECT_FALSE(read.plain) << variant;
+    EXPECT_TRUE(read.corners.empty()) << variant;
+  }
+  ReadWarnings quiet("plain.stl");
+  StlRecords read;
+  checkAsciiStlText("plain.stl", "solid a\n" + facet + "endsolid a\n", quiet, &read);
+  EXPECT_TRUE(read.plain);
+  EXPECT_EQ(read.corners.size(), 3u);
+}
+
 TEST(ReadSurfaceDouble, AsciiPlyKeepsDoubleValuesAndRoundsFloatOnesOnce) {
   const std::array<std::array<std::string, 3>, 4> text = {{
       {"0.1234567890123456", "-0.000000001", "1000.000000000001"},

@@ -29,8 +29,8 @@ struct SurfaceReadInfo {
   std::size_t ignoredPoints = 0;      ///< point primitives skipped
   std::size_t ignoredLines = 0;       ///< line primitives skipped
   /// The reader that parsed the file: "cgal" (double precision: CGAL's readers, or polydg's
-  /// own reading of OBJ, plain OFF and binary STL files as CGAL's readers read them, see
-  /// readSurface) or "assimp" (single precision).
+  /// own reading of OBJ, plain OFF and STL files as CGAL's readers read them, see readSurface)
+  /// or "assimp" (single precision).
   std::string reader;
   /// Lines of the file that were skipped (see "Malformed lines" at readSurface), one line each,
   /// "FILE:LINE: what; what was done", in file order: at most kMaxReadWarnings, then one line
@@ -56,10 +56,12 @@ inline constexpr std::size_t kMaxReadWarnings = 20;
 /// an OBJ file's `v` lines (x y z) and `f` lines of three or more corners (vertex indices only,
 /// one counted back from -1 resolved against the vertices before its line) and a plain OFF
 /// file's records ("OFF", records of exactly x y z or a face's size and indices, no comment)
-/// are read while their lines are checked (correctly rounded, as CGAL's streams read them), and
-/// a binary STL file's facets are read as CGAL's binary parser reads them, without its merging
-/// of equal points (the welding below merges them); `info->reader` still says "cgal" (tests
-/// compare the OBJ, OFF and STL results with CGAL's readers). If CGAL cannot read such a file (PLY
+/// and a plain ASCII STL file's facets (one solid after the other, names without keywords,
+/// nothing warned about) are read while their lines are checked (correctly rounded, as CGAL's
+/// streams read them), and a binary STL file's facets are read as CGAL's binary parser reads
+/// them; neither STL reading merges equal points as CGAL's parsers do (the welding below merges
+/// them). `info->reader` still says "cgal" (tests compare the OBJ, OFF and STL results with
+/// CGAL's readers). If CGAL cannot read such a file (PLY
 /// indices of 8 or 16 bits, an STL file without endsolid, ...), or the file fails one of the
 /// checks, or CGAL finds no vertex, assimp reads it instead, in single precision as for every
 /// other format: `info->reader` says which did. An OBJ file with `v` lines but no `f` line of
