@@ -431,6 +431,30 @@ TEST(ReadSurfaceDouble, BinaryStlReadsExactlyItsFloatValues) {
   }
 }
 
+/// Expects `ours`, read from the STL file at `path`, to be what CGAL's binary or ASCII STL parser
+/// reads (it merges bit-equal points as it reads): `points` points, the same bits in the same
+/// order (of first use), and the same triangles.
+void expectCgalsStl(const TriangleSurface& ours, const std::string& path, bool binary,
+                    std::size_t points) {
+  using Point = CGAL::Exact_predicates_inexact_constructions_kernel::Point_3;
+  std::vector<Point> cgal;
+  std::vector<std::array<std::size_t, 3>> triangles;
+  std::ifstream in(path, std::ios::binary);
+  ASSERT_TRUE(binary ? CGAL::IO::internal::parse_binary_STL(in, cgal, triangles)
+                     : CGAL::IO::internal::parse_ASCII_STL(in, cgal, triangles));
+  ASSERT_EQ(cgal.size(), points);
+  ASSERT_EQ(ours.vertices.size(), cgal.size());
+  for (std::size_t v = 0; v < cgal.size(); ++v)
+    for (int k = 0; k < 3; ++k)
+      EXPECT_EQ(std::bit_cast<std::uint64_t>(ours.vertices[v][k]),
+                std::bit_cast<std::uint64_t>(cgal[v][k]))
+          << "vertex " << v << ", coordinate " << k;
+  ASSERT_EQ(ours.triangles.size(), triangles.size());
+  for (std::size_t t = 0; t < triangles.size(); ++t)
+    for (std::size_t k = 0; k < 3; ++k)
+      EXPECT_EQ(ours.triangles[t][k], triangles[t][k]) << "triangle " << t;
+}
+
 TEST(ReadSurfaceDouble, BinaryStlReadsWhatCgalsBinaryParserReads) {
   // polydg reads a binary STL's facets itself; CGAL's binary parser, which merges bit-equal
   // points as it reads, is the reference: the welded surface has CGAL's points, in CGAL's order
@@ -451,22 +475,7 @@ TEST(ReadSurfaceDouble, BinaryStlReadsWhatCgalsBinaryParserReads) {
   const std::string path = dir.write("patch.stl", binaryStl("patch", facets));
   SurfaceReadInfo info;
   const TriangleSurface ours = readSurface(path, &info);
-  using Point = CGAL::Exact_predicates_inexact_constructions_kernel::Point_3;
-  std::vector<Point> points;
-  std::vector<std::array<std::size_t, 3>> triangles;
-  std::ifstream in(path, std::ios::binary);
-  ASSERT_TRUE(CGAL::IO::internal::parse_binary_STL(in, points, triangles));
-  ASSERT_EQ(points.size(), 17u * 13u);
-  ASSERT_EQ(ours.vertices.size(), points.size());
-  for (std::size_t v = 0; v < points.size(); ++v)
-    for (int k = 0; k < 3; ++k)
-      EXPECT_EQ(std::bit_cast<std::uint64_t>(ours.vertices[v][k]),
-                std::bit_cast<std::uint64_t>(points[v][k]))
-          << "vertex " << v << ", coordinate " << k;
-  ASSERT_EQ(ours.triangles.size(), triangles.size());
-  for (std::size_t t = 0; t < triangles.size(); ++t)
-    for (std::size_t k = 0; k < 3; ++k)
-      EXPECT_EQ(ours.triangles[t][k], triangles[t][k]) << "triangle " << t;
+  expectCgalsStl(ours, path, /*binary=*/true, 17 * 13);
   EXPECT_EQ(info.inputVertices, 3 * facets.size());
 }
 
@@ -508,22 +517,7 @@ TEST(ReadSurfaceDouble, PlainAsciiStlReadsWhatCgalsAsciiParserReads) {
   const TempDir dir("ascii_stl_cgal");
   const std::string path = dir.write("patch.stl", text);
   const TriangleSurface ours = readSurface(path);
-  using Point = CGAL::Exact_predicates_inexact_constructions_kernel::Point_3;
-  std::vector<Point> points;
-  std::vector<std::array<std::size_t, 3>> triangles;
-  std::ifstream in(path, std::ios::binary);
-  ASSERT_TRUE(CGAL::IO::internal::parse_ASCII_STL(in, points, triangles));
-  ASSERT_EQ(points.size(), 9u * 7u);
-  ASSERT_EQ(ours.vertices.size(), points.size());
-  for (std::size_t v = 0; v < points.size(); ++v)
-    for (int k = 0; k < 3; ++k)
-      EXPECT_EQ(std::bit_cast<std::uint64_t>(ours.vertices[v][k]),
-                std::bit_cast<std::uint64_t>(points[v][k]))
-          << "vertex " << v << ", coordinate " << k;
-  ASSERT_EQ(ours.triangles.size(), triangles.size());
-  for (std::size_t t = 0; t < triangles.size(); ++t)
-    for (std::size_t k = 0; k < 3; ++k)
-      EXPECT_EQ(ours.triangles[t][k], triangles[t][k]) << "triangle " << t;
+  expectCgalsStl(ours, path, /*binary=*/false, 9 * 7);
 
   // What is not plain goes to CGAL's parser as before: a solid opened inside another (CGAL
   // stops there), a keyword in a solid's name (CGAL reads it as one), no endsolid (CGAL fails),
