@@ -84,6 +84,8 @@ void run(const MeshCommandOptions& o, const CommonOptions& common, int& exitCode
   options.progress = [&bar](double f) { bar.update(f); };
   try {
     Model::fromSurface(surface, options, report, o.input);
+  } catch (const OutputError&) {
+    throw;  // about the output, not the surface
   } catch (const InputError& e) {
     throw InputError(o.input + ": " + e.what());
   }

@@ -302,7 +302,7 @@ class FoamWriter {
     std::ofstream os(path, std::ios::binary);
     os << text;
     os.close();
-    if (!os) throw InputError("cannot write " + path.string() + "; check the folder");
+    if (!os) throw OutputError("cannot write " + path.string() + "; check the folder");
   }
 
   fs::path dir_;

@@ -18,14 +18,14 @@ void writeFileAtomically(const fs::path& path, const std::function<void(std::ost
   {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
     if (!out)
-      throw InputError("cannot write " + path.string() + ": " + std::strerror(errno) +
-                       "; check that the folder exists and is writable");
+      throw OutputError("cannot write " + path.string() + ": " + std::strerror(errno) +
+                        "; check that the folder exists and is writable");
     write(out);
     out.flush();
     if (!out) {
       std::error_code ignored;
       fs::remove(tmp, ignored);
-      throw InputError("cannot write " + path.string() + ": write failed (disk full?)");
+      throw OutputError("cannot write " + path.string() + ": write failed (disk full?)");
     }
   }
   std::error_code ec;
@@ -33,7 +33,7 @@ void writeFileAtomically(const fs::path& path, const std::function<void(std::ost
   if (ec) {
     std::error_code ignored;
     fs::remove(tmp, ignored);
-    throw InputError("cannot write " + path.string() + ": " + ec.message());
+    throw OutputError("cannot write " + path.string() + ": " + ec.message());
   }
 }
 
@@ -45,13 +45,13 @@ void requireWritable(const fs::path& output) {
   const fs::path folder = output.parent_path().empty() ? fs::path(".") : output.parent_path();
   std::error_code ec;
   if (!fs::is_directory(folder, ec))
-    throw InputError("cannot write " + output.string() + ": the folder " + folder.string() +
-                     " does not exist; create it or choose another output path");
+    throw OutputError("cannot write " + output.string() + ": the folder " + folder.string() +
+                      " does not exist; create it or choose another output path");
   if (::access(folder.c_str(), W_OK) != 0)
-    throw InputError("cannot write " + output.string() + ": the folder " + folder.string() +
-                     " is not writable; choose another output path");
+    throw OutputError("cannot write " + output.string() + ": the folder " + folder.string() +
+                      " is not writable; choose another output path");
   if (fs::is_directory(output, ec))
-    throw InputError("cannot write " + output.string() + ": it is a folder; give a file name");
+    throw OutputError("cannot write " + output.string() + ": it is a folder; give a file name");
 }
 
 void requireOutput(const fs::path& output, std::initializer_list<fs::path> inputs) {

@@ -13,14 +13,14 @@
 namespace polydg {
 
 /// Writes `path` through `write(stream)` into "path.tmp-<pid>" and renames it into place.
-/// Throws InputError ("cannot write PATH: reason; ...") if the file cannot be written.
+/// Throws OutputError ("cannot write PATH: reason; ...") if the file cannot be written.
 void writeFileAtomically(const std::filesystem::path& path,
                          const std::function<void(std::ostream&)>& write);
 
 /// Writes `document` as indented JSON to `path`, atomically.
 void writeJsonFile(const std::filesystem::path& path, const nlohmann::json& document);
 
-/// Throws InputError if the file `output` could not be written where it is to go: its folder
+/// Throws OutputError if the file `output` could not be written where it is to go: its folder
 /// does not exist or is not writable, or `output` is a folder. Called before the work whose
 /// result the file holds, so that a mistyped path costs nothing and leaves nothing half done.
 void requireWritable(const std::filesystem::path& output);

@@ -120,12 +120,12 @@ class PendingFile {
     for (; at != std::string::npos; at = message.find(temporary_, at + path_.size()))
       message.replace(at, temporary_.size(), path_);
     return std::make_exception_ptr(
-        InputError(message + "; check the output's folder and its free space"));
+        OutputError(message + "; check the output's folder and its free space"));
   }
   void commit() {
     std::error_code ec;
     fs::rename(temporary_, path_, ec);
-    if (ec) throw InputError("cannot write " + path_ + ": " + ec.message());
+    if (ec) throw OutputError("cannot write " + path_ + ": " + ec.message());
     committed_ = true;
   }
 

@@ -128,6 +128,11 @@ TEST_F(Commands, OutputsIntoAMissingFolderAreRefusedBeforeTheWork) {
   // A folder where the file should go.
   fs::create_directory(path("folder.vtu"));
   expectRefused(runPolydg(cut + path("folder.vtu")), "it is a folder");
+  // A write that fails only when it is made (/proc takes no new files; as another user than
+  // root, its folder is refused first) names the output, not the surface that was read.
+  const CommandResult late = runPolydg("mesh " + torus + " --cells 4 -o /proc/polydg-x.vtu");
+  expectRefused(late, "polydg: error: cannot write /proc/polydg-x.vtu");
+  EXPECT_EQ(late.out.find(torus), std::string::npos) << late.out;
 }
 
 // Finite values whose loads or solution overflow (a traction near the largest double, gravity

@@ -18,6 +18,12 @@ struct InputError : Error {
   using Error::Error;
 };
 
+/// An output polydg cannot write: its folder is missing or not writable, or the write failed.
+/// An InputError (the CLI exits with 2), whose message names the output, never an input.
+struct OutputError : InputError {
+  using InputError::InputError;
+};
+
 /// A value an option may not take, named by its key in the formats users write (the keys of
 /// scenes, pipelines and Python: "E", "degree", "dt", "damping.mass"). The option's own check
 /// throws it; each front end says where the value came from (a file and its place, a
