@@ -1,8 +1,9 @@
-// Reading surfaces: guard the header counts; read OBJ/OFF/PLY/STL in double precision (OBJ and
-// plain OFF files as their text is checked, the others through CGAL's polygon-soup readers after
-// checks for what they misread) and everything else, or what CGAL cannot read, through assimp
-// with transforms baked in (the module libpolydg_assimp.so, mesh/assimp_import.h); then weld by
-// exact position and triangulate polygons exactly (mesh/surface_builder.h).
+// Reading surfaces: guard the header counts; read OBJ/OFF/PLY/STL in double precision as CGAL's
+// readers read them (OBJ, plain OFF and plain ASCII STL files as their text is checked, binary
+// STL directly, the others through CGAL's polygon-soup readers after checks for what they
+// misread) and everything else, or what CGAL cannot read, through assimp with transforms baked in
+// (the module libpolydg_assimp.so, mesh/assimp_import.h); then weld by exact position and
+// triangulate polygons exactly (mesh/surface_builder.h).
 #include "polydg/mesh/surface_io.h"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
