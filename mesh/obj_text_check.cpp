@@ -71,7 +71,6 @@ class ObjLineChecks {
 
   /// A `v` line: x y z, then perhaps a weight w or a colour r g b.
   void vertex(std::size_t number, const Words& w) {
-    ++out_.vertices;
     const std::size_t n = w.size() - 1;
     std::array<double, 3> xyz{};
     for (std::size_t k = 1; k <= std::min<std::size_t>(n, 3); ++k)
@@ -174,7 +173,7 @@ class ObjLineChecks {
                                  : "face index " + quoted(vertex) + " is not an integer") +
                      "; correct the face");
     const std::optional<long long> index = integerValue(vertex);
-    const auto before = static_cast<long long>(out_.vertices);
+    const auto before = static_cast<long long>(out_.positions.size());
     if (index && *index == 0)
       failAtLine(path_, number,
                  "face index 0 names no vertex (OBJ counts vertices from 1, and from -1 "

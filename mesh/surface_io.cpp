@@ -262,15 +262,14 @@ std::variant<PolygonSoup, Reason> readObj(const std::string& path, ReadWarnings&
   if (!scan.assimpReason.empty()) return scan.assimpReason;
   PolygonSoup soup;
   soup.meshes = std::max<std::size_t>(1, scan.materials.size());
-  soup.inputVertices = scan.vertices;
+  soup.inputVertices = scan.positions.size();
   soup.ignoredPoints = scan.points;
   soup.ignoredLines = scan.lines;
-  if (scan.polygons.empty() && scan.vertices > 0) {
+  if (scan.polygons.empty() && !scan.positions.empty()) {
     soup.onlyPointsOrLines = true;
     return soup;
   }
-  soup.points.reserve(scan.positions.size());
-  for (const std::array<double, 3>& p : scan.positions) soup.points.emplace_back(p[0], p[1], p[2]);
+  soup.points = toVec3(scan.positions);
   soup.polygons = std::move(scan.polygons);
   return soup;
 }
@@ -333,19 +332,16 @@ Reason offHeaderProblem(const OffHeader& header) {
   return "";
 }
 
-/// The `facets` facets of a binary STL file (84 + 50 n bytes, checked by the caller) as CGAL's
-/// binary parser reads them: each corner's three little-endian floats converted exactly to
-/// doubles. Written here without that parser's std::map of the points it has seen (most of
-/// reading a 75k-triangle scan): each facet keeps its own three points, which readSurface welds
-/// by exact position as it welds the points CGAL merged.
-Reason readBinaryStl(const std::string& path, std::uint32_t facets, std::vector<StlPoint>& points,
-                     std::vector<SoupPolygon>& triangles) {
+/// The corners of the `facets` facets of a binary STL file (84 + 50 n bytes, checked by the
+/// caller), three a facet, as CGAL's binary parser reads them: each corner's three little-endian
+/// floats converted exactly to doubles. Written here without that parser's std::map of the
+/// points it has seen (most of reading a 75k-triangle scan).
+Reason readBinaryStl(const std::string& path, std::uint32_t facets, std::vector<StlPoint>& points) {
   std::ifstream in(path, std::ios::binary);
   if (!in.seekg(84)) return "cannot read the file";
   constexpr std::size_t kFacetBytes = 50, kChunk = 65536;  // facets read at a time
   std::vector<char> bytes(kFacetBytes * std::min<std::size_t>(facets, kChunk));
   points.resize(3 * std::size_t{facets});
-  triangles.resize(facets);
   for (std::size_t first = 0; first < facets; first += kChunk) {
     const std::size_t count = std::min<std::size_t>(kChunk, facets - first);
     if (!in.read(bytes.data(), static_cast<std::streamsize>(count * kFacetBytes)))
@@ -360,7 +356,6 @@ Reason readBinaryStl(const std::string& path, std::uint32_t facets, std::vector<
                                      std::uint32_t{b[3]} << 24;
           points[3 * f + corner][k] = std::bit_cast<float>(word);
         }
-      triangles[f] = {3 * f, 3 * f + 1, 3 * f + 2};
     }
   }
   return "";
@@ -387,25 +382,31 @@ Reason readStl(const std::string& path, const std::string& head, std::vector<Stl
     return "neither binary (" + std::to_string(size) +
            " bytes, not 84 + 50 x its facet count) "
            "nor ASCII (no 'solid' first)";
-  if (binary) return readBinaryStl(path, facets, points, triangles);
-  const std::optional<std::string> text = readText(path);
-  if (!text) return "cannot read the file";
-  StlRecords records;
-  if (text->find('\0') == std::string::npos) {
-    checkAsciiStlText(path, *text, warnings, &records);
+  if (binary) {
+    if (Reason reason = readBinaryStl(path, facets, points); !reason.empty()) return reason;
   } else {
-    records.plain = false;
-  }
-  if (records.plain) {  // the facets the check read: not parsed a second time
-    const std::size_t n = records.corners.size() / 3;
+    const std::optional<std::string> text = readText(path);
+    if (!text) return "cannot read the file";
+    StlRecords records;
+    if (text->find('\0') == std::string::npos) {
+      checkAsciiStlText(path, *text, warnings, &records);
+    } else {
+      records.plain = false;
+    }
+    if (!records.plain) {
+      std::ifstream in(path, std::ios::binary);
+      return runCgal(
+          [&] { return CGAL::IO::internal::parse_ASCII_STL(in, points, triangles, true); });
+    }
+    // The facets the check read: not parsed a second time.
     points.resize(records.corners.size());
-    triangles.resize(n);
     for (std::size_t i = 0; i < records.corners.size(); ++i) points[i].c = records.corners[i];
-    for (std::size_t f = 0; f < n; ++f) triangles[f] = {3 * f, 3 * f + 1, 3 * f + 2};
-    return "";
   }
-  std::ifstream in(path, std::ios::binary);
-  return runCgal([&] { return CGAL::IO::internal::parse_ASCII_STL(in, points, triangles, true); });
+  // Read here, each facet keeps its own three corners, which readSurface welds by exact
+  // position as it welds the points CGAL's parsers merged.
+  triangles.resize(points.size() / 3);
+  for (std::size_t f = 0; f < triangles.size(); ++f) triangles[f] = {3 * f, 3 * f + 1, 3 * f + 2};
+  return "";
 }
 
 /// Reads an OBJ, OFF, PLY or STL file (`extension` in lower case) as CGAL's readers read it, or
@@ -453,9 +454,7 @@ std::variant<PolygonSoup, Reason> readWithCgal(const std::string& path,
       // A plain OFF file's records, read while checking them, are what CGAL would read: its
       // stream parser is not run a second time over the text (it took 3/4 of reading the
       // bunny).
-      soup.points.reserve(off.vertices.size());
-      for (const std::array<double, 3>& p : off.vertices)
-        soup.points.emplace_back(p[0], p[1], p[2]);
+      soup.points = toVec3(off.vertices);
       soup.polygons = std::move(off.faces);
     } else {
       std::vector<CgalPoint> points;

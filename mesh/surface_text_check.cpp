@@ -394,9 +394,6 @@ void checkAsciiStlText(const std::string& path, std::string_view text, ReadWarni
   // CGAL's parser: a "solid" inside a solid stops it (the file then fails), and a solid's name
   // is read as words, so a keyword there would be taken as one.
   bool inSolid = false, solidClosed = false;
-  const auto plainName = [&](const std::vector<std::string_view>& name) {
-    if (std::any_of(name.begin(), name.end(), isKeyword)) out.plain = false;
-  };
   // A number as strtod reads it, "nan" and "inf" included: normals are not used, and
   // exporters write NaN normals for degenerate facets.
   const auto isReal = [](std::string_view s) {
@@ -415,7 +412,8 @@ void checkAsciiStlText(const std::string& path, std::string_view text, ReadWarni
       if (word == "solid" && inSolid) out.plain = false;
       inSolid = word == "solid";
       solidClosed = solidClosed || !inSolid;
-      plainName(words.restOfLine());
+      const std::vector<std::string_view> name = words.restOfLine();
+      if (std::any_of(name.begin(), name.end(), isKeyword)) out.plain = false;
     } else if (word == "facet") {
       if (inFacet)
         failAtLine(path, facetLine,

@@ -48,12 +48,12 @@ bool isIntegerNumber(std::string_view token);
 
 /// What checkObjText found in an OBJ file, and its vertices and faces.
 struct ObjText {
-  /// The `v` lines' x y z (correctly rounded, as CGAL's stream reader rounds them), in order.
+  /// The `v` lines' x y z (correctly rounded, as CGAL's stream reader rounds them), in order:
+  /// one per `v` line.
   std::vector<std::array<double, 3>> positions;
   /// The `f` lines of three or more corners: their vertex indices from 0, a relative (negative)
   /// index resolved against the vertices before its line, as CGAL's OBJ reader resolves it.
   std::vector<std::vector<std::size_t>> polygons;
-  std::size_t vertices = 0;         ///< `v` lines
   std::size_t points = 0;           ///< `p` indices and faces of one corner
   std::size_t lines = 0;            ///< `l` segments and faces of two corners
   std::set<std::string> materials;  ///< used by faces, points and lines ("" before any usemtl)
