@@ -120,32 +120,32 @@ std::size_t elementZeroModes(const Eigen::MatrixXd& stiffness, int degree);
 ///    mesh's bounding box, b = (0.5, -0.6, 0.7) and
 ///        A = [ 0.31 -0.17  0.23;  0.13  0.27 -0.19;  -0.29  0.11  0.21 ]
 ///    (entries distinct, not symmetric: stretch, shear and rotation; |A (x - x0)| <= 0.34 L, so
-///    |u| >= 0.7 L on the whole box). K's rows of the IP system with every boundary face a
-///    Dirichlet face with g = u: the element term and all face terms of K (faceRows()), the
-///    neighbours' coefficients set to u's and the Dirichlet load of g = u, are solved for K's
-///    coefficients alone (3n x 3n LDL^T). IP is consistent, so the solution is u up to
-///    round-off; the element's error is max |u_h - u| / max |u| over K's vertices. The check
-///    therefore tests the discrete divergence theorem between K's element and face moments:
-///    a leaky or non-planar element, a reversed face or a wrong face moment gives a large
-///    error. The penalty is local, eta_K = (2 / theta) sum_F w_F^2 (vol(K) / area(F))
-///    trace(liftingFaceGram(F, K)) (= (2 / theta) sum_F w_F^2 for degree 1) with theta and w_F
-///    as in penaltyThreshold(): an upper bound of K's term 2 tau_K / theta of that threshold
-///    (the error does not depend on eta).
+///    |u| >= 0.7 L on the whole box). K's rows of the IP system with every face of K a
+///    Dirichlet face with g = u: the element term and K's face terms (faceRows()) and the
+///    Dirichlet load of g = u, solved for K's coefficients alone (3n x 3n LDL^T). An interior
+///    face gives K the same rows when its neighbour holds u exactly (no jump, and the average
+///    stress is sigma(u)), so the neighbours are not read. IP is consistent, so the solution is
+///    u up to round-off; the element's error is max |u_h - u| / max |u| over K's vertices. The
+///    check therefore tests the discrete divergence theorem between K's element and face
+///    moments: a leaky or non-planar element, a reversed face or a wrong face moment gives a
+///    large error. The penalty is local, eta_K = (2 / theta) sum_F (vol(K) / area(F))
+///    trace(liftingFaceGram(F, K)) (= 2 / theta times the number of faces for degree 1) with
+///    theta as in penaltyThreshold() and w_F = 1 on every face, as for Dirichlet faces there:
+///    an upper bound of K's term 2 tau_K / theta of that threshold (the error does not depend
+///    on eta).
 /// 3. Definiteness: with that penalty K's local matrix is positive definite on a valid element;
 ///    an inverted one (which passes 2, being consistent with the opposite orientation) is not.
 ///
-/// `moments` must be up to date and hold degree 2p moments. Throws std::invalid_argument if a
-/// face is used more than twice or twice with the same orientation (see faceUses()).
+/// `moments` must be up to date and hold degree 2p moments.
 LocalDgCheck localDgChecks(const PolyMesh& mesh, const MomentCache& moments,
                            const LocalDgCheckOptions& options = {});
 
 /// localDgChecks() of the elements selected by `options.only` (one entry per element, not
-/// empty), with moments computed here for those elements and their face neighbours only: the
-/// checks read nothing else. The same checks and the same numbers as localDgChecks() on the
-/// whole mesh (the patch field uses the whole mesh's bounding box; the neighbours keep every
-/// face, so their coupling counts are unchanged), at a cost that grows with the selection, not
-/// the mesh: `polydg mesh` selects the elements of a sliced mesh that are not whole grid
-/// cells. Element ids in the result refer to `mesh`.
+/// empty), with moments computed here for those elements only: the checks read nothing else.
+/// The same checks and the same numbers as localDgChecks() on the whole mesh (the patch field
+/// uses the whole mesh's bounding box), at a cost that grows with the selection, not the mesh:
+/// `polydg mesh` selects the elements of a sliced mesh that are not whole grid cells. Element
+/// ids in the result refer to `mesh`.
 LocalDgCheck localDgChecksOfSelection(const PolyMesh& mesh, const LocalDgCheckOptions& options);
 
 }  // namespace polydg

@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include <tbb/task_arena.h>
+
 #include "mesh/primitives.h"
 #include "polydg/mesh/geometry_checks.h"
 #include "polydg/mesh/slice.h"
@@ -272,6 +274,37 @@ TEST(DgChecks, LocalChecksOfASelectionNameTheCorruptedElement) {
   // Left out, the corrupted element is only a neighbour: its linear trace is still exact.
   options.only = everyKth(mesh, 2, 1);
   EXPECT_TRUE(localDgChecksOfSelection(mesh, options).passed());
+}
+
+TEST(DgChecks, LocalChecksOfASelectionInPartsEqualThoseOnTheWholeMesh) {
+  // More elements than localDgChecksOfSelection() copies and checks at a time (1024): the
+  // parts give the numbers of the whole mesh, and name a corrupted element of the third part
+  // by its id in the mesh.
+  const PolyMesh grid = hexGridMesh(14, 14, 14, Box3(Vec3::Zero(), Vec3::Ones()));
+  const ElementId bad(14 * 14 * 14 - 100);
+  ASSERT_GE(boundaryFaceOf(grid, bad), 0);
+  const PolyMesh mesh = withReversedFaces(grid, bad, boundaryFaceOf(grid, bad));
+  MomentCache moments(mesh, 2);
+  moments.update();
+  LocalDgCheckOptions options;
+  options.only.assign(mesh.numElements(), 1);
+  const LocalDgCheck whole = localDgChecks(mesh, moments, options);
+  const LocalDgCheck parts = localDgChecksOfSelection(mesh, options);
+  EXPECT_EQ(parts.elements, mesh.numElements());
+  EXPECT_EQ(parts.patchTestFailures, 1u);
+  EXPECT_EQ(parts.worstPatchTestElement, bad);
+  EXPECT_EQ(parts.maxPatchTestError, whole.maxPatchTestError);
+  EXPECT_EQ(parts.worstPatchTestElement, whole.worstPatchTestElement);
+  EXPECT_EQ(parts.nonDefiniteElements, whole.nonDefiniteElements);
+  EXPECT_EQ(parts.elementsWithWrongRigidModes, whole.elementsWithWrongRigidModes);
+  // On one thread, each part is copied right after the one before it, which shares faces and
+  // vertices with it.
+  tbb::task_arena oneThread(1);
+  const LocalDgCheck serial =
+      oneThread.execute([&] { return localDgChecksOfSelection(mesh, options); });
+  EXPECT_EQ(serial.patchTestFailures, 1u);
+  EXPECT_EQ(serial.worstPatchTestElement, bad);
+  EXPECT_EQ(serial.maxPatchTestError, whole.maxPatchTestError);
 }
 
 }  // namespace

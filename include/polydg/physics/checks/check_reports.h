@@ -62,7 +62,7 @@ struct LocalDgCheck {
   /// positive; the error is then computed with a full-pivoting LU solve). The local penalty
   /// makes it SPD on every valid element.
   std::size_t nonDefiniteElements = 0;
-  double seconds = 0.0;  ///< wall time, face roles and bases included (moments excluded)
+  double seconds = 0.0;  ///< wall time, bases included (moments excluded)
   /// Faces whose moments the checks integrated (localDgChecksOfSelection(); 0 when the caller
   /// gave the moments).
   std::size_t facesIntegrated = 0;
