@@ -19,26 +19,35 @@
 
 #include "cli/blas_threads.h"
 #include "cli/commands.h"
+#include "physics/solvers/cholmod_loader.h"
 #include "polydg/util/error.h"
 #include "polydg/util/process.h"
 
 namespace {
 
-/// Debian 12's OpenBLAS (0.3.21, DYNAMIC_ARCH) does not know recent Intel CPUs (this
-/// machine: family 6, model 207) and falls back to its Prescott (SSE3) kernels: CHOLMOD's
-/// supernodal factorizations, which the patch tests and rigid-mode checks of every command
-/// run, were then 1.5-2x slower. OpenBLAS reads OPENBLAS_CORETYPE only when it is loaded,
-/// before main(); so if OpenBLAS reports Prescott on a CPU with AVX-512 (or AVX2 and FMA),
-/// polydg starts itself again, once, with OPENBLAS_CORETYPE set to the matching kernels
-/// (SkylakeX, Haswell). A user's own OPENBLAS_CORETYPE is respected; another BLAS (no
-/// openblas_get_corename) is left alone; if the restart fails, polydg carries on as it is.
+/// Debian 12's OpenBLAS (0.3.21, DYNAMIC_ARCH) does not know recent Intel CPUs (family 6,
+/// model 207, say) and falls back to its Prescott (SSE3) kernels: CHOLMOD's supernodal
+/// factorizations, which the patch tests and rigid-mode checks of many commands run, were then
+/// 1.5-2x slower. OpenBLAS reads OPENBLAS_CORETYPE only when it is loaded; so on an Intel CPU
+/// with AVX2 polydg loads CHOLMOD, and with it OpenBLAS, at its start (elsewhere on the first
+/// factorization, cholmod_loader.h), and if OpenBLAS reports Prescott on a CPU with AVX-512
+/// (or AVX2 and FMA), polydg starts itself again, once, with OPENBLAS_CORETYPE set to the
+/// matching kernels (SkylakeX, Haswell). A user's own OPENBLAS_CORETYPE is respected; another
+/// BLAS (no openblas_get_corename) is left alone; if the restart fails, polydg carries on as
+/// it is.
 void useMatchingBlasKernels(char** argv) {
 #if defined(__x86_64__) && defined(__GNUC__)
   if (std::getenv("OPENBLAS_CORETYPE") != nullptr) return;
+  __builtin_cpu_init();
+  if (!__builtin_cpu_is("intel") || !__builtin_cpu_supports("avx2")) return;
+  try {
+    polydg::loadCholmod();
+  } catch (const std::exception&) {
+    return;  // said again, with the advice, where a command needs it
+  }
   using CoreName = const char* (*)();
   const auto corename = reinterpret_cast<CoreName>(dlsym(RTLD_DEFAULT, "openblas_get_corename"));
   if (corename == nullptr || std::strcmp(corename(), "Prescott") != 0) return;
-  __builtin_cpu_init();
   const char* kernels = nullptr;
   if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
       __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512vl"))
