@@ -68,8 +68,7 @@ POLYDG_HIDDEN cholmod_factor* cholmod_analyze(cholmod_sparse* a, cholmod_common*
 
 POLYDG_HIDDEN int cholmod_factorize_p(cholmod_sparse* a, double beta[2], int* fset, size_t fsize,
                                       cholmod_factor* l, cholmod_common* common) {
-  return polydg::real<&cholmod_factorize_p>("cholmod_factorize_p")(a, beta, fset, fsize, l,
-                                                                   common);
+  return polydg::real<&cholmod_factorize_p>("cholmod_factorize_p")(a, beta, fset, fsize, l, common);
 }
 
 POLYDG_HIDDEN cholmod_dense* cholmod_solve(int sys, cholmod_factor* l, cholmod_dense* b,
