@@ -1,7 +1,11 @@
 #include "polydg/mesh/poly_mesh.h"
 
 #include <algorithm>
+#include <functional>
 #include <stdexcept>
+
+#include <tbb/parallel_invoke.h>
+#include <tbb/parallel_scan.h>
 
 #include <boost/container/small_vector.hpp>
 
@@ -175,22 +179,36 @@ void PolyMesh::mergeElementGroups(const std::vector<std::uint32_t>& group, std::
     throw std::invalid_argument("mergeElementGroups: one group per element is needed");
   auto dropped = [&](ElementId e) { return e.valid() && group[e.index()] == kDroppedElement; };
   auto regrouped = [&](ElementId e) { return e.valid() ? ElementId(group[e.index()]) : e; };
-  // Faces are compacted in place: a kept face only moves towards the front.
+  // The kept faces' new ids, by a scan on all cores; then the faces are compacted in place (a
+  // kept face only moves towards the front, so in order, on one core) while the elements take
+  // their members' face lists on the other: neither reads what the other writes.
   std::vector<FaceId> newId(faces_.size());
-  std::size_t next = 0;
-  for (std::size_t i = 0; i < faces_.size(); ++i) {
-    Face& face = faces_[FaceId(i)];
-    const bool inside = (face.front.valid() && face.back.valid() &&
-                         group[face.front.index()] == group[face.back.index()]) ||
-                        dropped(face.front) || dropped(face.back);
-    if (inside) continue;
-    face.front = regrouped(face.front);
-    face.back = regrouped(face.back);
-    newId[i] = FaceId(next);
-    if (next != i) faces_[FaceId(next)] = std::move(face);
-    ++next;
-  }
-  faces_.raw().resize(next);
+  auto inside = [&](const Face& face) {
+    return (face.front.valid() && face.back.valid() &&
+            group[face.front.index()] == group[face.back.index()]) ||
+           dropped(face.front) || dropped(face.back);
+  };
+  const std::size_t kept = tbb::parallel_scan(
+      tbb::blocked_range<std::size_t>(0, faces_.size(), 4096), std::size_t(0),
+      [&](const tbb::blocked_range<std::size_t>& r, std::size_t next, bool final) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+          if (inside(faces_[FaceId(i)])) continue;
+          if (final) newId[i] = FaceId(next);
+          ++next;
+        }
+        return next;
+      },
+      std::plus<>());
+  auto compactFaces = [&] {
+    for (std::size_t i = 0; i < newId.size(); ++i) {
+      if (!newId[i].valid()) continue;
+      Face& face = faces_[FaceId(i)];
+      face.front = regrouped(face.front);
+      face.back = regrouped(face.back);
+      if (newId[i].index() != i) faces_[newId[i]] = std::move(face);
+    }
+    faces_.raw().resize(kept);
+  };
   // Groups numbered in order of their first element (as the merges here number them) take
   // their members' faces in place: group g's slot is never read again once g's members start
   // arriving. Any other numbering fills a new list.
@@ -199,14 +217,18 @@ void PolyMesh::mergeElementGroups(const std::vector<std::uint32_t>& group, std::
     inPlace = group[e] == kDroppedElement || group[e] <= e;
   ElementData<Element> fresh(inPlace ? 0 : groups);
   ElementData<Element>& merged = inPlace ? elements_ : fresh;
-  for (std::size_t e = 0; e < elements_.size(); ++e) {
-    const FaceList uses = std::move(elements_[ElementId(e)].faces);
-    elements_[ElementId(e)].faces.clear();
-    if (group[e] == kDroppedElement) continue;
-    FaceList& into = merged[ElementId(group[e])].faces;
-    for (const FaceUse& use : uses)
-      if (newId[use.face.index()].valid()) into.push_back({newId[use.face.index()], use.reversed});
-  }
+  auto regroupElements = [&] {
+    for (std::size_t e = 0; e < elements_.size(); ++e) {
+      const FaceList uses = std::move(elements_[ElementId(e)].faces);
+      elements_[ElementId(e)].faces.clear();
+      if (group[e] == kDroppedElement) continue;
+      FaceList& into = merged[ElementId(group[e])].faces;
+      for (const FaceUse& use : uses)
+        if (newId[use.face.index()].valid())
+          into.push_back({newId[use.face.index()], use.reversed});
+    }
+  };
+  tbb::parallel_invoke(compactFaces, regroupElements);
   if (inPlace)
     elements_.raw().resize(groups);
   else
