@@ -98,12 +98,15 @@ class PlaneSplitter::PolygonCut {
       : splitter_(splitter), polygon_(polygon), loops_(polygon.numLoops()) {
     for (std::size_t k = 0; k < polygon.numLoops(); ++k) {
       const std::size_t begin = polygon.loopBegin(k), end = polygon.loopEnd[k];
+      const int firstSide = splitter.side(polygon.vertices[begin], plane);
+      int sa = firstSide;  // each corner's side is found once
       for (std::size_t i = begin; i < end; ++i) {
         const std::uint32_t a = polygon.vertices[i];
         const std::uint32_t b = polygon.vertices[i + 1 == end ? begin : i + 1];
-        const int sa = splitter.side(a, plane), sb = splitter.side(b, plane);
+        const int sb = i + 1 == end ? firstSide : splitter.side(b, plane);
         loops_[k].push_back({a, sa});
         if (sa * sb < 0) loops_[k].push_back({splitter.edgePoint(a, b, plane), 0});
+        sa = sb;
       }
     }
   }
@@ -353,9 +356,13 @@ void sendLooseFlatGroupsToMinus(const PlaneSplitter& splitter, const Piece& piec
 /// The caps' edges: the minus side's edges in the plane that have no reverse within the minus
 /// side. Each such edge use as (undirected key, +1 if it runs from the lower id), summed per
 /// key; a net use makes that many edges, directed against the minus side's.
-EdgeList capEdges(const PlaneSplitter& splitter, const Piece& minus, const SplitPlane& plane) {
+/// Polygons whose `touching` flag is 0 have no corner in the plane and are passed over.
+EdgeList capEdges(const PlaneSplitter& splitter, const Piece& minus,
+                  const Small<char, 64>& touching, const SplitPlane& plane) {
   Small<std::pair<std::uint64_t, int>, 32> inPlane;
-  for (const PiecePolygon& polygon : minus) {
+  for (std::size_t p = 0; p < minus.size(); ++p) {
+    if (!touching[p]) continue;
+    const PiecePolygon& polygon = minus[p];
     for (std::size_t k = 0; k < polygon.numLoops(); ++k) {
       const std::size_t begin = polygon.loopBegin(k), end = polygon.loopEnd[k];
       for (std::size_t i = begin; i < end; ++i) {
@@ -405,10 +412,17 @@ PieceSplit PlaneSplitter::split(Piece piece, const SplitPlane& plane, FaceOrigin
   out.plus.reserve(piece.size() + 8);
   Placement placement = placePolygons(*this, piece, plane);
   if (placement.anyInPlane) sendLooseFlatGroupsToMinus(*this, piece, plane, placement);
+  // Per polygon of the minus side, whether it may have a corner in the plane: the caps' edges
+  // are looked for in those only (most polygons of a piece lie off the plane).
+  Small<char, 64> minusTouching;
+  minusTouching.reserve(piece.size() + 8);
   for (std::size_t i = 0; i < piece.size(); ++i) {
     PiecePolygon& polygon = piece[i];
     switch (placement.place[i]) {
-      case Place::Minus: out.minus.push_back(std::move(polygon)); break;
+      case Place::Minus:
+        out.minus.push_back(std::move(polygon));
+        minusTouching.push_back(placement.touches[i]);
+        break;
       case Place::Plus: out.plus.push_back(std::move(polygon)); break;
       case Place::InPlane:  // it bounds the side it faces away from
         (points_.normalDotSign(loopsOf(polygon), plane.normal) > 0 ? out.minus : out.plus)
@@ -420,11 +434,12 @@ PieceSplit PlaneSplitter::split(Piece piece, const SplitPlane& plane, FaceOrigin
         ++out.polygonsSplit;
         break;
     }
+    minusTouching.resize(out.minus.size(), 1);  // in the plane, or a part of a split polygon
   }
   if (out.minus.empty() || out.plus.empty()) return out;
 
   // Caps: closing both sides in the plane.
-  EdgeList caps = capEdges(*this, out.minus, plane);
+  EdgeList caps = capEdges(*this, out.minus, minusTouching, plane);
   if (caps.empty()) return out;
   sortByPosition(*this, caps);
   const Projection p = SplitPoints::projectionOf(plane.normal);
