@@ -34,6 +34,7 @@
 #include <CGAL/Polygon_mesh_processing/self_intersections.h>
 #include <CGAL/Surface_mesh.h>
 
+#include "mesh/surface_repair.h"
 #include "polydg/mesh/geometry.h"
 #include "polydg/mesh/meshing.h"
 #include "polydg/mesh/surface_io.h"
@@ -287,6 +288,96 @@ TEST(CorpusMeshing, TwistedCadPartsMeshDirectly) {
     }
   EXPECT_EQ(classes.clean, cellCounts.size() * files.size());
   std::cout << "worst relative volume error: " << classes.worstVolumeError << "\n";
+}
+
+/// CGAL's count of self-intersecting triangle pairs of `s` (closed and manifold), on the
+/// Surface_mesh made of it: the reference diagnose() counts on the soup.
+std::size_t cgalSelfIntersections(const TriangleSurface& s) {
+  std::vector<Point> points;
+  for (const Vec3& p : s.vertices) points.emplace_back(p.x(), p.y(), p.z());
+  std::vector<std::vector<std::size_t>> polygons;
+  for (const auto& t : s.triangles) polygons.push_back({t[0], t[1], t[2]});
+  CgalMesh mesh;
+  PMP::polygon_soup_to_polygon_mesh(points, polygons, mesh);
+  std::vector<std::pair<CgalMesh::Face_index, CgalMesh::Face_index>> pairs;
+  PMP::self_intersections(faces(mesh), mesh, std::back_inserter(pairs));
+  return pairs.size();
+}
+
+/// A double pyramid over a pentagram: apex v above, w below, the ring of five corners visited
+/// twice around the axis. Closed and manifold; fan triangles that share only an apex pass
+/// through each other, and the ring's edges cross.
+TriangleSurface pentagramBipyramid() {
+  TriangleSurface s;
+  s.vertices = {Vec3(0.0, 0.0, 1.0), Vec3(0.0, 0.0, -1.0)};
+  for (int i = 0; i < 5; ++i) {
+    const double angle = 2.0 * 3.14159265358979 * (2 * i % 5) / 5.0;
+    const double r = i % 2 == 0 ? 1.0 : 0.3;  // unequal: some triangles pass through others
+    s.vertices.emplace_back(r * std::cos(angle), r * std::sin(angle), 0.0);
+  }
+  for (std::uint32_t i = 0; i < 5; ++i) {
+    const std::uint32_t a = 2 + i, b = 2 + (i + 1) % 5;
+    s.triangles.push_back({0, a, b});
+    s.triangles.push_back({1, b, a});
+  }
+  return s;
+}
+
+/// Two double pyramids over a hexagon, the second turned a quarter about the x axis. In each, the
+/// small fan triangle (v, c, d) has its edge c d through the large (v, a, b), whose edge a b
+/// stays clear of it: the pair is found from one side only. The turn changes the boxes so that
+/// CGAL's box intersection hands the pair over the other way round: each side is needed.
+TriangleSurface piercedFans() {
+  TriangleSurface s;
+  for (const bool turned : {false, true})
+    for (const Vec3& p :
+         {Vec3(0.0, 0.0, 0.0), Vec3(0.0, 0.0, -3.0), Vec3(4.0, 0.0, 0.0), Vec3(0.0, 4.0, 0.0),
+          Vec3(-2.0, -1.0, 0.0), Vec3(-0.2, 0.9, 1.0), Vec3(0.9, -0.2, -1.0), Vec3(2.0, -2.0, 0.0)})
+      s.vertices.push_back(turned ? Vec3(p.x() + 20.0, p.z(), -p.y()) : p);
+  for (std::uint32_t base : {0u, 8u})
+    for (std::uint32_t i = 0; i < 6; ++i) {
+      const std::uint32_t a = base + 2 + i, b = base + 2 + (i + 1) % 6;
+      s.triangles.push_back({base, a, b});
+      s.triangles.push_back({base + 1, b, a});
+    }
+  return s;
+}
+
+TEST(SurfaceDiagnosis, SelfIntersectionsAreCountedAsCgalCountsThemOnTheMesh) {
+  TriangleSurface pillow;  // two triangles back to back: folded onto each other at every edge
+  pillow.vertices = {Vec3(0.0, 0.0, 0.0), Vec3(1.0, 0.0, 0.0), Vec3(0.0, 1.0, 0.0)};
+  pillow.triangles = {{0, 1, 2}, {0, 2, 1}};
+  TriangleSurface pierced = icosphere(Vec3::Zero(), 1.0, 2);  // a vertex pushed through
+  pierced.vertices[0] *= -1.5;
+  const Vec3 far(3.0e6, -2.0e6, 1.0e6);
+  const struct {
+    const char* name;
+    TriangleSurface surface;
+    bool intersecting;
+  } cases[] = {
+      {"sphere", icosphere(Vec3(0.1, 0.2, -0.3), 1.0, 3), false},
+      {"overlapping spheres",
+       combine(icosphere(Vec3::Zero(), 1.0, 2), icosphere(Vec3(0.8, 0.0, 0.0), 1.0, 2)), true},
+      {"overlapping spheres far from the origin",
+       combine(icosphere(far, 1.0, 2), icosphere(far + Vec3(0.8, 0.0, 0.0), 1.0, 2)), true},
+      // Both have a corner at (1, 0, 0), as two vertices: the six triangles about it on each
+      // side touch the other six there, which counts (they share no vertex).
+      {"spheres touching at a point",
+       combine(icosphere(Vec3::Zero(), 1.0, 1), icosphere(Vec3(2.0, 0.0, 0.0), 1.0, 1)), true},
+      {"pillow", pillow, true},
+      {"pierced sphere", pierced, true},
+      {"pentagram bipyramid", pentagramBipyramid(), true},
+      {"pierced fans", piercedFans(), true},
+      {"thin torus knot", torusKnot(2, 3, 1.0, 0.4, 0.1, 96, 8), false},
+      {"thick torus knot", torusKnot(2, 3, 1.0, 0.4, 0.45, 96, 8), true},
+  };
+  for (const auto& c : cases) {
+    const SurfaceDiagnosis d = diagnose(c.surface);
+    ASSERT_TRUE(d.topology.closed()) << c.name;
+    ASSERT_TRUE(d.checkedSelfIntersections) << c.name;
+    EXPECT_EQ(d.selfIntersections, cgalSelfIntersections(c.surface)) << c.name;
+    EXPECT_EQ(d.selfIntersections > 0, c.intersecting) << c.name << ": " << d.selfIntersections;
+  }
 }
 
 }  // namespace
