@@ -5,8 +5,10 @@
 #include <tbb/task_group.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <exception>
+#include <optional>
 #include <sstream>
 #include <string>
 
@@ -166,35 +168,67 @@ void orientAndSlice(const TriangleSurface& closed, double cellSize, const Meshin
   timer.done("merge_slivers");
 }
 
-/// meshSurface() for a surface closed edge by edge without degenerate triangles, the usual
-/// input: the self-intersection test (the costly, serial part of the diagnosis) runs while the
-/// surface is oriented and sliced. The result, if the test finds no defect; otherwise nothing
-/// (the slicing is dropped, and the caller repairs or refuses the surface from `d`).
-std::optional<MeshingResult> meshWhileDiagnosing(const TriangleSurface& input,
-                                                 const SurfaceTopology& topology, double cellSize,
-                                                 const MeshingOptions& options,
-                                                 SurfaceDiagnosis& d) {
+/// The self-intersection test of a surface closed edge by edge (selfIntersectionsOfClosedSurface,
+/// the costly, serial part of the diagnosis), run on another core from construction: it starts
+/// before the topology says whether it applies, since it takes no input but the soup. Stopped
+/// (not waited for to the end) if it does not apply.
+class ClosedSurfaceTest {
+ public:
+  explicit ClosedSurfaceTest(const TriangleSurface& surface) {
+    group_.run([this, &surface] {
+      const Stopwatch start;
+      count_ = selfIntersectionsOfClosedSurface(surface, &stop_);
+      seconds_ = start.seconds();
+    });
+  }
+  ~ClosedSurfaceTest() {
+    stop_ = true;
+    try {
+      group_.wait();
+    } catch (...) {  // an error of a test nobody reads
+    }
+  }
+  ClosedSurfaceTest(const ClosedSurfaceTest&) = delete;
+  ClosedSurfaceTest& operator=(const ClosedSurfaceTest&) = delete;
+
+  /// The count, once the test is done.
+  std::size_t count() {
+    group_.wait();
+    return count_.value();
+  }
+  double seconds() const { return seconds_; }
+  /// Asks the test to stop early: its count will not be read.
+  void stop() { stop_ = true; }
+
+ private:
+  tbb::task_group group_;
+  std::atomic<bool> stop_{false};
+  std::optional<std::size_t> count_;
+  double seconds_ = 0.0;
+};
+
+/// meshSurface() for a surface closed edge by edge, manifold, without singular vertices or
+/// degenerate triangles, the usual input: the surface is oriented and sliced while `test`
+/// runs. The result, if the test finds no defect; otherwise nothing (the slicing is dropped,
+/// and the caller repairs or refuses the surface from `d`).
+std::optional<MeshingResult> meshWhileTesting(const TriangleSurface& input,
+                                              const SurfaceTopology& topology, double cellSize,
+                                              const MeshingOptions& options,
+                                              ClosedSurfaceTest& test, SurfaceDiagnosis& d) {
   MeshingResult result;
   PhaseTimer timer(result.report.timings);
-  double checkSeconds = 0.0;
-  tbb::task_group diagnosis;
-  diagnosis.run([&] {
-    const Stopwatch start;
-    d = diagnose(input, &topology);
-    checkSeconds = start.seconds();
-  });
   std::exception_ptr failure;  // of the slicing; it matters only if the surface is sound
   try {
     orientAndSlice(input, cellSize, options, result, timer, &topology);
   } catch (...) {
     failure = std::current_exception();
   }
-  diagnosis.wait();
+  d = diagnose(input, &topology, test.count());
   if (broken(d)) return std::nullopt;
   if (failure) std::rethrow_exception(failure);
   recordDiagnosis(input, d, result.report);
   // Measured beside the other phases: "total" then adds up more than the wall time.
-  result.report.timings.insert(result.report.timings.begin(), {"check", checkSeconds});
+  result.report.timings.insert(result.report.timings.begin(), {"check", test.seconds()});
   return result;
 }
 
@@ -210,15 +244,17 @@ MeshingResult meshSurface(const TriangleSurface& input, const MeshingOptions& op
   const double cellSize = checkedCellSize(input, options);
   SurfaceDiagnosis d;
   bool diagnosed = false;
+  ClosedSurfaceTest test(input);
   const SurfaceTopology topology = analyzeTopology(input);
-  if (topology.boundaryEdges == 0 && topology.nonManifoldEdges == 0 &&
-      topology.degenerateTriangles == 0) {
+  if (isClosedManifoldSoup(topology)) {
     if (std::optional<MeshingResult> done =
-            meshWhileDiagnosing(input, topology, cellSize, options, d)) {
+            meshWhileTesting(input, topology, cellSize, options, test, d)) {
       finish(*done);
       return std::move(*done);
     }
     diagnosed = true;
+  } else {
+    test.stop();
   }
 
   MeshingResult result;

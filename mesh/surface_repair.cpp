@@ -1,7 +1,9 @@
 #include "mesh/surface_repair.h"
 
 #include <array>
+#include <atomic>
 #include <cstdint>
+#include <optional>
 #include <stdexcept>
 #include <vector>
 
@@ -121,8 +123,9 @@ bool intersectImproperly(const std::array<std::uint32_t, 3>& h,
 /// meet in CGAL's box_self_intersection_d (cutoff as CGAL's) and each pair of boxes is tested as
 /// CGAL tests two faces. Building the Surface_mesh was a fifth of the test on a 75k-triangle
 /// scan. (CGAL 5.6 has triangle_soup_self_intersections; Debian 12's is 5.5.)
-std::size_t selfIntersectionsOfManifoldSoup(const TriangleSurface& surface,
-                                            const std::vector<Point>& points) {
+std::optional<std::size_t> selfIntersectionsOfManifoldSoup(const TriangleSurface& surface,
+                                                           const std::vector<Point>& points,
+                                                           const std::atomic<bool>* stop) {
   using Box =
       CGAL::Box_intersection_d::Box_with_info_d<double, 3, std::uint32_t,
                                                 CGAL::Box_intersection_d::ID_FROM_BOX_ADDRESS>;
@@ -140,30 +143,44 @@ std::size_t selfIntersectionsOfManifoldSoup(const TriangleSurface& surface,
   std::vector<const Box*> pointers;
   pointers.reserve(boxes.size());
   for (const Box& b : boxes) pointers.push_back(&b);
+  struct Stopped {};
   const auto pair = [&](const Box* a, const Box* b) {
+    if (stop && stop->load(std::memory_order_relaxed)) throw Stopped{};
     count +=
         intersectImproperly(surface.triangles[a->info()], surface.triangles[b->info()], points);
   };
-  CGAL::box_self_intersection_d<CGAL::Sequential_tag>(pointers.begin(), pointers.end(), pair,
-                                                      std::ptrdiff_t(2000));
+  try {
+    CGAL::box_self_intersection_d<CGAL::Sequential_tag>(pointers.begin(), pointers.end(), pair,
+                                                        std::ptrdiff_t(2000));
+  } catch (const Stopped&) {
+    return std::nullopt;
+  }
   return count;
 }
 
 }  // namespace
 
-SurfaceDiagnosis diagnose(const TriangleSurface& surface, const SurfaceTopology* topology) {
+std::optional<std::size_t> selfIntersectionsOfClosedSurface(const TriangleSurface& surface,
+                                                            const std::atomic<bool>* stop) {
+  return selfIntersectionsOfManifoldSoup(surface, toPoints(surface), stop);
+}
+
+bool isClosedManifoldSoup(const SurfaceTopology& topology) {
+  return topology.closed() && topology.singularVertices == 0 && topology.degenerateTriangles == 0;
+}
+
+SurfaceDiagnosis diagnose(const TriangleSurface& surface, const SurfaceTopology* topology,
+                          std::optional<std::size_t> closedSurfaceCount) {
   SurfaceDiagnosis d;
   d.topology = topology ? *topology : analyzeTopology(surface);
   if (surface.triangles.empty()) return d;
   if (d.topology.nonManifoldEdges > 0) return d;
-  // Consistently oriented copy (orientation does not change intersections or nesting); a
-  // closed surface without singular vertices or degenerate triangles is one already, and its
-  // triangles go in as they are (no polygon allocated per triangle).
-  auto points = toPoints(surface);
-  if (d.topology.closed() && d.topology.singularVertices == 0 &&
-      d.topology.degenerateTriangles == 0) {
-    d.selfIntersections = selfIntersectionsOfManifoldSoup(surface, points);
+  if (isClosedManifoldSoup(d.topology)) {
+    d.selfIntersections =
+        closedSurfaceCount ? *closedSurfaceCount : *selfIntersectionsOfClosedSurface(surface);
   } else {
+    // A consistently oriented mesh of it (orientation does not change intersections).
+    auto points = toPoints(surface);
     auto polygons = toPolygons(surface);
     if (!d.topology.closed() || d.topology.singularVertices > 0)
       PMP::orient_polygon_soup(points, polygons);

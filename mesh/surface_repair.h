@@ -2,6 +2,9 @@
 // triangles, orientation, shells and cavities) and repairs of broken surfaces, with CGAL.
 #pragma once
 
+#include <atomic>
+#include <cstddef>
+#include <optional>
 #include <string>
 
 #include "polydg/mesh/surface.h"
@@ -24,11 +27,25 @@ struct SurfaceDiagnosis {
   }
 };
 
+/// The self-intersections diagnose() counts for a surface closed edge by edge, manifold and
+/// without singular vertices or degenerate triangles (analyzeTopology() says which), counted
+/// on the soup: CGAL's box intersection, and CGAL's test of two faces of a mesh on each pair
+/// (no mesh is built). Any soup can be given (the count then means nothing), so that the test
+/// can start before the topology is known; nothing if `stop` turned true before it ended.
+std::optional<std::size_t> selfIntersectionsOfClosedSurface(
+    const TriangleSurface& surface, const std::atomic<bool>* stop = nullptr);
+
+/// Whether diagnose() counts the self-intersections of a surface of this topology as
+/// selfIntersectionsOfClosedSurface() does.
+bool isClosedManifoldSoup(const SurfaceTopology& topology);
+
 /// Counts the defects of `surface`. Self-intersections are looked for when the surface can be
 /// made a manifold mesh (that is, when every edge has at most two triangles).
-/// `topology` is analyzeTopology()'s result if the caller has it (computed if null).
-SurfaceDiagnosis diagnose(const TriangleSurface& surface,
-                          const SurfaceTopology* topology = nullptr);
+/// `topology` is analyzeTopology()'s result if the caller has it (computed if null);
+/// `closedSurfaceCount`, selfIntersectionsOfClosedSurface()'s if the caller has it (used if the
+/// topology is one it applies to).
+SurfaceDiagnosis diagnose(const TriangleSurface& surface, const SurfaceTopology* topology = nullptr,
+                          std::optional<std::size_t> closedSurfaceCount = std::nullopt);
 
 /// Orients a closed, manifold, non-self-intersecting surface so that it bounds a volume: outer
 /// shells outward, cavities inward (CGAL's orient_to_bound_a_volume, after making the

@@ -15,6 +15,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -378,6 +379,17 @@ TEST(SurfaceDiagnosis, SelfIntersectionsAreCountedAsCgalCountsThemOnTheMesh) {
     EXPECT_EQ(d.selfIntersections, cgalSelfIntersections(c.surface)) << c.name;
     EXPECT_EQ(d.selfIntersections > 0, c.intersecting) << c.name << ": " << d.selfIntersections;
   }
+}
+
+TEST(SurfaceDiagnosis, ASelfIntersectionTestAskedToStopGivesNoCount) {
+  // meshSurface starts the test before it knows the test applies, and stops it if not.
+  const TriangleSurface overlapping =
+      combine(icosphere(Vec3::Zero(), 1.0, 2), icosphere(Vec3(0.8, 0.0, 0.0), 1.0, 2));
+  std::atomic<bool> stop{false};
+  EXPECT_EQ(selfIntersectionsOfClosedSurface(overlapping, &stop),
+            cgalSelfIntersections(overlapping));
+  stop = true;
+  EXPECT_FALSE(selfIntersectionsOfClosedSurface(overlapping, &stop).has_value());
 }
 
 }  // namespace
