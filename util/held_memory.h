@@ -15,11 +15,8 @@ extern "C" int mallctl(const char* name, void* oldp, std::size_t* oldlenp, void*
 namespace polydg {
 
 /// Freed memory worth returning to the kernel: less is reused sooner than its return saves
-/// (pages returned are faulted in and zeroed again when reused, about 0.6 ms a MiB on huge pages
-/// here). The bunny at 64 cells holds 40 MiB after merging slivers and reuses it: returning it
-/// cost 3% of the command's time for 10 MiB of peak. At 200 cells the 113 MiB held after the
-/// build are returned; the 34 MiB after merging are kept (2.5% more peak).
-inline constexpr std::size_t kReleaseAtLeast = std::size_t(64) << 20;
+/// (pages returned are faulted in and zeroed again when reused).
+inline constexpr std::size_t kReleaseAtLeast = std::size_t(32) << 20;
 
 /// The freed memory jemalloc holds in all its arenas, in bytes; 0 without jemalloc.
 inline std::size_t heldFreedMemory() {
