@@ -40,4 +40,21 @@ inline bool releaseFreedMemory() {
   return mallctl("arena.4096.purge", nullptr, nullptr, nullptr, 0) == 0;
 }
 
+/// jemalloc's oversize threshold: allocations of at least this many bytes come from an arena of
+/// their own, which reuses none of the memory freed in the others; 0 without jemalloc.
+inline std::size_t oversizeThreshold() {
+  if (!mallctl) return 0;
+  std::size_t threshold = 0, size = sizeof(threshold);
+  if (mallctl("opt.oversize_threshold", &threshold, &size, nullptr, 0) != 0) return 0;
+  return threshold;
+}
+
+/// releaseFreedMemory() before work whose arrays hold `perItem` bytes for each of `items`: if
+/// such an array stays under the oversize threshold, the work's arrays are served from the
+/// memory held, which is then kept (returned, it would be faulted in and zeroed again).
+inline bool releaseFreedMemoryBefore(std::size_t items, std::size_t perItem) {
+  if (items * perItem < oversizeThreshold()) return false;
+  return releaseFreedMemory();
+}
+
 }  // namespace polydg

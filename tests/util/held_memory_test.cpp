@@ -1,6 +1,6 @@
 // util/held_memory.h, in a process whose allocator is jemalloc (this test links it, as the
 // polydg program does): freed memory is held until released, and released only when there is
-// enough of it.
+// enough of it and the work that follows cannot reuse it.
 #include "util/held_memory.h"
 
 #include <gtest/gtest.h>
@@ -40,6 +40,21 @@ TEST(HeldMemory, LittleFreedMemoryIsKept) {
   EXPECT_LT(held, kReleaseAtLeast);
   EXPECT_FALSE(releaseFreedMemory());
   EXPECT_EQ(heldFreedMemory(), held);
+}
+
+TEST(HeldMemory, FreedMemoryIsKeptForWorkWhoseArraysItCanServe) {
+  ASSERT_NE(mallctl, nullptr) << "this test must run with jemalloc as its allocator";
+  const std::size_t threshold = oversizeThreshold();
+  ASSERT_GT(threshold, 0u);  // jemalloc's default is 8 MiB
+  releaseFreedMemory();
+  allocateAndFree(2 * kReleaseAtLeast);
+  const std::size_t held = heldFreedMemory();
+  // Arrays of a double per item just under the threshold: kept for them.
+  EXPECT_FALSE(releaseFreedMemoryBefore(threshold / sizeof(double) - 1, sizeof(double)));
+  EXPECT_EQ(heldFreedMemory(), held);
+  // At the threshold they come from the oversize arena: returned.
+  EXPECT_TRUE(releaseFreedMemoryBefore(threshold / sizeof(double), sizeof(double)));
+  EXPECT_LT(heldFreedMemory(), kReleaseAtLeast / 16);
 }
 
 }  // namespace
