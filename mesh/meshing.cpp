@@ -164,9 +164,7 @@ void orientAndSlice(const TriangleSurface& closed, double cellSize, const Meshin
     result.mesh = std::move(sliced);
   }
   // What slicing freed is returned before the arrays of validation and writing are made, if
-  // those (a number or a few per face) are too large to be made of it: the bunny at 64 cells
-  // (346k faces) reuses the 40 MiB held, which returned cost 3% of its time; at 200 cells the
-  // 34 MiB returned keep 2.5% off the peak.
+  // those (a number or a few per face) are too large to be made of it; smaller ones reuse it.
   releaseFreedMemoryBefore(result.mesh.numFaces(), sizeof(double));
   timer.done("merge_slivers");
 }

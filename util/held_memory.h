@@ -2,7 +2,8 @@
 // (cli/allocator.cpp), keeps freed pages for reuse for seconds. After slicing, what it holds is
 // the small allocations of the splitting and the build, which the large arrays that follow (the
 // mesh's, validation's, the writer's: jemalloc serves allocations of 8 MB and more from an arena
-// of their own) cannot reuse: held, they only raise the peak.
+// of their own) cannot reuse: held, they only raise the peak. Smaller arrays can, and for those
+// the memory is kept (releaseFreedMemoryBefore).
 #pragma once
 
 #include <cstddef>
