@@ -118,17 +118,19 @@ bool intersectImproperly(const std::array<std::uint32_t, 3>& h,
   return CGAL::do_intersect(th, tg);
 }
 
-/// CGAL's self_intersections() of the mesh a closed, manifold soup without singular vertices
-/// makes as it is, counted on the soup: a collinear triangle counts once, the others' boxes
-/// meet in CGAL's box_self_intersection_d (cutoff as CGAL's) and each pair of boxes is tested as
-/// CGAL tests two faces. Building the Surface_mesh was a fifth of the test on a 75k-triangle
-/// scan. (CGAL 5.6 has triangle_soup_self_intersections; Debian 12's is 5.5.)
-std::optional<std::size_t> selfIntersectionsOfManifoldSoup(const TriangleSurface& surface,
-                                                           const std::vector<Point>& points,
-                                                           const std::atomic<bool>* stop) {
+}  // namespace
+
+// CGAL's self_intersections() of the mesh a closed, manifold soup without singular vertices
+// makes as it is, counted on the soup: a collinear triangle counts once, the others' boxes meet
+// in CGAL's box_self_intersection_d (cutoff as CGAL's) and each pair of boxes is tested as CGAL
+// tests two faces. Building the Surface_mesh was a fifth of the test on a 75k-triangle scan.
+// (CGAL 5.6 has triangle_soup_self_intersections; Debian 12's is 5.5.)
+std::optional<std::size_t> selfIntersectionsOfClosedSurface(const TriangleSurface& surface,
+                                                            const std::atomic<bool>* stop) {
   using Box =
       CGAL::Box_intersection_d::Box_with_info_d<double, 3, std::uint32_t,
                                                 CGAL::Box_intersection_d::ID_FROM_BOX_ADDRESS>;
+  const std::vector<Point> points = toPoints(surface);
   std::size_t count = 0;
   std::vector<Box> boxes;
   boxes.reserve(surface.triangles.size());
@@ -156,13 +158,6 @@ std::optional<std::size_t> selfIntersectionsOfManifoldSoup(const TriangleSurface
     return std::nullopt;
   }
   return count;
-}
-
-}  // namespace
-
-std::optional<std::size_t> selfIntersectionsOfClosedSurface(const TriangleSurface& surface,
-                                                            const std::atomic<bool>* stop) {
-  return selfIntersectionsOfManifoldSoup(surface, toPoints(surface), stop);
 }
 
 bool isClosedManifoldSoup(const SurfaceTopology& topology) {
