@@ -160,77 +160,163 @@ void CorotatedStiffness::product(const std::vector<Eigen::Matrix3d>& r, const Ei
                               [&](auto p) { productOf<numMonomials(p())>(r, x, z, out, energy); });
 }
 
+/// The terms of product(), block by block: R_S B (R_S^T x_C - z_C) added to a row's output,
+/// and their energy.
+template <int N>
+class CorotatedStiffness::BlockTerms {
+ public:
+  static constexpr int BS = 3 * N;
+  using Vec = Eigen::Matrix<double, BS, 1>;
+  using Components = Eigen::Matrix<double, N, 3>;  // column d: component d
+
+  BlockTerms(const std::vector<Eigen::Matrix3d>& r, const Eigen::VectorXd& x,
+             const Eigen::VectorXd* z, bool corotational, bool energy)
+      : r_(r), x_(x), z_(z), corotational_(corotational), energy_(energy) {}
+
+  /// Adds to `out` (row element `row`'s 3n values) the block B against column element `col`,
+  /// warped with element `source`'s rotation (-1: not warped), B column-major or row-major;
+  /// returns the block's energy term (0 without energy).
+  double add(std::size_t row, double* out, const double* b, bool columnMajor, std::int64_t source,
+             std::size_t col, bool rowDifference = false, bool columnDifference = false) {
+    const bool warp = source >= 0 && corotational_;
+    const Eigen::Matrix3d* rot = warp ? &r_[static_cast<std::size_t>(source)] : nullptr;
+    side(rot, col, columnDifference, w_);
+    blockTimes(N, b, columnMajor, w_.data(), y_.data());
+    Eigen::Map<Vec> o(out);
+    if (rot)
+      Eigen::Map<Components>(o.data()).noalias() +=
+          Eigen::Map<const Components>(y_.data()) * rot->transpose();
+    else
+      o += y_;
+    if (!energy_) return 0.0;
+    side(rot, row, rowDifference, wa_);
+    return 0.5 * wa_.dot(y_);
+  }
+
+ private:
+  /// The vector a side of a block reads: R^T x - z (positions against the undeformed state:
+  /// the strain side and interior jumps) or R^T (x - z) (the displacement: the jump against a
+  /// Dirichlet face's fixed outside). (R (x) I)^T acts on the components as V R.
+  void side(const Eigen::Matrix3d* rot, std::size_t el, bool difference, Vec& o) {
+    v_ = Eigen::Map<const Vec>(x_.data() + el * BS);
+    if (z_ && difference) v_ -= Eigen::Map<const Vec>(z_->data() + el * BS);
+    if (rot)
+      Eigen::Map<Components>(o.data()).noalias() = Eigen::Map<const Components>(v_.data()) * (*rot);
+    else
+      o = v_;
+    if (z_ && !difference) o -= Eigen::Map<const Vec>(z_->data() + el * BS);
+  }
+
+  const std::vector<Eigen::Matrix3d>& r_;
+  const Eigen::VectorXd& x_;
+  const Eigen::VectorXd* z_;
+  bool corotational_, energy_;
+  Vec w_, y_, wa_, v_;
+};
+
+template <int N>
+double CorotatedStiffness::rowTerms(BlockTerms<N>& terms, std::size_t i, double* out,
+                                    double* transposedTerms) const {
+  constexpr std::size_t bb = static_cast<std::size_t>(3 * N) * (3 * N);
+  const bool bz = parts_.jumps.componentDiagonalCoupling;
+  const auto self = static_cast<std::int64_t>(i);
+  double sum = 0.0;
+  if (!bz && clamped_[i]) {  // the Dirichlet faces' strain terms (zero elsewhere)
+    sum += terms.add(i, out, parts_.dirichletTrial.data() + i * bb, true, self, i, true, false);
+    sum += terms.add(i, out, parts_.dirichletTest.data() + i * bb, true, self, i, false, true);
+  }
+  std::size_t neighbour = 0;
+  for (std::size_t k = rowStart_[i]; k < rowStart_[i + 1]; ++k) {
+    const RowSlot& s = slots_[k];
+    if (!s.diagonal && !bz)  // the neighbour's lifting terms in i's diagonal block
+      sum += terms.add(
+          i, out, parts_.neighbourLifting.data() + (parts_.neighbourStart[i] + neighbour++) * bb,
+          true, s.other, i);
+    if (transposedTerms && s.transposed) continue;  // added by the task of s.other
+    Part ps[3];
+    const int np = partsOf(i, s, ps);
+    for (int q = 0; q < np; ++q) {
+      if (ps[q].source >= 0 && !s.diagonal && bz) continue;  // BZ: no coupling strain
+      sum += terms.add(i, out, ps[q].b, ps[q].columnMajor, ps[q].source, s.other);
+    }
+    if (!transposedTerms || s.diagonal) continue;
+    // The same block read transposed, as row s.other's (partsOf() of its transposed slot),
+    // while it is in cache: the terms of s.other's row, kept per coupling block.
+    double* into = transposedTerms + s.block * static_cast<std::size_t>(3 * N);
+    std::fill(into, into + 3 * N, 0.0);
+    const auto other = static_cast<std::int64_t>(s.other);
+    const std::int64_t sources[3] = {self, other, -1};
+    for (int q = 0; q < np; ++q) {
+      if (sources[q] >= 0 && bz) continue;
+      sum += terms.add(s.other, into, ps[q].b, true, sources[q], i);
+    }
+  }
+  return sum;
+}
+
 template <int N>
 void CorotatedStiffness::productOf(const std::vector<Eigen::Matrix3d>& r, const Eigen::VectorXd& x,
                                    const Eigen::VectorXd* z, Eigen::VectorXd& out,
                                    double* energy) const {
   constexpr int BS = 3 * N;
-  using Vec = Eigen::Matrix<double, BS, 1>;
-  using Components = Eigen::Matrix<double, N, 3>;  // column d: component d
   out.setZero(x.size());
-  const bool bz = parts_.jumps.componentDiagonalCoupling;
-  const std::size_t bb = static_cast<std::size_t>(BS) * BS;
   const double e = tbb::parallel_deterministic_reduce(
       tbb::blocked_range<std::size_t>(0, ne_, 64), 0.0,
       [&](const tbb::blocked_range<std::size_t>& range, double sum) {
-        Vec w, y, wa, v;
-        for (std::size_t i = range.begin(); i != range.end(); ++i) {
-          Eigen::Map<Vec> oa(out.data() + i * BS);
-          // The vector a side of a block reads: R^T x - z (positions against the undeformed
-          // state: the strain side and interior jumps) or R^T (x - z) (the displacement: the
-          // jump against a Dirichlet face's fixed outside). (R (x) I)^T acts on the
-          // components as V R.
-          auto side = [&](const Eigen::Matrix3d* rot, std::size_t el, bool difference, Vec& o) {
-            v = Eigen::Map<const Vec>(x.data() + el * BS);
-            if (z && difference) v -= Eigen::Map<const Vec>(z->data() + el * BS);
-            if (rot)
-              Eigen::Map<Components>(o.data()).noalias() =
-                  Eigen::Map<const Components>(v.data()) * (*rot);
-            else
-              o = v;
-            if (z && !difference) o -= Eigen::Map<const Vec>(z->data() + el * BS);
-          };
-          // Row i's block B against column element `col`, warped with element `source`'s
-          // rotation (-1: not warped); B column-major or row-major.
-          auto apply = [&](const double* b, bool columnMajor, std::int64_t source, std::size_t col,
-                           bool rowDifference = false, bool columnDifference = false) {
-            const bool warp = source >= 0 && corotational_;
-            const Eigen::Matrix3d* rot = warp ? &r[static_cast<std::size_t>(source)] : nullptr;
-            side(rot, col, columnDifference, w);
-            blockTimes(N, b, columnMajor, w.data(), y.data());
-            if (rot)
-              Eigen::Map<Components>(oa.data()).noalias() +=
-                  Eigen::Map<const Components>(y.data()) * rot->transpose();
-            else
-              oa += y;
-            if (energy) {
-              side(rot, i, rowDifference, wa);
-              sum += 0.5 * wa.dot(y);
-            }
-          };
-          if (!bz && clamped_[i]) {  // the Dirichlet faces' strain terms (zero elsewhere)
-            const auto self = static_cast<std::int64_t>(i);
-            apply(parts_.dirichletTrial.data() + i * bb, true, self, i, true, false);
-            apply(parts_.dirichletTest.data() + i * bb, true, self, i, false, true);
-          }
-          std::size_t neighbour = 0;
-          for (std::size_t k = rowStart_[i]; k < rowStart_[i + 1]; ++k) {
-            const RowSlot& s = slots_[k];
-            if (!s.diagonal && !bz)  // the neighbour's lifting terms in i's diagonal block
-              apply(parts_.neighbourLifting.data() + (parts_.neighbourStart[i] + neighbour++) * bb,
-                    true, s.other, i);
-            Part ps[3];
-            const int np = partsOf(i, s, ps);
-            for (int q = 0; q < np; ++q) {
-              if (ps[q].source >= 0 && !s.diagonal && bz) continue;  // BZ: no coupling strain
-              apply(ps[q].b, ps[q].columnMajor, ps[q].source, s.other);
-            }
-          }
-        }
+        BlockTerms<N> terms(r, x, z, corotational_, energy != nullptr);
+        for (std::size_t i = range.begin(); i != range.end(); ++i)
+          sum += rowTerms<N>(terms, i, out.data() + i * BS, nullptr);
         return sum;
       },
       std::plus<double>());
   if (energy) *energy = e;
+}
+
+void CorotatedStiffness::forceAndAssemble(const std::vector<Eigen::Matrix3d>& r,
+                                          const Eigen::VectorXd& u, Eigen::VectorXd& force,
+                                          double& energy, const std::vector<double>& mass,
+                                          double cM, double cK, BlockRows<double>& rows) const {
+  detail::dispatchBasisDegree(degree_, [&](auto p) {
+    forceAndAssembleOf<numMonomials(p())>(r, u, force, energy, mass, cM, cK, rows);
+  });
+}
+
+template <int N>
+void CorotatedStiffness::forceAndAssembleOf(const std::vector<Eigen::Matrix3d>& r,
+                                            const Eigen::VectorXd& u, Eigen::VectorXd& force,
+                                            double& energy, const std::vector<double>& mass,
+                                            double cM, double cK, BlockRows<double>& rows) const {
+  constexpr int BS = 3 * N;
+  constexpr std::size_t bb = static_cast<std::size_t>(BS) * BS;
+  const Eigen::VectorXd x = x0_ + u;
+  force.setZero(x.size());
+  // One vector per stored coupling block: the terms of the greater element's row, which the
+  // task of the smaller one computes (each task writes its own row only).
+  transposedTerms_.resize(parts_.jumps.coupling.size() / bb * BS);
+  energy = tbb::parallel_deterministic_reduce(
+      tbb::blocked_range<std::size_t>(0, ne_, 32), 0.0,
+      [&](const tbb::blocked_range<std::size_t>& range, double sum) {
+        BlockTerms<N> terms(r, x, &x0_, corotational_, true);
+        std::vector<double> buffer;
+        for (std::size_t i = range.begin(); i != range.end(); ++i) {
+          buffer.resize((1 + greaterNeighbours(parts_.jumps.neighbours, i)) * bb);
+          elementBlocks<N>(r, mass, cM, cK, i, buffer.data(), buffer.data() + bb);
+          writeElementRows(rows, parts_.jumps.neighbours, i, buffer.data(), buffer.data() + bb);
+          sum += rowTerms<N>(terms, i, force.data() + i * BS, transposedTerms_.data());
+        }
+        return sum;
+      },
+      std::plus<double>());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ne_, 256),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                        Eigen::Map<Eigen::Matrix<double, BS, 1>> out(force.data() + i * BS);
+                        for (std::size_t k = rowStart_[i]; k < rowStart_[i + 1]; ++k)
+                          if (slots_[k].transposed)
+                            out += Eigen::Map<const Eigen::Matrix<double, BS, 1>>(
+                                transposedTerms_.data() + slots_[k].block * BS);
+                      }
+                    });
 }
 
 void CorotatedStiffness::assemble(const std::vector<Eigen::Matrix3d>& r,

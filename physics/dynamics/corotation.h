@@ -54,6 +54,13 @@ class CorotatedStiffness {
   void product(const std::vector<Eigen::Matrix3d>& r, const Eigen::VectorXd& x,
                const Eigen::VectorXd* z, Eigen::VectorXd& out, double* energy) const;
 
+  /// f(U) and its energy (product() with x = X0 + U and z = X0) and the blocks of cM M + cK
+  /// K_w into `rows` (assemble()) in one pass: each split block is read once, its force terms
+  /// while it is in cache from warping it. A corotated step needs both at the same rotations.
+  void forceAndAssemble(const std::vector<Eigen::Matrix3d>& r, const Eigen::VectorXd& u,
+                        Eigen::VectorXd& force, double& energy, const std::vector<double>& mass,
+                        double cM, double cK, BlockRows<double>& rows) const;
+
   /// The blocks of cM M + cK K_w into `system` (which has layout()'s pattern): `mass` holds each
   /// element's n x n scalar mass block, column-major.
   void assemble(const std::vector<Eigen::Matrix3d>& r, const std::vector<double>& mass, double cM,
@@ -80,9 +87,21 @@ class CorotatedStiffness {
     std::int64_t source;
   };
 
+  template <int N>
+  class BlockTerms;
+
   void buildSlots();
   void elementTerms(const DgBasis& basis, const MomentCache& moments, const Vec3& origin);
   int partsOf(std::size_t i, const RowSlot& s, Part out[3]) const;
+  /// Row i's terms of product() into `out`, and their energy. With `transposedTerms`, the
+  /// coupling blocks stored by i give the terms of the other element's row too, at
+  /// transposedTerms[3n * block], and the blocks stored by a smaller neighbour are left out.
+  template <int N>
+  double rowTerms(BlockTerms<N>& terms, std::size_t i, double* out, double* transposedTerms) const;
+  template <int N>
+  void forceAndAssembleOf(const std::vector<Eigen::Matrix3d>& r, const Eigen::VectorXd& u,
+                          Eigen::VectorXd& force, double& energy, const std::vector<double>& mass,
+                          double cM, double cK, BlockRows<double>& rows) const;
   template <int N>
   void productOf(const std::vector<Eigen::Matrix3d>& r, const Eigen::VectorXd& x,
                  const Eigen::VectorXd* z, Eigen::VectorXd& out, double* energy) const;
@@ -107,6 +126,8 @@ class CorotatedStiffness {
   std::vector<std::uint8_t> clamped_;  ///< 1: the element has a Dirichlet face
   std::vector<double> gradients_;      ///< (1/|K|) int d_k phi_i at k * n + i, 3n per element
   Eigen::VectorXd x0_;
+  /// forceAndAssemble()'s scratch: 3n values per coupling block, kept between calls.
+  mutable std::vector<double> transposedTerms_;
 };
 
 }  // namespace polydg

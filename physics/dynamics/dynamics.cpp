@@ -63,8 +63,9 @@ struct DynamicSolver::Impl final : SecondOrderSystem {
   std::optional<StepSolver> stepSolver;
   LoadVectors loads;
   /// CG: the step's matrix cM M + cK K_w by block rows, warped straight into them each time it
-  /// changes; CG multiplies with them and its preconditioner is built from them.
-  BlockRows<double> rows;
+  /// changes; CG multiplies with them and its preconditioner is built from them. Written by
+  /// forceAtU() too, with the force (const: it caches).
+  mutable BlockRows<double> rows;
   bool byRows = false;
   LocalMatrices system;  ///< Cholesky: the blocks of the step's matrix, for `matrix`
   /// Cholesky, and a step with contact terms (another pattern): the step's matrix in CSR,
@@ -77,6 +78,8 @@ struct DynamicSolver::Impl final : SecondOrderSystem {
   ContactModel* contact = nullptr;
   bool assembled = false;  ///< the step's matrix (rows or `system`) was assembled once
   double lastCM = 0.0, lastCK = 0.0;
+  /// The rows hold cM M + cK K_w with `current`'s rotations and the coefficients lastCM, lastCK.
+  mutable bool rowsAtCurrent = false;
   /// The corrections' last measured contraction, correction k / correction k - 1 (1: unknown),
   /// and the last step's first correction.
   double contractionRate = 1.0, firstCorrection = 0.0;
@@ -265,7 +268,15 @@ const DynamicSolver::Impl::ForceAtU& DynamicSolver::Impl::forceAtU() const {
     c.r = stiffness->rotations(state.u);
     c.rotationSeconds = tr.seconds();
     const Stopwatch tf;
-    c.f = elasticForce(c.r, state.u, &c.energy);
+    // A corotated CG step's matrix has these rotations too: warped with the force, every split
+    // block is read once (a step at 87k DOFs reads 143 MB of them). The coefficients are the
+    // last step's; assembleSystem() assembles again if the next step's differ.
+    rowsAtCurrent = byRows && assembled && options.corotational;
+    if (rowsAtCurrent)
+      stiffness->forceAndAssemble(c.r, state.u, c.f, c.energy, mass->blocks(), lastCM, lastCK,
+                                  rows);
+    else
+      c.f = elasticForce(c.r, state.u, &c.energy);
     c.forceSeconds = tf.seconds();
     current = std::move(c);
   }
@@ -304,19 +315,23 @@ void DynamicSolver::Impl::beginStep(StepReport& report) {
 /// coefficients change (BDF2 after its first step, a new dt). Whether it changed.
 bool DynamicSolver::Impl::assembleSystem(const ImplicitStep& step, StepReport& report) {
   const Stopwatch t;
-  const bool changed = !assembled || options.corotational || step.cK != lastCK || step.cM != lastCM;
-  if (step.cK != lastCK || step.cM != lastCM) contractionRate = 1.0;  // another matrix: unknown
+  const bool sameCoefficients = step.cK == lastCK && step.cM == lastCM;
+  const bool changed = !assembled || options.corotational || !sameCoefficients;
+  if (!sameCoefficients) contractionRate = 1.0;          // another matrix: unknown
+  const std::vector<Eigen::Matrix3d>& r = forceAtU().r;  // may write the rows (rowsAtCurrent)
   lastCM = step.cM;
   lastCK = step.cK;
   if (changed) {
-    assembled = true;
     matrixCurrent = false;
     if (byRows) {
-      stiffness->assemble(forceAtU().r, mass->blocks(), step.cM, step.cK, rows);
+      if (!(assembled && rowsAtCurrent && sameCoefficients))
+        stiffness->assemble(r, mass->blocks(), step.cM, step.cK, rows);
+      rowsAtCurrent = true;
     } else {
-      stiffness->assemble(forceAtU().r, mass->blocks(), step.cM, step.cK, system);
+      stiffness->assemble(r, mass->blocks(), step.cM, step.cK, system);
       csrMatrix();
     }
+    assembled = true;
   }
   report.assemblySeconds += t.seconds();
   return changed;
