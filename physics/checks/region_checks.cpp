@@ -4,8 +4,9 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
-#include <unordered_map>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 #include <Eigen/Dense>
 #include <boost/container/small_vector.hpp>
 
@@ -213,8 +214,8 @@ void copyMoments(const SubMesh& sub, const MomentCache& moments, MomentCache& gi
 }
 
 /// The region's rows of the IP system at a linear field's coefficients (the patch test),
-/// element by element, with what the count of zero modes needs of each element: its
-/// stiffness, its Jacobi scaling, its zero modes beyond 6 and the face terms it shares with
+/// element by element on every core, with what the count of zero modes needs of each element:
+/// its stiffness, its Jacobi scaling, its zero modes beyond 6 and the face terms it shares with
 /// other region elements.
 class RegionRows {
  public:
@@ -223,6 +224,8 @@ class RegionRows {
       : stiffnesses(regionSize),
         scales(regionSize),
         surplus(regionSize, 0),
+        faceBlocks(local.numFaces()),
+        joins(local.numFaces(), 0),
         local_(local),
         regionSize_(regionSize),
         basis_(basis),
@@ -230,58 +233,79 @@ class RegionRows {
         form_(form),
         degree_(degree),
         n_(basis.size()),
-        bs_(3 * n_) {
+        bs_(3 * n_),
+        residuals_(regionSize, 0.0),
+        definite_(regionSize, 1) {
     Eigen::Matrix3d gradient;
     gradient << 0.31, -0.17, 0.23, 0.13, 0.27, -0.19, -0.29, 0.11, 0.21;
     const Vec3 b = box.diagonal().norm() * Vec3(0.5, -0.6, 0.7), x0 = box.center();
     exact_.resize(static_cast<Eigen::Index>(local.numElements()) * bs_);
-    for (std::size_t i = 0; i < local.numElements(); ++i)
+    tbb::parallel_for(std::size_t(0), local.numElements(), [&](std::size_t i) {
       exact_.segment(static_cast<Eigen::Index>(i) * bs_, bs_) =
           linearFieldCoefficients(basis, ElementId(i), b, gradient, x0);
+    });
     const Eigen::Matrix3d strain = 0.5 * (gradient + gradient.transpose());
     stress_ = 2.0 * form.mu * strain + form.lambda * strain.trace() * Eigen::Matrix3d::Identity();
   }
 
-  /// Region element i's rows: r = A U - F over them, its block of A tested for definiteness.
-  void addElement(std::size_t i) {
-    const ElementId e(i);
-    const auto ue = coefficients(e);
-    elementStiffness(basis_, given_, e, form_.mu, form_.lambda, stiffness_);
-    surplus[i] = static_cast<long long>(elementZeroModes(stiffness_, degree_)) - 6;
-    // r = A U - F over K's rows and, entry by entry, the size of the terms summed into it.
-    a_ = stiffness_;
-    r_ = stiffness_ * ue;
-    size_ = stiffness_.cwiseAbs() * ue.cwiseAbs();
-    diagonal_ = stiffness_.diagonal();
-    for (const FaceUse& use : local_.element(e).faces) addFace(e, use);
-    // Relative to the largest term in K's rows: round-off in the sum stays below a few
-    // machine epsilons of it, times the relative round-off of the matrices' entries.
-    const double largest = size_.maxCoeff();
-    const double relative = largest > 0.0    ? r_.cwiseAbs().maxCoeff() / largest
-                            : r_.isZero(0.0) ? 0.0
-                                             : std::numeric_limits<double>::infinity();
-    worstResidual_ =
-        std::max(worstResidual_,
-                 std::isfinite(relative) ? relative : std::numeric_limits<double>::infinity());
-    // K's block of the IP matrix (every face with its terms) is SPD on a valid element.
-    const Eigen::LDLT<Eigen::MatrixXd> ldlt(a_);
-    for (const double d : ldlt.vectorD()) definite_ = definite_ && d > 0.0;
-    scales[i] = zeroModeScaling(diagonal_, bs_);
-    stiffnesses[i] = stiffness_;
+  /// Every region element's rows (addElement()), on every core: each task writes its elements'
+  /// entries and the face blocks of their sides only.
+  void addElements() {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, regionSize_, 16),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+                        Scratch s;
+                        for (std::size_t i = range.begin(); i != range.end(); ++i) addElement(i, s);
+                      });
   }
 
   /// The largest relative residual of the rows, or infinity if an element's block is not
   /// positive definite.
   double patchTestResidual() const {
-    return definite_ ? worstResidual_ : std::numeric_limits<double>::infinity();
+    if (std::find(definite_.begin(), definite_.end(), 0) != definite_.end())
+      return std::numeric_limits<double>::infinity();
+    return residuals_.empty() ? 0.0 : *std::max_element(residuals_.begin(), residuals_.end());
   }
 
   std::vector<Eigen::MatrixXd> stiffnesses;
   std::vector<Eigen::VectorXd> scales;
-  std::unordered_map<std::uint32_t, FaceBlocks> faceBlocks;  // by local face
-  std::vector<long long> surplus;                            // element zero modes beyond 6
+  std::vector<long long> surplus;  // element zero modes beyond 6
+  /// By local face; filled for the faces between two region elements, joins[f] = 1.
+  std::vector<FaceBlocks> faceBlocks;
+  std::vector<char> joins;
 
  private:
+  /// An element's matrices and vectors, reused from element to element by a task.
+  struct Scratch {
+    Eigen::MatrixXd stiffness, a, selfBlock, otherBlock;
+    Eigen::VectorXd r, size, diagonal;
+  };
+
+  /// Region element i's rows: r = A U - F over them, its block of A tested for definiteness.
+  void addElement(std::size_t i, Scratch& s) {
+    const ElementId e(i);
+    const auto ue = coefficients(e);
+    elementStiffness(basis_, given_, e, form_.mu, form_.lambda, s.stiffness);
+    surplus[i] = static_cast<long long>(elementZeroModes(s.stiffness, degree_)) - 6;
+    // r = A U - F over K's rows and, entry by entry, the size of the terms summed into it.
+    s.a = s.stiffness;
+    s.r = s.stiffness * ue;
+    s.size = s.stiffness.cwiseAbs() * ue.cwiseAbs();
+    s.diagonal = s.stiffness.diagonal();
+    for (const FaceUse& use : local_.element(e).faces) addFace(e, use, s);
+    // Relative to the largest term in K's rows: round-off in the sum stays below a few
+    // machine epsilons of it, times the relative round-off of the matrices' entries.
+    const double largest = s.size.maxCoeff();
+    const double relative = largest > 0.0     ? s.r.cwiseAbs().maxCoeff() / largest
+                            : s.r.isZero(0.0) ? 0.0
+                                              : std::numeric_limits<double>::infinity();
+    residuals_[i] = std::isfinite(relative) ? relative : std::numeric_limits<double>::infinity();
+    // K's block of the IP matrix (every face with its terms) is SPD on a valid element.
+    const Eigen::LDLT<Eigen::MatrixXd> ldlt(s.a);
+    for (const double d : ldlt.vectorD()) definite_[i] = definite_[i] && d > 0.0;
+    scales[i] = zeroModeScaling(s.diagonal, bs_);
+    stiffnesses[i] = s.stiffness;
+  }
+
   Eigen::VectorXd::ConstSegmentReturnType coefficients(ElementId e) const {
     return exact_.segment(static_cast<Eigen::Index>(e.index()) * bs_, bs_);
   }
@@ -289,8 +313,8 @@ class RegionRows {
   int coupled(ElementId e) const { return static_cast<int>(local_.element(e).faces.size()); }
 
   /// Face `use` of element e: its terms in K's rows, and for a face between region elements
-  /// its blocks kept.
-  void addFace(ElementId e, const FaceUse& use) {
+  /// its blocks kept (this side's).
+  void addFace(ElementId e, const FaceUse& use, Scratch& s) {
     const auto ue = coefficients(e);
     const ElementId other = across(local_, use.face, e);
     FaceView view;
@@ -301,20 +325,21 @@ class RegionRows {
     view.selfIsFront = !use.reversed;
     view.selfCoupledFaces = coupled(e);
     view.otherCoupledFaces = other.valid() ? coupled(other) : 0;
-    faceRows(local_, basis_, given_, view, form_, selfBlock_, otherBlock_);
-    a_ += selfBlock_;
+    faceRows(local_, basis_, given_, view, form_, s.selfBlock, s.otherBlock);
+    s.a += s.selfBlock;
     if (other.valid()) {
       // A Dirichlet face's S_F U_K is on both sides of A U = F: only its t_F is left below.
       const auto uo = coefficients(other);
-      r_.noalias() += selfBlock_ * ue + otherBlock_ * uo;
-      size_.noalias() +=
-          selfBlock_.cwiseAbs() * ue.cwiseAbs() + otherBlock_.cwiseAbs() * uo.cwiseAbs();
+      s.r.noalias() += s.selfBlock * ue + s.otherBlock * uo;
+      s.size.noalias() +=
+          s.selfBlock.cwiseAbs() * ue.cwiseAbs() + s.otherBlock.cwiseAbs() * uo.cwiseAbs();
       if (other.index() < regionSize_) {
-        diagonal_ += selfBlock_.diagonal();
-        FaceBlocks& t = faceBlocks[use.face.value];
+        s.diagonal += s.selfBlock.diagonal();
+        const std::size_t f = use.face.index();
         const int side = use.reversed ? 1 : 0;
-        t.self[side] = selfBlock_;
-        t.other[side] = otherBlock_;
+        faceBlocks[f].self[side] = s.selfBlock;
+        faceBlocks[f].other[side] = s.otherBlock;
+        if (side == 0) joins[f] = 1;  // written by one side only
       }
     } else {
       const Vec3 normal =
@@ -322,8 +347,8 @@ class RegionRows {
       const Vec3 traction = stress_ * normal;
       const Eigen::VectorXd integrals = faceIntegrals(local_, basis_, use.face, e);
       for (int d = 0; d < 3; ++d) {
-        r_.segment(d * n_, n_) -= traction[d] * integrals;
-        size_.segment(d * n_, n_) += std::abs(traction[d]) * integrals.cwiseAbs();
+        s.r.segment(d * n_, n_) -= traction[d] * integrals;
+        s.size.segment(d * n_, n_) += std::abs(traction[d]) * integrals.cwiseAbs();
       }
     }
   }
@@ -334,13 +359,10 @@ class RegionRows {
   const MomentCache& given_;
   const FormCoefficients& form_;
   const int degree_, n_, bs_;
-  Eigen::VectorXd exact_;   ///< the linear field's coefficients on every element
-  Eigen::Matrix3d stress_;  ///< its stress, constant
-  double worstResidual_ = 0.0;
-  bool definite_ = true;
-  // Scratch, reused from element to element.
-  Eigen::MatrixXd stiffness_, a_, selfBlock_, otherBlock_;
-  Eigen::VectorXd r_, size_, diagonal_;
+  Eigen::VectorXd exact_;          ///< the linear field's coefficients on every element
+  Eigen::Matrix3d stress_;         ///< its stress, constant
+  std::vector<double> residuals_;  ///< each element's relative residual
+  std::vector<char> definite_;     ///< each element's block positive definite
 };
 
 /// Zero modes: 6 per element (its own stiffness), and per face between region elements the
@@ -349,18 +371,31 @@ class RegionRows {
 void countRegionZeroModes(const PolyMesh& local, const RegionRows& rows, int bs,
                           RegionCoupling coupling, RegionDgCheck& c) {
   const std::size_t regionSize = rows.stiffnesses.size();
+  // Each joining face's pair of elements and its zero modes, on every core.
+  std::vector<std::uint32_t> joining;
+  for (std::size_t f = 0; f < rows.joins.size(); ++f)
+    if (rows.joins[f]) joining.push_back(static_cast<std::uint32_t>(f));
+  std::vector<std::size_t> pairModes(joining.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, joining.size(), 16),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      Eigen::MatrixXd pair(2 * bs, 2 * bs);
+                      Eigen::VectorXd pairScale(2 * bs);
+                      for (std::size_t k = range.begin(); k != range.end(); ++k) {
+                        const FaceBlocks& t = rows.faceBlocks[joining[k]];
+                        const Face& face = local.face(FaceId(std::size_t(joining[k])));
+                        const std::size_t front = face.front.index(), back = face.back.index();
+                        pair << rows.stiffnesses[front] + t.self[0], t.other[0], t.other[1],
+                            rows.stiffnesses[back] + t.self[1];
+                        pairScale << rows.scales[front], rows.scales[back];
+                        pairModes[k] = countZeroModes(pair, pairScale);
+                      }
+                    });
   UnionFind sets(regionSize);
   std::vector<long long> faceSurplus;
   std::vector<std::uint32_t> faceFront;
-  Eigen::MatrixXd pair(2 * bs, 2 * bs);
-  Eigen::VectorXd pairScale(2 * bs);
-  for (const auto& [f, t] : rows.faceBlocks) {
-    const Face& face = local.face(FaceId(std::size_t(f)));
-    const std::size_t front = face.front.index(), back = face.back.index();
-    pair << rows.stiffnesses[front] + t.self[0], t.other[0], t.other[1],
-        rows.stiffnesses[back] + t.self[1];
-    pairScale << rows.scales[front], rows.scales[back];
-    const std::size_t modes = countZeroModes(pair, pairScale);
+  for (std::size_t k = 0; k < joining.size(); ++k) {
+    const Face& face = local.face(FaceId(std::size_t(joining[k])));
+    const std::size_t modes = pairModes[k];
     if (coupling == RegionCoupling::HoldingFaces && modes > 6) {
       ++c.looseFaces;
       continue;
@@ -419,7 +454,7 @@ RegionDgCheck regionDgChecks(const PolyMesh& mesh, const MomentCache& moments,
   const FormCoefficients form{Method::IP, options.material.mu(), options.material.lambda(),
                               regionPenalty(sub, regionSize, basis, given)};
   RegionRows rows(local, regionSize, basis, given, form, box, degree);
-  for (std::size_t i = 0; i < regionSize; ++i) rows.addElement(i);
+  rows.addElements();
   c.patchTestResidual = rows.patchTestResidual();
 
   // 3. Zero modes per component of the region.
