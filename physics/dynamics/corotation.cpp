@@ -5,6 +5,7 @@
 #include <utility>
 
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 #include <Eigen/SVD>
@@ -12,6 +13,7 @@
 #include "physics/dg/block_rows.h"
 #include "physics/dg/polynomial_tables.h"
 #include "physics/dynamics/corotation_kernels.h"
+#include "util/uninitialized.h"
 
 namespace polydg {
 
@@ -232,14 +234,14 @@ double CorotatedStiffness::rowTerms(BlockTerms<N>& terms, std::size_t i, double*
       sum += terms.add(
           i, out, parts_.neighbourLifting.data() + (parts_.neighbourStart[i] + neighbour++) * bb,
           true, s.other, i);
-    if (transposedTerms && s.transposed) continue;  // added by the task of s.other
+    if (s.transposed) continue;  // stored by s.other, whose task computes these terms
     Part ps[3];
     const int np = partsOf(i, s, ps);
     for (int q = 0; q < np; ++q) {
       if (ps[q].source >= 0 && !s.diagonal && bz) continue;  // BZ: no coupling strain
       sum += terms.add(i, out, ps[q].b, ps[q].columnMajor, ps[q].source, s.other);
     }
-    if (!transposedTerms || s.diagonal) continue;
+    if (s.diagonal) continue;
     // The same block read transposed, as row s.other's (partsOf() of its transposed slot),
     // while it is in cache: the terms of s.other's row, kept per coupling block.
     double* into = transposedTerms + s.block * static_cast<std::size_t>(3 * N);
@@ -254,21 +256,45 @@ double CorotatedStiffness::rowTerms(BlockTerms<N>& terms, std::size_t i, double*
   return sum;
 }
 
+template <int N, class EachElement>
+double CorotatedStiffness::sumRows(const std::vector<Eigen::Matrix3d>& r, const Eigen::VectorXd& x,
+                                   const Eigen::VectorXd* z, bool energy, Eigen::VectorXd& out,
+                                   const EachElement& eachElement) const {
+  constexpr int BS = 3 * N;
+  constexpr std::size_t bb = static_cast<std::size_t>(BS) * BS;
+  out.setZero(x.size());
+  // One vector per stored coupling block: the terms of the greater element's row, which the
+  // task of the smaller one computes (each task writes its own row only).
+  UninitializedVector<double> transposed(parts_.jumps.coupling.size() / bb * BS);
+  const double e = tbb::parallel_deterministic_reduce(
+      tbb::blocked_range<std::size_t>(0, ne_, 32), 0.0,
+      [&](const tbb::blocked_range<std::size_t>& range, double sum) {
+        BlockTerms<N> terms(r, x, z, corotational_, energy);
+        for (std::size_t i = range.begin(); i != range.end(); ++i) {
+          eachElement(i);
+          sum += rowTerms<N>(terms, i, out.data() + i * BS, transposed.data());
+        }
+        return sum;
+      },
+      std::plus<double>());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ne_, 256),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                        Eigen::Map<Eigen::Matrix<double, BS, 1>> o(out.data() + i * BS);
+                        for (std::size_t k = rowStart_[i]; k < rowStart_[i + 1]; ++k)
+                          if (slots_[k].transposed)
+                            o += Eigen::Map<const Eigen::Matrix<double, BS, 1>>(
+                                transposed.data() + slots_[k].block * BS);
+                      }
+                    });
+  return e;
+}
+
 template <int N>
 void CorotatedStiffness::productOf(const std::vector<Eigen::Matrix3d>& r, const Eigen::VectorXd& x,
                                    const Eigen::VectorXd* z, Eigen::VectorXd& out,
                                    double* energy) const {
-  constexpr int BS = 3 * N;
-  out.setZero(x.size());
-  const double e = tbb::parallel_deterministic_reduce(
-      tbb::blocked_range<std::size_t>(0, ne_, 64), 0.0,
-      [&](const tbb::blocked_range<std::size_t>& range, double sum) {
-        BlockTerms<N> terms(r, x, z, corotational_, energy != nullptr);
-        for (std::size_t i = range.begin(); i != range.end(); ++i)
-          sum += rowTerms<N>(terms, i, out.data() + i * BS, nullptr);
-        return sum;
-      },
-      std::plus<double>());
+  const double e = sumRows<N>(r, x, z, energy != nullptr, out, [](std::size_t) {});
   if (energy) *energy = e;
 }
 
@@ -277,46 +303,19 @@ void CorotatedStiffness::forceAndAssemble(const std::vector<Eigen::Matrix3d>& r,
                                           double& energy, const std::vector<double>& mass,
                                           double cM, double cK, BlockRows<double>& rows) const {
   detail::dispatchBasisDegree(degree_, [&](auto p) {
-    forceAndAssembleOf<numMonomials(p())>(r, u, force, energy, mass, cM, cK, rows);
+    constexpr int N = numMonomials(p());
+    constexpr std::size_t bb = static_cast<std::size_t>(3 * N) * (3 * N);
+    // Each element's blocks warped into its rows first: its force terms then read them from
+    // cache. The force is product()'s, term for term and in its order.
+    tbb::enumerable_thread_specific<std::vector<double>> buffers;
+    const auto warp = [&](std::size_t i) {
+      std::vector<double>& buffer = buffers.local();
+      buffer.resize((1 + greaterNeighbours(parts_.jumps.neighbours, i)) * bb);
+      elementBlocks<N>(r, mass, cM, cK, i, buffer.data(), buffer.data() + bb);
+      writeElementRows(rows, parts_.jumps.neighbours, i, buffer.data(), buffer.data() + bb);
+    };
+    energy = sumRows<N>(r, Eigen::VectorXd(x0_ + u), &x0_, true, force, warp);
   });
-}
-
-template <int N>
-void CorotatedStiffness::forceAndAssembleOf(const std::vector<Eigen::Matrix3d>& r,
-                                            const Eigen::VectorXd& u, Eigen::VectorXd& force,
-                                            double& energy, const std::vector<double>& mass,
-                                            double cM, double cK, BlockRows<double>& rows) const {
-  constexpr int BS = 3 * N;
-  constexpr std::size_t bb = static_cast<std::size_t>(BS) * BS;
-  const Eigen::VectorXd x = x0_ + u;
-  force.setZero(x.size());
-  // One vector per stored coupling block: the terms of the greater element's row, which the
-  // task of the smaller one computes (each task writes its own row only).
-  transposedTerms_.resize(parts_.jumps.coupling.size() / bb * BS);
-  energy = tbb::parallel_deterministic_reduce(
-      tbb::blocked_range<std::size_t>(0, ne_, 32), 0.0,
-      [&](const tbb::blocked_range<std::size_t>& range, double sum) {
-        BlockTerms<N> terms(r, x, &x0_, corotational_, true);
-        std::vector<double> buffer;
-        for (std::size_t i = range.begin(); i != range.end(); ++i) {
-          buffer.resize((1 + greaterNeighbours(parts_.jumps.neighbours, i)) * bb);
-          elementBlocks<N>(r, mass, cM, cK, i, buffer.data(), buffer.data() + bb);
-          writeElementRows(rows, parts_.jumps.neighbours, i, buffer.data(), buffer.data() + bb);
-          sum += rowTerms<N>(terms, i, force.data() + i * BS, transposedTerms_.data());
-        }
-        return sum;
-      },
-      std::plus<double>());
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ne_, 256),
-                    [&](const tbb::blocked_range<std::size_t>& range) {
-                      for (std::size_t i = range.begin(); i != range.end(); ++i) {
-                        Eigen::Map<Eigen::Matrix<double, BS, 1>> out(force.data() + i * BS);
-                        for (std::size_t k = rowStart_[i]; k < rowStart_[i + 1]; ++k)
-                          if (slots_[k].transposed)
-                            out += Eigen::Map<const Eigen::Matrix<double, BS, 1>>(
-                                transposedTerms_.data() + slots_[k].block * BS);
-                      }
-                    });
 }
 
 void CorotatedStiffness::assemble(const std::vector<Eigen::Matrix3d>& r,

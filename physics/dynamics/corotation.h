@@ -93,15 +93,18 @@ class CorotatedStiffness {
   void buildSlots();
   void elementTerms(const DgBasis& basis, const MomentCache& moments, const Vec3& origin);
   int partsOf(std::size_t i, const RowSlot& s, Part out[3]) const;
-  /// Row i's terms of product() into `out`, and their energy. With `transposedTerms`, the
-  /// coupling blocks stored by i give the terms of the other element's row too, at
-  /// transposedTerms[3n * block], and the blocks stored by a smaller neighbour are left out.
+  /// Row i's terms of product() into `out`, and their energy, but those of the coupling blocks
+  /// stored by a smaller neighbour; the blocks i stores give the other element's row's terms
+  /// too, at transposedTerms[3n * block].
   template <int N>
   double rowTerms(BlockTerms<N>& terms, std::size_t i, double* out, double* transposedTerms) const;
-  template <int N>
-  void forceAndAssembleOf(const std::vector<Eigen::Matrix3d>& r, const Eigen::VectorXd& u,
-                          Eigen::VectorXd& force, double& energy, const std::vector<double>& mass,
-                          double cM, double cK, BlockRows<double>& rows) const;
+  /// product()'s rows (rowTerms() with the coupling blocks read once, their other row's terms
+  /// added in a second pass), its energy returned; eachElement(i) runs in element i's task
+  /// right before its row.
+  template <int N, class EachElement>
+  double sumRows(const std::vector<Eigen::Matrix3d>& r, const Eigen::VectorXd& x,
+                 const Eigen::VectorXd* z, bool energy, Eigen::VectorXd& out,
+                 const EachElement& eachElement) const;
   template <int N>
   void productOf(const std::vector<Eigen::Matrix3d>& r, const Eigen::VectorXd& x,
                  const Eigen::VectorXd* z, Eigen::VectorXd& out, double* energy) const;
@@ -126,8 +129,6 @@ class CorotatedStiffness {
   std::vector<std::uint8_t> clamped_;  ///< 1: the element has a Dirichlet face
   std::vector<double> gradients_;      ///< (1/|K|) int d_k phi_i at k * n + i, 3n per element
   Eigen::VectorXd x0_;
-  /// forceAndAssemble()'s scratch: 3n values per coupling block, kept between calls.
-  mutable std::vector<double> transposedTerms_;
 };
 
 }  // namespace polydg

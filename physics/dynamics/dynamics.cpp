@@ -78,6 +78,8 @@ struct DynamicSolver::Impl final : SecondOrderSystem {
   ContactModel* contact = nullptr;
   bool assembled = false;  ///< the step's matrix (rows or `system`) was assembled once
   double lastCM = 0.0, lastCK = 0.0;
+  /// lastCM and lastCK are a step's (this solver's last, or the one's before an edit).
+  bool coefficientsKnown = false;
   /// The rows hold cM M + cK K_w with `current`'s rotations and the coefficients lastCM, lastCK.
   mutable bool rowsAtCurrent = false;
   /// The corrections' last measured contraction, correction k / correction k - 1 (1: unknown),
@@ -271,7 +273,7 @@ const DynamicSolver::Impl::ForceAtU& DynamicSolver::Impl::forceAtU() const {
     // A corotated CG step's matrix has these rotations too: warped with the force, every split
     // block is read once (a step at 87k DOFs reads 143 MB of them). The coefficients are the
     // last step's; assembleSystem() assembles again if the next step's differ.
-    rowsAtCurrent = byRows && assembled && options.corotational;
+    rowsAtCurrent = byRows && coefficientsKnown && options.corotational;
     if (rowsAtCurrent)
       stiffness->forceAndAssemble(c.r, state.u, c.f, c.energy, mass->blocks(), lastCM, lastCK,
                                   rows);
@@ -321,10 +323,11 @@ bool DynamicSolver::Impl::assembleSystem(const ImplicitStep& step, StepReport& r
   const std::vector<Eigen::Matrix3d>& r = forceAtU().r;  // may write the rows (rowsAtCurrent)
   lastCM = step.cM;
   lastCK = step.cK;
+  coefficientsKnown = true;
   if (changed) {
     matrixCurrent = false;
     if (byRows) {
-      if (!(assembled && rowsAtCurrent && sameCoefficients))
+      if (!(rowsAtCurrent && sameCoefficients))
         stiffness->assemble(r, mass->blocks(), step.cM, step.cK, rows);
       rowsAtCurrent = true;
     } else {
@@ -567,8 +570,15 @@ DynamicSolver::DynamicSolver(const PolyMesh& mesh, const MomentCache& moments,
                              const DynamicLoads& loads, const DynamicsOptions& options,
                              DynamicSolver&& before, const std::vector<char>& changed)
     : impl_(std::make_unique<Impl>()) {
+  // The step's coefficients carried over: the first force after the edit then warps the step's
+  // matrix in the same pass (forceAtU()), as every later one does.
+  const bool carried = before.impl_ && before.impl_->coefficientsKnown;
+  const double cM = carried ? before.impl_->lastCM : 0.0, cK = carried ? before.impl_->lastCK : 0.0;
   impl_->setup(mesh, moments, loads, options, std::move(before.impl_), &changed);
   impl_->integrator->init(*impl_, impl_->state);
+  impl_->lastCM = cM;
+  impl_->lastCK = cK;
+  impl_->coefficientsKnown = carried;
 }
 DynamicSolver::~DynamicSolver() = default;
 DynamicSolver::DynamicSolver(DynamicSolver&&) noexcept = default;
