@@ -271,8 +271,8 @@ const DynamicSolver::Impl::ForceAtU& DynamicSolver::Impl::forceAtU() const {
     c.rotationSeconds = tr.seconds();
     const Stopwatch tf;
     // A corotated CG step's matrix has these rotations too: warped with the force, every split
-    // block is read once (a step at 87k DOFs reads 143 MB of them). The coefficients are the
-    // last step's; assembleSystem() assembles again if the next step's differ.
+    // block is read once. The coefficients are the last step's; assembleSystem() assembles
+    // again if the next step's differ.
     rowsAtCurrent = byRows && coefficientsKnown && options.corotational;
     if (rowsAtCurrent)
       stiffness->forceAndAssemble(c.r, state.u, c.f, c.energy, mass->blocks(), lastCM, lastCK,

@@ -170,7 +170,7 @@ TEST(CorotatedStiffness, ForceAndAssemblyInOnePassEqualTheProductAndTheAssembly)
       BlockRows<double> fusedRows = blockRowsLayout(k.layout());
       Eigen::VectorXd fusedForce;
       double fusedEnergy = 0.0;
-      for (int call = 0; call < 2; ++call)  // the second call reuses the scratch of the first
+      for (int call = 0; call < 2; ++call)  // the second call overwrites the first one's rows
         k.forceAndAssemble(r, u, fusedForce, fusedEnergy, body.mass->blocks(), cM, cK, fusedRows);
       const std::string what = std::string(toString(method)) + ", p = " + std::to_string(degree);
       EXPECT_TRUE(std::equal(fusedRows.values.begin(), fusedRows.values.end(), rows.values.begin(),
