@@ -183,8 +183,9 @@ bool BlockRows<T>::build(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>
 }
 
 template <class T>
-void BlockRows<T>::layOutInOrder(const std::vector<int>& order) {
-  std::vector<std::size_t> moved(offset.size());
+std::vector<std::size_t> BlockRows<T>::offsetsInOrder(const std::vector<int>& order,
+                                                      std::size_t count, std::size_t& total) const {
+  std::vector<std::size_t> moved(count);
   std::size_t next = 0;
   for (int e : order)
     for (int k = start[static_cast<std::size_t>(e)]; k < start[static_cast<std::size_t>(e) + 1];
@@ -192,9 +193,16 @@ void BlockRows<T>::layOutInOrder(const std::vector<int>& order) {
       moved[static_cast<std::size_t>(k)] = next;
       next += slotSize(static_cast<std::size_t>(k));
     }
-  if (offset.size() > static_cast<std::size_t>(start.back()))
-    moved.back() = next;  // the end of the values, if kept
-  UninitializedVector<T> laidOut(next);
+  if (count > static_cast<std::size_t>(start.back())) moved.back() = next;  // the values' end
+  total = next;
+  return moved;
+}
+
+template <class T>
+void BlockRows<T>::layOutInOrder(const std::vector<int>& order) {
+  std::size_t total = 0;
+  std::vector<std::size_t> moved = offsetsInOrder(order, offset.size(), total);
+  UninitializedVector<T> laidOut(total);
   tbb::parallel_for(std::size_t(0), order.size(), [&](std::size_t i) {
     const auto e = static_cast<std::size_t>(order[i]);
     for (auto k = static_cast<std::size_t>(start[e]); k < static_cast<std::size_t>(start[e + 1]);

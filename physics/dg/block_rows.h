@@ -44,12 +44,8 @@ struct BlockRows {
   /// sparse matrix).
   template <class U>
   void convertFrom(const BlockRows<U>& other) {
-    bs = other.bs;
-    n = other.n;
-    start = other.start;
-    element = other.element;
+    copyPattern(other);
     offset = other.offset;
-    diagonal = other.diagonal;
     values.resize(other.values.size());
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, values.size(), 1 << 16),
                       [&](const tbb::blocked_range<std::size_t>& r) {
@@ -57,6 +53,43 @@ struct BlockRows {
                           values[i] = static_cast<T>(other.values[i]);
                       });
   }
+
+  /// `other`'s pattern (block size, slots and their kinds), no values: what a smoother's
+  /// grouping and colouring read before convertInOrder() fills the values.
+  template <class U>
+  void copyPattern(const BlockRows<U>& other) {
+    bs = other.bs;
+    n = other.n;
+    start = other.start;
+    element = other.element;
+    diagonal = other.diagonal;
+    offset.clear();
+    values = UninitializedVector<T>();
+  }
+
+  /// `other`'s values (the pattern copyPattern() took) in this precision, laid out as
+  /// layOutInOrder(order) lays them: the conversion and the layout in one pass.
+  template <class U>
+  void convertInOrder(const BlockRows<U>& other, const std::vector<int>& order) {
+    std::size_t total = 0;
+    offset = offsetsInOrder(order, other.offset.size(), total);
+    values.resize(total);
+    tbb::parallel_for(std::size_t(0), order.size(), [&](std::size_t i) {
+      const auto e = static_cast<std::size_t>(order[i]);
+      for (auto k = static_cast<std::size_t>(start[e]); k < static_cast<std::size_t>(start[e + 1]);
+           ++k) {
+        const U* from = other.values.data() + other.offset[k];
+        T* to = values.data() + offset[k];
+        for (std::size_t j = 0, size = slotSize(k); j < size; ++j) to[j] = static_cast<T>(from[j]);
+      }
+    });
+  }
+
+  /// The offsets of `count` slots (the slots, and the end of the values if kept) when the
+  /// rows of the elements in `order` (each once) follow one another in that order; `total`:
+  /// the values they hold.
+  std::vector<std::size_t> offsetsInOrder(const std::vector<int>& order, std::size_t count,
+                                          std::size_t& total) const;
 
   /// Lays the values out again so that the rows of the elements in `order` (each element once)
   /// follow one another in that order: a smoother that visits elements colour by colour then

@@ -185,6 +185,36 @@ TEST(BlockRows, LaidOutInAnOrderTheyStreamInItAndMultiplyAsBefore) {
   EXPECT_EQ((after - before).cwiseAbs().maxCoeff(), 0.0);
 }
 
+TEST(BlockRows, ConvertedInAnOrderTheyEqualAConversionLaidOutAfterwards) {
+  // The p-multigrid's smoother copy converted straight into its sweep order (one pass) is the
+  // copy converted, then laid out: the same offsets and the same values, bit for bit. BZ's
+  // rows mix whole and component-diagonal slots.
+  const Eigen::SparseMatrix<double, Eigen::ColMajor, int> k =
+      b1System(benchmarkB1Mesh(BenchmarkMesh::Sliced, 3), Method::BZ, 1).matrix;
+  BlockRows<double> rows;
+  ASSERT_TRUE(rows.build(k, 4, 1.0));
+  const int ne = rows.elements();
+  std::vector<int> order(static_cast<std::size_t>(ne));
+  for (int e = 0; e < ne; ++e) order[static_cast<std::size_t>(e)] = e;
+  std::shuffle(order.begin(), order.end(), std::mt19937(20261207));
+  BlockRows<float> twoPasses, onePass;
+  twoPasses.convertFrom(rows);
+  twoPasses.layOutInOrder(order);
+  onePass.copyPattern(rows);
+  EXPECT_TRUE(onePass.values.empty());
+  EXPECT_EQ(onePass.start, rows.start);
+  EXPECT_EQ(onePass.element, rows.element);
+  onePass.convertInOrder(rows, order);
+  EXPECT_EQ(onePass.offset, twoPasses.offset);
+  ASSERT_EQ(onePass.values.size(), twoPasses.values.size());
+  EXPECT_TRUE(std::equal(onePass.values.begin(), onePass.values.end(), twoPasses.values.begin()));
+  // Every value is the source's, rounded: the diagonal block of the last element in the order.
+  const int last = order.back();
+  const double* exact = rows.diagonalBlock(last);
+  const float* rounded = onePass.diagonalBlock(last);
+  for (int i = 0; i < rows.bs * rows.bs; ++i) EXPECT_EQ(rounded[i], static_cast<float>(exact[i]));
+}
+
 TEST(BlockRows, RefusesAPatternTooSparseForBlocks) {
   // The identity of a 2-element, bs = 3 matrix: the elements' own blocks are stored whole,
   // 9 values for 3 nonzeros each.
