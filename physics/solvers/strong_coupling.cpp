@@ -44,9 +44,12 @@ double spectralNorm(const Mat& m) {
 
 /// couplingStrengths() with blocks of BS x BS (Eigen::Dynamic: a.bs, known at run time only):
 /// fixed sizes keep the per-pair matrices on the stack. At p = 2 forming M (two triangular
-/// solves per pair) costs the most either way.
+/// solves per pair) costs the most either way. A pair whose ||M||_F, an upper bound of its
+/// strength, is below `cutoff` gets that bound instead: no power iteration for a pair that
+/// cannot reach a threshold of `cutoff` (most pairs of a time step's matrix, whose mass
+/// weakens every coupling).
 template <int BS, class T>
-void strengthsOfSize(const BlockRows<T>& a, std::vector<double>& strength) {
+void strengthsOfSize(const BlockRows<T>& a, std::vector<double>& strength, double cutoff) {
   using Mat = Eigen::Matrix<double, BS, BS>;
   const int ne = a.elements(), bs = a.bs;
   const std::size_t bs2 = static_cast<std::size_t>(bs) * static_cast<std::size_t>(bs);
@@ -81,7 +84,8 @@ void strengthsOfSize(const BlockRows<T>& a, std::vector<double>& strength) {
       factor(e).template triangularView<Eigen::Lower>().solveInPlace(m);
       factor(f).template triangularView<Eigen::Lower>().solveInPlace(
           m.transpose());  // (L_f^-1 M^T)^T = M L_f^-T
-      strength[slot] = spectralNorm(m);
+      const double bound = m.norm();
+      strength[slot] = bound < cutoff ? bound : spectralNorm(m);
     }
   });
   tbb::parallel_for(0, ne, [&](int f) {
@@ -97,25 +101,32 @@ void strengthsOfSize(const BlockRows<T>& a, std::vector<double>& strength) {
   });
 }
 
+/// couplingStrengths(), exact from `cutoff` up (strengthsOfSize()).
+template <class T>
+std::vector<double> strengthsFrom(const BlockRows<T>& a, double cutoff) {
+  std::vector<double> strength(a.element.size(), 0.0);
+  switch (a.bs) {  // the block sizes of the DG degrees 0-3
+    case 3: strengthsOfSize<3>(a, strength, cutoff); break;
+    case 12: strengthsOfSize<12>(a, strength, cutoff); break;
+    case 30: strengthsOfSize<30>(a, strength, cutoff); break;
+    case 60: strengthsOfSize<60>(a, strength, cutoff); break;
+    default: strengthsOfSize<Eigen::Dynamic>(a, strength, cutoff); break;
+  }
+  return strength;
+}
+
 }  // namespace
 
 template <class T>
 std::vector<double> couplingStrengths(const BlockRows<T>& a) {
-  std::vector<double> strength(a.element.size(), 0.0);
-  switch (a.bs) {  // the block sizes of the DG degrees 0-3
-    case 3: strengthsOfSize<3>(a, strength); break;
-    case 12: strengthsOfSize<12>(a, strength); break;
-    case 30: strengthsOfSize<30>(a, strength); break;
-    case 60: strengthsOfSize<60>(a, strength); break;
-    default: strengthsOfSize<Eigen::Dynamic>(a, strength); break;
-  }
-  return strength;
+  return strengthsFrom(a, 0.0);
 }
 
 template <class T>
 BlockGroups groupStrongCouplings(const BlockRows<T>& a, double threshold, int maxBlocks) {
   const int ne = a.elements();
-  const std::vector<double> strength = couplingStrengths(a);
+  // Exact where it matters: pairs below the threshold are not joined, whatever their strength.
+  const std::vector<double> strength = strengthsFrom(a, threshold);
   // Strong pairs (e < f), strongest first; ties in element order, so the groups do not
   // depend on the threads.
   std::vector<std::tuple<double, int, int>> pairs;

@@ -100,6 +100,22 @@ TEST(StrongCoupling, GroupsFollowStrongPairsUpToTheCap) {
   EXPECT_TRUE(groupStrongCouplings(rows, 0.5, 8).singletons());
 }
 
+TEST(StrongCoupling, GroupsJoinPairsByTheirStrengthNotByItsBound) {
+  // 0 -(0.25)- 1 -(0.3)- 2 -(0.4)- 3 with threshold 0.35. The grouping skips the power
+  // iteration of pairs whose ||M||_F, an upper bound of the strength, lies below the
+  // threshold; here it is sqrt(3) c (0.43, 0.52, 0.69), above it for every pair, so each
+  // strength is computed and only 2-3 is joined.
+  const BlockRows<double> rows = chain({0.25, 0.3, 0.4});
+  const std::vector<double> strengths = couplingStrengths(rows);
+  EXPECT_NEAR(strengthOf(rows, strengths, 0, 1), 0.25, kStrengthTolerance);
+  const BlockGroups groups = groupStrongCouplings(rows, 0.35, 8);
+  EXPECT_EQ(groups.start, (std::vector<int>{0, 1, 2, 4}));
+  EXPECT_EQ(groups.members, (std::vector<int>{0, 1, 2, 3}));
+  // Below sqrt(3) c no pair can be joined: the bound alone decides.
+  EXPECT_TRUE(groupStrongCouplings(rows, 0.7, 8).singletons());
+  EXPECT_EQ(groupStrongCouplings(rows, 0.39, 8).groups(), 3);
+}
+
 TEST(StrongCoupling, NoGroupsOnHexGrids) {
   // The smoother of the p-multigrid stays per element on hex grids, at every degree (with its
   // threshold, 3/4 for p = 1): B2's cube (clamped on one side) and B1's (held on the whole
