@@ -150,31 +150,48 @@ struct PMultigrid::Impl {
     return ok;
   }
 
-  /// Colours, smoother groups and their inverses of a level that is smoothed.
-  bool prepareSmoother(Level& level, const BlockRows<double>* matrixBlocks) {
-    // The top level given by rows: the smoother reads the caller's rows; a level converted
-    // already: keepSmootherCopyOnly().
-    if (!level.rows && !level.useBlocks) {
-      if (matrixBlocks == nullptr) matrixBlocks = level.source;
-      if (matrixBlocks != nullptr && !matrixBlocks->values.empty()) {
-        level.blocks.convertFrom(*matrixBlocks);
-        level.useBlocks = true;
-      } else {
-        level.useBlocks = level.blocks.build(*level.matrix, level.n, 2.0);
-      }
-    }
-    if (level.rows)
-      level.smootherGroups = groupStrongCouplings(*level.rows, strongCoupling, kMaxGroupBlocks);
-    else if (level.useBlocks)
-      level.smootherGroups = groupStrongCouplings(level.blocks, strongCoupling, kMaxGroupBlocks);
-    else  // a pattern too sparse for blocks (BlockRows::build)
-      level.smootherGroups = singleBlocks(static_cast<int>(level.blockCount()));
+  /// The colours of `level`'s smoother groups, and the blocks of the last one.
+  static void colour(Level& level) {
     level.colours = colourGroups(level);
     level.inLastColour.assign(static_cast<std::size_t>(level.blockCount()), 0);
     if (!level.colours.empty())
       for (int g : level.colours.back())
         for (int e : level.smootherGroups.of(g))
           level.inLastColour[static_cast<std::size_t>(e)] = 1;
+  }
+
+  /// Colours, smoother groups and their inverses of a level that is smoothed; its groups
+  /// `groups` if given (moved from), else found from its matrix.
+  bool prepareSmoother(Level& level, const BlockRows<double>* matrixBlocks,
+                       BlockGroups* groups = nullptr) {
+    auto groupsOf = [&](const auto& blocks) {
+      return groups != nullptr ? std::move(*groups)
+                               : groupStrongCouplings(blocks, strongCoupling, kMaxGroupBlocks);
+    };
+    // The top level given by rows: the smoother reads the caller's rows; a level converted
+    // already: keepSmootherCopyOnly().
+    if (!level.rows && !level.useBlocks) {
+      if (matrixBlocks == nullptr) matrixBlocks = level.source;
+      if (matrixBlocks != nullptr && !matrixBlocks->values.empty()) {
+        // Groups and colours from the rows in double precision, then their single-precision
+        // copy converted straight into the order the sweeps visit (one pass, one allocation).
+        level.smootherGroups = groupsOf(*matrixBlocks);
+        level.blocks.copyPattern(*matrixBlocks);
+        level.useBlocks = true;
+        colour(level);
+        level.blocks.convertInOrder(*matrixBlocks, sweepOrder(level));
+        return invertGroups(level);
+      } else {
+        level.useBlocks = level.blocks.build(*level.matrix, level.n, 2.0);
+      }
+    }
+    if (level.rows)
+      level.smootherGroups = groupsOf(*level.rows);
+    else if (level.useBlocks)
+      level.smootherGroups = groupsOf(level.blocks);
+    else  // a pattern too sparse for blocks (BlockRows::build)
+      level.smootherGroups = singleBlocks(static_cast<int>(level.blockCount()));
+    colour(level);
     if (level.useBlocks) level.blocks.layOutInOrder(sweepOrder(level));
     return invertGroups(level);
   }
@@ -446,59 +463,76 @@ bool PMultigrid::Impl::build(const SpMat* matrix, const BlockRows<double>* rows,
                            frames->centres.size() == static_cast<std::size_t>(ne) &&
                            frames->scales.size() == static_cast<std::size_t>(ne) &&
                            frames->bases.size() == static_cast<std::size_t>(ne);
-  // Degree levels down to min(p, 2) with frames (then agglomerates of that degree), else down
-  // to 0.
-  const int groupDegree = std::min(degree, 2);
-  for (int q = degree - 1; q >= (agglomerate ? groupDegree : 0); --q) {
-    Level& fine = m.levels.back();
-    Level level;
-    level.n = numMonomials(q);
-    level.bs = 3 * level.n;
-    m.push(std::move(level), fine.rows ? restrictBlocks(*fine.rows, level.n)
-                                       : restrictMatrix(*fine.matrix, fine.n, level.n));
-  }
-  if (m.levels.size() == 1 && !agglomerate && top.rows) {
-    // The top level is the coarsest, factorized: it needs the CSR matrix.
-    SpMat matrix = top.rows->toSparse();
-    top.owned.swap(matrix);
-    top.matrix = &top.owned;
-    top.rows = nullptr;
-  }
-  if (agglomerate) {
-    Level& elements = m.levels.back();
-    if (m.levels.size() == 1 && matrixBlocks != nullptr && !matrixBlocks->values.empty())
-      elements.source = matrixBlocks;
-    m.addAggregateLevel(frames, groupDegree);
-    // Further levels while the coarsest is large and grouping still shrinks it, all with
-    // quadratic functions: groups of 4 x 4 x 4 cells and more span the thin parts of a real
-    // model (the bunny's ears), which bend within a group (for p = 1, linear groups take the
-    // Taylor parts of their parent's quadratics). They have an eighth of the blocks of the
-    // level before each, so they sweep twice: a V-cycle with two agglomeration levels then
-    // needs about as many iterations as one with an exact first agglomeration level on B2.
-    const double limit = std::max(static_cast<double>(kCoarseUnknowns), std::sqrt(nonzeros));
-    while (static_cast<double>(m.levels.back().unknowns()) > limit) {
-      const Eigen::Index before = m.levels.back().unknowns();
-      m.levels.back().sweeps = 2;
-      // The blocks of the last level are the groups of the one before.
-      m.addAggregateLevel(nullptr, 2);
-      const Eigen::Index after = m.levels.back().unknowns();
-      if (after >= before) {  // quadratic groups of groups on a line: no fewer unknowns
-        m.levels.pop_back();
-        break;
-      }
-      m.keepSmootherCopyOnly(m.levels[m.levels.size() - 2]);
-      if (after * 4 > before * 3) break;  // grouping stalled
+  // The top level's smoother groups from its rows in double precision (the caller's, or the
+  // CSR matrix's copy by blocks) while the levels below are built: their strengths are the
+  // larger part of the build, and neither task writes what the other reads.
+  const BlockRows<double>* topRows = rows ? rows
+                                     : matrixBlocks != nullptr && !matrixBlocks->values.empty()
+                                         ? matrixBlocks
+                                         : nullptr;
+  const bool topSmoothed = agglomerate || degree > 0;
+  BlockGroups topGroups;
+  auto buildLevels = [&] {
+    // Degree levels down to min(p, 2) with frames (then agglomerates of that degree), else down
+    // to 0.
+    const int groupDegree = std::min(degree, 2);
+    for (int q = degree - 1; q >= (agglomerate ? groupDegree : 0); --q) {
+      Level& fine = m.levels.back();
+      Level level;
+      level.n = numMonomials(q);
+      level.bs = 3 * level.n;
+      m.push(std::move(level), fine.rows ? restrictBlocks(*fine.rows, level.n)
+                                         : restrictMatrix(*fine.matrix, fine.n, level.n));
     }
-    m.finishAggregation();
-  } else if (degree > 0) {
-    // Level 0 couples elements through the penalty, mu eta_F [u].[v], which couples equal
-    // components only, and (IP) the lifting of the normal jump, which couples components
-    // through n n^T. K stores the element blocks whole, so level 0 inherits explicit zeros
-    // that would make CHOLMOD factorize a coupled pattern, several times the work of the
-    // pattern without them (the three components then separate wherever the normals are
-    // axis-aligned, and for BZ everywhere).
-    m.levels.back().owned.prune([](Eigen::Index, Eigen::Index, double v) { return v != 0.0; });
-  }
+    if (m.levels.size() == 1 && !agglomerate && top.rows) {
+      // The top level is the coarsest, factorized: it needs the CSR matrix.
+      SpMat matrix = top.rows->toSparse();
+      top.owned.swap(matrix);
+      top.matrix = &top.owned;
+      top.rows = nullptr;
+    }
+    if (agglomerate) {
+      Level& elements = m.levels.back();
+      if (m.levels.size() == 1 && matrixBlocks != nullptr && !matrixBlocks->values.empty())
+        elements.source = matrixBlocks;
+      m.addAggregateLevel(frames, groupDegree);
+      // Further levels while the coarsest is large and grouping still shrinks it, all with
+      // quadratic functions: groups of 4 x 4 x 4 cells and more span the thin parts of a real
+      // model (the bunny's ears), which bend within a group (for p = 1, linear groups take the
+      // Taylor parts of their parent's quadratics). They have an eighth of the blocks of the
+      // level before each, so they sweep twice: a V-cycle with two agglomeration levels then
+      // needs about as many iterations as one with an exact first agglomeration level on B2.
+      const double limit = std::max(static_cast<double>(kCoarseUnknowns), std::sqrt(nonzeros));
+      while (static_cast<double>(m.levels.back().unknowns()) > limit) {
+        const Eigen::Index before = m.levels.back().unknowns();
+        m.levels.back().sweeps = 2;
+        // The blocks of the last level are the groups of the one before.
+        m.addAggregateLevel(nullptr, 2);
+        const Eigen::Index after = m.levels.back().unknowns();
+        if (after >= before) {  // quadratic groups of groups on a line: no fewer unknowns
+          m.levels.pop_back();
+          break;
+        }
+        m.keepSmootherCopyOnly(m.levels[m.levels.size() - 2]);
+        if (after * 4 > before * 3) break;  // grouping stalled
+      }
+      m.finishAggregation();
+    } else if (degree > 0) {
+      // Level 0 couples elements through the penalty, mu eta_F [u].[v], which couples equal
+      // components only, and (IP) the lifting of the normal jump, which couples components
+      // through n n^T. K stores the element blocks whole, so level 0 inherits explicit zeros
+      // that would make CHOLMOD factorize a coupled pattern, several times the work of the
+      // pattern without them (the three components then separate wherever the normals are
+      // axis-aligned, and for BZ everywhere).
+      m.levels.back().owned.prune([](Eigen::Index, Eigen::Index, double v) { return v != 0.0; });
+    }
+  };
+  if (topRows != nullptr && topSmoothed)
+    tbb::parallel_invoke(
+        [&] { topGroups = groupStrongCouplings(*topRows, m.strongCoupling, kMaxGroupBlocks); },
+        buildLevels);
+  else
+    buildLevels();
   // Rows given to be copied (computeCopy()): read for the levels below, then converted for the
   // top level's smoother like a CSR matrix's (prepareSmoother()).
   if (rows != nullptr && matrixBlocks == rows && m.levels.size() > 1)
@@ -509,7 +543,9 @@ bool PMultigrid::Impl::build(const SpMat* matrix, const BlockRows<double>* rows,
   tbb::parallel_invoke(
       [&] {
         tbb::parallel_for(std::size_t(0), m.levels.size() - 1, [&](std::size_t k) {
-          if (!m.prepareSmoother(m.levels[k], k == 0 ? matrixBlocks : nullptr)) ok = false;
+          if (!m.prepareSmoother(m.levels[k], k == 0 ? matrixBlocks : nullptr,
+                                 k == 0 && topGroups.groups() > 0 ? &topGroups : nullptr))
+            ok = false;
         });
       },
       [&] {

@@ -15,8 +15,10 @@
 
 #include "cli/bench/problems.h"
 #include "mesh/primitives.h"
+#include "physics/dg/block_rows.h"
 #include "physics/solvers/linear_solver.h"
 #include "physics/solvers/static_solver.h"
+#include "physics/solvers/strong_coupling.h"
 #include "polydg/mesh/meshing.h"
 #include "polydg/mesh/surface_io.h"
 #include "tests/support/dg_systems.h"
@@ -198,15 +200,19 @@ TEST_P(VCycle, IsSymmetricPositiveDefinite) {
 
 INSTANTIATE_TEST_SUITE_P(ConstantsOrAgglomerates, VCycle, ::testing::Bool());
 
+/// The bundled torus sliced at 16 cells: 840 elements, many clipped by the surface.
+MeshingResult slicedTorus() {
+  MeshingOptions options;
+  options.cellsAlongLongest = 16;
+  return meshSurface(readSurface(std::string(POLYDG_TESTDATA_DIR) + "/torus.obj"), options);
+}
+
 TEST(PMultigrid, GroupedSmootherOnASlicedTorus) {
   // The bundled torus sliced at 16 cells (840 elements, many clipped by the surface, whose
   // penalties make strong couplings), IP, p = 2, held on the whole boundary. The smoother
   // solves strongly coupled elements in groups; the V-cycle stays symmetric positive definite
   // and CG needs fewer iterations than with one block per element (57 -> 53).
-  MeshingOptions options;
-  options.cellsAlongLongest = 16;
-  const MeshingResult meshed =
-      meshSurface(readSurface(std::string(POLYDG_TESTDATA_DIR) + "/torus.obj"), options);
+  const MeshingResult meshed = slicedTorus();
   const FramedSystem framed = b1FramedSystem(meshed.mesh, Method::IP, 2);
   const LinearSystem& system = framed.system;
   PMultigrid mg;
@@ -226,6 +232,31 @@ TEST(PMultigrid, GroupedSmootherOnASlicedTorus) {
   std::printf("sliced torus, p = 2: %d iterations\n", report.iterations);
   EXPECT_TRUE(report.success);
   EXPECT_LE(report.iterations, kTorusIterations);
+}
+
+TEST(PMultigrid, TheSameSmootherGroupsWhicheverWayTheRowsAreGiven) {
+  // The sliced torus of GroupedSmootherOnASlicedTorus at p = 1 (threshold 3/4). The top
+  // level's groups are found from K by block rows in double precision, beside the levels
+  // below: from the caller's rows (compute()), the rows a time step rewrites (computeCopy())
+  // or the CSR matrix's copy by blocks. Each way gives the groups the rows' strengths give.
+  const FramedSystem framed = b1FramedSystem(slicedTorus().mesh, Method::IP, 1);
+  BlockRows<double> rows;
+  ASSERT_TRUE(rows.build(framed.system.matrix, 4, 2.0));
+  const BlockGroups expected = groupStrongCouplings(rows, smootherStrongCoupling(1), 16);
+  int grouped = 0;
+  for (int g = 0; g < expected.groups(); ++g)
+    if (expected.size(g) > 1) grouped += expected.size(g);
+  ASSERT_GT(grouped, 0);
+  PMultigrid borrowed, copied, fromCsr;
+  ASSERT_TRUE(borrowed.compute(rows, 1, &framed.frames));
+  ASSERT_TRUE(copied.computeCopy(rows, 1, &framed.frames));
+  ASSERT_TRUE(fromCsr.compute(framed.system.matrix, 1, &rows, &framed.frames));
+  for (const PMultigrid* mg : {&borrowed, &copied, &fromCsr}) {
+    EXPECT_EQ(mg->groupedBlocks(), grouped);
+    EXPECT_EQ(mg->levels(), borrowed.levels());
+    EXPECT_EQ(mg->colours(), borrowed.colours());
+  }
+  expectSymmetricPositive(copied, framed.system.matrix.rows(), 20261207, 1);
 }
 
 TEST(PMultigrid, QuadraticGroupsThatWouldNotShrinkTheLevelAreNotAdded) {
