@@ -33,8 +33,8 @@ const StepMatrix& stepMatrix(int cells) {
   if (it != made.end()) return it->second;
   const int across = std::max(1, cells / 10);
   const PolyMesh mesh = hexGridMesh(cells, across, across, Box3(Vec3::Zero(), Vec3(10, 1, 1)));
-  const FramedSystem s = framedSystem(mesh, Material{1000, 0.3, 1}, bench::benchmarkB2Loads(),
-                                      Method::IP, 1);
+  const FramedSystem s =
+      framedSystem(mesh, Material{1000, 0.3, 1}, bench::benchmarkB2Loads(), Method::IP, 1);
   StepMatrix m;
   m.rows.build(s.system.matrix, 4, 2.0);
   BlockRows<double>& rows = m.rows;
@@ -44,7 +44,8 @@ const StepMatrix& stepMatrix(int cells) {
          k < rows.start[static_cast<std::size_t>(e) + 1]; ++k)
       if (rows.element[static_cast<std::size_t>(k)] == e)
         for (int c = 0; c < rows.bs; ++c)
-          rows.values[rows.offset[static_cast<std::size_t>(k)] + static_cast<std::size_t>(c * rows.bs + c)] += 1.0;
+          rows.values[rows.offset[static_cast<std::size_t>(k)] +
+                      static_cast<std::size_t>(c * rows.bs + c)] += 1.0;
   m.frames = s.frames;
   return made.emplace(cells, std::move(m)).first->second;
 }
