@@ -304,15 +304,11 @@ void CorotatedStiffness::forceAndAssemble(const std::vector<Eigen::Matrix3d>& r,
                                           double cM, double cK, BlockRows<double>& rows) const {
   detail::dispatchBasisDegree(degree_, [&](auto p) {
     constexpr int N = numMonomials(p());
-    constexpr std::size_t bb = static_cast<std::size_t>(3 * N) * (3 * N);
     // Each element's blocks warped into its rows first: its force terms then read them from
     // cache. The force is product()'s, term for term and in its order.
     tbb::enumerable_thread_specific<std::vector<double>> buffers;
     const auto warp = [&](std::size_t i) {
-      std::vector<double>& buffer = buffers.local();
-      buffer.resize((1 + greaterNeighbours(parts_.jumps.neighbours, i)) * bb);
-      elementBlocks<N>(r, mass, cM, cK, i, buffer.data(), buffer.data() + bb);
-      writeElementRows(rows, parts_.jumps.neighbours, i, buffer.data(), buffer.data() + bb);
+      elementRows<N>(r, mass, cM, cK, i, buffers.local(), rows);
     };
     energy = sumRows<N>(r, Eigen::VectorXd(x0_ + u), &x0_, true, force, warp);
   });
@@ -323,46 +319,45 @@ void CorotatedStiffness::assemble(const std::vector<Eigen::Matrix3d>& r,
                                   LocalMatrices& system) const {
   const std::size_t bb = static_cast<std::size_t>(bs_) * bs_;
   // Element i's blocks straight into the arrays of `system`.
-  const auto into = [&](std::size_t i, std::vector<double>&) {
-    return std::pair{system.diagonal.data() + i * bb,
-                     system.coupling.data() + parts_.jumps.couplingStart[i] * bb};
-  };
-  const auto written = [](std::size_t, const double*, const double*) {};
-  detail::dispatchBasisDegree(
-      degree_, [&](auto p) { assembleOf<numMonomials(p())>(r, mass, cM, cK, into, written); });
+  detail::dispatchBasisDegree(degree_, [&](auto p) {
+    constexpr int N = numMonomials(p());
+    assembleOf([&](std::size_t i, std::vector<double>&) {
+      elementBlocks<N>(r, mass, cM, cK, i, system.diagonal.data() + i * bb,
+                       system.coupling.data() + parts_.jumps.couplingStart[i] * bb);
+    });
+  });
 }
 
 void CorotatedStiffness::assemble(const std::vector<Eigen::Matrix3d>& r,
                                   const std::vector<double>& mass, double cM, double cK,
                                   BlockRows<double>& rows) const {
-  const std::size_t bb = static_cast<std::size_t>(bs_) * bs_;
-  // Element i's blocks into a buffer of the thread, then into its row and (transposed) its
-  // neighbours' rows: one pass over the rows and no LocalMatrices.
-  const auto into = [&](std::size_t i, std::vector<double>& buffer) {
-    const std::size_t couplings = greaterNeighbours(parts_.jumps.neighbours, i);
-    buffer.resize((1 + couplings) * bb);
-    return std::pair{buffer.data(), buffer.data() + bb};
-  };
-  const auto written = [&](std::size_t i, const double* diagonal, const double* coupling) {
-    writeElementRows(rows, parts_.jumps.neighbours, i, diagonal, coupling);
-  };
-  detail::dispatchBasisDegree(
-      degree_, [&](auto p) { assembleOf<numMonomials(p())>(r, mass, cM, cK, into, written); });
+  // One pass over the rows and no LocalMatrices.
+  detail::dispatchBasisDegree(degree_, [&](auto p) {
+    constexpr int N = numMonomials(p());
+    assembleOf([&](std::size_t i, std::vector<double>& buffer) {
+      elementRows<N>(r, mass, cM, cK, i, buffer, rows);
+    });
+  });
 }
 
-template <int N, class Into, class Written>
-void CorotatedStiffness::assembleOf(const std::vector<Eigen::Matrix3d>& r,
-                                    const std::vector<double>& mass, double cM, double cK,
-                                    const Into& into, const Written& written) const {
+template <class Each>
+void CorotatedStiffness::assembleOf(const Each& each) const {
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ne_, 32),
                     [&](const tbb::blocked_range<std::size_t>& range) {
                       std::vector<double> buffer;
-                      for (std::size_t i = range.begin(); i != range.end(); ++i) {
-                        const auto [diagonal, coupling] = into(i, buffer);
-                        elementBlocks<N>(r, mass, cM, cK, i, diagonal, coupling);
-                        written(i, diagonal, coupling);
-                      }
+                      for (std::size_t i = range.begin(); i != range.end(); ++i) each(i, buffer);
                     });
+}
+
+template <int N>
+void CorotatedStiffness::elementRows(const std::vector<Eigen::Matrix3d>& r,
+                                     const std::vector<double>& mass, double cM, double cK,
+                                     std::size_t i, std::vector<double>& buffer,
+                                     BlockRows<double>& rows) const {
+  constexpr std::size_t bb = static_cast<std::size_t>(3 * N) * (3 * N);
+  buffer.resize((1 + greaterNeighbours(parts_.jumps.neighbours, i)) * bb);
+  elementBlocks<N>(r, mass, cM, cK, i, buffer.data(), buffer.data() + bb);
+  writeElementRows(rows, parts_.jumps.neighbours, i, buffer.data(), buffer.data() + bb);
 }
 
 template <int N>

@@ -108,11 +108,15 @@ class CorotatedStiffness {
   template <int N>
   void productOf(const std::vector<Eigen::Matrix3d>& r, const Eigen::VectorXd& x,
                  const Eigen::VectorXd* z, Eigen::VectorXd& out, double* energy) const;
-  /// Element i's blocks of cM M + cK K_w, written where into(i, buffer) points (its diagonal
-  /// block, then its coupling blocks with neighbours f > i), then passed to written(i, ...).
-  template <int N, class Into, class Written>
-  void assembleOf(const std::vector<Eigen::Matrix3d>& r, const std::vector<double>& mass, double cM,
-                  double cK, const Into& into, const Written& written) const;
+  /// each(i, buffer) for every element i in parallel, `buffer` a scratch vector of the task.
+  template <class Each>
+  void assembleOf(const Each& each) const;
+  /// Element i's blocks of cM M + cK K_w (elementBlocks()) into `buffer`, then into its row of
+  /// `rows` and, transposed, its neighbours' rows (writeElementRows()).
+  template <int N>
+  void elementRows(const std::vector<Eigen::Matrix3d>& r, const std::vector<double>& mass,
+                   double cM, double cK, std::size_t i, std::vector<double>& buffer,
+                   BlockRows<double>& rows) const;
   /// Element i's blocks of cM M + cK K_w: its diagonal block into `d` (column-major), its
   /// coupling blocks with neighbours f > i, one after the other, into `c` (row-major).
   template <int N>
