@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <numeric>
 #include <random>
 
 #include "cli/bench/problems.h"
@@ -154,6 +155,14 @@ TEST(BlockRows, FindNeighboursCoupledOnlyThroughSomeComponents) {
   EXPECT_LT(compare(k, mesh.numElements(), 2.0).productError, 1e-14);
 }
 
+/// Elements 0 .. ne - 1 in an order shuffled by `seed`.
+std::vector<int> shuffledElements(int ne, unsigned seed) {
+  std::vector<int> order(static_cast<std::size_t>(ne));
+  std::iota(order.begin(), order.end(), 0);
+  std::shuffle(order.begin(), order.end(), std::mt19937(seed));
+  return order;
+}
+
 TEST(BlockRows, LaidOutInAnOrderTheyStreamInItAndMultiplyAsBefore) {
   // The smoother's copy laid out colour by colour: BZ's rows mix whole and component-diagonal
   // slots, so every slot size moves.
@@ -165,9 +174,7 @@ TEST(BlockRows, LaidOutInAnOrderTheyStreamInItAndMultiplyAsBefore) {
   const Eigen::VectorXd x = randomVector(k.cols());
   Eigen::VectorXd before(k.rows()), after(k.rows());
   for (int e = 0; e < ne; ++e) rows.rowProduct(e, x.data(), before.data() + e * rows.bs);
-  std::vector<int> order(static_cast<std::size_t>(ne));
-  for (int e = 0; e < ne; ++e) order[static_cast<std::size_t>(e)] = e;
-  std::shuffle(order.begin(), order.end(), std::mt19937(20261204));
+  const std::vector<int> order = shuffledElements(ne, 20261204);
   const std::size_t stored = rows.values.size();
   rows.layOutInOrder(order);
   EXPECT_EQ(rows.values.size(), stored);
@@ -193,10 +200,7 @@ TEST(BlockRows, ConvertedInAnOrderTheyEqualAConversionLaidOutAfterwards) {
       b1System(benchmarkB1Mesh(BenchmarkMesh::Sliced, 3), Method::BZ, 1).matrix;
   BlockRows<double> rows;
   ASSERT_TRUE(rows.build(k, 4, 1.0));
-  const int ne = rows.elements();
-  std::vector<int> order(static_cast<std::size_t>(ne));
-  for (int e = 0; e < ne; ++e) order[static_cast<std::size_t>(e)] = e;
-  std::shuffle(order.begin(), order.end(), std::mt19937(20261207));
+  const std::vector<int> order = shuffledElements(rows.elements(), 20261207);
   BlockRows<float> twoPasses, onePass;
   twoPasses.convertFrom(rows);
   twoPasses.layOutInOrder(order);
