@@ -15,10 +15,14 @@ namespace {
 
 /// out -= (A x)_e with N functions per component (0: a.n, known at run time only): compile-time
 /// sizes for the DG degrees let the short column loops unroll and vectorize (a third of the
-/// solve time, docs/benchmarks.md).
+/// solve time, docs/benchmarks.md). The row's sums stay in a local array: stored through
+/// `out`, which may alias the blocks as far as the compiler knows, they would be written and
+/// read again for every column (a quarter of a double-precision product's time).
 template <int N, class T>
 POLYDG_INLINE void subtractRows(const BlockRows<T>& a, int e, const double* x, double* out) {
   const int n = N > 0 ? N : a.n, bs = 3 * n;
+  double sums[N > 0 ? 3 * N : 60];  // 60: 3 numMonomials(3), degree 3 at most
+  std::copy(out, out + bs, sums);
   for (int k = a.start[static_cast<std::size_t>(e)]; k < a.start[static_cast<std::size_t>(e) + 1];
        ++k) {
     const std::size_t slot = static_cast<std::size_t>(k);
@@ -30,17 +34,18 @@ POLYDG_INLINE void subtractRows(const BlockRows<T>& a, int e, const double* x, d
         for (int j = 0; j < n; ++j) {
           const T* column = block + (d * n + j) * n;
           const double xj = xf[d * n + j];
-          double* od = out + d * n;
-          for (int i = 0; i < n; ++i) od[i] -= static_cast<double>(column[i]) * xj;
+          double* sd = sums + d * n;
+          for (int i = 0; i < n; ++i) sd[i] -= static_cast<double>(column[i]) * xj;
         }
       continue;
     }
     for (int d = 0; d < bs; ++d) {
       const T* column = block + d * bs;
       const double xd = xf[d];
-      for (int c = 0; c < bs; ++c) out[c] -= static_cast<double>(column[c]) * xd;
+      for (int c = 0; c < bs; ++c) sums[c] -= static_cast<double>(column[c]) * xd;
     }
   }
+  std::copy(sums, sums + bs, out);
 }
 
 template <class T>
