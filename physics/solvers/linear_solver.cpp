@@ -259,14 +259,24 @@ struct LinearSolver::Impl {
   }
 };
 
-LinearSolver::LinearSolver(const SolverOptions& options) : impl_(std::make_unique<Impl>()) {
+LinearSolver::LinearSolver(const SolverOptions& options, MatrixTerms terms)
+    : impl_(std::make_unique<Impl>()) {
   impl_->options = options;
+  impl_->multigrid = PMultigrid(terms);
 }
 LinearSolver::~LinearSolver() = default;
 LinearSolver::LinearSolver(LinearSolver&&) noexcept = default;
 LinearSolver& LinearSolver::operator=(LinearSolver&&) noexcept = default;
 
 SolverKind LinearSolver::kind() const { return impl_->kind; }
+
+const PMultigrid* LinearSolver::multigrid() const {
+  const Impl& m = *impl_;
+  return m.kind == SolverKind::ConjugateGradient &&
+                 m.preconditioner == CgPreconditioner::PMultigrid && m.multigrid.levels() > 0
+             ? &m.multigrid
+             : nullptr;
+}
 
 bool LinearSolver::compute(const SpMat& matrix, int blockSize, const ElementFrames* frames) {
   Impl& m = *impl_;

@@ -8,6 +8,7 @@
 
 #include <Eigen/SparseCore>
 
+#include "physics/solvers/p_multigrid.h"
 #include "polydg/physics/solvers/solver_options.h"
 
 namespace polydg {
@@ -24,7 +25,9 @@ SolverKind chooseSolver(std::size_t dofs, std::size_t nonzeros, const SolverOpti
 /// A solver that keeps its factorization (or preconditioner) for repeated right-hand sides.
 class LinearSolver {
  public:
-  explicit LinearSolver(const SolverOptions& options = {});
+  /// `terms`: what the matrices hold, for the p-multigrid.
+  explicit LinearSolver(const SolverOptions& options = {},
+                        MatrixTerms terms = MatrixTerms::Stiffness);
   ~LinearSolver();
   LinearSolver(LinearSolver&&) noexcept;
   LinearSolver& operator=(LinearSolver&&) noexcept;
@@ -74,6 +77,8 @@ class LinearSolver {
                         const Eigen::VectorXd* guess, double tolerance = 0.0);
 
   SolverKind kind() const;
+  /// The p-multigrid preconditioner CG uses, if it does (else null).
+  const PMultigrid* multigrid() const;
 
  private:
   struct Impl;

@@ -80,6 +80,9 @@ int functionsOfBlock(int blockSize, int degree) {
 }  // namespace
 
 struct PMultigrid::Impl {
+  explicit Impl(MatrixTerms t) : terms(t) {}
+
+  MatrixTerms terms;
   std::vector<Level> levels;  ///< levels[0] is K (degree p), each next one coarser
   /// The coupling strength from which the smoothers join blocks (smootherStrongCoupling(p)).
   double strongCoupling = kSmootherStrongCoupling;
@@ -401,11 +404,14 @@ struct PMultigrid::Impl {
   }
 };
 
-PMultigrid::PMultigrid() : impl_(std::make_unique<Impl>()) {}
+PMultigrid::PMultigrid(MatrixTerms terms) : impl_(std::make_unique<Impl>(terms)) {}
 PMultigrid::~PMultigrid() = default;
 PMultigrid::PMultigrid(PMultigrid&&) noexcept = default;
 PMultigrid& PMultigrid::operator=(PMultigrid&&) noexcept = default;
 
+int PMultigrid::sweeps(int level) const {
+  return level + 1 == levels() ? 0 : impl_->levels[static_cast<std::size_t>(level)].sweeps;
+}
 int PMultigrid::levels() const { return static_cast<int>(impl_->levels.size()); }
 int PMultigrid::groupedBlocks() const {
   if (impl_->levels.empty()) return 0;
@@ -502,10 +508,11 @@ bool PMultigrid::Impl::build(const SpMat* matrix, const BlockRows<double>* rows,
       // Taylor parts of their parent's quadratics). They have an eighth of the blocks of the
       // level before each, so they sweep twice: a V-cycle with two agglomeration levels then
       // needs about as many iterations as one with an exact first agglomeration level on B2.
+      // Once with a mass term (MatrixTerms::StiffnessAndMass).
       const double limit = std::max(static_cast<double>(kCoarseUnknowns), std::sqrt(nonzeros));
       while (static_cast<double>(m.levels.back().unknowns()) > limit) {
         const Eigen::Index before = m.levels.back().unknowns();
-        m.levels.back().sweeps = 2;
+        m.levels.back().sweeps = m.terms == MatrixTerms::StiffnessAndMass ? 1 : 2;
         // The blocks of the last level are the groups of the one before.
         m.addAggregateLevel(nullptr, 2);
         const Eigen::Index after = m.levels.back().unknowns();

@@ -54,7 +54,7 @@ const StepMatrix& stepMatrix(int cells) {
 void Build(benchmark::State& state) {
   const StepMatrix& m = stepMatrix(static_cast<int>(state.range(0)));
   for (auto _ : state) {
-    PMultigrid mg;
+    PMultigrid mg(MatrixTerms::StiffnessAndMass);
     if (!mg.computeCopy(m.rows, 1, &m.frames)) state.SkipWithError("not positive definite");
     benchmark::DoNotOptimize(mg.levels());
   }
@@ -64,7 +64,7 @@ void Build(benchmark::State& state) {
 /// One V-cycle (PMultigrid::apply()).
 void VCycle(benchmark::State& state) {
   const StepMatrix& m = stepMatrix(static_cast<int>(state.range(0)));
-  PMultigrid mg;
+  PMultigrid mg(MatrixTerms::StiffnessAndMass);
   if (!mg.computeCopy(m.rows, 1, &m.frames)) state.SkipWithError("not positive definite");
   const Eigen::VectorXd r = Eigen::VectorXd::LinSpaced(m.rows.elements() * m.rows.bs, -1.0, 1.0);
   Eigen::VectorXd z;

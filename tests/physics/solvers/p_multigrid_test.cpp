@@ -200,6 +200,23 @@ TEST_P(VCycle, IsSymmetricPositiveDefinite) {
 
 INSTANTIATE_TEST_SUITE_P(ConstantsOrAgglomerates, VCycle, ::testing::Bool());
 
+TEST(PMultigrid, AggregationLevelsSweepOnceForATimeStepsMatrix) {
+  // The hex cube of AgglomerationLevelsOfTheHexCube (p = 1, four levels): K's aggregation
+  // levels above the coarsest sweep twice, a time step's matrix's (MatrixTerms::
+  // StiffnessAndMass) once; the elements' level sweeps once and the coarsest is factorized.
+  const FramedSystem s = b2FramedSystem(Method::BZ, 1);
+  const std::vector<int> expected[] = {{1, 2, 2, 0}, {1, 1, 1, 0}};
+  for (MatrixTerms terms : {MatrixTerms::Stiffness, MatrixTerms::StiffnessAndMass}) {
+    PMultigrid mg(terms);
+    ASSERT_TRUE(mg.compute(s.system.matrix, 1, nullptr, &s.frames));
+    ASSERT_EQ(mg.levels(), 4);
+    std::vector<int> sweeps;
+    for (int k = 0; k < mg.levels(); ++k) sweeps.push_back(mg.sweeps(k));
+    EXPECT_EQ(sweeps, expected[terms == MatrixTerms::StiffnessAndMass]);
+    expectSymmetricPositive(mg, s.system.matrix.rows(), 20261207, 1);
+  }
+}
+
 /// The bundled torus sliced at 16 cells: 840 elements, many clipped by the surface.
 MeshingResult slicedTorus() {
   MeshingOptions options;
