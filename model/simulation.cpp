@@ -85,7 +85,10 @@ std::string solverAction(const StepReport& r, SolverKind kind, bool first) {
     return first            ? "cholesky: factorized"
            : r.refactorized ? "cholesky: refactorized"
                             : "cholesky: factorization reused";
-  const std::string cg = "cg (" + toString(r.preconditioner) + "): ";
+  const std::string cg =
+      "cg (" +
+      (r.preconditionerSwitched ? toString(CgPreconditioner::BlockJacobi) + ", then " : "") +
+      toString(r.preconditioner) + "): ";
   return cg + (first || r.preconditionerRebuilt ? "preconditioner built" : "preconditioner reused");
 }
 

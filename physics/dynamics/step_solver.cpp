@@ -15,7 +15,8 @@ namespace {
 /// on B10's beam a block-Jacobi iteration costs a fifth of a V-cycle (1.75 against 7.7 ms at
 /// 87k DOFs, 23.5 against 115 ms at 960k), and a solve takes 7-15 V-cycles; with 80, Newmark's
 /// 68 block-Jacobi iterations a solve at 960k DOFs cost 3.67 s a step where BDF2's V-cycles
-/// took 2.34 (docs/benchmarks.md).
+/// took 2.34 (docs/benchmarks.md). The solve that reaches the limit goes on from its iterate
+/// with the p-multigrid: the sliced bunny's first step took 506 block-Jacobi iterations.
 constexpr int kBlockJacobiLimit = 50;
 
 /// Adds the seconds from its making to its end to the report's preconditioner time (a prepare()
@@ -43,7 +44,19 @@ class PreconditionerTimer {
 StepSolver::StepSolver(const StepSolverOptions& options, const ElementFrames& frames, int blockSize)
     : options_(options), frames_(&frames), blockSize_(blockSize), active_(options.solver) {
   if (options_.adaptivePreconditioner) active_.preconditioner = CgPreconditioner::BlockJacobi;
-  solver_ = LinearSolver(active_);
+  makeSolver();
+}
+
+void StepSolver::makeSolver() {
+  SolverOptions options = active_;
+  if (blockJacobiFirst())
+    options.maxIterations = std::min(options.maxIterations, kBlockJacobiLimit);
+  solver_ = LinearSolver(options, MatrixTerms::StiffnessAndMass);
+  ready_ = false;
+}
+
+bool StepSolver::blockJacobiFirst() const {
+  return options_.adaptivePreconditioner && active_.preconditioner == CgPreconditioner::BlockJacobi;
 }
 
 void StepSolver::startWith(CgPreconditioner preconditioner) {
@@ -51,22 +64,15 @@ void StepSolver::startWith(CgPreconditioner preconditioner) {
       active_.preconditioner == preconditioner)
     return;
   active_.preconditioner = preconditioner;
-  solver_ = LinearSolver(active_);
-  ready_ = false;
-  switchToMultigrid_ = false;
+  makeSolver();
 }
 
-void StepSolver::beginStep() {
-  if (!switchToMultigrid_) return;
-  active_.preconditioner = CgPreconditioner::PMultigrid;
-  solver_ = LinearSolver(active_);
-  ready_ = false;
-  switchToMultigrid_ = false;
-}
+void StepSolver::beginStep() { blockJacobiIterations_ = 0; }
 
 void StepSolver::prepare(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix,
                          bool changed, StepReport& report) {
   const PreconditionerTimer timer(report);
+  prepared_ = {&matrix, nullptr, nullptr, false};
   if (!ready_) {
     const bool direct = chooseSolver(matrix, active_) == SolverKind::Cholesky;
     if (!solver_.compute(matrix, blockSize_, direct ? nullptr : frames_) && direct)
@@ -95,6 +101,7 @@ bool StepSolver::refreshDue() const {
 
 void StepSolver::prepare(const BlockRows<double>& rows, bool changed, StepReport& report) {
   const PreconditionerTimer timer(report);
+  prepared_ = {nullptr, &rows, nullptr, false};
   if (!ready_) {
     solver_.computeForUpdates(rows, frames_);
     report.preconditionerRebuilt = true;
@@ -114,12 +121,14 @@ void StepSolver::prepareWithAddedTerms(
     bool changed, StepReport& report) {
   prepare(rows, changed, report);
   solver_.setAddedTerms(&terms);
+  prepared_.terms = &terms;
   addedTerms_ = true;
 }
 
 void StepSolver::prepareWithContact(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& matrix,
                                     StepReport& report) {
   const PreconditionerTimer timer(report);
+  prepared_ = {&matrix, nullptr, nullptr, true};
   const bool direct = chooseSolver(matrix, active_) == SolverKind::Cholesky;
   if (!solver_.compute(matrix, blockSize_, direct ? nullptr : frames_) && direct)
     throwNotDefinite("system matrix with contacts", "");
@@ -137,8 +146,14 @@ Eigen::VectorXd StepSolver::solve(const Eigen::VectorXd& rhs, const Eigen::Vecto
         "the time step's right-hand side overflows double precision (an initial velocity or a "
         "load too large for the body); scale the scene's values or units down");
   LinearSolveReport lr;
-  Eigen::VectorXd x =
-      solver_.solve(rhs, lr, &guess, std::max(tolerance, options_.solver.tolerance));
+  const double target = std::max(tolerance, options_.solver.tolerance);
+  Eigen::VectorXd x = solver_.solve(rhs, lr, &guess, target);
+  if (!lr.success && blockJacobiFirst() && solver_.kind() == SolverKind::ConjugateGradient) {
+    report.iterations += lr.iterations;
+    blockJacobiIterations_ += lr.iterations;
+    switchToMultigrid(report);
+    x = solver_.solve(rhs, lr, &x, target);
+  }
   if (!lr.success)
     throw std::runtime_error("the time step's solve failed (CG did not converge in " +
                              std::to_string(lr.iterations) + " iterations, residual " +
@@ -149,18 +164,36 @@ Eigen::VectorXd StepSolver::solve(const Eigen::VectorXd& rhs, const Eigen::Vecto
   return x;
 }
 
+/// The p-multigrid of the matrix the last prepare() was given, in place of block-Jacobi, with
+/// the same added terms; timed as the preconditioner's build.
+void StepSolver::switchToMultigrid(StepReport& report) {
+  const PreconditionerTimer timer(report);
+  active_.preconditioner = CgPreconditioner::PMultigrid;
+  makeSolver();
+  if (prepared_.rows)
+    solver_.computeForUpdates(*prepared_.rows, frames_);
+  else
+    solver_.compute(*prepared_.matrix, blockSize_, frames_);
+  solver_.setAddedTerms(prepared_.terms);
+  // A matrix with contacts has another pattern: the next prepare() builds again without them.
+  ready_ = !prepared_.contacts;
+  baselineIterations_ = -1;
+  report.preconditionerRebuilt = true;
+  report.preconditionerSwitched = true;
+}
+
 void StepSolver::endStep(StepReport& report) {
-  // Contact terms outside the preconditioner add iterations that a new one would not save.
+  // Contact terms outside the preconditioner add iterations that a new one would not save. A
+  // step that switched counts its V-cycles only: the baseline may then be low (they started
+  // from block-Jacobi's iterate), which costs one early rebuild, where a high one would keep a
+  // preconditioner of the first step's rotations for steps that take five times its V-cycles
+  // (B10's beam at dt = 2).
   if (!addedTerms_) {
-    lastIterations_ = report.iterations;
-    if (baselineIterations_ < 0) baselineIterations_ = report.iterations;
+    lastIterations_ = report.iterations - blockJacobiIterations_;
+    if (baselineIterations_ < 0) baselineIterations_ = lastIterations_;
   }
   addedTerms_ = false;
   report.preconditioner = active_.preconditioner;
-  if (solver_.kind() == SolverKind::ConjugateGradient && options_.adaptivePreconditioner &&
-      active_.preconditioner == CgPreconditioner::BlockJacobi &&
-      report.iterations > kBlockJacobiLimit * report.solves)
-    switchToMultigrid_ = true;
 }
 
 }  // namespace polydg

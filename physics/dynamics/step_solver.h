@@ -14,7 +14,8 @@ namespace polydg {
 struct StepSolverOptions {
   SolverOptions solver;
   /// CG: start with block-Jacobi and switch to the p-multigrid once a solve needs more than
-  /// kBlockJacobiLimit iterations; false: solver.preconditioner throughout.
+  /// kBlockJacobiLimit iterations (that solve goes on with it); false: solver.preconditioner
+  /// throughout.
   bool adaptivePreconditioner = true;
   /// CG: the preconditioner of an earlier matrix is kept until a step needs more than this
   /// many times the iterations of the first step after it was built.
@@ -26,7 +27,7 @@ class StepSolver {
   /// `frames`: the elements' frames (the p-multigrid's agglomerates), kept by the caller.
   StepSolver(const StepSolverOptions& options, const ElementFrames& frames, int blockSize);
 
-  /// A step begins: a switch to the p-multigrid decided by the last step takes effect.
+  /// A step begins.
   void beginStep();
   /// Ready to solve with `matrix` (the step's matrix without contact terms): factorized or its
   /// preconditioner built the first time, and after prepareWithContact(); else, if `changed`,
@@ -50,10 +51,11 @@ class StepSolver {
                           StepReport& report);
   /// The solution of the prepared matrix for `rhs`, starting from `guess`; its iterations and
   /// residual go to `report`. Throws std::runtime_error if CG does not converge. CG stops at
-  /// `tolerance` (relative to |rhs|) if above the solver's.
+  /// `tolerance` (relative to |rhs|) if above the solver's. Block-Jacobi CG that reaches
+  /// kBlockJacobiLimit iterations goes on with the p-multigrid, for this and later solves.
   Eigen::VectorXd solve(const Eigen::VectorXd& rhs, const Eigen::VectorXd& guess,
                         StepReport& report, double tolerance = 0.0);
-  /// A step ended: the refresh rule's counts and the preconditioner switch.
+  /// A step ended: the refresh rule's counts.
   void endStep(StepReport& report);
   /// The next prepare() starts over (the system changed: contact set or removed).
   void reset() { ready_ = false; }
@@ -65,9 +67,24 @@ class StepSolver {
   /// its first step finding out again, with block-Jacobi's 150 iterations at 255k DOFs.
   void startWith(CgPreconditioner preconditioner);
   SolverKind kind() const { return solver_.kind(); }
+  const LinearSolver& solver() const { return solver_; }
 
  private:
   bool refreshDue() const;
+  /// A solver for active_ (block-Jacobi first: its CG stops at kBlockJacobiLimit iterations),
+  /// to be prepared.
+  void makeSolver();
+  bool blockJacobiFirst() const;
+  void switchToMultigrid(StepReport& report);
+
+  /// What the last prepare() was given: the step's matrix (CSR or rows), the terms added to
+  /// its product, and whether it holds contact terms (prepareWithContact()).
+  struct Prepared {
+    const Eigen::SparseMatrix<double, Eigen::ColMajor, int>* matrix = nullptr;
+    const BlockRows<double>* rows = nullptr;
+    const Eigen::SparseMatrix<double, Eigen::ColMajor, int>* terms = nullptr;
+    bool contacts = false;
+  };
 
   StepSolverOptions options_;
   const ElementFrames* frames_;
@@ -75,8 +92,9 @@ class StepSolver {
   SolverOptions active_;  ///< options_.solver with the preconditioner in use
   LinearSolver solver_;
   bool ready_ = false;  ///< factorized, or preconditioner built, for the matrix without contacts
-  bool switchToMultigrid_ = false;
-  bool addedTerms_ = false;  ///< this step solved with terms outside the preconditioner
+  Prepared prepared_;
+  int blockJacobiIterations_ = 0;  ///< of this step, before a switch to the p-multigrid
+  bool addedTerms_ = false;        ///< this step solved with terms outside the preconditioner
   int baselineIterations_ = -1, lastIterations_ = 0;
 };
 

@@ -44,6 +44,8 @@ struct StepReport {
   double residual = 0.0;               ///< relative residual of the step's solve
   bool refactorized = false;           ///< Cholesky: the matrix was factorized (numerically) again
   bool preconditionerRebuilt = false;  ///< CG: the preconditioner was rebuilt for this step
+  /// CG: block-Jacobi reached its limit in this step and the p-multigrid went on
+  bool preconditionerSwitched = false;
   CgPreconditioner preconditioner = CgPreconditioner::BlockJacobi;  ///< CG: the one used
   /// Polar decompositions. The rotations and the force of the step's start count here and in
   /// assemblySeconds also when state() computed them after the last step.
