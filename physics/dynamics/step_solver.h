@@ -93,8 +93,10 @@ class StepSolver {
   LinearSolver solver_;
   bool ready_ = false;  ///< factorized, or preconditioner built, for the matrix without contacts
   Prepared prepared_;
-  int blockJacobiIterations_ = 0;  ///< of this step, before a switch to the p-multigrid
-  bool addedTerms_ = false;        ///< this step solved with terms outside the preconditioner
+  /// Of this step: block-Jacobi's iterations, and all iterations before a switch to the
+  /// p-multigrid.
+  int blockJacobiIterations_ = 0, iterationsBeforeSwitch_ = 0;
+  bool addedTerms_ = false;  ///< this step solved with terms outside the preconditioner
   int baselineIterations_ = -1, lastIterations_ = 0;
 };
 

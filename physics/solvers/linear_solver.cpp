@@ -1,5 +1,6 @@
 #include "physics/solvers/linear_solver.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <tbb/blocked_range.h>
@@ -211,7 +212,8 @@ struct LinearSolver::Impl {
   }
 
   Eigen::VectorXd conjugateGradient(const Eigen::VectorXd& f, LinearSolveReport& report,
-                                    const Eigen::VectorXd* guess, double tolerance) const {
+                                    const Eigen::VectorXd* guess, double tolerance,
+                                    int maxIterations) const {
     const double fNorm = std::sqrt(parallelDot(f, f));
     Eigen::VectorXd u = Eigen::VectorXd::Zero(f.size());
     if (!std::isfinite(fNorm)) {  // else an infinite target would pass u = 0 as converged
@@ -234,7 +236,8 @@ struct LinearSolver::Impl {
     const double target = tolerance * fNorm;
     int it = 0;
     double rNorm = std::sqrt(parallelDot(r, r));
-    while (it < options.maxIterations && rNorm > target) {
+    report.initialResidual = rNorm / fNorm;
+    while (it < maxIterations && rNorm > target) {
       ++it;
       const double alpha = rz / productDot(p, q);
       // u += alpha p, r -= alpha q and |r|^2 in one pass.
@@ -386,7 +389,8 @@ Eigen::VectorXd LinearSolver::solve(const Eigen::VectorXd& rhs, LinearSolveRepor
 }
 
 Eigen::VectorXd LinearSolver::solve(const Eigen::VectorXd& rhs, LinearSolveReport& report,
-                                    const Eigen::VectorXd* guess, double tolerance) {
+                                    const Eigen::VectorXd* guess, double tolerance,
+                                    int maxIterations) {
   Impl& m = *impl_;
   report = LinearSolveReport{};
   report.used = m.kind;
@@ -399,7 +403,9 @@ Eigen::VectorXd LinearSolver::solve(const Eigen::VectorXd& rhs, LinearSolveRepor
     u = report.success ? Eigen::VectorXd(m.cholesky->solve(rhs))
                        : Eigen::VectorXd::Zero(rhs.size());
   } else {
-    u = m.conjugateGradient(rhs, report, guess, tolerance > 0.0 ? tolerance : m.options.tolerance);
+    u = m.conjugateGradient(rhs, report, guess, tolerance > 0.0 ? tolerance : m.options.tolerance,
+                            maxIterations > 0 ? std::min(maxIterations, m.options.maxIterations)
+                                              : m.options.maxIterations);
   }
   report.solveSeconds = t0.seconds();
   if (!u.allFinite()) report.success = false;  // overflowed: loads too large for the matrix

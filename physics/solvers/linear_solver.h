@@ -72,9 +72,11 @@ class LinearSolver {
   Eigen::VectorXd solve(const Eigen::VectorXd& rhs, LinearSolveReport& report);
   /// The same with CG starting from `guess` (if not null; Cholesky ignores it): the last time
   /// step's solution saves iterations. A `tolerance` above 0 replaces the options' for this
-  /// solve (CG; a solve whose result a further solve corrects needs less).
+  /// solve (CG; a solve whose result a further solve corrects needs less), a `maxIterations`
+  /// above 0 lowers their limit.
   Eigen::VectorXd solve(const Eigen::VectorXd& rhs, LinearSolveReport& report,
-                        const Eigen::VectorXd* guess, double tolerance = 0.0);
+                        const Eigen::VectorXd* guess, double tolerance = 0.0,
+                        int maxIterations = 0);
 
   SolverKind kind() const;
   /// The p-multigrid preconditioner CG uses, if it does (else null).

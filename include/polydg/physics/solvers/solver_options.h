@@ -53,11 +53,12 @@ struct SolverOptions {
 struct LinearSolveReport {
   SolverKind used = SolverKind::Auto;
   CgPreconditioner preconditioner = CgPreconditioner::PMultigrid;  ///< CG only
-  bool success = false;        ///< factorization succeeded (SPD) / CG converged
-  double factorSeconds = 0.0;  ///< symbolic + numeric factorization, or preconditioner setup
-  double solveSeconds = 0.0;   ///< triangular solves, or CG iterations
-  int iterations = 0;          ///< CG iterations (0 for Cholesky)
-  double residual = 0.0;       ///< |F - K U| / |F| (0 if F = 0)
+  bool success = false;          ///< factorization succeeded (SPD) / CG converged
+  double factorSeconds = 0.0;    ///< symbolic + numeric factorization, or preconditioner setup
+  double solveSeconds = 0.0;     ///< triangular solves, or CG iterations
+  int iterations = 0;            ///< CG iterations (0 for Cholesky)
+  double residual = 0.0;         ///< |F - K U| / |F| (0 if F = 0)
+  double initialResidual = 0.0;  ///< CG: |F - K U0| / |F| at its start
 };
 
 }  // namespace polydg
