@@ -454,6 +454,45 @@ TEST(Dynamics, AStepSolveThatSwitchesToTheMultigridKeepsItsAddedTerms) {
   EXPECT_LT((x - reference).norm(), 1e-6 * reference.norm());
 }
 
+TEST(Dynamics, BlockJacobiAFewIterationsShortOfTheTargetFinishesWithoutSwitching) {
+  // B2's clamped hex cube, p = 1, whose block-Jacobi CG is far from 1e-12 after 50 iterations.
+  // Asked for a residual a little below the one it reaches in 50 (its rate so far says two
+  // more iterations), the step's solve finishes with block-Jacobi; asked for a thousandth of it,
+  // the solve goes on with the p-multigrid.
+  const FramedSystem s = b2FramedSystem(Method::BZ, 1);
+  const Eigen::SparseMatrix<double>& k = s.system.matrix;
+  BlockRows<double> rows;
+  ASSERT_TRUE(rows.build(k, 4, 2.0));
+  SolverOptions jacobi;
+  jacobi.kind = SolverKind::ConjugateGradient;
+  jacobi.preconditioner = CgPreconditioner::BlockJacobi;
+  jacobi.maxIterations = 50;
+  LinearSolver fifty(jacobi);
+  ASSERT_TRUE(fifty.compute(rows));
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(k.rows());
+  LinearSolveReport lr;
+  fifty.solve(s.system.rhs, lr, &zero, 1e-12);
+  ASSERT_FALSE(lr.success);
+  std::printf("block-Jacobi after 50 iterations: residual %.3e\n", lr.residual);
+  for (double share : {0.99, 1e-3}) {
+    StepSolverOptions o;
+    o.solver.kind = SolverKind::ConjugateGradient;
+    o.solver.tolerance = 1e-12;
+    StepSolver solver(o, s.frames, s.system.blockSize);
+    StepReport report;
+    report.solves = 0;  // as DynamicSolver counts them: none before the step's first
+    solver.prepare(rows, true, report);
+    solver.solve(s.system.rhs, zero, report, share * lr.residual);
+    std::printf("target %.2g of it: %d iterations%s\n", share, report.iterations,
+                report.preconditionerSwitched ? ", switched" : "");
+    EXPECT_EQ(report.preconditionerSwitched, share < 0.5) << "share " << share;
+    if (share > 0.5) {
+      EXPECT_LE(report.iterations, 55);
+      EXPECT_LE(report.residual, share * lr.residual);
+    }
+  }
+}
+
 TEST(Dynamics, StepsOfChangingLengthAgreeBetweenConjugateGradientsAndCholesky) {
   // CG's step matrix is warped with the force at the end of each step, with that step's
   // coefficients (forceAtU()); a step of another length must assemble its own. The beam
