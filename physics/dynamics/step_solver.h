@@ -71,8 +71,7 @@ class StepSolver {
 
  private:
   bool refreshDue() const;
-  /// A solver for active_ (block-Jacobi first: its CG stops at kBlockJacobiLimit iterations),
-  /// to be prepared.
+  /// A solver for active_ and a time step's matrices, to be prepared.
   void makeSolver();
   bool blockJacobiFirst() const;
   void switchToMultigrid(StepReport& report);

@@ -423,6 +423,20 @@ TEST(Dynamics, TheStepSolversMultigridIsOneForAMatrixWithMass) {
   for (int k = 0; k < 3; ++k) EXPECT_EQ(mg->sweeps(k), 1) << "level " << k;
 }
 
+/// A step solver's options for CG (block-Jacobi first) to `tolerance`, and a report as
+/// DynamicSolver starts a step's: no solves counted yet (StepReport's default counts one).
+StepSolverOptions cgSteps(double tolerance) {
+  StepSolverOptions o;
+  o.solver.kind = SolverKind::ConjugateGradient;
+  o.solver.tolerance = tolerance;
+  return o;
+}
+StepReport stepStart() {
+  StepReport report;
+  report.solves = 0;
+  return report;
+}
+
 TEST(Dynamics, AStepSolveThatSwitchesToTheMultigridKeepsItsAddedTerms) {
   // B2's clamped hex cube, p = 1: K alone, which block-Jacobi CG does not solve in 50
   // iterations, with terms added to the product as a few contact points add them (springs at
@@ -435,11 +449,8 @@ TEST(Dynamics, AStepSolveThatSwitchesToTheMultigridKeepsItsAddedTerms) {
   Eigen::SparseMatrix<double> terms(k.rows(), k.cols());
   for (Eigen::Index dof : {Eigen::Index(100), Eigen::Index(2000), Eigen::Index(5000)})
     terms.insert(dof, dof) = 10.0 * k.coeff(dof, dof);
-  StepSolverOptions o;
-  o.solver.kind = SolverKind::ConjugateGradient;
-  o.solver.tolerance = 1e-10;
-  StepSolver solver(o, s.frames, s.system.blockSize);
-  StepReport report;
+  StepSolver solver(cgSteps(1e-10), s.frames, s.system.blockSize);
+  StepReport report = stepStart();
   solver.prepareWithAddedTerms(rows, terms, true, report);
   const Eigen::VectorXd x = solver.solve(s.system.rhs, Eigen::VectorXd::Zero(k.rows()), report);
   EXPECT_TRUE(report.preconditionerSwitched);
@@ -475,12 +486,8 @@ TEST(Dynamics, BlockJacobiAFewIterationsShortOfTheTargetFinishesWithoutSwitching
   ASSERT_FALSE(lr.success);
   std::printf("block-Jacobi after 50 iterations: residual %.3e\n", lr.residual);
   for (double share : {0.99, 1e-3}) {
-    StepSolverOptions o;
-    o.solver.kind = SolverKind::ConjugateGradient;
-    o.solver.tolerance = 1e-12;
-    StepSolver solver(o, s.frames, s.system.blockSize);
-    StepReport report;
-    report.solves = 0;  // as DynamicSolver counts them: none before the step's first
+    StepSolver solver(cgSteps(1e-12), s.frames, s.system.blockSize);
+    StepReport report = stepStart();
     solver.prepare(rows, true, report);
     solver.solve(s.system.rhs, zero, report, share * lr.residual);
     std::printf("target %.2g of it: %d iterations%s\n", share, report.iterations,
