@@ -169,12 +169,6 @@ Eigen::VectorXd faceIntegrals(const PolyMesh& mesh, const DgBasis& basis, FaceId
   return out;
 }
 
-/// The face terms of a face between two region elements from each side (faceRows()' self and
-/// other blocks S_F and O_F, by side: 0 the face's front element, 1 its back).
-struct FaceBlocks {
-  Eigen::MatrixXd self[2], other[2];
-};
-
 /// Copies the region's elements into `sub` (local ids 0 .. size - 1) and then, if there are
 /// any, their face neighbours outside it; `box` receives the region's bounds. Returns the
 /// region's size.
@@ -215,8 +209,10 @@ void copyMoments(const SubMesh& sub, const MomentCache& moments, MomentCache& gi
 
 /// The region's rows of the IP system at a linear field's coefficients (the patch test),
 /// element by element on every core, with what the count of zero modes needs of each element:
-/// its stiffness, its Jacobi scaling, its zero modes beyond 6 and the face terms it shares with
-/// other region elements.
+/// its stiffness, its Jacobi scaling, its zero modes beyond 6, and the faces it shares with
+/// other region elements (whose terms pairMatrix() computes again: kept, the four blocks of
+/// every such face took 100 MB for a cut of 3,250 elements of B10's beam at 130 cells, and
+/// the kernel's clearing of their fresh pages a quarter of the cut command).
 class RegionRows {
  public:
   RegionRows(const PolyMesh& local, std::size_t regionSize, const DgBasis& basis,
@@ -224,7 +220,6 @@ class RegionRows {
       : stiffnesses(regionSize),
         scales(regionSize),
         surplus(regionSize, 0),
-        faceBlocks(local.numFaces()),
         joins(local.numFaces(), 0),
         local_(local),
         regionSize_(regionSize),
@@ -269,16 +264,41 @@ class RegionRows {
   std::vector<Eigen::MatrixXd> stiffnesses;
   std::vector<Eigen::VectorXd> scales;
   std::vector<long long> surplus;  // element zero modes beyond 6
-  /// By local face; filled for the faces between two region elements, joins[f] = 1.
-  std::vector<FaceBlocks> faceBlocks;
+  /// By local face: 1 for the faces between two region elements.
   std::vector<char> joins;
 
- private:
   /// An element's matrices and vectors, reused from element to element by a task.
   struct Scratch {
-    Eigen::MatrixXd stiffness, a, selfBlock, otherBlock;
+    Eigen::MatrixXd stiffness, a, selfBlock, otherBlock, backSelf, backOther;
     Eigen::VectorXd r, size, diagonal;
   };
+
+  /// The IP matrix of joining face f's two elements with its terms, [K_front + S_0, O_0;
+  /// O_1, K_back + S_1] (faceRows()' self and other blocks S and O by side: 0 the face's
+  /// front element, 1 its back), into `pair`.
+  void pairMatrix(FaceId f, Scratch& s, Eigen::MatrixXd& pair) const {
+    const Face& face = local_.face(f);
+    faceRows(local_, basis_, given_, joiningView(f, face.front, face.back, true), form_,
+             s.selfBlock, s.otherBlock);
+    faceRows(local_, basis_, given_, joiningView(f, face.back, face.front, false), form_,
+             s.backSelf, s.backOther);
+    pair.resize(2 * bs_, 2 * bs_);
+    pair << stiffnesses[face.front.index()] + s.selfBlock, s.otherBlock, s.backOther,
+        stiffnesses[face.back.index()] + s.backSelf;
+  }
+
+ private:
+  FaceView joiningView(FaceId f, ElementId self, ElementId other, bool selfIsFront) const {
+    FaceView view;
+    view.face = f;
+    view.kind = FaceKind::Interior;
+    view.self = self;
+    view.other = other;
+    view.selfIsFront = selfIsFront;
+    view.selfCoupledFaces = coupled(self);
+    view.otherCoupledFaces = coupled(other);
+    return view;
+  }
 
   /// Region element i's rows: r = A U - F over them, its block of A tested for definiteness.
   void addElement(std::size_t i, Scratch& s) {
@@ -312,8 +332,8 @@ class RegionRows {
   // Every face of the full problem has face terms: c_K is the element's face count.
   int coupled(ElementId e) const { return static_cast<int>(local_.element(e).faces.size()); }
 
-  /// Face `use` of element e: its terms in K's rows, and for a face between region elements
-  /// its blocks kept (this side's).
+  /// Face `use` of element e: its terms in K's rows; a face between region elements is marked
+  /// in `joins`.
   void addFace(ElementId e, const FaceUse& use, Scratch& s) {
     const auto ue = coefficients(e);
     const ElementId other = across(local_, use.face, e);
@@ -335,11 +355,7 @@ class RegionRows {
           s.selfBlock.cwiseAbs() * ue.cwiseAbs() + s.otherBlock.cwiseAbs() * uo.cwiseAbs();
       if (other.index() < regionSize_) {
         s.diagonal += s.selfBlock.diagonal();
-        const std::size_t f = use.face.index();
-        const int side = use.reversed ? 1 : 0;
-        faceBlocks[f].self[side] = s.selfBlock;
-        faceBlocks[f].other[side] = s.otherBlock;
-        if (side == 0) joins[f] = 1;  // written by one side only
+        if (!use.reversed) joins[use.face.index()] = 1;  // written by one side only
       }
     } else {
       const Vec3 normal =
@@ -378,15 +394,15 @@ void countRegionZeroModes(const PolyMesh& local, const RegionRows& rows, int bs,
   std::vector<std::size_t> pairModes(joining.size());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, joining.size(), 16),
                     [&](const tbb::blocked_range<std::size_t>& range) {
-                      Eigen::MatrixXd pair(2 * bs, 2 * bs);
+                      RegionRows::Scratch s;
+                      Eigen::MatrixXd pair;
                       Eigen::VectorXd pairScale(2 * bs);
                       for (std::size_t k = range.begin(); k != range.end(); ++k) {
-                        const FaceBlocks& t = rows.faceBlocks[joining[k]];
-                        const Face& face = local.face(FaceId(std::size_t(joining[k])));
-                        const std::size_t front = face.front.index(), back = face.back.index();
-                        pair << rows.stiffnesses[front] + t.self[0], t.other[0], t.other[1],
-                            rows.stiffnesses[back] + t.self[1];
-                        pairScale << rows.scales[front], rows.scales[back];
+                        const FaceId f{std::size_t{joining[k]}};
+                        const Face& face = local.face(f);
+                        rows.pairMatrix(f, s, pair);
+                        pairScale << rows.scales[face.front.index()],
+                            rows.scales[face.back.index()];
                         pairModes[k] = countZeroModes(pair, pairScale);
                       }
                     });
