@@ -23,11 +23,10 @@ TimeSeries::TimeSeries(const fs::path& folder, VtuEncoding encoding)
 SimulationFrame TimeSeries::write(const PolyMesh& mesh, const DynamicSolver& solver, int step,
                                   const TriangleSurface* surface,
                                   const Eigen::Matrix<double, Eigen::Dynamic, 3>* displacement) {
-  const CornerValues moved = cornerDisplacements(mesh, solver.basis(), solver.displacement());
-  const CornerValues moving = cornerDisplacements(mesh, solver.basis(), solver.velocity());
   SimulationFrame frame =
       writeMesh(mesh, step, solver.time(), {CellArray{"von_mises", 1, solver.vonMises()}}, {},
-                {displacementPointData(moved), displacementPointData(moving, "velocity")});
+                {displacementPointData(mesh, solver.basis(), solver.displacement()),
+                 displacementPointData(mesh, solver.basis(), solver.velocity(), "velocity")});
   char name[32];
   if (surface) {
     std::snprintf(name, sizeof name, "scene_%06d.vtp", step);

@@ -89,6 +89,17 @@ CornerArray displacementPointData(const CornerValues& corners, std::string name)
                      }};
 }
 
+CornerArray displacementPointData(const PolyMesh& mesh, const DgBasis& basis,
+                                  const Eigen::VectorXd& coefficients, std::string name) {
+  return CornerArray{std::move(name), 3,
+                     [&mesh, &basis, &coefficients](ElementId e, VertexId v, double* out) {
+                       const Vec3 u = displacementAt(basis, coefficients, e, mesh.position(v));
+                       out[0] = u.x();
+                       out[1] = u.y();
+                       out[2] = u.z();
+                     }};
+}
+
 ElementFields elementFields(const PolyMesh& mesh, const DgBasis& basis, const MomentCache& moments,
                             const Eigen::VectorXd& coefficients, const Material& material) {
   const std::size_t ne = mesh.numElements();
