@@ -22,6 +22,7 @@
 #include "mesh/vtk_cell_types.h"
 #include "mesh/vtk_format.h"
 #include "mesh/vtu_cell_streams.h"
+#include "mesh/vtu_layout.h"
 #include "mesh/vtu_restore_arrays.h"
 #include "polydg/mesh/geometry.h"
 #include "polydg/mesh/tet_mesh.h"
@@ -331,10 +332,12 @@ void writeContents(std::ostream& os, const PolyMesh& mesh, const CellStreams& s,
 
 }  // namespace
 
-void writeVtu(const PolyMesh& mesh, const std::string& path, const VtuWriteOptions& options,
-              const std::vector<CellArray>& cellData, const std::vector<PointArray>& pointData,
-              const std::vector<CornerArray>& cornerData, const VtuFieldData& fieldData,
-              std::span<const double> volumes, std::span<const char> boxes) {
+namespace {
+
+/// The arrays' and the field data's names and sizes (writeVtu's std::invalid_argument).
+void checkArraysOf(const PolyMesh& mesh, const std::vector<CellArray>& cellData,
+                   const std::vector<PointArray>& pointData,
+                   const std::vector<CornerArray>& cornerData, const VtuFieldData& fieldData) {
   std::unordered_set<std::string> cellNames{"volume"}, pointNames;
   checkArrays(cellData, mesh.numElements(), "cell", cellNames);
   checkArrays(pointData, mesh.numVertices(), "point", pointNames);
@@ -344,16 +347,67 @@ void writeVtu(const PolyMesh& mesh, const std::string& path, const VtuWriteOptio
       throw std::invalid_argument("writeVtu: corner array '" + a.name + "' has no value function");
   }
   checkFieldData(fieldData);
-  requireNoneOrOnePerElement(volumes.size(), mesh, "writeVtu", "volumes");
-  requireNoneOrOnePerElement(boxes.size(), mesh, "writeVtu", "box flags");
-  // Everything that can fail for reasons other than I/O happens before the file is opened.
-  const CellStreams streams(mesh, boxes);
-  const FileValues values = fileValues(mesh, streams, volumes, cellData, pointData, cornerData);
+}
 
+/// The file of `mesh` written as `streams` lay it out.
+void writeWithStreams(const PolyMesh& mesh, const CellStreams& streams, const std::string& path,
+                      const VtuWriteOptions& options, const std::vector<CellArray>& cellData,
+                      const std::vector<PointArray>& pointData,
+                      const std::vector<CornerArray>& cornerData, const VtuFieldData& fieldData,
+                      std::span<const double> volumes) {
+  const FileValues values = fileValues(mesh, streams, volumes, cellData, pointData, cornerData);
   vtk_format::writeReplacing(path, [&](std::ostream& os) {
     writeContents(os, mesh, streams, values, cellData, pointData, cornerData, fieldData,
                   options.encoding);
   });
+}
+
+}  // namespace
+
+void writeVtu(const PolyMesh& mesh, const std::string& path, const VtuWriteOptions& options,
+              const std::vector<CellArray>& cellData, const std::vector<PointArray>& pointData,
+              const std::vector<CornerArray>& cornerData, const VtuFieldData& fieldData,
+              std::span<const double> volumes, std::span<const char> boxes) {
+  checkArraysOf(mesh, cellData, pointData, cornerData, fieldData);
+  requireNoneOrOnePerElement(volumes.size(), mesh, "writeVtu", "volumes");
+  requireNoneOrOnePerElement(boxes.size(), mesh, "writeVtu", "box flags");
+  // Everything that can fail for reasons other than I/O happens before the file is opened.
+  const CellStreams streams(mesh, boxes);
+  writeWithStreams(mesh, streams, path, options, cellData, pointData, cornerData, fieldData,
+                   volumes);
+}
+
+struct VtuLayout::Impl {
+  explicit Impl(const PolyMesh& m)
+      : mesh(m),
+        streams(m),
+        volumes(signedVolumes(m)),
+        vertices(m.numVertices()),
+        faces(m.numFaces()),
+        elements(m.numElements()) {}
+  const PolyMesh& mesh;
+  const CellStreams streams;
+  const std::vector<double> volumes;
+  const std::size_t vertices, faces, elements;
+};
+
+VtuLayout::VtuLayout(const PolyMesh& mesh) : impl_(std::make_unique<Impl>(mesh)) {}
+VtuLayout::~VtuLayout() = default;
+const PolyMesh& VtuLayout::mesh() const { return impl_->mesh; }
+bool VtuLayout::fits(const PolyMesh& mesh) const {
+  return &mesh == &impl_->mesh && mesh.numVertices() == impl_->vertices &&
+         mesh.numFaces() == impl_->faces && mesh.numElements() == impl_->elements;
+}
+
+void writeVtu(const VtuLayout& layout, const std::string& path, const VtuWriteOptions& options,
+              const std::vector<CellArray>& cellData, const std::vector<PointArray>& pointData,
+              const std::vector<CornerArray>& cornerData) {
+  const VtuLayout::Impl& l = *layout.impl_;
+  if (!layout.fits(l.mesh))
+    throw std::logic_error("writeVtu: the mesh changed since its layout was made");
+  checkArraysOf(l.mesh, cellData, pointData, cornerData, {});
+  writeWithStreams(l.mesh, l.streams, path, options, cellData, pointData, cornerData, {},
+                   l.volumes);
 }
 
 void writeTetVtu(const TetMesh& mesh, const std::string& path, const VtuWriteOptions& options,

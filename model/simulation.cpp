@@ -442,6 +442,7 @@ void Simulation::afterEdit(const ElementLineage& lineage, const DgBasis& oldBasi
 
 /// A frame of the time series (with the deformed surface if the scene embeds one).
 void Simulation::writeFrame(int k) {
+  if (series_ && editedSinceFrame_) series_->meshChanged();
   editedSinceFrame_ = false;
   if (!series_) return;
   const Stopwatch t;

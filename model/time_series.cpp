@@ -62,7 +62,7 @@ SimulationFrame TimeSeries::write(const PolyMesh& mesh, int step, double t,
 SimulationFrame TimeSeries::writeMesh(const PolyMesh& mesh, int step, double t,
                                       const std::vector<CellArray>& cells,
                                       const std::vector<PointArray>& points,
-                                      const std::vector<CornerArray>& corners) const {
+                                      const std::vector<CornerArray>& corners) {
   SimulationFrame frame;
   frame.step = step;
   frame.t = t;
@@ -72,7 +72,8 @@ SimulationFrame TimeSeries::writeMesh(const PolyMesh& mesh, int step, double t,
   VtuWriteOptions options;
   options.encoding = encoding_;
   try {
-    writeVtu(mesh, (folder_ / name).string(), options, cells, points, corners);
+    if (!layout_ || !layout_->fits(mesh)) layout_ = std::make_unique<VtuLayout>(mesh);
+    writeVtu(*layout_, (folder_ / name).string(), options, cells, points, corners);
   } catch (const std::runtime_error& e) {
     throw InputError(e.what());
   }

@@ -4,11 +4,13 @@
 #pragma once
 
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include <Eigen/Core>
 
+#include "mesh/vtu_layout.h"
 #include "physics/dynamics/dynamics.h"
 #include "polydg/model/scene.h"
 
@@ -27,6 +29,9 @@ class TimeSeries {
   SimulationFrame write(const PolyMesh& mesh, const DynamicSolver& solver, int step,
                         const TriangleSurface* surface,
                         const Eigen::Matrix<double, Eigen::Dynamic, 3>* displacement);
+  /// The mesh was edited since the last frame: the next one lays its cells out again (the
+  /// layout is kept between frames of an unchanged mesh).
+  void meshChanged() { layout_.reset(); }
   /// A frame with the given point and cell data on `mesh` (the tet methods' frames: point
   /// displacement and velocity).
   SimulationFrame write(const PolyMesh& mesh, int step, double t,
@@ -37,12 +42,13 @@ class TimeSeries {
   SimulationFrame writeMesh(const PolyMesh& mesh, int step, double t,
                             const std::vector<CellArray>& cells,
                             const std::vector<PointArray>& points,
-                            const std::vector<CornerArray>& corners) const;
+                            const std::vector<CornerArray>& corners);
   void writeCollection() const;
 
   std::filesystem::path folder_;
   VtuEncoding encoding_;
   std::vector<SimulationFrame> frames_;
+  std::unique_ptr<VtuLayout> layout_;  ///< of the mesh of the last frame
 };
 
 }  // namespace polydg

@@ -28,6 +28,7 @@
 
 #include "mesh/face_triangulation.h"
 #include "mesh/primitives.h"
+#include "mesh/vtu_layout.h"
 #include "polydg/mesh/geometry.h"
 #include "tests/support/vtu_encodings.h"
 #include "tests/support/vtu_meshes.h"
@@ -442,6 +443,37 @@ TEST(VtuCut, CornerDataIsAveragedPerSideOfACut) {
       std::invalid_argument);
   EXPECT_THROW(writeVtu(mesh, path.string(), {}, {}, {}, {CornerArray{"no_function", 1, {}}}),
                std::invalid_argument);
+}
+
+TEST(VtuLayout, WritesTheBytesOfItsMeshAndRefusesItOnceEdited) {
+  // A mesh whose cut sides have their own points, with corner and cell data: what a layout
+  // keeps (streams, points per side, volumes) and what each file brings (the arrays).
+  PolyMesh mesh = finitelyCutGrid();
+  const CornerArray index{"element_index", 1, [](ElementId e, VertexId v, double* out) {
+                            out[0] = static_cast<double>(e.index()) + 0.25 * v.index();
+                          }};
+  std::vector<double> values(mesh.numElements());
+  for (std::size_t e = 0; e < values.size(); ++e) values[e] = -1.5 * static_cast<double>(e);
+  const std::vector<CellArray> cells{CellArray{"minus", 1, values}};
+  const fs::path dir = testDir();
+  const VtuLayout layout(mesh);
+  EXPECT_TRUE(layout.fits(mesh));
+  for (VtuEncoding encoding : {VtuEncoding::Ascii, VtuEncoding::Binary, VtuEncoding::Appended}) {
+    writeVtu(mesh, (dir / "mesh.vtu").string(), {encoding}, cells, {}, {index});
+    writeVtu(layout, (dir / "layout.vtu").string(), {encoding}, cells, {}, {index});
+    EXPECT_EQ(readText(dir / "layout.vtu"), readText(dir / "mesh.vtu"));
+  }
+  // Arrays are checked as writeVtu(mesh, ...) checks them.
+  EXPECT_THROW(
+      writeVtu(layout, (dir / "bad.vtu").string(), {}, {}, {}, {CornerArray{"no_function", 1, {}}}),
+      std::invalid_argument);
+  // Another mesh with the same counts, and this one with a vertex more, do not fit.
+  const PolyMesh copy = finitelyCutGrid();
+  EXPECT_FALSE(layout.fits(copy));
+  mesh.addVertex(Vec3(5, 5, 5));
+  EXPECT_FALSE(layout.fits(mesh));
+  EXPECT_THROW(writeVtu(layout, (dir / "stale.vtu").string(), {}, {}, {}, {}), std::logic_error);
+  EXPECT_FALSE(fs::exists(dir / "stale.vtu"));
 }
 
 TEST(VtuCut, MeshesWithoutCutsWriteOnePointPerVertex) {
