@@ -463,6 +463,13 @@ TEST(VtuLayout, WritesTheBytesOfItsMeshAndRefusesItOnceEdited) {
     writeVtu(layout, (dir / "layout.vtu").string(), {encoding}, cells, {}, {index});
     EXPECT_EQ(readText(dir / "layout.vtu"), readText(dir / "mesh.vtu"));
   }
+  // A grid whose face stream the writer asks for in two chunks (1.11 million values, chunks of
+  // 2^20): the layout's held stream gives the second chunk its own values.
+  const PolyMesh grid = hexGridMesh(33, 33, 33, Box3(Vec3::Zero(), Vec3(1, 2, 3)));
+  const VtuLayout gridLayout(grid);
+  writeVtu(grid, (dir / "grid.vtu").string());
+  writeVtu(gridLayout, (dir / "grid_layout.vtu").string(), {}, {}, {}, {});
+  EXPECT_EQ(readText(dir / "grid_layout.vtu"), readText(dir / "grid.vtu"));
   // Arrays are checked as writeVtu(mesh, ...) checks them.
   EXPECT_THROW(
       writeVtu(layout, (dir / "bad.vtu").string(), {}, {}, {}, {CornerArray{"no_function", 1, {}}}),
