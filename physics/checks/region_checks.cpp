@@ -278,25 +278,26 @@ class RegionRows {
   /// front element, 1 its back), into `pair`.
   void pairMatrix(FaceId f, Scratch& s, Eigen::MatrixXd& pair) const {
     const Face& face = local_.face(f);
-    faceRows(local_, basis_, given_, joiningView(f, face.front, face.back, true), form_,
-             s.selfBlock, s.otherBlock);
-    faceRows(local_, basis_, given_, joiningView(f, face.back, face.front, false), form_,
-             s.backSelf, s.backOther);
+    faceRows(local_, basis_, given_, faceView(f, face.front, face.back, true), form_, s.selfBlock,
+             s.otherBlock);
+    faceRows(local_, basis_, given_, faceView(f, face.back, face.front, false), form_, s.backSelf,
+             s.backOther);
     pair.resize(2 * bs_, 2 * bs_);
     pair << stiffnesses[face.front.index()] + s.selfBlock, s.otherBlock, s.backOther,
         stiffnesses[face.back.index()] + s.backSelf;
   }
 
  private:
-  FaceView joiningView(FaceId f, ElementId self, ElementId other, bool selfIsFront) const {
+  /// Face f seen from element `self`: interior if `other` is valid, else a Dirichlet face.
+  FaceView faceView(FaceId f, ElementId self, ElementId other, bool selfIsFront) const {
     FaceView view;
     view.face = f;
-    view.kind = FaceKind::Interior;
+    view.kind = other.valid() ? FaceKind::Interior : FaceKind::Dirichlet;
     view.self = self;
     view.other = other;
     view.selfIsFront = selfIsFront;
     view.selfCoupledFaces = coupled(self);
-    view.otherCoupledFaces = coupled(other);
+    view.otherCoupledFaces = other.valid() ? coupled(other) : 0;
     return view;
   }
 
@@ -337,15 +338,8 @@ class RegionRows {
   void addFace(ElementId e, const FaceUse& use, Scratch& s) {
     const auto ue = coefficients(e);
     const ElementId other = across(local_, use.face, e);
-    FaceView view;
-    view.face = use.face;
-    view.kind = other.valid() ? FaceKind::Interior : FaceKind::Dirichlet;
-    view.self = e;
-    view.other = other;
-    view.selfIsFront = !use.reversed;
-    view.selfCoupledFaces = coupled(e);
-    view.otherCoupledFaces = other.valid() ? coupled(other) : 0;
-    faceRows(local_, basis_, given_, view, form_, s.selfBlock, s.otherBlock);
+    faceRows(local_, basis_, given_, faceView(use.face, e, other, !use.reversed), form_,
+             s.selfBlock, s.otherBlock);
     s.a += s.selfBlock;
     if (other.valid()) {
       // A Dirichlet face's S_F U_K is on both sides of A U = F: only its t_F is left below.
