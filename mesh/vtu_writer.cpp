@@ -332,10 +332,6 @@ void writeContents(std::ostream& os, const PolyMesh& mesh, const CellStreams& s,
   writeDocument(os, d, enc);
 }
 
-}  // namespace
-
-namespace {
-
 /// The arrays' and the field data's names and sizes (writeVtu's std::invalid_argument).
 void checkArraysOf(const PolyMesh& mesh, const std::vector<CellArray>& cellData,
                    const std::vector<PointArray>& pointData,
@@ -366,46 +362,34 @@ void writeWithStreams(const PolyMesh& mesh, const CellStreams& streams,
   });
 }
 
-/// `generated`'s values made once and held (as 32-bit integers where they fit, 4 bytes a value):
-/// a generator of the same size and largest value that copies them, so that a file written with
-/// it has the same bytes.
+/// `generated`'s values made once and held as 32-bit integers (4 bytes a value), handed out by
+/// a generator of the same size and largest value, so that a file written with it has the same
+/// bytes. Values that do not fit are not held: generator() is then `generated` itself.
 class HeldInts {
  public:
-  explicit HeldInts(const vtk_format::GeneratedInts& generated)
-      : size_(generated.size), largest_(generated.largest) {
-    if (largest_ <= std::numeric_limits<std::int32_t>::max())
-      hold(generated, narrow_);
-    else
-      hold(generated, wide_);
+  explicit HeldInts(vtk_format::GeneratedInts generated) : generated_(std::move(generated)) {
+    if (generated_.largest > std::numeric_limits<std::int32_t>::max()) return;
+    values_.resize(generated_.size);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, values_.size(), vtk_format::kChunkValues),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        std::vector<std::int64_t> made(r.size());
+                        generated_.fill(r.begin(), r.end(), made.data());
+                        std::copy(made.begin(), made.end(),
+                                  values_.begin() + static_cast<std::ptrdiff_t>(r.begin()));
+                      });
   }
   vtk_format::GeneratedInts generator() const {
-    return {size_, largest_, [this](std::size_t begin, std::size_t end, std::int64_t* out) {
-              if (wide_.empty())
-                std::copy(narrow_.begin() + static_cast<std::ptrdiff_t>(begin),
-                          narrow_.begin() + static_cast<std::ptrdiff_t>(end), out);
-              else
-                std::copy(wide_.begin() + static_cast<std::ptrdiff_t>(begin),
-                          wide_.begin() + static_cast<std::ptrdiff_t>(end), out);
+    if (values_.size() != generated_.size) return generated_;
+    return {generated_.size, generated_.largest,
+            [this](std::size_t begin, std::size_t end, std::int64_t* out) {
+              std::copy(values_.begin() + static_cast<std::ptrdiff_t>(begin),
+                        values_.begin() + static_cast<std::ptrdiff_t>(end), out);
             }};
   }
 
  private:
-  template <class T>
-  void hold(const vtk_format::GeneratedInts& generated, std::vector<T>& values) {
-    values.resize(size_);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, size_, vtk_format::kChunkValues),
-                      [&](const tbb::blocked_range<std::size_t>& r) {
-                        std::vector<std::int64_t> made(r.size());
-                        generated.fill(r.begin(), r.end(), made.data());
-                        std::copy(made.begin(), made.end(),
-                                  values.begin() + static_cast<std::ptrdiff_t>(r.begin()));
-                      });
-  }
-
-  std::size_t size_;
-  std::int64_t largest_;
-  std::vector<std::int32_t> narrow_;
-  std::vector<std::int64_t> wide_;
+  vtk_format::GeneratedInts generated_;
+  std::vector<std::int32_t> values_;
 };
 
 }  // namespace
